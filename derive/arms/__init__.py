@@ -1,0 +1,1 @@
+"""Bundled arm specs (package data)."""

@@ -1,0 +1,271 @@
+"""The command line; the only module that touches the filesystem.
+
+Exit codes: 0 ok, 1 check found differences, 2 bad input (one line on stderr, no
+traceback), 3 `generate --require-ik` found an arm without an IK method.
+"""
+
+from __future__ import annotations
+
+import argparse
+import difflib
+import importlib.util
+import math
+import os
+import sys
+import tempfile
+import time
+from importlib import resources
+from pathlib import Path
+from types import ModuleType
+
+from derive.emit import render_module
+from derive.pipeline import build_plan
+from derive.spec import ArmSpec, SpecError, load_spec
+
+DEFAULT_OUT = "generated"
+DIFF_LINES = 40
+
+
+class UsageError(Exception):
+    """Bad command-line input; the message is printed on one line and the exit code is 2."""
+
+
+def bundled_specs() -> list[Path]:
+    """The bundled arm spec files, sorted by name."""
+    folder = resources.files("derive.arms")
+    return sorted((Path(str(folder)) / p.name for p in folder.iterdir()
+                   if p.name.endswith(".toml")), key=lambda p: p.name)
+
+
+def resolve_spec(text: str) -> ArmSpec:
+    """A spec from a file path, or a bundled arm by name."""
+    path = Path(text)
+    if path.suffix == ".toml" or path.exists():
+        return load_spec(path)
+    for candidate in bundled_specs():
+        if candidate.stem == text:
+            return load_spec(candidate)
+    names = ", ".join(p.stem for p in bundled_specs())
+    raise UsageError(f"{text}: no such spec file or bundled arm; bundled arms: {names}")
+
+
+def outputs_for(spec: ArmSpec) -> dict[str, str]:
+    """File name -> content of everything generated for one arm."""
+    plan = build_plan(spec)
+    return {f"{spec.name}.py": render_module(plan)}
+
+
+def write_atomic(path: Path, text: str) -> None:
+    """Write through a temporary file and rename, so no partial file is ever visible."""
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+    try:
+        with os.fdopen(fd, "w", encoding="utf-8", newline="\n") as handle:
+            handle.write(text)
+        os.replace(tmp, path)
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise
+
+
+def load_specs(texts: list[str]) -> list[ArmSpec]:
+    """Specs named on the command line (all bundled arms if none), with unique names."""
+    specs = [resolve_spec(t) for t in texts] if texts else [load_spec(p) for p in bundled_specs()]
+    seen: dict[str, str] = {}
+    for spec in specs:
+        if spec.name in seen:
+            raise UsageError(f"{spec.source}: name: {spec.name!r} is also the name of "
+                             f"{seen[spec.name]}; arm names must be unique")
+        seen[spec.name] = spec.source
+    return specs
+
+
+def cmd_generate(args: argparse.Namespace) -> int:
+    """Generate the module of each arm; report each arm on one line."""
+    out = Path(args.out)
+    failed, no_ik = [], []
+    for text in args.specs or [str(p) for p in bundled_specs()]:
+        start = time.perf_counter()
+        try:
+            spec = resolve_spec(text)
+            plan = build_plan(spec)
+            files = {f"{spec.name}.py": render_module(plan)}
+            for name, content in files.items():
+                write_atomic(out / name, content)
+        except (SpecError, UsageError, OSError) as exc:
+            print(f"error: {exc}", file=sys.stderr)
+            failed.append(text)
+            continue
+        seconds = time.perf_counter() - start
+        structure = "; ".join(plan.structure)
+        if plan.ik:
+            method = f"IK {plan.ik.method} ({plan.ik.case}), up to {plan.ik.max_solutions}"
+        else:
+            method = f"FK only, no IK: {plan.refusal}"
+            no_ik.append(spec.name)
+        print(f"{spec.name}: {structure}; {method}; {seconds:.2f} s")
+    if failed:
+        print(f"error: failed: {', '.join(failed)} (other arms were written)", file=sys.stderr)
+        return 2
+    if args.require_ik and no_ik:
+        print(f"error: no IK method for: {', '.join(no_ik)}", file=sys.stderr)
+        return 3
+    return 0
+
+
+def cmd_check(args: argparse.Namespace) -> int:
+    """Compare DIR with a fresh generation; never writes into DIR."""
+    out = Path(args.out)
+    specs = load_specs(args.specs)
+    expected: dict[str, str] = {}
+    with tempfile.TemporaryDirectory() as tmp:
+        for spec in specs:
+            for name, content in outputs_for(spec).items():
+                write_atomic(Path(tmp) / name, content)
+        for path in sorted(Path(tmp).iterdir()):
+            expected[path.name] = path.read_text(encoding="utf-8")
+    names = set(expected)
+    if not args.specs and out.is_dir():
+        names |= {p.name for p in out.iterdir() if p.suffix in (".py", ".md")}
+    problems = []
+    for name in sorted(names):
+        path = out / name
+        if name not in expected:
+            problems.append(f"{path}: not generated by any arm (stale extra file)")
+            continue
+        if not path.is_file():
+            problems.append(f"{path}: missing")
+            continue
+        actual = path.read_text(encoding="utf-8", errors="replace")
+        if actual != expected[name]:
+            diff = list(difflib.unified_diff(actual.splitlines(), expected[name].splitlines(),
+                                             str(path), f"{path} (regenerated)", lineterm=""))
+            shown = "\n".join(diff[:DIFF_LINES])
+            more = f"\n... {len(diff) - DIFF_LINES} more diff lines" if len(diff) > DIFF_LINES else ""
+            problems.append(f"{path}: differs from the regenerated file\n{shown}{more}")
+    if not problems:
+        print(f"{out}: up to date ({len(expected)} files)")
+        return 0
+    for problem in problems:
+        print(problem)
+    specs_text = " ".join(args.specs)
+    print(f"to update: derive generate {specs_text + ' ' if specs_text else ''}--out {out}"
+          + (f" and delete the stale files" if any("stale" in p for p in problems) else ""))
+    return 1
+
+
+def load_module(spec: ArmSpec) -> ModuleType:
+    """Generate an arm's module into a temporary folder and import it."""
+    content = render_module(build_plan(spec))
+    with tempfile.TemporaryDirectory() as tmp:
+        path = Path(tmp) / f"{spec.name}.py"
+        path.write_text(content, encoding="utf-8")
+        loader_spec = importlib.util.spec_from_file_location(f"derive_ik_{spec.name}", path)
+        module = importlib.util.module_from_spec(loader_spec)
+        loader_spec.loader.exec_module(module)
+    return module
+
+
+def parse_numbers(values: list[str], what: str) -> list[float]:
+    """Floats from command-line words (commas allowed as separators)."""
+    words = [w for v in values for w in v.replace(",", " ").split()]
+    try:
+        numbers = [float(w) for w in words]
+    except ValueError:
+        raise UsageError(f"{what}: expected numbers, got {' '.join(words)[:60]!r}") from None
+    if not all(math.isfinite(x) for x in numbers):
+        raise UsageError(f"{what}: numbers must be finite")
+    return numbers
+
+
+def joint_vector(spec: ArmSpec, values: list[float], radians: bool) -> list[float]:
+    """Joint values from the user's units (degrees for R joints unless --rad)."""
+    if len(values) != spec.dof:
+        raise UsageError(f"expected {spec.dof} joint values for {spec.name}, got {len(values)}")
+    return [math.radians(v) if k == "R" and not radians else v
+            for v, k in zip(values, spec.joint_types)]
+
+
+def format_pose(pose: object) -> str:
+    """Four rows of a 4x4 matrix."""
+    return "\n".join("  ".join(f"{x: .10f}" for x in row) for row in pose)
+
+
+def cmd_fk(args: argparse.Namespace) -> int:
+    """Print the pose of a joint vector."""
+    spec = resolve_spec(args.arm)
+    module = load_module(spec)
+    q = joint_vector(spec, parse_numbers(args.q, "q"), args.rad)
+    print(format_pose(module.fk(q)))
+    return 0
+
+
+def cmd_solve(args: argparse.Namespace) -> int:
+    """Print every IK solution of a pose, its FK residual and the joints outside limits."""
+    import numpy as np
+
+    spec = resolve_spec(args.arm)
+    module = load_module(spec)
+    if not hasattr(module, "ik"):
+        raise UsageError(f"{spec.name}: no IK method applies to this arm")
+    if args.q is not None:
+        pose = module.fk(joint_vector(spec, parse_numbers(args.q, "--q"), args.rad))
+    else:
+        numbers = parse_numbers([args.pose], "--pose")
+        if len(numbers) not in (12, 16):
+            raise UsageError("--pose: give 12 numbers (3 rows of 4) or 16 (4 rows of 4)")
+        pose = np.array(numbers[:12] + [0.0, 0.0, 0.0, 1.0]).reshape(4, 4)
+    try:
+        sols = module.ik(pose)
+    except ValueError as exc:
+        raise UsageError(f"--pose: {exc}") from None
+    print("pose:")
+    print(format_pose(pose))
+    print(f"{len(sols)} solution(s) (degrees for R joints):")
+    for k, q in enumerate(sols, start=1):
+        shown = [math.degrees(v) if t == "R" else v for v, t in zip(q, spec.joint_types)]
+        residual = float(np.abs(module.fk(q) - pose).max())
+        outside = [f"q{i + 1}" for i, (v, (lo, hi)) in enumerate(zip(q, module.LIMITS))
+                   if not lo <= v <= hi]
+        flag = f"  out of limits: {', '.join(outside)}" if outside else ""
+        print(f"{k:2d}: " + " ".join(f"{v:10.4f}" for v in shown)
+              + f"  residual {residual:.1e}{flag}")
+    return 0
+
+
+def parser() -> argparse.ArgumentParser:
+    """The argument parser of `derive`."""
+    top = argparse.ArgumentParser(prog="derive", description="Closed-form IK solvers from DH tables.")
+    sub = top.add_subparsers(dest="command", required=True)
+    gen = sub.add_parser("generate", help="write generated/<name>.py for each arm")
+    gen.add_argument("specs", nargs="*", help="spec files or bundled arm names (default: all bundled)")
+    gen.add_argument("--out", default=DEFAULT_OUT, help="output folder (default ./generated)")
+    gen.add_argument("--require-ik", action="store_true", help="exit 3 if an arm has no IK method")
+    gen.set_defaults(run=cmd_generate)
+    chk = sub.add_parser("check", help="fail if DIR is not what generate would write")
+    chk.add_argument("specs", nargs="*", help="spec files (default: all bundled arms)")
+    chk.add_argument("--out", default=DEFAULT_OUT, help="folder to check (default ./generated)")
+    chk.set_defaults(run=cmd_check)
+    fk = sub.add_parser("fk", help="print the pose for joint values")
+    fk.add_argument("arm", help="spec file or bundled arm name")
+    fk.add_argument("q", nargs="+", help="joint values (degrees for R joints unless --rad)")
+    fk.add_argument("--rad", action="store_true", help="R joint values are in radians")
+    fk.set_defaults(run=cmd_fk)
+    solve = sub.add_parser("solve", help="print every IK solution of a pose")
+    solve.add_argument("arm", help="spec file or bundled arm name")
+    group = solve.add_mutually_exclusive_group(required=True)
+    group.add_argument("--pose", help="'r11 r12 r13 px r21 ... pz' (12 or 16 numbers)")
+    group.add_argument("--q", nargs="+", help="solve the pose of these joint values")
+    solve.add_argument("--rad", action="store_true", help="--q values are in radians")
+    solve.set_defaults(run=cmd_solve)
+    return top
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Entry point of the `derive` command."""
+    args = parser().parse_args(argv)
+    try:
+        return args.run(args)
+    except (SpecError, UsageError) as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        return 2

@@ -1,0 +1,285 @@
+"""plan -> printed IR (CSE, printing) -> jinja2 render.
+
+The printed IR holds only ``str``, ``int`` and tuples of them; templates loop over it and
+do nothing else. Printing is deterministic: numbers print as Python float literals (the
+shortest repr), terms in SymPy's canonical order, CSE with ``order="canonical"`` and a fresh
+``x0, x1, ...`` stream per function.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from importlib import resources
+from pathlib import Path
+
+import jinja2
+import sympy as sp
+from sympy.printing.str import StrPrinter
+
+from derive import symbols as sym
+from derive.plan import Assign, Plan, Solve
+
+GENERATOR = "derive-ik"
+REGENERATE = "derive generate"
+
+
+class CodePrinter(StrPrinter):
+    """Python source for SymPy expressions: float literals, ``prefix``-qualified functions."""
+
+    def __init__(self, prefix: str = "") -> None:
+        super().__init__({"order": None})
+        self.prefix = prefix
+
+    def _print_Rational(self, expr: sp.Rational) -> str:
+        return _float(float(expr))
+
+    def _print_Integer(self, expr: sp.Integer) -> str:
+        return _float(float(expr))
+
+    def _print_Float(self, expr: sp.Float) -> str:
+        return _float(float(expr))
+
+    def _print_Pi(self, expr: sp.Expr) -> str:
+        return _float(math.pi)
+
+    def _print_Mul(self, expr: sp.Mul) -> str:
+        coeff, rest = expr.as_coeff_Mul()
+        if coeff.is_Rational and not coeff.is_Integer and rest is not sp.S.One:
+            if coeff < 0:
+                return f"-{repr(float(-coeff))}*{self.parenthesize(rest, 49)}"
+            return f"{repr(float(coeff))}*{self.parenthesize(rest, 49)}"
+        return super()._print_Mul(expr)
+
+    def _print_Function(self, expr: sp.Function) -> str:
+        args = ", ".join(self._print(a) for a in expr.args)
+        return f"{self.prefix}{expr.func.__name__}({args})"
+
+    def _print_Pow(self, expr: sp.Pow, rational: bool = False) -> str:
+        base, exp = expr.as_base_exp()
+        if exp == sp.S.Half:
+            return f"{self.prefix}sqrt({self._print(base)})"
+        if exp.is_Integer and exp == 2 and base.is_Symbol:
+            return f"{self._print(base)}*{self._print(base)}"
+        return super()._print_Pow(expr, rational)
+
+
+def _float(value: float) -> str:
+    return repr(value)
+
+
+@dataclass(frozen=True)
+class Line:
+    """One line of generated code at an indentation depth (in 4-space units)."""
+
+    depth: int
+    text: str
+
+
+def assign_lines(targets: tuple[sp.Symbol, ...], exprs: tuple[sp.Expr, ...],
+                 names: sp.utilities.iterables.numbered_symbols, printer: CodePrinter,
+                 depth: int) -> list[Line]:
+    """CSE'd straight-line code for targets = exprs."""
+    temps, reduced = sp.cse(list(exprs), symbols=names, order="canonical")
+    lines = [Line(depth, f"{t} = {printer.doprint(e)}") for t, e in temps]
+    lines += [Line(depth, f"{t} = {printer.doprint(e)}") for t, e in zip(targets, reduced)]
+    return lines
+
+
+def fk_lines(plan: Plan, printer: CodePrinter, columns: bool) -> tuple[tuple[str, ...], tuple[str, ...]]:
+    """Body of the scalar or vectorised FK: joint definitions, trig, CSE'd pose entries.
+
+    Args:
+        plan: the arm's plan.
+        printer: scalar (``math``) or vector (``np.``) printer.
+        columns: read joint k as ``Q[:, k]`` (vectorised) instead of ``q[k]``.
+
+    Returns:
+        (the body's lines, the 12 names holding the top three rows of the pose).
+    """
+    names = sp.numbered_symbols("x")
+    lines = _joint_lines(plan, printer, columns)
+    pose = plan.fk_pose
+    entries = [pose[i, j] for i in range(3) for j in range(4)]
+    targets = tuple(sym.named(f"t{i}{j}") for i in range(3) for j in range(4))
+    lines += [ln.text for ln in assign_lines(targets, tuple(entries), names, printer, 0)]
+    return tuple(lines), tuple(str(t) for t in targets)
+
+
+def _joint_lines(plan: Plan, printer: CodePrinter, columns: bool) -> list[str]:
+    lines = []
+    for k, (target, expr) in enumerate(plan.joint_defs):
+        source = f"Q[:, {k}]" if columns else f"q[{k}]"
+        value = printer.doprint(expr.xreplace({sym.q(k + 1): sym.named("QQ")}))
+        lines.append(f"{target} = {value.replace('QQ', source)}")
+        if str(target).startswith("theta"):
+            i = k + 1
+            lines.append(f"c{i} = {printer.prefix}cos({target})")
+            lines.append(f"s{i} = {printer.prefix}sin({target})")
+    return lines
+
+
+def ik_lines(plan: Plan, printer: CodePrinter) -> tuple[tuple[int, str], ...]:
+    """Body of the scalar IK: one block per step, each Solve opening a loop over its values."""
+    assert plan.ik is not None
+    names = sp.numbered_symbols("x")
+    lines: list[Line] = []
+    depth = 0
+    for step in plan.ik.steps:
+        if isinstance(step, Assign):
+            lines.append(Line(depth, f"# {step.note}"))
+            lines += assign_lines(step.targets, step.exprs, names, printer, depth)
+            continue
+        lines += solve_lines(step, names, printer, depth)
+        depth += 1
+    outputs = ", ".join(printer.doprint(e) for e in plan.ik.outputs)
+    lines.append(Line(depth, f"_keep(found, target, ({outputs},))"))
+    return tuple((ln.depth, ln.text) for ln in lines)
+
+
+def solve_lines(step: Solve, names: sp.utilities.iterables.numbered_symbols,
+                printer: CodePrinter, depth: int) -> list[Line]:
+    """The loop header of one Solve step, with its arguments CSE'd before it."""
+    arg_names = tuple(sym.named(f"arg{k}") for k in range(len(step.args)))
+    temps = assign_lines(arg_names, step.args, names, printer, depth)
+    lines = [Line(depth, f"# {step.note}")]
+    lines += [ln for ln in temps if not ln.text.startswith("arg")]
+    args = {ln.text.split(" = ")[0]: ln.text.split(" = ", 1)[1] for ln in temps
+            if ln.text.startswith("arg")}
+    values = [args[str(a)] for a in arg_names]
+    var = f"theta{step.joint}"
+    ref = f"ref[{step.joint - 1}]"
+    call = {
+        "poly": f"_poly_angles(({', '.join(values)},))",
+        "cs1": f"_cs1({', '.join(values)})",
+        "cs2": f"_cs2({', '.join(values)}, {ref})",
+        "atan2": f"_atan2({', '.join(values)}, {ref})",
+    }[step.kind]
+    lines.append(Line(depth, f"for {var} in {call}:"))
+    lines.append(Line(depth + 1, f"c{step.joint} = cos({var})"))
+    lines.append(Line(depth + 1, f"s{step.joint} = sin({var})"))
+    return lines
+
+
+@dataclass(frozen=True)
+class PrintedModule:
+    """Everything the module template needs, as strings and ints."""
+
+    name: str
+    digest: str
+    convention: str
+    length_unit: str
+    joint_types: str
+    dof: int
+    structure: tuple[str, ...]
+    dh_table: tuple[str, ...]
+    dh_const: str
+    limits_const: str
+    offsets_const: str
+    revolute_const: str
+    base_const: str
+    tool_const: str
+    reach: str
+    fk_body: tuple[str, ...]
+    fk_batch_body: tuple[str, ...]
+    fk_outputs: tuple[str, ...]
+    has_ik: int
+    method: str
+    case: str
+    max_solutions: int
+    solves_for: str
+    refusal: str
+    ik_body: tuple[tuple[int, str], ...]
+
+
+def print_plan(plan: Plan) -> PrintedModule:
+    """The printed IR of a plan."""
+    arm = plan.arm
+    scalar, vector = CodePrinter(), CodePrinter("np.")
+    fk_body, outputs = fk_lines(plan, scalar, columns=False)
+    fk_batch_body, _ = fk_lines(plan, vector, columns=True)
+    ik = plan.ik
+    offsets = tuple(float(e.subs(sym.q(k + 1), 0)) for k, (_, e) in enumerate(plan.joint_defs))
+    return PrintedModule(
+        name=arm.name,
+        digest=arm.digest,
+        convention=arm.convention,
+        length_unit=arm.length_unit,
+        joint_types=arm.joint_types,
+        dof=arm.dof,
+        structure=plan.structure,
+        dh_table=dh_table(plan),
+        dh_const=_tuple_of_tuples(arm.dh),
+        limits_const=_tuple_of_tuples(arm.limits),
+        offsets_const=_tuple(offsets),
+        revolute_const=_tuple(tuple(k == "R" for k in arm.joint_types)),
+        base_const=_tuple_of_tuples(tuple(arm.base[4 * i:4 * i + 4] for i in range(4))),
+        tool_const=_tuple_of_tuples(tuple(arm.tool[4 * i:4 * i + 4] for i in range(4))),
+        reach=_float(arm.reach),
+        fk_body=fk_body,
+        fk_batch_body=fk_batch_body,
+        fk_outputs=outputs,
+        has_ik=int(ik is not None),
+        method=ik.method if ik else "",
+        case=ik.case if ik else "",
+        max_solutions=ik.max_solutions if ik else 0,
+        solves_for=ik.solves_for if ik else "",
+        refusal=plan.refusal,
+        ik_body=ik_lines(plan, scalar) if ik else (),
+    )
+
+
+def _tuple(values: tuple) -> str:
+    def one(v: object) -> str:
+        if isinstance(v, bool):
+            return repr(v)
+        if math.isinf(float(v)):
+            return "math.inf" if float(v) > 0 else "-math.inf"
+        return repr(float(v))
+    inner = ", ".join(one(v) for v in values)
+    return f"({inner},)" if len(values) == 1 else f"({inner})"
+
+
+def _tuple_of_tuples(rows: tuple) -> str:
+    return "(\n" + "".join(f"    {_tuple(tuple(r))},\n" for r in rows) + ")"
+
+
+def dh_table(plan: Plan) -> tuple[str, ...]:
+    """The DH table as aligned text rows, in the spec's convention and naming."""
+    arm = plan.arm
+    head = ("alpha_{i-1}", "a_{i-1}") if arm.convention == "modified" else ("alpha_i", "a_i")
+    rows = [("i", "type", head[0] + " [deg]", head[1], "d_i", "theta_i [deg]")]
+    for i, (alpha, a, d, theta) in enumerate(arm.dh, start=1):
+        kind = arm.joint_types[i - 1]
+        var_d = f"q{i} + {d:g}" if kind == "P" else f"{d:g}"
+        var_t = f"q{i} + {math.degrees(theta):g}" if kind == "R" else f"{math.degrees(theta):g}"
+        rows.append((str(i), kind, f"{math.degrees(alpha):g}", f"{a:g}", var_d, var_t))
+    widths = [max(len(r[k]) for r in rows) for k in range(6)]
+    return tuple("  ".join(c.ljust(w) for c, w in zip(r, widths)).rstrip() for r in rows)
+
+
+def template_dir() -> Path:
+    """The templates folder: the repository's ``templates/``, or the installed copy."""
+    here = Path(__file__).resolve().parent.parent / "templates"
+    if here.is_dir():
+        return here
+    return Path(str(resources.files("derive.templates")))
+
+
+def environment() -> jinja2.Environment:
+    """The jinja2 environment: strict undefined, no autoescape, fixed newlines."""
+    return jinja2.Environment(
+        loader=jinja2.FileSystemLoader(str(template_dir())),
+        undefined=jinja2.StrictUndefined,
+        autoescape=False,
+        keep_trailing_newline=True,
+        trim_blocks=True,
+        lstrip_blocks=True,
+    )
+
+
+def render_module(plan: Plan) -> str:
+    """The generated Python module of an arm."""
+    printed = print_plan(plan)
+    return environment().get_template("module.py.j2").render(
+        m=printed, generator=GENERATOR, regenerate=REGENERATE)

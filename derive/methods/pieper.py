@@ -1,0 +1,202 @@
+"""Pieper's solution for 6R arms whose last three axes meet in a point (lecture, Pieper -1..-7).
+
+The derivation follows the lecture step by step, first in general symbolic form (a_i,
+alpha_i, d_i as symbols), then with the arm's numbers substituted:
+
+1. Base, X_0 and Tz(d_1) go into the base, Tz(d_6) and X_6 into the tool, so that the
+   flange target 0_6T = (B X_0 Tz(d1))^-1 T (Tz(d6) X_6 E)^-1 has alpha_0 = a_0 = d_1 = d_6 = 0
+   (ALGORITHMS.md section 1). Its position is the wrist centre 0P_4org.
+2. f(theta3) = 2_3T 3P_4org, g(theta2, theta3) = 1_2T f, (x, y, z) = 0_1T g.
+3. r = x^2 + y^2 + z^2 = 2 a1 (k1 c2 + k2 s2) + k3 and z = s(alpha1) (k1 s2 - k2 c2) + k4;
+   k1..k4 are read off these derived expressions (and checked against the lecture's
+   definitions k1 = f1, k2 = -f2).
+4. The case: a1 = 0 gives r = k3; s(alpha1) = 0 gives z = k4; otherwise the ellipse
+   (r - k3)^2 / (4 a1^2) + (z - k4)^2 / s(alpha1)^2 = k1^2 + k2^2. With u = tan(theta3/2) this is
+   a polynomial in u (quadratic, quadratic, quartic).
+5. theta2 from the r and z equations (one root in the general case, two otherwise), theta1 from
+   x and y, then the wrist W = (0_3R Rx(alpha3))^T 0_6R = Rz(theta4) Rx(alpha4) Rz(theta5)
+   Rx(alpha5) Rz(theta6), solved for the arm's actual twists (Z-Y-Z is the special case).
+"""
+
+from __future__ import annotations
+
+from functools import lru_cache
+
+import sympy as sp
+
+from derive import symbols as sym
+from derive.classify import Structure, is_zero
+from derive.halfangle import half_angle_poly, linear_coeffs, reduce_pairs
+from derive.plan import Assign, IkPlan, Solve, Step
+from derive.transforms import (
+    Chain, general_joint, general_pairs, general_twist, inverse, numbers_of, product,
+    rot_x, rot_z, trans, x_factor, z_factor,
+)
+
+NAME = "pieper"
+
+
+def derive(chain: Chain, structure: Structure) -> IkPlan | str:
+    """Pieper plan for the chain, or a one-line reason why the method does not apply."""
+    if chain.dof != 6:
+        return f"Pieper: needs 6 joints, the arm has {chain.dof}"
+    if any(j.kind != "R" for j in chain.joints):
+        return "Pieper: prismatic joints are not supported by this method yet"
+    if 4 not in structure.concurrent:
+        return "Pieper: axes 4, 5, 6 do not meet in a point"
+    numbers = numbers_of(chain)
+    length = sum(abs(float(t.a)) for t in chain.twists) + sum(abs(float(j.d)) for j in chain.joints)
+    position = position_equations(numbers, max(length, 1e-300))
+    wrist = wrist_equations(numbers)
+    steps = [flange_target(chain), *position.steps, *wrist]
+    outputs = tuple(sym.theta(j.index) - float(j.offset) for j in chain.joints)
+    return IkPlan(
+        method=NAME,
+        case=position.case,
+        max_solutions=position.fanout * 2,
+        steps=tuple(steps),
+        outputs=outputs,
+        details=tuple(sorted(position.details.items())),
+    )
+
+
+def flange_target(chain: Chain) -> Assign:
+    """0_6T from the world target: base, X_0, Tz(d1) and Tz(d6), X_6, tool moved out."""
+    first, last = chain.joints[0], chain.joints[-1]
+    head = product([chain.base, x_factor(chain.twists[0]), trans(0, 0, first.d)])
+    tail = product([trans(0, 0, last.d), x_factor(chain.twists[-1]), chain.tool])
+    target = product([inverse(head), sym.world_pose(), inverse(tail)])
+    names = sym.flange_pose()
+    pairs = [(names[i, j], target[i, j]) for i in range(3) for j in range(4)]
+    return Assign(tuple(p[0] for p in pairs), tuple(p[1] for p in pairs),
+                  "flange target 0_6T = (B X0 Tz(d1))^-1 T (Tz(d6) X6 E)^-1")
+
+
+class PositionResult:
+    """The position part: steps for theta3, theta2, theta1, the case, and report facts."""
+
+    def __init__(self, steps: list[Step], case: str, fanout: int, details: dict) -> None:
+        self.steps = steps
+        self.case = case
+        self.fanout = fanout
+        self.details = details
+
+
+def general_f_g() -> tuple[sp.Matrix, sp.Matrix]:
+    """f = 2_3T 3P_4org and g = 1_2T f in general symbolic form (lecture, Pieper -2, -3)."""
+    p4 = x_factor(general_twist(3)) * trans(0, 0, sym.d(4))
+    f = (x_factor(general_twist(2)) * z_factor(general_joint(3)) * p4)[:, 3]
+    g = x_factor(general_twist(1)) * z_factor(general_joint(2)) * f
+    return f[:3, :].applyfunc(sp.expand), g[:3, :].applyfunc(sp.expand)
+
+
+@lru_cache(maxsize=1)
+def k_functions() -> dict[str, sp.Expr]:
+    """k1..k4 read off the derived r and z (lecture, Pieper -3, -4), general form.
+
+    Raises:
+        AssertionError: the derived r or z does not have the lecture's form.
+    """
+    f, g = general_f_g()
+    a1, sa1, c2, s2 = sym.link_a(1), sym.sin_alpha(1), sym.c(2), sym.s(2)
+    r = reduce_pairs(g.dot(g), general_pairs(range(1, 4)))
+    rc, rs, k3 = linear_coeffs(r, c2, s2)
+    zc, zs, k4 = linear_coeffs(g[2], c2, s2)
+    k1, k2 = sp.cancel(rc / (2 * a1)), sp.cancel(rs / (2 * a1))
+    assert sp.expand(zs - sa1 * k1) == 0 and sp.expand(zc + sa1 * k2) == 0
+    assert sp.expand(k1 - f[0]) == 0 and sp.expand(k2 + f[1]) == 0
+    return {"f1": f[0], "f2": f[1], "f3": f[2], "g1": g[0], "g2": g[1], "g3": g[2],
+            "k1": k1, "k2": k2, "k3": k3, "k4": k4}
+
+
+def position_equations(numbers: dict, length: float) -> PositionResult:
+    """theta3 from the case's polynomial, then theta2, then theta1 (lecture, Pieper -4, -5).
+
+    Args:
+        numbers: the arm's numbers for the general symbols.
+        length: the arm's size (sum of |a_i| and |d_i|), which scales the singularity tests.
+    """
+    general = k_functions()
+    spec = {name: sp.expand(e.xreplace(numbers)) for name, e in general.items()}
+    a1, sa1 = numbers[sym.link_a(1)], numbers[sym.sin_alpha(1)]
+    r, z, u = sym.named("r"), sym.named("z"), sym.named("u")
+    c2, s2, c3, s3 = sym.c(2), sym.s(2), sym.c(3), sym.s(3)
+    k1, k2, k3, k4 = (spec[k] for k in ("k1", "k2", "k3", "k4"))
+    r_eq = 2 * a1 * (k1 * c2 + k2 * s2) + k3 - r
+    z_eq = sa1 * (k1 * s2 - k2 * c2) + k4 - z
+    if is_zero(a1, 1e-12) and is_zero(sa1, 1e-12):
+        raise AssertionError("axes 1 and 2 coincide; classification should have refused")
+    if is_zero(a1, 1e-12):
+        case, equation, theta2_eq = "a1 = 0: r = k3(theta3), quadratic in u", k3 - r, z_eq
+    elif is_zero(sa1, 1e-12):
+        case, equation, theta2_eq = "sin(alpha1) = 0: z = k4(theta3), quadratic in u", k4 - z, r_eq
+    else:
+        case = "general: (r - k3)^2/(4 a1^2) + (z - k4)^2/s(alpha1)^2 = k1^2 + k2^2, quartic in u"
+        equation = (sa1**2 * (r - k3) ** 2 + 4 * a1**2 * (z - k4) ** 2
+                    - 4 * a1**2 * sa1**2 * (k1**2 + k2**2))
+        theta2_eq = None
+    equation = reduce_pairs(equation, [(s3, c3)])
+    coeffs = half_angle_poly(equation, c3, s3, u)
+    if all(is_zero(cf, 0.0) for cf in coeffs if cf.is_number) and not any(
+            cf.free_symbols for cf in coeffs):
+        raise AssertionError("the theta3 equation vanishes identically")
+    details = {**{f"general_{k}": v for k, v in general.items()},
+               **{k: v for k, v in spec.items()},
+               "theta3_equation": equation}
+    steps: list[Step] = [
+        Assign((sym.named("x"), sym.named("y"), z, r),
+               (sym.named("px"), sym.named("py"), sym.named("pz"),
+                sym.named("px")**2 + sym.named("py")**2 + sym.named("pz")**2),
+               "wrist centre (x, y, z) = 0P_4org and r = x^2 + y^2 + z^2"),
+        Solve(3, "poly", coeffs, f"theta3: Pieper {case.split(':')[0]} case, polynomial "
+              f"in u = tan(theta3/2) of degree {len(coeffs) - 1}", len(coeffs) - 1),
+    ]
+    if theta2_eq is None:
+        ra, rb, rc = linear_coeffs(r_eq, c2, s2)
+        za, zb, zc = linear_coeffs(z_eq, c2, s2)
+        scale = abs(float(2 * a1 * sa1)) * length**2
+        steps.append(Solve(2, "cs2", (ra, rb, -rc, za, zb, -zc, sp.Float(scale)),
+                           "theta2: r and z equations, linear in (c2, s2)", 1))
+        fan2 = 1
+    else:
+        ta, tb, tc = linear_coeffs(theta2_eq, c2, s2)
+        steps.append(Solve(2, "cs1", (ta, tb, -tc),
+                           "theta2: a c2 + b s2 = c by the half-angle method", 2))
+        fan2 = 2
+    g1, g2 = spec["g1"], spec["g2"]
+    steps.append(Assign((sym.named("g1"), sym.named("g2")), (g1, g2),
+                        "g1(theta2, theta3), g2(theta2, theta3)"))
+    gs1, gs2 = sym.named("g1"), sym.named("g2")
+    steps.append(Solve(1, "cs2", (gs1, -gs2, sym.named("x"), gs2, gs1, sym.named("y"),
+                                  sp.Float(length**2)),
+                       "theta1: x = c1 g1 - s1 g2, y = s1 g1 + c1 g2", 1))
+    degree = len(coeffs) - 1
+    return PositionResult(steps, case, degree * fan2, details)
+
+
+def wrist_equations(numbers: dict) -> list[Step]:
+    """theta5, theta4, theta6 from W = Rz(t4) Rx(alpha4) Rz(t5) Rx(alpha5) Rz(t6) (section 2.6)."""
+    rot03 = product([z_factor(general_joint(i)) * x_factor(general_twist(i))
+                     for i in (1, 2, 3)])[:3, :3].xreplace(numbers)
+    rot03 = rot03.applyfunc(sp.expand)
+    flange = sym.flange_pose()[:3, :3]
+    w_names = sp.Matrix(3, 3, lambda i, j: sym.named(f"W{i + 1}{j + 1}"))
+    w_value = (rot03.T * flange).applyfunc(sp.expand)
+    c4, s4, c5, s5 = sym.c(4), sym.s(4), sym.c(5), sym.s(5)
+    inner = (rot_x(sym.cos_alpha(4), sym.sin_alpha(4)) * rot_z(c5, s5)
+             * rot_x(sym.cos_alpha(5), sym.sin_alpha(5)))[:3, :3].xreplace(numbers)
+    v = inner[:, 2].applyfunc(sp.expand)
+    a5, b5, e5 = linear_coeffs(v[2], c5, s5)
+    m = (inner.T * rot_z(c4, s4)[:3, :3].T * w_names).applyfunc(sp.expand)
+    v1, v2 = sym.named("v1"), sym.named("v2")
+    return [
+        Assign(tuple(w_names), tuple(w_value),
+               "wrist W = (0_3R Rx(alpha3))^T 0_6R = Rz(t4) Rx(alpha4) Rz(t5) Rx(alpha5) Rz(t6)"),
+        Solve(5, "cs1", (a5, b5, sym.named("W33") - e5),
+              "theta5: W33 = e3^T Rx(alpha4) Rz(theta5) Rx(alpha5) e3", 2),
+        Assign((v1, v2), (v[0], v[1]), "v = Rx(alpha4) Rz(theta5) Rx(alpha5) e3"),
+        Solve(4, "cs2", (v1, -v2, sym.named("W13"), v2, v1, sym.named("W23"), sp.Integer(1)),
+              "theta4: (W13, W23) = Rz(theta4) (v1, v2); free at a singular wrist", 1),
+        Solve(6, "atan2", (m[1, 0], m[0, 0]),
+              "theta6: Rz(theta6) = (Rx(alpha4) Rz(theta5) Rx(alpha5))^T Rz(theta4)^T W", 1),
+    ]

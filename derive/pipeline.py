@@ -1,0 +1,88 @@
+"""spec -> structure -> method -> plan: the one place that chooses a solution method."""
+
+from __future__ import annotations
+
+import math
+
+import sympy as sp
+
+from derive import symbols as sym
+from derive.classify import Structure, classify
+from derive.methods import pieper
+from derive.plan import ArmInfo, IkPlan, Plan
+from derive.spec import ArmSpec
+from derive.transforms import Chain, chain_from_spec, world_transform
+
+# Tried in order; each returns a plan, or a one-line reason why it does not apply.
+METHODS = (pieper.derive,)
+
+
+def build_plan(spec: ArmSpec) -> Plan:
+    """Derive everything the generated module and the report need for one arm."""
+    chain = chain_from_spec(spec)
+    structure = classify(chain)
+    ik, refusal = choose_method(chain, structure)
+    return Plan(
+        arm=arm_info(spec, chain),
+        structure=structure.describe(chain.dof),
+        fk_pose=world_transform(chain, expand=False),
+        joint_defs=joint_definitions(chain),
+        ik=ik,
+        refusal=refusal,
+    )
+
+
+def choose_method(chain: Chain, structure: Structure) -> tuple[IkPlan | None, str]:
+    """The first method that applies, or None and the reasons none does (one line)."""
+    if structure.coincident:
+        i = structure.coincident[0]
+        return None, f"axes {i} and {i + 1} coincide: the arm has a redundant joint"
+    reasons = []
+    for method in METHODS:
+        result = method(chain, structure)
+        if isinstance(result, IkPlan):
+            return result, ""
+        reasons.append(result)
+    return None, "; ".join(reasons)
+
+
+def joint_definitions(chain: Chain) -> tuple[tuple[sp.Symbol, sp.Expr], ...]:
+    """theta_i = q_i + offset (R) or d_i = q_i + offset (P), offsets as floats."""
+    defs = []
+    for j in chain.joints:
+        target = sym.theta(j.index) if j.kind == "R" else sym.d(j.index)
+        offset = sp.Float(float(j.offset), 17) if j.offset != 0 else sp.Integer(0)
+        defs.append((target, sym.q(j.index) + offset))
+    return tuple(defs)
+
+
+def arm_info(spec: ArmSpec, chain: Chain) -> ArmInfo:
+    """Numeric facts about the arm for the generated module."""
+    to_rad = math.radians if spec.angle_unit == "deg" else float
+    dh = tuple((to_rad(j.alpha), j.a, j.d, to_rad(j.theta)) for j in spec.joints)
+    limits = []
+    for j in spec.joints:
+        if j.limits is None:
+            limits.append((-math.inf, math.inf))
+        elif j.kind == "R":
+            limits.append((to_rad(j.limits[0]), to_rad(j.limits[1])))
+        else:
+            limits.append(j.limits)
+    reach = sum(abs(j.a) + abs(j.d) for j in spec.joints)
+    reach += sum(max(abs(lo), abs(hi)) for (lo, hi), j in zip(limits, spec.joints)
+                 if j.kind == "P" and math.isfinite(lo) and math.isfinite(hi))
+    for frame in (chain.base, chain.tool):
+        reach += sum(abs(float(v)) for v in frame[:3, 3])
+    return ArmInfo(
+        name=spec.name,
+        digest=spec.digest(),
+        convention=spec.convention,
+        angle_unit=spec.angle_unit,
+        length_unit=spec.length_unit,
+        joint_types=spec.joint_types,
+        dh=dh,
+        limits=tuple(limits),
+        base=tuple(float(v) for v in chain.base),
+        tool=tuple(float(v) for v in chain.tool),
+        reach=max(reach, 1e-12),
+    )

@@ -1,0 +1,324 @@
+"""Arm description: parse and validate a TOML spec into frozen dataclasses.
+
+This module is the one place where spec files are validated. Every error is a
+:class:`SpecError` whose one-line message names the file, the field (with the joint
+number where there is one) and what is allowed. Values are read as TOML numbers only:
+nothing from a spec is evaluated, and the arm name is the only spec text that reaches
+generated code or file names.
+
+Spec format (all keys other than those listed are errors)::
+
+    name = "puma560"            # [a-z][a-z0-9_]*, at most 64 characters
+    convention = "standard"     # "standard" | "modified" (Craig)
+    angle_unit = "deg"          # "deg" | "rad": alpha, theta, revolute limits, rpy
+    length_unit = "m"           # a label
+    [[joint]]
+    type = "R"                  # "R": theta_i = q_i + theta; "P": d_i = q_i + d
+    alpha = -90.0               # modified DH: alpha_{i-1}; standard DH: alpha_i
+    a = 0.0                     # modified DH: a_{i-1};     standard DH: a_i
+    d = 0.0
+    theta = 0.0
+    limits = [-160.0, 160.0]    # optional
+    [base]                      # optional: matrix = 4x4, or translation (+ rpy)
+    [tool]                      # optional: same keys
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import keyword
+import math
+import re
+import tomllib
+from dataclasses import dataclass
+from pathlib import Path
+
+NAME_PATTERN = re.compile(r"[a-z][a-z0-9_]*")
+NAME_MAX = 64
+MAX_JOINTS = 12
+RIGID_TOL = 1e-9
+TOP_KEYS = ("name", "convention", "angle_unit", "length_unit", "joint", "base", "tool")
+JOINT_KEYS = ("type", "alpha", "a", "d", "theta", "limits")
+FRAME_KEYS = ("matrix", "translation", "rpy")
+
+
+class SpecError(ValueError):
+    """A spec file is invalid; the message is one line naming file, field and what is allowed."""
+
+
+@dataclass(frozen=True)
+class Joint:
+    """One DH row as written in the spec (angles in the spec's angle unit).
+
+    Attributes:
+        kind: "R" (revolute) or "P" (prismatic).
+        alpha: link twist (alpha_{i-1} in modified DH, alpha_i in standard DH).
+        a: link length (a_{i-1} in modified DH, a_i in standard DH).
+        d: link offset d_i (the constant part for a prismatic joint).
+        theta: joint angle offset theta_i (the full angle for a prismatic joint).
+        limits: (lower, upper) in the spec's unit, or None.
+    """
+
+    kind: str
+    alpha: float
+    a: float
+    d: float
+    theta: float
+    limits: tuple[float, float] | None
+
+
+@dataclass(frozen=True)
+class Frame:
+    """A rigid transform given in the spec: a 4x4 matrix, or translation and roll-pitch-yaw.
+
+    Attributes:
+        matrix: 16 numbers, row-major, when given as `matrix`; else None.
+        translation: (x, y, z) when given as `translation`; else None.
+        rpy: (roll, pitch, yaw) in the spec's angle unit; R = Rz(yaw) Ry(pitch) Rx(roll).
+    """
+
+    matrix: tuple[float, ...] | None
+    translation: tuple[float, float, float] | None
+    rpy: tuple[float, float, float]
+
+
+@dataclass(frozen=True)
+class ArmSpec:
+    """A validated arm description.
+
+    Attributes:
+        name: identifier of the arm; also the generated module's name.
+        convention: "standard" or "modified".
+        angle_unit: "deg" or "rad".
+        length_unit: a label for the length unit.
+        joints: the DH rows in order.
+        base: frame 0 in the world, or None.
+        tool: tool frame in the last link frame, or None.
+        source: the file the spec came from (for messages), or "<memory>".
+    """
+
+    name: str
+    convention: str
+    angle_unit: str
+    length_unit: str
+    joints: tuple[Joint, ...]
+    base: Frame | None
+    tool: Frame | None
+    source: str = "<memory>"
+
+    @property
+    def dof(self) -> int:
+        """Number of joints."""
+        return len(self.joints)
+
+    @property
+    def joint_types(self) -> str:
+        """Joint kinds as one string, e.g. "RRRRRR"."""
+        return "".join(j.kind for j in self.joints)
+
+    def canonical(self) -> dict:
+        """The spec as plain data with a fixed key order (source excluded)."""
+        def frame(f: Frame | None) -> dict | None:
+            if f is None:
+                return None
+            return {"matrix": f.matrix, "translation": f.translation, "rpy": f.rpy}
+
+        return {
+            "name": self.name,
+            "convention": self.convention,
+            "angle_unit": self.angle_unit,
+            "length_unit": self.length_unit,
+            "joints": [
+                {"type": j.kind, "alpha": j.alpha, "a": j.a, "d": j.d, "theta": j.theta,
+                 "limits": j.limits}
+                for j in self.joints
+            ],
+            "base": frame(self.base),
+            "tool": frame(self.tool),
+        }
+
+    def digest(self) -> str:
+        """SHA-256 (first 16 hex digits) of the canonical spec; independent of file layout."""
+        text = json.dumps(self.canonical(), sort_keys=True, separators=(",", ":"))
+        return hashlib.sha256(text.encode()).hexdigest()[:16]
+
+
+def load_spec(path: str | Path) -> ArmSpec:
+    """Read and validate a spec file.
+
+    Args:
+        path: the TOML file.
+
+    Returns:
+        The validated spec.
+
+    Raises:
+        SpecError: the file is missing, unreadable, not TOML, or invalid.
+    """
+    where = str(path)
+    try:
+        raw = Path(path).read_bytes()
+    except OSError as exc:
+        raise SpecError(f"{where}: cannot read the spec file ({exc.strerror or exc})") from None
+    return parse_spec(raw, where)
+
+
+def parse_spec(raw: bytes | str, where: str = "<memory>") -> ArmSpec:
+    """Validate spec text.
+
+    Args:
+        raw: TOML text (bytes must be UTF-8).
+        where: the name used in error messages.
+
+    Returns:
+        The validated spec.
+
+    Raises:
+        SpecError: the text is not UTF-8 TOML or does not describe a valid arm.
+    """
+    if isinstance(raw, bytes):
+        try:
+            raw = raw.decode("utf-8")
+        except UnicodeDecodeError:
+            raise SpecError(f"{where}: not UTF-8 text; a spec is a TOML file") from None
+    try:
+        data = tomllib.loads(raw)
+    except tomllib.TOMLDecodeError as exc:
+        raise SpecError(f"{where}: not valid TOML ({exc})") from None
+    except RecursionError:
+        raise SpecError(f"{where}: not valid TOML (nesting too deep)") from None
+    return _validate(data, where)
+
+
+def _validate(data: dict, where: str) -> ArmSpec:
+    _no_unknown_keys(data, TOP_KEYS, where, "")
+    name = _choice_or_text(data, "name", where)
+    if not NAME_PATTERN.fullmatch(name) or len(name) > NAME_MAX or keyword.iskeyword(name):
+        raise SpecError(
+            f"{where}: name: {name[:40]!r} is not allowed; use [a-z][a-z0-9_]* "
+            f"(at most {NAME_MAX} characters, not a Python keyword)")
+    convention = _choice_or_text(data, "convention", where, ("standard", "modified"))
+    angle_unit = _choice_or_text(data, "angle_unit", where, ("deg", "rad"))
+    length_unit = _choice_or_text(data, "length_unit", where)
+    if not re.fullmatch(r"[A-Za-z]{1,16}", length_unit):
+        raise SpecError(f"{where}: length_unit: {length_unit[:40]!r} is not allowed; "
+                        "use a unit label of 1 to 16 letters, e.g. \"m\" or \"mm\"")
+    rows = data.get("joint")
+    if rows is None:
+        raise SpecError(f"{where}: joint: missing; give one [[joint]] table per joint")
+    if not isinstance(rows, list) or not all(isinstance(r, dict) for r in rows):
+        raise SpecError(f"{where}: joint: must be an array of tables ([[joint]])")
+    if not 1 <= len(rows) <= MAX_JOINTS:
+        raise SpecError(f"{where}: joint: {len(rows)} joints; allowed 1 to {MAX_JOINTS}")
+    joints = tuple(_joint(row, where, i + 1) for i, row in enumerate(rows))
+    base = _frame(data.get("base"), where, "base", angle_unit)
+    tool = _frame(data.get("tool"), where, "tool", angle_unit)
+    return ArmSpec(name, convention, angle_unit, length_unit, joints, base, tool, where)
+
+
+def _no_unknown_keys(table: dict, allowed: tuple[str, ...], where: str, prefix: str) -> None:
+    for key in table:
+        if key not in allowed:
+            raise SpecError(f"{where}: {prefix}{str(key)[:40]}: unknown key; allowed keys: "
+                            f"{', '.join(allowed)}")
+
+
+def _choice_or_text(data: dict, key: str, where: str, choices: tuple[str, ...] = ()) -> str:
+    allowed = " | ".join(f'"{c}"' for c in choices) if choices else "a string"
+    if key not in data:
+        raise SpecError(f"{where}: {key}: missing; allowed: {allowed}")
+    value = data[key]
+    if not isinstance(value, str):
+        raise SpecError(f"{where}: {key}: must be a string; allowed: {allowed}")
+    if choices and value not in choices:
+        raise SpecError(f"{where}: {key}: {value[:40]!r} is not allowed; allowed: {allowed}")
+    return value
+
+
+def _number(value: object, where: str, field: str) -> float:
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        raise SpecError(f"{where}: {field}: must be a number (got {type(value).__name__})")
+    try:
+        number = float(value)
+    except OverflowError:
+        raise SpecError(f"{where}: {field}: number too large; allowed: finite numbers "
+                        "of magnitude below 1e12") from None
+    if not math.isfinite(number) or abs(number) > 1e12:
+        raise SpecError(f"{where}: {field}: {value!r} is not allowed; allowed: finite numbers "
+                        "of magnitude below 1e12")
+    return number
+
+
+def _numbers(value: object, where: str, field: str, count: int) -> tuple[float, ...]:
+    if not isinstance(value, list) or len(value) != count:
+        raise SpecError(f"{where}: {field}: must be a list of {count} numbers")
+    return tuple(_number(v, where, f"{field}[{k}]") for k, v in enumerate(value))
+
+
+def _joint(row: dict, where: str, index: int) -> Joint:
+    prefix = f"joint {index}: "
+    _no_unknown_keys(row, JOINT_KEYS, where, prefix)
+    kind = row.get("type")
+    if kind not in ("R", "P"):
+        shown = "missing" if kind is None else f"{str(kind)[:20]!r} is not allowed"
+        raise SpecError(f'{where}: {prefix}type: {shown}; allowed: "R" | "P"')
+    values = {}
+    for key in ("alpha", "a", "d", "theta"):
+        if key not in row:
+            raise SpecError(f"{where}: {prefix}{key}: missing; give a number")
+        values[key] = _number(row[key], where, prefix + key)
+    limits = None
+    if "limits" in row:
+        lo, hi = _numbers(row["limits"], where, prefix + "limits", 2)
+        if not lo < hi:
+            raise SpecError(f"{where}: {prefix}limits: [{lo}, {hi}] is reversed or empty; "
+                            "give [lower, upper] with lower < upper")
+        limits = (lo, hi)
+    return Joint(kind, values["alpha"], values["a"], values["d"], values["theta"], limits)
+
+
+def _frame(table: object, where: str, field: str, angle_unit: str) -> Frame | None:
+    if table is None:
+        return None
+    if not isinstance(table, dict):
+        raise SpecError(f"{where}: {field}: must be a table with `matrix`, or `translation` "
+                        "and optional `rpy`")
+    _no_unknown_keys(table, FRAME_KEYS, where, field + ".")
+    if "matrix" in table:
+        if len(table) != 1:
+            raise SpecError(f"{where}: {field}: give either `matrix` or `translation`/`rpy`, "
+                            "not both")
+        rows = table["matrix"]
+        if not isinstance(rows, list) or len(rows) != 4:
+            raise SpecError(f"{where}: {field}.matrix: must be 4 rows of 4 numbers")
+        flat = sum((_numbers(r, where, f"{field}.matrix[{i}]", 4) for i, r in enumerate(rows)),
+                   ())
+        _check_rigid(flat, where, field)
+        return Frame(flat, None, (0.0, 0.0, 0.0))
+    if "translation" not in table:
+        raise SpecError(f"{where}: {field}: give `matrix` (4x4) or `translation` [x, y, z]")
+    translation = _numbers(table["translation"], where, field + ".translation", 3)
+    rpy = (0.0, 0.0, 0.0)
+    if "rpy" in table:
+        rpy = _numbers(table["rpy"], where, field + ".rpy", 3)
+    return Frame(None, translation, rpy)
+
+
+def _check_rigid(flat: tuple[float, ...], where: str, field: str) -> None:
+    """Reject a matrix that is not [R t; 0 0 0 1] with R orthonormal and det R = +1."""
+    if flat[12:] != (0.0, 0.0, 0.0, 1.0):
+        raise SpecError(f"{where}: {field}.matrix: last row must be [0, 0, 0, 1]")
+    rot = [flat[0:3], flat[4:7], flat[8:11]]
+    for i in range(3):
+        for j in range(3):
+            dot = sum(rot[k][i] * rot[k][j] for k in range(3))
+            if abs(dot - (1.0 if i == j else 0.0)) > RIGID_TOL:
+                raise SpecError(f"{where}: {field}.matrix: rotation part is not orthonormal "
+                                f"(tolerance {RIGID_TOL}); a rigid transform is required")
+    det = (rot[0][0] * (rot[1][1] * rot[2][2] - rot[1][2] * rot[2][1])
+           - rot[0][1] * (rot[1][0] * rot[2][2] - rot[1][2] * rot[2][0])
+           + rot[0][2] * (rot[1][0] * rot[2][1] - rot[1][1] * rot[2][0]))
+    if det < 0:
+        raise SpecError(f"{where}: {field}.matrix: rotation part is a reflection (det -1); "
+                        "a rigid transform is required")

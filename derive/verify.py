@@ -1,0 +1,163 @@
+"""Round-trip verification of a generated solver against its forward kinematics.
+
+Used by the tests and by benchmark scripts. A round trip draws joint vectors q (a share of
+joints at the degenerate values 0, +-pi/2, pi), computes T = fk(q), solves ik(T) and measures
+
+* soundness: every returned solution reproduces T (rotation error in radians, position error
+  relative to the arm's REACH);
+* completeness: q is among the solutions (revolute joints modulo 2 pi, DEDUP tolerance).
+
+A sample is *singular* when the smallest singular value of the normalised Jacobian at q is below
+SINGULAR_SIGMA. There the pose leaves some joints free; completeness then asks for a solution
+that reproduces the pose and equals q on the joints outside the Jacobian's null space, and
+soundness is held to the looser SINGULAR_TOL.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from types import ModuleType
+
+import numpy as np
+
+SOUND_TOL = 1e-9
+SINGULAR_TOL = 1e-6
+SINGULAR_SIGMA = 1e-6
+MATCH_TOL = 1e-6
+DEGENERATE_VALUES = (0.0, math.pi / 2, -math.pi / 2, math.pi)
+
+
+@dataclass
+class RoundTrip:
+    """Figures of one round-trip run.
+
+    Attributes:
+        samples: number of joint vectors drawn.
+        singular: how many of them were singular.
+        solutions: total number of solutions returned.
+        worst_rot: largest rotation error of a solution at a non-singular sample (rad).
+        worst_pos: largest position error / REACH at a non-singular sample.
+        worst_singular: largest error (either kind) at a singular sample.
+        unsound: samples with a solution above tolerance.
+        found: non-singular samples whose q was among the solutions.
+        singular_found: singular samples covered as described in the module docstring.
+        misses: indices of non-singular samples whose q was not found.
+        counts: number of solutions -> number of samples.
+    """
+
+    samples: int = 0
+    singular: int = 0
+    solutions: int = 0
+    worst_rot: float = 0.0
+    worst_pos: float = 0.0
+    worst_singular: float = 0.0
+    unsound: list[int] = field(default_factory=list)
+    found: int = 0
+    singular_found: int = 0
+    misses: list[int] = field(default_factory=list)
+    counts: dict[int, int] = field(default_factory=dict)
+
+    @property
+    def completeness(self) -> float:
+        """Share of non-singular samples whose q was found."""
+        regular = self.samples - self.singular
+        return self.found / regular if regular else 1.0
+
+    def summary(self) -> str:
+        """One line with every figure."""
+        counts = ", ".join(f"{k}: {v}" for k, v in sorted(self.counts.items()))
+        return (f"{self.samples} samples ({self.singular} singular): completeness "
+                f"{self.found}/{self.samples - self.singular} = {100 * self.completeness:.3f}%, "
+                f"singular covered {self.singular_found}/{self.singular}; unsound {len(self.unsound)}; "
+                f"worst rot {self.worst_rot:.1e} rad, pos {self.worst_pos:.1e} x reach, "
+                f"singular {self.worst_singular:.1e}; solution counts {{{counts}}}")
+
+
+def sample_joints(module: ModuleType, n: int, rng: np.random.Generator,
+                  degenerate_share: float = 0.2) -> np.ndarray:
+    """n joint vectors: revolute uniform in (-pi, pi], prismatic within limits (or +-REACH)."""
+    revolute = np.array([k == "R" for k in module.JOINT_TYPES])
+    Q = np.empty((n, module.DOF))
+    for j, (lo, hi) in enumerate(module.LIMITS):
+        if revolute[j]:
+            Q[:, j] = rng.uniform(-math.pi, math.pi, n)
+        else:
+            lo = lo if math.isfinite(lo) else -module.REACH
+            hi = hi if math.isfinite(hi) else module.REACH
+            Q[:, j] = rng.uniform(lo, hi, n)
+    special = rng.random((n, module.DOF)) < degenerate_share
+    picks = rng.choice(DEGENERATE_VALUES, size=(n, module.DOF))
+    Q[special & revolute] = picks[special & revolute]
+    return Q
+
+
+def pose_error(module: ModuleType, q: np.ndarray, T: np.ndarray) -> tuple[float, float]:
+    """(rotation error in rad, position error / REACH) of fk(q) against T."""
+    P = module.fk(q)
+    rot = float(np.abs(P[:3, :3] - T[:3, :3]).max())
+    pos = float(np.abs(P[:3, 3] - T[:3, 3]).max()) / module.REACH
+    return rot, pos
+
+
+def jacobian_nullity(module: ModuleType, q: np.ndarray) -> tuple[float, np.ndarray]:
+    """Smallest singular value of the normalised Jacobian at q and its right singular vector.
+
+    Columns are central differences of fk (rotation entries, and position / REACH).
+    """
+    h = 1e-6
+    cols = []
+    for j in range(module.DOF):
+        step = np.zeros(module.DOF)
+        step[j] = h if module.JOINT_TYPES[j] == "R" else h * module.REACH
+        d = (module.fk(q + step) - module.fk(q - step)) / (2 * h)
+        d[:3, 3] /= module.REACH
+        cols.append(d[:3, :].ravel())
+    J = np.array(cols).T
+    _, sigma, vt = np.linalg.svd(J)
+    if len(sigma) < module.DOF:
+        return 0.0, vt[-1]
+    return float(sigma[-1]), vt[-1]
+
+
+def same_joints(a: np.ndarray, b: np.ndarray, revolute: np.ndarray, mask: np.ndarray) -> bool:
+    """a equals b on the masked joints (revolute modulo 2 pi) within MATCH_TOL."""
+    d = np.abs(a - b)
+    d[revolute] = np.abs(np.remainder(d[revolute] + math.pi, 2 * math.pi) - math.pi)
+    return bool(np.all(d[mask] <= MATCH_TOL))
+
+
+def roundtrip(module: ModuleType, Q: np.ndarray) -> RoundTrip:
+    """Solve fk(q) for each row q of Q and collect the figures of :class:`RoundTrip`."""
+    out = RoundTrip()
+    revolute = np.array([k == "R" for k in module.JOINT_TYPES])
+    everything = np.ones(module.DOF, dtype=bool)
+    for index, q in enumerate(Q):
+        T = module.fk(q)
+        sols = module.ik(T)
+        out.samples += 1
+        out.solutions += len(sols)
+        out.counts[len(sols)] = out.counts.get(len(sols), 0) + 1
+        sigma, null = jacobian_nullity(module, q)
+        singular = sigma < SINGULAR_SIGMA
+        errors = [pose_error(module, s, T) for s in sols]
+        worst = max((max(e) for e in errors), default=0.0)
+        if singular:
+            out.singular += 1
+            out.worst_singular = max(out.worst_singular, worst)
+            if worst > SINGULAR_TOL:
+                out.unsound.append(index)
+            mask = np.abs(null) < 0.1
+            if any(same_joints(s, q, revolute, mask) and max(e) <= SINGULAR_TOL
+                   for s, e in zip(sols, errors)):
+                out.singular_found += 1
+            continue
+        out.worst_rot = max([out.worst_rot] + [e[0] for e in errors])
+        out.worst_pos = max([out.worst_pos] + [e[1] for e in errors])
+        if worst > SOUND_TOL:
+            out.unsound.append(index)
+        if any(same_joints(s, q, revolute, everything) for s in sols):
+            out.found += 1
+        else:
+            out.misses.append(index)
+    return out

@@ -1,0 +1,103 @@
+"""Shared helpers: import generated modules, build modules from spec text, reference FK."""
+
+from __future__ import annotations
+
+import importlib.util
+import itertools
+import math
+import sys
+from pathlib import Path
+from types import ModuleType
+
+import numpy as np
+import pytest
+
+from derive.emit import render_module
+from derive.pipeline import build_plan
+from derive.spec import parse_spec
+
+ROOT = Path(__file__).resolve().parent.parent
+GENERATED = ROOT / "generated"
+BUNDLED = ("lecture_6r", "lecture_rrr", "parallel_6r", "planar_2r", "puma560")
+_counter = itertools.count()
+
+
+def import_path(path: Path) -> ModuleType:
+    """Import a Python file under a unique module name."""
+    name = f"_derive_test_{path.stem}_{next(_counter)}"
+    spec = importlib.util.spec_from_file_location(name, path)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+@pytest.fixture(scope="session")
+def generated():
+    """Committed generated module of a bundled arm, by name (cached per session)."""
+    cache: dict[str, ModuleType] = {}
+
+    def get(name: str) -> ModuleType:
+        if name not in cache:
+            cache[name] = import_path(GENERATED / f"{name}.py")
+        return cache[name]
+
+    return get
+
+
+def build_module(text: str, folder: Path) -> ModuleType:
+    """Generate the module of a spec given as TOML text into folder and import it."""
+    spec = parse_spec(text, "<test spec>")
+    path = folder / f"{spec.name}_{next(_counter)}.py"
+    path.write_text(render_module(build_plan(spec)), encoding="utf-8")
+    return import_path(path)
+
+
+def spec_text(name: str, convention: str, rows: list[tuple], unit: str = "deg",
+              kinds: str | None = None, extra: str = "") -> str:
+    """TOML for an arm; rows are (alpha, a, d, theta) in the spec's unit."""
+    kinds = kinds or "R" * len(rows)
+    out = (f'name = "{name}"\nconvention = "{convention}"\nangle_unit = "{unit}"\n'
+           f'length_unit = "m"\n')
+    for kind, (alpha, a, d, theta) in zip(kinds, rows):
+        out += (f'[[joint]]\ntype = "{kind}"\nalpha = {float(alpha)!r}\na = {float(a)!r}\n'
+                f'd = {float(d)!r}\ntheta = {float(theta)!r}\n')
+    return out + extra
+
+
+def rx(a: float) -> np.ndarray:
+    c, s = math.cos(a), math.sin(a)
+    return np.array([[1, 0, 0, 0], [0, c, -s, 0], [0, s, c, 0], [0, 0, 0, 1.0]])
+
+
+def rz(a: float) -> np.ndarray:
+    c, s = math.cos(a), math.sin(a)
+    return np.array([[c, -s, 0, 0], [s, c, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1.0]])
+
+
+def tr(x: float, y: float, z: float) -> np.ndarray:
+    m = np.eye(4)
+    m[:3, 3] = (x, y, z)
+    return m
+
+
+def reference_fk(convention: str, dh_rad: list[tuple], kinds: str, q: np.ndarray,
+                 base: np.ndarray | None = None, tool: np.ndarray | None = None) -> np.ndarray:
+    """Textbook FK written independently of derive: Craig's or the standard link transform."""
+    T = np.eye(4) if base is None else base.copy()
+    for (alpha, a, d, theta), kind, qi in zip(dh_rad, kinds, q):
+        theta_i = theta + qi if kind == "R" else theta
+        d_i = d + qi if kind == "P" else d
+        if convention == "modified":
+            T = T @ rx(alpha) @ tr(a, 0, 0) @ rz(theta_i) @ tr(0, 0, d_i)
+        else:
+            T = T @ rz(theta_i) @ tr(0, 0, d_i) @ tr(a, 0, 0) @ rx(alpha)
+    return T if tool is None else T @ tool
+
+
+def wrapped_close(a: np.ndarray, b: np.ndarray, tol: float) -> bool:
+    """Equal modulo 2 pi within tol (radians)."""
+    d = np.remainder(np.asarray(a) - np.asarray(b) + math.pi, 2 * math.pi) - math.pi
+    return bool(np.all(np.abs(d) <= tol))
+
+
+sys.path.insert(0, str(ROOT / "tests"))

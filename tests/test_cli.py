@@ -1,0 +1,111 @@
+"""The command line: exit codes, atomic writes, check, fk and solve."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from derive.cli import main
+from conftest import ROOT, spec_text
+
+USER_ARM = spec_text("user_arm", "modified",
+                     [(0, 0, 0, 0), (-90, 0.1, 0, 0), (0, 0.5, 0.05, 0), (-90, 0.04, 0.45, 0),
+                      (90, 0, 0, 0), (-90, 0, 0, 0)])
+
+
+def run(*args: str, cwd: Path | None = None) -> subprocess.CompletedProcess:
+    return subprocess.run([sys.executable, "-m", "derive", *args], capture_output=True,
+                          text=True, cwd=cwd or ROOT)
+
+
+def test_generate_writes_module_and_reports_structure(tmp_path, capsys):
+    spec = tmp_path / "user_arm.toml"
+    spec.write_text(USER_ARM)
+    assert main(["generate", str(spec), "--out", str(tmp_path / "out")]) == 0
+    line = capsys.readouterr().out.strip()
+    assert line.startswith("user_arm: spherical wrist at joints 4-6; IK pieper")
+    assert line.endswith(" s")
+    assert [p.name for p in (tmp_path / "out").iterdir()] == ["user_arm.py"]
+
+
+def test_bad_spec_exits_2_without_traceback_or_file(tmp_path):
+    spec = tmp_path / "bad.toml"
+    spec.write_text(USER_ARM.replace("a = 0.5", "a = \"0.5\""))
+    result = run("generate", str(spec), "--out", str(tmp_path / "out"))
+    assert result.returncode == 2
+    assert "Traceback" not in result.stderr
+    assert f"{spec}: joint 3: a: must be a number" in result.stderr
+    assert not (tmp_path / "out").exists()
+
+
+def test_failure_part_way_keeps_earlier_files(tmp_path, capsys):
+    good = tmp_path / "user_arm.toml"
+    good.write_text(USER_ARM)
+    bad = tmp_path / "bad.toml"
+    bad.write_text("name = 1")
+    out = tmp_path / "out"
+    assert main(["generate", str(good), str(bad), "--out", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert "failed: " in err and str(bad) in err
+    assert (out / "user_arm.py").is_file()
+    assert [p.name for p in out.iterdir()] == ["user_arm.py"]
+
+
+def test_unknown_arm_name_exits_2(capsys):
+    assert main(["fk", "no_such_arm", "0"]) == 2
+    assert "bundled arms: lecture_6r" in capsys.readouterr().err
+
+
+def test_require_ik_exits_3_for_fk_only_arm(tmp_path):
+    spec = tmp_path / "two.toml"
+    spec.write_text(spec_text("two", "standard", [(90, 0, 1, 0), (90, 1, 0, 0)]))
+    assert main(["generate", str(spec), "--out", str(tmp_path)]) == 0
+    assert main(["generate", str(spec), "--out", str(tmp_path), "--require-ik"]) == 3
+
+
+def test_check_detects_edited_removed_and_extra_files(tmp_path, capsys):
+    out = tmp_path / "gen"
+    assert main(["generate", "--out", str(out)]) == 0
+    assert main(["check", "--out", str(out)]) == 0
+    target = out / "puma560.py"
+    original = target.read_text()
+    target.write_text(original.replace("DOF = 6", "DOF = 7"))
+    before = target.read_bytes()
+    capsys.readouterr()
+    assert main(["check", "--out", str(out)]) == 1
+    report = capsys.readouterr().out
+    assert f"{target}: differs" in report and "-DOF = 7" in report and "to update: derive generate" in report
+    assert target.read_bytes() == before
+    target.unlink()
+    assert main(["check", "--out", str(out)]) == 1
+    assert "puma560.py: missing" in capsys.readouterr().out
+    target.write_text(original)
+    (out / "old_arm.py").write_text("")
+    assert main(["check", "--out", str(out)]) == 1
+    assert "old_arm.py: not generated" in capsys.readouterr().out
+
+
+def test_fk_command_prints_report_pose():
+    result = run("fk", "puma560", "20", "20", "20", "20", "20", "20")
+    assert result.returncode == 0
+    first = [float(x) for x in result.stdout.splitlines()[0].split()]
+    assert first == pytest.approx([0.1057541557, -0.6425141384, 0.7589411311, 0.5776495331], abs=1e-9)
+
+
+def test_solve_command_lists_eight_solutions_with_limits():
+    result = run("solve", "puma560", "--q", "20", "20", "20", "20", "20", "20")
+    assert result.returncode == 0, result.stderr
+    assert "8 solution(s)" in result.stdout
+    rows = [ln for ln in result.stdout.splitlines() if "residual" in ln]
+    assert len(rows) == 8
+    assert any("out of limits" in r for r in rows)
+    assert all(float(r.split("residual")[1].split()[0]) < 1e-9 for r in rows)
+
+
+def test_solve_rejects_non_rigid_pose():
+    result = run("solve", "puma560", "--pose", "1 0 0 0.5 0 2 0 0 0 0 1 0.2")
+    assert result.returncode == 2 and "not orthonormal" in result.stderr
+    assert "Traceback" not in result.stderr
