@@ -147,14 +147,19 @@ def solve_lines(step: Solve, names: sp.utilities.iterables.numbered_symbols,
     args = {ln.text.split(" = ")[0]: ln.text.split(" = ", 1)[1] for ln in temps
             if ln.text.startswith("arg")}
     values = [args[str(a)] for a in arg_names]
-    var = f"theta{step.joint}"
-    ref = f"ref[{step.joint - 1}]"
+    ref = printer.doprint(step.ref)
+    joined = ", ".join(values)
     call = {
-        "poly": f"_poly_angles(({', '.join(values)},))",
-        "cs1": f"_cs1({', '.join(values)})",
-        "cs2": f"_cs2({', '.join(values)}, {ref})",
-        "atan2": f"_atan2({', '.join(values)}, {ref})",
+        "poly": f"_poly_angles(({joined},))",
+        "polyd": f"_poly_real(({joined},))",
+        "cs1": f"_cs1({joined})",
+        "cs2": f"_cs2({joined}, {ref})",
+        "atan2": f"_atan2({joined}, {ref})",
     }[step.kind]
+    if step.kind == "polyd":
+        lines.append(Line(depth, f"for d{step.joint} in {call}:"))
+        return lines
+    var = f"theta{step.joint}"
     lines.append(Line(depth, f"for {var} in {call}:"))
     lines.append(Line(depth + 1, f"c{step.joint} = cos({var})"))
     lines.append(Line(depth + 1, f"s{step.joint} = sin({var})"))
@@ -190,6 +195,7 @@ class PrintedModule:
     solves_for: str
     refusal: str
     ik_body: tuple[tuple[int, str], ...]
+    qref_names: str
 
 
 def print_plan(plan: Plan) -> PrintedModule:
@@ -226,6 +232,7 @@ def print_plan(plan: Plan) -> PrintedModule:
         solves_for=ik.solves_for if ik else "",
         refusal=plan.refusal,
         ik_body=ik_lines(plan, scalar) if ik else (),
+        qref_names=", ".join(f"qr{i}" for i in range(1, arm.dof + 1)),
     )
 
 

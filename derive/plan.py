@@ -12,10 +12,9 @@ Solve kinds (the generated module implements each once, as a helper):
 ``cs1``    a cos t + b sin t = e: t = atan2(b, a) +- acos(e / sqrt(a^2 + b^2)); args (a, b, e)
 ``cs2``    a1 c + b1 s = e1, a2 c + b2 s = e2: one t from the 2x2 system;
            args (a1, b1, e1, a2, b2, e2); a singular system leaves t free (reference value)
+``atan2``  t = atan2(y, x); args (y, x); both vanishing leaves t free (reference value)
 ``poly``   polynomial in u = tan(t/2), coefficients highest degree first; u = inf is t = pi
-``polyd``  polynomial in a prismatic joint's d, coefficients highest degree first
-``lind``   a d + b = 0 for a prismatic joint's d; args (a, b)
-``sum``    t = angle - (sum of earlier angles); args (sin(angle), cos(angle), earlier...)
+``polyd``  polynomial in a prismatic joint's d_i, coefficients highest degree first
 =========  =========================================================================
 """
 
@@ -82,6 +81,8 @@ class Solve:
         args: the kind's arguments, expressions in earlier quantities.
         note: the derivation step, printed as a comment ("Pieper r/z ellipse, ...").
         fanout: the most values this step can produce.
+        ref: the value the joint takes where the pose leaves it free (``cs2``, ``atan2``), as an
+            expression in the reference joint values qr_i.
     """
 
     joint: int
@@ -89,6 +90,7 @@ class Solve:
     args: tuple[sp.Expr, ...]
     note: str
     fanout: int
+    ref: sp.Expr = sp.Integer(0)
 
 
 Step = Assign | Solve

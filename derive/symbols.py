@@ -4,6 +4,7 @@ Glossary (lecture notation, Craig ch. 4):
 
 =============  =====================================================================
 ``q1..qn``     joint variables: radians for R joints, length for P joints
+``qr1..qrn``   reference joint values (free joints at singular poses take them)
 ``theta1..``   joint angles theta_i = q_i + offset (R joints)
 ``c1, s1..``   cos(theta_i), sin(theta_i); ``c23`` style sums appear only in reports
 ``d1..dn``     link offsets d_i; the joint variable's d_i = q_i + d for P joints
@@ -35,6 +36,12 @@ ANGLE_SNAP = 1e-12
 def q(i: int) -> sp.Symbol:
     """Joint variable q_i."""
     return sp.Symbol(f"q{i}", real=True)
+
+
+@lru_cache(maxsize=None)
+def q_ref(i: int) -> sp.Symbol:
+    """Reference value of q_i, taken by a joint that a singular pose leaves free."""
+    return sp.Symbol(f"qr{i}", real=True)
 
 
 @lru_cache(maxsize=None)

@@ -216,8 +216,8 @@ def general_pairs(indices: range) -> list[tuple[sp.Symbol, sp.Symbol]]:
 def numbers_of(chain: Chain) -> dict[sp.Symbol, sp.Expr]:
     """Substitution of the general symbols by this arm's numbers.
 
-    Twists 0..n give cos(alpha_i), sin(alpha_i), a_i; revolute joints give d_i (a prismatic
-    joint's d_i stays a variable).
+    Twists 0..n give cos(alpha_i), sin(alpha_i), a_i; revolute joints give d_i; prismatic
+    joints give c_i, s_i of their constant theta_i (their d_i stays a variable).
     """
     subs: dict[sp.Symbol, sp.Expr] = {}
     for i, t in enumerate(chain.twists):
@@ -227,4 +227,26 @@ def numbers_of(chain: Chain) -> dict[sp.Symbol, sp.Expr]:
     for j in chain.joints:
         if j.kind == "R":
             subs[sym.d(j.index)] = j.d
+        else:
+            subs[sym.c(j.index)], subs[sym.s(j.index)] = sym.cos_sin(j.theta)
     return subs
+
+
+def reverse_chain(chain: Chain) -> Chain:
+    """The chain read from the tool back to the base (ALGORITHMS.md section 1).
+
+    T^-1 = E^-1 X_n^-1 Z_n^-1 ... X_1^-1 Z_1^-1 X_0^-1 B^-1 with X_i^-1 = X(-alpha_i, -a_i) and
+    Z_i^-1 = Z(-theta_i, -d_i). Joint k of the reversed chain is joint n + 1 - k of the arm
+    with q'_k = -q_{n+1-k}: its offset and constant part change sign.
+    """
+    n = chain.dof
+    twists = tuple(Twist(t.ca, -t.sa, -t.a) for t in reversed(chain.twists))
+    joints = []
+    for k, j in enumerate(reversed(chain.joints), start=1):
+        if j.kind == "R":
+            joints.append(JointZ(k, "R", -j.offset, sym.theta(k), -j.d))
+        else:
+            joints.append(JointZ(k, "P", -j.offset, -j.theta, sym.d(k)))
+    assert len(joints) == n
+    return Chain(twists, tuple(joints), inverse(chain.tool), inverse(chain.base),
+                 chain.convention)

@@ -15,7 +15,7 @@ Arm: lecture_6r, modified DH, lengths in mm, angles of the table in degrees.
     6  R     -90                0        0    q6 + 0
 
 Structure: spherical wrist at joints 4-6.
-Inverse kinematics: pieper method, case general: (r - k3)^2/(4 a1^2) + (z - k4)^2/s(alpha1)^2 = k1^2 + k2^2, quartic in u.
+Inverse kinematics: pieper method, case general: (r - k3)^2/(4 a1^2) + (z - k4)^2/s(alpha1)^2 = k1^2 + k2^2, degree 4 in u = tan(theta3/2).
 At most 8 solutions per pose. The solver is defined on the full pose (rotation and position).
 
 Joint variables q are radians for R joints and length units for P joints. Poses are 4x4
@@ -245,7 +245,7 @@ def ik(T, *, within_limits=False, q_ref=None):
             within POSE_TOL.
     """
     target = _pose(T)
-    ref = _reference(q_ref)
+    qr1, qr2, qr3, qr4, qr5, qr6, = _reference(q_ref)
     (w11, w12, w13, wx, w21, w22, w23, wy, w31, w32, w33, wz) = target
     found = []
     # flange target 0_6T = (B X0 Tz(d1))^-1 T (Tz(d6) X6 E)^-1
@@ -266,7 +266,7 @@ def ik(T, *, within_limits=False, q_ref=None):
     y = py
     z = pz
     r = px*px + py*py + pz*pz
-    # theta3: Pieper general case, polynomial in u = tan(theta3/2) of degree 4
+    # theta3: Pieper general case, polynomial of degree 4 in u = tan(theta3/2)
     x0 = r*r
     x1 = z*z
     x2 = x0 + 3600.0*x1
@@ -275,14 +275,14 @@ def ik(T, *, within_limits=False, q_ref=None):
         c3 = cos(theta3)
         s3 = sin(theta3)
         # theta2: r and z equations, linear in (c2, s2)
-        for theta2 in _cs2(2400.0*c3 + 20280.0*s3 - 20400.0, 20280.0*c3 - 2400.0*s3, 27200.0*c3 + r + 229840.0*s3 - 232344.0, -338.0*c3 + 40.0*s3, 40.0*c3 + 338.0*s3 - 340.0, z, 33570240.0, ref[1]):
+        for theta2 in _cs2(2400.0*c3 + 20280.0*s3 - 20400.0, 20280.0*c3 - 2400.0*s3, 27200.0*c3 + r + 229840.0*s3 - 232344.0, -338.0*c3 + 40.0*s3, 40.0*c3 + 338.0*s3 - 340.0, z, 33570240.0, qr2):
             c2 = cos(theta2)
             s2 = sin(theta2)
             # g1(theta2, theta3), g2(theta2, theta3)
             g1 = -40.0*c2*c3 - 338.0*c2*s3 + 340.0*c2 - 338.0*c3*s2 + 40.0*s2*s3 - 30.0
             g2 = 0.0
-            # theta1: x = c1 g1 - s1 g2, y = s1 g1 + c1 g2
-            for theta1 in _cs2(g1, -g2, x, g2, g1, y, 559504.0, ref[0]):
+            # theta1: x = c1 g1 - s1 g2, y = s1 g1 + c1 g2; free with the wrist centre on axis 1
+            for theta1 in _cs2(g1, -g2, x, g2, g1, y, 559504.0, qr1):
                 c1 = cos(theta1)
                 s1 = sin(theta1)
                 # wrist W = (0_3R Rx(alpha3))^T 0_6R = Rz(t4) Rx(alpha4) Rz(t5) Rx(alpha5) Rz(t6)
@@ -313,11 +313,11 @@ def ik(T, *, within_limits=False, q_ref=None):
                     v1 = -s5
                     v2 = 0.0
                     # theta4: (W13, W23) = Rz(theta4) (v1, v2); free at a singular wrist
-                    for theta4 in _cs2(v1, -v2, W13, v2, v1, W23, 1.0, ref[3]):
+                    for theta4 in _cs2(v1, -v2, W13, v2, v1, W23, 1.0, qr4):
                         c4 = cos(theta4)
                         s4 = sin(theta4)
                         # theta6: Rz(theta6) = (Rx(alpha4) Rz(theta5) Rx(alpha5))^T Rz(theta4)^T W
-                        for theta6 in _atan2(-W11*s4 + W21*c4, W11*c4*c5 + W21*c5*s4 + W31*s5, ref[5]):
+                        for theta6 in _atan2(-W11*s4 + W21*c4, W11*c4*c5 + W21*c5*s4 + W31*s5, qr6):
                             c6 = cos(theta6)
                             s6 = sin(theta6)
                             _keep(found, target, (theta1, theta2, theta3, theta4, theta5, theta6,))
@@ -365,8 +365,11 @@ def _pose(T):
 
 def _reference(q_ref):
     if q_ref is None:
-        return _OFFSETS
-    return tuple(float(q) + o for q, o in zip(q_ref, _OFFSETS))
+        return (0.0,) * DOF
+    q_ref = tuple(float(x) for x in q_ref)
+    if len(q_ref) != DOF or not all(math.isfinite(x) for x in q_ref):
+        raise ValueError(f"q_ref must be {DOF} finite numbers")
+    return q_ref
 
 
 def _keep(found, target, q):
@@ -405,11 +408,22 @@ def _same(q, p):
 
 
 def _limit_variants(q):
-    """Every joint vector equal to q modulo 2 pi (revolute joints) inside LIMITS."""
+    """Every joint vector equal to q modulo 2 pi (revolute joints) inside LIMITS.
+
+    A joint without limits keeps its wrapped value; one whose finite range is wider than
+    2 pi contributes each of its in-range values.
+    """
     options = []
     for x, r, (lo, hi) in zip(q, _REVOLUTE, LIMITS):
-        cands = (x, x - _TWO_PI, x + _TWO_PI) if r else (x,)
-        ok = [c for c in cands if lo - 1e-12 <= c <= hi + 1e-12]
+        if r and math.isfinite(lo) and math.isfinite(hi):
+            k = math.ceil((lo - 1e-12 - x) / _TWO_PI)
+            ok = []
+            while x + k * _TWO_PI <= hi + 1e-12:
+                ok.append(x + k * _TWO_PI)
+                k += 1
+            ok.sort(key=abs)
+        else:
+            ok = [x] if lo - 1e-12 <= x <= hi + 1e-12 else []
         if not ok:
             return []
         options.append(ok)
@@ -445,6 +459,25 @@ def _atan2(y, x, ref):
     if abs(y) + abs(x) <= 1e-12:
         return (ref,)
     return (atan2(y, x),)
+
+
+def _poly_real(coeffs):
+    """Real roots of the polynomial (highest degree first), polished, ascending, distinct."""
+    c = [float(x) for x in coeffs]
+    scale = max(abs(x) for x in c)
+    if scale == 0.0:
+        return ()
+    while len(c) > 1 and abs(c[0]) <= _LEAD_TOL * scale:
+        c.pop(0)
+    if len(c) < 2:
+        return ()
+    roots = sorted(_newton(c, z.real) for z in np.roots(c).tolist()
+                   if abs(z.imag) <= _ROOT_IMAG_TOL * (1.0 + abs(z)))
+    out = []
+    for x in roots:
+        if not out or abs(x - out[-1]) > 1e-12 * (1.0 + abs(x)):
+            out.append(x)
+    return out
 
 
 def _poly_angles(coeffs):

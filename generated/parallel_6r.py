@@ -15,7 +15,7 @@ Arm: parallel_6r, modified DH, lengths in mm, angles of the table in degrees.
     6  R     -90                0        0      q6 + 0
 
 Structure: axes 2, 3, 4 parallel.
-Inverse kinematics: none. Pieper: axes 4, 5, 6 do not meet in a point.
+Inverse kinematics: none. Pieper: neither axes 4, 5, 6 nor axes 1, 2, 3 meet in a point.
 
 Joint variables q are radians for R joints and length units for P joints. Poses are 4x4
 homogeneous transforms of the tool frame in the world (base and tool frames included).

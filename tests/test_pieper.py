@@ -40,7 +40,7 @@ def test_lecture_arm_uses_the_general_case_quartic(generated):
     assert plan.ik.case.startswith("general")
     poly = [s for s in plan.ik.steps if getattr(s, "kind", "") == "poly"][0]
     assert poly.joint == 3 and len(poly.args) == 5
-    assert "quartic in u" in generated("lecture_6r").__doc__
+    assert "degree 4 in u = tan(theta3/2)" in generated("lecture_6r").__doc__
 
 
 def test_puma_report_pose_has_the_reports_eight_solutions(generated):
@@ -197,3 +197,63 @@ def test_random_pieper_arms_round_trip(convention, case, tmp_path):
         assert result.unsound == [], (rows, result.summary())
         assert result.misses == [], (rows, result.summary())
         assert result.singular_found == result.singular, (rows, result.summary())
+
+
+def check_round_trips(m, rng, samples=60):
+    result = roundtrip(m, sample_joints(m, samples, rng))
+    assert result.unsound == [], result.summary()
+    assert result.misses == [], result.summary()
+    assert result.singular_found == result.singular, result.summary()
+    return result
+
+
+@pytest.mark.parametrize("convention", ["standard", "modified"])
+def test_spherical_joint_at_the_base_is_solved_on_the_reversed_chain(convention, tmp_path):
+    rng = np.random.default_rng(5 + len(convention))
+    for _ in range(4):
+        alpha, a, d, theta = canonical_rows(rng, "general")
+        # mirror the wrist conditions to the base: axes 1, 2, 3 meet, 4-6 generic
+        a[1] = a[2] = d[2] = 0.0
+        a[4], a[5], d[5] = (float(rng.uniform(0.2, 0.8)) for _ in range(3))
+        a[3] = float(rng.uniform(0.3, 1.0))
+        m = build_module(spec_text("base_wrist", convention,
+                                   rows_for(convention, alpha, a, d, theta)), tmp_path)
+        assert "axes 1-3 meet: reversed chain" in m.__doc__
+        check_round_trips(m, rng)
+
+
+def test_stanford_arm_prismatic_joint_3(tmp_path):
+    rows = [(-90.0, 0.0, 0.412, 0.0), (90.0, 0.0, 0.154, 0.0), (0.0, 0.0, 0.0, 0.0),
+            (-90.0, 0.0, 0.0, 0.0), (90.0, 0.0, 0.0, 0.0), (0.0, 0.0, 0.263, 0.0)]
+    text = spec_text("stanford", "standard", rows, kinds="RRPRRR")
+    text = text.replace('type = "P"\nalpha = 0.0\na = 0.0\nd = 0.0\ntheta = 0.0\n',
+                        'type = "P"\nalpha = 0.0\na = 0.0\nd = 0.0\ntheta = 0.0\n'
+                        'limits = [0.1, 0.8]\n')
+    m = build_module(text, tmp_path)
+    assert "degree 2 in d3" in m.__doc__
+    result = check_round_trips(m, np.random.default_rng(2), 150)
+    assert max(result.counts) == 8
+    inside = m.ik(m.fk([0.3, 0.2, 0.5, 0.1, 0.4, 0.2]), within_limits=True)
+    assert all(0.1 <= q[2] <= 0.8 for q in inside) and len(inside) == 4
+
+
+@pytest.mark.parametrize("case", ["general", "a1=0", "salpha1=0"])
+def test_random_prismatic_joint_3_arms(case, tmp_path):
+    rng = np.random.default_rng(40 + ["general", "a1=0", "salpha1=0"].index(case))
+    for convention in ("standard", "modified"):
+        alpha, a, d, theta = canonical_rows(rng, case)
+        alpha[2] = float(rng.uniform(20, 70))  # cos(alpha2) = 0 with sin(alpha1) = 0 is planar
+        rows = rows_for(convention, alpha, a, d, theta)
+        text = spec_text("prismatic3", convention, rows, kinds="RRPRRR")
+        text = text.replace('type = "P"\n', 'type = "P"\nlimits = [-1.0, 1.0]\n')
+        m = build_module(text, tmp_path)
+        assert "in d3" in m.__doc__
+        check_round_trips(m, rng, 80)
+
+
+def test_degenerate_prismatic_arm_is_refused_with_a_reason(tmp_path):
+    rows = [(0.0, 0.5, 0.0, 0.0), (90.0, 0.4, 0.1, 0.0), (-90.0, 0.0, 0.0, 0.0),
+            (90.0, 0.0, 0.3, 0.0), (-90.0, 0.0, 0.0, 0.0), (0.0, 0.0, 0.0, 0.0)]
+    plan = build_plan(parse_spec(spec_text("flat", "standard", rows, kinds="RRPRRR")))
+    assert plan.ik is None
+    assert "does not involve joint 3" in plan.refusal

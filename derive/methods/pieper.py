@@ -20,6 +20,7 @@ alpha_i, d_i as symbols), then with the arm's numbers substituted:
 
 from __future__ import annotations
 
+from dataclasses import replace
 from functools import lru_cache
 
 import sympy as sp
@@ -30,29 +31,62 @@ from derive.halfangle import half_angle_poly, linear_coeffs, reduce_pairs
 from derive.plan import Assign, IkPlan, Solve, Step
 from derive.transforms import (
     Chain, general_joint, general_pairs, general_twist, inverse, numbers_of, product,
-    rot_x, rot_z, trans, x_factor, z_factor,
+    reverse_chain, rot_x, rot_z, trans, x_factor, z_factor,
 )
 
 NAME = "pieper"
 
 
 def derive(chain: Chain, structure: Structure) -> IkPlan | str:
-    """Pieper plan for the chain, or a one-line reason why the method does not apply."""
+    """Pieper plan for the chain, or a one-line reason why the method does not apply.
+
+    Axes 4, 5, 6 meeting in a point are solved directly; axes 1, 2, 3 meeting in a point by
+    solving the reversed chain for T^-1 (ALGORITHMS.md section 2.8).
+    """
     if chain.dof != 6:
         return f"Pieper: needs 6 joints, the arm has {chain.dof}"
-    if any(j.kind != "R" for j in chain.joints):
-        return "Pieper: prismatic joints are not supported by this method yet"
-    if 4 not in structure.concurrent:
-        return "Pieper: axes 4, 5, 6 do not meet in a point"
+    refs = tuple(sym.q_ref(j.index) + j.offset for j in chain.joints)
+    if 4 in structure.concurrent:
+        return derive_wrist_last(chain, sym.world_pose(), refs, "")
+    if 1 in structure.concurrent:
+        rev = reverse_chain(chain)
+        rev_refs = tuple(-sym.q_ref(7 - k) + rev.joints[k - 1].offset for k in range(1, 7))
+        plan = derive_wrist_last(rev, inverse(sym.world_pose()), rev_refs,
+                                 "axes 1-3 meet: reversed chain (joint k is joint 7 - k, "
+                                 "q'_k = -q_{7-k}), solved for T^-1; ")
+        if isinstance(plan, str):
+            return plan
+        return replace(plan, outputs=tuple(-plan.outputs[5 - j] for j in range(6)))
+    return "Pieper: neither axes 4, 5, 6 nor axes 1, 2, 3 meet in a point"
+
+
+def derive_wrist_last(chain: Chain, target: sp.Matrix, refs: tuple[sp.Expr, ...],
+                      prefix: str) -> IkPlan | str:
+    """Pieper plan for a chain whose axes 4, 5, 6 meet in a point.
+
+    Args:
+        chain: the (possibly reversed) chain.
+        target: the world target as an expression in w11..wz (T, or T^-1 when reversed).
+        refs: per joint, the reference angle (or length) a free joint takes.
+        prefix: text put before the case (how the chain was obtained).
+    """
+    kinds = "".join(j.kind for j in chain.joints)
+    if kinds not in ("RRRRRR", "RRPRRR"):
+        return "Pieper: prismatic joints are supported at position 3 of the position chain only"
     numbers = numbers_of(chain)
-    length = sum(abs(float(t.a)) for t in chain.twists) + sum(abs(float(j.d)) for j in chain.joints)
-    position = position_equations(numbers, max(length, 1e-300))
-    wrist = wrist_equations(numbers)
-    steps = [flange_target(chain), *position.steps, *wrist]
-    outputs = tuple(sym.theta(j.index) - float(j.offset) for j in chain.joints)
+    length = sum(abs(float(t.a)) for t in chain.twists)
+    length += sum(abs(float(j.d)) for j in chain.joints if j.kind == "R")
+    try:
+        position = position_equations(numbers, max(length, 1e-300), refs, kinds[2] == "P")
+    except NotApplicable as exc:
+        return str(exc)
+    wrist = wrist_equations(numbers, refs)
+    steps = [flange_target(chain, target), *position.steps, *wrist]
+    outputs = tuple((sym.theta(j.index) if j.kind == "R" else sym.d(j.index)) - j.offset
+                    for j in chain.joints)
     return IkPlan(
         method=NAME,
-        case=position.case,
+        case=prefix + position.case,
         max_solutions=position.fanout * 2,
         steps=tuple(steps),
         outputs=outputs,
@@ -60,16 +94,20 @@ def derive(chain: Chain, structure: Structure) -> IkPlan | str:
     )
 
 
-def flange_target(chain: Chain) -> Assign:
+def flange_target(chain: Chain, target: sp.Matrix) -> Assign:
     """0_6T from the world target: base, X_0, Tz(d1) and Tz(d6), X_6, tool moved out."""
     first, last = chain.joints[0], chain.joints[-1]
     head = product([chain.base, x_factor(chain.twists[0]), trans(0, 0, first.d)])
     tail = product([trans(0, 0, last.d), x_factor(chain.twists[-1]), chain.tool])
-    target = product([inverse(head), sym.world_pose(), inverse(tail)])
+    flange = product([inverse(head), target, inverse(tail)])
     names = sym.flange_pose()
-    pairs = [(names[i, j], target[i, j]) for i in range(3) for j in range(4)]
+    pairs = [(names[i, j], flange[i, j]) for i in range(3) for j in range(4)]
     return Assign(tuple(p[0] for p in pairs), tuple(p[1] for p in pairs),
                   "flange target 0_6T = (B X0 Tz(d1))^-1 T (Tz(d6) X6 E)^-1")
+
+
+class NotApplicable(Exception):
+    """The method does not apply to this arm; the message says why, in one line."""
 
 
 class PositionResult:
@@ -109,12 +147,16 @@ def k_functions() -> dict[str, sp.Expr]:
             "k1": k1, "k2": k2, "k3": k3, "k4": k4}
 
 
-def position_equations(numbers: dict, length: float) -> PositionResult:
-    """theta3 from the case's polynomial, then theta2, then theta1 (lecture, Pieper -4, -5).
+def position_equations(numbers: dict, length: float, refs: tuple[sp.Expr, ...],
+                       prismatic3: bool) -> PositionResult:
+    """Joint 3 from the case's polynomial, then theta2, then theta1 (lecture, Pieper -4, -5).
 
     Args:
         numbers: the arm's numbers for the general symbols.
         length: the arm's size (sum of |a_i| and |d_i|), which scales the singularity tests.
+        refs: reference values of the joints, for free joints.
+        prismatic3: joint 3 is prismatic: the lecture's "theta_i or d_i"; f is affine in d3 and
+            the case's equation is a polynomial in d3 (ALGORITHMS.md section 2.7).
     """
     general = k_functions()
     spec = {name: sp.expand(e.xreplace(numbers)) for name, e in general.items()}
@@ -124,39 +166,49 @@ def position_equations(numbers: dict, length: float) -> PositionResult:
     k1, k2, k3, k4 = (spec[k] for k in ("k1", "k2", "k3", "k4"))
     r_eq = 2 * a1 * (k1 * c2 + k2 * s2) + k3 - r
     z_eq = sa1 * (k1 * s2 - k2 * c2) + k4 - z
+    var = "d3" if prismatic3 else "u = tan(theta3/2)"
     if is_zero(a1, 1e-12) and is_zero(sa1, 1e-12):
         raise AssertionError("axes 1 and 2 coincide; classification should have refused")
     if is_zero(a1, 1e-12):
-        case, equation, theta2_eq = "a1 = 0: r = k3(theta3), quadratic in u", k3 - r, z_eq
+        case, equation, theta2_eq = "a1 = 0: r = k3", k3 - r, z_eq
     elif is_zero(sa1, 1e-12):
-        case, equation, theta2_eq = "sin(alpha1) = 0: z = k4(theta3), quadratic in u", k4 - z, r_eq
+        case, equation, theta2_eq = "sin(alpha1) = 0: z = k4", k4 - z, r_eq
     else:
-        case = "general: (r - k3)^2/(4 a1^2) + (z - k4)^2/s(alpha1)^2 = k1^2 + k2^2, quartic in u"
+        case = "general: (r - k3)^2/(4 a1^2) + (z - k4)^2/s(alpha1)^2 = k1^2 + k2^2"
         equation = (sa1**2 * (r - k3) ** 2 + 4 * a1**2 * (z - k4) ** 2
                     - 4 * a1**2 * sa1**2 * (k1**2 + k2**2))
         theta2_eq = None
-    equation = reduce_pairs(equation, [(s3, c3)])
-    coeffs = half_angle_poly(equation, c3, s3, u)
-    if all(is_zero(cf, 0.0) for cf in coeffs if cf.is_number) and not any(
-            cf.free_symbols for cf in coeffs):
-        raise AssertionError("the theta3 equation vanishes identically")
+    if prismatic3:
+        equation = sp.expand(equation)
+        coeffs = tuple(sp.Poly(equation, sym.d(3)).all_coeffs())
+        kind = "polyd"
+    else:
+        equation = reduce_pairs(equation, [(s3, c3)])
+        coeffs = half_angle_poly(equation, c3, s3, u)
+        kind = "poly"
+    degree = len(coeffs) - 1
+    if degree < 1:
+        raise NotApplicable(f"Pieper: the {case.split(':')[0]} case's equation does not involve "
+                            "joint 3, so the wrist centre cannot move in 3D (degenerate arm)")
+    case = f"{case}, degree {degree} in {var}"
     details = {**{f"general_{k}": v for k, v in general.items()},
                **{k: v for k, v in spec.items()},
-               "theta3_equation": equation}
+               "joint3_equation": equation}
+    name = "d3" if prismatic3 else "theta3"
     steps: list[Step] = [
         Assign((sym.named("x"), sym.named("y"), z, r),
                (sym.named("px"), sym.named("py"), sym.named("pz"),
                 sym.named("px")**2 + sym.named("py")**2 + sym.named("pz")**2),
                "wrist centre (x, y, z) = 0P_4org and r = x^2 + y^2 + z^2"),
-        Solve(3, "poly", coeffs, f"theta3: Pieper {case.split(':')[0]} case, polynomial "
-              f"in u = tan(theta3/2) of degree {len(coeffs) - 1}", len(coeffs) - 1),
+        Solve(3, kind, coeffs, f"{name}: Pieper {case.split(':')[0]} case, polynomial "
+              f"of degree {degree} in {var}", degree),
     ]
     if theta2_eq is None:
         ra, rb, rc = linear_coeffs(r_eq, c2, s2)
         za, zb, zc = linear_coeffs(z_eq, c2, s2)
         scale = abs(float(2 * a1 * sa1)) * length**2
         steps.append(Solve(2, "cs2", (ra, rb, -rc, za, zb, -zc, sp.Float(scale)),
-                           "theta2: r and z equations, linear in (c2, s2)", 1))
+                           "theta2: r and z equations, linear in (c2, s2)", 1, refs[1]))
         fan2 = 1
     else:
         ta, tb, tc = linear_coeffs(theta2_eq, c2, s2)
@@ -169,12 +221,12 @@ def position_equations(numbers: dict, length: float) -> PositionResult:
     gs1, gs2 = sym.named("g1"), sym.named("g2")
     steps.append(Solve(1, "cs2", (gs1, -gs2, sym.named("x"), gs2, gs1, sym.named("y"),
                                   sp.Float(length**2)),
-                       "theta1: x = c1 g1 - s1 g2, y = s1 g1 + c1 g2", 1))
-    degree = len(coeffs) - 1
+                       "theta1: x = c1 g1 - s1 g2, y = s1 g1 + c1 g2; free with the wrist "
+                       "centre on axis 1", 1, refs[0]))
     return PositionResult(steps, case, degree * fan2, details)
 
 
-def wrist_equations(numbers: dict) -> list[Step]:
+def wrist_equations(numbers: dict, refs: tuple[sp.Expr, ...]) -> list[Step]:
     """theta5, theta4, theta6 from W = Rz(t4) Rx(alpha4) Rz(t5) Rx(alpha5) Rz(t6) (section 2.6)."""
     rot03 = product([z_factor(general_joint(i)) * x_factor(general_twist(i))
                      for i in (1, 2, 3)])[:3, :3].xreplace(numbers)
@@ -196,7 +248,8 @@ def wrist_equations(numbers: dict) -> list[Step]:
               "theta5: W33 = e3^T Rx(alpha4) Rz(theta5) Rx(alpha5) e3", 2),
         Assign((v1, v2), (v[0], v[1]), "v = Rx(alpha4) Rz(theta5) Rx(alpha5) e3"),
         Solve(4, "cs2", (v1, -v2, sym.named("W13"), v2, v1, sym.named("W23"), sp.Integer(1)),
-              "theta4: (W13, W23) = Rz(theta4) (v1, v2); free at a singular wrist", 1),
+              "theta4: (W13, W23) = Rz(theta4) (v1, v2); free at a singular wrist", 1, refs[3]),
         Solve(6, "atan2", (m[1, 0], m[0, 0]),
-              "theta6: Rz(theta6) = (Rx(alpha4) Rz(theta5) Rx(alpha5))^T Rz(theta4)^T W", 1),
+              "theta6: Rz(theta6) = (Rx(alpha4) Rz(theta5) Rx(alpha5))^T Rz(theta4)^T W", 1,
+              refs[5]),
     ]
