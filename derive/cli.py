@@ -233,6 +233,29 @@ def cmd_solve(args: argparse.Namespace) -> int:
     return 0
 
 
+def cmd_bench(args: argparse.Namespace) -> int:
+    """Print generation time, solver timings and round-trip figures per arm."""
+    import json
+
+    from derive.bench import measure
+
+    results = []
+    for spec in load_specs(args.specs):
+        start = time.perf_counter()
+        render_module(build_plan(spec))
+        generation = time.perf_counter() - start
+        figures = {"generate_s": generation, **measure(load_module(spec), args.samples, args.seed)}
+        results.append(figures)
+        if not args.json:
+            line = f"{spec.name}: generate {generation:.2f} s; fk {figures['fk_us']:.1f} us"
+            if "ik_us" in figures:
+                line += f"; ik {figures['ik_us']:.1f} us/pose (median)\n  {figures['summary']}"
+            print(line, flush=True)
+    if args.json:
+        print(json.dumps(results, indent=2, sort_keys=True))
+    return 0
+
+
 def parser() -> argparse.ArgumentParser:
     """The argument parser of `derive`."""
     top = argparse.ArgumentParser(prog="derive", description="Closed-form IK solvers from DH tables.")
@@ -258,6 +281,12 @@ def parser() -> argparse.ArgumentParser:
     group.add_argument("--q", nargs="+", help="solve the pose of these joint values")
     solve.add_argument("--rad", action="store_true", help="--q values are in radians")
     solve.set_defaults(run=cmd_solve)
+    bench = sub.add_parser("bench", help="time generation and solvers; round-trip figures")
+    bench.add_argument("specs", nargs="*", help="spec files or bundled arm names (default: all)")
+    bench.add_argument("--samples", type=int, default=10000, help="round-trip samples (10000)")
+    bench.add_argument("--seed", type=int, default=0, help="random seed (0)")
+    bench.add_argument("--json", action="store_true", help="print figures as JSON")
+    bench.set_defaults(run=cmd_bench)
     return top
 
 

@@ -10,8 +10,9 @@ Solve kinds (the generated module implements each once, as a helper):
 
 =========  =========================================================================
 ``cs1``    a cos t + b sin t = e: t = atan2(b, a) +- acos(e / sqrt(a^2 + b^2)); args (a, b, e)
-``cs2``    a1 c + b1 s = e1, a2 c + b2 s = e2: one t from the 2x2 system;
-           args (a1, b1, e1, a2, b2, e2); a singular system leaves t free (reference value)
+``cs2``    a1 c + b1 s = e1, a2 c + b2 s = e2: one t from the 2x2 system; args (a1, b1, e1,
+           a2, b2, e2, det_scale, rhs_scale): t is free (reference value) when the determinant
+           is below 1e-18 det_scale or e1^2 + e2^2 below 1e-18 rhs_scale
 ``atan2``  t = atan2(y, x); args (y, x); both vanishing leaves t free (reference value)
 ``poly``   polynomial in u = tan(t/2), coefficients highest degree first; u = inf is t = pi
 ``polyd``  polynomial in a prismatic joint's d_i, coefficients highest degree first

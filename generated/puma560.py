@@ -278,7 +278,7 @@ def ik(T, *, within_limits=False, q_ref=None):
             g1 = -0.02*c2*c3 + 0.433*c2*s3 + 0.432*c2 + 0.433*c3*s2 + 0.02*s2*s3
             g2 = 0.149
             # theta1: x = c1 g1 - s1 g2, y = s1 g1 + c1 g2; free with the wrist centre on axis 1
-            for theta1 in _cs2(g1, -g2, x, g2, g1, y, 1.069156, qr1):
+            for theta1 in _cs2(g1, -g2, x, g2, g1, y, 1.069156, 1.069156, qr1):
                 c1 = cos(theta1)
                 s1 = sin(theta1)
                 # wrist W = (0_3R Rx(alpha3))^T 0_6R = Rz(t4) Rx(alpha4) Rz(t5) Rx(alpha5) Rz(t6)
@@ -309,7 +309,7 @@ def ik(T, *, within_limits=False, q_ref=None):
                     v1 = s5
                     v2 = 0.0
                     # theta4: (W13, W23) = Rz(theta4) (v1, v2); free at a singular wrist
-                    for theta4 in _cs2(v1, -v2, W13, v2, v1, W23, 1.0, qr4):
+                    for theta4 in _cs2(v1, -v2, W13, v2, v1, W23, 1.0, 1.0, qr4):
                         c4 = cos(theta4)
                         s4 = sin(theta4)
                         # theta6: Rz(theta6) = (Rx(alpha4) Rz(theta5) Rx(alpha5))^T Rz(theta4)^T W
@@ -442,10 +442,14 @@ def _cs1(a, b, e):
     return (base + delta, base - delta)
 
 
-def _cs2(a1, b1, e1, a2, b2, e2, scale, ref):
-    """The angle t with a1 c + b1 s = e1 and a2 c + b2 s = e2; ref if the system is singular."""
+def _cs2(a1, b1, e1, a2, b2, e2, det_scale, rhs_scale, ref):
+    """The angle t with a1 c + b1 s = e1 and a2 c + b2 s = e2; ref where t is free.
+
+    t is free when the system is singular or, for a consistent system, when its right-hand
+    side vanishes (then so does the determinant, up to the errors of earlier joints).
+    """
     det = a1 * b2 - a2 * b1
-    if abs(det) <= _FREE_TOL * scale:
+    if abs(det) <= _FREE_TOL * det_scale or e1 * e1 + e2 * e2 <= _FREE_TOL * rhs_scale:
         return (ref,)
     return (atan2((a1 * e2 - a2 * e1) / det, (e1 * b2 - b1 * e2) / det),)
 

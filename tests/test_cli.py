@@ -109,3 +109,12 @@ def test_solve_rejects_non_rigid_pose():
     result = run("solve", "puma560", "--pose", "1 0 0 0.5 0 2 0 0 0 0 1 0.2")
     assert result.returncode == 2 and "not orthonormal" in result.stderr
     assert "Traceback" not in result.stderr
+
+
+def test_bench_reports_round_trip_figures(capsys):
+    import json
+    assert main(["bench", "puma560", "--samples", "30", "--json"]) == 0
+    figures = json.loads(capsys.readouterr().out)[0]
+    assert figures["name"] == "puma560" and figures["samples"] == 30
+    assert figures["unsound"] == 0 and figures["completeness"] == 1.0
+    assert figures["ik_us"] > 0 and figures["generate_s"] > 0

@@ -257,3 +257,45 @@ def test_degenerate_prismatic_arm_is_refused_with_a_reason(tmp_path):
     plan = build_plan(parse_spec(spec_text("flat", "standard", rows, kinds="RRPRRR")))
     assert plan.ik is None
     assert "does not involve joint 3" in plan.refusal
+
+
+def test_wrist_centre_on_axis_1_takes_theta1_from_q_ref(tmp_path):
+    m = hard_case_module(PIEPER_CASES["craig_lecture_pieper"]["rows"], tmp_path)
+    theta3 = 0.3
+    f1 = 340 - 338 * math.sin(theta3) - 40 * math.cos(theta3)
+    f2 = 338 * math.cos(theta3) - 40 * math.sin(theta3)
+    # g1 = c2 f1 - s2 f2 - 30 = 0 puts the wrist centre on axis 1 (g2 = 0 for this arm)
+    theta2 = math.atan2(-f2, f1) + math.acos(30 / math.hypot(f1, f2))
+    q = np.array([0.7, theta2, theta3, 0.4, 0.5, 0.6])
+    T = m.fk(q)
+    assert math.hypot(*T[:2, 3]) < 1e-9
+    with_ref = m.ik(T, q_ref=q)
+    assert any(wrapped_close(s, q, 1e-9) for s in with_ref)
+    default = m.ik(T)
+    assert len(default) > 0 and np.allclose(default[:, 0], 0.0)
+    # a shoulder singularity: the theta3 roots are double here, so the singular tolerance holds
+    for s in default:
+        assert np.abs(m.fk(s) - T).max() < 1e-6 * m.REACH
+
+
+def test_singular_wrist_keeps_theta4_plus_theta6(generated):
+    m = generated("puma560")
+    q = np.radians([30.0, -40.0, 20.0, 50.0, 0.0, 70.0])
+    T = m.fk(q)
+    sols = m.ik(T)
+    assert len(sols) == 7  # the branch with a singular wrist has one representative, not two
+    for s in sols:
+        assert np.abs(m.fk(s) - T).max() < 1e-9
+    match = [s for s in sols if wrapped_close(s[:3], q[:3], 1e-9)]
+    assert len(match) == 1
+    assert match[0][3] == 0.0
+    assert wrapped_close(match[0][3] + match[0][5], q[3] + q[5], 1e-9)
+    flipped = m.ik(T, q_ref=q)
+    assert any(wrapped_close(s, q, 1e-9) for s in flipped)
+
+
+def test_fewer_real_solutions_return_only_the_real_ones(tmp_path):
+    data = PIEPER_CASES["pieper_parallel_axes_1_2"]
+    m = hard_case_module(data["rows"], tmp_path)
+    T = np.vstack([np.array(data["T"]), [0, 0, 0, 1.0]])
+    assert len(m.ik(T)) == 4

@@ -207,7 +207,7 @@ def position_equations(numbers: dict, length: float, refs: tuple[sp.Expr, ...],
         ra, rb, rc = linear_coeffs(r_eq, c2, s2)
         za, zb, zc = linear_coeffs(z_eq, c2, s2)
         scale = abs(float(2 * a1 * sa1)) * length**2
-        steps.append(Solve(2, "cs2", (ra, rb, -rc, za, zb, -zc, sp.Float(scale)),
+        steps.append(Solve(2, "cs2", (ra, rb, -rc, za, zb, -zc, sp.Float(scale), sp.Integer(0)),
                            "theta2: r and z equations, linear in (c2, s2)", 1, refs[1]))
         fan2 = 1
     else:
@@ -220,7 +220,7 @@ def position_equations(numbers: dict, length: float, refs: tuple[sp.Expr, ...],
                         "g1(theta2, theta3), g2(theta2, theta3)"))
     gs1, gs2 = sym.named("g1"), sym.named("g2")
     steps.append(Solve(1, "cs2", (gs1, -gs2, sym.named("x"), gs2, gs1, sym.named("y"),
-                                  sp.Float(length**2)),
+                                  sp.Float(length**2), sp.Float(length**2)),
                        "theta1: x = c1 g1 - s1 g2, y = s1 g1 + c1 g2; free with the wrist "
                        "centre on axis 1", 1, refs[0]))
     return PositionResult(steps, case, degree * fan2, details)
@@ -247,7 +247,8 @@ def wrist_equations(numbers: dict, refs: tuple[sp.Expr, ...]) -> list[Step]:
         Solve(5, "cs1", (a5, b5, sym.named("W33") - e5),
               "theta5: W33 = e3^T Rx(alpha4) Rz(theta5) Rx(alpha5) e3", 2),
         Assign((v1, v2), (v[0], v[1]), "v = Rx(alpha4) Rz(theta5) Rx(alpha5) e3"),
-        Solve(4, "cs2", (v1, -v2, sym.named("W13"), v2, v1, sym.named("W23"), sp.Integer(1)),
+        Solve(4, "cs2", (v1, -v2, sym.named("W13"), v2, v1, sym.named("W23"), sp.Integer(1),
+                          sp.Integer(1)),
               "theta4: (W13, W23) = Rz(theta4) (v1, v2); free at a singular wrist", 1, refs[3]),
         Solve(6, "atan2", (m[1, 0], m[0, 0]),
               "theta6: Rz(theta6) = (Rx(alpha4) Rz(theta5) Rx(alpha5))^T Rz(theta4)^T W", 1,
