@@ -50,6 +50,7 @@ def measure(module: ModuleType, samples: int, seed: int = 0) -> dict:
         figures.update(
             samples=result.samples, singular=result.singular, found=result.found,
             completeness=result.completeness, singular_found=result.singular_found,
+            singular_posed=result.singular_posed,
             unsound=len(result.unsound), worst_rot=result.worst_rot, worst_pos=result.worst_pos,
             worst_singular=result.worst_singular,
             counts={str(k): v for k, v in sorted(result.counts.items())},

@@ -133,7 +133,7 @@ def ik_lines(plan: Plan, printer: CodePrinter) -> tuple[tuple[int, str], ...]:
         lines += solve_lines(step, names, printer, depth)
         depth += 1
     outputs = ", ".join(printer.doprint(e) for e in plan.ik.outputs)
-    lines.append(Line(depth, f"_keep(found, target, ({outputs},))"))
+    lines.append(Line(depth, f"_keep(found, target, ({outputs},), tol)"))
     return tuple((ln.depth, ln.text) for ln in lines)
 
 
@@ -154,6 +154,7 @@ def solve_lines(step: Solve, names: sp.utilities.iterables.numbered_symbols,
         "polyd": f"_poly_real(({joined},))",
         "cs1": f"_cs1({joined})",
         "cs2": f"_cs2({joined}, {ref})",
+        "cs2r": f"_cs2_reach({joined}, {ref})",
         "atan2": f"_atan2({joined}, {ref})",
     }[step.kind]
     if step.kind == "polyd":
@@ -196,6 +197,8 @@ class PrintedModule:
     refusal: str
     ik_body: tuple[tuple[int, str], ...]
     qref_names: str
+    rotation_entries: str
+    position_entries: str
 
 
 def print_plan(plan: Plan) -> PrintedModule:
@@ -233,6 +236,8 @@ def print_plan(plan: Plan) -> PrintedModule:
         refusal=plan.refusal,
         ik_body=ik_lines(plan, scalar) if ik else (),
         qref_names=", ".join(f"qr{i}" for i in range(1, arm.dof + 1)),
+        rotation_entries="()" if ik and ik.certify == "position" else "(0, 1, 2, 4, 5, 6, 8, 9, 10)",
+        position_entries="(3, 7, 11)",
     )
 
 

@@ -8,13 +8,13 @@ import sympy as sp
 
 from derive import symbols as sym
 from derive.classify import Structure, classify
-from derive.methods import pieper
+from derive.methods import parallel, pieper, planar
 from derive.plan import ArmInfo, IkPlan, Plan
 from derive.spec import ArmSpec
 from derive.transforms import Chain, chain_from_spec, world_transform
 
 # Tried in order; each returns a plan, or a one-line reason why it does not apply.
-METHODS = (pieper.derive,)
+METHODS = (pieper.derive, parallel.derive, planar.derive)
 
 
 def build_plan(spec: ArmSpec) -> Plan:

@@ -13,6 +13,9 @@ Solve kinds (the generated module implements each once, as a helper):
 ``cs2``    a1 c + b1 s = e1, a2 c + b2 s = e2: one t from the 2x2 system; args (a1, b1, e1,
            a2, b2, e2, det_scale, rhs_scale): t is free (reference value) when the determinant
            is below 1e-18 det_scale or e1^2 + e2^2 below 1e-18 rhs_scale
+``cs2r``   cs2 whose free value must keep a radius A + B cos t + C sin t inside [lo, hi]; args
+           (the cs2 args, A, B, C, lo, hi): q_ref's value if inside, else the nearest one
+           putting the radius mid-range
 ``atan2``  t = atan2(y, x); args (y, x); both vanishing leaves t free (reference value)
 ``poly``   polynomial in u = tan(t/2), coefficients highest degree first; u = inf is t = pi
 ``polyd``  polynomial in a prismatic joint's d_i, coefficients highest degree first
@@ -109,6 +112,8 @@ class IkPlan:
         outputs: q_1..q_n as expressions of the solved joint quantities.
         details: derivation facts for the report: name -> expression (sorted by name).
         solves_for: the pose components the solver is defined on, in words.
+        certify: "pose" (every solution reproduces the whole pose) or "position" (the tool
+            point only: arms that do not control the orientation).
     """
 
     method: str
@@ -118,6 +123,7 @@ class IkPlan:
     outputs: tuple[sp.Expr, ...]
     details: tuple[tuple[str, sp.Expr], ...] = ()
     solves_for: str = "the full pose (rotation and position)"
+    certify: str = "pose"
 
 
 @dataclass(frozen=True)

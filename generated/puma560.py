@@ -231,7 +231,7 @@ _FREE_TOL = 1e-18
 _TWO_PI = 2.0 * math.pi
 
 
-def ik(T, *, within_limits=False, q_ref=None):
+def ik(T, *, within_limits=False, q_ref=None, tol=CERTIFY_TOL):
     """All solutions for the world pose T, as an (n, DOF) array; empty (0, DOF) if unreachable.
 
     Args:
@@ -239,6 +239,10 @@ def ik(T, *, within_limits=False, q_ref=None):
         within_limits: keep only solutions inside LIMITS; revolute joints whose range allows
             it are also tried at q +- 2 pi, and every variant inside the limits is returned.
         q_ref: joint vector whose values free joints take at singular poses (default zeros).
+        tol: certification tolerance: a solution is returned only if its forward kinematics
+            matches T within tol in rotation entries and tol * REACH in position. For an arm
+            that does not control every pose component this is also the test that T's other
+            components are reachable: if they are not, the result is empty.
 
     Raises:
         ValueError: T is not 4x4, has non-finite entries, or its rotation is not orthonormal
@@ -248,7 +252,7 @@ def ik(T, *, within_limits=False, q_ref=None):
     qr1, qr2, qr3, qr4, qr5, qr6, = _reference(q_ref)
     (w11, w12, w13, wx, w21, w22, w23, wy, w31, w32, w33, wz) = target
     found = []
-    # flange target 0_6T = (B X0 Tz(d1))^-1 T (Tz(d6) X6 E)^-1
+    # flange target 0_nT = (B X0 Tz(d1))^-1 T (Tz(dn) Xn E)^-1
     r11 = w11
     r12 = w12
     r13 = w13
@@ -316,7 +320,7 @@ def ik(T, *, within_limits=False, q_ref=None):
                         for theta6 in _atan2(-W11*s4 + W21*c4, W11*c4*c5 + W21*c5*s4 - W31*s5, qr6):
                             c6 = cos(theta6)
                             s6 = sin(theta6)
-                            _keep(found, target, (theta1, theta2, theta3, theta4, theta5, theta6,))
+                            _keep(found, target, (theta1, theta2, theta3, theta4, theta5, theta6,), tol)
     return _finish(found, within_limits)
 
 
@@ -368,13 +372,20 @@ def _reference(q_ref):
     return q_ref
 
 
-def _keep(found, target, q):
+_ROTATION_ENTRIES = (0, 1, 2, 4, 5, 6, 8, 9, 10)
+_POSITION_ENTRIES = (3, 7, 11)
+
+
+def _keep(found, target, q, tol):
     """Append q if its forward kinematics reproduces the target (certification)."""
     e = _fk_entries(q)
-    rot = max(abs(e[k] - target[k]) for k in (0, 1, 2, 4, 5, 6, 8, 9, 10))
-    pos = max(abs(e[k] - target[k]) for k in (3, 7, 11))
-    if rot <= CERTIFY_TOL and pos <= CERTIFY_TOL * REACH:
-        found.append(q)
+    for k in _ROTATION_ENTRIES:
+        if abs(e[k] - target[k]) > tol:
+            return
+    for k in _POSITION_ENTRIES:
+        if abs(e[k] - target[k]) > tol * REACH:
+            return
+    found.append(q)
 
 
 def _wrap(x):
@@ -452,6 +463,22 @@ def _cs2(a1, b1, e1, a2, b2, e2, det_scale, rhs_scale, ref):
     if abs(det) <= _FREE_TOL * det_scale or e1 * e1 + e2 * e2 <= _FREE_TOL * rhs_scale:
         return (ref,)
     return (atan2((a1 * e2 - a2 * e1) / det, (e1 * b2 - b1 * e2) / det),)
+
+
+def _cs2_reach(a1, b1, e1, a2, b2, e2, det_scale, rhs_scale, A, B, C, lo, hi, ref):
+    """As _cs2; a free t keeps A + B cos t + C sin t in [lo, hi] (reachability of later joints)."""
+    det = a1 * b2 - a2 * b1
+    if abs(det) > _FREE_TOL * det_scale and e1 * e1 + e2 * e2 > _FREE_TOL * rhs_scale:
+        return (atan2((a1 * e2 - a2 * e1) / det, (e1 * b2 - b1 * e2) / det),)
+    if lo <= A + B * cos(ref) + C * sin(ref) <= hi:
+        return (ref,)
+    rho = sqrt(B * B + C * C)
+    if rho == 0.0:
+        return (ref,)
+    mid = 0.5 * (lo + hi)
+    base = atan2(C, B)
+    delta = acos(max(-1.0, min(1.0, (mid - A) / rho)))
+    return (min((base + delta, base - delta), key=lambda t: abs(_wrap(t - ref))),)
 
 
 def _atan2(y, x, ref):

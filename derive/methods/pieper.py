@@ -28,6 +28,9 @@ import sympy as sp
 from derive import symbols as sym
 from derive.classify import Structure, is_zero
 from derive.halfangle import half_angle_poly, linear_coeffs, reduce_pairs
+from derive.methods.common import (
+    NotApplicable, flange_target, joint_outputs, joint_refs, reversed_refs, unreverse_outputs,
+)
 from derive.plan import Assign, IkPlan, Solve, Step
 from derive.transforms import (
     Chain, general_joint, general_pairs, general_twist, inverse, numbers_of, product,
@@ -45,18 +48,17 @@ def derive(chain: Chain, structure: Structure) -> IkPlan | str:
     """
     if chain.dof != 6:
         return f"Pieper: needs 6 joints, the arm has {chain.dof}"
-    refs = tuple(sym.q_ref(j.index) + j.offset for j in chain.joints)
+    refs = joint_refs(chain)
     if 4 in structure.concurrent:
         return derive_wrist_last(chain, sym.world_pose(), refs, "")
     if 1 in structure.concurrent:
         rev = reverse_chain(chain)
-        rev_refs = tuple(-sym.q_ref(7 - k) + rev.joints[k - 1].offset for k in range(1, 7))
-        plan = derive_wrist_last(rev, inverse(sym.world_pose()), rev_refs,
+        plan = derive_wrist_last(rev, inverse(sym.world_pose()), reversed_refs(rev),
                                  "axes 1-3 meet: reversed chain (joint k is joint 7 - k, "
                                  "q'_k = -q_{7-k}), solved for T^-1; ")
         if isinstance(plan, str):
             return plan
-        return replace(plan, outputs=tuple(-plan.outputs[5 - j] for j in range(6)))
+        return replace(plan, outputs=unreverse_outputs(plan.outputs))
     return "Pieper: neither axes 4, 5, 6 nor axes 1, 2, 3 meet in a point"
 
 
@@ -82,8 +84,7 @@ def derive_wrist_last(chain: Chain, target: sp.Matrix, refs: tuple[sp.Expr, ...]
         return str(exc)
     wrist = wrist_equations(numbers, refs)
     steps = [flange_target(chain, target), *position.steps, *wrist]
-    outputs = tuple((sym.theta(j.index) if j.kind == "R" else sym.d(j.index)) - j.offset
-                    for j in chain.joints)
+    outputs = joint_outputs(chain)
     return IkPlan(
         method=NAME,
         case=prefix + position.case,
@@ -92,22 +93,6 @@ def derive_wrist_last(chain: Chain, target: sp.Matrix, refs: tuple[sp.Expr, ...]
         outputs=outputs,
         details=tuple(sorted(position.details.items())),
     )
-
-
-def flange_target(chain: Chain, target: sp.Matrix) -> Assign:
-    """0_6T from the world target: base, X_0, Tz(d1) and Tz(d6), X_6, tool moved out."""
-    first, last = chain.joints[0], chain.joints[-1]
-    head = product([chain.base, x_factor(chain.twists[0]), trans(0, 0, first.d)])
-    tail = product([trans(0, 0, last.d), x_factor(chain.twists[-1]), chain.tool])
-    flange = product([inverse(head), target, inverse(tail)])
-    names = sym.flange_pose()
-    pairs = [(names[i, j], flange[i, j]) for i in range(3) for j in range(4)]
-    return Assign(tuple(p[0] for p in pairs), tuple(p[1] for p in pairs),
-                  "flange target 0_6T = (B X0 Tz(d1))^-1 T (Tz(d6) X6 E)^-1")
-
-
-class NotApplicable(Exception):
-    """The method does not apply to this arm; the message says why, in one line."""
 
 
 class PositionResult:

@@ -1,0 +1,61 @@
+"""Steps shared by the solution methods."""
+
+from __future__ import annotations
+
+import sympy as sp
+
+from derive import symbols as sym
+from derive.plan import Assign
+from derive.transforms import Chain, inverse, product, trans, x_factor
+
+
+class NotApplicable(Exception):
+    """The method does not apply to this arm; the message says why, in one line."""
+
+
+def flange_target(chain: Chain, target: sp.Matrix) -> Assign:
+    """0_nT from the world target: base, X_0, Tz(d1) and Tz(dn), X_n, tool moved out.
+
+    Tz(d1) and Tz(dn) move out only for revolute end joints (they commute with Rz(theta)),
+    so that the flange target has alpha_0 = a_0 = d_1 = d_n = 0 (ALGORITHMS.md section 1).
+    """
+    first, last = chain.joints[0], chain.joints[-1]
+    head = [chain.base, x_factor(chain.twists[0])]
+    tail = [x_factor(chain.twists[-1]), chain.tool]
+    if first.kind == "R":
+        head.append(trans(0, 0, first.d))
+    if last.kind == "R":
+        tail.insert(0, trans(0, 0, last.d))
+    flange = product([inverse(product(head)), target, inverse(product(tail))])
+    names = sym.flange_pose()
+    pairs = [(names[i, j], flange[i, j]) for i in range(3) for j in range(4)]
+    return Assign(tuple(p[0] for p in pairs), tuple(p[1] for p in pairs),
+                  "flange target 0_nT = (B X0 Tz(d1))^-1 T (Tz(dn) Xn E)^-1")
+
+
+def joint_outputs(chain: Chain) -> tuple[sp.Expr, ...]:
+    """q_i = theta_i - offset (R) or d_i - offset (P), offsets as floats."""
+    return tuple((sym.theta(j.index) if j.kind == "R" else sym.d(j.index)) - _number(j.offset)
+                 for j in chain.joints)
+
+
+def joint_refs(chain: Chain) -> tuple[sp.Expr, ...]:
+    """theta_i (or d_i) of the reference joint values qr_i: what a free joint takes."""
+    return tuple(sym.q_ref(j.index) + _number(j.offset) for j in chain.joints)
+
+
+def reversed_refs(rev: Chain) -> tuple[sp.Expr, ...]:
+    """Reference values for a reversed chain, whose joint k is q'_k = -q_{n+1-k}."""
+    n = rev.dof
+    return tuple(-sym.q_ref(n + 1 - k) + _number(rev.joints[k - 1].offset)
+                 for k in range(1, n + 1))
+
+
+def unreverse_outputs(outputs: tuple[sp.Expr, ...]) -> tuple[sp.Expr, ...]:
+    """The arm's q_j = -q'_{n+1-j} from a reversed chain's outputs."""
+    n = len(outputs)
+    return tuple(-outputs[n - 1 - j] for j in range(n))
+
+
+def _number(value: sp.Expr) -> sp.Expr:
+    return sp.Integer(0) if value == 0 else sp.Float(float(value), 17)

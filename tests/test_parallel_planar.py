@@ -1,0 +1,161 @@
+"""Three parallel axes (UR type), planar arms and arms with fewer than six joints."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from derive.pipeline import build_plan
+from derive.spec import parse_spec
+from derive.verify import roundtrip, sample_joints
+from conftest import build_module, spec_text, wrapped_close
+
+UR_COURSE_ARM = [(0.0, 0.0, 0.0), (-90.0, 0.0, 116.5), (0.0, 203.5, 0.0), (0.0, 173.0, 0.0),
+                 (90.0, 0.0, 79.2), (-90.0, 0.0, 0.0)]
+UR_COURSE_T = [[0.519298147546, 0.0070239512832, 0.854564273805, 347.392802557],
+               [-0.822517374485, -0.267282955241, 0.502020906445, 57.0424762899],
+               [0.231936634936, -0.963592489565, -0.133022221559, 6.3589802627]]
+UR_COURSE_SOLUTIONS = [
+    [-151.350299159, -166.220157444, -57.9793650055, -143.448405678, 91.766911907, -13.7708675391],
+    [-151.350299159, -147.440857125, -40.7552306896, 0.548159687357, -91.766911907, 166.229132461],
+    [-151.350299159, 140.940483254, 57.9793650055, 153.432223613, 91.766911907, -13.7708675391],
+    [-151.350299159, 175.251054161, 40.7552306896, -43.6542129784, -91.766911907, 166.229132461],
+    [-10.0, -31.1170869886, 38.0261164468, -176.909029458, 50.0, 160.0],
+    [-10.0, -14.6443709826, 60.0, -35.3556290174, -50.0, -20.0],
+    [-10.0, 3.71110633032, -38.0261164468, -135.684989884, 50.0, 160.0],
+    [-10.0, 40.0, -60.0, 30.0, -50.0, -20.0],
+]
+UR5 = [(90.0, 0.0, 0.089159, 0.0), (0.0, -0.425, 0.0, 0.0), (0.0, -0.39225, 0.0, 0.0),
+       (90.0, 0.0, 0.10915, 0.0), (-90.0, 0.0, 0.09465, 0.0), (0.0, 0.0, 0.0823, 0.0)]
+
+
+def check(m, rng, samples):
+    result = roundtrip(m, sample_joints(m, samples, rng))
+    print(result.summary())
+    assert result.unsound == [], result.summary()
+    assert result.misses == [], result.summary()
+    assert result.singular_posed == result.singular, result.summary()
+    return result
+
+
+def test_parallel_6r_follows_the_blog_posts_order(generated):
+    m = generated("parallel_6r")
+    assert "three-parallel method" in m.__doc__ and "a5 = 0" in m.__doc__
+    from derive.cli import resolve_spec
+    plan = build_plan(resolve_spec("parallel_6r"))
+    order = [s.joint for s in plan.ik.steps if hasattr(s, "joint")]
+    assert order == [1, 5, 6, 3, 2, 4]
+
+
+def test_parallel_6r_round_trips(generated):
+    result = check(generated("parallel_6r"), np.random.default_rng(21), 300)
+    assert max(result.counts) == 8
+
+
+@pytest.mark.parametrize("mirror", [1.0, -1.0])
+def test_course_arm_solution_set_and_its_mirror(mirror, tmp_path):
+    rows = [(mirror * a if a else 0.0, l, d, 0.0) for a, l, d in UR_COURSE_ARM]
+    m = build_module(spec_text("ur_course", "modified", rows), tmp_path)
+    M = np.diag([1.0, mirror, 1.0, 1.0])
+    T = M @ np.vstack([np.array(UR_COURSE_T), [0, 0, 0, 1.0]]) @ M
+    sols = m.ik(T)
+    assert len(sols) == 8
+    for row in UR_COURSE_SOLUTIONS:
+        assert any(wrapped_close(s, mirror * np.radians(row), 1e-6) for s in sols), row
+
+
+def test_ur5_published_dh_round_trips(tmp_path):
+    m = build_module(spec_text("ur5", "standard", UR5), tmp_path)
+    assert "three-parallel" in m.__doc__
+    check(m, np.random.default_rng(5), 300)
+
+
+def test_axes_3_4_5_parallel_use_the_reversed_chain(tmp_path):
+    reversed_ur5 = [(0.0, 0.0, 0.0823, 0.0), (-90.0, 0.0, 0.09465, 0.0),
+                    (90.0, 0.0, 0.10915, 0.0), (0.0, -0.39225, 0.0, 0.0),
+                    (0.0, -0.425, 0.0, 0.0), (90.0, 0.0, 0.089159, 0.0)]
+    m = build_module(spec_text("rev_ur", "modified", reversed_ur5), tmp_path)
+    assert "axes 3-5 parallel: reversed chain" in m.__doc__
+    check(m, np.random.default_rng(6), 200)
+
+
+def test_random_three_parallel_arms_with_a5_nonzero_give_a_quartic(tmp_path):
+    rng = np.random.default_rng(8)
+    for _ in range(3):
+        rows = [(0.0, 0.0, 0.0, 0.0), (-90.0, 0.1, float(rng.uniform(0.1, 0.3)), 0.0),
+                (0.0, float(rng.uniform(0.3, 0.6)), 0.0, 0.0),
+                (0.0, float(rng.uniform(0.3, 0.6)), float(rng.uniform(-0.1, 0.1)), 0.0),
+                (float(rng.uniform(30, 80)), float(rng.uniform(-0.2, 0.2)), float(rng.uniform(0.05, 0.2)), 0.0),
+                (float(rng.uniform(-80, -30)), float(rng.uniform(0.05, 0.2)), 0.0, 0.0)]
+        m = build_module(spec_text("ur_a5", "modified", rows), tmp_path)
+        assert "a5 != 0: quartic" in m.__doc__
+        check(m, rng, 80)
+
+
+def test_lecture_rrr_returns_the_two_published_solutions(generated):
+    m = generated("lecture_rrr")
+    T = m.fk(np.radians([39.6, 75.5, -70.2]))
+    sols = np.degrees(m.ik(T))
+    assert len(sols) == 2
+    for published in ([39.6, 75.5, -70.2], [78.4, -75.5, 42.1]):
+        assert any(np.abs(s - published).max() < 0.3 for s in sols), published
+
+
+def test_lecture_rrr_too_far_to_reach_and_off_plane(generated):
+    m = generated("lecture_rrr")
+    far = np.eye(4)
+    far[0, 3] = 1.5  # c2 > 1: "too far for the manipulator to reach"
+    assert m.ik(far).shape == (0, 3)
+    tilted = m.fk(np.radians([10.0, 20.0, 30.0]))
+    tilted[2, 3] = 0.01
+    assert m.ik(tilted).shape == (0, 3)
+
+
+def test_planar_2r_agrees_with_the_course_pages_closed_form(generated):
+    m = generated("planar_2r")
+    a1 = a2 = 1.0
+    rng = np.random.default_rng(4)
+    for _ in range(200):
+        radius = rng.uniform(0.05, 1.95)
+        angle = rng.uniform(-math.pi, math.pi)
+        x, y = radius * math.cos(angle), radius * math.sin(angle)
+        T = np.eye(4)
+        T[:2, 3] = (x, y)
+        sols = m.ik(T)
+        assert len(sols) == 2
+        for sign in (1, -1):
+            q2 = sign * math.acos((x * x + y * y - a1 * a1 - a2 * a2) / (2 * a1 * a2))
+            q1 = math.atan2(y, x) - math.atan2(a2 * math.sin(q2), a1 + a2 * math.cos(q2))
+            assert any(wrapped_close(s, [q1, q2], 1e-9) for s in sols)
+
+
+def test_planar_2r_ignores_the_rotation_but_not_z(generated):
+    m = generated("planar_2r")
+    T = m.fk(np.radians([30.0, 40.0]))
+    T[:3, :3] = np.eye(3)
+    assert len(m.ik(T)) == 2
+    T[2, 3] = 1e-3
+    assert len(m.ik(T)) == 0
+    assert len(m.ik(T, tol=1e-2)) == 2
+    assert "x and y" in m.__doc__
+
+
+def test_scara_rrpr_round_trips(tmp_path):
+    rows = [(0.0, 0.325, 0.4, 0.0), (0.0, 0.275, 0.0, 0.0), (0.0, 0.0, 0.0, 0.0),
+            (0.0, 0.0, 0.05, 0.0)]
+    text = spec_text("scara", "standard", rows, kinds="RRPR")
+    text = text.replace('type = "P"\n', 'type = "P"\nlimits = [-0.2, 0.0]\n')
+    m = build_module(text, tmp_path)
+    assert "SCARA" in m.__doc__
+    check(m, np.random.default_rng(9), 300)
+
+
+def test_arm_no_method_covers_gets_a_one_line_reason():
+    rows = [(90.0, 0.3, 0.1, 0.0), (1.0, 1.0, 0.0, 0.0), (90.0, 0.0, 0.2, 0.0),
+            (1.0, 1.5, 0.0, 0.0), (90.0, 0.0, 0.0, 0.0), (1.0, 0.0, 0.0, 0.0)]
+    plan = build_plan(parse_spec(spec_text("general6r", "standard", rows)))
+    assert plan.ik is None
+    assert "Pieper: neither axes 4, 5, 6 nor axes 1, 2, 3 meet in a point" in plan.refusal
+    assert "\n" not in plan.refusal
