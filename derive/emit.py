@@ -199,6 +199,7 @@ class PrintedModule:
     qref_names: str
     rotation_entries: str
     position_entries: str
+    components: str
 
 
 def print_plan(plan: Plan) -> PrintedModule:
@@ -238,6 +239,7 @@ def print_plan(plan: Plan) -> PrintedModule:
         qref_names=", ".join(f"qr{i}" for i in range(1, arm.dof + 1)),
         rotation_entries="()" if ik and ik.certify == "position" else "(0, 1, 2, 4, 5, 6, 8, 9, 10)",
         position_entries="(3, 7, 11)",
+        components=ik.certify if ik else "",
     )
 
 

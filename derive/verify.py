@@ -99,9 +99,14 @@ def sample_joints(module: ModuleType, n: int, rng: np.random.Generator,
 
 
 def pose_error(module: ModuleType, q: np.ndarray, T: np.ndarray) -> tuple[float, float]:
-    """(rotation error in rad, position error / REACH) of fk(q) against T."""
+    """(rotation error in rad, position error / REACH) of fk(q) against T.
+
+    For a solver of the position only (IK_COMPONENTS == "position") the rotation error is 0.
+    """
     P = module.fk(q)
     rot = float(np.abs(P[:3, :3] - T[:3, :3]).max())
+    if module.IK_COMPONENTS == "position":
+        rot = 0.0
     pos = float(np.abs(P[:3, 3] - T[:3, 3]).max()) / module.REACH
     return rot, pos
 
@@ -109,7 +114,8 @@ def pose_error(module: ModuleType, q: np.ndarray, T: np.ndarray) -> tuple[float,
 def jacobian_nullity(module: ModuleType, q: np.ndarray) -> tuple[float, np.ndarray]:
     """Smallest singular value of the normalised Jacobian at q and its right singular vector.
 
-    Columns are central differences of fk (rotation entries, and position / REACH).
+    Columns are central differences of fk (rotation entries, and position / REACH); only the
+    position rows for a solver of the position (IK_COMPONENTS == "position").
     """
     h = 1e-6
     cols = []
@@ -118,7 +124,7 @@ def jacobian_nullity(module: ModuleType, q: np.ndarray) -> tuple[float, np.ndarr
         step[j] = h if module.JOINT_TYPES[j] == "R" else h * module.REACH
         d = (module.fk(q + step) - module.fk(q - step)) / (2 * h)
         d[:3, 3] /= module.REACH
-        cols.append(d[:3, :].ravel())
+        cols.append(d[:3, 3] if module.IK_COMPONENTS == "position" else d[:3, :].ravel())
     J = np.array(cols).T
     _, sigma, vt = np.linalg.svd(J)
     if len(sigma) < module.DOF:

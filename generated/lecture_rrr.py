@@ -157,6 +157,8 @@ def fk_batch(Q):
     return out
 
 
+# "pose": solutions reproduce the whole pose; "position": the tool point only.
+IK_COMPONENTS = "pose"
 CERTIFY_TOL = 1e-6
 POSE_TOL = 1e-6
 DEDUP_TOL = 1e-6

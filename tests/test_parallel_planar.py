@@ -159,3 +159,10 @@ def test_arm_no_method_covers_gets_a_one_line_reason():
     assert plan.ik is None
     assert "Pieper: neither axes 4, 5, 6 nor axes 1, 2, 3 meet in a point" in plan.refusal
     assert "\n" not in plan.refusal
+
+
+@pytest.mark.parametrize("name", ["lecture_rrr", "planar_2r"])
+def test_planar_bundled_round_trips(generated, name):
+    m = generated(name)
+    result = check(m, np.random.default_rng(12), 400)
+    assert result.singular_found == result.singular
