@@ -20,6 +20,8 @@ from types import ModuleType
 
 from derive.emit import render_module
 from derive.pipeline import build_plan
+from derive.plan import Plan
+from derive.report import Example, render_report
 from derive.spec import ArmSpec, SpecError, load_spec
 
 DEFAULT_OUT = "generated"
@@ -49,10 +51,30 @@ def resolve_spec(text: str) -> ArmSpec:
     raise UsageError(f"{text}: no such spec file or bundled arm; bundled arms: {names}")
 
 
-def outputs_for(spec: ArmSpec) -> dict[str, str]:
-    """File name -> content of everything generated for one arm."""
+def outputs_for(spec: ArmSpec) -> tuple[Plan, dict[str, str]]:
+    """The plan and file name -> content of everything generated for one arm."""
     plan = build_plan(spec)
-    return {f"{spec.name}.py": render_module(plan)}
+    module_source = render_module(plan)
+    report = render_report(plan, worked_example(plan, import_source(spec.name, module_source)))
+    return plan, {f"{spec.name}.py": module_source, f"{spec.name}.md": report}
+
+
+def worked_example(plan: Plan, module: ModuleType) -> Example:
+    """The report's example: the spec's pose, or fk of its joint values, and the solutions."""
+    import numpy as np
+
+    arm = plan.arm
+    if arm.example_pose is not None:
+        pose = np.array(arm.example_pose).reshape(4, 4)
+        how = "the world pose given in the spec's [example]"
+    else:
+        pose = module.fk(list(arm.example_q))
+        shown = ", ".join(f"{math.degrees(v):g}" if t == "R" else f"{v:g}"
+                          for v, t in zip(arm.example_q, arm.joint_types))
+        how = f"the pose of q = ({shown}) (degrees for R joints)"
+    solutions = module.ik(pose) if hasattr(module, "ik") else ()
+    return Example(tuple(float(v) for v in pose.ravel()),
+                   tuple(tuple(float(v) for v in row) for row in solutions), how)
 
 
 def write_atomic(path: Path, text: str) -> None:
@@ -88,8 +110,7 @@ def cmd_generate(args: argparse.Namespace) -> int:
         start = time.perf_counter()
         try:
             spec = resolve_spec(text)
-            plan = build_plan(spec)
-            files = {f"{spec.name}.py": render_module(plan)}
+            plan, files = outputs_for(spec)
             for name, content in files.items():
                 write_atomic(out / name, content)
         except (SpecError, UsageError, OSError) as exc:
@@ -120,7 +141,7 @@ def cmd_check(args: argparse.Namespace) -> int:
     expected: dict[str, str] = {}
     with tempfile.TemporaryDirectory() as tmp:
         for spec in specs:
-            for name, content in outputs_for(spec).items():
+            for name, content in outputs_for(spec)[1].items():
                 write_atomic(Path(tmp) / name, content)
         for path in sorted(Path(tmp).iterdir()):
             expected[path.name] = path.read_text(encoding="utf-8")
@@ -155,12 +176,16 @@ def cmd_check(args: argparse.Namespace) -> int:
 
 
 def load_module(spec: ArmSpec) -> ModuleType:
-    """Generate an arm's module into a temporary folder and import it."""
-    content = render_module(build_plan(spec))
+    """Generate an arm's module and import it."""
+    return import_source(spec.name, render_module(build_plan(spec)))
+
+
+def import_source(name: str, content: str) -> ModuleType:
+    """Import generated module source through a temporary file."""
     with tempfile.TemporaryDirectory() as tmp:
-        path = Path(tmp) / f"{spec.name}.py"
+        path = Path(tmp) / f"{name}.py"
         path.write_text(content, encoding="utf-8")
-        loader_spec = importlib.util.spec_from_file_location(f"derive_ik_{spec.name}", path)
+        loader_spec = importlib.util.spec_from_file_location(f"derive_ik_{name}", path)
         module = importlib.util.module_from_spec(loader_spec)
         loader_spec.loader.exec_module(module)
     return module
@@ -256,11 +281,24 @@ def cmd_bench(args: argparse.Namespace) -> int:
     return 0
 
 
+def cmd_report(args: argparse.Namespace) -> int:
+    """Write (or print) the derivation report of one arm."""
+    spec = resolve_spec(args.arm)
+    plan = build_plan(spec)
+    module = import_source(spec.name, render_module(plan))
+    text = render_report(plan, worked_example(plan, module), args.format)
+    if args.output:
+        write_atomic(Path(args.output), text)
+    else:
+        sys.stdout.write(text)
+    return 0
+
+
 def parser() -> argparse.ArgumentParser:
     """The argument parser of `derive`."""
     top = argparse.ArgumentParser(prog="derive", description="Closed-form IK solvers from DH tables.")
     sub = top.add_subparsers(dest="command", required=True)
-    gen = sub.add_parser("generate", help="write generated/<name>.py for each arm")
+    gen = sub.add_parser("generate", help="write generated/<name>.py and <name>.md for each arm")
     gen.add_argument("specs", nargs="*", help="spec files or bundled arm names (default: all bundled)")
     gen.add_argument("--out", default=DEFAULT_OUT, help="output folder (default ./generated)")
     gen.add_argument("--require-ik", action="store_true", help="exit 3 if an arm has no IK method")
@@ -281,6 +319,11 @@ def parser() -> argparse.ArgumentParser:
     group.add_argument("--q", nargs="+", help="solve the pose of these joint values")
     solve.add_argument("--rad", action="store_true", help="--q values are in radians")
     solve.set_defaults(run=cmd_solve)
+    report = sub.add_parser("report", help="the derivation, lecture style (Markdown or LaTeX)")
+    report.add_argument("arm", help="spec file or bundled arm name")
+    report.add_argument("--format", choices=("md", "tex"), default="md", help="md (default) or tex")
+    report.add_argument("-o", "--output", help="write to this file (default: standard output)")
+    report.set_defaults(run=cmd_report)
     bench = sub.add_parser("bench", help="time generation and solvers; round-trip figures")
     bench.add_argument("specs", nargs="*", help="spec files or bundled arm names (default: all)")
     bench.add_argument("--samples", type=int, default=10000, help="round-trip samples (10000)")

@@ -11,7 +11,7 @@ from derive.classify import Structure, classify
 from derive.methods import parallel, pieper, planar
 from derive.plan import ArmInfo, IkPlan, Plan
 from derive.spec import ArmSpec
-from derive.transforms import Chain, chain_from_spec, world_transform
+from derive.transforms import Chain, chain_from_spec, frame_matrix, link_transform, world_transform
 
 # Tried in order; each returns a plan, or a one-line reason why it does not apply.
 METHODS = (pieper.derive, parallel.derive, planar.derive)
@@ -26,6 +26,7 @@ def build_plan(spec: ArmSpec) -> Plan:
         arm=arm_info(spec, chain),
         structure=structure.describe(chain.dof),
         fk_pose=world_transform(chain, expand=False),
+        links=tuple(link_transform(chain, i) for i in range(1, chain.dof + 1)),
         joint_defs=joint_definitions(chain),
         ik=ik,
         refusal=refusal,
@@ -73,6 +74,13 @@ def arm_info(spec: ArmSpec, chain: Chain) -> ArmInfo:
                  if j.kind == "P" and math.isfinite(lo) and math.isfinite(hi))
     for frame in (chain.base, chain.tool):
         reach += sum(abs(float(v)) for v in frame[:3, 3])
+    example_q = None
+    example_pose = None
+    if spec.example_pose is not None:
+        example_pose = tuple(float(v) for v in frame_matrix(spec.example_pose, spec.angle_unit))
+    else:
+        values = spec.example_q or tuple(20.0 if j.kind == "R" else 0.0 for j in spec.joints)
+        example_q = tuple(to_rad(v) if j.kind == "R" else v for v, j in zip(values, spec.joints))
     return ArmInfo(
         name=spec.name,
         digest=spec.digest(),
@@ -85,4 +93,6 @@ def arm_info(spec: ArmSpec, chain: Chain) -> ArmInfo:
         base=tuple(float(v) for v in chain.base),
         tool=tuple(float(v) for v in chain.tool),
         reach=max(reach, 1e-12),
+        example_q=example_q,
+        example_pose=example_pose,
     )

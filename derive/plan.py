@@ -46,6 +46,8 @@ class ArmInfo:
         tool: 16 floats, row-major.
         reach: characteristic length of the arm (sum of |a| and |d| and the frame offsets),
             used to scale position tolerances.
+        example_q: joint values of the worked example (radians / length), or None.
+        example_pose: world pose of the worked example (16 floats, row-major), or None.
     """
 
     name: str
@@ -59,6 +61,8 @@ class ArmInfo:
     base: tuple[float, ...]
     tool: tuple[float, ...]
     reach: float
+    example_q: tuple[float, ...] | None = None
+    example_pose: tuple[float, ...] | None = None
 
     @property
     def dof(self) -> int:
@@ -134,6 +138,7 @@ class Plan:
         arm: the arm's numeric description.
         structure: structure facts found by classification, e.g. "spherical wrist at joints 4-6".
         fk_pose: world pose B 0_nT E as a 4x4 matrix in c_i, s_i (R) and d_i (P).
+        links: the link transforms (i-1)_iT in the spec's convention, in c_i, s_i and d_i.
         joint_defs: (symbol, expression in q_i) defining theta_i or d_i for each joint.
         ik: the IK plan, or None when no method applies.
         refusal: why no IK method applies (one line), or "" when ik is set.
@@ -142,6 +147,7 @@ class Plan:
     arm: ArmInfo
     structure: tuple[str, ...]
     fk_pose: sp.Matrix
+    links: tuple[sp.Matrix, ...]
     joint_defs: tuple[tuple[sp.Symbol, sp.Expr], ...]
     ik: IkPlan | None
     refusal: str = ""

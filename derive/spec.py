@@ -21,6 +21,8 @@ Spec format (all keys other than those listed are errors)::
     limits = [-160.0, 160.0]    # optional
     [base]                      # optional: matrix = 4x4, or translation (+ rpy)
     [tool]                      # optional: same keys
+    [example]                   # optional: the report's worked example: q = [...] (joint
+                                # values in the spec's units), or a world pose given like base
 """
 
 from __future__ import annotations
@@ -38,7 +40,7 @@ NAME_PATTERN = re.compile(r"[a-z][a-z0-9_]*")
 NAME_MAX = 64
 MAX_JOINTS = 12
 RIGID_TOL = 1e-9
-TOP_KEYS = ("name", "convention", "angle_unit", "length_unit", "joint", "base", "tool")
+TOP_KEYS = ("name", "convention", "angle_unit", "length_unit", "joint", "base", "tool", "example")
 JOINT_KEYS = ("type", "alpha", "a", "d", "theta", "limits")
 FRAME_KEYS = ("matrix", "translation", "rpy")
 
@@ -95,6 +97,8 @@ class ArmSpec:
         joints: the DH rows in order.
         base: frame 0 in the world, or None.
         tool: tool frame in the last link frame, or None.
+        example_q: joint values of the report's worked example (spec units), or None.
+        example_pose: world pose of the worked example, or None (then example_q or a default).
         source: the file the spec came from (for messages), or "<memory>".
     """
 
@@ -105,6 +109,8 @@ class ArmSpec:
     joints: tuple[Joint, ...]
     base: Frame | None
     tool: Frame | None
+    example_q: tuple[float, ...] | None = None
+    example_pose: Frame | None = None
     source: str = "<memory>"
 
     @property
@@ -136,6 +142,7 @@ class ArmSpec:
             ],
             "base": frame(self.base),
             "tool": frame(self.tool),
+            "example": {"q": self.example_q, "pose": frame(self.example_pose)},
         }
 
     def digest(self) -> str:
@@ -214,7 +221,23 @@ def _validate(data: dict, where: str) -> ArmSpec:
     joints = tuple(_joint(row, where, i + 1) for i, row in enumerate(rows))
     base = _frame(data.get("base"), where, "base", angle_unit)
     tool = _frame(data.get("tool"), where, "tool", angle_unit)
-    return ArmSpec(name, convention, angle_unit, length_unit, joints, base, tool, where)
+    example_q, example_pose = _example(data.get("example"), where, len(joints))
+    return ArmSpec(name, convention, angle_unit, length_unit, joints, base, tool,
+                   example_q, example_pose, where)
+
+
+def _example(table: object, where: str, dof: int) -> tuple[tuple[float, ...] | None,
+                                                            Frame | None]:
+    if table is None:
+        return None, None
+    if not isinstance(table, dict):
+        raise SpecError(f"{where}: example: must be a table with `q`, or a pose (`matrix`, or "
+                        "`translation` and optional `rpy`)")
+    if "q" in table:
+        if len(table) != 1:
+            raise SpecError(f"{where}: example: give either `q` or a pose, not both")
+        return _numbers(table["q"], where, "example.q", dof), None
+    return None, _frame(table, where, "example", "")
 
 
 def _no_unknown_keys(table: dict, allowed: tuple[str, ...], where: str, prefix: str) -> None:

@@ -28,7 +28,7 @@ def test_generate_writes_module_and_reports_structure(tmp_path, capsys):
     line = capsys.readouterr().out.strip()
     assert line.startswith("user_arm: spherical wrist at joints 4-6; IK pieper")
     assert line.endswith(" s")
-    assert [p.name for p in (tmp_path / "out").iterdir()] == ["user_arm.py"]
+    assert sorted(p.name for p in (tmp_path / "out").iterdir()) == ["user_arm.md", "user_arm.py"]
 
 
 def test_bad_spec_exits_2_without_traceback_or_file(tmp_path):
@@ -51,7 +51,7 @@ def test_failure_part_way_keeps_earlier_files(tmp_path, capsys):
     err = capsys.readouterr().err
     assert "failed: " in err and str(bad) in err
     assert (out / "user_arm.py").is_file()
-    assert [p.name for p in out.iterdir()] == ["user_arm.py"]
+    assert sorted(p.name for p in out.iterdir()) == ["user_arm.md", "user_arm.py"]
 
 
 def test_unknown_arm_name_exits_2(capsys):

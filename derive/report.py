@@ -1,0 +1,322 @@
+"""plan -> derivation report: Markdown with LaTeX math, or a standalone LaTeX document.
+
+The report is built from the same plan as the solver module, in the lecture's order: the DH
+table and link transforms, the structure and the method, the method's derivation (for
+Pieper: f, g, k1..k4, r and z, the case, the polynomial), every step of the plan as an
+equation, and a worked example whose numbers come from walking the plan along one branch of
+the generated solver's own solutions. Every formula is printed by SymPy's LaTeX printer.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+import sympy as sp
+
+from derive import symbols as sym
+from derive.emit import GENERATOR, environment
+from derive.plan import Assign, Plan, Solve
+
+DIGITS = 4
+CRAIG = "Craig's"
+
+
+@dataclass(frozen=True)
+class Block:
+    """One piece of the report.
+
+    Attributes:
+        kind: "h2", "h3", "p" (text), "math" (lhs = rhs, display) or "table".
+        text: the text, or the math block's left-hand side (LaTeX, may be empty).
+        math: the math block's right-hand side, printed by SymPy.
+        rows: the table's rows, the first one its header.
+    """
+
+    kind: str
+    text: str = ""
+    math: str = ""
+    rows: tuple[tuple[str, ...], ...] = ()
+
+
+@dataclass(frozen=True)
+class Example:
+    """The worked example: a world pose and the generated solver's solutions for it.
+
+    Attributes:
+        pose: 16 floats, row-major.
+        solutions: the rows `ik` returned.
+        how: where the pose comes from, in words.
+    """
+
+    pose: tuple[float, ...]
+    solutions: tuple[tuple[float, ...], ...]
+    how: str
+
+
+def tex(expr: sp.Basic) -> str:
+    """LaTeX of an expression, rationals shown as decimals, general twists as cos/sin(alpha_i)."""
+    subs = {}
+    for i in range(0, 13):
+        alpha = sp.Symbol(f"alpha_{i}", real=True)
+        subs[sym.cos_alpha(i)] = sp.cos(alpha)
+        subs[sym.sin_alpha(i)] = sp.sin(alpha)
+    expr = sp.sympify(expr).xreplace(subs)
+    expr = expr.xreplace({r: sp.Float(float(r), 15) for r in expr.atoms(sp.Rational)
+                          if not r.is_Integer})
+    return sp.latex(expr)
+
+
+def number(value: float) -> str:
+    """A number rounded for the worked example."""
+    text = f"{value:.{DIGITS}f}"
+    return "0.0000" if text == "-0.0000" else text
+
+
+def matrix_of(values: np.ndarray) -> str:
+    """A numeric matrix as LaTeX via SymPy, rounded to DIGITS decimals."""
+    rows = [[sp.Float(round(float(v), DIGITS), DIGITS + 3) for v in row] for row in values]
+    return tex(sp.Matrix(rows))
+
+
+def arm_blocks(plan: Plan) -> list[Block]:
+    """The DH table, the convention's link transform, base and tool."""
+    arm = plan.arm
+    modified = arm.convention == "modified"
+    general = ("R_X(\\alpha_{i-1}) D_X(a_{i-1}) R_Z(\\theta_i) D_Z(d_i)" if modified
+               else "R_Z(\\theta_i) D_Z(d_i) D_X(a_i) R_X(\\alpha_i)")
+    head = ("alpha_{i-1} [deg]", "a_{i-1}") if modified else ("alpha_i [deg]", "a_i")
+    rows = [("i", "type", head[0], head[1], "d_i", "theta_i [deg]")]
+    for k, (alpha, a, d, theta) in enumerate(arm.dh, start=1):
+        kind = arm.joint_types[k - 1]
+        rows.append((str(k), kind, f"{math.degrees(alpha):g}", f"{a:g}",
+                     f"q{k} + {d:g}" if kind == "P" else f"{d:g}",
+                     f"q{k} + {math.degrees(theta):g}" if kind == "R" else
+                     f"{math.degrees(theta):g}"))
+    out = [
+        Block("h2", "1. The arm"),
+        Block("p", f"{arm.convention.capitalize()} DH parameters (lengths in {arm.length_unit}); "
+              f"the link transform is {CRAIG if modified else 'the standard one'}, "
+              f"${{}}^{{i-1}}_{{i}}T = {general}$:"),
+        Block("table", rows=tuple(rows)),
+    ]
+    base = np.array(arm.base).reshape(4, 4)
+    tool = np.array(arm.tool).reshape(4, 4)
+    if not np.array_equal(base, np.eye(4)):
+        out.append(Block("math", "{}^{W}_{0}T", matrix_of(base)))
+    if not np.array_equal(tool, np.eye(4)):
+        out.append(Block("math", "{}^{n}_{E}T", matrix_of(tool)))
+    return out
+
+
+def link_blocks(plan: Plan) -> list[Block]:
+    """Every link transform with this arm's numbers, and 0_nT."""
+    out = [Block("h2", "2. Link transforms"),
+           Block("p", "With $c_i = \\cos\\theta_i$, $s_i = \\sin\\theta_i$:")]
+    for k, link in enumerate(plan.links, start=1):
+        out.append(Block("math", f"{{}}^{{{k - 1}}}_{{{k}}}T", tex(link)))
+    total = sp.eye(4)
+    for link in plan.links:
+        total = (total * link).applyfunc(sp.expand)
+    out.append(Block("math", f"{{}}^{{0}}_{{{plan.arm.dof}}}T", tex(total)))
+    return out
+
+
+def method_blocks(plan: Plan) -> list[Block]:
+    """Structure, method, and the method's derivation facts."""
+    out = [Block("h2", "3. Structure and method"),
+           Block("p", "Structure found from the DH table: " + "; ".join(plan.structure) + ".")]
+    if plan.ik is None:
+        out.append(Block("p", f"No closed-form method applies: {plan.refusal}."))
+        return out
+    ik = plan.ik
+    out.append(Block("p", f"Method: {ik.method}; case: {ik.case}. At most {ik.max_solutions} "
+                     f"solutions; the solver is defined on {ik.solves_for}."))
+    details = dict(ik.details)
+    if "general_f1" in details:
+        out.append(Block("h3", "Pieper's functions, general form (lecture, Pieper -2 to -4)"))
+        for name in ("f1", "f2", "f3", "g1", "g2", "g3", "k1", "k2", "k3", "k4"):
+            out.append(Block("math", f"{name[0]}_{{{name[1]}}}", tex(details[f"general_{name}"])))
+        out.append(Block("h3", "With this arm's numbers"))
+        out.append(Block("math", "f", tex(sp.Matrix([details[k] for k in ("f1", "f2", "f3")]))))
+        out.append(Block("math", "g", tex(sp.Matrix([details[k] for k in ("g1", "g2", "g3")]))))
+        for name in ("k1", "k2", "k3", "k4"):
+            out.append(Block("math", f"k_{{{name[1]}}}", tex(details[name])))
+        out.append(Block("p", "$r = x^2 + y^2 + z^2 = 2 a_1 (k_1 c_2 + k_2 s_2) + k_3$ and "
+                         "$z = \\sin\\alpha_1 (k_1 s_2 - k_2 c_2) + k_4$; the case's equation, "
+                         "reduced with $s_3^2 = 1 - c_3^2$:"))
+        out.append(Block("math", "0", tex(details["joint3_equation"])))
+    return out
+
+
+def step_blocks(plan: Plan) -> list[Block]:
+    """Every step of the plan as the equation it solves, in order."""
+    assert plan.ik is not None
+    out = [Block("h2", "4. The solution, step by step"),
+           Block("p", "Each step below is one block of the generated `ik`; a step that solves a "
+                 "joint is a loop over its values.")]
+    for step in plan.ik.steps:
+        out.append(Block("h3", step.note))
+        if isinstance(step, Assign):
+            for target, expr in zip(step.targets, step.exprs):
+                out.append(Block("math", tex(target), tex(expr)))
+            continue
+        for lhs, rhs in solve_equations(step):
+            out.append(Block("math", lhs, rhs))
+    return out
+
+
+def joint_symbol(step: Solve) -> sp.Symbol:
+    """theta_j, or d_j for a prismatic joint's step."""
+    return sym.d(step.joint) if step.kind == "polyd" else sym.theta(step.joint)
+
+
+def solve_equations(step: Solve) -> list[tuple[str, str]]:
+    """The equation(s) a Solve step solves, as (lhs, rhs) LaTeX pairs."""
+    t = joint_symbol(step)
+    c, s = sp.cos(t), sp.sin(t)
+    a = step.args
+    if step.kind == "cs1":
+        return [(tex(a[0] * c + a[1] * s), tex(a[2]))]
+    if step.kind in ("cs2", "cs2r"):
+        return [(tex(a[0] * c + a[1] * s), tex(a[2])), (tex(a[3] * c + a[4] * s), tex(a[5]))]
+    if step.kind == "atan2":
+        return [(tex(sp.tan(t)), tex(a[0] / a[1]))]
+    var = sym.named("u") if step.kind == "poly" else t
+    degree = len(a) - 1
+    return [(tex(sum(cf * var ** (degree - k) for k, cf in enumerate(a))), "0")]
+
+
+def walk(plan: Plan, pose: np.ndarray, q: tuple[float, ...]) -> list[tuple[str, str]]:
+    """Every intermediate number of the plan along the branch of solution q.
+
+    Assignments are evaluated in order; each Solve step takes its joint's value from q (the
+    solver's own result), so the numbers shown are the ones the solver computed.
+    """
+    assert plan.ik is not None
+    env: dict[sp.Symbol, float] = {}
+    world = sym.world_pose()
+    for i in range(3):
+        for j in range(4):
+            env[world[i, j]] = float(pose[i, j])
+    values = plan_values(plan, q)
+    lines = []
+    for step in plan.ik.steps:
+        if isinstance(step, Assign):
+            for target, expr in zip(step.targets, step.exprs):
+                env[target] = float(expr.xreplace(env))
+                lines.append((tex(target), number(env[target])))
+            continue
+        args = [float(a.xreplace(env)) for a in step.args]
+        shown = ", ".join(number(x) for x in args)
+        t = joint_symbol(step)
+        value = values[t]
+        env[t] = value
+        if step.kind != "polyd":
+            env[sym.c(step.joint)], env[sym.s(step.joint)] = math.cos(value), math.sin(value)
+            lines.append((f"{tex(t)} / ^\\circ\\ (\\text{{{step.kind}}}: {shown})",
+                          number(math.degrees(value))))
+        else:
+            lines.append((f"{tex(t)}\\ (\\text{{{step.kind}}}: {shown})", number(value)))
+    return lines
+
+
+def plan_values(plan: Plan, q: tuple[float, ...]) -> dict[sp.Symbol, float]:
+    """The plan's joint symbols (theta_j / d_j of possibly reversed chains) for a solution q."""
+    assert plan.ik is not None
+    values = {}
+    for qi, out in zip(q, plan.ik.outputs):
+        (var,) = sorted(out.free_symbols, key=sp.default_sort_key)
+        coeff = out.coeff(var)
+        values[var] = float((qi - out.xreplace({var: 0})) / coeff)
+    return values
+
+
+def example_blocks(plan: Plan, example: Example) -> list[Block]:
+    """The worked example: pose, flange target, one branch's numbers, all solutions."""
+    arm = plan.arm
+    pose = np.array(example.pose).reshape(4, 4)
+    base, tool = np.array(arm.base).reshape(4, 4), np.array(arm.tool).reshape(4, 4)
+    flange = np.linalg.inv(base) @ pose @ np.linalg.inv(tool)
+    out = [Block("h2", "5. Worked example"),
+           Block("p", f"The target is {example.how}:"),
+           Block("math", "T", matrix_of(pose)),
+           Block("math", f"{{}}^{{0}}_{{{arm.dof}}}T = ({{}}^{{W}}_{{0}}T)^{{-1}} T "
+                 f"({{}}^{{{arm.dof}}}_{{E}}T)^{{-1}}", matrix_of(flange))]
+    if plan.ik is None:
+        return out
+    if not example.solutions:
+        out.append(Block("p", "The pose is out of reach: no solution."))
+        return out
+    first = example.solutions[0]
+    out.append(Block("p", "Every intermediate quantity along the first solution's branch "
+                     "(solve steps show their numeric arguments):"))
+    out += [Block("math", lhs, rhs) for lhs, rhs in walk(plan, pose, first)]
+    if arm.dof == 6:
+        out += wrist_matrices(plan, first, flange)
+    rows = [("#",) + tuple(f"q{k + 1}" + (" [deg]" if t == "R" else "")
+                           for k, t in enumerate(arm.joint_types))]
+    for n, sol in enumerate(example.solutions, start=1):
+        rows.append((str(n),) + tuple(number(math.degrees(v)) if t == "R" else number(v)
+                                      for v, t in zip(sol, arm.joint_types)))
+    out.append(Block("p", f"All {len(example.solutions)} solutions, each certified by forward "
+                     "kinematics:"))
+    out.append(Block("table", rows=tuple(rows)))
+    return out
+
+
+def wrist_matrices(plan: Plan, q: tuple[float, ...], flange: np.ndarray) -> list[Block]:
+    """0_3R and 3_6R = 0_3R^T 0_6R at solution q (lecture, Pieper -5)."""
+    subs = {}
+    for k, ((_, expr), kind) in enumerate(zip(plan.joint_defs, plan.arm.joint_types)):
+        value = float(expr.xreplace({sym.q(k + 1): q[k]}))
+        if kind == "R":
+            subs[sym.c(k + 1)], subs[sym.s(k + 1)] = math.cos(value), math.sin(value)
+        else:
+            subs[sym.d(k + 1)] = value
+    t03 = sp.eye(4)
+    for link in plan.links[:3]:
+        t03 = t03 * link
+    r03 = np.array(t03[:3, :3].xreplace(subs).evalf(), dtype=float)
+    return [Block("math", "{}^{0}_{3}R", matrix_of(r03)),
+            Block("math", "{}^{3}_{6}R = ({}^{0}_{3}R)^T {}^{0}_{6}R", matrix_of(r03.T @ flange[:3, :3]))]
+
+
+def report_blocks(plan: Plan, example: Example) -> tuple[Block, ...]:
+    """All blocks of the report, in order."""
+    blocks = arm_blocks(plan) + link_blocks(plan) + method_blocks(plan)
+    if plan.ik is not None:
+        blocks += step_blocks(plan)
+    return tuple(blocks + example_blocks(plan, example))
+
+
+TEX_SPECIALS = {"\\": "\\textbackslash{}", "_": "\\_", "^": "\\^{}", "#": "\\#",
+                "%": "\\%", "&": "\\&", "{": "\\{", "}": "\\}", "~": "\\~{}"}
+
+
+def latex_text(text: str) -> str:
+    """Text for LaTeX: specials escaped outside $...$ (inline math is kept as it is)."""
+    parts = text.split("$")
+    for k in range(0, len(parts), 2):
+        parts[k] = "".join(TEX_SPECIALS.get(ch, ch) for ch in parts[k])
+    return "$".join(parts)
+
+
+def for_tex(block: Block) -> Block:
+    """A block whose plain text is escaped for LaTeX."""
+    if block.kind in ("h2", "h3", "p"):
+        return Block(block.kind, latex_text(block.text))
+    if block.kind == "table":
+        return Block("table", rows=tuple(tuple(latex_text(c) for c in r) for r in block.rows))
+    return block
+
+
+def render_report(plan: Plan, example: Example, fmt: str = "md") -> str:
+    """The report as Markdown ("md") or a standalone LaTeX document ("tex")."""
+    blocks = report_blocks(plan, example)
+    if fmt == "tex":
+        blocks = tuple(for_tex(b) for b in blocks)
+    template = environment().get_template(f"report.{fmt}.j2")
+    return template.render(name=plan.arm.name, name_tex=latex_text(plan.arm.name),
+                           digest=plan.arm.digest, generator=GENERATOR, blocks=blocks)
