@@ -86,27 +86,33 @@ def assign_lines(targets: tuple[sp.Symbol, ...], exprs: tuple[sp.Expr, ...],
     return lines
 
 
-def fk_lines(plan: Plan, printer: CodePrinter, columns: bool) -> tuple[tuple[str, ...], tuple[str, ...]]:
-    """Body of the scalar or vectorised FK: joint definitions, trig, CSE'd pose entries.
+def fk_pose_lines(plan: Plan) -> tuple[tuple[str, ...], tuple[str, ...]]:
+    """Body of _fk_from_cs: the CSE'd pose entries in c_i, s_i (and d_i of prismatic joints).
 
-    Args:
-        plan: the arm's plan.
-        printer: scalar (``math``) or vector (``np.``) printer.
-        columns: read joint k as ``Q[:, k]`` (vectorised) instead of ``q[k]``.
+    The lines hold only arithmetic, so the same text serves scalars and numpy arrays.
 
     Returns:
-        (the body's lines, the 12 names holding the top three rows of the pose).
+        (the lines, the 12 names holding the top three rows of the pose).
     """
     names = sp.numbered_symbols("x")
-    lines = _joint_lines(plan, printer, columns)
     pose = plan.fk_pose
     entries = [pose[i, j] for i in range(3) for j in range(4)]
     targets = tuple(sym.named(f"t{i}{j}") for i in range(3) for j in range(4))
-    lines += [ln.text for ln in assign_lines(targets, tuple(entries), names, printer, 0)]
+    lines = [ln.text for ln in assign_lines(targets, tuple(entries), names, CodePrinter(), 0)]
     return tuple(lines), tuple(str(t) for t in targets)
 
 
-def _joint_lines(plan: Plan, printer: CodePrinter, columns: bool) -> list[str]:
+def cs_arguments(plan: Plan) -> str:
+    """The arguments of _fk_from_cs: c1, s1, ... for R joints, d_i for P joints, in order."""
+    out = []
+    for target, _ in plan.joint_defs:
+        name = str(target)
+        out += [f"c{name[5:]}", f"s{name[5:]}"] if name.startswith("theta") else [name]
+    return ", ".join(out)
+
+
+def fk_joint_lines(plan: Plan, printer: CodePrinter, columns: bool) -> tuple[str, ...]:
+    """theta_i = q_i + offset with c_i, s_i (or d_i = q_i + offset) from q or from Q's columns."""
     lines = []
     for k, (target, expr) in enumerate(plan.joint_defs):
         source = f"Q[:, {k}]" if columns else f"q[{k}]"
@@ -116,7 +122,24 @@ def _joint_lines(plan: Plan, printer: CodePrinter, columns: bool) -> list[str]:
             i = k + 1
             lines.append(f"c{i} = {printer.prefix}cos({target})")
             lines.append(f"s{i} = {printer.prefix}sin({target})")
-    return lines
+    return tuple(lines)
+
+
+def same_joints(plan: Plan) -> bool:
+    """The plan's theta_i / d_i are the arm's (not a reversed chain's): q_i = theta_i - offset."""
+    assert plan.ik is not None
+    for (target, _), out in zip(plan.joint_defs, plan.ik.outputs):
+        if out.free_symbols != {target} or out.coeff(target) != 1:
+            return False
+    return True
+
+
+def match_expression(certify: str) -> str:
+    """The certification test of entries e against target t, unrolled."""
+    rotation = () if certify == "position" else (0, 1, 2, 4, 5, 6, 8, 9, 10)
+    tests = [f"abs(e[{k}] - t[{k}]) <= tol" for k in rotation]
+    tests += [f"abs(e[{k}] - t[{k}]) <= ptol" for k in (3, 7, 11)]
+    return " and ".join(tests)
 
 
 def ik_lines(plan: Plan, printer: CodePrinter) -> tuple[tuple[int, str], ...]:
@@ -133,7 +156,12 @@ def ik_lines(plan: Plan, printer: CodePrinter) -> tuple[tuple[int, str], ...]:
         lines += solve_lines(step, names, printer, depth)
         depth += 1
     outputs = ", ".join(printer.doprint(e) for e in plan.ik.outputs)
-    lines.append(Line(depth, f"_keep(found, target, ({outputs},), tol)"))
+    if same_joints(plan):
+        lines.append(Line(depth, f"_keep(found, target, ({outputs},), "
+                                 f"_fk_from_cs({cs_arguments(plan)}), tol)"))
+    else:
+        lines.append(Line(depth, f"q = ({outputs},)"))
+        lines.append(Line(depth, "_keep(found, target, q, _fk_q(q), tol)"))
     return tuple((ln.depth, ln.text) for ln in lines)
 
 
@@ -186,9 +214,11 @@ class PrintedModule:
     base_const: str
     tool_const: str
     reach: str
-    fk_body: tuple[str, ...]
-    fk_batch_body: tuple[str, ...]
+    fk_pose_body: tuple[str, ...]
+    fk_joints: tuple[str, ...]
+    fk_batch_joints: tuple[str, ...]
     fk_outputs: tuple[str, ...]
+    cs_args: str
     has_ik: int
     method: str
     case: str
@@ -197,8 +227,7 @@ class PrintedModule:
     refusal: str
     ik_body: tuple[tuple[int, str], ...]
     qref_names: str
-    rotation_entries: str
-    position_entries: str
+    match: str
     components: str
 
 
@@ -206,8 +235,7 @@ def print_plan(plan: Plan) -> PrintedModule:
     """The printed IR of a plan."""
     arm = plan.arm
     scalar, vector = CodePrinter(), CodePrinter("np.")
-    fk_body, outputs = fk_lines(plan, scalar, columns=False)
-    fk_batch_body, _ = fk_lines(plan, vector, columns=True)
+    fk_pose_body, outputs = fk_pose_lines(plan)
     ik = plan.ik
     offsets = tuple(float(e.subs(sym.q(k + 1), 0)) for k, (_, e) in enumerate(plan.joint_defs))
     return PrintedModule(
@@ -226,9 +254,11 @@ def print_plan(plan: Plan) -> PrintedModule:
         base_const=_tuple_of_tuples(tuple(arm.base[4 * i:4 * i + 4] for i in range(4))),
         tool_const=_tuple_of_tuples(tuple(arm.tool[4 * i:4 * i + 4] for i in range(4))),
         reach=_float(arm.reach),
-        fk_body=fk_body,
-        fk_batch_body=fk_batch_body,
+        fk_pose_body=fk_pose_body,
+        fk_joints=fk_joint_lines(plan, scalar, columns=False),
+        fk_batch_joints=fk_joint_lines(plan, vector, columns=True),
         fk_outputs=outputs,
+        cs_args=cs_arguments(plan),
         has_ik=int(ik is not None),
         method=ik.method if ik else "",
         case=ik.case if ik else "",
@@ -237,8 +267,7 @@ def print_plan(plan: Plan) -> PrintedModule:
         refusal=plan.refusal,
         ik_body=ik_lines(plan, scalar) if ik else (),
         qref_names=", ".join(f"qr{i}" for i in range(1, arm.dof + 1)),
-        rotation_entries="()" if ik and ik.certify == "position" else "(0, 1, 2, 4, 5, 6, 8, 9, 10)",
-        position_entries="(3, 7, 11)",
+        match=match_expression(ik.certify) if ik else "",
         components=ik.certify if ik else "",
     )
 

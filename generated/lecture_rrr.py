@@ -33,8 +33,10 @@ centre on axis 1, a singular wrist) takes its value from q_ref (0 by default) an
 after it absorb the rest: one representative per branch.
 """
 
+import cmath
 import math
 from math import acos, atan2, cos, sin, sqrt
+from operator import sub as _sub
 
 import numpy as np
 
@@ -68,19 +70,12 @@ TOOL = np.array((
 REACH = 1.4
 _OFFSETS = (0.0, 0.0, 0.0)
 _REVOLUTE = (True, True, True)
+_PERIODS = tuple(2.0 * math.pi if r else math.inf for r in _REVOLUTE)
 
 
-def _fk_entries(q):
-    """Top three rows of the world pose, row-major, for one joint vector."""
-    theta1 = q[0]
-    c1 = cos(theta1)
-    s1 = sin(theta1)
-    theta2 = q[1]
-    c2 = cos(theta2)
-    s2 = sin(theta2)
-    theta3 = q[2]
-    c3 = cos(theta3)
-    s3 = sin(theta3)
+def _fk_from_cs(c1, s1, c2, s2, c3, s3):
+    """Top three rows of the world pose, row-major, from cos and sin of the joint angles
+    (and d of prismatic joints); works on floats and on numpy arrays alike."""
     x0 = c1*c2
     x1 = s1*s2
     x2 = x0 - x1
@@ -105,12 +100,26 @@ def _fk_entries(q):
     return (t00, t01, t02, t03, t10, t11, t12, t13, t20, t21, t22, t23)
 
 
+def _fk_q(q):
+    """Top three rows of the world pose for one joint vector (a sequence of floats)."""
+    theta1 = q[0]
+    c1 = cos(theta1)
+    s1 = sin(theta1)
+    theta2 = q[1]
+    c2 = cos(theta2)
+    s2 = sin(theta2)
+    theta3 = q[2]
+    c3 = cos(theta3)
+    s3 = sin(theta3)
+    return _fk_from_cs(c1, s1, c2, s2, c3, s3)
+
+
 def fk(q):
     """World pose of the tool frame (base and tool included) for joint vector q."""
     q = np.asarray(q, dtype=float)
     if q.shape != (DOF,):
         raise ValueError(f"q must have shape ({DOF},), got {q.shape}")
-    e = _fk_entries(q.tolist())
+    e = _fk_q(q.tolist())
     return np.array([e[0:4], e[4:8], e[8:12], (0.0, 0.0, 0.0, 1.0)])
 
 
@@ -128,29 +137,8 @@ def fk_batch(Q):
     theta3 = Q[:, 2]
     c3 = np.cos(theta3)
     s3 = np.sin(theta3)
-    x0 = c1*c2
-    x1 = s1*s2
-    x2 = x0 - x1
-    x3 = c3*x2
-    x4 = c1*s2
-    x5 = c2*s1
-    x6 = x4 + x5
-    x7 = -x6
-    x8 = s3*x2
-    t00 = s3*x7 + x3
-    t01 = c3*x7 - x8
-    t02 = 0.0
-    t03 = c1 + 0.4*x0 - 0.4*x1
-    t10 = c3*x6 + x8
-    t11 = -s3*x6 + x3
-    t12 = 0.0
-    t13 = s1 + 0.4*x4 + 0.4*x5
-    t20 = 0.0
-    t21 = 0.0
-    t22 = 1.0
-    t23 = 0.0
     out = np.zeros((Q.shape[0], 4, 4))
-    entries = (t00, t01, t02, t03, t10, t11, t12, t13, t20, t21, t22, t23)
+    entries = _fk_from_cs(c1, s1, c2, s2, c3, s3)
     for k, value in enumerate(entries):
         out[:, k // 4, k % 4] = value
     out[:, 3, 3] = 1.0
@@ -163,7 +151,10 @@ CERTIFY_TOL = 1e-6
 POSE_TOL = 1e-6
 DEDUP_TOL = 1e-6
 _ROOT_IMAG_TOL = 1e-6
+_RESIDUAL_TOL = 1e-8
+_MERGE_TOL = 1e-7
 _LEAD_TOL = 1e-10
+_OMEGA = (1.0, complex(-0.5, math.sqrt(3.0) / 2.0), complex(-0.5, -math.sqrt(3.0) / 2.0))
 _FREE_TOL = 1e-18
 _TWO_PI = 2.0 * math.pi
 
@@ -220,7 +211,7 @@ def ik(T, *, within_limits=False, q_ref=None, tol=CERTIFY_TOL):
             for theta3 in _atan2(c1*c2*r21 - r11*x0 - r11*x1 - r21*x2, c1*c2*r11 - r11*x2 + r21*x0 + r21*x1, qr3):
                 c3 = cos(theta3)
                 s3 = sin(theta3)
-                _keep(found, target, (theta1, theta2, theta3,), tol)
+                _keep(found, target, (theta1, theta2, theta3,), _fk_from_cs(c1, s1, c2, s2, c3, s3), tol)
     return _finish(found, within_limits)
 
 
@@ -245,20 +236,35 @@ def nearest(T, q_ref, *, within_limits=True, weights=None):
 
 
 def _pose(T):
-    """The 12 top entries of a validated pose, as floats."""
+    """The 12 top entries of a validated pose, as floats (plain Python: this is the hot path)."""
+    if type(T) is np.ndarray and T.shape == (4, 4):
+        v = T.ravel().tolist()
+    else:
+        try:
+            A = np.asarray(T, dtype=float)
+        except (TypeError, ValueError):
+            raise ValueError("T must be a 4x4 array of numbers") from None
+        if A.shape != (4, 4):
+            raise ValueError(f"T must have shape (4, 4), got {A.shape}")
+        v = A.ravel().tolist()
     try:
-        A = np.asarray(T, dtype=float)
+        v = [float(x) for x in v]
     except (TypeError, ValueError):
         raise ValueError("T must be a 4x4 array of numbers") from None
-    if A.shape != (4, 4):
-        raise ValueError(f"T must have shape (4, 4), got {A.shape}")
-    v = A.ravel().tolist()
-    if not all(math.isfinite(x) for x in v):
+    if not all(map(math.isfinite, v)):
         raise ValueError("T has non-finite entries")
     if max(abs(v[12]), abs(v[13]), abs(v[14]), abs(v[15] - 1.0)) > POSE_TOL:
         raise ValueError("T's last row must be [0, 0, 0, 1]")
-    R = np.array([v[0:3], v[4:7], v[8:11]])
-    if np.abs(R.T @ R - np.eye(3)).max() > POSE_TOL or np.linalg.det(R) < 0:
+    a, b, c = v[0:3], v[4:7], v[8:11]
+    worst = max(abs(a[0] * a[0] + a[1] * a[1] + a[2] * a[2] - 1.0),
+                abs(b[0] * b[0] + b[1] * b[1] + b[2] * b[2] - 1.0),
+                abs(c[0] * c[0] + c[1] * c[1] + c[2] * c[2] - 1.0),
+                abs(a[0] * b[0] + a[1] * b[1] + a[2] * b[2]),
+                abs(a[0] * c[0] + a[1] * c[1] + a[2] * c[2]),
+                abs(b[0] * c[0] + b[1] * c[1] + b[2] * c[2]))
+    det = (a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0])
+           + a[2] * (b[0] * c[1] - b[1] * c[0]))
+    if worst > POSE_TOL or det < 0.0:
         raise ValueError(f"T's rotation is not orthonormal within {POSE_TOL}")
     return tuple(v[:12])
 
@@ -272,20 +278,11 @@ def _reference(q_ref):
     return q_ref
 
 
-_ROTATION_ENTRIES = (0, 1, 2, 4, 5, 6, 8, 9, 10)
-_POSITION_ENTRIES = (3, 7, 11)
-
-
-def _keep(found, target, q, tol):
-    """Append q if its forward kinematics reproduces the target (certification)."""
-    e = _fk_entries(q)
-    for k in _ROTATION_ENTRIES:
-        if abs(e[k] - target[k]) > tol:
-            return
-    for k in _POSITION_ENTRIES:
-        if abs(e[k] - target[k]) > tol * REACH:
-            return
-    found.append(q)
+def _keep(found, t, q, e, tol):
+    """Append q if its forward kinematics e reproduces the target t (certification)."""
+    ptol = tol * REACH
+    if abs(e[0] - t[0]) <= tol and abs(e[1] - t[1]) <= tol and abs(e[2] - t[2]) <= tol and abs(e[4] - t[4]) <= tol and abs(e[5] - t[5]) <= tol and abs(e[6] - t[6]) <= tol and abs(e[8] - t[8]) <= tol and abs(e[9] - t[9]) <= tol and abs(e[10] - t[10]) <= tol and abs(e[3] - t[3]) <= ptol and abs(e[7] - t[7]) <= ptol and abs(e[11] - t[11]) <= ptol:
+        found.append(q)
 
 
 def _wrap(x):
@@ -294,24 +291,22 @@ def _wrap(x):
 
 
 def _finish(found, within_limits):
+    """Wrap revolute values to (-pi, pi], drop repeats (DEDUP_TOL), expand limit variants."""
     rows = []
     for q in found:
-        q = tuple(_wrap(x) if r else x for x, r in zip(q, _REVOLUTE))
-        if not any(_same(q, p) for p in rows):
+        q = tuple(map(math.remainder, q, _PERIODS))
+        if -math.pi in q:
+            q = tuple(math.pi if x == -math.pi and p != math.inf else x
+                      for x, p in zip(q, _PERIODS))
+        for p in rows:
+            if (abs(math.remainder(q[-1] - p[-1], _PERIODS[-1])) <= DEDUP_TOL
+                    and max(map(abs, map(math.remainder, map(_sub, q, p), _PERIODS))) <= DEDUP_TOL):
+                break
+        else:
             rows.append(q)
     if within_limits:
         rows = [v for q in rows for v in _limit_variants(q)]
     return np.array(rows, dtype=float).reshape(len(rows), DOF)
-
-
-def _same(q, p):
-    for x, y, r in zip(q, p, _REVOLUTE):
-        d = abs(x - y)
-        if r:
-            d = min(d, _TWO_PI - d)
-        if d > DEDUP_TOL:
-            return False
-    return True
 
 
 def _limit_variants(q):
@@ -388,6 +383,7 @@ def _atan2(y, x, ref):
     return (atan2(y, x),)
 
 
+
 def _poly_real(coeffs):
     """Real roots of the polynomial (highest degree first), polished, ascending, distinct."""
     c = [float(x) for x in coeffs]
@@ -398,8 +394,7 @@ def _poly_real(coeffs):
         c.pop(0)
     if len(c) < 2:
         return ()
-    roots = sorted(_newton(c, z.real) for z in np.roots(c).tolist()
-                   if abs(z.imag) <= _ROOT_IMAG_TOL * (1.0 + abs(z)))
+    roots = sorted(_real_roots(c))
     out = []
     for x in roots:
         if not out or abs(x - out[-1]) > 1e-12 * (1.0 + abs(x)):
@@ -410,42 +405,149 @@ def _poly_real(coeffs):
 def _poly_angles(coeffs):
     """Angles t whose u = tan(t/2) is a real root of the polynomial (highest degree first).
 
-    A vanishing leading coefficient is a root at u = infinity, t = pi (ALGORITHMS.md 2.4).
-    Near-double roots come out of the eigenvalue solver as complex pairs with a small
-    imaginary part; they are accepted and polished by Newton steps. Candidates are certified
+    The polynomial is solved in u, or in v = 1/u when its last coefficient is the larger
+    end, so that a vanishing leading coefficient (a root at u = infinity, t = pi; ALGORITHMS.md
+    2.4) is an ordinary root v = 0. Angles are wrapped to (-pi, pi] (within 1e-12 of +-pi:
+    pi), sorted, and equal ones (1e-12) merged. Near-double roots come out as complex pairs
+    with a small imaginary part; they are accepted and polished. Every candidate is certified
     by forward kinematics afterwards, so a spurious angle costs time, never correctness.
     """
     c = [float(x) for x in coeffs]
-    scale = max(abs(x) for x in c)
-    if scale == 0.0:
+    if max(abs(x) for x in c) == 0.0:
         return ()
+    flip = abs(c[0]) < abs(c[-1])
+    if flip:
+        c.reverse()
     angles = []
-    while len(c) > 1 and abs(c[0]) <= _LEAD_TOL * scale:
+    while c[0] == 0.0:
         c.pop(0)
-        if not angles:
-            angles.append(math.pi)
-    if len(c) > 1:
-        for z in np.roots(c).tolist():
-            if abs(z.imag) <= _ROOT_IMAG_TOL * (1.0 + abs(z)):
-                angles.append(2.0 * math.atan(_polish(c, z.real)))
+        angles.append(0.0 if flip else math.pi)
+    for x in _real_roots(c) if len(c) > 1 else ():
+        angles.append(_wrap_snap(2.0 * atan2(1.0, x) if flip else 2.0 * math.atan(x)))
     angles.sort()
     out = []
     for t in angles:
-        if not out or abs(t - out[-1]) > 1e-12:
+        if not out or t - out[-1] > 1e-12:
             out.append(t)
     return out
 
 
-def _polish(c, u):
-    """Two Newton steps on the polynomial (on its reverse in 1/u when |u| > 1)."""
-    if abs(u) > 1.0:
-        v = 1.0 / u
-        v = _newton(c[::-1], v)
-        return 1.0 / v if v != 0.0 else u
-    return _newton(c, u)
+def _wrap_snap(t):
+    t = _wrap(t)
+    return math.pi if math.pi - abs(t) <= 1e-12 else t
+
+
+def _real_roots(p):
+    """Real roots of p (highest degree first, p[0] != 0), Newton-polished.
+
+    Closed forms for degrees 1, 2 and 4 (Ferrari); the companion matrix (numpy.roots) for
+    other degrees and whenever a closed-form root fails the residual test.
+    """
+    d = len(p) - 1
+    lead = p[0]
+    if d == 1:
+        return [-p[1] / lead]
+    if d == 2:
+        zs = _quadratic(p[1] / lead, p[2] / lead)
+    elif d == 4:
+        zs = _quartic(p[1] / lead, p[2] / lead, p[3] / lead, p[4] / lead)
+    else:
+        zs = None
+    if zs is not None:
+        roots = _accept(p, zs)
+        if roots is not None:
+            return roots
+    return _accept(p, np.roots(p).tolist(), check=False)
+
+
+def _accept(p, zs, check=True):
+    """Polished real parts of the near-real zs; None if one fails the residual test.
+
+    A double root comes out split, as a complex pair or as two reals about sqrt(eps) apart;
+    roots closer than _MERGE_TOL are replaced by their mean, which is accurate.
+    """
+    xs = []
+    for z in zs:
+        z = complex(z)
+        if abs(z.imag) <= _ROOT_IMAG_TOL * (1.0 + abs(z)):
+            xs.append(z.real)
+    xs.sort()
+    out = []
+    k = 0
+    while k < len(xs):
+        x = xs[k]
+        if k + 1 < len(xs) and xs[k + 1] - x <= _MERGE_TOL * (1.0 + abs(x)):
+            x = 0.5 * (x + xs[k + 1])
+            k += 1
+        else:
+            x = _newton(p, x)
+        if check and not _small_residual(p, x):
+            return None
+        out.append(x)
+        k += 1
+    return out
+
+
+def _small_residual(p, x):
+    value = size = 0.0
+    ax = abs(x)
+    for k in p:
+        value = value * x + k
+        size = size * ax + abs(k)
+    return abs(value) <= _RESIDUAL_TOL * size
+
+
+def _quadratic(b, c):
+    """Both roots of x^2 + b x + c (complex b, c allowed), without cancellation."""
+    t = cmath.sqrt(b * b - 4.0 * c)
+    if (b.conjugate() * t).real < 0.0:
+        t = -t
+    q = -0.5 * (b + t)
+    if q == 0:
+        return [q, q]
+    return [q, c / q]
+
+
+def _cubic_largest(a2, a1, a0):
+    """The root of largest modulus of m^3 + a2 m^2 + a1 m + a0 (Cardano, complex)."""
+    P = a1 - a2 * a2 / 3.0
+    Q = 2.0 * a2 ** 3 / 27.0 - a2 * a1 / 3.0 + a0
+    w = cmath.sqrt(Q * Q / 4.0 + P ** 3 / 27.0)
+    u3 = -Q / 2.0 + w
+    if abs(u3) < abs(-Q / 2.0 - w):
+        u3 = -Q / 2.0 - w
+    if u3 == 0:
+        return -a2 / 3.0
+    u = complex(u3) ** (1.0 / 3.0)
+    best = None
+    for k in range(3):
+        uk = u * _OMEGA[k]
+        m = uk - P / (3.0 * uk) - a2 / 3.0
+        if best is None or abs(m) > abs(best):
+            best = m
+    return best
+
+
+def _quartic(B, C, D, E):
+    """The four roots of x^4 + B x^3 + C x^2 + D x + E (Ferrari, complex arithmetic)."""
+    a = B / 4.0
+    p = C - 6.0 * a * a
+    q = D - 2.0 * a * C + 8.0 * a ** 3
+    r = E - a * D + a * a * C - 3.0 * a ** 4
+    m = _cubic_largest(p, p * p / 4.0 - r, -q * q / 8.0)
+    s = cmath.sqrt(2.0 * m)
+    if s == 0:
+        t = cmath.sqrt(p * p - 4.0 * r)
+        y1, y2 = cmath.sqrt((-p + t) / 2.0), cmath.sqrt((-p - t) / 2.0)
+        ys = [y1, -y1, y2, -y2]
+    else:
+        h = q / (2.0 * s)
+        ys = _quadratic(-s, p / 2.0 + m + h) + _quadratic(s, p / 2.0 + m - h)
+    return [y - a for y in ys]
 
 
 def _newton(c, x):
+    """Two Newton steps on the polynomial c (highest degree first), skipped if unstable."""
     for _ in range(2):
         p = dp = 0.0
         for k in c:
@@ -458,3 +560,5 @@ def _newton(c, x):
             break
         x -= step
     return x
+
+
