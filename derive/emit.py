@@ -134,11 +134,13 @@ def same_joints(plan: Plan) -> bool:
     return True
 
 
-def match_expression(certify: str) -> str:
-    """The certification test of entries e against target t, unrolled."""
+def match_expression(certify: str, vector: bool = False) -> str:
+    """The certification test of entries e against target t, unrolled (elementwise if vector)."""
     rotation = () if certify == "position" else (0, 1, 2, 4, 5, 6, 8, 9, 10)
     tests = [f"abs(e[{k}] - t[{k}]) <= tol" for k in rotation]
     tests += [f"abs(e[{k}] - t[{k}]) <= ptol" for k in (3, 7, 11)]
+    if vector:
+        return " & ".join(f"({t})" for t in tests)
     return " and ".join(tests)
 
 
@@ -163,6 +165,64 @@ def ik_lines(plan: Plan, printer: CodePrinter) -> tuple[tuple[int, str], ...]:
         lines.append(Line(depth, f"q = ({outputs},)"))
         lines.append(Line(depth, "_keep(found, target, q, _fk_q(q), tol)"))
     return tuple((ln.depth, ln.text) for ln in lines)
+
+
+def ik_batch_lines(plan: Plan, printer: CodePrinter) -> tuple[str, ...]:
+    """Body of the vectorised IK: one array axis per Solve step, so broadcasting does the
+    branching and flattening the axes gives the scalar solver's loop order."""
+    assert plan.ik is not None
+    names = sp.numbered_symbols("x")
+    solves = [s for s in plan.ik.steps if isinstance(s, Solve)]
+    lines = [f"shape = (T.shape[0],) + (1,) * {len(solves)}"]
+    world = sym.world_pose()
+    lines += [f"{world[i, j]} = T[:, {i}, {j}].reshape(shape)" for i in range(3) for j in range(4)]
+    lines.append("valid = np.ones(shape, dtype=bool)")
+    level = 0
+    for step in plan.ik.steps:
+        if isinstance(step, Assign):
+            lines.append(f"# {step.note}")
+            lines += [ln.text for ln in assign_lines(step.targets, step.exprs, names, printer, 0)]
+            continue
+        level += 1
+        lines += batch_solve_lines(step, names, printer, level)
+    outputs = ", ".join(f"np.broadcast_to({printer.doprint(e)}, valid.shape)"
+                        for e in plan.ik.outputs)
+    lines.append(f"Q = np.stack(({outputs}), axis=-1).reshape(T.shape[0], -1, DOF)")
+    if same_joints(plan):
+        lines.append(f"e = _fk_from_cs({cs_arguments(plan)})")
+    else:
+        lines.append("e = _fk_from_cs(*_cs_columns(Q))")
+    world = ", ".join(str(world[i, j]) for i in range(3) for j in range(4))
+    lines.append(f"t = ({world})")
+    lines.append("ptol = tol * REACH")
+    lines.append(f"valid = valid & {match_expression(plan.ik.certify, vector=True)}")
+    lines.append("return Q, valid.reshape(T.shape[0], -1)")
+    return tuple(lines)
+
+
+def batch_solve_lines(step: Solve, names: sp.utilities.iterables.numbered_symbols,
+                      printer: CodePrinter, level: int) -> list[str]:
+    """One Solve step of the vectorised IK: its values along axis `level`, validity combined."""
+    arg_names = tuple(sym.named(f"arg{k}") for k in range(len(step.args)))
+    temps = assign_lines(arg_names, step.args, names, printer, 0)
+    lines = [f"# {step.note}"] + [ln.text for ln in temps if not ln.text.startswith("arg")]
+    args = {ln.text.split(" = ")[0]: ln.text.split(" = ", 1)[1] for ln in temps
+            if ln.text.startswith("arg")}
+    joined = ", ".join(args[str(a)] for a in arg_names)
+    ref = printer.doprint(step.ref)
+    var = f"d{step.joint}" if step.kind == "polyd" else f"theta{step.joint}"
+    call = {
+        "poly": f"_vpoly(({joined},), {level}, valid, True)",
+        "polyd": f"_vpoly(({joined},), {level}, valid, False)",
+        "cs1": f"_vcs1({joined}, {level}, valid)",
+        "cs2": f"_vcs2({joined}, {ref}, {level}, valid)",
+        "cs2r": f"_vcs2_reach({joined}, {ref}, {level}, valid)",
+        "atan2": f"_vatan2({joined}, {ref}, {level}, valid)",
+    }[step.kind]
+    lines += [f"{var}, ok = {call}", "valid = valid & ok"]
+    if step.kind != "polyd":
+        lines += [f"c{step.joint} = np.cos({var})", f"s{step.joint} = np.sin({var})"]
+    return lines
 
 
 def solve_lines(step: Solve, names: sp.utilities.iterables.numbered_symbols,
@@ -227,6 +287,7 @@ class PrintedModule:
     refusal: str
     ik_body: tuple[tuple[int, str], ...]
     qref_names: str
+    ik_batch_body: tuple[str, ...]
     match: str
     components: str
 
@@ -267,6 +328,7 @@ def print_plan(plan: Plan) -> PrintedModule:
         refusal=plan.refusal,
         ik_body=ik_lines(plan, scalar) if ik else (),
         qref_names=", ".join(f"qr{i}" for i in range(1, arm.dof + 1)),
+        ik_batch_body=ik_batch_lines(plan, vector) if ik else (),
         match=match_expression(ik.certify) if ik else "",
         components=ik.certify if ik else "",
     )

@@ -24,7 +24,8 @@ homogeneous transforms of the tool frame in the world (base and tool frames incl
 API:
     fk(q) -> (4, 4) ndarray
     fk_batch(Q: (N, DOF)) -> (N, 4, 4) ndarray
-    ik(T, *, within_limits=False, q_ref=None) -> (n, DOF) ndarray, all solutions
+    ik(T, *, within_limits=False, q_ref=None, tol=CERTIFY_TOL) -> (n, DOF) ndarray, all solutions
+    ik_batch(T: (N, 4, 4), *, q_ref=None, tol=CERTIFY_TOL) -> (Q (N, M, DOF), valid (N, M))
     nearest(T, q_ref, *, within_limits=True, weights=None) -> (DOF,) ndarray or None
 
 Every solution `ik` returns has been checked by forward kinematics against T (tolerance
@@ -160,31 +161,36 @@ def fk(q):
     return np.array([e[0:4], e[4:8], e[8:12], (0.0, 0.0, 0.0, 1.0)])
 
 
+def _cs_columns(Q):
+    """Arguments of _fk_from_cs from joint vectors Q (..., DOF)."""
+    theta1 = Q[..., 0]
+    c1 = np.cos(theta1)
+    s1 = np.sin(theta1)
+    theta2 = Q[..., 1]
+    c2 = np.cos(theta2)
+    s2 = np.sin(theta2)
+    theta3 = Q[..., 2]
+    c3 = np.cos(theta3)
+    s3 = np.sin(theta3)
+    theta4 = Q[..., 3]
+    c4 = np.cos(theta4)
+    s4 = np.sin(theta4)
+    theta5 = Q[..., 4]
+    c5 = np.cos(theta5)
+    s5 = np.sin(theta5)
+    theta6 = Q[..., 5]
+    c6 = np.cos(theta6)
+    s6 = np.sin(theta6)
+    return (c1, s1, c2, s2, c3, s3, c4, s4, c5, s5, c6, s6,)
+
+
 def fk_batch(Q):
     """World poses (N, 4, 4) for joint vectors Q of shape (N, DOF), without a Python loop."""
     Q = np.asarray(Q, dtype=float)
     if Q.ndim != 2 or Q.shape[1] != DOF:
         raise ValueError(f"Q must have shape (N, {DOF}), got {Q.shape}")
-    theta1 = Q[:, 0]
-    c1 = np.cos(theta1)
-    s1 = np.sin(theta1)
-    theta2 = Q[:, 1]
-    c2 = np.cos(theta2)
-    s2 = np.sin(theta2)
-    theta3 = Q[:, 2]
-    c3 = np.cos(theta3)
-    s3 = np.sin(theta3)
-    theta4 = Q[:, 3]
-    c4 = np.cos(theta4)
-    s4 = np.sin(theta4)
-    theta5 = Q[:, 4]
-    c5 = np.cos(theta5)
-    s5 = np.sin(theta5)
-    theta6 = Q[:, 5]
-    c6 = np.cos(theta6)
-    s6 = np.sin(theta6)
     out = np.zeros((Q.shape[0], 4, 4))
-    entries = _fk_from_cs(c1, s1, c2, s2, c3, s3, c4, s4, c5, s5, c6, s6)
+    entries = _fk_from_cs(*_cs_columns(Q))
     for k, value in enumerate(entries):
         out[:, k // 4, k % 4] = value
     out[:, 3, 3] = 1.0
@@ -266,23 +272,23 @@ def ik(T, *, within_limits=False, q_ref=None, tol=CERTIFY_TOL):
                 # wrist W = (0_3R Rx(alpha3))^T 0_6R = Rz(t4) Rx(alpha4) Rz(t5) Rx(alpha5) Rz(t6)
                 x4 = c2*s3
                 x5 = c3*s2
-                x6 = s2*s3
-                x7 = c1*r11
-                x8 = r21*s1
-                x9 = c1*r12
-                x10 = r22*s1
-                x11 = c1*r13
-                x12 = r23*s1
-                x13 = c2*c3
-                W11 = c1*c2*c3*r11 + c2*c3*r21*s1 - r31*x4 - r31*x5 - x6*x7 - x6*x8
-                W12 = c1*c2*c3*r12 + c2*c3*r22*s1 - r32*x4 - r32*x5 - x10*x6 - x6*x9
-                W13 = c1*c2*c3*r13 + c2*c3*r23*s1 - r33*x4 - r33*x5 - x11*x6 - x12*x6
+                x6 = -x4 - x5
+                x7 = c2*c3
+                x8 = s2*s3
+                x9 = c1*x7 - c1*x8
+                x10 = s1*x7 - s1*x8
+                x11 = s2*s3 - x7
+                x12 = -c1*x4 - c1*x5
+                x13 = -s1*x4 - s1*x5
+                W11 = r11*x9 + r21*x10 + r31*x6
+                W12 = r12*x9 + r22*x10 + r32*x6
+                W13 = r13*x9 + r23*x10 + r33*x6
                 W21 = -c1*r21 + r11*s1
                 W22 = -c1*r22 + r12*s1
                 W23 = -c1*r23 + r13*s1
-                W31 = r31*s2*s3 - r31*x13 - x4*x7 - x4*x8 - x5*x7 - x5*x8
-                W32 = r32*s2*s3 - r32*x13 - x10*x4 - x10*x5 - x4*x9 - x5*x9
-                W33 = r33*s2*s3 - r33*x13 - x11*x4 - x11*x5 - x12*x4 - x12*x5
+                W31 = r11*x12 + r21*x13 + r31*x11
+                W32 = r12*x12 + r22*x13 + r32*x11
+                W33 = r13*x12 + r23*x13 + r33*x11
                 # theta5: W33 = e3^T Rx(alpha4) Rz(theta5) Rx(alpha5) e3
                 for theta5 in _cs1(1.0, 0.0, W33):
                     c5 = cos(theta5)
@@ -300,6 +306,137 @@ def ik(T, *, within_limits=False, q_ref=None, tol=CERTIFY_TOL):
                             s6 = sin(theta6)
                             _keep(found, target, (theta1, theta2, theta3, theta4, theta5, theta6,), _fk_from_cs(c1, s1, c2, s2, c3, s3, c4, s4, c5, s5, c6, s6), tol)
     return _finish(found, within_limits)
+
+
+def ik_batch(T, *, q_ref=None, tol=CERTIFY_TOL, chunk=4096):
+    """All solutions for many world poses at once, vectorised with numpy (no loop over poses).
+
+    Args:
+        T: (N, 4, 4) poses.
+        q_ref: as for ik (one joint vector for all poses).
+        tol: as for ik.
+        chunk: poses solved together; memory grows with it, not with N.
+
+    Returns:
+        (Q, valid): Q (N, M, DOF) with M = 8, the most solutions a pose can
+        have; valid (N, M) marks the slots that hold a solution. For each pose the valid slots
+        are the rows ik returns, in the same order (within_limits is not offered here). A pose
+        that is not a valid transform (not finite, rotation not orthonormal within POSE_TOL)
+        gets no valid slot instead of an exception.
+    """
+    T, good = _vpose(T)
+    qr1, qr2, qr3, qr4, qr5, qr6, = _reference(q_ref)
+    n = T.shape[0]
+    Q = np.zeros((n, 8, DOF))
+    valid = np.zeros((n, 8), dtype=bool)
+    for start in range(0, n, chunk):
+        part = slice(start, min(n, start + chunk))
+        cand, ok = _ik_candidates(T[part], qr1, qr2, qr3, qr4, qr5, qr6, tol)
+        Q[part], valid[part] = _vfinish(cand, ok & good[part, None])
+    return Q, valid
+
+
+def _ik_candidates(T, qr1, qr2, qr3, qr4, qr5, qr6, tol):
+    """Every branch of the solution for poses T (n, 4, 4): (n, M, DOF) values and (n, M)
+    validity, certified by forward kinematics (tol as for ik)."""
+    shape = (T.shape[0],) + (1,) * 6
+    w11 = T[:, 0, 0].reshape(shape)
+    w12 = T[:, 0, 1].reshape(shape)
+    w13 = T[:, 0, 2].reshape(shape)
+    wx = T[:, 0, 3].reshape(shape)
+    w21 = T[:, 1, 0].reshape(shape)
+    w22 = T[:, 1, 1].reshape(shape)
+    w23 = T[:, 1, 2].reshape(shape)
+    wy = T[:, 1, 3].reshape(shape)
+    w31 = T[:, 2, 0].reshape(shape)
+    w32 = T[:, 2, 1].reshape(shape)
+    w33 = T[:, 2, 2].reshape(shape)
+    wz = T[:, 2, 3].reshape(shape)
+    valid = np.ones(shape, dtype=bool)
+    # flange target 0_nT = (B X0 Tz(d1))^-1 T (Tz(dn) Xn E)^-1
+    r11 = w13
+    r12 = -w12
+    r13 = w11
+    px = -206.0*w11 + wx
+    r21 = w23
+    r22 = -w22
+    r23 = w21
+    py = -206.0*w21 + wy
+    r31 = w33
+    r32 = -w32
+    r33 = w31
+    pz = -206.0*w31 + wz - 373.0
+    # wrist centre (x, y, z) = 0P_4org and r = x^2 + y^2 + z^2
+    x = px
+    y = py
+    z = pz
+    r = px*px + py*py + pz*pz
+    # theta3: Pieper general case, polynomial of degree 4 in u = tan(theta3/2)
+    x0 = r*r
+    x1 = z*z
+    x2 = x0 + 3600.0*x1
+    x3 = 919360.0*r
+    theta3, ok = _vpoly((-519088.0*r + x2 + 66431969536.0, x3 - 236959523840.0, -929376.0*r + 2.0*x0 + 7200.0*x1 + 316127094272.0, x3 - 186946339840.0, -410288.0*r + x2 + 41348782336.0,), 1, valid, True)
+    valid = valid & ok
+    c3 = np.cos(theta3)
+    s3 = np.sin(theta3)
+    # theta2: r and z equations, linear in (c2, s2)
+    theta2, ok = _vcs2(2400.0*c3 + 20280.0*s3 - 20400.0, 20280.0*c3 - 2400.0*s3, 27200.0*c3 + r + 229840.0*s3 - 232344.0, -338.0*c3 + 40.0*s3, 40.0*c3 + 338.0*s3 - 340.0, z, 33570240.0, 0.0, qr2, 2, valid)
+    valid = valid & ok
+    c2 = np.cos(theta2)
+    s2 = np.sin(theta2)
+    # g1(theta2, theta3), g2(theta2, theta3)
+    g1 = -40.0*c2*c3 - 338.0*c2*s3 + 340.0*c2 - 338.0*c3*s2 + 40.0*s2*s3 - 30.0
+    g2 = 0.0
+    # theta1: x = c1 g1 - s1 g2, y = s1 g1 + c1 g2; free with the wrist centre on axis 1
+    theta1, ok = _vcs2(g1, -g2, x, g2, g1, y, 559504.0, 559504.0, qr1, 3, valid)
+    valid = valid & ok
+    c1 = np.cos(theta1)
+    s1 = np.sin(theta1)
+    # wrist W = (0_3R Rx(alpha3))^T 0_6R = Rz(t4) Rx(alpha4) Rz(t5) Rx(alpha5) Rz(t6)
+    x4 = c2*s3
+    x5 = c3*s2
+    x6 = -x4 - x5
+    x7 = c2*c3
+    x8 = s2*s3
+    x9 = c1*x7 - c1*x8
+    x10 = s1*x7 - s1*x8
+    x11 = s2*s3 - x7
+    x12 = -c1*x4 - c1*x5
+    x13 = -s1*x4 - s1*x5
+    W11 = r11*x9 + r21*x10 + r31*x6
+    W12 = r12*x9 + r22*x10 + r32*x6
+    W13 = r13*x9 + r23*x10 + r33*x6
+    W21 = -c1*r21 + r11*s1
+    W22 = -c1*r22 + r12*s1
+    W23 = -c1*r23 + r13*s1
+    W31 = r11*x12 + r21*x13 + r31*x11
+    W32 = r12*x12 + r22*x13 + r32*x11
+    W33 = r13*x12 + r23*x13 + r33*x11
+    # theta5: W33 = e3^T Rx(alpha4) Rz(theta5) Rx(alpha5) e3
+    theta5, ok = _vcs1(1.0, 0.0, W33, 4, valid)
+    valid = valid & ok
+    c5 = np.cos(theta5)
+    s5 = np.sin(theta5)
+    # v = Rx(alpha4) Rz(theta5) Rx(alpha5) e3
+    v1 = -s5
+    v2 = 0.0
+    # theta4: (W13, W23) = Rz(theta4) (v1, v2); free at a singular wrist
+    theta4, ok = _vcs2(v1, -v2, W13, v2, v1, W23, 1.0, 1.0, qr4, 5, valid)
+    valid = valid & ok
+    c4 = np.cos(theta4)
+    s4 = np.sin(theta4)
+    # theta6: Rz(theta6) = (Rx(alpha4) Rz(theta5) Rx(alpha5))^T Rz(theta4)^T W
+    theta6, ok = _vatan2(-W11*s4 + W21*c4, W11*c4*c5 + W21*c5*s4 + W31*s5, qr6, 6, valid)
+    valid = valid & ok
+    c6 = np.cos(theta6)
+    s6 = np.sin(theta6)
+    Q = np.stack((np.broadcast_to(theta1, valid.shape), np.broadcast_to(theta2, valid.shape), np.broadcast_to(theta3, valid.shape), np.broadcast_to(theta4, valid.shape), np.broadcast_to(theta5, valid.shape), np.broadcast_to(theta6, valid.shape)), axis=-1).reshape(T.shape[0], -1, DOF)
+    e = _fk_from_cs(c1, s1, c2, s2, c3, s3, c4, s4, c5, s5, c6, s6)
+    t = (w11, w12, w13, wx, w21, w22, w23, wy, w31, w32, w33, wz)
+    ptol = tol * REACH
+    valid = valid & (abs(e[0] - t[0]) <= tol) & (abs(e[1] - t[1]) <= tol) & (abs(e[2] - t[2]) <= tol) & (abs(e[4] - t[4]) <= tol) & (abs(e[5] - t[5]) <= tol) & (abs(e[6] - t[6]) <= tol) & (abs(e[8] - t[8]) <= tol) & (abs(e[9] - t[9]) <= tol) & (abs(e[10] - t[10]) <= tol) & (abs(e[3] - t[3]) <= ptol) & (abs(e[7] - t[7]) <= ptol) & (abs(e[11] - t[11]) <= ptol)
+    return Q, valid.reshape(T.shape[0], -1)
 
 
 def nearest(T, q_ref, *, within_limits=True, weights=None):
@@ -649,3 +786,259 @@ def _newton(c, x):
     return x
 
 
+def _vnew_axis(values, ok, like, axis):
+    """Broadcast a step's result (no branching) to the shape of `like` with ok combined."""
+    values, ok, _ = np.broadcast_arrays(values, ok, like)
+    return values, ok
+
+
+def _vcs1(a, b, e, axis, like):
+    """Vectorised _cs1: two values along `axis` (+acos, then -acos) and their validity."""
+    a, b, e, _ = np.broadcast_arrays(a, b, e, like)
+    rho = np.sqrt(a * a + b * b)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        ratio = e / rho
+    ok = (rho > 0.0) & (np.abs(ratio) <= 1.0 + 1e-9)
+    base = np.arctan2(b, a)
+    delta = np.arccos(np.clip(np.where(ok, ratio, 0.0), -1.0, 1.0))
+    return (np.concatenate((base + delta, base - delta), axis),
+            np.concatenate((ok, ok), axis))
+
+
+def _vcs2(a1, b1, e1, a2, b2, e2, det_scale, rhs_scale, ref, axis, like):
+    """Vectorised _cs2 (one value; ref where the angle is free)."""
+    det = a1 * b2 - a2 * b1
+    free = (np.abs(det) <= _FREE_TOL * det_scale) | (e1 * e1 + e2 * e2 <= _FREE_TOL * rhs_scale)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        value = np.arctan2((a1 * e2 - a2 * e1) / det, (e1 * b2 - b1 * e2) / det)
+    return _vnew_axis(np.where(free, ref, value), True, like, axis)
+
+
+def _vcs2_reach(a1, b1, e1, a2, b2, e2, det_scale, rhs_scale, A, B, C, lo, hi, ref, axis, like):
+    """Vectorised _cs2_reach."""
+    det = a1 * b2 - a2 * b1
+    free = (np.abs(det) <= _FREE_TOL * det_scale) | (e1 * e1 + e2 * e2 <= _FREE_TOL * rhs_scale)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        value = np.arctan2((a1 * e2 - a2 * e1) / det, (e1 * b2 - b1 * e2) / det)
+        radius = A + B * np.cos(ref) + C * np.sin(ref)
+        rho = np.sqrt(B * B + C * C)
+        delta = np.arccos(np.clip((0.5 * (lo + hi) - A) / rho, -1.0, 1.0))
+    base = np.arctan2(C, B)
+    plus, minus = base + delta, base - delta
+    nearer = np.where(np.abs(_vwrap(plus - ref)) <= np.abs(_vwrap(minus - ref)), plus, minus)
+    keep_ref = ((lo <= radius) & (radius <= hi)) | (rho == 0.0)
+    chosen = np.where(keep_ref, ref, nearer)
+    return _vnew_axis(np.where(free, chosen, value), True, like, axis)
+
+
+def _vatan2(y, x, ref, axis, like):
+    """Vectorised _atan2."""
+    free = np.abs(y) + np.abs(x) <= 1e-12
+    return _vnew_axis(np.where(free, ref, np.arctan2(y, x)), True, like, axis)
+
+
+def _vwrap(t):
+    """Angles wrapped to (-pi, pi] (as _wrap: a value rounding to -pi becomes pi)."""
+    w = t - _TWO_PI * np.round(t / _TWO_PI)
+    return np.where(w <= -math.pi, w + _TWO_PI, w)
+
+
+def _vroots(p):
+    """Real roots of the rows of p (m, d+1), p[:, 0] != 0, as _real_roots does per row.
+
+    Returns (roots (m, d), valid (m, d), fallback (m,)): rows marked fallback (other degrees,
+    a zero leading coefficient, a closed-form root failing the residual test) are to be
+    solved by the scalar routine.
+    """
+    m, d = p.shape[0], p.shape[1] - 1
+    lead = p[:, 0]
+    fallback = lead == 0.0
+    mon = p[:, 1:] / np.where(fallback, 1.0, lead)[:, None]
+    if d == 2:
+        zs = np.stack(_vquadratic(mon[:, 0].astype(complex), mon[:, 1].astype(complex)), axis=1)
+    elif d == 4:
+        zs = np.stack(_vquartic(*(mon[:, k].astype(complex) for k in range(4))), axis=1)
+    elif d == 1:
+        zs = (-mon[:, :1]).astype(complex)
+    else:
+        return np.zeros((m, d)), np.zeros((m, d), bool), np.ones(m, bool)
+    with np.errstate(all="ignore"):
+        ok = np.abs(zs.imag) <= _ROOT_IMAG_TOL * (1.0 + np.abs(zs))
+        x = np.where(ok, zs.real, np.inf)
+        x.sort(axis=1)
+        ok = np.isfinite(x)
+        head = np.zeros_like(ok)
+        consumed = np.zeros_like(ok)
+        for k in range(d - 1):
+            pair = (ok[:, k] & ok[:, k + 1] & ~consumed[:, k]
+                    & (x[:, k + 1] - x[:, k] <= _MERGE_TOL * (1.0 + np.abs(x[:, k]))))
+            x[:, k] = np.where(pair, 0.5 * (x[:, k] + x[:, k + 1]), x[:, k])
+            head[:, k] |= pair
+            consumed[:, k + 1] |= pair
+        ok &= ~consumed
+        x = np.where(ok, x, 0.0)
+        x = np.where(ok & ~head, _vnewton(p, x), x)
+        value = np.zeros_like(x)
+        size = np.zeros_like(x)
+        ax = np.abs(x)
+        for k in range(d + 1):
+            value = value * x + p[:, k:k + 1]
+            size = size * ax + np.abs(p[:, k:k + 1])
+        bad = ok & ~(np.abs(value) <= _RESIDUAL_TOL * size)
+    fallback |= bad.any(axis=1)
+    return x, ok, fallback
+
+
+def _vnewton(p, x):
+    """Two guarded Newton steps on the rows' polynomials, elementwise."""
+    with np.errstate(all="ignore"):
+        for _ in range(2):
+            val = np.zeros_like(x)
+            der = np.zeros_like(x)
+            for k in range(p.shape[1]):
+                der = der * x + val
+                val = val * x + p[:, k:k + 1]
+            step = val / der
+            good = np.isfinite(step) & (np.abs(step) <= 1e-3 * (1.0 + np.abs(x)))
+            x = np.where(good, x - step, x)
+    return x
+
+
+def _vquadratic(b, c):
+    """Both roots of x^2 + b x + c (complex arrays), as _quadratic."""
+    t = np.sqrt(b * b - 4.0 * c)
+    t = np.where((np.conj(b) * t).real < 0.0, -t, t)
+    q = -0.5 * (b + t)
+    with np.errstate(all="ignore"):
+        other = np.where(q == 0, q, c / q)
+    return q, other
+
+
+def _vcubic_largest(a2, a1, a0):
+    """The root of largest modulus of m^3 + a2 m^2 + a1 m + a0, as _cubic_largest."""
+    P = a1 - a2 * a2 / 3.0
+    Q = 2.0 * a2 ** 3 / 27.0 - a2 * a1 / 3.0 + a0
+    w = np.sqrt(Q * Q / 4.0 + P ** 3 / 27.0)
+    u3 = np.where(np.abs(-Q / 2.0 + w) < np.abs(-Q / 2.0 - w), -Q / 2.0 - w, -Q / 2.0 + w)
+    zero = u3 == 0
+    u = np.where(zero, 1.0, u3) ** (1.0 / 3.0)
+    best = np.zeros(u.shape, dtype=complex)
+    best_abs = np.full(u.shape, -1.0)
+    for w_k in _OMEGA:
+        uk = u * w_k
+        mk = uk - P / (3.0 * uk) - a2 / 3.0
+        better = np.abs(mk) > best_abs
+        best = np.where(better, mk, best)
+        best_abs = np.where(better, np.abs(mk), best_abs)
+    return np.where(zero, -a2 / 3.0, best)
+
+
+def _vquartic(B, C, D, E):
+    """The four roots of x^4 + B x^3 + C x^2 + D x + E (complex arrays), as _quartic."""
+    a = B / 4.0
+    p = C - 6.0 * a * a
+    q = D - 2.0 * a * C + 8.0 * a ** 3
+    r = E - a * D + a * a * C - 3.0 * a ** 4
+    with np.errstate(all="ignore"):
+        m = _vcubic_largest(p, p * p / 4.0 - r, -q * q / 8.0)
+        s = np.sqrt(2.0 * m)
+        zero = s == 0
+        h = np.where(zero, 0.0, q / np.where(zero, 1.0, 2.0 * s))
+        y1, y2 = _vquadratic(-s, p / 2.0 + m + h)
+        y3, y4 = _vquadratic(s, p / 2.0 + m - h)
+        t = np.sqrt(p * p - 4.0 * r)
+        b1, b2 = np.sqrt((-p + t) / 2.0), np.sqrt((-p - t) / 2.0)
+    y1, y2, y3, y4 = (np.where(zero, alt, y) for y, alt in ((y1, b1), (y2, -b1), (y3, b2), (y4, -b2)))
+    return y1 - a, y2 - a, y3 - a, y4 - a
+
+
+def _vpoly(coeffs, axis, like, angles):
+    """Vectorised _poly_angles (angles=True) or _poly_real: values along `axis`, validity.
+
+    Rows the closed forms cannot settle are solved by the scalar routine, one by one.
+    """
+    cs = np.broadcast_arrays(*coeffs, like)[:-1]
+    shape = cs[0].shape
+    c = np.stack([np.asarray(x, dtype=float).ravel() for x in cs], axis=1)
+    m, d = c.shape[0], c.shape[1] - 1
+    if angles:
+        flip = np.abs(c[:, 0]) < np.abs(c[:, -1])
+        p = np.where(flip[:, None], c[:, ::-1], c)
+    else:
+        flip = np.zeros(m, bool)
+        p = c
+    x, ok, fallback = _vroots(p)
+    if not angles:
+        fallback |= np.abs(c[:, 0]) <= _LEAD_TOL * np.abs(c).max(axis=1)
+    if angles:
+        with np.errstate(all="ignore"):
+            t = np.where(flip[:, None], 2.0 * np.arctan2(1.0, x), 2.0 * np.arctan(x))
+        t = _vwrap(t)
+        t = np.where(math.pi - np.abs(t) <= 1e-12, math.pi, t)
+        t = np.where(ok, t, np.inf)
+        t.sort(axis=1)
+        ok = np.isfinite(t)
+        with np.errstate(invalid="ignore"):
+            ok[:, 1:] &= ~(t[:, 1:] - t[:, :-1] <= 1e-12)
+        order = np.argsort(~ok, axis=1, kind="stable")
+        x = np.take_along_axis(np.where(ok, t, 0.0), order, axis=1)
+        ok = np.take_along_axis(ok, order, axis=1)
+    else:
+        close = np.zeros_like(ok)
+        close[:, 1:] = ok[:, 1:] & ok[:, :-1] & (x[:, 1:] - x[:, :-1] <= 1e-12 * (1.0 + np.abs(x[:, 1:])))
+        ok &= ~close
+        order = np.argsort(~ok, axis=1, kind="stable")
+        x = np.take_along_axis(x, order, axis=1)
+        ok = np.take_along_axis(ok, order, axis=1)
+    scale = np.abs(c).max(axis=1)
+    ok &= (scale > 0.0)[:, None]
+    for i in np.flatnonzero(fallback & (scale > 0.0)):
+        values = (_poly_angles if angles else _poly_real)(c[i])
+        x[i] = 0.0
+        ok[i] = False
+        x[i, :len(values)] = values
+        ok[i, :len(values)] = True
+    inner = shape[:axis] + shape[axis + 1:]
+    x = np.moveaxis(x.reshape(inner + (d,)), -1, axis)
+    ok = np.moveaxis(ok.reshape(inner + (d,)), -1, axis)
+    return x, ok
+
+
+def _vpose(T):
+    """Per-row validity of poses (N, 4, 4) and the poses with invalid rows replaced."""
+    T = np.asarray(T, dtype=float)
+    if T.ndim != 3 or T.shape[1:] != (4, 4):
+        raise ValueError(f"T must have shape (N, 4, 4), got {T.shape}")
+    finite = np.isfinite(T).all(axis=(1, 2))
+    safe = np.where(finite[:, None, None], T, np.eye(4))
+    R = safe[:, :3, :3]
+    gram = np.abs(np.einsum("nki,nkj->nij", R, R) - np.eye(3)).max(axis=(1, 2))
+    bottom = np.abs(safe[:, 3, :] - (0.0, 0.0, 0.0, 1.0)).max(axis=1)
+    good = finite & (gram <= POSE_TOL) & (bottom <= POSE_TOL) & (np.linalg.det(R) > 0.0)
+    return np.where(good[:, None, None], safe, np.eye(4)), good
+
+
+def _vfinish(Q, valid):
+    """Wrap revolute values and drop repeats within each pose (vectorised).
+
+    Pairs are compared on their last joint first; only the few rows where that agrees are
+    compared in full.
+    """
+    count = Q.shape[1]
+    rev = np.array(_REVOLUTE)
+    Q = Q.copy()
+    Q[:, :, rev] = _vwrap(Q[:, :, rev])
+    ok = valid.copy()
+    period = _PERIODS[-1]
+    for j in range(1, count):
+        for i in range(j):
+            last = np.abs(Q[:, j, -1] - Q[:, i, -1])
+            if period != math.inf:
+                last = np.minimum(last, _TWO_PI - last)
+            rows = np.flatnonzero(ok[:, i] & ok[:, j] & (last <= DEDUP_TOL))
+            if rows.size == 0:
+                continue
+            d = np.abs(Q[rows, j, :] - Q[rows, i, :])
+            d[:, rev] = np.minimum(d[:, rev], _TWO_PI - d[:, rev])
+            ok[rows[d.max(axis=1) <= DEDUP_TOL], j] = False
+    return np.where(ok[:, :, None], Q, 0.0), ok

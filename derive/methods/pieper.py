@@ -213,12 +213,11 @@ def position_equations(numbers: dict, length: float, refs: tuple[sp.Expr, ...],
 
 def wrist_equations(numbers: dict, refs: tuple[sp.Expr, ...]) -> list[Step]:
     """theta5, theta4, theta6 from W = Rz(t4) Rx(alpha4) Rz(t5) Rx(alpha5) Rz(t6) (section 2.6)."""
-    rot03 = product([z_factor(general_joint(i)) * x_factor(general_twist(i))
-                     for i in (1, 2, 3)])[:3, :3].xreplace(numbers)
-    rot03 = rot03.applyfunc(sp.expand)
+    rot03 = product([(z_factor(general_joint(i)) * x_factor(general_twist(i))).xreplace(numbers)
+                     for i in (1, 2, 3)], expand=False)[:3, :3]
     flange = sym.flange_pose()[:3, :3]
     w_names = sp.Matrix(3, 3, lambda i, j: sym.named(f"W{i + 1}{j + 1}"))
-    w_value = (rot03.T * flange).applyfunc(sp.expand)
+    w_value = rot03.T * flange
     c4, s4, c5, s5 = sym.c(4), sym.s(4), sym.c(5), sym.s(5)
     inner = (rot_x(sym.cos_alpha(4), sym.sin_alpha(4)) * rot_z(c5, s5)
              * rot_x(sym.cos_alpha(5), sym.sin_alpha(5)))[:3, :3].xreplace(numbers)
