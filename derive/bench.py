@@ -6,8 +6,10 @@ only calls it. Timings are medians over repeated calls on this machine.
 
 from __future__ import annotations
 
+import math
 import statistics
 import time
+import tracemalloc
 from types import ModuleType
 
 import numpy as np
@@ -25,13 +27,68 @@ def median_us(call, args_list: list) -> float:
     return 1e6 * statistics.median(times)
 
 
-def measure(module: ModuleType, samples: int, seed: int = 0) -> dict:
+def batch_agreement(module: ModuleType, poses: np.ndarray) -> int:
+    """How many poses get exactly ik's solutions (same rows, same order, 1e-6) from ik_batch."""
+    Q, valid = module.ik_batch(poses)
+    revolute = np.array([k == "R" for k in module.JOINT_TYPES])
+    agree = 0
+    for T, rows, ok in zip(poses, Q, valid):
+        single = module.ik(T)
+        batch = rows[ok]
+        if single.shape == batch.shape:
+            d = single - batch
+            d[:, revolute] = np.remainder(d[:, revolute] + math.pi, 2 * math.pi) - math.pi
+            agree += bool(np.abs(d).max(initial=0.0) <= 1e-6)
+    return agree
+
+
+def batch_figures(module: ModuleType, n: int, seed: int, memory_n: int) -> dict:
+    """ik_batch microseconds per pose at n poses, and its peak memory at memory_n poses."""
+    rng = np.random.default_rng(seed + 1)
+    poses = module.fk_batch(sample_joints(module, n, rng))
+    module.ik_batch(poses[:100])
+    start = time.perf_counter()
+    module.ik_batch(poses)
+    figures = {"batch_n": n, "ik_batch_us": 1e6 * (time.perf_counter() - start) / n}
+    if memory_n:
+        big = module.fk_batch(sample_joints(module, memory_n, rng))
+        tracemalloc.start()
+        module.ik_batch(big)
+        _, peak = tracemalloc.get_traced_memory()
+        tracemalloc.stop()
+        figures.update(memory_n=memory_n, ik_batch_peak_mb=peak / 2**20,
+                       input_mb=big.nbytes / 2**20)
+    return figures
+
+
+def eaik_figures(module: ModuleType, poses: np.ndarray) -> dict:
+    """EAIK's single and batched IK on the same poses, if eaik is installed (revolute, DH)."""
+    try:
+        from eaik.IK_DH import DhRobot
+    except ImportError:
+        return {}
+    if set(module.JOINT_TYPES) != {"R"} or module.DOF != 6:
+        return {}
+    dh = np.array(module.DH)
+    robot = DhRobot(dh[:, 0], dh[:, 1], dh[:, 2])
+    flange = [np.linalg.inv(module.BASE) @ T @ np.linalg.inv(module.TOOL) for T in poses]
+    single = median_us(robot.IK, [(T,) for T in flange[:2000]])
+    start = time.perf_counter()
+    robot.IK_batched(flange)
+    batch = 1e6 * (time.perf_counter() - start) / len(flange)
+    return {"eaik_ik_us": single, "eaik_batch_us": batch}
+
+
+def measure(module: ModuleType, samples: int, seed: int = 0, batch_n: int = 100_000,
+            memory_n: int = 0) -> dict:
     """Timings and round-trip figures of a generated module.
 
     Args:
         module: the imported generated module.
         samples: joint vectors for the round trip (20% of joints at degenerate values).
         seed: the random seed.
+        batch_n: poses for the ik_batch timing.
+        memory_n: poses for the ik_batch peak-memory figure (0: skip).
 
     Returns:
         A dict of figures (JSON-serialisable).
@@ -47,6 +104,10 @@ def measure(module: ModuleType, samples: int, seed: int = 0) -> dict:
         module.ik(poses[0])
         figures["ik_us"] = median_us(module.ik, [(T,) for T in poses])
         result = roundtrip(module, Q)
+        figures.update(batch_figures(module, batch_n, seed, memory_n))
+        figures["batch_agrees"] = batch_agreement(module, module.fk_batch(Q))
+        if module.JOINT_TYPES == "RRRRRR" and module.DOF == 6:
+            figures.update(eaik_figures(module, module.fk_batch(Q)))
         figures.update(
             samples=result.samples, singular=result.singular, found=result.found,
             completeness=result.completeness, singular_found=result.singular_found,

@@ -269,13 +269,12 @@ def cmd_bench(args: argparse.Namespace) -> int:
         start = time.perf_counter()
         render_module(build_plan(spec))
         generation = time.perf_counter() - start
-        figures = {"generate_s": generation, **measure(load_module(spec), args.samples, args.seed)}
+        module = load_module(spec)
+        figures = {"generate_s": generation,
+                   **measure(module, args.samples, args.seed, args.batch, args.memory)}
         results.append(figures)
         if not args.json:
-            line = f"{spec.name}: generate {generation:.2f} s; fk {figures['fk_us']:.1f} us"
-            if "ik_us" in figures:
-                line += f"; ik {figures['ik_us']:.1f} us/pose (median)\n  {figures['summary']}"
-            print(line, flush=True)
+            print(bench_text(spec.name, figures), flush=True)
     if args.json:
         print(json.dumps(results, indent=2, sort_keys=True))
     return 0
@@ -292,6 +291,24 @@ def cmd_report(args: argparse.Namespace) -> int:
     else:
         sys.stdout.write(text)
     return 0
+
+
+def bench_text(name: str, f: dict) -> str:
+    """The human-readable lines of one arm's benchmark figures."""
+    line = f"{name}: generate {f['generate_s']:.2f} s; fk {f['fk_us']:.1f} us"
+    if "ik_us" not in f:
+        return line
+    line += (f"; ik {f['ik_us']:.1f} us/pose (median); ik_batch {f['ik_batch_us']:.2f} us/pose "
+             f"at N = {f['batch_n']}")
+    if "ik_batch_peak_mb" in f:
+        line += (f"; ik_batch peak {f['ik_batch_peak_mb']:.0f} MB for {f['memory_n']} poses "
+                 f"(input {f['input_mb']:.0f} MB)")
+    if "eaik_ik_us" in f:
+        line += (f"\n  EAIK on the same poses: ik {f['eaik_ik_us']:.1f} us (ratio "
+                 f"{f['ik_us'] / f['eaik_ik_us']:.1f}x), batch {f['eaik_batch_us']:.2f} us/pose "
+                 f"(ratio {f['ik_batch_us'] / f['eaik_batch_us']:.1f}x)")
+    return (line + f"\n  ik_batch equals ik on {f['batch_agrees']}/{f['samples']} poses"
+            f"\n  {f['summary']}")
 
 
 def parser() -> argparse.ArgumentParser:
@@ -328,6 +345,9 @@ def parser() -> argparse.ArgumentParser:
     bench.add_argument("specs", nargs="*", help="spec files or bundled arm names (default: all)")
     bench.add_argument("--samples", type=int, default=10000, help="round-trip samples (10000)")
     bench.add_argument("--seed", type=int, default=0, help="random seed (0)")
+    bench.add_argument("--batch", type=int, default=100_000, help="poses for ik_batch timing")
+    bench.add_argument("--memory", type=int, default=0,
+                       help="also measure ik_batch peak memory on this many poses")
     bench.add_argument("--json", action="store_true", help="print figures as JSON")
     bench.set_defaults(run=cmd_bench)
     return top

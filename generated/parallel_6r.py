@@ -760,12 +760,15 @@ def _accept(p, zs, check=True):
 
 
 def _small_residual(p, x):
-    value = size = 0.0
+    """p(x) is negligible against the size of its terms, or Newton's step from x is."""
+    value = size = slope = 0.0
     ax = abs(x)
     for k in p:
+        slope = slope * x + value
         value = value * x + k
         size = size * ax + abs(k)
-    return abs(value) <= _RESIDUAL_TOL * size
+    return (abs(value) <= _RESIDUAL_TOL * size
+            or abs(value) <= _RESIDUAL_TOL * (1.0 + ax) * abs(slope))
 
 
 def _quadratic(b, c):
@@ -927,11 +930,15 @@ def _vroots(p):
         x = np.where(ok & ~head, _vnewton(p, x), x)
         value = np.zeros_like(x)
         size = np.zeros_like(x)
+        slope = np.zeros_like(x)
         ax = np.abs(x)
         for k in range(d + 1):
+            slope = slope * x + value
             value = value * x + p[:, k:k + 1]
             size = size * ax + np.abs(p[:, k:k + 1])
-        bad = ok & ~(np.abs(value) <= _RESIDUAL_TOL * size)
+        small = ((np.abs(value) <= _RESIDUAL_TOL * size)
+                 | (np.abs(value) <= _RESIDUAL_TOL * (1.0 + ax) * np.abs(slope)))
+        bad = ok & ~small
     fallback |= bad.any(axis=1)
     return x, ok, fallback
 
@@ -1056,13 +1063,19 @@ def _vpose(T):
     T = np.asarray(T, dtype=float)
     if T.ndim != 3 or T.shape[1:] != (4, 4):
         raise ValueError(f"T must have shape (N, 4, 4), got {T.shape}")
-    finite = np.isfinite(T).all(axis=(1, 2))
-    safe = np.where(finite[:, None, None], T, np.eye(4))
-    R = safe[:, :3, :3]
-    gram = np.abs(np.einsum("nki,nkj->nij", R, R) - np.eye(3)).max(axis=(1, 2))
-    bottom = np.abs(safe[:, 3, :] - (0.0, 0.0, 0.0, 1.0)).max(axis=1)
-    good = finite & (gram <= POSE_TOL) & (bottom <= POSE_TOL) & (np.linalg.det(R) > 0.0)
-    return np.where(good[:, None, None], safe, np.eye(4)), good
+    flat = T.reshape(-1, 16)
+    with np.errstate(invalid="ignore", over="ignore"):
+        (a0, a1, a2, _, b0, b1, b2, _, c0, c1, c2, _, z0, z1, z2, z3) = flat.T
+        worst = np.abs(a0 * a0 + a1 * a1 + a2 * a2 - 1.0)
+        for dot in (b0 * b0 + b1 * b1 + b2 * b2 - 1.0, c0 * c0 + c1 * c1 + c2 * c2 - 1.0,
+                    a0 * b0 + a1 * b1 + a2 * b2, a0 * c0 + a1 * c1 + a2 * c2,
+                    b0 * c0 + b1 * c1 + b2 * c2, z0, z1, z2, z3 - 1.0):
+            worst = np.maximum(worst, np.abs(dot))
+        det = (a0 * (b1 * c2 - b2 * c1) - a1 * (b0 * c2 - b2 * c0) + a2 * (b0 * c1 - b1 * c0))
+        good = (worst <= POSE_TOL) & (det > 0.0) & np.isfinite(flat).all(axis=1)
+    if good.all():
+        return T, good
+    return np.where(good[:, None, None], T, np.eye(4)), good
 
 
 def _vfinish(Q, valid):
