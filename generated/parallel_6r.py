@@ -508,7 +508,7 @@ def nearest(T, q_ref, *, within_limits=True, weights=None):
 
 def _pose(T):
     """The 12 top entries of a validated pose, as floats (plain Python: this is the hot path)."""
-    if type(T) is np.ndarray and T.shape == (4, 4):
+    if type(T) is np.ndarray and T.shape == (4, 4) and T.dtype == np.float64:
         v = T.ravel().tolist()
     else:
         try:
@@ -518,10 +518,6 @@ def _pose(T):
         if A.shape != (4, 4):
             raise ValueError(f"T must have shape (4, 4), got {A.shape}")
         v = A.ravel().tolist()
-    try:
-        v = [float(x) for x in v]
-    except (TypeError, ValueError):
-        raise ValueError("T must be a 4x4 array of numbers") from None
     if not all(map(math.isfinite, v)):
         raise ValueError("T has non-finite entries")
     if max(abs(v[12]), abs(v[13]), abs(v[14]), abs(v[15] - 1.0)) > POSE_TOL:
@@ -562,7 +558,11 @@ def _wrap(x):
 
 
 def _finish(found, within_limits):
-    """Wrap revolute values to (-pi, pi], drop repeats (DEDUP_TOL), expand limit variants."""
+    """Wrap revolute values to (-pi, pi], drop repeats (DEDUP_TOL), expand limit variants.
+
+    Repeats are found by comparing the last joint first, then all joints; the first of
+    equal candidates is kept.
+    """
     rows = []
     for q in found:
         q = tuple(map(math.remainder, q, _PERIODS))
