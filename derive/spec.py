@@ -40,6 +40,10 @@ NAME_PATTERN = re.compile(r"[a-z][a-z0-9_]*")
 NAME_MAX = 64
 MAX_JOINTS = 12
 RIGID_TOL = 1e-9
+# Spec numbers: 0, or magnitudes a robot description can mean (lengths from nanometres to
+# kilometres in any unit, angles); outside this range the derivation's tolerances lose sense.
+MIN_MAGNITUDE = 1e-9
+MAX_MAGNITUDE = 1e9
 TOP_KEYS = ("name", "convention", "angle_unit", "length_unit", "joint", "base", "tool", "example")
 JOINT_KEYS = ("type", "alpha", "a", "d", "theta", "limits")
 FRAME_KEYS = ("matrix", "translation", "rpy")
@@ -265,11 +269,12 @@ def _number(value: object, where: str, field: str) -> float:
     try:
         number = float(value)
     except OverflowError:
-        raise SpecError(f"{where}: {field}: number too large; allowed: finite numbers "
-                        "of magnitude below 1e12") from None
-    if not math.isfinite(number) or abs(number) > 1e12:
-        raise SpecError(f"{where}: {field}: {value!r} is not allowed; allowed: finite numbers "
-                        "of magnitude below 1e12")
+        raise SpecError(f"{where}: {field}: number too large; allowed: 0 or finite numbers "
+                        f"of magnitude {MIN_MAGNITUDE:g} to {MAX_MAGNITUDE:g}") from None
+    if not math.isfinite(number) or abs(number) > MAX_MAGNITUDE or (
+            number != 0.0 and abs(number) < MIN_MAGNITUDE):
+        raise SpecError(f"{where}: {field}: {str(value)[:40]} is not allowed; allowed: 0 or "
+                        f"finite numbers of magnitude {MIN_MAGNITUDE:g} to {MAX_MAGNITUDE:g}")
     return number
 
 
