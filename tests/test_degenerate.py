@@ -1,0 +1,54 @@
+"""Degenerate poses, on purpose: singular wrists, stretched and folded elbows, theta = pi roots
+of each step, targets 1e-12 around the workspace boundary, the wrist centre on axis 1."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from degenerate import WORST, contains, run_suite, solve_checked
+from conftest import build_module, spec_text
+
+# arm -> (elbow joint, joints solved by a half-angle step or a cs1 step, wrist joint)
+BUNDLED_SUITES = {
+    "puma560": (3, [1, 2, 3, 4, 5, 6], 5),
+    "lecture_6r": (3, [1, 2, 3, 4, 5, 6], 5),
+    "parallel_6r": (3, [1, 2, 3, 4, 5, 6], 5),
+    "lecture_rrr": (2, [1, 2, 3], None),
+    "planar_2r": (2, [1, 2], None),
+}
+
+
+@pytest.mark.parametrize("name", sorted(BUNDLED_SUITES))
+def test_degenerate_suite_of_bundled_arm(generated, name):
+    elbow, pi_joints, wrist = BUNDLED_SUITES[name]
+    counts = run_suite(generated(name), elbow, pi_joints, wrist, np.random.default_rng(3))
+    print(name, counts, f"worst error so far {WORST['error']:.1e}")
+    assert counts["elbow"] >= 2 and counts["boundary"] >= 12
+    assert counts["pi"] == len(pi_joints)
+
+
+def test_wrist_centre_on_axis_1_of_an_offset_free_puma(tmp_path):
+    rows = [(-90.0, 0.0, 0.0, 0.0), (0.0, 0.432, 0.0, 0.0), (90.0, -0.02, 0.0, 0.0),
+            (-90.0, 0.0, 0.433, 0.0), (90.0, 0.0, 0.0, 0.0), (0.0, 0.0, 0.0, 0.0)]
+    m = build_module(spec_text("puma_no_offset", "standard", rows), tmp_path)
+    q = np.array([0.4, 0.0, 0.3, 0.5, 0.6, 0.7])
+    lo, hi = -math.pi / 2, math.pi / 2
+
+    def wrist_x(theta2):
+        qq = q.copy()
+        qq[0], qq[1] = 0.0, theta2
+        return m.fk(qq)[0, 3]
+
+    assert wrist_x(lo) * wrist_x(hi) < 0
+    for _ in range(80):
+        mid = 0.5 * (lo + hi)
+        lo, hi = (mid, hi) if wrist_x(lo) * wrist_x(mid) > 0 else (lo, mid)
+    q[1] = 0.5 * (lo + hi)
+    T = m.fk(q)
+    assert math.hypot(T[0, 3], T[1, 3]) < 1e-12
+    sols = solve_checked(m, T)
+    assert len(sols) > 0
+    assert contains(m, m.ik(T, q_ref=q), q)
