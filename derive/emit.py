@@ -187,11 +187,12 @@ def ik_batch_lines(plan: Plan, printer: CodePrinter) -> tuple[str, ...]:
         lines += batch_solve_lines(step, names, printer, level)
     outputs = ", ".join(f"np.broadcast_to({printer.doprint(e)}, valid.shape)"
                         for e in plan.ik.outputs)
-    lines.append(f"Q = np.stack(({outputs}), axis=-1).reshape(T.shape[0], -1, DOF)")
+    lines.append(f"Q = np.stack(({outputs}), axis=-1)")
     if same_joints(plan):
         lines.append(f"e = _fk_from_cs({cs_arguments(plan)})")
     else:
         lines.append("e = _fk_from_cs(*_cs_columns(Q))")
+    lines.append("Q = Q.reshape(T.shape[0], -1, DOF)")
     world = ", ".join(str(world[i, j]) for i in range(3) for j in range(4))
     lines.append(f"t = ({world})")
     lines.append("ptol = tol * REACH")
@@ -210,11 +211,12 @@ def batch_solve_lines(step: Solve, names: sp.utilities.iterables.numbered_symbol
             if ln.text.startswith("arg")}
     joined = ", ".join(args[str(a)] for a in arg_names)
     ref = printer.doprint(step.ref)
+    free = repr(1e-10 * step.scale)
     var = f"d{step.joint}" if step.kind == "polyd" else f"theta{step.joint}"
     call = {
-        "poly": f"_vpoly(({joined},), {level}, valid, True)",
-        "polyd": f"_vpoly(({joined},), {level}, valid, False)",
-        "cs1": f"_vcs1({joined}, {level}, valid)",
+        "poly": f"_vpoly(({joined},), {level}, valid, True, {ref}, {free})",
+        "polyd": f"_vpoly(({joined},), {level}, valid, False, {ref}, {free}, {step.unit!r})",
+        "cs1": f"_vcs1({joined}, {step.scale!r}, {ref}, {level}, valid)",
         "cs2": f"_vcs2({joined}, {ref}, {level}, valid)",
         "cs2r": f"_vcs2_reach({joined}, {ref}, {level}, valid)",
         "atan2": f"_vatan2({joined}, {ref}, {level}, valid)",
@@ -236,11 +238,12 @@ def solve_lines(step: Solve, names: sp.utilities.iterables.numbered_symbols,
             if ln.text.startswith("arg")}
     values = [args[str(a)] for a in arg_names]
     ref = printer.doprint(step.ref)
+    free = repr(1e-10 * step.scale)
     joined = ", ".join(values)
     call = {
-        "poly": f"_poly_angles(({joined},))",
-        "polyd": f"_poly_real(({joined},))",
-        "cs1": f"_cs1({joined})",
+        "poly": f"_poly_angles(({joined},), {ref}, {free})",
+        "polyd": f"_poly_real(({joined},), {ref}, {free}, {step.unit!r})",
+        "cs1": f"_cs1({joined}, {step.scale!r}, {ref})",
         "cs2": f"_cs2({joined}, {ref})",
         "cs2r": f"_cs2_reach({joined}, {ref})",
         "atan2": f"_atan2({joined}, {ref})",

@@ -89,8 +89,15 @@ class Solve:
         args: the kind's arguments, expressions in earlier quantities.
         note: the derivation step, printed as a comment ("Pieper r/z ellipse, ...").
         fanout: the most values this step can produce.
-        ref: the value the joint takes where the pose leaves it free (``cs2``, ``atan2``), as an
-            expression in the reference joint values qr_i.
+        ref: the value the joint takes where the pose leaves it free (``cs2``, ``atan2``, and
+            ``poly`` when the polynomial vanishes identically), as an expression in the
+            reference joint values qr_i.
+        scale: for ``poly``: a typical magnitude of the coefficients; when all of them are
+            below 1e-10 of it the polynomial vanishes identically and the joint is free.
+            For ``cs1``: the typical size of a^2 + b^2; when a^2 + b^2 and e^2 are below
+            1e-18 of it the equation holds for every angle, and the joint is free.
+        unit: for ``polyd``: the arm's length; the roots are found for d_i / unit, so that the
+            coefficients, powers of a length, are compared at one scale.
     """
 
     joint: int
@@ -99,6 +106,8 @@ class Solve:
     note: str
     fanout: int
     ref: sp.Expr = sp.Integer(0)
+    scale: float = 0.0
+    unit: float = 1.0
 
 
 Step = Assign | Solve

@@ -200,7 +200,7 @@ def ik(T, *, within_limits=False, q_ref=None, tol=CERTIFY_TOL):
     r33 = w33
     pz = wz
     # theta2: law of cosines, x^2 + y^2 = 4*c2/5 + 29/25 (elbow up / down)
-    for theta2 in _cs1(0.8, 0.0, px*px + py*py - 1.16):
+    for theta2 in _cs1(0.8, 0.0, px*px + py*py - 1.16, 0.0, 0.0):
         c2 = cos(theta2)
         s2 = sin(theta2)
         # k1, k2 with x = k1 c1 - k2 s1 (+ const)
@@ -280,7 +280,7 @@ def _ik_candidates(T, qr1, qr2, qr3, tol):
     r33 = w33
     pz = wz
     # theta2: law of cosines, x^2 + y^2 = 4*c2/5 + 29/25 (elbow up / down)
-    theta2, ok = _vcs1(0.8, 0.0, px*px + py*py - 1.16, 1, valid)
+    theta2, ok = _vcs1(0.8, 0.0, px*px + py*py - 1.16, 0.0, 0.0, 1, valid)
     valid = valid & ok
     c2 = np.cos(theta2)
     s2 = np.sin(theta2)
@@ -300,8 +300,9 @@ def _ik_candidates(T, qr1, qr2, qr3, tol):
     valid = valid & ok
     c3 = np.cos(theta3)
     s3 = np.sin(theta3)
-    Q = np.stack((np.broadcast_to(theta1, valid.shape), np.broadcast_to(theta2, valid.shape), np.broadcast_to(theta3, valid.shape)), axis=-1).reshape(T.shape[0], -1, DOF)
+    Q = np.stack((np.broadcast_to(theta1, valid.shape), np.broadcast_to(theta2, valid.shape), np.broadcast_to(theta3, valid.shape)), axis=-1)
     e = _fk_from_cs(c1, s1, c2, s2, c3, s3)
+    Q = Q.reshape(T.shape[0], -1, DOF)
     t = (w11, w12, w13, wx, w21, w22, w23, wy, w31, w32, w33, wz)
     ptol = tol * REACH
     valid = valid & (abs(e[0] - t[0]) <= tol) & (abs(e[1] - t[1]) <= tol) & (abs(e[2] - t[2]) <= tol) & (abs(e[4] - t[4]) <= tol) & (abs(e[5] - t[5]) <= tol) & (abs(e[6] - t[6]) <= tol) & (abs(e[8] - t[8]) <= tol) & (abs(e[9] - t[9]) <= tol) & (abs(e[10] - t[10]) <= tol) & (abs(e[3] - t[3]) <= ptol) & (abs(e[7] - t[7]) <= ptol) & (abs(e[11] - t[11]) <= ptol)
@@ -428,9 +429,15 @@ def _limit_variants(q):
     return out
 
 
-def _cs1(a, b, e):
-    """Angles t with a cos t + b sin t = e: atan2(b, a) +- acos(e / sqrt(a^2 + b^2))."""
+def _cs1(a, b, e, scale=0.0, ref=0.0):
+    """Angles t with a cos t + b sin t = e: atan2(b, a) +- acos(e / sqrt(a^2 + b^2)).
+
+    When a^2 + b^2 and e^2 are both at most _FREE_TOL * scale the equation holds for every
+    t (the angle is free; e.g. the elbow folded onto axis 1): (ref,).
+    """
     rho = sqrt(a * a + b * b)
+    if rho * rho <= _FREE_TOL * scale:
+        return (ref,) if e * e <= _FREE_TOL * scale else ()
     if rho == 0.0:
         return ()
     ratio = e / rho
@@ -477,12 +484,23 @@ def _atan2(y, x, ref):
 
 
 
-def _poly_real(coeffs):
-    """Real roots of the polynomial (highest degree first), polished, ascending, distinct."""
+def _poly_real(coeffs, ref=0.0, free=0.0, unit=1.0):
+    """Real roots of the polynomial (highest degree first), polished, ascending, distinct;
+    (ref,) when every coefficient is at most `free` (the polynomial vanishes: d is free).
+
+    The roots are found for x / unit, unit being the arm's length, so that coefficients of a
+    polynomial in a length are compared at their proper scale (a constant leading coefficient
+    is small beside r^2 in metres squared to the fourth, yet never negligible).
+    """
     c = [float(x) for x in coeffs]
     scale = max(abs(x) for x in c)
+    if scale <= free:
+        return (ref,)
     if scale == 0.0:
         return ()
+    n = len(c) - 1
+    c = [x * unit ** (n - k) for k, x in enumerate(c)]
+    scale = max(abs(x) for x in c)
     while len(c) > 1 and abs(c[0]) <= _LEAD_TOL * scale:
         c.pop(0)
     if len(c) < 2:
@@ -492,10 +510,10 @@ def _poly_real(coeffs):
     for x in roots:
         if not out or abs(x - out[-1]) > 1e-12 * (1.0 + abs(x)):
             out.append(x)
-    return out
+    return [x * unit for x in out]
 
 
-def _poly_angles(coeffs):
+def _poly_angles(coeffs, ref=0.0, free=0.0):
     """Angles t whose u = tan(t/2) is a real root of the polynomial (highest degree first).
 
     The polynomial is solved in u, or in v = 1/u when its last coefficient is the larger
@@ -504,9 +522,14 @@ def _poly_angles(coeffs):
     pi), sorted, and equal ones (1e-12) merged. Near-double roots come out as complex pairs
     with a small imaginary part; they are accepted and polished. Every candidate is certified
     by forward kinematics afterwards, so a spurious angle costs time, never correctness.
+    When every coefficient is at most `free` the polynomial vanishes identically: the angle
+    is free and takes ref.
     """
     c = [float(x) for x in coeffs]
-    if max(abs(x) for x in c) == 0.0:
+    size = max(abs(x) for x in c)
+    if size <= free:
+        return (ref,)
+    if size == 0.0:
         return ()
     flip = abs(c[0]) < abs(c[-1])
     if flip:
@@ -664,17 +687,20 @@ def _vnew_axis(values, ok, like, axis):
     return values, ok
 
 
-def _vcs1(a, b, e, axis, like):
-    """Vectorised _cs1: two values along `axis` (+acos, then -acos) and their validity."""
-    a, b, e, _ = np.broadcast_arrays(a, b, e, like)
+def _vcs1(a, b, e, scale, ref, axis, like):
+    """Vectorised _cs1: two values along `axis` (+acos, then -acos) and their validity; where
+    the angle is free, ref as the first value and the second invalid."""
+    a, b, e, ref, _ = np.broadcast_arrays(a, b, e, ref, like)
     rho = np.sqrt(a * a + b * b)
+    small = rho * rho <= _FREE_TOL * scale
+    free = small & (e * e <= _FREE_TOL * scale)
     with np.errstate(divide="ignore", invalid="ignore"):
         ratio = e / rho
-    ok = (rho > 0.0) & (np.abs(ratio) <= 1.0 + 1e-9)
+    ok = ~small & (rho > 0.0) & (np.abs(ratio) <= 1.0 + 1e-9)
     base = np.arctan2(b, a)
     delta = np.arccos(np.clip(np.where(ok, ratio, 0.0), -1.0, 1.0))
-    return (np.concatenate((base + delta, base - delta), axis),
-            np.concatenate((ok, ok), axis))
+    return (np.concatenate((np.where(free, ref, base + delta), base - delta), axis),
+            np.concatenate((ok | free, ok), axis))
 
 
 def _vcs2(a1, b1, e1, a2, b2, e2, det_scale, rhs_scale, ref, axis, like):
@@ -828,19 +854,21 @@ def _vquartic(B, C, D, E):
     return y1 - a, y2 - a, y3 - a, y4 - a
 
 
-def _vpoly(coeffs, axis, like, angles):
+def _vpoly(coeffs, axis, like, angles, ref=0.0, free=0.0, unit=1.0):
     """Vectorised _poly_angles (angles=True) or _poly_real: values along `axis`, validity.
 
     Rows the closed forms cannot settle are solved by the scalar routine, one by one.
     """
     cs = np.broadcast_arrays(*coeffs, like)[:-1]
     shape = cs[0].shape
-    c = np.stack([np.asarray(x, dtype=float).ravel() for x in cs], axis=1)
-    m, d = c.shape[0], c.shape[1] - 1
+    raw = np.stack([np.asarray(x, dtype=float).ravel() for x in cs], axis=1)
+    m, d = raw.shape[0], raw.shape[1] - 1
     if angles:
+        c = raw
         flip = np.abs(c[:, 0]) < np.abs(c[:, -1])
         p = np.where(flip[:, None], c[:, ::-1], c)
     else:
+        c = raw * unit ** np.arange(d, -1, -1.0)  # the polynomial in x / unit, as _poly_real
         flip = np.zeros(m, bool)
         p = c
     x, ok, fallback = _vroots(p)
@@ -864,12 +892,18 @@ def _vpoly(coeffs, axis, like, angles):
         close[:, 1:] = ok[:, 1:] & ok[:, :-1] & (x[:, 1:] - x[:, :-1] <= 1e-12 * (1.0 + np.abs(x[:, 1:])))
         ok &= ~close
         order = np.argsort(~ok, axis=1, kind="stable")
-        x = np.take_along_axis(x, order, axis=1)
+        x = np.take_along_axis(x, order, axis=1) * unit
         ok = np.take_along_axis(ok, order, axis=1)
-    scale = np.abs(c).max(axis=1)
+    scale = np.abs(raw).max(axis=1)
     ok &= (scale > 0.0)[:, None]
-    for i in np.flatnonzero(fallback & (scale > 0.0)):
-        values = (_poly_angles if angles else _poly_real)(c[i])
+    vanishing = scale <= free
+    fallback |= vanishing
+    refs = np.broadcast_to(ref, shape).ravel()
+    for i in np.flatnonzero(fallback & ((scale > 0.0) | vanishing)):
+        if angles:
+            values = _poly_angles(raw[i], float(refs[i]), free)
+        else:
+            values = _poly_real(raw[i], float(refs[i]), free, unit)
         x[i] = 0.0
         ok[i] = False
         x[i, :len(values)] = values

@@ -250,12 +250,12 @@ def ik(T, *, within_limits=False, q_ref=None, tol=CERTIFY_TOL):
     y = py
     z = pz
     r = px*px + py*py + pz*pz
-    # theta3: Pieper a1 = 0 case, polynomial of degree 2 in u = tan(theta3/2)
-    for theta3 in _poly_angles((0.413994 - r, 0.748224, 0.379434 - r,)):
+    # theta3: Pieper a1 = 0 case, polynomial of degree 2 in u = tan(theta3/2); free when it vanishes identically
+    for theta3 in _poly_angles((0.413994 - r, 0.748224, 0.379434 - r,), qr3, 7.482240000000001e-11):
         c3 = cos(theta3)
         s3 = sin(theta3)
-        # theta2: a c2 + b s2 = c by the half-angle method
-        for theta2 in _cs1(0.433*c3 + 0.02*s3, 0.02*c3 - 0.433*s3 - 0.432, z):
+        # theta2: a c2 + b s2 = c by the half-angle method; free when the equation vanishes identically
+        for theta2 in _cs1(0.433*c3 + 0.02*s3, 0.02*c3 - 0.433*s3 - 0.432, z, 1.069156, qr2):
             c2 = cos(theta2)
             s2 = sin(theta2)
             # g1(theta2, theta3), g2(theta2, theta3)
@@ -286,7 +286,7 @@ def ik(T, *, within_limits=False, q_ref=None, tol=CERTIFY_TOL):
                 W32 = r12*x8 + r22*x9 + r32*x7
                 W33 = r13*x8 + r23*x9 + r33*x7
                 # theta5: W33 = e3^T Rx(alpha4) Rz(theta5) Rx(alpha5) e3
-                for theta5 in _cs1(1.0, 0.0, W33):
+                for theta5 in _cs1(1.0, 0.0, W33, 0.0, 0.0):
                     c5 = cos(theta5)
                     s5 = sin(theta5)
                     # v = Rx(alpha4) Rz(theta5) Rx(alpha5) e3
@@ -367,13 +367,13 @@ def _ik_candidates(T, qr1, qr2, qr3, qr4, qr5, qr6, tol):
     y = py
     z = pz
     r = px*px + py*py + pz*pz
-    # theta3: Pieper a1 = 0 case, polynomial of degree 2 in u = tan(theta3/2)
-    theta3, ok = _vpoly((0.413994 - r, 0.748224, 0.379434 - r,), 1, valid, True)
+    # theta3: Pieper a1 = 0 case, polynomial of degree 2 in u = tan(theta3/2); free when it vanishes identically
+    theta3, ok = _vpoly((0.413994 - r, 0.748224, 0.379434 - r,), 1, valid, True, qr3, 7.482240000000001e-11)
     valid = valid & ok
     c3 = np.cos(theta3)
     s3 = np.sin(theta3)
-    # theta2: a c2 + b s2 = c by the half-angle method
-    theta2, ok = _vcs1(0.433*c3 + 0.02*s3, 0.02*c3 - 0.433*s3 - 0.432, z, 2, valid)
+    # theta2: a c2 + b s2 = c by the half-angle method; free when the equation vanishes identically
+    theta2, ok = _vcs1(0.433*c3 + 0.02*s3, 0.02*c3 - 0.433*s3 - 0.432, z, 1.069156, qr2, 2, valid)
     valid = valid & ok
     c2 = np.cos(theta2)
     s2 = np.sin(theta2)
@@ -406,7 +406,7 @@ def _ik_candidates(T, qr1, qr2, qr3, qr4, qr5, qr6, tol):
     W32 = r12*x8 + r22*x9 + r32*x7
     W33 = r13*x8 + r23*x9 + r33*x7
     # theta5: W33 = e3^T Rx(alpha4) Rz(theta5) Rx(alpha5) e3
-    theta5, ok = _vcs1(1.0, 0.0, W33, 4, valid)
+    theta5, ok = _vcs1(1.0, 0.0, W33, 0.0, 0.0, 4, valid)
     valid = valid & ok
     c5 = np.cos(theta5)
     s5 = np.sin(theta5)
@@ -423,8 +423,9 @@ def _ik_candidates(T, qr1, qr2, qr3, qr4, qr5, qr6, tol):
     valid = valid & ok
     c6 = np.cos(theta6)
     s6 = np.sin(theta6)
-    Q = np.stack((np.broadcast_to(theta1, valid.shape), np.broadcast_to(theta2, valid.shape), np.broadcast_to(theta3, valid.shape), np.broadcast_to(theta4, valid.shape), np.broadcast_to(theta5, valid.shape), np.broadcast_to(theta6, valid.shape)), axis=-1).reshape(T.shape[0], -1, DOF)
+    Q = np.stack((np.broadcast_to(theta1, valid.shape), np.broadcast_to(theta2, valid.shape), np.broadcast_to(theta3, valid.shape), np.broadcast_to(theta4, valid.shape), np.broadcast_to(theta5, valid.shape), np.broadcast_to(theta6, valid.shape)), axis=-1)
     e = _fk_from_cs(c1, s1, c2, s2, c3, s3, c4, s4, c5, s5, c6, s6)
+    Q = Q.reshape(T.shape[0], -1, DOF)
     t = (w11, w12, w13, wx, w21, w22, w23, wy, w31, w32, w33, wz)
     ptol = tol * REACH
     valid = valid & (abs(e[0] - t[0]) <= tol) & (abs(e[1] - t[1]) <= tol) & (abs(e[2] - t[2]) <= tol) & (abs(e[4] - t[4]) <= tol) & (abs(e[5] - t[5]) <= tol) & (abs(e[6] - t[6]) <= tol) & (abs(e[8] - t[8]) <= tol) & (abs(e[9] - t[9]) <= tol) & (abs(e[10] - t[10]) <= tol) & (abs(e[3] - t[3]) <= ptol) & (abs(e[7] - t[7]) <= ptol) & (abs(e[11] - t[11]) <= ptol)
@@ -551,9 +552,15 @@ def _limit_variants(q):
     return out
 
 
-def _cs1(a, b, e):
-    """Angles t with a cos t + b sin t = e: atan2(b, a) +- acos(e / sqrt(a^2 + b^2))."""
+def _cs1(a, b, e, scale=0.0, ref=0.0):
+    """Angles t with a cos t + b sin t = e: atan2(b, a) +- acos(e / sqrt(a^2 + b^2)).
+
+    When a^2 + b^2 and e^2 are both at most _FREE_TOL * scale the equation holds for every
+    t (the angle is free; e.g. the elbow folded onto axis 1): (ref,).
+    """
     rho = sqrt(a * a + b * b)
+    if rho * rho <= _FREE_TOL * scale:
+        return (ref,) if e * e <= _FREE_TOL * scale else ()
     if rho == 0.0:
         return ()
     ratio = e / rho
@@ -600,12 +607,23 @@ def _atan2(y, x, ref):
 
 
 
-def _poly_real(coeffs):
-    """Real roots of the polynomial (highest degree first), polished, ascending, distinct."""
+def _poly_real(coeffs, ref=0.0, free=0.0, unit=1.0):
+    """Real roots of the polynomial (highest degree first), polished, ascending, distinct;
+    (ref,) when every coefficient is at most `free` (the polynomial vanishes: d is free).
+
+    The roots are found for x / unit, unit being the arm's length, so that coefficients of a
+    polynomial in a length are compared at their proper scale (a constant leading coefficient
+    is small beside r^2 in metres squared to the fourth, yet never negligible).
+    """
     c = [float(x) for x in coeffs]
     scale = max(abs(x) for x in c)
+    if scale <= free:
+        return (ref,)
     if scale == 0.0:
         return ()
+    n = len(c) - 1
+    c = [x * unit ** (n - k) for k, x in enumerate(c)]
+    scale = max(abs(x) for x in c)
     while len(c) > 1 and abs(c[0]) <= _LEAD_TOL * scale:
         c.pop(0)
     if len(c) < 2:
@@ -615,10 +633,10 @@ def _poly_real(coeffs):
     for x in roots:
         if not out or abs(x - out[-1]) > 1e-12 * (1.0 + abs(x)):
             out.append(x)
-    return out
+    return [x * unit for x in out]
 
 
-def _poly_angles(coeffs):
+def _poly_angles(coeffs, ref=0.0, free=0.0):
     """Angles t whose u = tan(t/2) is a real root of the polynomial (highest degree first).
 
     The polynomial is solved in u, or in v = 1/u when its last coefficient is the larger
@@ -627,9 +645,14 @@ def _poly_angles(coeffs):
     pi), sorted, and equal ones (1e-12) merged. Near-double roots come out as complex pairs
     with a small imaginary part; they are accepted and polished. Every candidate is certified
     by forward kinematics afterwards, so a spurious angle costs time, never correctness.
+    When every coefficient is at most `free` the polynomial vanishes identically: the angle
+    is free and takes ref.
     """
     c = [float(x) for x in coeffs]
-    if max(abs(x) for x in c) == 0.0:
+    size = max(abs(x) for x in c)
+    if size <= free:
+        return (ref,)
+    if size == 0.0:
         return ()
     flip = abs(c[0]) < abs(c[-1])
     if flip:
@@ -787,17 +810,20 @@ def _vnew_axis(values, ok, like, axis):
     return values, ok
 
 
-def _vcs1(a, b, e, axis, like):
-    """Vectorised _cs1: two values along `axis` (+acos, then -acos) and their validity."""
-    a, b, e, _ = np.broadcast_arrays(a, b, e, like)
+def _vcs1(a, b, e, scale, ref, axis, like):
+    """Vectorised _cs1: two values along `axis` (+acos, then -acos) and their validity; where
+    the angle is free, ref as the first value and the second invalid."""
+    a, b, e, ref, _ = np.broadcast_arrays(a, b, e, ref, like)
     rho = np.sqrt(a * a + b * b)
+    small = rho * rho <= _FREE_TOL * scale
+    free = small & (e * e <= _FREE_TOL * scale)
     with np.errstate(divide="ignore", invalid="ignore"):
         ratio = e / rho
-    ok = (rho > 0.0) & (np.abs(ratio) <= 1.0 + 1e-9)
+    ok = ~small & (rho > 0.0) & (np.abs(ratio) <= 1.0 + 1e-9)
     base = np.arctan2(b, a)
     delta = np.arccos(np.clip(np.where(ok, ratio, 0.0), -1.0, 1.0))
-    return (np.concatenate((base + delta, base - delta), axis),
-            np.concatenate((ok, ok), axis))
+    return (np.concatenate((np.where(free, ref, base + delta), base - delta), axis),
+            np.concatenate((ok | free, ok), axis))
 
 
 def _vcs2(a1, b1, e1, a2, b2, e2, det_scale, rhs_scale, ref, axis, like):
@@ -951,19 +977,21 @@ def _vquartic(B, C, D, E):
     return y1 - a, y2 - a, y3 - a, y4 - a
 
 
-def _vpoly(coeffs, axis, like, angles):
+def _vpoly(coeffs, axis, like, angles, ref=0.0, free=0.0, unit=1.0):
     """Vectorised _poly_angles (angles=True) or _poly_real: values along `axis`, validity.
 
     Rows the closed forms cannot settle are solved by the scalar routine, one by one.
     """
     cs = np.broadcast_arrays(*coeffs, like)[:-1]
     shape = cs[0].shape
-    c = np.stack([np.asarray(x, dtype=float).ravel() for x in cs], axis=1)
-    m, d = c.shape[0], c.shape[1] - 1
+    raw = np.stack([np.asarray(x, dtype=float).ravel() for x in cs], axis=1)
+    m, d = raw.shape[0], raw.shape[1] - 1
     if angles:
+        c = raw
         flip = np.abs(c[:, 0]) < np.abs(c[:, -1])
         p = np.where(flip[:, None], c[:, ::-1], c)
     else:
+        c = raw * unit ** np.arange(d, -1, -1.0)  # the polynomial in x / unit, as _poly_real
         flip = np.zeros(m, bool)
         p = c
     x, ok, fallback = _vroots(p)
@@ -987,12 +1015,18 @@ def _vpoly(coeffs, axis, like, angles):
         close[:, 1:] = ok[:, 1:] & ok[:, :-1] & (x[:, 1:] - x[:, :-1] <= 1e-12 * (1.0 + np.abs(x[:, 1:])))
         ok &= ~close
         order = np.argsort(~ok, axis=1, kind="stable")
-        x = np.take_along_axis(x, order, axis=1)
+        x = np.take_along_axis(x, order, axis=1) * unit
         ok = np.take_along_axis(ok, order, axis=1)
-    scale = np.abs(c).max(axis=1)
+    scale = np.abs(raw).max(axis=1)
     ok &= (scale > 0.0)[:, None]
-    for i in np.flatnonzero(fallback & (scale > 0.0)):
-        values = (_poly_angles if angles else _poly_real)(c[i])
+    vanishing = scale <= free
+    fallback |= vanishing
+    refs = np.broadcast_to(ref, shape).ravel()
+    for i in np.flatnonzero(fallback & ((scale > 0.0) | vanishing)):
+        if angles:
+            values = _poly_angles(raw[i], float(refs[i]), free)
+        else:
+            values = _poly_real(raw[i], float(refs[i]), free, unit)
         x[i] = 0.0
         ok[i] = False
         x[i, :len(values)] = values

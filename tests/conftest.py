@@ -11,6 +11,7 @@ from types import ModuleType
 
 import numpy as np
 import pytest
+from hypothesis import HealthCheck, Phase, settings
 
 from derive.emit import render_module
 from derive.pipeline import build_plan
@@ -20,6 +21,16 @@ ROOT = Path(__file__).resolve().parent.parent
 GENERATED = ROOT / "generated"
 BUNDLED = ("lecture_6r", "lecture_rrr", "parallel_6r", "planar_2r", "puma560")
 _counter = itertools.count()
+
+# Property-test profiles: "ci" (the default) keeps the suite to minutes, with a fixed seed
+# and no shrinking (a failure prints its arm at once); "long" is the thorough run,
+# `python -m pytest tests/test_properties.py --hypothesis-profile=long`.
+settings.register_profile("ci", max_examples=30, deadline=None, derandomize=True,
+                          phases=[Phase.explicit, Phase.reuse, Phase.generate],
+                          suppress_health_check=[HealthCheck.too_slow])
+settings.register_profile("long", max_examples=2000, deadline=None,
+                          suppress_health_check=[HealthCheck.too_slow])
+settings.load_profile("ci")
 
 
 def import_path(path: Path) -> ModuleType:

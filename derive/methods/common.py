@@ -59,3 +59,16 @@ def unreverse_outputs(outputs: tuple[sp.Expr, ...]) -> tuple[sp.Expr, ...]:
 
 def _number(value: sp.Expr) -> sp.Expr:
     return sp.Integer(0) if value == 0 else sp.Float(float(value), 17)
+
+
+def typical_magnitude(exprs: tuple[sp.Expr, ...], length: float) -> float:
+    """The largest |expr| at a typical pose: wrist centre and flange position at lengths of
+    the arm's size, identity rotation. Scales the test for a polynomial vanishing identically.
+    """
+    pose = sym.flange_pose()
+    subs = {pose[i, j]: float(i == j) for i in range(3) for j in range(3)}
+    subs.update({sym.named("px"): length / 2, sym.named("py"): length / 3,
+                 sym.named("pz"): length / 4, sym.named("x"): length / 2,
+                 sym.named("y"): length / 3, sym.named("z"): length / 4,
+                 sym.named("r"): length**2 * (1 / 4 + 1 / 9 + 1 / 16)})
+    return max(abs(float(e.xreplace(subs))) for e in exprs)

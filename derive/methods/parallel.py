@@ -25,7 +25,8 @@ from derive import symbols as sym
 from derive.classify import Structure
 from derive.halfangle import half_angle_poly, linear_coeffs, reduce_pairs
 from derive.methods.common import (
-    NotApplicable, flange_target, joint_outputs, joint_refs, reversed_refs, unreverse_outputs,
+    NotApplicable, flange_target, joint_outputs, joint_refs, reversed_refs, typical_magnitude,
+    unreverse_outputs,
 )
 from derive.methods.planar import flange_factors, heading_step, planar_steps
 from derive.plan import Assign, IkPlan, Solve, Step
@@ -76,14 +77,14 @@ def derive_234(chain: Chain, target: sp.Matrix, refs: tuple[sp.Expr, ...],
     lhs = (inverse(base_part) * sym.flange_pose())[2, :].applyfunc(sp.expand)
     rhs = (row * wrist_part).applyfunc(sp.expand)
     equations = [sp.expand(lhs[k] - rhs[k]) for k in range(4)]
+    length = sum(abs(float(t.a)) for t in chain.twists) + sum(abs(float(j.d)) for j in chain.joints)
     g = sp.Matrix(3, 4, lambda i, j: sym.named(f"G{i + 1}{j + 1}"))
     g_value = (inverse(base_part) * sym.flange_pose() * inverse(wrist_part))[:3, :]
     g_value = g_value.applyfunc(sp.expand)
     position = planar_part[:2, 3].applyfunc(sp.expand)
-    length = sum(abs(float(t.a)) for t in chain.twists) + sum(abs(float(j.d)) for j in chain.joints)
     planar = planar_steps(position[0], position[1], 2, 3, g[0, 3], g[1, 3], refs, length)
     steps: list[Step] = [flange_target(chain, target)]
-    steps += theta1_theta5_steps(equations[3], equations[2])
+    steps += theta1_theta5_steps(equations[3], equations[2], refs, length)
     steps += theta6_steps(equations[0], equations[1], g_value, planar[0], refs)
     steps.append(Assign(tuple(g), tuple(g_value),
                         "G = (Z1 X1)^-1 0_6T (X4 Z5 X5 Z6)^-1 = Z2 X2 Z3 X3 Z4 (planar)"))
@@ -97,7 +98,8 @@ def derive_234(chain: Chain, target: sp.Matrix, refs: tuple[sp.Expr, ...],
     return IkPlan(NAME, case, 8, tuple(steps), outputs)
 
 
-def theta1_theta5_steps(pos_eq: sp.Expr, z6_eq: sp.Expr) -> list[Step]:
+def theta1_theta5_steps(pos_eq: sp.Expr, z6_eq: sp.Expr, refs: tuple[sp.Expr, ...],
+                        length: float) -> list[Step]:
     """theta1 and theta5 from entries (3,4) and (3,3) of the invariant equation."""
     c1, s1, c5, s5, u = sym.c(1), sym.s(1), sym.c(5), sym.s(5), sym.named("u")
     if not pos_eq.has(c5, s5):
@@ -109,7 +111,7 @@ def theta1_theta5_steps(pos_eq: sp.Expr, z6_eq: sp.Expr) -> list[Step]:
             raise NotApplicable("three-parallel: entry (3,3) does not involve theta5")
         return [
             Solve(1, "cs1", (a, b, -c), "theta1: translation entry (3,4) of the invariant "
-                  "equation, a c1 + b s1 = c", 2),
+                  "equation, a c1 + b s1 = c", 2, refs[0], length**2),
             Solve(5, "cs1", (a5, b5, -c5_), "theta5: entry (3,3) of the invariant equation", 2),
         ]
     pa, pb, pc = linear_coeffs(pos_eq, c5, s5)
@@ -125,7 +127,8 @@ def theta1_theta5_steps(pos_eq: sp.Expr, z6_eq: sp.Expr) -> list[Step]:
     coeffs = half_angle_poly(equation, c1, s1, u)
     return [
         Solve(1, "poly", coeffs, f"theta1: (c5, s5) eliminated from entries (3,3), (3,4): "
-              f"polynomial of degree {len(coeffs) - 1} in u = tan(theta1/2)", len(coeffs) - 1),
+              f"polynomial of degree {len(coeffs) - 1} in u = tan(theta1/2)", len(coeffs) - 1,
+              refs[0], typical_magnitude(coeffs, length)),
         Solve(5, "cs2", (pa, pb, -pc, za, zb, -zc, sp.Integer(0), sp.Integer(0)),
               "theta5: entries (3,3) and (3,4), linear in (c5, s5)", 1),
     ]

@@ -29,7 +29,8 @@ from derive import symbols as sym
 from derive.classify import Structure, is_zero
 from derive.halfangle import half_angle_poly, linear_coeffs, reduce_pairs
 from derive.methods.common import (
-    NotApplicable, flange_target, joint_outputs, joint_refs, reversed_refs, unreverse_outputs,
+    NotApplicable, flange_target, joint_outputs, joint_refs, reversed_refs, typical_magnitude,
+    unreverse_outputs,
 )
 from derive.plan import Assign, IkPlan, Solve, Step
 from derive.transforms import (
@@ -83,7 +84,7 @@ def derive_wrist_last(chain: Chain, target: sp.Matrix, refs: tuple[sp.Expr, ...]
     except NotApplicable as exc:
         return str(exc)
     wrist = wrist_equations(numbers, refs)
-    steps = [flange_target(chain, target), *position.steps, *wrist]
+    steps = [flange_target(chain, target), *reach_guided(position.steps, wrist), *wrist]
     outputs = joint_outputs(chain)
     return IkPlan(
         method=NAME,
@@ -186,7 +187,8 @@ def position_equations(numbers: dict, length: float, refs: tuple[sp.Expr, ...],
                 sym.named("px")**2 + sym.named("py")**2 + sym.named("pz")**2),
                "wrist centre (x, y, z) = 0P_4org and r = x^2 + y^2 + z^2"),
         Solve(3, kind, coeffs, f"{name}: Pieper {case.split(':')[0]} case, polynomial "
-              f"of degree {degree} in {var}", degree),
+              f"of degree {degree} in {var}; free when it vanishes identically", degree,
+              refs[2], typical_magnitude(coeffs, length), length if prismatic3 else 1.0),
     ]
     if theta2_eq is None:
         ra, rb, rc = linear_coeffs(r_eq, c2, s2)
@@ -197,8 +199,10 @@ def position_equations(numbers: dict, length: float, refs: tuple[sp.Expr, ...],
         fan2 = 1
     else:
         ta, tb, tc = linear_coeffs(theta2_eq, c2, s2)
+        size = length if is_zero(a1, 1e-12) else 2 * abs(float(a1)) * length
         steps.append(Solve(2, "cs1", (ta, tb, -tc),
-                           "theta2: a c2 + b s2 = c by the half-angle method", 2))
+                           "theta2: a c2 + b s2 = c by the half-angle method; free when the "
+                           "equation vanishes identically", 2, refs[1], size**2))
         fan2 = 2
     g1, g2 = spec["g1"], spec["g2"]
     steps.append(Assign((sym.named("g1"), sym.named("g2")), (g1, g2),
@@ -209,6 +213,34 @@ def position_equations(numbers: dict, length: float, refs: tuple[sp.Expr, ...],
                        "theta1: x = c1 g1 - s1 g2, y = s1 g1 + c1 g2; free with the wrist "
                        "centre on axis 1", 1, refs[0]))
     return PositionResult(steps, case, degree * fan2, details)
+
+
+def reach_guided(position: list[Step], wrist: list[Step]) -> list[Step]:
+    """The position steps, theta1 chosen so the wrist can reach W33 when theta1 is free.
+
+    A wrist whose twists are not both +-90 deg reaches W33 only in [e5 - rho5, e5 + rho5]
+    (W33 = a5 c5 + b5 s5 + e5). With the wrist centre on axis 1, theta1 is free; a value at
+    which W33, linear in (c1, s1), lies outside that range would leave no wrist solution,
+    so theta1 then keeps W33 inside it (the ``cs2r`` kind). Orthogonal wrists reach every W33
+    and keep the plain ``cs2``.
+    """
+    w_assign, theta5 = wrist[0], wrist[1]
+    a5, b5, e5 = theta5.args
+    e5 = -(e5 - sym.named("W33"))
+    rho = sp.sqrt(a5**2 + b5**2)
+    lo, hi = float(e5 - rho), float(e5 + rho)
+    if lo <= -1.0 + 1e-12 and hi >= 1.0 - 1e-12:
+        return position
+    w33 = sp.expand(w_assign.exprs[8])
+    wa, wb, we = linear_coeffs(w33, sym.c(1), sym.s(1))
+    out = []
+    for step in position:
+        if isinstance(step, Solve) and step.joint == 1 and step.kind == "cs2":
+            step = replace(step, kind="cs2r", args=(*step.args, we, wa, wb, sp.Float(lo),
+                                                    sp.Float(hi)),
+                           note=step.note + "; then chosen so that the wrist reaches W33")
+        out.append(step)
+    return out
 
 
 def wrist_equations(numbers: dict, refs: tuple[sp.Expr, ...]) -> list[Step]:
