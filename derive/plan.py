@@ -9,7 +9,12 @@ complete and the solver certifies them by forward kinematics.
 Solve kinds (the generated module implements each once, as a helper):
 
 =========  =========================================================================
-``cs1``    a cos t + b sin t = e: t = atan2(b, a) +- acos(e / sqrt(a^2 + b^2)); args (a, b, e)
+``cs1``    a cos t + b sin t = e: t = atan2(b, a) +- acos(e / sqrt(a^2 + b^2)); args (a, b, e);
+           t is free (reference value) when the equation vanishes identically (Solve.scale)
+``cs1r``   cs1 whose free value must leave the next joint t' a value keeping
+           W = sum M_ij u_i(t') u_j(t) inside [lo, hi], u = (1, cos, sin); args (a, b, e,
+           M00, M01, M02, M10, M11, M12, M20, M21, M22, lo, hi): the first value in 5 degree
+           steps out from the reference value that allows it
 ``cs2``    a1 c + b1 s = e1, a2 c + b2 s = e2: one t from the 2x2 system; args (a1, b1, e1,
            a2, b2, e2, det_scale, rhs_scale): t is free (reference value) when the determinant
            is below 1e-18 det_scale or e1^2 + e2^2 below 1e-18 rhs_scale

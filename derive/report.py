@@ -177,7 +177,7 @@ def solve_equations(step: Solve) -> list[tuple[str, str]]:
     t = joint_symbol(step)
     c, s = sp.cos(t), sp.sin(t)
     a = step.args
-    if step.kind == "cs1":
+    if step.kind in ("cs1", "cs1r"):
         return [(tex(a[0] * c + a[1] * s), tex(a[2]))]
     if step.kind in ("cs2", "cs2r"):
         return [(tex(a[0] * c + a[1] * s), tex(a[2])), (tex(a[3] * c + a[4] * s), tex(a[5]))]

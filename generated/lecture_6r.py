@@ -205,9 +205,11 @@ DEDUP_TOL = 1e-6
 _ROOT_IMAG_TOL = 1e-6
 _RESIDUAL_TOL = 1e-8
 _MERGE_TOL = 1e-6
+_CLUSTER_TOL = 1e-3
 _LEAD_TOL = 1e-10
 _OMEGA = (1.0, complex(-0.5, math.sqrt(3.0) / 2.0), complex(-0.5, -math.sqrt(3.0) / 2.0))
 _FREE_TOL = 1e-18
+_REACH_STEP = 0.08726646259971647  # 5 degrees: the search step of _cs1_reach
 _TWO_PI = 2.0 * math.pi
 
 
@@ -579,6 +581,25 @@ def _cs1(a, b, e, scale=0.0, ref=0.0):
     return (base + delta, base - delta)
 
 
+def _cs1_reach(a, b, e, m00, m01, m02, m10, m11, m12, m20, m21, m22, lo, hi, scale, ref):
+    """As _cs1; a free t is the first, in 5 degree steps out from ref, at which some t' keeps
+    W = (m00 + m01 c + m02 s) + (m10 + m11 c + m12 s) c' + (m20 + m21 c + m22 s) s' in
+    [lo, hi] (c, s of t and c', s' of t': the next joint must still let the wrist reach)."""
+    rho = sqrt(a * a + b * b)
+    if rho * rho > _FREE_TOL * scale or e * e > _FREE_TOL * scale:
+        return _cs1(a, b, e, scale, ref)
+    for k in range(72):
+        t = ref + _REACH_STEP * ((k + 1) // 2) * (1 if k % 2 else -1)
+        c, s = cos(t), sin(t)
+        A = m00 + m01 * c + m02 * s
+        B = m10 + m11 * c + m12 * s
+        C = m20 + m21 * c + m22 * s
+        r = sqrt(B * B + C * C)
+        if A - r <= hi and A + r >= lo:
+            return (t,)
+    return (ref,)
+
+
 def _cs2(a1, b1, e1, a2, b2, e2, det_scale, rhs_scale, ref):
     """The angle t with a1 c + b1 s = e1 and a2 c + b2 s = e2; ref where t is free.
 
@@ -711,13 +732,21 @@ def _accept(p, zs, check=True):
     """Polished real parts of the near-real zs; None if one fails the residual test.
 
     A double root comes out split, as a complex pair or as two reals about sqrt(eps) apart;
-    roots closer than _MERGE_TOL are replaced by their mean, which is accurate.
+    roots closer than _MERGE_TOL are replaced by their mean, which is accurate. A root of
+    multiplicity k splits by about eps^(1/k) (1e-4 for k = 4) into a cluster, not all real,
+    whose mean is accurate too: such a cluster within _CLUSTER_TOL gives its mean.
     """
     xs = []
+    split = False
     for z in zs:
         z = complex(z)
         if abs(z.imag) <= _ROOT_IMAG_TOL * (1.0 + abs(z)):
             xs.append(z.real)
+        elif abs(z.imag) <= _CLUSTER_TOL * (1.0 + abs(z)):
+            split = True
+    if split:
+        xs = [z.real for z in _clusters([complex(z) for z in zs])
+              if abs(z.imag) <= _ROOT_IMAG_TOL * (1.0 + abs(z))]
     xs.sort()
     out = []
     k = 0
@@ -732,6 +761,21 @@ def _accept(p, zs, check=True):
             return None
         out.append(x)
         k += 1
+    return out
+
+
+def _clusters(zs):
+    """zs with each cluster of nearby roots that are not all real replaced by its mean."""
+    out = []
+    left = list(zs)
+    while left:
+        z = left.pop(0)
+        group = [z] + [w for w in left if abs(w - z) <= _CLUSTER_TOL * (1.0 + abs(z))]
+        if len(group) > 1 and any(abs(w.imag) > _ROOT_IMAG_TOL * (1.0 + abs(w)) for w in group):
+            left = [w for w in left if all(w is not g for g in group)]
+            out.append(sum(group) / len(group))
+        else:
+            out.append(z)
     return out
 
 
@@ -834,6 +878,19 @@ def _vcs1(a, b, e, scale, ref, axis, like):
             np.concatenate((ok | free, ok), axis))
 
 
+def _vcs1_reach(a, b, e, m00, m01, m02, m10, m11, m12, m20, m21, m22, lo, hi, scale, ref,
+                axis, like):
+    """Vectorised _cs1_reach: _vcs1, with the (rare) free rows settled by the scalar routine."""
+    values, ok = _vcs1(a, b, e, scale, ref, axis, like)
+    args = np.broadcast_arrays(a, b, e, m00, m01, m02, m10, m11, m12, m20, m21, m22, ref, like)
+    a, b, e = args[:3]
+    free = (a * a + b * b <= _FREE_TOL * scale) & (e * e <= _FREE_TOL * scale)
+    for index in zip(*np.nonzero(free)):
+        row = [float(x[index]) for x in args[:12]]
+        values[index] = _cs1_reach(*row, lo, hi, scale, float(args[12][index]))[0]
+    return values, ok
+
+
 def _vcs2(a1, b1, e1, a2, b2, e2, det_scale, rhs_scale, ref, axis, like):
     """Vectorised _cs2 (one value; ref where the angle is free)."""
     det = a1 * b2 - a2 * b1
@@ -876,8 +933,8 @@ def _vroots(p):
     """Real roots of the rows of p (m, d+1), p[:, 0] != 0, as _real_roots does per row.
 
     Returns (roots (m, d), valid (m, d), fallback (m,)): rows marked fallback (other degrees,
-    a zero leading coefficient, a closed-form root failing the residual test) are to be
-    solved by the scalar routine.
+    a zero leading coefficient, a closed-form root failing the residual test, a multiple root
+    split into a cluster) are to be solved by the scalar routine.
     """
     m, d = p.shape[0], p.shape[1] - 1
     lead = p[:, 0]
@@ -893,6 +950,8 @@ def _vroots(p):
         return np.zeros((m, d)), np.zeros((m, d), bool), np.ones(m, bool)
     with np.errstate(all="ignore"):
         ok = np.abs(zs.imag) <= _ROOT_IMAG_TOL * (1.0 + np.abs(zs))
+        # a split multiple root (imaginary parts up to _CLUSTER_TOL): the scalar routine
+        fallback |= (~ok & (np.abs(zs.imag) <= _CLUSTER_TOL * (1.0 + np.abs(zs)))).any(axis=1)
         x = np.where(ok, zs.real, np.inf)
         x.sort(axis=1)
         ok = np.isfinite(x)

@@ -49,3 +49,18 @@ def test_ik_batch_marks_invalid_poses_per_row(generated):
 def test_ik_batch_slot_count_is_the_maximum(generated):
     assert generated("puma560").ik_batch(np.eye(4)[None])[0].shape == (1, 8, 6)
     assert generated("planar_2r").ik_batch(np.eye(4)[None])[0].shape == (1, 2, 2)
+
+
+@pytest.mark.parametrize("coeffs, roots", [
+    ((1.0, -4.0, 6.0, -4.0, 1.0), [1.0]),                       # (x - 1)^4: a cluster of four
+    ((1.0, 0.0, -2.0, 0.0, 1.0), [-1.0, 1.0]),                  # (x^2 - 1)^2: two double roots
+    ((1.0, -2.0, 2.0, -2.0, 1.0), [1.0]),                       # (x - 1)^2 (x^2 + 1)
+    ((1.0, 0.0, 1.0, 0.0, 0.25), []),                           # (x^2 + 1/2)^2: no real root
+])
+def test_multiple_roots_are_found_by_scalar_and_vectorised_routines(generated, coeffs, roots):
+    m = generated("puma560")
+    scalar = m._poly_real(coeffs)
+    assert len(scalar) == len(roots)
+    assert np.allclose(scalar, roots, atol=1e-9)
+    x, ok = m._vpoly(tuple(np.array([c]) for c in coeffs), 0, np.ones(1, bool), False)
+    assert np.allclose(np.sort(x[ok]), roots, atol=1e-9)

@@ -221,8 +221,10 @@ def reach_guided(position: list[Step], wrist: list[Step]) -> list[Step]:
     A wrist whose twists are not both +-90 deg reaches W33 only in [e5 - rho5, e5 + rho5]
     (W33 = a5 c5 + b5 s5 + e5). With the wrist centre on axis 1, theta1 is free; a value at
     which W33, linear in (c1, s1), lies outside that range would leave no wrist solution,
-    so theta1 then keeps W33 inside it (the ``cs2r`` kind). Orthogonal wrists reach every W33
-    and keep the plain ``cs2``.
+    so theta1 then keeps W33 inside it (the ``cs2r`` kind). With the wrist centre also on
+    axis 2, theta2 is free too and is chosen so that some theta1 can (``cs1r``; W33 is
+    bilinear in (c1, s1) and (c2, s2)). Orthogonal wrists reach every W33 and keep the plain
+    kinds.
     """
     w_assign, theta5 = wrist[0], wrist[1]
     a5, b5, e5 = theta5.args
@@ -233,12 +235,18 @@ def reach_guided(position: list[Step], wrist: list[Step]) -> list[Step]:
         return position
     w33 = sp.expand(w_assign.exprs[8])
     wa, wb, we = linear_coeffs(w33, sym.c(1), sym.s(1))
+    grid = [linear_coeffs(w, sym.c(2), sym.s(2)) for w in (we, wa, wb)]
+    m = tuple(e for c, s, rest in grid for e in (rest, c, s))
+    bounds = (sp.Float(lo), sp.Float(hi))
     out = []
     for step in position:
         if isinstance(step, Solve) and step.joint == 1 and step.kind == "cs2":
-            step = replace(step, kind="cs2r", args=(*step.args, we, wa, wb, sp.Float(lo),
-                                                    sp.Float(hi)),
+            step = replace(step, kind="cs2r", args=(*step.args, we, wa, wb, *bounds),
                            note=step.note + "; then chosen so that the wrist reaches W33")
+        elif isinstance(step, Solve) and step.joint == 2 and step.kind == "cs1":
+            step = replace(step, kind="cs1r", args=(*step.args, *m, *bounds),
+                           note=step.note + "; then chosen so that a theta1 lets the wrist "
+                           "reach W33")
         out.append(step)
     return out
 
