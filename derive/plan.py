@@ -17,7 +17,7 @@ Solve kinds (the generated module implements each once, as a helper):
            steps out from the reference value that allows it
 ``cs2``    a1 c + b1 s = e1, a2 c + b2 s = e2: one t from the 2x2 system; args (a1, b1, e1,
            a2, b2, e2, det_scale, rhs_scale): t is free (reference value) when the determinant
-           is below 1e-18 det_scale or e1^2 + e2^2 below 1e-18 rhs_scale
+           is below 1e-14 det_scale or e1^2 + e2^2 below 1e-14 rhs_scale
 ``cs2r``   cs2 whose free value must keep a radius A + B cos t + C sin t inside [lo, hi]; args
            (the cs2 args, A, B, C, lo, hi): q_ref's value if inside, else the nearest one
            putting the radius mid-range
@@ -100,7 +100,7 @@ class Solve:
         scale: for ``poly``: a typical magnitude of the coefficients; when all of them are
             below 1e-10 of it the polynomial vanishes identically and the joint is free.
             For ``cs1``: the typical size of a^2 + b^2; when a^2 + b^2 and e^2 are below
-            1e-18 of it the equation holds for every angle, and the joint is free.
+            1e-14 of it the equation holds for every angle, and the joint is free.
         unit: for ``polyd``: the arm's length; the roots are found for d_i / unit, so that the
             coefficients, powers of a length, are compared at one scale.
     """

@@ -162,7 +162,7 @@ _MERGE_TOL = 1e-6
 _CLUSTER_TOL = 1e-3
 _LEAD_TOL = 1e-10
 _OMEGA = (1.0, complex(-0.5, math.sqrt(3.0) / 2.0), complex(-0.5, -math.sqrt(3.0) / 2.0))
-_FREE_TOL = 1e-18
+_FREE_TOL = 1e-14  # squared sizes: a joint is free below 1e-7 of its equation's scale
 _REACH_STEP = 0.08726646259971647  # 5 degrees: the search step of _cs1_reach
 _TWO_PI = 2.0 * math.pi
 

@@ -211,7 +211,7 @@ _MERGE_TOL = 1e-6
 _CLUSTER_TOL = 1e-3
 _LEAD_TOL = 1e-10
 _OMEGA = (1.0, complex(-0.5, math.sqrt(3.0) / 2.0), complex(-0.5, -math.sqrt(3.0) / 2.0))
-_FREE_TOL = 1e-18
+_FREE_TOL = 1e-14  # squared sizes: a joint is free below 1e-7 of its equation's scale
 _REACH_STEP = 0.08726646259971647  # 5 degrees: the search step of _cs1_reach
 _TWO_PI = 2.0 * math.pi
 
@@ -272,7 +272,7 @@ def ik(T, *, within_limits=False, q_ref=None, tol=CERTIFY_TOL):
             x6 = 0.5*rad0
             x7 = 0.5*rad180
             x8 = x6 + x7
-            for theta6 in _cs2_reach(-s5, 0.0, -c1*r21 + r11*s1, 0.0, s5, -c1*r22 + r12*s1, 10000.0, 0.0, x8, x6 - x7, rad90 - x8, 930.25, 141752.25, qr6):
+            for theta6 in _cs2_reach(-s5, 0.0, -c1*r21 + r11*s1, 0.0, s5, -c1*r22 + r12*s1, 1.0, 0.0, x8, x6 - x7, rad90 - x8, 930.25, 141752.25, qr6):
                 c6 = cos(theta6)
                 s6 = sin(theta6)
                 # G = (Z1 X1)^-1 0_6T (X4 Z5 X5 Z6)^-1 = Z2 X2 Z3 X3 Z4 (planar)
@@ -417,7 +417,7 @@ def _ik_candidates(T, qr1, qr2, qr3, qr4, qr5, qr6, tol):
     x6 = 0.5*rad0
     x7 = 0.5*rad180
     x8 = x6 + x7
-    theta6, ok = _vcs2_reach(-s5, 0.0, -c1*r21 + r11*s1, 0.0, s5, -c1*r22 + r12*s1, 10000.0, 0.0, x8, x6 - x7, rad90 - x8, 930.25, 141752.25, qr6, 3, valid)
+    theta6, ok = _vcs2_reach(-s5, 0.0, -c1*r21 + r11*s1, 0.0, s5, -c1*r22 + r12*s1, 1.0, 0.0, x8, x6 - x7, rad90 - x8, 930.25, 141752.25, qr6, 3, valid)
     valid = valid & ok
     c6 = np.cos(theta6)
     s6 = np.sin(theta6)

@@ -112,3 +112,12 @@ def wrapped_close(a: np.ndarray, b: np.ndarray, tol: float) -> bool:
 
 
 sys.path.insert(0, str(ROOT / "tests"))
+
+
+def pytest_terminal_summary(terminalreporter) -> None:
+    """The worst pose error the degenerate-pose suites met in this run (for the notes)."""
+    from degenerate import WORST
+    if WORST["error"]:
+        terminalreporter.write_line(
+            f"degenerate-pose suites: worst pose error {WORST['error']:.1e} "
+            "(rotation entries; position / REACH)")

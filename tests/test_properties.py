@@ -67,7 +67,9 @@ def test_random_planar_arms(text):
 # scale; 2: theta = pi was asked of the prismatic joint, the reversed joints misread;
 # 4: a prismatic joint 3 whose d3 quartic has a quadruple root at d3 = 0 (split roots are
 # now clustered); 5: the wrist centre on axes 1 and 2 with a non-orthogonal wrist (theta1
-# and theta2 free, now chosen so the wrist can reach).
+# and theta2 free, now chosen so the wrist can reach); 6: the same 5e-9 rad from that
+# configuration, where theta1 and theta2 are determined by terms of 1e-9 of the arm's size
+# (a joint is now free below 1e-7 of its equation's scale).
 REGRESSIONS = (
     ("standard", "RRRPRR", 0.01,
      [(-90.0, 0.0, 0.0, 0.0), (-90.0, 0.0, 0.0, -180.0), (-90.0, 0.0, -0.008924, 0.0),
@@ -85,6 +87,9 @@ REGRESSIONS = (
     ("modified", "RRRRRR", 0.0,
      [(90.0, 0.0, 0.0, 0.0), (90.0, 0.0, 0.0, 0.0), (0.0, 0.1, 0.0, 0.0),
       (0.0, 0.1, 0.0, 0.0), (30.0, 0.0, 0.0, 0.0), (-150.0, 0.0, 0.0, 0.0)]),
+    ("standard", "RRRRRR", 0.0,
+     [(-90.0, 0.0, 0.0, 0.0), (0.0, 0.05, 0.0, 0.0), (0.0, 0.05, 0.0, 0.0),
+      (30.0, 0.0, 0.0, 0.0), (-149.0, 0.0, 0.0, 0.0), (90.0, 0.0, 0.0, 0.0)]),
 )
 
 

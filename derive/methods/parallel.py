@@ -34,8 +34,8 @@ from derive.transforms import Chain, inverse, numbers_of, product, reverse_chain
 
 NAME = "three-parallel"
 # theta5 comes from acos of entry (3,3), accurate to ~1e-8 near 0 and pi: |h| below 1e-7
-# (h^2 below 1e-18 * 1e4) is treated as the singular wrist, where theta6 is free.
-SIN5_FREE = sp.Float(1e4)
+# (h^2 below _FREE_TOL = 1e-14) is treated as the singular wrist, where theta6 is free.
+SIN5_FREE = sp.Integer(1)
 
 
 def derive(chain: Chain, structure: Structure) -> IkPlan | str:
