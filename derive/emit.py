@@ -150,12 +150,14 @@ def ik_lines(plan: Plan, printer: CodePrinter) -> tuple[tuple[int, str], ...]:
     names = sp.numbered_symbols("x")
     lines: list[Line] = []
     depth = 0
+    loops = []
     for step in plan.ik.steps:
         if isinstance(step, Assign):
             lines.append(Line(depth, f"# {step.note}"))
             lines += assign_lines(step.targets, step.exprs, names, printer, depth)
             continue
         lines += solve_lines(step, names, printer, depth)
+        loops.append((depth, step.joint))
         depth += 1
     outputs = ", ".join(printer.doprint(e) for e in plan.ik.outputs)
     if same_joints(plan):
@@ -164,6 +166,10 @@ def ik_lines(plan: Plan, printer: CodePrinter) -> tuple[tuple[int, str], ...]:
     else:
         lines.append(Line(depth, f"q = ({outputs},)"))
         lines.append(Line(depth, "_keep(found, target, q, _fk_q(q), tol)"))
+    for level, joint in reversed(loops):
+        # a free joint's loop (over _Free values) ends at its first value that gave a solution
+        lines.append(Line(level + 1, f"if _v{joint}.__class__ is _Free and len(found) > _n{joint}:"))
+        lines.append(Line(level + 2, "break"))
     return tuple((ln.depth, ln.text) for ln in lines)
 
 
@@ -197,7 +203,14 @@ def ik_batch_lines(plan: Plan, printer: CodePrinter) -> tuple[str, ...]:
     lines.append(f"t = ({world})")
     lines.append("ptol = tol * REACH")
     lines.append(f"valid = valid & {match_expression(plan.ik.certify, vector=True)}")
-    lines.append("return Q, valid.reshape(T.shape[0], -1)")
+    # a free joint's first value without a certified solution below it: the scalar solver,
+    # which tries further values, settles that pose
+    lines.append("retry = np.zeros(T.shape[0], dtype=bool)")
+    for k in range(1, level + 1):
+        rest = tuple(range(k + 1, level + 1))
+        below = f"valid.any(axis={rest}, keepdims=True)" if rest else "valid"
+        lines.append(f"retry |= (free{k} & ~{below}).reshape(T.shape[0], -1).any(axis=1)")
+    lines.append("return Q, valid.reshape(T.shape[0], -1), retry")
     return tuple(lines)
 
 
@@ -222,7 +235,8 @@ def batch_solve_lines(step: Solve, names: sp.utilities.iterables.numbered_symbol
         "cs2r": f"_vcs2_reach({joined}, {ref}, {level}, valid)",
         "atan2": f"_vatan2({joined}, {ref}, {level}, valid)",
     }[step.kind]
-    lines += [f"{var}, ok = {call}", "valid = valid & ok"]
+    lines += [f"{var}, ok, free{level} = {call}", "valid = valid & ok",
+              f"free{level} = free{level} & valid"]
     if step.kind != "polyd":
         lines += [f"c{step.joint} = np.cos({var})", f"s{step.joint} = np.sin({var})"]
     return lines
@@ -250,11 +264,12 @@ def solve_lines(step: Solve, names: sp.utilities.iterables.numbered_symbols,
         "cs2r": f"_cs2_reach({joined}, {ref})",
         "atan2": f"_atan2({joined}, {ref})",
     }[step.kind]
+    lines.append(Line(depth, f"_n{step.joint} = len(found)"))
     if step.kind == "polyd":
-        lines.append(Line(depth, f"for d{step.joint} in {call}:"))
+        lines.append(Line(depth, f"for d{step.joint} in (_v{step.joint} := {call}):"))
         return lines
     var = f"theta{step.joint}"
-    lines.append(Line(depth, f"for {var} in {call}:"))
+    lines.append(Line(depth, f"for {var} in (_v{step.joint} := {call}):"))
     lines.append(Line(depth + 1, f"c{step.joint} = cos({var})"))
     lines.append(Line(depth + 1, f"s{step.joint} = sin({var})"))
     return lines

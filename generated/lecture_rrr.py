@@ -163,7 +163,8 @@ _CLUSTER_TOL = 1e-3
 _LEAD_TOL = 1e-10
 _OMEGA = (1.0, complex(-0.5, math.sqrt(3.0) / 2.0), complex(-0.5, -math.sqrt(3.0) / 2.0))
 _FREE_TOL = 1e-14  # squared sizes: a joint is free below 1e-7 of its equation's scale
-_REACH_STEP = 0.08726646259971647  # 5 degrees: the search step of _cs1_reach
+# the values a free joint tries, as offsets from its preferred value: 0, +5, -5, +10, ... deg
+_FREE_STEPS = tuple(math.radians(5.0 * ((k + 1) // 2) * (1 if k % 2 else -1)) for k in range(72))
 _TWO_PI = 2.0 * math.pi
 
 
@@ -202,24 +203,33 @@ def ik(T, *, within_limits=False, q_ref=None, tol=CERTIFY_TOL):
     r33 = w33
     pz = wz
     # theta2: law of cosines, x^2 + y^2 = 4*c2/5 + 29/25 (elbow up / down)
-    for theta2 in _cs1(0.8, 0.0, px*px + py*py - 1.16, 0.0, 0.0):
+    _n2 = len(found)
+    for theta2 in (_v2 := _cs1(0.8, 0.0, px*px + py*py - 1.16, 0.0, 0.0)):
         c2 = cos(theta2)
         s2 = sin(theta2)
         # k1, k2 with x = k1 c1 - k2 s1 (+ const)
         k1 = 0.4*c2 + 1.0
         k2 = 0.4*s2
         # theta1: x = k1 c1 - k2 s1, y = k1 s1 + k2 c1, i.e. atan2(y, x) - atan2(k2, k1)
-        for theta1 in _cs2(k1, -k2, px, 0.4*s2, 0.4*c2 + 1.0, py, 1.9599999999999997, 1.9599999999999997, qr1):
+        _n1 = len(found)
+        for theta1 in (_v1 := _cs2(k1, -k2, px, 0.4*s2, 0.4*c2 + 1.0, py, 1.9599999999999997, 1.9599999999999997, qr1)):
             c1 = cos(theta1)
             s1 = sin(theta1)
             # theta3: heading, Rz(theta3) = A^T R B^T
             x0 = c1*s2
             x1 = c2*s1
             x2 = s1*s2
-            for theta3 in _atan2(c1*c2*r21 - r11*x0 - r11*x1 - r21*x2, c1*c2*r11 - r11*x2 + r21*x0 + r21*x1, qr3):
+            _n3 = len(found)
+            for theta3 in (_v3 := _atan2(c1*c2*r21 - r11*x0 - r11*x1 - r21*x2, c1*c2*r11 - r11*x2 + r21*x0 + r21*x1, qr3)):
                 c3 = cos(theta3)
                 s3 = sin(theta3)
                 _keep(found, target, (theta1, theta2, theta3,), _fk_from_cs(c1, s1, c2, s2, c3, s3), tol)
+                if _v3.__class__ is _Free and len(found) > _n3:
+                    break
+            if _v1.__class__ is _Free and len(found) > _n1:
+                break
+        if _v2.__class__ is _Free and len(found) > _n2:
+            break
     return _finish(found, within_limits)
 
 
@@ -235,7 +245,9 @@ def ik_batch(T, *, q_ref=None, tol=CERTIFY_TOL, chunk=4096):
     Returns:
         (Q, valid): Q (N, M, DOF) with M = 2, the most solutions a pose can
         have; valid (N, M) marks the slots that hold a solution. For each pose the valid slots
-        are the rows ik returns, in the same order (within_limits is not offered here). A pose
+        are the rows ik returns, in the same order (within_limits is not offered here; the
+        rare poses where a free joint's first value leaves a branch without solution are
+        solved by ik, which tries further values). A pose
         that is not a valid transform (not finite, rotation not orthonormal within POSE_TOL)
         gets no valid slot instead of an exception.
     """
@@ -246,14 +258,21 @@ def ik_batch(T, *, q_ref=None, tol=CERTIFY_TOL, chunk=4096):
     valid = np.zeros((n, 2), dtype=bool)
     for start in range(0, n, chunk):
         part = slice(start, min(n, start + chunk))
-        cand, ok = _ik_candidates(T[part], qr1, qr2, qr3, tol)
+        cand, ok, retry = _ik_candidates(T[part], qr1, qr2, qr3, tol)
         Q[part], valid[part] = _vfinish(cand, ok & good[part, None])
+        for i in start + np.flatnonzero(retry & good[part]):
+            # a free joint whose first value left a branch without solution (rare): the
+            # scalar solver tries its further values
+            sols = ik(T[i], q_ref=q_ref, tol=tol)[:2]
+            Q[i], valid[i] = 0.0, False
+            Q[i, :len(sols)], valid[i, :len(sols)] = sols, True
     return Q, valid
 
 
 def _ik_candidates(T, qr1, qr2, qr3, tol):
-    """Every branch of the solution for poses T (n, 4, 4): (n, M, DOF) values and (n, M)
-    validity, certified by forward kinematics (tol as for ik)."""
+    """Every branch of the solution for poses T (n, 4, 4): (n, M, DOF) values, (n, M)
+    validity, certified by forward kinematics (tol as for ik), and (n,) the poses to retry
+    with the scalar solver (a free joint's value left its branch without solution)."""
     shape = (T.shape[0],) + (1,) * 3
     w11 = T[:, 0, 0].reshape(shape)
     w12 = T[:, 0, 1].reshape(shape)
@@ -282,24 +301,27 @@ def _ik_candidates(T, qr1, qr2, qr3, tol):
     r33 = w33
     pz = wz
     # theta2: law of cosines, x^2 + y^2 = 4*c2/5 + 29/25 (elbow up / down)
-    theta2, ok = _vcs1(0.8, 0.0, px*px + py*py - 1.16, 0.0, 0.0, 1, valid)
+    theta2, ok, free1 = _vcs1(0.8, 0.0, px*px + py*py - 1.16, 0.0, 0.0, 1, valid)
     valid = valid & ok
+    free1 = free1 & valid
     c2 = np.cos(theta2)
     s2 = np.sin(theta2)
     # k1, k2 with x = k1 c1 - k2 s1 (+ const)
     k1 = 0.4*c2 + 1.0
     k2 = 0.4*s2
     # theta1: x = k1 c1 - k2 s1, y = k1 s1 + k2 c1, i.e. atan2(y, x) - atan2(k2, k1)
-    theta1, ok = _vcs2(k1, -k2, px, 0.4*s2, 0.4*c2 + 1.0, py, 1.9599999999999997, 1.9599999999999997, qr1, 2, valid)
+    theta1, ok, free2 = _vcs2(k1, -k2, px, 0.4*s2, 0.4*c2 + 1.0, py, 1.9599999999999997, 1.9599999999999997, qr1, 2, valid)
     valid = valid & ok
+    free2 = free2 & valid
     c1 = np.cos(theta1)
     s1 = np.sin(theta1)
     # theta3: heading, Rz(theta3) = A^T R B^T
     x0 = c1*s2
     x1 = c2*s1
     x2 = s1*s2
-    theta3, ok = _vatan2(c1*c2*r21 - r11*x0 - r11*x1 - r21*x2, c1*c2*r11 - r11*x2 + r21*x0 + r21*x1, qr3, 3, valid)
+    theta3, ok, free3 = _vatan2(c1*c2*r21 - r11*x0 - r11*x1 - r21*x2, c1*c2*r11 - r11*x2 + r21*x0 + r21*x1, qr3, 3, valid)
     valid = valid & ok
+    free3 = free3 & valid
     c3 = np.cos(theta3)
     s3 = np.sin(theta3)
     Q = np.stack((np.broadcast_to(theta1, valid.shape), np.broadcast_to(theta2, valid.shape), np.broadcast_to(theta3, valid.shape)), axis=-1)
@@ -308,7 +330,11 @@ def _ik_candidates(T, qr1, qr2, qr3, tol):
     t = (w11, w12, w13, wx, w21, w22, w23, wy, w31, w32, w33, wz)
     ptol = tol * REACH
     valid = valid & (abs(e[0] - t[0]) <= tol) & (abs(e[1] - t[1]) <= tol) & (abs(e[2] - t[2]) <= tol) & (abs(e[4] - t[4]) <= tol) & (abs(e[5] - t[5]) <= tol) & (abs(e[6] - t[6]) <= tol) & (abs(e[8] - t[8]) <= tol) & (abs(e[9] - t[9]) <= tol) & (abs(e[10] - t[10]) <= tol) & (abs(e[3] - t[3]) <= ptol) & (abs(e[7] - t[7]) <= ptol) & (abs(e[11] - t[11]) <= ptol)
-    return Q, valid.reshape(T.shape[0], -1)
+    retry = np.zeros(T.shape[0], dtype=bool)
+    retry |= (free1 & ~valid.any(axis=(2, 3), keepdims=True)).reshape(T.shape[0], -1).any(axis=1)
+    retry |= (free2 & ~valid.any(axis=(3,), keepdims=True)).reshape(T.shape[0], -1).any(axis=1)
+    retry |= (free3 & ~valid).reshape(T.shape[0], -1).any(axis=1)
+    return Q, valid.reshape(T.shape[0], -1), retry
 
 
 def nearest(T, q_ref, *, within_limits=True, weights=None):
@@ -431,15 +457,26 @@ def _limit_variants(q):
     return out
 
 
+class _Free(tuple):
+    """The values a free joint tries, first the preferred one, then 5 degree steps out from
+    it in both directions. The solver stops at the first value that gives a certified
+    solution: a later joint may not reach from every value (a wrist whose twists are not
+    +-90 deg reaches only part of the orientations)."""
+
+
+def _free(t):
+    return _Free([t + step for step in _FREE_STEPS])
+
+
 def _cs1(a, b, e, scale=0.0, ref=0.0):
     """Angles t with a cos t + b sin t = e: atan2(b, a) +- acos(e / sqrt(a^2 + b^2)).
 
     When a^2 + b^2 and e^2 are both at most _FREE_TOL * scale the equation holds for every
-    t (the angle is free; e.g. the elbow folded onto axis 1): (ref,).
+    t (the angle is free; e.g. the elbow folded onto axis 1): _free(ref).
     """
     rho = sqrt(a * a + b * b)
     if rho * rho <= _FREE_TOL * scale:
-        return (ref,) if e * e <= _FREE_TOL * scale else ()
+        return _free(ref) if e * e <= _FREE_TOL * scale else ()
     if rho == 0.0:
         return ()
     ratio = e / rho
@@ -457,16 +494,16 @@ def _cs1_reach(a, b, e, m00, m01, m02, m10, m11, m12, m20, m21, m22, lo, hi, sca
     rho = sqrt(a * a + b * b)
     if rho * rho > _FREE_TOL * scale or e * e > _FREE_TOL * scale:
         return _cs1(a, b, e, scale, ref)
-    for k in range(72):
-        t = ref + _REACH_STEP * ((k + 1) // 2) * (1 if k % 2 else -1)
+    for step in _FREE_STEPS:
+        t = ref + step
         c, s = cos(t), sin(t)
         A = m00 + m01 * c + m02 * s
         B = m10 + m11 * c + m12 * s
         C = m20 + m21 * c + m22 * s
         r = sqrt(B * B + C * C)
         if A - r <= hi and A + r >= lo:
-            return (t,)
-    return (ref,)
+            return _free(t)
+    return _free(ref)
 
 
 def _cs2(a1, b1, e1, a2, b2, e2, det_scale, rhs_scale, ref):
@@ -477,7 +514,7 @@ def _cs2(a1, b1, e1, a2, b2, e2, det_scale, rhs_scale, ref):
     """
     det = a1 * b2 - a2 * b1
     if abs(det) <= _FREE_TOL * det_scale or e1 * e1 + e2 * e2 <= _FREE_TOL * rhs_scale:
-        return (ref,)
+        return _free(ref)
     return (atan2((a1 * e2 - a2 * e1) / det, (e1 * b2 - b1 * e2) / det),)
 
 
@@ -487,20 +524,20 @@ def _cs2_reach(a1, b1, e1, a2, b2, e2, det_scale, rhs_scale, A, B, C, lo, hi, re
     if abs(det) > _FREE_TOL * det_scale and e1 * e1 + e2 * e2 > _FREE_TOL * rhs_scale:
         return (atan2((a1 * e2 - a2 * e1) / det, (e1 * b2 - b1 * e2) / det),)
     if lo <= A + B * cos(ref) + C * sin(ref) <= hi:
-        return (ref,)
+        return _free(ref)
     rho = sqrt(B * B + C * C)
     if rho == 0.0:
-        return (ref,)
+        return _free(ref)
     mid = 0.5 * (lo + hi)
     base = atan2(C, B)
     delta = acos(max(-1.0, min(1.0, (mid - A) / rho)))
-    return (min((base + delta, base - delta), key=lambda t: abs(_wrap(t - ref))),)
+    return _free(min((base + delta, base - delta), key=lambda t: abs(_wrap(t - ref))))
 
 
 def _atan2(y, x, ref):
     """atan2(y, x), or ref when both vanish (the angle is free)."""
     if abs(y) + abs(x) <= 1e-12:
-        return (ref,)
+        return _free(ref)
     return (atan2(y, x),)
 
 
@@ -539,24 +576,26 @@ def _poly_angles(coeffs, ref=0.0, free=0.0):
 
     The polynomial is solved in u, or in v = 1/u when its last coefficient is the larger
     end, so that a vanishing leading coefficient (a root at u = infinity, t = pi; ALGORITHMS.md
-    2.4) is an ordinary root v = 0. Angles are wrapped to (-pi, pi] (within 1e-12 of +-pi:
+    2.4) is an ordinary root v = 0. When both ends vanish (below _LEAD_TOL of the largest
+    coefficient) the leading one is deflated as its exact root. Angles are wrapped to (-pi, pi] (within 1e-12 of +-pi:
     pi), sorted, and equal ones (1e-12) merged. Near-double roots come out as complex pairs
     with a small imaginary part; they are accepted and polished. Every candidate is certified
     by forward kinematics afterwards, so a spurious angle costs time, never correctness.
     When every coefficient is at most `free` the polynomial vanishes identically: the angle
-    is free and takes ref.
+    is free: _free(ref).
     """
     c = [float(x) for x in coeffs]
     size = max(abs(x) for x in c)
     if size <= free:
-        return (ref,)
+        return _free(ref)
     if size == 0.0:
         return ()
     flip = abs(c[0]) < abs(c[-1])
     if flip:
         c.reverse()
     angles = []
-    while c[0] == 0.0:
+    while len(c) > 1 and abs(c[0]) <= _LEAD_TOL * size:
+        # both ends vanish (roots at u = 0 and u = infinity): the one at this end is exact
         c.pop(0)
         angles.append(0.0 if flip else math.pi)
     for x in _real_roots(c) if len(c) > 1 else ():
@@ -725,15 +764,16 @@ def _newton(c, x):
     return x
 
 
-def _vnew_axis(values, ok, like, axis):
-    """Broadcast a step's result (no branching) to the shape of `like` with ok combined."""
-    values, ok, _ = np.broadcast_arrays(values, ok, like)
-    return values, ok
+def _vnew_axis(values, ok, like, axis, free=False):
+    """Broadcast a step's result (no branching) to the shape of `like`: values, validity and
+    where the joint was free."""
+    values, ok, free, _ = np.broadcast_arrays(values, ok, free, like)
+    return values, ok, free
 
 
 def _vcs1(a, b, e, scale, ref, axis, like):
-    """Vectorised _cs1: two values along `axis` (+acos, then -acos) and their validity; where
-    the angle is free, ref as the first value and the second invalid."""
+    """Vectorised _cs1: two values along `axis` (+acos, then -acos), their validity and where
+    the joint was free (ref as the first value, the second invalid)."""
     a, b, e, ref, _ = np.broadcast_arrays(a, b, e, ref, like)
     rho = np.sqrt(a * a + b * b)
     small = rho * rho <= _FREE_TOL * scale
@@ -744,20 +784,19 @@ def _vcs1(a, b, e, scale, ref, axis, like):
     base = np.arctan2(b, a)
     delta = np.arccos(np.clip(np.where(ok, ratio, 0.0), -1.0, 1.0))
     return (np.concatenate((np.where(free, ref, base + delta), base - delta), axis),
-            np.concatenate((ok | free, ok), axis))
+            np.concatenate((ok | free, ok), axis),
+            np.concatenate((free, np.zeros_like(free)), axis))
 
 
 def _vcs1_reach(a, b, e, m00, m01, m02, m10, m11, m12, m20, m21, m22, lo, hi, scale, ref,
                 axis, like):
     """Vectorised _cs1_reach: _vcs1, with the (rare) free rows settled by the scalar routine."""
-    values, ok = _vcs1(a, b, e, scale, ref, axis, like)
+    values, ok, free = _vcs1(a, b, e, scale, ref, axis, like)
     args = np.broadcast_arrays(a, b, e, m00, m01, m02, m10, m11, m12, m20, m21, m22, ref, like)
-    a, b, e = args[:3]
-    free = (a * a + b * b <= _FREE_TOL * scale) & (e * e <= _FREE_TOL * scale)
     for index in zip(*np.nonzero(free)):
         row = [float(x[index]) for x in args[:12]]
         values[index] = _cs1_reach(*row, lo, hi, scale, float(args[12][index]))[0]
-    return values, ok
+    return values, ok, free
 
 
 def _vcs2(a1, b1, e1, a2, b2, e2, det_scale, rhs_scale, ref, axis, like):
@@ -766,7 +805,7 @@ def _vcs2(a1, b1, e1, a2, b2, e2, det_scale, rhs_scale, ref, axis, like):
     free = (np.abs(det) <= _FREE_TOL * det_scale) | (e1 * e1 + e2 * e2 <= _FREE_TOL * rhs_scale)
     with np.errstate(divide="ignore", invalid="ignore"):
         value = np.arctan2((a1 * e2 - a2 * e1) / det, (e1 * b2 - b1 * e2) / det)
-    return _vnew_axis(np.where(free, ref, value), True, like, axis)
+    return _vnew_axis(np.where(free, ref, value), True, like, axis, free)
 
 
 def _vcs2_reach(a1, b1, e1, a2, b2, e2, det_scale, rhs_scale, A, B, C, lo, hi, ref, axis, like):
@@ -783,13 +822,13 @@ def _vcs2_reach(a1, b1, e1, a2, b2, e2, det_scale, rhs_scale, A, B, C, lo, hi, r
     nearer = np.where(np.abs(_vwrap(plus - ref)) <= np.abs(_vwrap(minus - ref)), plus, minus)
     keep_ref = ((lo <= radius) & (radius <= hi)) | (rho == 0.0)
     chosen = np.where(keep_ref, ref, nearer)
-    return _vnew_axis(np.where(free, chosen, value), True, like, axis)
+    return _vnew_axis(np.where(free, chosen, value), True, like, axis, free)
 
 
 def _vatan2(y, x, ref, axis, like):
     """Vectorised _atan2."""
     free = np.abs(y) + np.abs(x) <= 1e-12
-    return _vnew_axis(np.where(free, ref, np.arctan2(y, x)), True, like, axis)
+    return _vnew_axis(np.where(free, ref, np.arctan2(y, x)), True, like, axis, free)
 
 
 def _vwrap(t):
@@ -802,12 +841,12 @@ def _vroots(p):
     """Real roots of the rows of p (m, d+1), p[:, 0] != 0, as _real_roots does per row.
 
     Returns (roots (m, d), valid (m, d), fallback (m,)): rows marked fallback (other degrees,
-    a zero leading coefficient, a closed-form root failing the residual test, a multiple root
+    a leading coefficient below _LEAD_TOL, a closed-form root failing the residual test, a multiple root
     split into a cluster) are to be solved by the scalar routine.
     """
     m, d = p.shape[0], p.shape[1] - 1
     lead = p[:, 0]
-    fallback = lead == 0.0
+    fallback = np.abs(lead) <= _LEAD_TOL * np.abs(p).max(axis=1)
     mon = p[:, 1:] / np.where(fallback, 1.0, lead)[:, None]
     if d == 2:
         zs = np.stack(_vquadratic(mon[:, 0].astype(complex), mon[:, 1].astype(complex)), axis=1)
@@ -914,7 +953,8 @@ def _vquartic(B, C, D, E):
 
 
 def _vpoly(coeffs, axis, like, angles, ref=0.0, free=0.0, unit=1.0):
-    """Vectorised _poly_angles (angles=True) or _poly_real: values along `axis`, validity.
+    """Vectorised _poly_angles (angles=True) or _poly_real: values along `axis`, validity and
+    where the joint was free.
 
     Rows the closed forms cannot settle are solved by the scalar routine, one by one.
     """
@@ -958,6 +998,7 @@ def _vpoly(coeffs, axis, like, angles, ref=0.0, free=0.0, unit=1.0):
     vanishing = scale <= free
     fallback |= vanishing
     refs = np.broadcast_to(ref, shape).ravel()
+    freed = np.zeros_like(ok)
     for i in np.flatnonzero(fallback & ((scale > 0.0) | vanishing)):
         if angles:
             values = _poly_angles(raw[i], float(refs[i]), free)
@@ -965,12 +1006,14 @@ def _vpoly(coeffs, axis, like, angles, ref=0.0, free=0.0, unit=1.0):
             values = _poly_real(raw[i], float(refs[i]), free, unit)
         x[i] = 0.0
         ok[i] = False
+        if values.__class__ is _Free:
+            values = values[:1]
+            freed[i, 0] = True
         x[i, :len(values)] = values
         ok[i, :len(values)] = True
     inner = shape[:axis] + shape[axis + 1:]
-    x = np.moveaxis(x.reshape(inner + (d,)), -1, axis)
-    ok = np.moveaxis(ok.reshape(inner + (d,)), -1, axis)
-    return x, ok
+    x, ok, freed = (np.moveaxis(v.reshape(inner + (d,)), -1, axis) for v in (x, ok, freed))
+    return x, ok, freed
 
 
 def _vpose(T):

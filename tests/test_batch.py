@@ -62,5 +62,6 @@ def test_multiple_roots_are_found_by_scalar_and_vectorised_routines(generated, c
     scalar = m._poly_real(coeffs)
     assert len(scalar) == len(roots)
     assert np.allclose(scalar, roots, atol=1e-9)
-    x, ok = m._vpoly(tuple(np.array([c]) for c in coeffs), 0, np.ones(1, bool), False)
+    x, ok, free = m._vpoly(tuple(np.array([c]) for c in coeffs), 0, np.ones(1, bool), False)
+    assert not free.any()
     assert np.allclose(np.sort(x[ok]), roots, atol=1e-9)

@@ -69,7 +69,9 @@ def test_random_planar_arms(text):
 # now clustered); 5: the wrist centre on axes 1 and 2 with a non-orthogonal wrist (theta1
 # and theta2 free, now chosen so the wrist can reach); 6: the same 5e-9 rad from that
 # configuration, where theta1 and theta2 are determined by terms of 1e-9 of the arm's size
-# (a joint is now free below 1e-7 of its equation's scale).
+# (a joint is now free below 1e-7 of its equation's scale); 7-9: non-orthogonal wrists where
+# a free joint's first value leaves the wrist unable to reach (now the next values are tried),
+# and a theta3 quartic whose two ends both vanish (roots at u = 0 and u = infinity).
 REGRESSIONS = (
     ("standard", "RRRPRR", 0.01,
      [(-90.0, 0.0, 0.0, 0.0), (-90.0, 0.0, 0.0, -180.0), (-90.0, 0.0, -0.008924, 0.0),
@@ -90,6 +92,15 @@ REGRESSIONS = (
     ("standard", "RRRRRR", 0.0,
      [(-90.0, 0.0, 0.0, 0.0), (0.0, 0.05, 0.0, 0.0), (0.0, 0.05, 0.0, 0.0),
       (30.0, 0.0, 0.0, 0.0), (-149.0, 0.0, 0.0, 0.0), (90.0, 0.0, 0.0, 0.0)]),
+    ("standard", "RRRRRR", 0.0,
+     [(15.0, 0.1, -0.339753, 90.0), (107.0, 0.1, 0.0, 0.0), (90.0, 0.0, 0.0, 90.0),
+      (90.0, 0.0, 0.1, 0.0), (15.0, 0.0, 0.0, 90.0), (-23.0, 0.268124, -0.115595, 0.0)]),
+    ("standard", "RRRRRR", 0.0,
+     [(90.0, 0.1, 0.0, 0.0), (107.0, 0.1, 0.0, 0.0), (90.0, 0.0, 0.0, 0.0),
+      (90.0, 0.0, 0.1, 0.0), (15.0, 0.0, 0.0, 0.0), (-90.0, 0.0, 0.0, 0.0)]),
+    ("standard", "RRRRRR", 0.0,
+     [(90.0, 1.0, 0.0, 0.0), (90.0, 1.0, 0.0, 0.0), (-90.0, 0.0, 0.0, 0.0),
+      (15.0, 0.0, 1.0, 0.0), (15.0, 0.0, 0.0, 0.0), (43.0, 0.0, 0.0, 0.0)]),
 )
 
 
