@@ -160,6 +160,9 @@ _ROOT_IMAG_TOL = 1e-6
 _RESIDUAL_TOL = 1e-8
 _MERGE_TOL = 1e-6
 _CLUSTER_TOL = 1e-3
+# a cos + b sin = e with |e| up to (1 + _CLAMP_TOL) sqrt(a^2 + b^2) is solved at the boundary:
+# earlier joints from a double root (elbow stretched) carry errors of ~1e-8
+_CLAMP_TOL = 1e-7
 _LEAD_TOL = 1e-10
 _OMEGA = (1.0, complex(-0.5, math.sqrt(3.0) / 2.0), complex(-0.5, -math.sqrt(3.0) / 2.0))
 _FREE_TOL = 1e-14  # squared sizes: a joint is free below 1e-7 of its equation's scale
@@ -469,7 +472,8 @@ def _free(t):
 
 
 def _cs1(a, b, e, scale=0.0, ref=0.0):
-    """Angles t with a cos t + b sin t = e: atan2(b, a) +- acos(e / sqrt(a^2 + b^2)).
+    """Angles t with a cos t + b sin t = e: atan2(b, a) +- acos(e / sqrt(a^2 + b^2)), the
+    acos argument clamped when it exceeds 1 by at most _CLAMP_TOL.
 
     When a^2 + b^2 and e^2 are both at most _FREE_TOL * scale the equation holds for every
     t (the angle is free; e.g. the elbow folded onto axis 1): _free(ref).
@@ -480,7 +484,7 @@ def _cs1(a, b, e, scale=0.0, ref=0.0):
     if rho == 0.0:
         return ()
     ratio = e / rho
-    if abs(ratio) > 1.0 + 1e-9:
+    if abs(ratio) > 1.0 + _CLAMP_TOL:
         return ()
     base = atan2(b, a)
     delta = acos(max(-1.0, min(1.0, ratio)))
@@ -780,7 +784,7 @@ def _vcs1(a, b, e, scale, ref, axis, like):
     free = small & (e * e <= _FREE_TOL * scale)
     with np.errstate(divide="ignore", invalid="ignore"):
         ratio = e / rho
-    ok = ~small & (rho > 0.0) & (np.abs(ratio) <= 1.0 + 1e-9)
+    ok = ~small & (rho > 0.0) & (np.abs(ratio) <= 1.0 + _CLAMP_TOL)
     base = np.arctan2(b, a)
     delta = np.arccos(np.clip(np.where(ok, ratio, 0.0), -1.0, 1.0))
     return (np.concatenate((np.where(free, ref, base + delta), base - delta), axis),
