@@ -69,12 +69,17 @@ def eaik_figures(module: ModuleType, poses: np.ndarray) -> dict:
         return {}
     if set(module.JOINT_TYPES) != {"R"} or module.DOF != 6:
         return {}
+    if "modified DH" in (module.__doc__ or ""):
+        return {"eaik_skipped": "EAIK's DhRobot takes standard DH; this arm is modified DH"}
     dh = np.array(module.DH)
-    robot = DhRobot(dh[:, 0], dh[:, 1], dh[:, 2])
     flange = [np.linalg.inv(module.BASE) @ T @ np.linalg.inv(module.TOOL) for T in poses]
-    single = median_us(robot.IK, [(T,) for T in flange[:2000]])
-    start = time.perf_counter()
-    robot.IK_batched(flange)
+    try:
+        robot = DhRobot(dh[:, 0], dh[:, 1], dh[:, 2])
+        single = median_us(robot.IK, [(T,) for T in flange[:2000]])
+        start = time.perf_counter()
+        robot.IK_batched(flange)
+    except (RuntimeError, ValueError) as exc:  # EAIK refuses arms it cannot decompose
+        return {"eaik_skipped": f"EAIK: {exc}"}
     batch = 1e6 * (time.perf_counter() - start) / len(flange)
     return {"eaik_ik_us": single, "eaik_batch_us": batch}
 

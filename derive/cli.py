@@ -303,6 +303,8 @@ def bench_text(name: str, f: dict) -> str:
     if "ik_batch_peak_mb" in f:
         line += (f"; ik_batch peak {f['ik_batch_peak_mb']:.0f} MB for {f['memory_n']} poses "
                  f"(input {f['input_mb']:.0f} MB)")
+    if "eaik_skipped" in f:
+        line += f"\n  {f['eaik_skipped']}"
     if "eaik_ik_us" in f:
         line += (f"\n  EAIK on the same poses: ik {f['eaik_ik_us']:.1f} us (ratio "
                  f"{f['ik_us'] / f['eaik_ik_us']:.1f}x), batch {f['eaik_batch_us']:.2f} us/pose "
