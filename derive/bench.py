@@ -10,6 +10,7 @@ import math
 import statistics
 import time
 import tracemalloc
+from functools import partial
 from types import ModuleType
 
 import numpy as np
@@ -28,12 +29,13 @@ def median_us(call, args_list: list) -> float:
 
 
 def batch_agreement(module: ModuleType, poses: np.ndarray) -> int:
-    """How many poses get exactly ik's solutions (same rows, same order, 1e-6) from ik_batch."""
+    """How many poses get exactly the Python ik's solutions (same rows, same order, 1e-6)
+    from ik_batch (default backend)."""
     Q, valid = module.ik_batch(poses)
     revolute = np.array([k == "R" for k in module.JOINT_TYPES])
     agree = 0
     for T, rows, ok in zip(poses, Q, valid):
-        single = module.ik(T)
+        single = module.ik(T, backend="python")
         batch = rows[ok]
         if single.shape == batch.shape:
             d = single - batch
@@ -42,14 +44,41 @@ def batch_agreement(module: ModuleType, poses: np.ndarray) -> int:
     return agree
 
 
-def batch_figures(module: ModuleType, n: int, seed: int, memory_n: int) -> dict:
-    """ik_batch microseconds per pose at n poses, and its peak memory at memory_n poses."""
+def compiled_backend(module: ModuleType, pose: np.ndarray) -> dict:
+    """Whether the compiled backend is there: its threads and the seconds its first calls took
+    (numba compiling, or loading its cache); empty without numba."""
+    try:
+        import numba
+    except ImportError:
+        return {}
+    start = time.perf_counter()
+    module.ik(pose, backend="numba")
+    module.ik_batch(pose[None], backend="numba")
+    return {"threads": numba.get_num_threads(), "compile_s": time.perf_counter() - start}
+
+
+def batch_us(module: ModuleType, poses: np.ndarray, **options) -> float:
+    """ik_batch microseconds per pose (after a warm-up call)."""
+    module.ik_batch(poses[:100], **options)
+    start = time.perf_counter()
+    module.ik_batch(poses, **options)
+    return 1e6 * (time.perf_counter() - start) / len(poses)
+
+
+def batch_figures(module: ModuleType, n: int, seed: int, memory_n: int, threads: int) -> dict:
+    """ik_batch microseconds per pose at n poses (default backend; with the compiled one also on
+    one thread, and the Python backend), and its peak memory at memory_n poses."""
     rng = np.random.default_rng(seed + 1)
     poses = module.fk_batch(sample_joints(module, n, rng))
-    module.ik_batch(poses[:100])
-    start = time.perf_counter()
-    module.ik_batch(poses)
-    figures = {"batch_n": n, "ik_batch_us": 1e6 * (time.perf_counter() - start) / n}
+    figures = {"batch_n": n, "ik_batch_us": batch_us(module, poses),
+               "ik_batch_python_us": batch_us(module, poses, backend="python")}
+    if threads:
+        import numba
+        numba.set_num_threads(1)
+        try:
+            figures["ik_batch_1thread_us"] = batch_us(module, poses)
+        finally:
+            numba.set_num_threads(threads)
     if memory_n:
         big = module.fk_batch(sample_joints(module, memory_n, rng))
         tracemalloc.start()
@@ -106,10 +135,14 @@ def measure(module: ModuleType, samples: int, seed: int = 0, batch_n: int = 100_
         "fk_us": median_us(module.fk, [(q,) for q in Q[:2000]]),
     }
     if hasattr(module, "ik"):
+        figures.update(compiled_backend(module, poses[0]))
+        figures["backend"] = "numba" if "threads" in figures else "python"
         module.ik(poses[0])
         figures["ik_us"] = median_us(module.ik, [(T,) for T in poses])
+        figures["ik_python_us"] = median_us(partial(module.ik, backend="python"),
+                                            [(T,) for T in poses])
         result = roundtrip(module, Q)
-        figures.update(batch_figures(module, batch_n, seed, memory_n))
+        figures.update(batch_figures(module, batch_n, seed, memory_n, figures.get("threads", 0)))
         figures["batch_agrees"] = batch_agreement(module, module.fk_batch(Q))
         if module.JOINT_TYPES == "RRRRRR" and module.DOF == 6:
             figures.update(eaik_figures(module, module.fk_batch(Q)))

@@ -72,7 +72,8 @@ def worked_example(plan: Plan, module: ModuleType) -> Example:
         shown = ", ".join(f"{math.degrees(v):g}" if t == "R" else f"{v:g}"
                           for v, t in zip(arm.example_q, arm.joint_types))
         how = f"the pose of q = ({shown}) (degrees for R joints)"
-    solutions = module.ik(pose) if hasattr(module, "ik") else ()
+    # one pose: the Python solver (compiling the numba one would cost seconds)
+    solutions = module.ik(pose, backend="python") if hasattr(module, "ik") else ()
     return Example(tuple(float(v) for v in pose.ravel()),
                    tuple(tuple(float(v) for v in row) for row in solutions), how)
 
@@ -241,7 +242,7 @@ def cmd_solve(args: argparse.Namespace) -> int:
             raise UsageError("--pose: give 12 numbers (3 rows of 4) or 16 (4 rows of 4)")
         pose = np.array(numbers[:12] + [0.0, 0.0, 0.0, 1.0]).reshape(4, 4)
     try:
-        sols = module.ik(pose)
+        sols = module.ik(pose, backend="python")  # one pose: not worth compiling
     except ValueError as exc:
         raise UsageError(f"--pose: {exc}") from None
     print("pose:")
@@ -298,10 +299,14 @@ def bench_text(name: str, f: dict) -> str:
     line = f"{name}: generate {f['generate_s']:.2f} s; fk {f['fk_us']:.1f} us"
     if "ik_us" not in f:
         return line
-    line += (f"; ik {f['ik_us']:.1f} us/pose (median); ik_batch {f['ik_batch_us']:.2f} us/pose "
-             f"at N = {f['batch_n']}")
+    if f["backend"] == "numba":
+        line += (f"\n  compiled (numba, {f['threads']} threads; first calls "
+                 f"{f['compile_s']:.1f} s): ik {f['ik_us']:.1f} us/pose (median); ik_batch {f['ik_batch_us']:.2f} us/pose "
+                 f"at N = {f['batch_n']}, {f['ik_batch_1thread_us']:.2f} on one thread")
+    line += (f"\n  python: ik {f['ik_python_us']:.1f} us/pose (median); ik_batch "
+             f"{f['ik_batch_python_us']:.2f} us/pose at N = {f['batch_n']}")
     if "ik_batch_peak_mb" in f:
-        line += (f"; ik_batch peak {f['ik_batch_peak_mb']:.0f} MB for {f['memory_n']} poses "
+        line += (f"\n  ik_batch peak {f['ik_batch_peak_mb']:.0f} MB for {f['memory_n']} poses "
                  f"(input {f['input_mb']:.0f} MB)")
     if "eaik_skipped" in f:
         line += f"\n  {f['eaik_skipped']}"
@@ -309,7 +314,7 @@ def bench_text(name: str, f: dict) -> str:
         line += (f"\n  EAIK on the same poses: ik {f['eaik_ik_us']:.1f} us (ratio "
                  f"{f['ik_us'] / f['eaik_ik_us']:.1f}x), batch {f['eaik_batch_us']:.2f} us/pose "
                  f"(ratio {f['ik_batch_us'] / f['eaik_batch_us']:.1f}x)")
-    return (line + f"\n  ik_batch equals ik on {f['batch_agrees']}/{f['samples']} poses"
+    return (line + f"\n  ik_batch equals the Python ik on {f['batch_agrees']}/{f['samples']} poses"
             f"\n  {f['summary']}")
 
 

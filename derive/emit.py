@@ -308,12 +308,15 @@ class PrintedModule:
     ik_body: tuple[tuple[int, str], ...]
     qref_names: str
     ik_batch_body: tuple[str, ...]
+    kernel_body: tuple[tuple[int, str], ...]
+    world_names: str
     match: str
     components: str
 
 
 def print_plan(plan: Plan) -> PrintedModule:
     """The printed IR of a plan."""
+    from derive import kernel  # kernel prints with this module's helpers: imported late
     arm = plan.arm
     scalar, vector = CodePrinter(), CodePrinter("np.")
     fk_pose_body, outputs = fk_pose_lines(plan)
@@ -349,6 +352,8 @@ def print_plan(plan: Plan) -> PrintedModule:
         ik_body=ik_lines(plan, scalar) if ik else (),
         qref_names=", ".join(f"qr{i}" for i in range(1, arm.dof + 1)),
         ik_batch_body=ik_batch_lines(plan, vector) if ik else (),
+        kernel_body=kernel.kernel_lines(plan, scalar) if ik else (),
+        world_names=", ".join(str(sym.world_pose()[i, j]) for i in range(3) for j in range(4)),
         match=match_expression(ik.certify) if ik else "",
         components=ik.certify if ik else "",
     )

@@ -139,14 +139,15 @@ def same_joints(a: np.ndarray, b: np.ndarray, revolute: np.ndarray, mask: np.nda
     return bool(np.all(d[mask] <= MATCH_TOL))
 
 
-def roundtrip(module: ModuleType, Q: np.ndarray) -> RoundTrip:
-    """Solve fk(q) for each row q of Q and collect the figures of :class:`RoundTrip`."""
+def roundtrip(module: ModuleType, Q: np.ndarray, backend: str | None = None) -> RoundTrip:
+    """Solve fk(q) for each row q of Q (with ik's `backend`) and collect the figures of
+    :class:`RoundTrip`."""
     out = RoundTrip()
     revolute = np.array([k == "R" for k in module.JOINT_TYPES])
     everything = np.ones(module.DOF, dtype=bool)
     for index, q in enumerate(Q):
         T = module.fk(q)
-        sols = module.ik(T)
+        sols = module.ik(T, backend=backend)
         out.samples += 1
         out.solutions += len(sols)
         out.counts[len(sols)] = out.counts.get(len(sols), 0) + 1

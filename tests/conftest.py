@@ -33,6 +33,11 @@ settings.register_profile("long", max_examples=2000, deadline=None,
 settings.load_profile("ci")
 
 
+# tests of the compiled solvers need numba, which the test extra installs
+needs_numba = pytest.mark.skipif(importlib.util.find_spec("numba") is None,
+                                 reason="numba is not installed (the test extra installs it)")
+
+
 def import_path(path: Path) -> ModuleType:
     """Import a Python file under a unique module name."""
     name = f"_derive_test_{path.stem}_{next(_counter)}"
@@ -60,7 +65,12 @@ def build_module(text: str, folder: Path) -> ModuleType:
     spec = parse_spec(text, "<test spec>")
     path = folder / f"{spec.name}_{next(_counter)}.py"
     path.write_text(render_module(build_plan(spec)), encoding="utf-8")
-    return import_path(path)
+    module = import_path(path)
+    if hasattr(module, "BACKEND"):
+        # numba would compile each throwaway arm's solver (seconds); tests of the compiled
+        # solver name backend="numba"
+        module.BACKEND = "python"
+    return module
 
 
 def spec_text(name: str, convention: str, rows: list[tuple], unit: str = "deg",

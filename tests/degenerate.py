@@ -21,15 +21,16 @@ PI = math.pi
 WORST = {"error": 0.0}
 
 
-def solve_checked(m: ModuleType, T: np.ndarray) -> np.ndarray:
-    """ik(T) with warnings as errors; asserts no NaN and soundness; returns the solutions.
+def solve_checked(m: ModuleType, T: np.ndarray, backend: str | None = None) -> np.ndarray:
+    """ik(T) and ik_batch (with `backend`) with warnings as errors; asserts no NaN, soundness
+    and that the two agree; returns ik's solutions.
 
     The largest pose error seen is kept in WORST["error"] (rotation rad, position / REACH).
     """
     with warnings.catch_warnings():
         warnings.simplefilter("error")
-        sols = m.ik(T)
-        batch, valid = m.ik_batch(T[None])
+        sols = m.ik(T, backend=backend)
+        batch, valid = m.ik_batch(T[None], backend=backend)
     rows = batch[0][valid[0]]
     assert not np.isnan(sols).any() and not np.isnan(batch).any()
     for s in list(sols) + list(rows):
@@ -92,8 +93,9 @@ def elbow_singularities(m: ModuleType, q: np.ndarray, joint: int) -> list[np.nda
 
 
 def run_suite(m: ModuleType, elbow: int, pi_joints: list[int], wrist: int | None,
-              rng: np.random.Generator) -> dict:
-    """Every degenerate construction for one solver; returns counts of what was checked."""
+              rng: np.random.Generator, backend: str | None = None) -> dict:
+    """Every degenerate construction for one solver (solved with `backend`); returns counts of
+    what was checked."""
     counts = {"wrist": 0, "elbow": 0, "pi": 0, "boundary": 0}
     base = rng.uniform(-2.5, 2.5, m.DOF)
     base[[k for k, t in enumerate(m.JOINT_TYPES) if t == "P"]] = 0.0
@@ -102,26 +104,26 @@ def run_suite(m: ModuleType, elbow: int, pi_joints: list[int], wrist: int | None
             q = base.copy()
             q[wrist - 1] = theta_to_q(m, wrist, theta)
             T = m.fk(q)
-            sols = solve_checked(m, T)
+            sols = solve_checked(m, T, backend)
             assert len(sols) > 0
             counts["wrist"] += 1
     for joint in pi_joints:
         q = base.copy()
         q[joint - 1] = theta_to_q(m, joint, PI)
-        sols = solve_checked(m, m.fk(q))
+        sols = solve_checked(m, m.fk(q), backend)
         assert len(sols) > 0
         if jacobian_nullity(m, q)[0] >= 1e-6:  # at a singular q only the pose must be kept
             assert contains(m, sols, q), (joint, q)
         counts["pi"] += 1
     for q in elbow_singularities(m, base, elbow):
         T = m.fk(q)
-        sols = solve_checked(m, T)
+        sols = solve_checked(m, T, backend)
         assert len(sols) > 0
         counts["elbow"] += 1
         for axis in range(3):
             for sign in (1.0, -1.0):
                 moved = T.copy()
                 moved[axis, 3] += sign * 1e-12 * m.REACH
-                solve_checked(m, moved)
+                solve_checked(m, moved, backend)
                 counts["boundary"] += 1
     return counts

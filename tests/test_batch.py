@@ -3,12 +3,13 @@
 from __future__ import annotations
 
 import math
+from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
 import pytest
 
 from derive.verify import sample_joints
-from conftest import BUNDLED
+from conftest import BUNDLED, needs_numba
 
 
 def same_rows(a: np.ndarray, b: np.ndarray, revolute: np.ndarray, tol: float) -> bool:
@@ -31,6 +32,70 @@ def test_ik_batch_equals_ik_pose_by_pose(generated, name):
         # same set, same order; values agree to 1e-6 (at singular poses the scalar and the
         # vectorised arithmetic differ by ~1e-8)
         assert same_rows(m.ik(T[i]), batch[i][valid[i]], revolute, 1e-6), i
+
+
+@needs_numba
+@pytest.mark.parametrize("name", BUNDLED)
+def test_backends_give_the_same_solutions(generated, name):
+    """The compiled solver (numba) and the Python one: ik and ik_batch, the same rows in the
+    same order, on random poses (20% of joints at degenerate values)."""
+    m = generated(name)
+    Q = sample_joints(m, 300, np.random.default_rng(37))
+    T = m.fk_batch(Q)
+    revolute = np.array([k == "R" for k in m.JOINT_TYPES])
+    compiled, valid_c = m.ik_batch(T, backend="numba")
+    vector, valid_v = m.ik_batch(T, backend="python")
+    assert np.array_equal(valid_c, valid_v)
+    for i in range(len(T)):
+        reference = m.ik(T[i], backend="python")
+        assert same_rows(reference, m.ik(T[i], backend="numba"), revolute, 1e-6), i
+        assert same_rows(reference, compiled[i][valid_c[i]], revolute, 1e-6), i
+        assert same_rows(reference, vector[i][valid_v[i]], revolute, 1e-6), i
+        assert not compiled[i][~valid_c[i]].any()
+
+
+@needs_numba
+def test_compiled_solver_takes_free_joints_from_q_ref(generated):
+    """At a singular wrist theta4 is free: the compiled solver settles the pose itself, with
+    theta4 from q_ref, exactly as the Python solver does."""
+    m = generated("puma560")
+    q = np.radians([20.0, -30.0, 40.0, 10.0, 0.0, 25.0])
+    T = m.fk(q)
+    q_ref = np.radians([0.0, 0.0, 0.0, 33.0, 0.0, 0.0])
+    rows, settled = m._compile()[1](*T[:3].ravel(), m.CERTIFY_TOL, tuple(q_ref))
+    assert settled
+    expected = m.ik(T, q_ref=q_ref, backend="python")
+    assert np.isclose(expected[:, 3], math.radians(33.0)).any()  # the singular branch
+    revolute = np.ones(6, dtype=bool)
+    assert same_rows(expected, rows, revolute, 1e-9)
+    assert same_rows(expected, m.ik(T, q_ref=q_ref, backend="numba"), revolute, 1e-9)
+    Qb, valid = m.ik_batch(T[None], q_ref=q_ref, backend="numba")
+    assert same_rows(expected, Qb[0][valid[0]], revolute, 1e-9)
+
+
+@needs_numba
+def test_compiled_batch_from_several_threads_at_once(generated):
+    """numba's default thread pool aborts the process if entered twice at once: ik_batch
+    serialises its compiled calls, so threads get their own correct results."""
+    m = generated("puma560")
+    T = m.fk_batch(sample_joints(m, 3000, np.random.default_rng(41)))
+    expected = m.ik_batch(T, backend="numba")
+    with ThreadPoolExecutor(4) as pool:
+        results = list(pool.map(lambda _: m.ik_batch(T, backend="numba"), range(8)))
+    for Q, valid in results:
+        assert np.array_equal(Q, expected[0]) and np.array_equal(valid, expected[1])
+
+
+def test_backend_argument_is_checked(generated, monkeypatch):
+    m = generated("planar_2r")
+    with pytest.raises(ValueError, match="backend"):
+        m.ik(np.eye(4), backend="fortran")
+    with pytest.raises(ValueError, match="backend"):
+        m.ik_batch(np.eye(4)[None], backend="C")
+    monkeypatch.setattr(m, "_compiled", False)  # as in a process without numba
+    with pytest.raises(ImportError, match="numba"):
+        m.ik(np.eye(4), backend="numba")
+    assert m.ik_batch(np.eye(4)[None])[1].any()  # "auto" falls back to the Python solver
 
 
 def test_ik_batch_marks_invalid_poses_per_row(generated):

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from degenerate import WORST, contains, run_suite, solve_checked
-from conftest import build_module, spec_text
+from conftest import build_module, needs_numba, spec_text
 
 # arm -> (elbow joint, joints solved by a half-angle step or a cs1 step, wrist joint)
 BUNDLED_SUITES = {
@@ -21,10 +21,12 @@ BUNDLED_SUITES = {
 }
 
 
+@pytest.mark.parametrize("backend", ["python", pytest.param("numba", marks=needs_numba)])
 @pytest.mark.parametrize("name", sorted(BUNDLED_SUITES))
-def test_degenerate_suite_of_bundled_arm(generated, name):
+def test_degenerate_suite_of_bundled_arm(generated, name, backend):
     elbow, pi_joints, wrist = BUNDLED_SUITES[name]
-    counts = run_suite(generated(name), elbow, pi_joints, wrist, np.random.default_rng(3))
+    counts = run_suite(generated(name), elbow, pi_joints, wrist, np.random.default_rng(3),
+                       backend)
     print(name, counts, f"worst error so far {WORST['error']:.1e}")
     assert counts["elbow"] >= 2 and counts["boundary"] >= 12
     assert counts["pi"] == len(pi_joints)

@@ -15,25 +15,29 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from hypothesis import given
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
 
 from derive.pipeline import build_plan
 from derive.spec import parse_spec
 from derive.verify import roundtrip, sample_joints
 from degenerate import run_suite
-from conftest import build_module, spec_text
+from conftest import build_module, needs_numba, spec_text
 from strategies import parallel_arms, pieper_arms, planar_arms
 
 
-def verify_family(text: str, methods: tuple[str, ...], elbow: int, wrist: int | None) -> None:
-    """Generate, import and verify one arm; `methods` are those its family may be solved by."""
+def verify_family(text: str, methods: tuple[str, ...], elbow: int, wrist: int | None,
+                  backend: str = "python") -> None:
+    """Generate, import and verify one arm with ik's `backend`; `methods` are those its
+    family may be solved by. The Python solver is the default: numba compiles a solver in
+    seconds, too slow for hundreds of arms; COMPILED below checks fewer arms compiled."""
     plan = build_plan(parse_spec(text, "<hypothesis>"))
     assert plan.ik is not None, (plan.refusal, text)
     assert plan.ik.method in methods, (plan.ik.method, text)
     with tempfile.TemporaryDirectory() as tmp:
         m = build_module(text, Path(tmp))
     rng = np.random.default_rng(zlib.crc32(text.encode()))  # the same on every run
-    result = roundtrip(m, sample_joints(m, 12, rng))
+    result = roundtrip(m, sample_joints(m, 12, rng), backend)
     assert result.unsound == [], (result.summary(), text)
     assert result.misses == [], (result.summary(), text)
     assert result.singular_posed == result.singular, (result.summary(), text)
@@ -42,7 +46,7 @@ def verify_family(text: str, methods: tuple[str, ...], elbow: int, wrist: int | 
     # theta = pi for each revolute joint solved by a step (a prismatic joint has no pi)
     solved = [arm(s.joint) for s in plan.ik.steps
               if hasattr(s, "joint") and m.JOINT_TYPES[arm(s.joint) - 1] == "R"]
-    run_suite(m, arm(elbow), solved, None if wrist is None else arm(wrist), rng)
+    run_suite(m, arm(elbow), solved, None if wrist is None else arm(wrist), rng, backend)
 
 
 @given(pieper_arms())
@@ -59,6 +63,25 @@ def test_random_three_parallel_arms(text):
 @given(planar_arms())
 def test_random_planar_arms(text):
     verify_family(text, ("planar",), 2, None)
+
+
+# The compiled solvers (numba) of a few random arms per family, through the same checks.
+COMPILED = settings(max_examples=3, deadline=None, derandomize=True,
+                    suppress_health_check=[HealthCheck.too_slow])
+
+
+@needs_numba
+@COMPILED
+@given(st.one_of(pieper_arms(), parallel_arms()))
+def test_compiled_random_spatial_arms(text):
+    verify_family(text, ("pieper", "three-parallel"), 3, 5, backend="numba")
+
+
+@needs_numba
+@COMPILED
+@given(planar_arms())
+def test_compiled_random_planar_arms(text):
+    verify_family(text, ("planar",), 2, None, backend="numba")
 
 
 # Arms the property tests once found failing, kept as fixed cases. 1 and 3: reversed chains
@@ -110,11 +133,12 @@ REGRESSIONS = (
 )
 
 
+@pytest.mark.parametrize("backend", ["python", pytest.param("numba", marks=needs_numba)])
 @pytest.mark.parametrize("convention, kinds, travel, rows", REGRESSIONS)
-def test_regression_arms(convention, kinds, travel, rows):
+def test_regression_arms(convention, kinds, travel, rows, backend):
     text = spec_text("regression_arm", convention, rows, kinds=kinds)
     text = text.replace('type = "P"\n', f'type = "P"\nlimits = [{-travel}, {travel}]\n')
-    verify_family(text, ("pieper", "three-parallel"), 3, 5)
+    verify_family(text, ("pieper", "three-parallel"), 3, 5, backend)
 
 
 KNOWN_GAP = ("modified", "RRRRRR", 0.0,
