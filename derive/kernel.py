@@ -76,10 +76,13 @@ def kernel_solve_lines(step: Solve, names: sp.utilities.iterables.numbered_symbo
         at = 32 * (j - 1)
         call = f"_kpoly(({', '.join(values)},), {angles}, {free}, {unit!r}, buf[{at}:{at + 32}])"
         head = [f"_n{j} = {call}", f"_f{j} = _n{j} == -2", f"if _f{j}:", f"    _n{j} = 1",
-                f"    buf[{at}] = {ref}", f"elif _n{j} < 0:", "    return -1", f"_m{j} = n",
-                f"for _k{j} in range(_n{j}):", f"    {var} = buf[{at} + _k{j}]"]
+                f"    buf[{at}] = {ref}"]
         if angles:
-            head += [f"    c{j} = cos({var})", f"    s{j} = sin({var})"]
+            head += [f"    buf[{at + 20}], buf[{at + 24}] = cos({ref}), sin({ref})"]
+        head += [f"elif _n{j} < 0:", "    return -1", f"_m{j} = n",
+                 f"for _k{j} in range(_n{j}):", f"    {var} = buf[{at} + _k{j}]"]
+        if angles:
+            head += [f"    c{j} = buf[{at + 20} + _k{j}]", f"    s{j} = buf[{at + 24} + _k{j}]"]
     elif step.kind in ("cs1", "cs1r"):
         call = (f"_kcs1({', '.join(values[:3])}, {step.scale!r})" if step.kind == "cs1"
                 else f"_kcs1r({', '.join(values)}, {step.scale!r}, {ref})")

@@ -386,8 +386,10 @@ def ik_batch(T, *, q_ref=None, tol=CERTIFY_TOL, chunk=4096, backend=None):
         raise ValueError(f"T must have shape (N, 4, 4), got {T.shape}")
     refs = _reference(q_ref)
     n = T.shape[0]
-    Q = np.zeros((n, 8, DOF))
-    valid = np.zeros((n, 8), dtype=bool)
+    # np.full writes its memory here: np.zeros would leave the page faults to the kernel's
+    # threads, which contend for them (about a third of the kernel's time)
+    Q = np.full((n, 8, DOF), 0.0)
+    valid = np.full((n, 8), False)
     retry = np.zeros(n, dtype=bool)
     with _BATCH_LOCK:  # numba's default thread pool must not be entered twice at once
         kernels[0](T, float(tol), refs, Q, valid, retry)
@@ -1260,13 +1262,14 @@ def _ksolve(w11, w12, w13, wx, w21, w22, w23, wy, w31, w32, w33, wz, tol, qref, 
     if _f3:
         _n3 = 1
         buf[64] = qr3
+        buf[84], buf[88] = cos(qr3), sin(qr3)
     elif _n3 < 0:
         return -1
     _m3 = n
     for _k3 in range(_n3):
         theta3 = buf[64 + _k3]
-        c3 = cos(theta3)
-        s3 = sin(theta3)
+        c3 = buf[84 + _k3]
+        s3 = buf[88 + _k3]
         # theta2: r and z equations, linear in (c2, s2)
         theta2, c2, s2, _st = _kcs2(2400.0*c3 + 20280.0*s3 - 20400.0, 20280.0*c3 - 2400.0*s3, 27200.0*c3 + r + 229840.0*s3 - 232344.0, -338.0*c3 + 40.0*s3, 40.0*c3 + 338.0*s3 - 340.0, z, 33570240.0, 0.0)
         _f2 = _st == 1
@@ -1350,13 +1353,15 @@ def _ksolve(w11, w12, w13, wx, w21, w22, w23, wy, w31, w32, w33, wz, tol, qref, 
 
 
 # --- compiled kernel -------------------------------------------------------------------------
-# The functions below are plain Python written in the subset numba compiles (the Python
-# solver shares the quadratic and quartic closed forms). When numba is
-# installed, ik_batch compiles them once (cached beside this file) and solves every pose in
-# one compiled loop. They follow the scalar solver step by step; a pose they cannot settle
-# with the closed forms alone (a free joint, a polynomial of another degree, a root failing
-# the residual test, a split multiple root) is marked and solved by ik, so the solution sets
-# are ik's.
+# The functions below are plain Python written in the subset numba compiles. With numba
+# installed, ik and ik_batch compile them once per process and solve each pose (ik_batch:
+# every pose, on every core) in compiled code. They follow the Python solver step by step,
+# free joints included (a free joint takes its first value; the Python solver's further
+# values are its business). A pose they cannot settle with the closed forms (a polynomial
+# of another degree, a root failing the residual test, a split multiple root, a free joint
+# whose first value gives no solution) goes to the Python solver, so the solutions are its.
+# Real polynomials are solved in real arithmetic (about four times faster than the complex
+# closed forms the Python solver uses, which remain the fallback).
 
 def _kpose_ok(T, i):
     """Whether T[i] is a finite rigid transform within POSE_TOL (as _vpose)."""
@@ -1510,6 +1515,62 @@ def _ksort(x, n):
         x[j + 1] = v
 
 
+def _kquadratic_real(b, c):
+    """Both roots of x^2 + b x + c for real b, c, without cancellation, as complex numbers
+    (a complex pair where the discriminant is negative)."""
+    disc = b * b - 4.0 * c
+    if disc < 0.0:
+        re, im = -0.5 * b, 0.5 * sqrt(-disc)
+        return complex(re, im), complex(re, -im)
+    q = -0.5 * (b + math.copysign(sqrt(disc), b))
+    if q == 0.0:
+        return complex(0.0, 0.0), complex(0.0, 0.0)
+    return complex(q, 0.0), complex(c / q, 0.0)
+
+
+def _kquartic_real(B, C, D, E):
+    """The four roots of x^4 + B x^3 + C x^2 + D x + E for real coefficients (Ferrari in real
+    arithmetic: the resolvent cubic's largest real root, polished by Newton, then two real
+    quadratics); where that root is not positive or is ill-conditioned, _kquartic's complex
+    arithmetic."""
+    a = B / 4.0
+    p = C - 6.0 * a * a
+    q = D - 2.0 * a * C + 8.0 * a * a * a
+    r = E - a * D + a * a * C - 3.0 * a * a * a * a
+    a2, a1, a0 = p, p * p / 4.0 - r, -q * q / 8.0
+    P = a1 - a2 * a2 / 3.0
+    Q = 2.0 * a2 * a2 * a2 / 27.0 - a2 * a1 / 3.0 + a0
+    delta = Q * Q / 4.0 + P * P * P / 27.0
+    if delta > 0.0:
+        w = -0.5 * Q - math.copysign(sqrt(delta), Q)
+        A = math.copysign(abs(w) ** (1.0 / 3.0), w)
+        z = A - P / (3.0 * A) if A != 0.0 else 0.0
+    elif sqrt(max(0.0, -P / 3.0)) > 0.0:
+        rho = sqrt(-P / 3.0)
+        cos3 = max(-1.0, min(1.0, -0.5 * Q / rho / rho / rho))
+        z = 2.0 * rho * math.cos(acos(cos3) / 3.0)
+    else:
+        z = 0.0
+    m = z - a2 / 3.0
+    # m a (near) multiple root of the cubic (the quartic has a multiple root) is
+    # ill-conditioned in real arithmetic, as is m <= 0
+    slope = (3.0 * m + 2.0 * a2) * m + a1
+    if not m > 0.0 or abs(slope) <= 1e-3 * (3.0 * m * m + abs(2.0 * a2 * m) + abs(a1)):
+        return _kquartic(complex(B), complex(C), complex(D), complex(E))
+    for _ in range(2):
+        slope = (3.0 * m + 2.0 * a2) * m + a1
+        step = (((m + a2) * m + a1) * m + a0) / slope if slope != 0.0 else 0.0
+        if abs(step) <= 1e-3 * (1.0 + abs(m)):
+            m -= step
+    s = sqrt(2.0 * max(m, 0.0))
+    if not s > 0.0:
+        return _kquartic(complex(B), complex(C), complex(D), complex(E))
+    h = q / (2.0 * s)
+    y1, y2 = _kquadratic_real(-s, p / 2.0 + m + h)
+    y3, y4 = _kquadratic_real(s, p / 2.0 + m - h)
+    return y1 - a, y2 - a, y3 - a, y4 - a
+
+
 def _kroots(p, out, xs):
     """_real_roots for the closed forms (degrees 1, 2 and 4): the count of ascending roots
     written to out, or -1 where _real_roots would need numpy.roots or clusters. xs: scratch."""
@@ -1523,11 +1584,10 @@ def _kroots(p, out, xs):
     if d == 1:
         zs = (complex(-p[1] / p[0]), zero, zero, zero)
     elif d == 2:
-        z0, z1 = _kquadratic(complex(p[1] / p[0]), complex(p[2] / p[0]))
+        z0, z1 = _kquadratic_real(p[1] / p[0], p[2] / p[0])
         zs = (z0, z1, zero, zero)
     else:
-        zs = _kquartic(complex(p[1] / p[0]), complex(p[2] / p[0]),
-                       complex(p[3] / p[0]), complex(p[4] / p[0]))
+        zs = _kquartic_real(p[1] / p[0], p[2] / p[0], p[3] / p[0], p[4] / p[0])
     n = 0
     for k in range(d):
         z = zs[k]
@@ -1556,8 +1616,9 @@ def _kroots(p, out, xs):
 
 def _kpoly(coeffs, angles, free, unit, buf):
     """_poly_angles (angles) or _poly_real: the count of values written to buf[:d]; -2 where
-    the polynomial vanishes (the joint is free), -1 where the closed forms do not apply. buf (32 long) is the step's own scratch: the values stay
-    there while later steps run."""
+    the polynomial vanishes (the joint is free), -1 where the closed forms do not apply.
+    buf (32 long) is the step's own scratch: the values stay there (for angles, their cos
+    and sin at buf[20 + k] and buf[24 + k]) while later steps run."""
     d = len(coeffs) - 1
     size = 0.0
     for k in range(d + 1):
@@ -1577,13 +1638,26 @@ def _kpoly(coeffs, angles, free, unit, buf):
         return -1
     count = 0
     if angles:
+        # cos and sin of t = 2 atan(u) (u = 1 / v when flipped) from u itself, at buf[20:24]
+        # and buf[24:28], kept beside the angles through sorting and merging
+        cos_t, sin_t = buf[20:24], buf[24:28]
         for k in range(n):
-            t = _kwrap(2.0 * atan2(1.0, x[k]) if flip else 2.0 * math.atan(x[k]))
+            u = x[k]
+            t = _kwrap(2.0 * atan2(1.0, u) if flip else 2.0 * math.atan(u))
             x[k] = math.pi if math.pi - abs(t) <= 1e-12 else t
-        _ksort(x, n)
+            w = 1.0 / (1.0 + u * u)
+            cos_t[k] = (u * u - 1.0) * w if flip else (1.0 - u * u) * w
+            sin_t[k] = 2.0 * u * w
+        for k in range(1, n):  # insertion sort by angle, carrying cos and sin
+            t, c, s = x[k], cos_t[k], sin_t[k]
+            j = k - 1
+            while j >= 0 and x[j] > t:
+                x[j + 1], cos_t[j + 1], sin_t[j + 1] = x[j], cos_t[j], sin_t[j]
+                j -= 1
+            x[j + 1], cos_t[j + 1], sin_t[j + 1] = t, c, s
         for k in range(n):
             if count == 0 or x[k] - values[count - 1] > 1e-12:
-                values[count] = x[k]
+                values[count], cos_t[count], sin_t[count] = x[k], cos_t[k], sin_t[k]
                 count += 1
     else:
         for k in range(n):
@@ -1686,7 +1760,8 @@ def _kfk_q(q):
 
 
 _KERNEL = ("_kpose_ok", "_kcs1", "_kcs2", "_kcs1r", "_kcs2r", "_katan2", "_kwrap", "_kquadratic",
-           "_kcubic_largest", "_kquartic", "_ksort", "_kroots", "_kpoly", "_kdistinct", "_kfinish", "_kone", "_ksolve",
+           "_kcubic_largest", "_kquartic", "_kquadratic_real", "_kquartic_real", "_ksort",
+           "_kroots", "_kpoly", "_kdistinct", "_kfinish", "_kone", "_ksolve",
            "_kbatch", "_knewton", "_ksmall_residual", "_kfk", "_kfk_q")
 _compiled = None
 _BATCH_LOCK = threading.Lock()
