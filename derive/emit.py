@@ -214,15 +214,25 @@ def ik_batch_lines(plan: Plan, printer: CodePrinter) -> tuple[str, ...]:
     return tuple(lines)
 
 
+def step_arguments(step: Solve, names: sp.utilities.iterables.numbered_symbols,
+                   printer: CodePrinter, depth: int) -> tuple[list[Line], list[str]]:
+    """A Solve step's note and the CSE'd temporaries of its arguments, and the arguments'
+    printed expressions (in terms of those temporaries)."""
+    arg_names = tuple(sym.named(f"arg{k}") for k in range(len(step.args)))
+    temps = assign_lines(arg_names, step.args, names, printer, depth)
+    lines = [Line(depth, f"# {step.note}")]
+    lines += [ln for ln in temps if not ln.text.startswith("arg")]
+    args = {ln.text.split(" = ")[0]: ln.text.split(" = ", 1)[1] for ln in temps
+            if ln.text.startswith("arg")}
+    return lines, [args[str(a)] for a in arg_names]
+
+
 def batch_solve_lines(step: Solve, names: sp.utilities.iterables.numbered_symbols,
                       printer: CodePrinter, level: int) -> list[str]:
     """One Solve step of the vectorised IK: its values along axis `level`, validity combined."""
-    arg_names = tuple(sym.named(f"arg{k}") for k in range(len(step.args)))
-    temps = assign_lines(arg_names, step.args, names, printer, 0)
-    lines = [f"# {step.note}"] + [ln.text for ln in temps if not ln.text.startswith("arg")]
-    args = {ln.text.split(" = ")[0]: ln.text.split(" = ", 1)[1] for ln in temps
-            if ln.text.startswith("arg")}
-    joined = ", ".join(args[str(a)] for a in arg_names)
+    head, values = step_arguments(step, names, printer, 0)
+    lines = [ln.text for ln in head]
+    joined = ", ".join(values)
     ref = printer.doprint(step.ref)
     free = repr(1e-10 * step.scale)
     var = f"d{step.joint}" if step.kind == "polyd" else f"theta{step.joint}"
@@ -245,13 +255,7 @@ def batch_solve_lines(step: Solve, names: sp.utilities.iterables.numbered_symbol
 def solve_lines(step: Solve, names: sp.utilities.iterables.numbered_symbols,
                 printer: CodePrinter, depth: int) -> list[Line]:
     """The loop header of one Solve step, with its arguments CSE'd before it."""
-    arg_names = tuple(sym.named(f"arg{k}") for k in range(len(step.args)))
-    temps = assign_lines(arg_names, step.args, names, printer, depth)
-    lines = [Line(depth, f"# {step.note}")]
-    lines += [ln for ln in temps if not ln.text.startswith("arg")]
-    args = {ln.text.split(" = ")[0]: ln.text.split(" = ", 1)[1] for ln in temps
-            if ln.text.startswith("arg")}
-    values = [args[str(a)] for a in arg_names]
+    lines, values = step_arguments(step, names, printer, depth)
     ref = printer.doprint(step.ref)
     free = repr(1e-10 * step.scale)
     joined = ", ".join(values)

@@ -12,7 +12,7 @@ import sympy as sp
 
 from derive import symbols as sym
 from derive.emit import (CodePrinter, Line, assign_lines, cs_arguments, match_expression,
-                         same_joints)
+                         same_joints, step_arguments)
 from derive.plan import Assign, Plan, Solve
 
 
@@ -59,13 +59,7 @@ def kernel_solve_lines(step: Solve, names: sp.utilities.iterables.numbered_symbo
                        printer: CodePrinter, depth: int) -> list[Line]:
     """One Solve step of _ksolve: its values (a loop for polynomials and a c + b s = e, one
     value otherwise), ref where the joint is free (_f{joint}), n marked before (_m{joint})."""
-    arg_names = tuple(sym.named(f"arg{k}") for k in range(len(step.args)))
-    temps = assign_lines(arg_names, step.args, names, printer, depth)
-    lines = [Line(depth, f"# {step.note}")]
-    lines += [ln for ln in temps if not ln.text.startswith("arg")]
-    args = {ln.text.split(" = ")[0]: ln.text.split(" = ", 1)[1] for ln in temps
-            if ln.text.startswith("arg")}
-    values = [args[str(a)] for a in arg_names]
+    lines, values = step_arguments(step, names, printer, depth)
     j = step.joint
     var = f"d{j}" if step.kind == "polyd" else f"theta{j}"
     ref = printer.doprint(step.ref)

@@ -498,22 +498,12 @@ def _cs1(a, b, e, scale=0.0, ref=0.0):
 
 
 def _cs1_reach(a, b, e, m00, m01, m02, m10, m11, m12, m20, m21, m22, lo, hi, scale, ref):
-    """As _cs1; a free t is the first, in 5 degree steps out from ref, at which some t' keeps
-    W = (m00 + m01 c + m02 s) + (m10 + m11 c + m12 s) c' + (m20 + m21 c + m22 s) s' in
-    [lo, hi] (c, s of t and c', s' of t': the next joint must still let the wrist reach)."""
+    """As _cs1; a free t starts at the first value _reach_first1 finds (the next joint must
+    still let the wrist reach)."""
     rho = sqrt(a * a + b * b)
     if rho * rho > _FREE_TOL * scale or e * e > _FREE_TOL * scale:
         return _cs1(a, b, e, scale, ref)
-    for step in _FREE_STEPS:
-        t = ref + step
-        c, s = cos(t), sin(t)
-        A = m00 + m01 * c + m02 * s
-        B = m10 + m11 * c + m12 * s
-        C = m20 + m21 * c + m22 * s
-        r = sqrt(B * B + C * C)
-        if A - r <= hi and A + r >= lo:
-            return _free(t)
-    return _free(ref)
+    return _free(_reach_first1(m00, m01, m02, m10, m11, m12, m20, m21, m22, lo, hi, ref))
 
 
 def _cs2(a1, b1, e1, a2, b2, e2, det_scale, rhs_scale, ref):
@@ -529,19 +519,11 @@ def _cs2(a1, b1, e1, a2, b2, e2, det_scale, rhs_scale, ref):
 
 
 def _cs2_reach(a1, b1, e1, a2, b2, e2, det_scale, rhs_scale, A, B, C, lo, hi, ref):
-    """As _cs2; a free t keeps A + B cos t + C sin t in [lo, hi] (reachability of later joints)."""
+    """As _cs2; a free t starts at _reach_first2's value (reachability of later joints)."""
     det = a1 * b2 - a2 * b1
     if abs(det) > _FREE_TOL * det_scale and e1 * e1 + e2 * e2 > _FREE_TOL * rhs_scale:
         return (atan2((a1 * e2 - a2 * e1) / det, (e1 * b2 - b1 * e2) / det),)
-    if lo <= A + B * cos(ref) + C * sin(ref) <= hi:
-        return _free(ref)
-    rho = sqrt(B * B + C * C)
-    if rho == 0.0:
-        return _free(ref)
-    mid = 0.5 * (lo + hi)
-    base = atan2(C, B)
-    delta = acos(max(-1.0, min(1.0, (mid - A) / rho)))
-    return _free(min((base + delta, base - delta), key=lambda t: abs(_wrap(t - ref))))
+    return _free(_reach_first2(A, B, C, lo, hi, ref))
 
 
 def _atan2(y, x, ref):
@@ -1124,11 +1106,11 @@ def _kcs2(a1, b1, e1, a2, b2, e2, det_scale, rhs_scale):
     return _katan2((a1 * e2 - a2 * e1) / det, (e1 * b2 - b1 * e2) / det)
 
 
-def _kcs1r(a, b, e, m00, m01, m02, m10, m11, m12, m20, m21, m22, lo, hi, scale, ref):
-    """_cs1_reach as _kcs1 does _cs1; a free angle comes as its one first value."""
-    n, t0, c0, s0, t1, c1, s1, status = _kcs1(a, b, e, scale)
-    if status == 0:
-        return n, t0, c0, s0, t1, c1, s1, 0
+def _reach_first1(m00, m01, m02, m10, m11, m12, m20, m21, m22, lo, hi, ref):
+    """The first value of a free t, in 5 degree steps out from ref, at which some t' keeps
+    W = (m00 + m01 c + m02 s) + (m10 + m11 c + m12 s) c' + (m20 + m21 c + m22 s) s' in
+    [lo, hi] (c, s of t and c', s' of t': the next joint must still let the wrist reach);
+    ref if there is none."""
     for step in _FREE_STEPS:
         t = ref + step
         c, s = cos(t), sin(t)
@@ -1137,8 +1119,30 @@ def _kcs1r(a, b, e, m00, m01, m02, m10, m11, m12, m20, m21, m22, lo, hi, scale, 
         C = m20 + m21 * c + m22 * s
         r = sqrt(B * B + C * C)
         if A - r <= hi and A + r >= lo:
-            return 1, t, c, s, 0.0, 1.0, 0.0, 1
-    return 1, ref, cos(ref), sin(ref), 0.0, 1.0, 0.0, 1
+            return t
+    return ref
+
+
+def _reach_first2(A, B, C, lo, hi, ref):
+    """The first value of a free t: ref if it keeps A + B cos t + C sin t in [lo, hi], else
+    the nearer to ref of the two t at which it is mid-range."""
+    rho = sqrt(B * B + C * C)
+    if lo <= A + B * cos(ref) + C * sin(ref) <= hi or rho == 0.0:
+        return ref
+    base = atan2(C, B)
+    delta = acos(max(-1.0, min(1.0, (0.5 * (lo + hi) - A) / rho)))
+    if abs(_kwrap(base - delta - ref)) < abs(_kwrap(base + delta - ref)):
+        return base - delta
+    return base + delta
+
+
+def _kcs1r(a, b, e, m00, m01, m02, m10, m11, m12, m20, m21, m22, lo, hi, scale, ref):
+    """_cs1_reach as _kcs1 does _cs1; a free angle comes as its one first value."""
+    n, t0, c0, s0, t1, c1, s1, status = _kcs1(a, b, e, scale)
+    if status == 0:
+        return n, t0, c0, s0, t1, c1, s1, 0
+    t = _reach_first1(m00, m01, m02, m10, m11, m12, m20, m21, m22, lo, hi, ref)
+    return 1, t, cos(t), sin(t), 0.0, 1.0, 0.0, 1
 
 
 def _kcs2r(a1, b1, e1, a2, b2, e2, det_scale, rhs_scale, A, B, C, lo, hi, ref):
@@ -1146,14 +1150,7 @@ def _kcs2r(a1, b1, e1, a2, b2, e2, det_scale, rhs_scale, A, B, C, lo, hi, ref):
     t, c, s, status = _kcs2(a1, b1, e1, a2, b2, e2, det_scale, rhs_scale)
     if status == 0:
         return t, c, s, 0
-    t = ref
-    rho = sqrt(B * B + C * C)
-    if not lo <= A + B * cos(ref) + C * sin(ref) <= hi and rho != 0.0:
-        base = atan2(C, B)
-        delta = acos(max(-1.0, min(1.0, (0.5 * (lo + hi) - A) / rho)))
-        t = base + delta
-        if abs(_kwrap(base - delta - ref)) < abs(_kwrap(t - ref)):
-            t = base - delta
+    t = _reach_first2(A, B, C, lo, hi, ref)
     return t, cos(t), sin(t), 1
 
 
@@ -1462,10 +1459,11 @@ def _kfk_q(q):
     return _kfk(c1, s1, c2, s2)
 
 
-_KERNEL = ("_kpose_ok", "_kcs1", "_kcs2", "_kcs1r", "_kcs2r", "_katan2", "_kwrap", "_kquadratic",
-           "_kcubic_largest", "_kquartic", "_kquadratic_real", "_kquartic_real", "_ksort",
-           "_kroots", "_kpoly", "_kdistinct", "_kfinish", "_kone", "_ksolve",
-           "_kbatch", "_knewton", "_ksmall_residual", "_kfk", "_kfk_q")
+_KERNEL = ("_kpose_ok", "_kcs1", "_kcs2", "_reach_first1", "_reach_first2", "_kcs1r", "_kcs2r",
+           "_katan2", "_kwrap", "_kquadratic", "_kcubic_largest", "_kquartic",
+           "_kquadratic_real", "_kquartic_real", "_ksort", "_kroots", "_kpoly", "_kdistinct",
+           "_kfinish", "_kone", "_ksolve", "_kbatch", "_knewton", "_ksmall_residual", "_kfk",
+           "_kfk_q")
 _compiled = None
 _BATCH_LOCK = threading.Lock()
 
