@@ -1,7 +1,7 @@
 """Benchmark figures of one generated solver: timings and round-trip soundness/completeness.
 
 Pure measurement: the caller generates and imports the module (the CLI does), this module
-only calls it. Timings are medians over repeated calls for single poses and the best of three
+only calls it. Timings are medians over repeated calls for single poses and the best of five
 calls for batches, on this machine.
 """
 
@@ -59,11 +59,11 @@ def compiled_backend(module: ModuleType, pose: np.ndarray) -> dict:
 
 
 def batch_us(module: ModuleType, poses: np.ndarray, **options) -> float:
-    """ik_batch microseconds per pose: the best of three calls after a warm-up call (single
+    """ik_batch microseconds per pose: the best of five calls after a warm-up call (single
     calls on this kind of machine vary by up to 2x, the best one is repeatable)."""
     module.ik_batch(poses[:100], **options)
     best = math.inf
-    for _ in range(3):
+    for _ in range(5):
         start = time.perf_counter()
         module.ik_batch(poses, **options)
         best = min(best, time.perf_counter() - start)
@@ -111,7 +111,7 @@ def eaik_figures(module: ModuleType, poses: np.ndarray) -> dict:
         robot = DhRobot(dh[:, 0], dh[:, 1], dh[:, 2])
         single = median_us(robot.IK, [(T,) for T in flange[:2000]])
         best = math.inf
-        for _ in range(3):
+        for _ in range(5):
             start = time.perf_counter()
             robot.IK_batched(flange)
             best = min(best, time.perf_counter() - start)

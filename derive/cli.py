@@ -294,6 +294,13 @@ def cmd_report(args: argparse.Namespace) -> int:
     return 0
 
 
+def versus(ours: float, theirs: float) -> str:
+    """How our time compares with another solver's: "ours 4.1x faster" or "ours 2.3x slower"."""
+    if ours <= theirs:
+        return f"ours {theirs / ours:.1f}x faster"
+    return f"ours {ours / theirs:.1f}x slower"
+
+
 def bench_text(name: str, f: dict) -> str:
     """The human-readable lines of one arm's benchmark figures."""
     line = f"{name}: generate {f['generate_s']:.2f} s; fk {f['fk_us']:.1f} us"
@@ -311,9 +318,9 @@ def bench_text(name: str, f: dict) -> str:
     if "eaik_skipped" in f:
         line += f"\n  {f['eaik_skipped']}"
     if "eaik_ik_us" in f:
-        line += (f"\n  EAIK on the same poses: ik {f['eaik_ik_us']:.1f} us (ratio "
-                 f"{f['ik_us'] / f['eaik_ik_us']:.1f}x), batch {f['eaik_batch_us']:.2f} us/pose "
-                 f"(ratio {f['ik_batch_us'] / f['eaik_batch_us']:.1f}x)")
+        line += (f"\n  EAIK on the same poses: ik {f['eaik_ik_us']:.1f} us "
+                 f"({versus(f['ik_us'], f['eaik_ik_us'])}), batch {f['eaik_batch_us']:.2f} "
+                 f"us/pose ({versus(f['ik_batch_us'], f['eaik_batch_us'])})")
     return (line + f"\n  ik_batch equals the Python ik on {f['batch_agrees']}/{f['samples']} poses"
             f"\n  {f['summary']}")
 

@@ -8,6 +8,8 @@ it return -1, and the scalar solver settles the pose.
 
 from __future__ import annotations
 
+import math
+
 import sympy as sp
 
 from derive import symbols as sym
@@ -25,8 +27,11 @@ def kernel_lines(plan: Plan, printer: CodePrinter) -> tuple[tuple[int, str], ...
     assert plan.ik is not None
     names = sp.numbered_symbols("x")
     world = sym.world_pose()
-    lines = [Line(0, f"{', '.join(f'qr{i}' for i in range(1, plan.arm.dof + 1))}, = qref"),
-             Line(0, "ptol = tol * REACH"), Line(0, "n = 0"),
+    joints = range(1, plan.arm.dof + 1)
+    n = plan.arm.dof
+    lines = [Line(0, f"{', '.join(f'{v}{i}' for i in joints)}, = ref[{k * n}:{(k + 1) * n}]")
+             for k, v in enumerate(("qr", "cr", "sr"))]
+    lines += [Line(0, "ptol = tol * REACH"), Line(0, "n = 0"),
              Line(0, f"t = ({', '.join(str(world[i, j]) for i in range(3) for j in range(4))})")]
     depth = 0
     checks: list[tuple[int, int]] = []
@@ -63,6 +68,7 @@ def kernel_solve_lines(step: Solve, names: sp.utilities.iterables.numbered_symbo
     j = step.joint
     var = f"d{j}" if step.kind == "polyd" else f"theta{j}"
     ref = printer.doprint(step.ref)
+    cos_ref, sin_ref = reference_cs(step.ref, printer)
     free = repr(1e-10 * step.scale)
     if step.kind in ("poly", "polyd"):
         angles = step.kind == "poly"
@@ -72,7 +78,7 @@ def kernel_solve_lines(step: Solve, names: sp.utilities.iterables.numbered_symbo
         head = [f"_n{j} = {call}", f"_f{j} = _n{j} == -2", f"if _f{j}:", f"    _n{j} = 1",
                 f"    buf[{at}] = {ref}"]
         if angles:
-            head += [f"    buf[{at + 20}], buf[{at + 24}] = cos({ref}), sin({ref})"]
+            head += [f"    buf[{at + 20}], buf[{at + 24}] = {cos_ref}, {sin_ref}"]
         head += [f"elif _n{j} < 0:", "    return -1", f"_m{j} = n",
                  f"for _k{j} in range(_n{j}):", f"    {var} = buf[{at} + _k{j}]"]
         if angles:
@@ -85,7 +91,7 @@ def kernel_solve_lines(step: Solve, names: sp.utilities.iterables.numbered_symbo
                 f"_f{j} = _st == 1"]
         if step.kind == "cs1":  # _kcs1r gives a free angle's value itself
             head += [f"if _f{j}:",
-                     f"    _n{j}, _a{j}, _ac{j}, _as{j} = 1, {ref}, cos({ref}), sin({ref})"]
+                     f"    _n{j}, _a{j}, _ac{j}, _as{j} = 1, {ref}, {cos_ref}, {sin_ref}"]
         head += [f"_m{j} = n", f"for _k{j} in range(_n{j}):",
                  f"    {var}, c{j}, s{j} = {first} if _k{j} == 0 else {second}"]
     else:
@@ -94,6 +100,18 @@ def kernel_solve_lines(step: Solve, names: sp.utilities.iterables.numbered_symbo
                 "cs2r": f"_kcs2r({', '.join(values)}, {ref})"}[step.kind]
         head = [f"{var}, c{j}, s{j}, _st = {call}", f"_f{j} = _st == 1"]
         if step.kind != "cs2r":  # _kcs2r gives a free angle's value itself
-            head += [f"if _f{j}:", f"    {var}, c{j}, s{j} = {ref}, cos({ref}), sin({ref})"]
+            head += [f"if _f{j}:", f"    {var}, c{j}, s{j} = {ref}, {cos_ref}, {sin_ref}"]
         head.append(f"_m{j} = n")
     return lines + [Line(depth + (1 if h.startswith("    ") else 0), h.strip()) for h in head]
+
+
+def reference_cs(ref: sp.Expr, printer: CodePrinter) -> tuple[str, str]:
+    """cos and sin of a free joint's reference value as _ksolve prints them: cr_i, sr_i for
+    q_ref's own value (the caller computes them once, not once per pose), numbers for a
+    number, cos(...) and sin(...) otherwise."""
+    if isinstance(ref, sp.Symbol) and ref.name.startswith("qr"):
+        return f"cr{ref.name[2:]}", f"sr{ref.name[2:]}"
+    if ref.is_number:
+        return repr(math.cos(float(ref))), repr(math.sin(float(ref)))
+    text = printer.doprint(ref)
+    return f"cos({text})", f"sin({text})"

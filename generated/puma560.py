@@ -252,7 +252,7 @@ def ik(T, *, within_limits=False, q_ref=None, tol=CERTIFY_TOL, backend=None):
     refs = _reference(q_ref)
     kernels = _kernels(backend)
     if kernels is not None:
-        rows, settled = kernels[1](*target, float(tol), refs)
+        rows, settled = kernels[1](*target, float(tol), _kreference(refs))
         if settled:
             return _result([tuple(q) for q in rows.tolist()], within_limits)
     return _result(_finish(_ik_scalar(target, *refs, tol)), within_limits)
@@ -388,7 +388,7 @@ def ik_batch(T, *, q_ref=None, tol=CERTIFY_TOL, chunk=4096, backend=None):
     valid = np.full((n, 8), False)
     retry = np.zeros(n, dtype=bool)
     with _BATCH_LOCK:  # numba's default thread pool must not be entered twice at once
-        kernels[0](T, float(tol), refs, Q, valid, retry)
+        kernels[0](T, float(tol), _kreference(refs), Q, valid, retry)
     for i in np.flatnonzero(retry):
         _settle(Q, valid, i, ik(T[i], q_ref=q_ref, tol=tol, backend="python"))
     return Q, valid
@@ -590,6 +590,12 @@ def _reference(q_ref):
     if len(q_ref) != DOF or not all(math.isfinite(x) for x in q_ref):
         raise ValueError(f"q_ref must be {DOF} finite numbers")
     return q_ref
+
+
+def _kreference(refs):
+    """The compiled solver's ref argument: q_ref's values, then their cosines, then their
+    sines (one flat tuple: numba's parallel loop takes no nested ones)."""
+    return refs + tuple(map(math.cos, refs)) + tuple(map(math.sin, refs))
 
 
 def _keep(found, t, q, e, tol):
@@ -1201,10 +1207,13 @@ def _vfinish(Q, valid):
     return np.where(ok[:, :, None], Q, 0.0), ok
 
 
-def _ksolve(w11, w12, w13, wx, w21, w22, w23, wy, w31, w32, w33, wz, tol, qref, found, buf):
+def _ksolve(w11, w12, w13, wx, w21, w22, w23, wy, w31, w32, w33, wz, tol, ref, found, buf):
     """The solutions of one pose into found (rows in ik's branch order, before wrapping and
-    dropping repeats): their count, or -1 where the scalar solver must settle the pose."""
-    qr1, qr2, qr3, qr4, qr5, qr6, = qref
+    dropping repeats): their count, or -1 where the scalar solver must settle the pose.
+    ref: q_ref, its cosines and its sines (_kreference)."""
+    qr1, qr2, qr3, qr4, qr5, qr6, = ref[0:6]
+    cr1, cr2, cr3, cr4, cr5, cr6, = ref[6:12]
+    sr1, sr2, sr3, sr4, sr5, sr6, = ref[12:18]
     ptol = tol * REACH
     n = 0
     t = (w11, w12, w13, wx, w21, w22, w23, wy, w31, w32, w33, wz)
@@ -1232,7 +1241,7 @@ def _ksolve(w11, w12, w13, wx, w21, w22, w23, wy, w31, w32, w33, wz, tol, qref, 
     if _f3:
         _n3 = 1
         buf[64] = qr3
-        buf[84], buf[88] = cos(qr3), sin(qr3)
+        buf[84], buf[88] = cr3, sr3
     elif _n3 < 0:
         return -1
     _m3 = n
@@ -1244,7 +1253,7 @@ def _ksolve(w11, w12, w13, wx, w21, w22, w23, wy, w31, w32, w33, wz, tol, qref, 
         _n2, _a2, _ac2, _as2, _b2, _bc2, _bs2, _st = _kcs1(0.433*c3 + 0.02*s3, 0.02*c3 - 0.433*s3 - 0.432, z, 1.069156)
         _f2 = _st == 1
         if _f2:
-            _n2, _a2, _ac2, _as2 = 1, qr2, cos(qr2), sin(qr2)
+            _n2, _a2, _ac2, _as2 = 1, qr2, cr2, sr2
         _m2 = n
         for _k2 in range(_n2):
             theta2, c2, s2 = (_a2, _ac2, _as2) if _k2 == 0 else (_b2, _bc2, _bs2)
@@ -1255,7 +1264,7 @@ def _ksolve(w11, w12, w13, wx, w21, w22, w23, wy, w31, w32, w33, wz, tol, qref, 
             theta1, c1, s1, _st = _kcs2(g1, -g2, x, g2, g1, y, 1.069156, 1.069156)
             _f1 = _st == 1
             if _f1:
-                theta1, c1, s1 = qr1, cos(qr1), sin(qr1)
+                theta1, c1, s1 = qr1, cr1, sr1
             _m1 = n
             # wrist W = (0_3R Rx(alpha3))^T 0_6R = Rz(t4) Rx(alpha4) Rz(t5) Rx(alpha5) Rz(t6)
             x0 = c2*s3
@@ -1281,7 +1290,7 @@ def _ksolve(w11, w12, w13, wx, w21, w22, w23, wy, w31, w32, w33, wz, tol, qref, 
             _n5, _a5, _ac5, _as5, _b5, _bc5, _bs5, _st = _kcs1(1.0, 0.0, W33, 0.0)
             _f5 = _st == 1
             if _f5:
-                _n5, _a5, _ac5, _as5 = 1, 0.0, cos(0.0), sin(0.0)
+                _n5, _a5, _ac5, _as5 = 1, 0.0, 1.0, 0.0
             _m5 = n
             for _k5 in range(_n5):
                 theta5, c5, s5 = (_a5, _ac5, _as5) if _k5 == 0 else (_b5, _bc5, _bs5)
@@ -1292,13 +1301,13 @@ def _ksolve(w11, w12, w13, wx, w21, w22, w23, wy, w31, w32, w33, wz, tol, qref, 
                 theta4, c4, s4, _st = _kcs2(v1, -v2, W13, v2, v1, W23, 1.0, 1.0)
                 _f4 = _st == 1
                 if _f4:
-                    theta4, c4, s4 = qr4, cos(qr4), sin(qr4)
+                    theta4, c4, s4 = qr4, cr4, sr4
                 _m4 = n
                 # theta6: Rz(theta6) = (Rx(alpha4) Rz(theta5) Rx(alpha5))^T Rz(theta4)^T W
                 theta6, c6, s6, _st = _katan2(-W11*s4 + W21*c4, W11*c4*c5 + W21*c5*s4 - W31*s5)
                 _f6 = _st == 1
                 if _f6:
-                    theta6, c6, s6 = qr6, cos(qr6), sin(qr6)
+                    theta6, c6, s6 = qr6, cr6, sr6
                 _m6 = n
                 e = _kfk(c1, s1, c2, s2, c3, s3, c4, s4, c5, s5, c6, s6)
                 if abs(e[0] - t[0]) <= tol and abs(e[1] - t[1]) <= tol and abs(e[2] - t[2]) <= tol and abs(e[4] - t[4]) <= tol and abs(e[5] - t[5]) <= tol and abs(e[6] - t[6]) <= tol and abs(e[8] - t[8]) <= tol and abs(e[9] - t[9]) <= tol and abs(e[10] - t[10]) <= tol and abs(e[3] - t[3]) <= ptol and abs(e[7] - t[7]) <= ptol and abs(e[11] - t[11]) <= ptol:
@@ -1365,10 +1374,10 @@ def _kcs1(a, b, e, scale):
     if abs(ratio) > 1.0 + _CLAMP_TOL:
         return 0, 0.0, 1.0, 0.0, 0.0, 1.0, 0.0, 0
     ratio = max(-1.0, min(1.0, ratio))
-    base = atan2(b, a)
-    delta = acos(ratio)
-    cb, sb = a / rho, b / rho
+    base = _kangle(b, a)
     sd = sqrt((1.0 - ratio) * (1.0 + ratio))
+    delta = _kangle(sd, ratio)
+    cb, sb = a / rho, b / rho
     return (2, base + delta, cb * ratio - sb * sd, sb * ratio + cb * sd,
             base - delta, cb * ratio + sb * sd, sb * ratio - cb * sd, 0)
 
@@ -1378,7 +1387,13 @@ def _kcs2(a1, b1, e1, a2, b2, e2, det_scale, rhs_scale):
     det = a1 * b2 - a2 * b1
     if abs(det) <= _FREE_TOL * det_scale or e1 * e1 + e2 * e2 <= _FREE_TOL * rhs_scale:
         return 0.0, 1.0, 0.0, 1
-    return _katan2((a1 * e2 - a2 * e1) / det, (e1 * b2 - b1 * e2) / det)
+    # (cos t, sin t) = (x, y) / det: the direction of (x, y), reversed where det < 0
+    sign = math.copysign(1.0, det)
+    x, y = sign * (e1 * b2 - b1 * e2), sign * (a1 * e2 - a2 * e1)
+    h = sqrt(x * x + y * y)
+    if h == 0.0:
+        return 0.0, 1.0, 0.0, 0
+    return _kangle(y, x), x / h, y / h, 0
 
 
 def _reach_first1(m00, m01, m02, m10, m11, m12, m20, m21, m22, lo, hi, ref):
@@ -1404,8 +1419,9 @@ def _reach_first2(A, B, C, lo, hi, ref):
     rho = sqrt(B * B + C * C)
     if lo <= A + B * cos(ref) + C * sin(ref) <= hi or rho == 0.0:
         return ref
-    base = atan2(C, B)
-    delta = acos(max(-1.0, min(1.0, (0.5 * (lo + hi) - A) / rho)))
+    base = _kangle(C, B)
+    ratio = max(-1.0, min(1.0, (0.5 * (lo + hi) - A) / rho))
+    delta = _kangle(sqrt((1.0 - ratio) * (1.0 + ratio)), ratio)
     if abs(_kwrap(base - delta - ref)) < abs(_kwrap(base + delta - ref)):
         return base - delta
     return base + delta
@@ -1434,11 +1450,44 @@ def _katan2(y, x):
     h = sqrt(x * x + y * y)
     if abs(y) + abs(x) <= 1e-12 or h == 0.0:
         return 0.0, 1.0, 0.0, 1
-    return atan2(y, x), x / h, y / h, 0
+    return _kangle(y, x), x / h, y / h, 0
+
+
+# _kangle's segments: t = min(|x|, |y|) / max(|x|, |y|) in [0, 1] falls in segment
+# k = int(8 t + 0.5); its angle is _ANGLE_AT[k] + atan(r), r = tan of the offset from it
+# (|r| <= 0.0625), from the series r - r^3/3 + ... - r^15/15 (truncated below 1e-19 of r)
+_ANGLE_AT = np.array([0.0] + [
+    (math.atan((k - 0.5) / 8.0) + math.atan(min(1.0, (k + 0.5) / 8.0))) / 2.0 for k in range(1, 9)])
+_TAN_AT = np.tan(_ANGLE_AT)
+
+
+def _kangle(y, x):
+    """atan2(y, x) to within a few units in the last place, about twice as fast as the
+    library's (which rounds correctly): the octant, one of nine segments of it, and an odd
+    series. Zeros, infinities and nan go to the library's."""
+    ax, ay = abs(x), abs(y)
+    steep = ay > ax
+    num, den = (ax, ay) if steep else (ay, ax)
+    if not (0.0 < den < math.inf and num <= den):
+        return atan2(y, x)
+    t = num / den
+    k = int(8.0 * t + 0.5)
+    c = _TAN_AT[k]
+    r = (t - c) / (1.0 + t * c)
+    r2 = r * r
+    a = _ANGLE_AT[k] + (r + r * r2 * (-1.0 / 3.0 + r2 * (1.0 / 5.0 + r2 * (-1.0 / 7.0 + r2 * (
+        1.0 / 9.0 + r2 * (-1.0 / 11.0 + r2 * (1.0 / 13.0 + r2 * (-1.0 / 15.0))))))))
+    if steep:
+        a = 0.5 * math.pi - a
+    if x < 0.0:
+        a = math.pi - a
+    return math.copysign(a, y)
 
 
 def _kwrap(t):
     """t wrapped to (-pi, pi]."""
+    if -math.pi < t <= math.pi:
+        return t
     w = t - _TWO_PI * math.floor(t / _TWO_PI + 0.5)
     return w + _TWO_PI if w <= -math.pi else w
 
@@ -1630,7 +1679,7 @@ def _kpoly(coeffs, angles, free, unit, buf):
         cos_t, sin_t = buf[20:24], buf[24:28]
         for k in range(n):
             u = x[k]
-            t = _kwrap(2.0 * atan2(1.0, u) if flip else 2.0 * math.atan(u))
+            t = _kwrap(2.0 * (_kangle(1.0, u) if flip else _kangle(u, 1.0)))
             x[k] = math.pi if math.pi - abs(t) <= 1e-12 else t
             w = 1.0 / (1.0 + u * u)
             cos_t[k] = (u * u - 1.0) * w if flip else (1.0 - u * u) * w
@@ -1660,10 +1709,10 @@ def _kdistinct(rows, m, q):
     for p in range(m):
         same = True
         for j in range(DOF):
-            d = q[j] - rows[p, j]
-            if _REVOLUTE[j]:
-                d = _kwrap(d)
-            if abs(d) > DEDUP_TOL:
+            d = abs(q[j] - rows[p, j])
+            if _REVOLUTE[j] and d > math.pi:  # both in (-pi, pi]: d < 2 pi
+                d = _TWO_PI - d
+            if d > DEDUP_TOL:
                 same = False
                 break
         if same:
@@ -1683,18 +1732,18 @@ def _kfinish(found, count, rows, q):
     return m
 
 
-def _kone(w11, w12, w13, wx, w21, w22, w23, wy, w31, w32, w33, wz, tol, qref):
+def _kone(w11, w12, w13, wx, w21, w22, w23, wy, w31, w32, w33, wz, tol, ref):
     """ik's solutions of one pose (the 12 top entries, validated) as (rows, settled); settled
     is False where the scalar solver must settle the pose."""
     found = np.zeros((8, DOF))
     rows = np.zeros((8, DOF))
-    count = _ksolve(w11, w12, w13, wx, w21, w22, w23, wy, w31, w32, w33, wz, tol, qref, found, np.zeros(32 * DOF))
+    count = _ksolve(w11, w12, w13, wx, w21, w22, w23, wy, w31, w32, w33, wz, tol, ref, found, np.zeros(32 * DOF))
     if count < 0:
         return rows[:0], False
     return rows[:_kfinish(found, count, rows, np.zeros(DOF))], True
 
 
-def _kbatch(T, tol, qref, Q, valid, retry):
+def _kbatch(T, tol, ref, Q, valid, retry):
     """Every pose of T (n, 4, 4): solutions into Q, valid (rows in ik's order, repeats
     dropped); retry[i] where the scalar solver must settle pose i. The poses are split into
     _KPARTS ranges, solved in parallel when compiled; each pose's result depends on that pose
@@ -1709,7 +1758,7 @@ def _kbatch(T, tol, qref, Q, valid, retry):
                 continue
             count = _ksolve(T[i, 0, 0], T[i, 0, 1], T[i, 0, 2], T[i, 0, 3], T[i, 1, 0],
                             T[i, 1, 1], T[i, 1, 2], T[i, 1, 3], T[i, 2, 0], T[i, 2, 1],
-                            T[i, 2, 2], T[i, 2, 3], tol, qref, found, buf)
+                            T[i, 2, 2], T[i, 2, 3], tol, ref, found, buf)
             if count < 0:
                 retry[i] = True
                 continue
@@ -1717,6 +1766,15 @@ def _kbatch(T, tol, qref, Q, valid, retry):
 
 
 _KPARTS = 64
+# LLVM may fuse multiply-adds, reorder sums and divide by reciprocals in the kernel (about a
+# fifth of its time; the results move by rounding only: the certification and every test of
+# the compiled solver run on this arithmetic). nan and inf stay IEEE: poses are checked
+# with isfinite, and fallbacks test for them.
+_FASTMATH = {"contract", "arcp", "nsz", "reassoc"}
+# except in the polynomial roots: near a multiple root they move by far more than rounding,
+# and whether two roots merge must not depend on how LLVM ordered the arithmetic
+_KSTRICT = ("_kquadratic", "_kcubic_largest", "_kquartic", "_kquadratic_real", "_kquartic_real",
+            "_kroots", "_knewton", "_ksmall_residual")
 _prange = range
 _knewton = _newton
 _ksmall_residual = _small_residual
@@ -1747,7 +1805,7 @@ def _kfk_q(q):
 
 
 _KERNEL = ("_kpose_ok", "_kcs1", "_kcs2", "_reach_first1", "_reach_first2", "_kcs1r", "_kcs2r",
-           "_katan2", "_kwrap", "_kquadratic", "_kcubic_largest", "_kquartic",
+           "_katan2", "_kangle", "_kwrap", "_kquadratic", "_kcubic_largest", "_kquartic",
            "_kquadratic_real", "_kquartic_real", "_ksort", "_kroots", "_kpoly", "_kdistinct",
            "_kfinish", "_kone", "_ksolve", "_kbatch", "_knewton", "_ksmall_residual", "_kfk",
            "_kfk_q")
@@ -1789,8 +1847,10 @@ def _compile():
             try:
                 for name in _KERNEL:
                     source = getattr(names[name], "py_func", names[name])
-                    names[name] = numba.njit(**options)(source)
-                names["_kbatch"] = numba.njit(parallel=True, **options)(names["_kbatch"].py_func)
+                    fast = set() if name in _KSTRICT else _FASTMATH
+                    names[name] = numba.njit(fastmath=fast, **options)(source)
+                names["_kbatch"] = numba.njit(parallel=True, fastmath=_FASTMATH, **options)(
+                    names["_kbatch"].py_func)
                 break
             except RuntimeError:
                 continue
