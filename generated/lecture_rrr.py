@@ -202,14 +202,27 @@ def ik(T, *, within_limits=False, q_ref=None, tol=CERTIFY_TOL, backend=None):
         ValueError: T is not 4x4, has non-finite entries, or its rotation is not orthonormal
             within POSE_TOL.
     """
-    target = _pose(T)
     refs = _reference(q_ref)
     kernels = _kernels(backend)
     if kernels is not None:
-        rows, settled = kernels[1](*target, float(tol), _kreference(refs))
-        if settled:
-            return _result([tuple(q) for q in rows.tolist()], within_limits)
+        A = _array44(T)
+        if A is not None:  # else _pose says what is wrong with T
+            rows, status = kernels[1](A[None], float(tol), refs)
+            if status == 0:
+                return _result([tuple(q) for q in rows.tolist()], True) if within_limits else rows
+    # the Python solver; for the compiled one a pose it did not settle, or an invalid one
+    target = _pose(T)
     return _result(_finish(_ik_scalar(target, *refs, tol)), within_limits)
+
+
+def _array44(T):
+    """T as a float64 array if it is 4x4, else None."""
+    if type(T) is not np.ndarray or T.dtype != np.float64:
+        try:
+            T = np.asarray(T, dtype=float)
+        except (TypeError, ValueError):
+            return None
+    return T if T.shape == (4, 4) else None
 
 
 def _ik_scalar(target, qr1, qr2, qr3, tol):
@@ -296,7 +309,7 @@ def ik_batch(T, *, q_ref=None, tol=CERTIFY_TOL, chunk=4096, backend=None):
     valid = np.full((n, 2), False)
     retry = np.zeros(n, dtype=bool)
     with _BATCH_LOCK:  # numba's default thread pool must not be entered twice at once
-        kernels[0](T, float(tol), _kreference(refs), Q, valid, retry)
+        kernels[0](T, float(tol), refs, Q, valid, retry)
     for i in np.flatnonzero(retry):
         _settle(Q, valid, i, ik(T[i], q_ref=q_ref, tol=tol, backend="python"))
     return Q, valid
@@ -448,16 +461,10 @@ def _pose(T):
 def _reference(q_ref):
     if q_ref is None:
         return (0.0,) * DOF
-    q_ref = tuple(float(x) for x in q_ref)
-    if len(q_ref) != DOF or not all(math.isfinite(x) for x in q_ref):
+    q_ref = tuple(map(float, q_ref.tolist() if type(q_ref) is np.ndarray else q_ref))
+    if len(q_ref) != DOF or not all(map(math.isfinite, q_ref)):
         raise ValueError(f"q_ref must be {DOF} finite numbers")
     return q_ref
-
-
-def _kreference(refs):
-    """The compiled solver's ref argument: q_ref's values, then their cosines, then their
-    sines (one flat tuple: numba's parallel loop takes no nested ones)."""
-    return refs + tuple(map(math.cos, refs)) + tuple(map(math.sin, refs))
 
 
 def _keep(found, t, q, e, tol):
@@ -1072,7 +1079,7 @@ def _vfinish(Q, valid):
 def _ksolve(w11, w12, w13, wx, w21, w22, w23, wy, w31, w32, w33, wz, tol, ref, found, buf):
     """The solutions of one pose into found (rows in ik's branch order, before wrapping and
     dropping repeats): their count, or -1 where the scalar solver must settle the pose.
-    ref: q_ref, its cosines and its sines (_kreference)."""
+    ref: q_ref's values, then their cosines, then their sines (_kreference)."""
     qr1, qr2, qr3, = ref[0:3]
     cr1, cr2, cr3, = ref[3:6]
     sr1, sr2, sr3, = ref[6:9]
@@ -1532,23 +1539,36 @@ def _kfinish(found, count, rows, q):
     return m
 
 
-def _kone(w11, w12, w13, wx, w21, w22, w23, wy, w31, w32, w33, wz, tol, ref):
-    """ik's solutions of one pose (the 12 top entries, validated) as (rows, settled); settled
-    is False where the scalar solver must settle the pose."""
-    found = np.zeros((2, DOF))
+def _kreference(q):
+    """_ksolve's ref argument: q_ref's values, then their cosines, then their sines (one flat
+    tuple: numba's parallel loop takes no nested ones)."""
+    cosines = (cos(q[0]), cos(q[1]), cos(q[2]),)
+    sines = (sin(q[0]), sin(q[1]), sin(q[2]),)
+    return q + cosines + sines
+
+
+def _kone(T, tol, qref):
+    """ik's solutions of the pose T[0] as (rows, status): status 0 where they are settled,
+    1 where the scalar solver must settle the pose, 2 where T[0] is no valid pose."""
     rows = np.zeros((2, DOF))
-    count = _ksolve(w11, w12, w13, wx, w21, w22, w23, wy, w31, w32, w33, wz, tol, ref, found, np.zeros(32 * DOF))
+    if not _kpose_ok(T, 0):
+        return rows[:0], 2
+    found = np.zeros((2, DOF))
+    count = _ksolve(T[0, 0, 0], T[0, 0, 1], T[0, 0, 2], T[0, 0, 3], T[0, 1, 0], T[0, 1, 1],
+                    T[0, 1, 2], T[0, 1, 3], T[0, 2, 0], T[0, 2, 1], T[0, 2, 2], T[0, 2, 3], tol,
+                    _kreference(qref), found, np.zeros(32 * DOF))
     if count < 0:
-        return rows[:0], False
-    return rows[:_kfinish(found, count, rows, np.zeros(DOF))], True
+        return rows[:0], 1
+    return rows[:_kfinish(found, count, rows, np.zeros(DOF))], 0
 
 
-def _kbatch(T, tol, ref, Q, valid, retry):
+def _kbatch(T, tol, qref, Q, valid, retry):
     """Every pose of T (n, 4, 4): solutions into Q, valid (rows in ik's order, repeats
     dropped); retry[i] where the scalar solver must settle pose i. The poses are split into
     _KPARTS ranges, solved in parallel when compiled; each pose's result depends on that pose
     alone."""
     n = T.shape[0]
+    ref = _kreference(qref)
     for part in _prange(_KPARTS):
         found = np.zeros((2, DOF))
         buf = np.zeros(32 * DOF)
@@ -1598,7 +1618,7 @@ def _kfk_q(q):
 _KERNEL = ("_kpose_ok", "_kcs1", "_kcs2", "_reach_first1", "_reach_first2", "_kcs1r", "_kcs2r",
            "_katan2", "_kangle", "_kwrap", "_kquadratic", "_kcubic_largest", "_kquartic",
            "_kquadratic_real", "_kquartic_real", "_ksort", "_kroots", "_kpoly", "_kdistinct",
-           "_kfinish", "_kone", "_ksolve", "_kbatch", "_knewton", "_ksmall_residual", "_kfk",
+           "_kfinish", "_kreference", "_kone", "_ksolve", "_kbatch", "_knewton", "_ksmall_residual", "_kfk",
            "_kfk_q")
 _compiled = None
 _BATCH_LOCK = threading.Lock()

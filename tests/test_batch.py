@@ -62,8 +62,8 @@ def test_compiled_solver_takes_free_joints_from_q_ref(generated):
     q = np.radians([20.0, -30.0, 40.0, 10.0, 0.0, 25.0])
     T = m.fk(q)
     q_ref = np.radians([0.0, 0.0, 0.0, 33.0, 0.0, 0.0])
-    rows, settled = m._compile()[1](*T[:3].ravel(), m.CERTIFY_TOL, m._kreference(tuple(q_ref)))
-    assert settled
+    rows, status = m._compile()[1](T[None], m.CERTIFY_TOL, tuple(q_ref))
+    assert status == 0  # settled in compiled code
     expected = m.ik(T, q_ref=q_ref, backend="python")
     assert np.isclose(expected[:, 3], math.radians(33.0)).any()  # the singular branch
     revolute = np.ones(6, dtype=bool)

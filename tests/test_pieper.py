@@ -11,7 +11,7 @@ from derive.pipeline import build_plan
 from derive.spec import parse_spec
 from derive.verify import roundtrip, sample_joints
 from cases import PIEPER_CASES, PUMA_REPORT_FLAGS, PUMA_REPORT_SOLUTIONS
-from conftest import build_module, spec_text, wrapped_close
+from conftest import build_module, needs_numba, spec_text, wrapped_close
 
 
 def cup_pose() -> np.ndarray:
@@ -132,16 +132,22 @@ def test_out_of_reach_pose_returns_empty(generated):
         assert sols.shape == (0, 6)
 
 
-def test_bad_poses_raise_value_error(generated):
+@pytest.mark.parametrize("backend", ["python", pytest.param("numba", marks=needs_numba)])
+def test_bad_poses_raise_value_error(generated, backend):
+    """The compiled ik checks the pose in compiled code; what it rejects gets the Python
+    solver's message."""
     m = generated("puma560")
     with pytest.raises(ValueError, match="shape"):
-        m.ik(np.eye(3))
+        m.ik(np.eye(3), backend=backend)
     with pytest.raises(ValueError, match="non-finite"):
-        m.ik(np.full((4, 4), np.nan))
+        m.ik(np.full((4, 4), np.nan), backend=backend)
     with pytest.raises(ValueError, match="orthonormal"):
-        m.ik(np.diag([1.0, 2.0, 1.0, 1.0]))
+        m.ik(np.diag([1.0, 2.0, 1.0, 1.0]), backend=backend)
+    with pytest.raises(ValueError, match="last row"):
+        m.ik(np.vstack([np.eye(4)[:3], [0.0, 0.0, 0.1, 1.0]]), backend=backend)
     with pytest.raises(ValueError, match="4x4 array of numbers"):
-        m.ik("pose")
+        m.ik("pose", backend=backend)
+    assert m.ik(np.eye(4).tolist(), backend=backend).shape[1] == 6  # nested lists are fine
 
 
 @pytest.mark.parametrize("name", ["puma560", "lecture_6r"])
