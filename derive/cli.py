@@ -357,7 +357,8 @@ def parser() -> argparse.ArgumentParser:
     report.set_defaults(run=cmd_report)
     bench = sub.add_parser("bench", help="time generation and solvers; round-trip figures")
     bench.add_argument("specs", nargs="*", help="spec files or bundled arm names (default: all)")
-    bench.add_argument("--samples", type=int, default=10000, help="round-trip samples (10000)")
+    bench.add_argument("--samples", "--n", type=int, default=10000,
+                       help="round-trip samples (10000)")
     bench.add_argument("--seed", type=int, default=0, help="random seed (0)")
     bench.add_argument("--batch", type=int, default=100_000, help="poses for ik_batch timing")
     bench.add_argument("--memory", type=int, default=0,

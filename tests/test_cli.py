@@ -113,7 +113,7 @@ def test_solve_rejects_non_rigid_pose():
 
 def test_bench_reports_round_trip_figures(capsys):
     import json
-    assert main(["bench", "puma560", "--samples", "30", "--json"]) == 0
+    assert main(["bench", "puma560", "--n", "30", "--json"]) == 0  # --n: --samples
     figures = json.loads(capsys.readouterr().out)[0]
     assert figures["name"] == "puma560" and figures["samples"] == 30
     assert figures["unsound"] == 0 and figures["completeness"] == 1.0
