@@ -308,8 +308,9 @@ def bench_text(name: str, f: dict) -> str:
         return line
     if f["backend"] == "numba":
         line += (f"\n  compiled (numba, {f['threads']} threads; first calls "
-                 f"{f['compile_s']:.1f} s): ik {f['ik_us']:.1f} us/pose (median); ik_batch {f['ik_batch_us']:.2f} us/pose "
-                 f"at N = {f['batch_n']}, {f['ik_batch_1thread_us']:.2f} on one thread")
+                 f"{f['compile_s']:.1f} s): ik {f['ik_us']:.1f} us/pose (median); ik_batch "
+                 f"{f['ik_batch_us']:.2f} us/pose at N = {f['batch_n']}, "
+                 f"{f['ik_batch_1thread_us']:.2f} on one thread")
     line += (f"\n  python: ik {f['ik_python_us']:.1f} us/pose (median); ik_batch "
              f"{f['ik_batch_python_us']:.2f} us/pose at N = {f['batch_n']}")
     if "ik_batch_peak_mb" in f:

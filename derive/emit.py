@@ -318,6 +318,12 @@ class PrintedModule:
     components: str
 
 
+def world_names() -> str:
+    """The names of the world pose's 12 top entries, row by row (w11, w12, w13, wx, ...)."""
+    world = sym.world_pose()
+    return ", ".join(str(world[i, j]) for i in range(3) for j in range(4))
+
+
 def print_plan(plan: Plan) -> PrintedModule:
     """The printed IR of a plan."""
     from derive import kernel  # kernel prints with this module's helpers: imported late
@@ -357,7 +363,7 @@ def print_plan(plan: Plan) -> PrintedModule:
         qref_names=", ".join(f"qr{i}" for i in range(1, arm.dof + 1)),
         ik_batch_body=ik_batch_lines(plan, vector) if ik else (),
         kernel_body=kernel.kernel_lines(plan, scalar) if ik else (),
-        world_names=", ".join(str(sym.world_pose()[i, j]) for i in range(3) for j in range(4)),
+        world_names=world_names(),
         match=match_expression(ik.certify) if ik else "",
         components=ik.certify if ik else "",
     )

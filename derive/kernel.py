@@ -12,9 +12,8 @@ import math
 
 import sympy as sp
 
-from derive import symbols as sym
 from derive.emit import (CodePrinter, Line, assign_lines, cs_arguments, match_expression,
-                         same_joints, step_arguments)
+                         same_joints, step_arguments, world_names)
 from derive.plan import Assign, Plan, Solve
 
 
@@ -26,13 +25,11 @@ def kernel_lines(plan: Plan, printer: CodePrinter) -> tuple[tuple[int, str], ...
     free joint's further values)."""
     assert plan.ik is not None
     names = sp.numbered_symbols("x")
-    world = sym.world_pose()
-    joints = range(1, plan.arm.dof + 1)
-    n = plan.arm.dof
-    lines = [Line(0, f"{', '.join(f'{v}{i}' for i in joints)}, = ref[{k * n}:{(k + 1) * n}]")
+    dof = plan.arm.dof
+    lines = [Line(0, f"{', '.join(f'{v}{i}' for i in range(1, dof + 1))}, = "
+                     f"ref[{k * dof}:{(k + 1) * dof}]")
              for k, v in enumerate(("qr", "cr", "sr"))]
-    lines += [Line(0, "ptol = tol * REACH"), Line(0, "n = 0"),
-             Line(0, f"t = ({', '.join(str(world[i, j]) for i in range(3) for j in range(4))})")]
+    lines += [Line(0, "ptol = tol * REACH"), Line(0, "n = 0"), Line(0, f"t = ({world_names()})")]
     depth = 0
     checks: list[tuple[int, int]] = []
     for step in plan.ik.steps:

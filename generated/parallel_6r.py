@@ -1820,6 +1820,13 @@ def _kreference(q):
     return q + cosines + sines
 
 
+def _ksolve_pose(T, i, tol, ref, found, buf):
+    """_ksolve on the pose T[i]."""
+    return _ksolve(T[i, 0, 0], T[i, 0, 1], T[i, 0, 2], T[i, 0, 3], T[i, 1, 0], T[i, 1, 1],
+                   T[i, 1, 2], T[i, 1, 3], T[i, 2, 0], T[i, 2, 1], T[i, 2, 2], T[i, 2, 3], tol,
+                   ref, found, buf)
+
+
 def _kone(T, tol, qref):
     """ik's solutions of the pose T[0] as (rows, status): status 0 where they are settled,
     1 where the scalar solver must settle the pose, 2 where T[0] is no valid pose."""
@@ -1827,9 +1834,7 @@ def _kone(T, tol, qref):
     if not _kpose_ok(T, 0):
         return rows[:0], 2
     found = np.zeros((8, DOF))
-    count = _ksolve(T[0, 0, 0], T[0, 0, 1], T[0, 0, 2], T[0, 0, 3], T[0, 1, 0], T[0, 1, 1],
-                    T[0, 1, 2], T[0, 1, 3], T[0, 2, 0], T[0, 2, 1], T[0, 2, 2], T[0, 2, 3], tol,
-                    _kreference(qref), found, np.zeros(32 * DOF))
+    count = _ksolve_pose(T, 0, tol, _kreference(qref), found, np.zeros(32 * DOF))
     if count < 0:
         return rows[:0], 1
     return rows[:_kfinish(found, count, rows, np.zeros(DOF))], 0
@@ -1849,9 +1854,7 @@ def _kbatch(T, tol, qref, Q, valid, retry):
         for i in range(part * n // _KPARTS, (part + 1) * n // _KPARTS):
             if not _kpose_ok(T, i):
                 continue
-            count = _ksolve(T[i, 0, 0], T[i, 0, 1], T[i, 0, 2], T[i, 0, 3], T[i, 1, 0],
-                            T[i, 1, 1], T[i, 1, 2], T[i, 1, 3], T[i, 2, 0], T[i, 2, 1],
-                            T[i, 2, 2], T[i, 2, 3], tol, ref, found, buf)
+            count = _ksolve_pose(T, i, tol, ref, found, buf)
             if count < 0:
                 retry[i] = True
                 continue
@@ -1900,8 +1903,8 @@ def _kfk_q(q):
 _KERNEL = ("_kpose_ok", "_kcs1", "_kcs2", "_reach_first1", "_reach_first2", "_kcs1r", "_kcs2r",
            "_katan2", "_kangle", "_kwrap", "_kquadratic", "_kcubic_largest", "_kquartic",
            "_kquadratic_real", "_kquartic_real", "_ksort", "_kroots", "_kpoly", "_kdistinct",
-           "_kfinish", "_kreference", "_kone", "_ksolve", "_kbatch", "_knewton", "_ksmall_residual", "_kfk",
-           "_kfk_q")
+           "_kfinish", "_kreference", "_ksolve_pose", "_kone", "_ksolve", "_kbatch", "_knewton",
+           "_ksmall_residual", "_kfk", "_kfk_q")
 _compiled = None
 _BATCH_LOCK = threading.Lock()
 
