@@ -11,7 +11,6 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 from importlib import resources
-from pathlib import Path
 
 import jinja2
 import sympy as sp
@@ -398,18 +397,19 @@ def dh_table(plan: Plan) -> tuple[str, ...]:
     return tuple("  ".join(c.ljust(w) for c, w in zip(r, widths)).rstrip() for r in rows)
 
 
-def template_dir() -> Path:
-    """The templates folder: the repository's ``templates/``, or the installed copy."""
-    here = Path(__file__).resolve().parent.parent / "templates"
-    if here.is_dir():
-        return here
-    return Path(str(resources.files("derive.templates")))
+def _package_template(name: str) -> str:
+    """A template's text from the package's own data (``derive.templates``), nowhere else:
+    a ``templates/`` folder elsewhere on ``sys.path`` never shadows it."""
+    entry = resources.files("derive.templates").joinpath(name)
+    if not name.endswith(".j2") or "/" in name or not entry.is_file():
+        raise jinja2.TemplateNotFound(name)
+    return entry.read_text(encoding="utf-8")
 
 
 def environment() -> jinja2.Environment:
-    """The jinja2 environment: strict undefined, no autoescape, fixed newlines."""
+    """The jinja2 environment: package templates only, strict undefined, no autoescape."""
     return jinja2.Environment(
-        loader=jinja2.FileSystemLoader(str(template_dir())),
+        loader=jinja2.FunctionLoader(_package_template),
         undefined=jinja2.StrictUndefined,
         autoescape=False,
         keep_trailing_newline=True,
