@@ -32,6 +32,7 @@ import json
 import keyword
 import math
 import re
+import sys
 import tomllib
 from dataclasses import dataclass
 from pathlib import Path
@@ -44,6 +45,13 @@ RIGID_TOL = 1e-9
 # kilometres in any unit, angles); outside this range the derivation's tolerances lose sense.
 MIN_MAGNITUDE = 1e-9
 MAX_MAGNITUDE = 1e9
+# Modules a generated module or its users import besides the standard library's
+# (sys.stdlib_module_names): a generated <name>.py must not shadow them in its folder.
+SHADOWED_MODULES = frozenset({
+    "numpy", "numba", "llvmlite", "scipy", "sympy", "mpmath", "jinja2", "markupsafe",
+    "derive", "pytest", "hypothesis", "setuptools", "pip", "pkg_resources", "matplotlib",
+    "yaml", "six", "typing_extensions", "conftest",
+})
 TOP_KEYS = ("name", "convention", "angle_unit", "length_unit", "joint", "base", "tool", "example")
 JOINT_KEYS = ("type", "alpha", "a", "d", "theta", "limits")
 FRAME_KEYS = ("matrix", "translation", "rpy")
@@ -190,7 +198,7 @@ def parse_spec(raw: bytes | str, where: str = "<memory>") -> ArmSpec:
     """
     if isinstance(raw, bytes):
         try:
-            raw = raw.decode("utf-8")
+            raw = raw.decode("utf-8-sig")  # a byte-order mark (as some editors save) is fine
         except UnicodeDecodeError:
             raise SpecError(f"{where}: not UTF-8 text; a spec is a TOML file") from None
     try:
@@ -209,6 +217,11 @@ def _validate(data: dict, where: str) -> ArmSpec:
         raise SpecError(
             f"{where}: name: {name[:40]!r} is not allowed; use [a-z][a-z0-9_]* "
             f"(at most {NAME_MAX} characters, not a Python keyword)")
+    if name in SHADOWED_MODULES or name in sys.stdlib_module_names:
+        raise SpecError(
+            f"{where}: name: {name!r} is the name of a module the generated code or Python "
+            f"uses; {name}.py would shadow it for every import in its folder; choose another "
+            f"name (e.g. {name}_arm)")
     convention = _choice_or_text(data, "convention", where, ("standard", "modified"))
     angle_unit = _choice_or_text(data, "angle_unit", where, ("deg", "rad"))
     length_unit = _choice_or_text(data, "length_unit", where)
