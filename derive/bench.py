@@ -149,6 +149,8 @@ def measure(module: ModuleType, samples: int, seed: int = 0, batch_n: int = 100_
         figures["ik_us"] = median_us(module.ik, [(T,) for T in poses])
         figures["ik_python_us"] = median_us(partial(module.ik, backend="python"),
                                             [(T,) for T in poses])
+        # nearest (within the limits, every 2 pi variant considered) against the same poses
+        figures["nearest_us"] = median_us(module.nearest, list(zip(poses, Q)))
         result = roundtrip(module, Q)
         figures.update(batch_figures(module, batch_n, seed, memory_n, figures.get("threads", 0)))
         figures["batch_agrees"] = batch_agreement(module, module.fk_batch(Q))

@@ -159,7 +159,7 @@ def _fk_q(q):
 
 def fk(q):
     """World pose of the tool frame (base and tool included) for joint vector q."""
-    q = np.asarray(q, dtype=float)
+    q = _real(q, "q")
     if q.shape != (DOF,):
         raise ValueError(f"q must have shape ({DOF},), got {q.shape}")
     e = _fk_q(q.tolist())
@@ -189,9 +189,22 @@ def _cs_columns(Q):
     return (c1, s1, c2, s2, c3, s3, c4, s4, c5, s5, c6, s6,)
 
 
+def _real(x, name):
+    """x as a float64 array; ValueError for complex or non-numeric input."""
+    if type(x) is np.ndarray and x.dtype == np.float64:
+        return x
+    try:
+        a = np.asarray(x)
+        if a.dtype.kind == "c":
+            raise TypeError
+        return a.astype(float)
+    except (TypeError, ValueError):
+        raise ValueError(f"{name} must be an array of real numbers") from None
+
+
 def fk_batch(Q):
     """World poses (N, 4, 4) for joint vectors Q of shape (N, DOF), without a Python loop."""
-    Q = np.asarray(Q, dtype=float)
+    Q = _real(Q, "Q")
     if Q.ndim != 2 or Q.shape[1] != DOF:
         raise ValueError(f"Q must have shape (N, {DOF}), got {Q.shape}")
     out = np.zeros((Q.shape[0], 4, 4))
@@ -217,22 +230,36 @@ _CLUSTER_TOL = 1e-3
 # a cos + b sin = e with |e| up to (1 + _CLAMP_TOL) sqrt(a^2 + b^2) is solved at the boundary:
 # earlier joints from a double root (elbow stretched) carry errors of ~1e-8
 _CLAMP_TOL = 1e-7
+# ... and from |e| down to (1 - _FOLD_TOL) sqrt(a^2 + b^2) as the double root acos(+-1): there
+# the angle moves by up to acos(1 - _FOLD_TOL) ~ 1.4e-7 while the equation's residual stays
+# below _FOLD_TOL sqrt(a^2 + b^2), and every backend gives the same value (acos near +-1 turns
+# one rounding of its argument into 1e-8 of angle)
+_FOLD_TOL = 1e-14
 _LEAD_TOL = 1e-10
 _OMEGA = (1.0, complex(-0.5, math.sqrt(3.0) / 2.0), complex(-0.5, -math.sqrt(3.0) / 2.0))
 _FREE_TOL = 1e-14  # squared sizes: a joint is free below 1e-7 of its equation's scale
 # the values a free joint tries, as offsets from its preferred value: 0, +5, -5, +10, ... deg
 _FREE_STEPS = tuple(math.radians(5.0 * ((k + 1) // 2) * (1 if k % 2 else -1)) for k in range(72))
 _TWO_PI = 2.0 * math.pi
+# a revolute value within _SEAM_TOL of -pi or pi is returned as pi, in every backend, so
+# that one solution has one value at the seam (rounding puts it on either side)
+_SEAM_TOL = 1e-9
+_SEAM = math.pi - _SEAM_TOL
+# all_turns=True returns at most this many rows (every 2 pi variant of every joint)
+MAX_TURN_ROWS = 100_000
 
 
-def ik(T, *, within_limits=False, q_ref=None, tol=CERTIFY_TOL, backend=None):
+def ik(T, *, within_limits=False, q_ref=None, tol=CERTIFY_TOL, backend=None, all_turns=False):
     """All solutions for the world pose T, as an (n, DOF) array; empty (0, DOF) if unreachable.
 
     Args:
         T: 4x4 homogeneous transform of the tool frame in the world.
-        within_limits: keep only solutions inside LIMITS; revolute joints whose range allows
-            it are also tried at q +- 2 pi, and every variant inside the limits is returned.
-        q_ref: joint vector whose values free joints take at singular poses (default zeros).
+        within_limits: keep only solutions inside LIMITS. Each solution comes once, each
+            revolute joint at the value q + 2 pi k inside its limits nearest q_ref's (joints
+            without limits too: by default the wrapped value). A solution with a joint that
+            no such k brings inside its limits is dropped.
+        q_ref: joint vector whose values free joints take at singular poses, and that
+            within_limits picks variants near (default zeros).
         tol: certification tolerance: a solution is returned only if its forward kinematics
             matches T within tol in rotation entries and tol * REACH in position. For an arm
             that does not control every pose component this is also the test that T's other
@@ -243,30 +270,39 @@ def ik(T, *, within_limits=False, q_ref=None, tol=CERTIFY_TOL, backend=None):
             which is "auto" unless you set it. The two agree to
             rounding (far below tol); poses the compiled closed forms do not settle (a free
             joint, a split multiple root) are solved in Python either way.
+        all_turns: with within_limits, every variant of every solution inside the limits
+            (all k per joint, as a product; at most MAX_TURN_ROWS rows, else ValueError).
 
     Raises:
-        ValueError: T is not 4x4, has non-finite entries, or its rotation is not orthonormal
-            within POSE_TOL.
+        ValueError: T is not 4x4, has non-finite or complex entries, or its rotation is not
+            orthonormal within POSE_TOL; q_ref is not DOF finite numbers; tol is not a
+            positive finite number; all_turns would give more than MAX_TURN_ROWS rows.
     """
     refs = _reference(q_ref)
+    tol = _tolerance(tol)
+    if within_limits:
+        def result(rows):
+            return _in_limits(rows, refs, all_turns)
+    else:
+        result = _as_rows
     kernels = _kernels(backend)
     if kernels is not None:
         A = _array44(T)
         if A is not None:  # else _pose says what is wrong with T
             rows, status = kernels[1](A[None], float(tol), refs)
             if status == 0:
-                return _result([tuple(q) for q in rows.tolist()], True) if within_limits else rows
+                return result(rows.tolist()) if within_limits else rows
     # the Python solver; for the compiled one a pose it did not settle, or an invalid one
     target = _pose(T)
-    return _result(_finish(_ik_scalar(target, *refs, tol)), within_limits)
+    return result(_finish(_ik_scalar(target, *refs, tol)))
 
 
 def _array44(T):
     """T as a float64 array if it is 4x4, else None."""
     if type(T) is not np.ndarray or T.dtype != np.float64:
         try:
-            T = np.asarray(T, dtype=float)
-        except (TypeError, ValueError):
+            T = _real(T, "T")
+        except ValueError:
             return None
     return T if T.shape == (4, 4) else None
 
@@ -387,10 +423,13 @@ def ik_batch(T, *, q_ref=None, tol=CERTIFY_TOL, chunk=4096, backend=None):
         transform (not finite, rotation not orthonormal within POSE_TOL) gets no valid slot
         instead of an exception.
     """
+    tol = _tolerance(tol)
+    if type(chunk) is bool or not isinstance(chunk, (int, np.integer)) or chunk < 1:
+        raise ValueError(f"chunk must be a positive integer, got {chunk!r}")
     kernels = _kernels(backend)
     if kernels is None:
-        return _ik_batch_numpy(T, q_ref, tol, chunk)
-    T = np.ascontiguousarray(T, dtype=float)
+        return _ik_batch_numpy(T, q_ref, tol, int(chunk))
+    T = np.ascontiguousarray(_real(T, "T"))
     if T.ndim != 3 or T.shape[1:] != (4, 4):
         raise ValueError(f"T must have shape (N, 4, 4), got {T.shape}")
     refs = _reference(q_ref)
@@ -549,20 +588,28 @@ def _ik_candidates(T, qr1, qr2, qr3, qr4, qr5, qr6, tol):
 def nearest(T, q_ref, *, within_limits=True, weights=None):
     """The solution closest to q_ref (weighted squared joint distance), or None.
 
-    With within_limits=False revolute differences are wrapped to (-pi, pi]; with limits they
-    are not, since a joint cannot pass through its limits.
+    With within_limits=True each revolute joint takes its value q + 2 pi k inside LIMITS
+    nearest q_ref's (the distance is a sum over joints, so this is the nearest variant of
+    the whole vector); with within_limits=False revolute differences are wrapped to
+    (-pi, pi] and the solution is returned wrapped.
+
+    Args:
+        weights: DOF finite non-negative numbers (default ones).
     """
-    q_ref = np.asarray(q_ref, dtype=float)
-    if q_ref.shape != (DOF,):
-        raise ValueError(f"q_ref must have shape ({DOF},), got {q_ref.shape}")
-    sols = ik(T, within_limits=within_limits, q_ref=q_ref)
+    refs = np.array(_reference(q_ref, required=True))
+    if weights is None:
+        w = np.ones(DOF)
+    else:
+        w = _real(weights, "weights")
+        if w.shape != (DOF,) or not np.isfinite(w).all() or (w < 0.0).any():
+            raise ValueError(f"weights must be {DOF} finite non-negative numbers")
+    sols = ik(T, within_limits=within_limits, q_ref=refs)
     if len(sols) == 0:
         return None
-    diff = sols - q_ref
+    diff = sols - refs
     if not within_limits:
         rev = np.array(_REVOLUTE)
         diff[:, rev] = np.remainder(diff[:, rev] + math.pi, _TWO_PI) - math.pi
-    w = np.ones(DOF) if weights is None else np.asarray(weights, dtype=float)
     return sols[int(np.argmin((diff * diff) @ w))]
 
 
@@ -572,9 +619,9 @@ def _pose(T):
         v = T.ravel().tolist()
     else:
         try:
-            A = np.asarray(T, dtype=float)
-        except (TypeError, ValueError):
-            raise ValueError("T must be a 4x4 array of numbers") from None
+            A = _real(T, "T")
+        except ValueError:
+            raise ValueError("T must be a 4x4 array of real numbers") from None
         if A.shape != (4, 4):
             raise ValueError(f"T must have shape (4, 4), got {A.shape}")
         v = A.ravel().tolist()
@@ -596,13 +643,38 @@ def _pose(T):
     return tuple(v[:12])
 
 
-def _reference(q_ref):
-    if q_ref is None:
-        return (0.0,) * DOF
-    q_ref = tuple(map(float, q_ref.tolist() if type(q_ref) is np.ndarray else q_ref))
-    if len(q_ref) != DOF or not all(map(math.isfinite, q_ref)):
-        raise ValueError(f"q_ref must be {DOF} finite numbers")
-    return q_ref
+def _reference(q_ref, required=False):
+    """q_ref as a tuple of DOF floats (zeros for None unless required)."""
+    if q_ref is None and not required:
+        return _ZEROS
+    if type(q_ref) is tuple and len(q_ref) == DOF and all(type(x) is float for x in q_ref):
+        values = q_ref
+    else:
+        try:
+            a = _real(q_ref, "q_ref")
+        except ValueError:
+            a = None
+        if a is None or a.shape != (DOF,):
+            shape = "" if a is None else f", got shape {a.shape}"
+            raise ValueError(f"q_ref must be {DOF} finite real numbers, shape ({DOF},){shape}")
+        values = tuple(a.tolist())
+    if not all(map(math.isfinite, values)):
+        raise ValueError(f"q_ref must be {DOF} finite real numbers, got {values}")
+    return values
+
+
+_ZEROS = (0.0,) * DOF
+
+
+def _tolerance(tol):
+    """tol as a float, if it is a positive finite number."""
+    try:
+        value = float(tol)
+    except (TypeError, ValueError):
+        value = math.nan
+    if type(tol) is bool or not (0.0 < value < math.inf):
+        raise ValueError(f"tol must be a positive finite number, got {tol!r}")
+    return value
 
 
 def _keep(found, t, q, e, tol):
@@ -618,7 +690,8 @@ def _wrap(x):
 
 
 def _finish(found):
-    """Revolute values wrapped to (-pi, pi] and repeats (DEDUP_TOL) dropped.
+    """Revolute values wrapped to (-pi, pi] (pi within _SEAM_TOL of +-pi) and repeats
+    (DEDUP_TOL, revolute differences modulo 2 pi) dropped.
 
     Repeats are found by comparing the last joint first, then all joints; the first of
     equal candidates is kept.
@@ -626,8 +699,8 @@ def _finish(found):
     rows = []
     for q in found:
         q = tuple(map(math.remainder, q, _PERIODS))
-        if -math.pi in q:
-            q = tuple(math.pi if x == -math.pi and p != math.inf else x
+        if max(map(abs, q)) > _SEAM:
+            q = tuple(math.pi if abs(x) > _SEAM and p != math.inf else x
                       for x, p in zip(q, _PERIODS))
         for p in rows:
             if (abs(math.remainder(q[-1] - p[-1], _PERIODS[-1])) <= DEDUP_TOL
@@ -638,37 +711,73 @@ def _finish(found):
     return rows
 
 
-def _result(rows, within_limits):
-    """ik's array of the distinct solutions rows, expanded to their limit variants."""
-    if within_limits:
-        rows = [v for q in rows for v in _limit_variants(q)]
+def _as_rows(rows):
+    """ik's (n, DOF) array of rows."""
+    if type(rows) is np.ndarray:
+        return rows
     return np.array(rows, dtype=float).reshape(len(rows), DOF)
 
 
-def _limit_variants(q):
-    """Every joint vector equal to q modulo 2 pi (revolute joints) inside LIMITS.
+def _in_limits(rows, refs, all_turns):
+    """The rows inside LIMITS: each once, every revolute joint at its variant q + 2 pi k
+    nearest refs; with all_turns, every variant (a bounded product)."""
+    if not all_turns:
+        kept = [v for v in (_nearest_variant(q, refs) for q in rows) if v is not None]
+        return _as_rows(kept)
+    options = [_turns(q) for q in rows]
+    total = sum(math.prod(len(o) for o in opts) for opts in options)
+    if total > MAX_TURN_ROWS:
+        raise ValueError(f"all_turns: the limits allow {total} variants of the solutions; "
+                         f"at most MAX_TURN_ROWS = {MAX_TURN_ROWS} are returned")
+    out = []
+    for opts in options:
+        combos = [()]
+        for values in opts:
+            combos = [c + (v,) for c in combos for v in values]
+        out += combos if opts else []
+    return _as_rows(out)
 
-    A joint without limits keeps its wrapped value; one whose finite range is wider than
-    2 pi contributes each of its in-range values.
-    """
+
+def _turn_range(x, lo, hi):
+    """The k with lo <= x + 2 pi k <= hi (1e-12 slack): (first, last), empty if first > last."""
+    first = -math.inf if lo == -math.inf else math.ceil((lo - 1e-12 - x) / _TWO_PI)
+    last = math.inf if hi == math.inf else math.floor((hi + 1e-12 - x) / _TWO_PI)
+    return first, last
+
+
+def _nearest_variant(q, refs):
+    """q with each revolute joint at its value inside LIMITS nearest refs, or None."""
+    out = []
+    for x, r, (lo, hi), ref in zip(q, _REVOLUTE, LIMITS, refs):
+        if not r:
+            if not lo - 1e-12 <= x <= hi + 1e-12:
+                return None
+            out.append(x)
+            continue
+        first, last = _turn_range(x, lo, hi)
+        if first > last:
+            return None
+        k = min(max(round((ref - x) / _TWO_PI), first), last)
+        out.append(x + k * _TWO_PI if k else x)
+    return tuple(out)
+
+
+def _turns(q):
+    """Per joint, every value of q's joint inside LIMITS (revolute: x + 2 pi k, nearest to
+    zero first; an unlimited revolute joint only its wrapped value); [] if some has none."""
     options = []
     for x, r, (lo, hi) in zip(q, _REVOLUTE, LIMITS):
-        if r and math.isfinite(lo) and math.isfinite(hi):
-            k = math.ceil((lo - 1e-12 - x) / _TWO_PI)
-            ok = []
-            while x + k * _TWO_PI <= hi + 1e-12:
-                ok.append(x + k * _TWO_PI)
-                k += 1
-            ok.sort(key=abs)
-        else:
-            ok = [x] if lo - 1e-12 <= x <= hi + 1e-12 else []
-        if not ok:
+        first, last = _turn_range(x, lo, hi) if r else (0, 0)
+        if not r and not lo - 1e-12 <= x <= hi + 1e-12 or first > last:
             return []
-        options.append(ok)
-    out = [()]
-    for ok in options:
-        out = [v + (c,) for v in out for c in ok]
-    return out
+        if math.isinf(first) or math.isinf(last):
+            options.append([x])
+            continue
+        if last - first >= MAX_TURN_ROWS:
+            raise ValueError(f"all_turns: joint limits allow more than MAX_TURN_ROWS = "
+                             f"{MAX_TURN_ROWS} turns")
+        options.append(sorted((x + k * _TWO_PI for k in range(first, last + 1)), key=abs))
+    return options
 
 
 class _Free(tuple):
@@ -684,7 +793,8 @@ def _free(t):
 
 def _cs1(a, b, e, scale=0.0, ref=0.0):
     """Angles t with a cos t + b sin t = e: atan2(b, a) +- acos(e / sqrt(a^2 + b^2)), the
-    acos argument clamped when it exceeds 1 by at most _CLAMP_TOL.
+    acos argument clamped when it exceeds 1 by at most _CLAMP_TOL, and taken as +-1 within
+    _FOLD_TOL below (the double root).
 
     When a^2 + b^2 and e^2 are both at most _FREE_TOL * scale the equation holds for every
     t (the angle is free; e.g. the elbow folded onto axis 1): _free(ref).
@@ -698,7 +808,10 @@ def _cs1(a, b, e, scale=0.0, ref=0.0):
     if abs(ratio) > 1.0 + _CLAMP_TOL:
         return ()
     base = atan2(b, a)
-    delta = acos(max(-1.0, min(1.0, ratio)))
+    if abs(ratio) >= 1.0 - _FOLD_TOL:
+        delta = 0.0 if ratio > 0.0 else math.pi
+    else:
+        delta = acos(ratio)
     return (base + delta, base - delta)
 
 
@@ -930,7 +1043,10 @@ def _vcs1(a, b, e, scale, ref, axis, like):
         ratio = e / rho
     ok = ~small & (rho > 0.0) & (np.abs(ratio) <= 1.0 + _CLAMP_TOL)
     base = np.arctan2(b, a)
-    delta = np.arccos(np.clip(np.where(ok, ratio, 0.0), -1.0, 1.0))
+    ratio = np.where(ok, ratio, 0.0)
+    fold = np.abs(ratio) >= 1.0 - _FOLD_TOL
+    delta = np.where(fold, np.where(ratio > 0.0, 0.0, math.pi),
+                     np.arccos(np.clip(ratio, -1.0, 1.0)))
     return (np.concatenate((np.where(free, ref, base + delta), base - delta), axis),
             np.concatenate((ok | free, ok), axis),
             np.concatenate((free, np.zeros_like(free)), axis))
@@ -1166,7 +1282,7 @@ def _vpoly(coeffs, axis, like, angles, ref=0.0, free=0.0, unit=1.0):
 
 def _vpose(T):
     """Per-row validity of poses (N, 4, 4) and the poses with invalid rows replaced."""
-    T = np.asarray(T, dtype=float)
+    T = _real(T, "T")
     if T.ndim != 3 or T.shape[1:] != (4, 4):
         raise ValueError(f"T must have shape (N, 4, 4), got {T.shape}")
     flat = T.reshape(-1, 16)
@@ -1185,7 +1301,8 @@ def _vpose(T):
 
 
 def _vfinish(Q, valid):
-    """Wrap revolute values and drop repeats within each pose (vectorised).
+    """Wrap revolute values (as _finish: pi at the seam) and drop repeats within each pose
+    (vectorised).
 
     Pairs are compared on their last joint first; only the few rows where that agrees are
     compared in full.
@@ -1193,7 +1310,8 @@ def _vfinish(Q, valid):
     count = Q.shape[1]
     rev = np.array(_REVOLUTE)
     Q = Q.copy()
-    Q[:, :, rev] = _vwrap(Q[:, :, rev])
+    W = _vwrap(Q[:, :, rev])
+    Q[:, :, rev] = np.where(np.abs(W) > _SEAM, math.pi, W)
     ok = valid.copy()
     period = _PERIODS[-1]
     for j in range(1, count):
@@ -1380,7 +1498,8 @@ def _kcs1(a, b, e, scale):
     ratio = e / rho
     if abs(ratio) > 1.0 + _CLAMP_TOL:
         return 0, 0.0, 1.0, 0.0, 0.0, 1.0, 0.0, 0
-    ratio = max(-1.0, min(1.0, ratio))
+    if abs(ratio) >= 1.0 - _FOLD_TOL:
+        ratio = 1.0 if ratio > 0.0 else -1.0
     base = _kangle(b, a)
     sd = sqrt((1.0 - ratio) * (1.0 + ratio))
     delta = _kangle(sd, ratio)
@@ -1732,7 +1851,11 @@ def _kfinish(found, count, rows, q):
     m = 0
     for r in range(count):
         for j in range(DOF):
-            q[j] = _kwrap(found[r, j]) if _REVOLUTE[j] else found[r, j]
+            q[j] = found[r, j]
+            if _REVOLUTE[j]:
+                q[j] = _kwrap(q[j])
+                if abs(q[j]) > _SEAM:
+                    q[j] = math.pi
         if _kdistinct(rows, m, q):
             rows[m, :] = q
             m += 1

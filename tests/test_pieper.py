@@ -75,16 +75,30 @@ def test_puma_limits_with_wrapping_versus_the_reports_flags(generated):
         assert all(lo <= v <= hi for v, (lo, hi) in zip(q, m.LIMITS))
 
 
-def test_within_limits_returns_every_in_range_variant(generated):
+def test_within_limits_returns_each_solution_once_nearest_q_ref(generated):
     m = generated("puma560")
-    q = np.radians([10.0, 20.0, 30.0, 40.0, 50.0, 60.0])
-    inside = m.ik(m.fk(q), within_limits=True)
-    # theta6 range is +-260 deg: both 60 and 60 - 360 = -300 ... only 60 is inside;
-    # theta6 = -120 (the flipped wrist) has -120 and 240 inside
-    values = sorted(np.degrees(inside[:, 5]).round(6))
-    assert 60.0 in values
-    flipped = [v for v in values if abs(v - 240.0) < 1e-6 or abs(v + 120.0) < 1e-6]
-    assert len(flipped) in (0, 2)
+    q = np.radians([10.0, 20.0, 30.0, -100.0, 50.0, 60.0])
+    T = m.fk(q)
+    plain = m.ik(T)
+    inside = m.ik(T, within_limits=True)
+    assert len(inside) <= len(plain)
+    for row in inside:
+        assert all(lo <= v <= hi for v, (lo, hi) in zip(row, m.LIMITS))
+        assert any(wrapped_close(row, p, 1e-12) for p in plain)
+    # theta6's range is +-266 deg: the flipped wrist's theta6 = -120 deg is also inside as
+    # 240; with q_ref near 240 that variant is the one returned
+    flipped = [r for r in inside if abs(np.degrees(r[5]) + 120.0) < 1e-6]
+    assert flipped
+    ref = flipped[0].copy()
+    ref[5] += 2 * math.pi
+    near = m.ik(T, within_limits=True, q_ref=ref)
+    assert any(abs(np.degrees(r[5]) - 240.0) < 1e-6 for r in near)
+    assert not any(abs(np.degrees(r[5]) + 120.0) < 1e-6 for r in near)
+    # all_turns: every variant inside the limits, as the product over joints
+    every = m.ik(T, within_limits=True, all_turns=True)
+    values = np.degrees(every[:, 5]).round(6)
+    assert 240.0 in values and -120.0 in values and 60.0 in values
+    assert len(every) > len(inside)
 
 
 def test_nearest_picks_the_closest_solution(generated):
@@ -145,7 +159,7 @@ def test_bad_poses_raise_value_error(generated, backend):
         m.ik(np.diag([1.0, 2.0, 1.0, 1.0]), backend=backend)
     with pytest.raises(ValueError, match="last row"):
         m.ik(np.vstack([np.eye(4)[:3], [0.0, 0.0, 0.1, 1.0]]), backend=backend)
-    with pytest.raises(ValueError, match="4x4 array of numbers"):
+    with pytest.raises(ValueError, match="4x4 array of real numbers"):
         m.ik("pose", backend=backend)
     assert m.ik(np.eye(4).tolist(), backend=backend).shape[1] == 6  # nested lists are fine
 

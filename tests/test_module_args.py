@@ -1,0 +1,126 @@
+"""The generated module's arguments: what is checked, and limits that span many turns."""
+
+from __future__ import annotations
+
+import math
+import tracemalloc
+
+import numpy as np
+import pytest
+
+from conftest import build_module
+
+UR5_ROWS = [(90.0, 0.0, 0.089159), (0.0, -0.425, 0.0), (0.0, -0.39225, 0.0),
+            (90.0, 0.0, 0.10915), (-90.0, 0.0, 0.09465), (0.0, 0.0, 0.0823)]
+
+
+def spec_with_limits(name: str, rows: list[tuple[float, float, float]], limit: float) -> str:
+    """Standard-DH revolute arm (degrees, metres) with limits +-limit on every joint."""
+    out = f'name = "{name}"\nconvention = "standard"\nangle_unit = "deg"\nlength_unit = "m"\n'
+    for alpha, a, d in rows:
+        out += (f"[[joint]]\ntype = \"R\"\nalpha = {alpha!r}\na = {a!r}\nd = {d!r}\n"
+                f"theta = 0.0\nlimits = [{-limit!r}, {limit!r}]\n")
+    return out
+
+
+@pytest.fixture(scope="module")
+def ur5(tmp_path_factory):
+    return build_module(spec_with_limits("ur5", UR5_ROWS, 360.0), tmp_path_factory.mktemp("ur5"))
+
+
+@pytest.fixture(scope="module")
+def wide_2r(tmp_path_factory):
+    rows = [(0.0, 1.0, 0.0), (0.0, 1.0, 0.0)]
+    return build_module(spec_with_limits("wide_2r", rows, 1e7), tmp_path_factory.mktemp("w2r"))
+
+
+def test_within_limits_gives_each_solution_once(ur5):
+    q = np.radians([30.0, -60.0, 45.0, -20.0, 70.0, 10.0])
+    T = ur5.fk(q)
+    plain = ur5.ik(T)
+    assert len(plain) == 8
+    inside = ur5.ik(T, within_limits=True)
+    assert inside.shape == plain.shape  # +-360 deg: every solution, once (was 512 rows)
+    np.testing.assert_array_equal(inside, plain)  # q_ref = 0: the wrapped values
+    ref = q + 2 * math.pi * np.array([-1, 0, -1, 0, 0, -1])
+    near = ur5.ik(T, within_limits=True, q_ref=ref)
+    assert np.abs(near - ref).max(axis=1).min() < 1e-9  # q's variant next to q_ref
+    limit = math.radians(360.0)
+    for shift in (-2 * math.pi, 2 * math.pi):  # no other variant inside is nearer q_ref
+        other = near + shift
+        assert ((np.abs(other) > limit) | (np.abs(other - ref) >= np.abs(near - ref))).all()
+    assert ur5.ik(T, within_limits=True, all_turns=True).shape == (8 * 2**6, 6)
+
+
+def test_nearest_takes_each_joint_nearest_variant(ur5):
+    q = np.radians([30.0, -60.0, 45.0, -20.0, 70.0, 10.0])
+    ref = q + 2 * math.pi * np.array([-1, 0, -1, 0, 0, -1]) + 0.01
+    best = ur5.nearest(ur5.fk(q), ref)
+    np.testing.assert_allclose(best, q + 2 * math.pi * np.array([-1, 0, -1, 0, 0, -1]), atol=1e-9)
+    weights = np.array([1.0, 1.0, 1.0, 0.0, 0.0, 0.0])
+    assert ur5.nearest(ur5.fk(q), ref, weights=weights) is not None
+
+
+def test_limits_of_many_turns_stay_cheap(wide_2r):
+    """+-1e7 deg (27,778 turns per joint): the nearest variant is computed, not enumerated."""
+    T = wide_2r.fk([0.3, 0.4])
+    tracemalloc.start()
+    inside = wide_2r.ik(T, within_limits=True)
+    best = wide_2r.nearest(T, [1000.0, -1000.0])
+    peak = tracemalloc.get_traced_memory()[1]
+    tracemalloc.stop()
+    assert inside.shape == (2, 2)
+    assert peak < 1_000_000
+    assert abs(best[0] - 1000.0) <= math.pi and abs(best[1] + 1000.0) <= math.pi
+    with pytest.raises(ValueError, match="MAX_TURN_ROWS"):
+        wide_2r.ik(T, within_limits=True, all_turns=True)
+
+
+@pytest.mark.parametrize("tol", [-1e-6, 0.0, math.nan, math.inf, "x", True])
+def test_tol_must_be_positive_and_finite(ur5, tol):
+    T = ur5.fk(np.zeros(6))
+    with pytest.raises(ValueError, match="tol must be a positive finite number"):
+        ur5.ik(T, tol=tol)
+    with pytest.raises(ValueError, match="tol must be a positive finite number"):
+        ur5.ik_batch(T[None], tol=tol)
+
+
+@pytest.mark.parametrize("chunk", [-5, 0, 2.5, "10", True])
+def test_chunk_must_be_a_positive_integer(ur5, chunk):
+    with pytest.raises(ValueError, match="chunk must be a positive integer"):
+        ur5.ik_batch(ur5.fk(np.zeros(6))[None], chunk=chunk)
+
+
+def test_numpy_integer_chunk_is_fine(ur5):
+    Q, valid = ur5.ik_batch(ur5.fk(np.zeros(6))[None], chunk=np.int64(3))
+    assert valid.sum() >= 1
+
+
+@pytest.mark.parametrize("weights", [[1.0] * 5, [1.0] * 5 + [math.nan], [1.0] * 5 + [-1.0],
+                                     [1j] * 6])
+def test_weights_must_be_finite_and_non_negative(ur5, weights):
+    with pytest.raises(ValueError, match="weights must be 6 finite non-negative numbers|real"):
+        ur5.nearest(ur5.fk(np.zeros(6)), np.zeros(6), weights=weights)
+
+
+def test_complex_input_is_refused(ur5):
+    T = ur5.fk(np.zeros(6)).astype(complex)
+    T[0, 3] += 1e-3j
+    with pytest.raises(ValueError, match="real numbers"):
+        ur5.ik(T)
+    with pytest.raises(ValueError, match="real numbers"):
+        ur5.ik_batch(T[None])
+    with pytest.raises(ValueError, match="real numbers"):
+        ur5.fk(np.zeros(6, dtype=complex))
+    with pytest.raises(ValueError, match="q_ref must be 6 finite real numbers"):
+        ur5.ik(ur5.fk(np.zeros(6)), q_ref=np.zeros(6, dtype=complex))
+
+
+@pytest.mark.parametrize("q_ref", [np.zeros((1, 6)), np.zeros(5), [0.0] * 5 + [math.inf],
+                                   "abcdef", [[0.0] * 6]])
+def test_q_ref_shape_and_values_are_checked(ur5, q_ref):
+    T = ur5.fk(np.zeros(6))
+    with pytest.raises(ValueError, match=r"q_ref must be 6 finite real numbers"):
+        ur5.ik(T, q_ref=q_ref)
+    with pytest.raises(ValueError, match=r"q_ref must be 6 finite real numbers"):
+        ur5.nearest(T, q_ref)
