@@ -289,9 +289,10 @@ def ik(T, *, within_limits=False, q_ref=None, tol=CERTIFY_TOL, backend=None, all
     if kernels is not None:
         A = _array44(T)
         if A is not None:  # else _pose says what is wrong with T
-            rows, status = kernels[1](A[None], float(tol), refs)
+            limited = within_limits and not all_turns
+            rows, status = kernels[1](A[None], tol, refs, limited)
             if status == 0:
-                return result(rows.tolist()) if within_limits else rows
+                return rows if not within_limits or limited else result(rows)
     # the Python solver; for the compiled one a pose it did not settle, or an invalid one
     target = _pose(T)
     return result(_finish(_ik_scalar(target, *refs, tol)))
@@ -604,9 +605,9 @@ def nearest(T, q_ref, *, within_limits=True, weights=None):
     Args:
         weights: DOF finite non-negative numbers (default ones).
     """
-    refs = np.array(_reference(q_ref, required=True))
+    refs = _reference(q_ref, required=True)
     if weights is None:
-        w = np.ones(DOF)
+        w = _ONES
     else:
         w = _real(weights, "weights")
         if w.shape != (DOF,) or not np.isfinite(w).all() or (w < 0.0).any():
@@ -614,11 +615,12 @@ def nearest(T, q_ref, *, within_limits=True, weights=None):
     sols = ik(T, within_limits=within_limits, q_ref=refs)
     if len(sols) == 0:
         return None
-    diff = sols - refs
-    if not within_limits:
-        rev = np.array(_REVOLUTE)
-        diff[:, rev] = np.remainder(diff[:, rev] + math.pi, _TWO_PI) - math.pi
-    return sols[int(np.argmin((diff * diff) @ w))]
+    kernels = _kernels(None)
+    pick = _kpick if kernels is None else kernels[2]
+    return sols[pick(sols, refs, w, not within_limits)]
+
+
+_ONES = np.ones(DOF)
 
 
 def _pose(T):
@@ -728,10 +730,22 @@ def _as_rows(rows):
 
 def _in_limits(rows, refs, all_turns):
     """The rows inside LIMITS: each once, every revolute joint at its variant q + 2 pi k
-    nearest refs; with all_turns, every variant (a bounded product)."""
-    if not all_turns:
-        kept = [v for v in (_nearest_variant(q, refs) for q in rows) if v is not None]
-        return _as_rows(kept)
+    nearest refs (vectorised over the rows); with all_turns, every variant (a bounded
+    product)."""
+    if all_turns:
+        return _every_turn(rows.tolist() if type(rows) is np.ndarray else rows)
+    Q = _as_rows(rows)
+    k = np.rint((np.array(refs) - Q) / _TWO_PI) * _REV
+    # for a prismatic joint first <= 0 <= last says it is inside its limits
+    first = np.ceil((_LOWER - Q) / _TWO_PI)
+    last = np.floor((_UPPER - Q) / _TWO_PI)
+    k = np.minimum(np.maximum(k, first), last) * _REV
+    ok = ((first <= k) & (k <= last)).all(axis=1)
+    return (Q + k * _TWO_PI)[ok]
+
+
+def _every_turn(rows):
+    """Every variant of the rows inside LIMITS, at most MAX_TURN_ROWS of them."""
     options = [_turns(q) for q in rows]
     total = sum(math.prod(len(o) for o in opts) for opts in options)
     if total > MAX_TURN_ROWS:
@@ -746,28 +760,16 @@ def _in_limits(rows, refs, all_turns):
     return _as_rows(out)
 
 
+_REV = np.array([1.0 if r else 0.0 for r in _REVOLUTE])
+_LOWER = np.array([lo - 1e-12 for lo, _ in LIMITS])
+_UPPER = np.array([hi + 1e-12 for _, hi in LIMITS])
+
+
 def _turn_range(x, lo, hi):
     """The k with lo <= x + 2 pi k <= hi (1e-12 slack): (first, last), empty if first > last."""
     first = -math.inf if lo == -math.inf else math.ceil((lo - 1e-12 - x) / _TWO_PI)
     last = math.inf if hi == math.inf else math.floor((hi + 1e-12 - x) / _TWO_PI)
     return first, last
-
-
-def _nearest_variant(q, refs):
-    """q with each revolute joint at its value inside LIMITS nearest refs, or None."""
-    out = []
-    for x, r, (lo, hi), ref in zip(q, _REVOLUTE, LIMITS, refs):
-        if not r:
-            if not lo - 1e-12 <= x <= hi + 1e-12:
-                return None
-            out.append(x)
-            continue
-        first, last = _turn_range(x, lo, hi)
-        if first > last:
-            return None
-        k = min(max(round((ref - x) / _TWO_PI), first), last)
-        out.append(x + k * _TWO_PI if k else x)
-    return tuple(out)
 
 
 def _turns(q):
@@ -1887,9 +1889,49 @@ def _ksolve_pose(T, i, tol, ref, found, buf):
                    ref, found, buf)
 
 
-def _kone(T, tol, qref):
+def _kvariants(rows, m, ref):
+    """_in_limits on rows[:m], in place: the rows inside LIMITS, each revolute joint at its
+    variant q + 2 pi k nearest ref; their number."""
+    count = 0
+    for r in range(m):
+        inside = True
+        for j in range(DOF):
+            x = rows[r, j]
+            first = np.ceil((_LOWER[j] - x) / _TWO_PI)
+            last = np.floor((_UPPER[j] - x) / _TWO_PI)
+            k = 0.0
+            if _REVOLUTE[j]:
+                k = min(max(np.rint((ref[j] - x) / _TWO_PI), first), last)
+            if not first <= k <= last:
+                inside = False
+                break
+            rows[count, j] = x + k * _TWO_PI
+        if inside:
+            count += 1
+    return count
+
+
+def _kpick(Q, ref, w, wrap):
+    """The index of the row of Q nearest ref in weighted squared distance (revolute
+    differences wrapped to (-pi, pi] if wrap); the first of equals."""
+    best = 0
+    least = math.inf
+    for r in range(Q.shape[0]):
+        total = 0.0
+        for j in range(DOF):
+            d = Q[r, j] - ref[j]
+            if wrap and _REVOLUTE[j]:
+                d -= _TWO_PI * np.rint(d / _TWO_PI)
+            total += w[j] * d * d
+        if total < least:
+            best, least = r, total
+    return best
+
+
+def _kone(T, tol, qref, limited):
     """ik's solutions of the pose T[0] as (rows, status): status 0 where they are settled,
-    1 where the scalar solver must settle the pose, 2 where T[0] is no valid pose."""
+    1 where the scalar solver must settle the pose, 2 where T[0] is no valid pose. limited:
+    as ik's within_limits (without all_turns)."""
     rows = np.zeros((8, DOF))
     if not _kpose_ok(T, 0):
         return rows[:0], 2
@@ -1897,7 +1939,10 @@ def _kone(T, tol, qref):
     count = _ksolve_pose(T, 0, tol, _kreference(qref), found, np.zeros(32 * DOF))
     if count < 0:
         return rows[:0], 1
-    return rows[:_kfinish(found, count, rows, np.zeros(DOF))], 0
+    m = _kfinish(found, count, rows, np.zeros(DOF))
+    if limited:
+        m = _kvariants(rows, m, qref)
+    return rows[:m], 0
 
 
 def _kbatch(T, tol, qref, Q, valid, retry):
@@ -1963,7 +2008,7 @@ def _kfk_q(q):
 _KERNEL = ("_kpose_ok", "_kcs1", "_kcs2", "_reach_first1", "_reach_first2", "_kcs1r", "_kcs2r",
            "_katan2", "_kangle", "_kwrap", "_kquadratic", "_kcubic_largest", "_kquartic",
            "_kquadratic_real", "_kquartic_real", "_ksort", "_kroots", "_kpoly", "_kdistinct",
-           "_kfinish", "_kreference", "_ksolve_pose", "_kone", "_ksolve", "_kbatch", "_knewton",
+           "_kfinish", "_kreference", "_ksolve_pose", "_kvariants", "_kpick", "_kone", "_ksolve", "_kbatch", "_knewton",
            "_ksmall_residual", "_kfk", "_kfk_q")
 _compiled = None
 _BATCH_LOCK = threading.Lock()
@@ -1984,7 +2029,7 @@ def _kernels(backend):
 
 
 def _compile():
-    """(_kbatch, _kone) compiled by numba, once per process (numba caches the machine code
+    """(_kbatch, _kone, _kpick) compiled by numba, once per process (numba caches the machine code
     beside this file when the module was imported by its name and the folder is writable;
     otherwise it compiles without a cache); None without numba."""
     global _compiled
@@ -2010,5 +2055,5 @@ def _compile():
                 break
             except RuntimeError:
                 continue
-        _compiled = (names["_kbatch"], names["_kone"])
+        _compiled = (names["_kbatch"], names["_kone"], names["_kpick"])
     return _compiled or None

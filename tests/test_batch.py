@@ -62,7 +62,7 @@ def test_compiled_solver_takes_free_joints_from_q_ref(generated):
     q = np.radians([20.0, -30.0, 40.0, 10.0, 0.0, 25.0])
     T = m.fk(q)
     q_ref = np.radians([0.0, 0.0, 0.0, 33.0, 0.0, 0.0])
-    rows, status = m._compile()[1](T[None], m.CERTIFY_TOL, tuple(q_ref))
+    rows, status = m._compile()[1](T[None], m.CERTIFY_TOL, tuple(q_ref), False)
     assert status == 0  # settled in compiled code
     expected = m.ik(T, q_ref=q_ref, backend="python")
     assert np.isclose(expected[:, 3], math.radians(33.0)).any()  # the singular branch

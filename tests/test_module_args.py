@@ -8,7 +8,7 @@ import tracemalloc
 import numpy as np
 import pytest
 
-from conftest import build_module
+from conftest import build_module, needs_numba
 
 UR5_ROWS = [(90.0, 0.0, 0.089159), (0.0, -0.425, 0.0), (0.0, -0.39225, 0.0),
             (90.0, 0.0, 0.10915), (-90.0, 0.0, 0.09465), (0.0, 0.0, 0.0823)]
@@ -124,3 +124,25 @@ def test_q_ref_shape_and_values_are_checked(ur5, q_ref):
         ur5.ik(T, q_ref=q_ref)
     with pytest.raises(ValueError, match=r"q_ref must be 6 finite real numbers"):
         ur5.nearest(T, q_ref)
+
+
+@needs_numba
+def test_compiled_limits_and_nearest_match_python(ur5):
+    """within_limits and nearest run compiled when numba is there: the same rows and picks."""
+    rng = np.random.default_rng(5)
+    for q in rng.uniform(-2 * math.pi, 2 * math.pi, (50, 6)):
+        T = ur5.fk(q)
+        ref = q + rng.normal(0.0, 0.01, 6)
+        rows = {b: ur5.ik(T, within_limits=True, q_ref=ref, backend=b)
+                for b in ("python", "numba")}
+        assert rows["python"].shape == rows["numba"].shape
+        assert np.abs(rows["python"] - rows["numba"]).max(initial=0.0) < 1e-9
+        ur5.BACKEND = "numba"
+        try:
+            compiled = ur5.nearest(T, ref)
+            wrapped = ur5.nearest(T, ref, within_limits=False)
+        finally:
+            ur5.BACKEND = "python"
+        np.testing.assert_allclose(compiled, ur5.nearest(T, ref), atol=1e-9)
+        np.testing.assert_allclose(wrapped, ur5.nearest(T, ref, within_limits=False), atol=1e-9)
+        np.testing.assert_allclose(compiled, q, atol=1e-6)  # q itself is inside +-360 deg
