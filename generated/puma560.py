@@ -33,7 +33,9 @@ API:
 
 Every solution `ik` returns has been checked by forward kinematics against T (tolerance
 CERTIFY_TOL in rotation and CERTIFY_TOL * REACH in position). Revolute values are wrapped to
-(-pi, pi]. Rows come in branch order: the joints in the order they are solved, each joint's
+(-pi, pi], a value just above -pi (_SEAM_BAND) given as its equivalent just above pi, one
+within _SEAM_SNAP of pi as pi, so that each solution has one value at the seam in every
+backend. Rows come in branch order: the joints in the order they are solved, each joint's
 values in the order its step produces them (polynomial roots by increasing angle, `+acos`
 before `-acos`). At a singular configuration a joint that the pose leaves free (the wrist
 centre on axis 1, a singular wrist) takes its value from q_ref (0 by default) and the joints
@@ -241,10 +243,14 @@ _FREE_TOL = 1e-14  # squared sizes: a joint is free below 1e-7 of its equation's
 # the values a free joint tries, as offsets from its preferred value: 0, +5, -5, +10, ... deg
 _FREE_STEPS = tuple(math.radians(5.0 * ((k + 1) // 2) * (1 if k % 2 else -1)) for k in range(72))
 _TWO_PI = 2.0 * math.pi
-# a revolute value within _SEAM_TOL of -pi or pi is returned as pi, in every backend, so
-# that one solution has one value at the seam (rounding puts it on either side)
-_SEAM_TOL = 1e-9
-_SEAM = math.pi - _SEAM_TOL
+# The seam: rounding puts a joint at pi on either side of it, and one solution would get two
+# values a full turn apart. A revolute value within _SEAM_BAND above -pi is returned as its
+# equivalent just above pi (the value is kept; only the turn changes), and one within
+# _SEAM_SNAP of pi as pi itself, in every backend: returned values lie in
+# (-pi + _SEAM_BAND, pi + _SEAM_BAND].
+_SEAM_BAND = 1e-9
+_SEAM_SNAP = 1e-12
+_SEAM = math.pi - _SEAM_BAND
 # all_turns=True returns at most this many rows (every 2 pi variant of every joint)
 MAX_TURN_ROWS = 100_000
 
@@ -692,7 +698,7 @@ def _wrap(x):
 
 
 def _finish(found):
-    """Revolute values wrapped to (-pi, pi] (pi within _SEAM_TOL of +-pi) and repeats
+    """Revolute values wrapped to (-pi, pi] (at the seam: _seam) and repeats
     (DEDUP_TOL, revolute differences modulo 2 pi) dropped.
 
     Repeats are found by comparing the last joint first, then all joints; the first of
@@ -702,7 +708,7 @@ def _finish(found):
     for q in found:
         q = tuple(map(math.remainder, q, _PERIODS))
         if max(map(abs, q)) > _SEAM:
-            q = tuple(math.pi if abs(x) > _SEAM and p != math.inf else x
+            q = tuple(_seam(x) if abs(x) > _SEAM and p != math.inf else x
                       for x, p in zip(q, _PERIODS))
         for p in rows:
             if (abs(math.remainder(q[-1] - p[-1], _PERIODS[-1])) <= DEDUP_TOL
@@ -711,6 +717,14 @@ def _finish(found):
         else:
             rows.append(q)
     return rows
+
+
+def _seam(x):
+    """A wrapped revolute value near +-pi: above pi if it is within _SEAM_BAND above -pi, pi
+    itself within _SEAM_SNAP of pi."""
+    if x < 0.0:
+        x += _TWO_PI
+    return math.pi if abs(x - math.pi) <= _SEAM_SNAP else x
 
 
 def _as_rows(rows):
@@ -1313,7 +1327,8 @@ def _vfinish(Q, valid):
     rev = np.array(_REVOLUTE)
     Q = Q.copy()
     W = _vwrap(Q[:, :, rev])
-    Q[:, :, rev] = np.where(np.abs(W) > _SEAM, math.pi, W)
+    W = np.where(W < -_SEAM, W + _TWO_PI, W)  # _seam, vectorised
+    Q[:, :, rev] = np.where(np.abs(W - math.pi) <= _SEAM_SNAP, math.pi, W)
     ok = valid.copy()
     period = _PERIODS[-1]
     for j in range(1, count):
@@ -1856,7 +1871,9 @@ def _kfinish(found, count, rows, q):
             q[j] = found[r, j]
             if _REVOLUTE[j]:
                 q[j] = _kwrap(q[j])
-                if abs(q[j]) > _SEAM:
+                if q[j] < -_SEAM:  # _seam
+                    q[j] += _TWO_PI
+                if abs(q[j] - math.pi) <= _SEAM_SNAP:
                     q[j] = math.pi
         if _kdistinct(rows, m, q):
             rows[m, :] = q
