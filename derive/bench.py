@@ -75,10 +75,14 @@ def batch_figures(module: ModuleType, n: int, seed: int, memory_n: int, threads:
     one thread, and the Python backend), and its peak memory at memory_n poses."""
     rng = np.random.default_rng(seed + 1)
     poses = module.fk_batch(sample_joints(module, n, rng))
-    figures = {"batch_n": n, "ik_batch_us": batch_us(module, poses),
-               "ik_batch_python_us": batch_us(module, poses, backend="python")}
+    figures = {
+        "batch_n": n,
+        "ik_batch_us": batch_us(module, poses),
+        "ik_batch_python_us": batch_us(module, poses, backend="python"),
+    }
     if threads:
         import numba
+
         numba.set_num_threads(1)
         try:
             figures["ik_batch_1thread_us"] = batch_us(module, poses)
@@ -90,8 +94,9 @@ def batch_figures(module: ModuleType, n: int, seed: int, memory_n: int, threads:
         module.ik_batch(big)
         _, peak = tracemalloc.get_traced_memory()
         tracemalloc.stop()
-        figures.update(memory_n=memory_n, ik_batch_peak_mb=peak / 2**20,
-                       input_mb=big.nbytes / 2**20)
+        figures.update(
+            memory_n=memory_n, ik_batch_peak_mb=peak / 2**20, input_mb=big.nbytes / 2**20
+        )
     return figures
 
 
@@ -121,8 +126,9 @@ def eaik_figures(module: ModuleType, poses: np.ndarray) -> dict:
     return {"eaik_ik_us": single, "eaik_batch_us": batch}
 
 
-def measure(module: ModuleType, samples: int, seed: int = 0, batch_n: int = 100_000,
-            memory_n: int = 0) -> dict:
+def measure(
+    module: ModuleType, samples: int, seed: int = 0, batch_n: int = 100_000, memory_n: int = 0
+) -> dict:
     """Timings and round-trip figures of a generated module.
 
     Args:
@@ -147,8 +153,9 @@ def measure(module: ModuleType, samples: int, seed: int = 0, batch_n: int = 100_
         figures["backend"] = "numba" if "threads" in figures else "python"
         module.ik(poses[0])
         figures["ik_us"] = median_us(module.ik, [(T,) for T in poses])
-        figures["ik_python_us"] = median_us(partial(module.ik, backend="python"),
-                                            [(T,) for T in poses])
+        figures["ik_python_us"] = median_us(
+            partial(module.ik, backend="python"), [(T,) for T in poses]
+        )
         # nearest (within the limits, every 2 pi variant considered) against the same poses
         figures["nearest_us"] = median_us(module.nearest, list(zip(poses, Q)))
         result = roundtrip(module, Q)
@@ -157,10 +164,15 @@ def measure(module: ModuleType, samples: int, seed: int = 0, batch_n: int = 100_
         if module.JOINT_TYPES == "RRRRRR" and module.DOF == 6:
             figures.update(eaik_figures(module, module.fk_batch(Q)))
         figures.update(
-            samples=result.samples, singular=result.singular, found=result.found,
-            completeness=result.completeness, singular_found=result.singular_found,
+            samples=result.samples,
+            singular=result.singular,
+            found=result.found,
+            completeness=result.completeness,
+            singular_found=result.singular_found,
             singular_posed=result.singular_posed,
-            unsound=len(result.unsound), worst_rot=result.worst_rot, worst_pos=result.worst_pos,
+            unsound=len(result.unsound),
+            worst_rot=result.worst_rot,
+            worst_pos=result.worst_pos,
             worst_singular=result.worst_singular,
             counts={str(k): v for k, v in sorted(result.counts.items())},
             summary=result.summary(),

@@ -72,8 +72,11 @@ def is_zero(value: sp.Expr, tol: float) -> bool:
 def classify(chain: Chain) -> Structure:
     """Axis relations of consecutive axes of a canonical chain."""
     n = chain.dof
-    scale = max([1.0] + [abs(float(t.a)) for t in chain.twists]
-                + [abs(float(j.d)) for j in chain.joints if j.kind == "R"])
+    scale = max(
+        [1.0]
+        + [abs(float(t.a)) for t in chain.twists]
+        + [abs(float(j.d)) for j in chain.joints if j.kind == "R"]
+    )
     parallel, intersecting, coincident = [], [], []
     for i in range(1, n):
         twist = chain.twists[i]
@@ -86,10 +89,18 @@ def classify(chain: Chain) -> Structure:
             coincident.append(i)
         elif zero_a and both_r:
             intersecting.append(i)
-    concurrent = [i for i in range(1, n - 1)
-                  if i in intersecting and i + 1 in intersecting
-                  and is_zero(chain.joints[i].d, LENGTH_TOL * scale)]
-    triples = [i for i in range(1, n - 1) if i in parallel and i + 1 in parallel
-               and i not in coincident and i + 1 not in coincident]
-    return Structure(tuple(parallel), tuple(intersecting), tuple(coincident),
-                     tuple(concurrent), tuple(triples))
+    concurrent = [
+        i
+        for i in range(1, n - 1)
+        if i in intersecting
+        and i + 1 in intersecting
+        and is_zero(chain.joints[i].d, LENGTH_TOL * scale)
+    ]
+    triples = [
+        i
+        for i in range(1, n - 1)
+        if i in parallel and i + 1 in parallel and i not in coincident and i + 1 not in coincident
+    ]
+    return Structure(
+        tuple(parallel), tuple(intersecting), tuple(coincident), tuple(concurrent), tuple(triples)
+    )

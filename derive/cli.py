@@ -18,6 +18,10 @@ import time
 from importlib import resources
 from pathlib import Path
 from types import ModuleType
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from collections.abc import Iterable
 
 from derive.emit import render_module
 from derive.pipeline import build_plan
@@ -36,8 +40,10 @@ class UsageError(Exception):
 def bundled_specs() -> list[Path]:
     """The bundled arm spec files, sorted by name."""
     folder = resources.files("derive.arms")
-    return sorted((Path(str(folder)) / p.name for p in folder.iterdir()
-                   if p.name.endswith(".toml")), key=lambda p: p.name)
+    return sorted(
+        (Path(str(folder)) / p.name for p in folder.iterdir() if p.name.endswith(".toml")),
+        key=lambda p: p.name,
+    )
 
 
 def resolve_spec(text: str) -> ArmSpec:
@@ -69,14 +75,20 @@ def worked_example(plan: Plan, module: ModuleType) -> Example:
         pose = np.array(arm.example_pose).reshape(4, 4)
         how = "the world pose given in the spec's [example]"
     else:
+        assert arm.example_q is not None  # a spec gives an example pose or joint values
         pose = module.fk(list(arm.example_q))
-        shown = ", ".join(f"{math.degrees(v):g}" if t == "R" else f"{v:g}"
-                          for v, t in zip(arm.example_q, arm.joint_types))
+        shown = ", ".join(
+            f"{math.degrees(v):g}" if t == "R" else f"{v:g}"
+            for v, t in zip(arm.example_q, arm.joint_types)
+        )
         how = f"the pose of q = ({shown}) (degrees for R joints)"
     # one pose: the Python solver (compiling the numba one would cost seconds)
     solutions = module.ik(pose, backend="python") if hasattr(module, "ik") else ()
-    return Example(tuple(float(v) for v in pose.ravel()),
-                   tuple(tuple(float(v) for v in row) for row in solutions), how)
+    return Example(
+        tuple(float(v) for v in pose.ravel()),
+        tuple(tuple(float(v) for v in row) for row in solutions),
+        how,
+    )
 
 
 TMP_SUFFIX = ".derive-tmp"
@@ -120,8 +132,10 @@ def load_specs(texts: list[str]) -> list[ArmSpec]:
     seen: dict[str, str] = {}
     for spec in specs:
         if spec.name in seen:
-            raise UsageError(f"{spec.source}: name: {spec.name!r} is also the name of "
-                             f"{seen[spec.name]}; arm names must be unique")
+            raise UsageError(
+                f"{spec.source}: name: {spec.name!r} is also the name of "
+                f"{seen[spec.name]}; arm names must be unique"
+            )
         seen[spec.name] = spec.source
     return specs
 
@@ -151,8 +165,11 @@ def cmd_generate(args: argparse.Namespace) -> int:
         print(f"{spec.name}: {structure}; {method}; {seconds:.2f} s")
     if failed:
         if len(failed) < len(args.specs or bundled_specs()):
-            print(f"error: {len(failed)} arm(s) failed ({', '.join(failed)}); "
-                  "the other arms were written", file=sys.stderr)
+            print(
+                f"error: {len(failed)} arm(s) failed ({', '.join(failed)}); "
+                "the other arms were written",
+                file=sys.stderr,
+            )
         return 2
     if args.require_ik and no_ik:
         print(f"error: no IK method for: {', '.join(no_ik)}", file=sys.stderr)
@@ -189,8 +206,10 @@ def cmd_check(args: argparse.Namespace) -> int:
     for problem in problems:
         print(problem)
     specs_text = " ".join(args.specs)
-    print(f"to update: derive generate {specs_text + ' ' if specs_text else ''}--out {out}"
-          + (f" and delete the stale files" if any("stale" in p for p in problems) else ""))
+    print(
+        f"to update: derive generate {specs_text + ' ' if specs_text else ''}--out {out}"
+        + (" and delete the stale files" if any("stale" in p for p in problems) else "")
+    )
     return 1
 
 
@@ -200,8 +219,10 @@ def describe_difference(path: Path, actual: bytes, expected: bytes) -> str:
     old = actual.decode("utf-8", errors="replace").splitlines()
     new = expected.decode("utf-8").splitlines()
     if old == new:
-        return (f"{path}: differs from the regenerated file in bytes, not in lines (line "
-                "endings or a byte-order mark; generated files are UTF-8 with \\n newlines)")
+        return (
+            f"{path}: differs from the regenerated file in bytes, not in lines (line "
+            "endings or a byte-order mark; generated files are UTF-8 with \\n newlines)"
+        )
     diff = list(difflib.unified_diff(old, new, str(path), f"{path} (regenerated)", lineterm=""))
     shown = "\n".join(diff[:DIFF_LINES])
     more = f"\n... {len(diff) - DIFF_LINES} more diff lines" if len(diff) > DIFF_LINES else ""
@@ -219,6 +240,7 @@ def import_source(name: str, content: str) -> ModuleType:
         path = Path(tmp) / f"{name}.py"
         path.write_text(content, encoding="utf-8")
         loader_spec = importlib.util.spec_from_file_location(f"derive_ik_{name}", path)
+        assert loader_spec is not None and loader_spec.loader is not None
         module = importlib.util.module_from_spec(loader_spec)
         loader_spec.loader.exec_module(module)
     return module
@@ -240,11 +262,12 @@ def joint_vector(spec: ArmSpec, values: list[float], radians: bool) -> list[floa
     """Joint values from the user's units (degrees for R joints unless --rad)."""
     if len(values) != spec.dof:
         raise UsageError(f"expected {spec.dof} joint values for {spec.name}, got {len(values)}")
-    return [math.radians(v) if k == "R" and not radians else v
-            for v, k in zip(values, spec.joint_types)]
+    return [
+        math.radians(v) if k == "R" and not radians else v for v, k in zip(values, spec.joint_types)
+    ]
 
 
-def format_pose(pose: object) -> str:
+def format_pose(pose: Iterable[Iterable[float]]) -> str:
     """Four rows of a 4x4 matrix."""
     return "\n".join("  ".join(f"{x: .10f}" for x in row) for row in pose)
 
@@ -272,7 +295,7 @@ def cmd_solve(args: argparse.Namespace) -> int:
         numbers = parse_numbers([args.pose], "--pose")
         if len(numbers) not in (12, 16):
             raise UsageError("--pose: give 12 numbers (3 rows of 4) or 16 (4 rows of 4)")
-        pose = np.array(numbers[:12] + [0.0, 0.0, 0.0, 1.0]).reshape(4, 4)
+        pose = np.array([*numbers[:12], 0.0, 0.0, 0.0, 1.0]).reshape(4, 4)
     try:
         sols = module.ik(pose, backend="python")  # one pose: not worth compiling
     except ValueError as exc:
@@ -283,11 +306,15 @@ def cmd_solve(args: argparse.Namespace) -> int:
     for k, q in enumerate(sols, start=1):
         shown = [math.degrees(v) if t == "R" else v for v, t in zip(q, spec.joint_types)]
         residual = float(np.abs(module.fk(q) - pose).max())
-        outside = [f"q{i + 1}" for i, (v, (lo, hi)) in enumerate(zip(q, module.LIMITS))
-                   if not lo <= v <= hi]
+        outside = [
+            f"q{i + 1}"
+            for i, (v, (lo, hi)) in enumerate(zip(q, module.LIMITS))
+            if not lo <= v <= hi
+        ]
         flag = f"  out of limits: {', '.join(outside)}" if outside else ""
-        print(f"{k:2d}: " + " ".join(f"{v:10.4f}" for v in shown)
-              + f"  residual {residual:.1e}{flag}")
+        print(
+            f"{k:2d}: " + " ".join(f"{v:10.4f}" for v in shown) + f"  residual {residual:.1e}{flag}"
+        )
     return 0
 
 
@@ -303,8 +330,10 @@ def cmd_bench(args: argparse.Namespace) -> int:
         render_module(build_plan(spec))
         generation = time.perf_counter() - start
         module = load_module(spec)
-        figures = {"generate_s": generation,
-                   **measure(module, args.samples, args.seed, args.batch, args.memory)}
+        figures = {
+            "generate_s": generation,
+            **measure(module, args.samples, args.seed, args.batch, args.memory),
+        }
         results.append(figures)
         if not args.json:
             print(bench_text(spec.name, figures), flush=True)
@@ -339,32 +368,46 @@ def bench_text(name: str, f: dict) -> str:
     if "ik_us" not in f:
         return line
     if f["backend"] == "numba":
-        line += (f"\n  compiled (numba, {f['threads']} threads; first calls "
-                 f"{f['compile_s']:.1f} s): ik {f['ik_us']:.1f} us/pose (median); ik_batch "
-                 f"{f['ik_batch_us']:.2f} us/pose at N = {f['batch_n']}, "
-                 f"{f['ik_batch_1thread_us']:.2f} on one thread")
+        line += (
+            f"\n  compiled (numba, {f['threads']} threads; first calls "
+            f"{f['compile_s']:.1f} s): ik {f['ik_us']:.1f} us/pose (median); ik_batch "
+            f"{f['ik_batch_us']:.2f} us/pose at N = {f['batch_n']}, "
+            f"{f['ik_batch_1thread_us']:.2f} on one thread"
+        )
     line += f"\n  nearest (within limits) {f['nearest_us']:.1f} us/pose (median)"
-    line += (f"\n  python: ik {f['ik_python_us']:.1f} us/pose (median); ik_batch "
-             f"{f['ik_batch_python_us']:.2f} us/pose at N = {f['batch_n']}")
+    line += (
+        f"\n  python: ik {f['ik_python_us']:.1f} us/pose (median); ik_batch "
+        f"{f['ik_batch_python_us']:.2f} us/pose at N = {f['batch_n']}"
+    )
     if "ik_batch_peak_mb" in f:
-        line += (f"\n  ik_batch peak {f['ik_batch_peak_mb']:.0f} MB for {f['memory_n']} poses "
-                 f"(input {f['input_mb']:.0f} MB)")
+        line += (
+            f"\n  ik_batch peak {f['ik_batch_peak_mb']:.0f} MB for {f['memory_n']} poses "
+            f"(input {f['input_mb']:.0f} MB)"
+        )
     if "eaik_skipped" in f:
         line += f"\n  {f['eaik_skipped']}"
     if "eaik_ik_us" in f:
-        line += (f"\n  EAIK on the same poses: ik {f['eaik_ik_us']:.1f} us "
-                 f"({versus(f['ik_us'], f['eaik_ik_us'])}), batch {f['eaik_batch_us']:.2f} "
-                 f"us/pose ({versus(f['ik_batch_us'], f['eaik_batch_us'])})")
-    return (line + f"\n  ik_batch equals the Python ik on {f['batch_agrees']}/{f['samples']} poses"
-            f"\n  {f['summary']}")
+        line += (
+            f"\n  EAIK on the same poses: ik {f['eaik_ik_us']:.1f} us "
+            f"({versus(f['ik_us'], f['eaik_ik_us'])}), batch {f['eaik_batch_us']:.2f} "
+            f"us/pose ({versus(f['ik_batch_us'], f['eaik_batch_us'])})"
+        )
+    return (
+        line + f"\n  ik_batch equals the Python ik on {f['batch_agrees']}/{f['samples']} poses"
+        f"\n  {f['summary']}"
+    )
 
 
 def parser() -> argparse.ArgumentParser:
     """The argument parser of `derive`."""
-    top = argparse.ArgumentParser(prog="derive", description="Closed-form IK solvers from DH tables.")
+    top = argparse.ArgumentParser(
+        prog="derive", description="Closed-form IK solvers from DH tables."
+    )
     sub = top.add_subparsers(dest="command", required=True)
     gen = sub.add_parser("generate", help="write generated/<name>.py and <name>.md for each arm")
-    gen.add_argument("specs", nargs="*", help="spec files or bundled arm names (default: all bundled)")
+    gen.add_argument(
+        "specs", nargs="*", help="spec files or bundled arm names (default: all bundled)"
+    )
     gen.add_argument("--out", default=DEFAULT_OUT, help="output folder (default ./generated)")
     gen.add_argument("--require-ik", action="store_true", help="exit 3 if an arm has no IK method")
     gen.set_defaults(run=cmd_generate)
@@ -391,12 +434,14 @@ def parser() -> argparse.ArgumentParser:
     report.set_defaults(run=cmd_report)
     bench = sub.add_parser("bench", help="time generation and solvers; round-trip figures")
     bench.add_argument("specs", nargs="*", help="spec files or bundled arm names (default: all)")
-    bench.add_argument("--samples", "--n", type=int, default=10000,
-                       help="round-trip samples (10000)")
+    bench.add_argument(
+        "--samples", "--n", type=int, default=10000, help="round-trip samples (10000)"
+    )
     bench.add_argument("--seed", type=int, default=0, help="random seed (0)")
     bench.add_argument("--batch", type=int, default=100_000, help="poses for ik_batch timing")
-    bench.add_argument("--memory", type=int, default=0,
-                       help="also measure ik_batch peak memory on this many poses")
+    bench.add_argument(
+        "--memory", type=int, default=0, help="also measure ik_batch peak memory on this many poses"
+    )
     bench.add_argument("--json", action="store_true", help="print figures as JSON")
     bench.set_defaults(run=cmd_bench)
     return top

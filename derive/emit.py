@@ -46,8 +46,8 @@ class CodePrinter(StrPrinter):
         coeff, rest = expr.as_coeff_Mul()
         if coeff.is_Rational and not coeff.is_Integer and rest is not sp.S.One:
             if coeff < 0:
-                return f"-{repr(float(-coeff))}*{self.parenthesize(rest, 49)}"
-            return f"{repr(float(coeff))}*{self.parenthesize(rest, 49)}"
+                return f"-{float(-coeff)!r}*{self.parenthesize(rest, 49)}"
+            return f"{float(coeff)!r}*{self.parenthesize(rest, 49)}"
         return super()._print_Mul(expr)
 
     def _print_Function(self, expr: sp.Function) -> str:
@@ -75,9 +75,13 @@ class Line:
     text: str
 
 
-def assign_lines(targets: tuple[sp.Symbol, ...], exprs: tuple[sp.Expr, ...],
-                 names: sp.utilities.iterables.numbered_symbols, printer: CodePrinter,
-                 depth: int) -> list[Line]:
+def assign_lines(
+    targets: tuple[sp.Symbol, ...],
+    exprs: tuple[sp.Expr, ...],
+    names: sp.utilities.iterables.numbered_symbols,
+    printer: CodePrinter,
+    depth: int,
+) -> list[Line]:
     """CSE'd straight-line code for targets = exprs."""
     temps, reduced = sp.cse(list(exprs), symbols=names, order="canonical")
     lines = [Line(depth, f"{t} = {printer.doprint(e)}") for t, e in temps]
@@ -160,14 +164,19 @@ def ik_lines(plan: Plan, printer: CodePrinter) -> tuple[tuple[int, str], ...]:
         depth += 1
     outputs = ", ".join(printer.doprint(e) for e in plan.ik.outputs)
     if same_joints(plan):
-        lines.append(Line(depth, f"_keep(found, target, ({outputs},), "
-                                 f"_fk_from_cs({cs_arguments(plan)}), tol)"))
+        lines.append(
+            Line(
+                depth, f"_keep(found, target, ({outputs},), _fk_from_cs({cs_arguments(plan)}), tol)"
+            )
+        )
     else:
         lines.append(Line(depth, f"q = ({outputs},)"))
         lines.append(Line(depth, "_keep(found, target, q, _fk_q(q), tol)"))
     for level, joint in reversed(loops):
         # a free joint's loop (over _Free values) ends at its first value that gave a solution
-        lines.append(Line(level + 1, f"if _v{joint}.__class__ is _Free and len(found) > _n{joint}:"))
+        lines.append(
+            Line(level + 1, f"if _v{joint}.__class__ is _Free and len(found) > _n{joint}:")
+        )
         lines.append(Line(level + 2, "break"))
     return tuple((ln.depth, ln.text) for ln in lines)
 
@@ -190,8 +199,9 @@ def ik_batch_lines(plan: Plan, printer: CodePrinter) -> tuple[str, ...]:
             continue
         level += 1
         lines += batch_solve_lines(step, names, printer, level)
-    outputs = ", ".join(f"np.broadcast_to({printer.doprint(e)}, valid.shape)"
-                        for e in plan.ik.outputs)
+    outputs = ", ".join(
+        f"np.broadcast_to({printer.doprint(e)}, valid.shape)" for e in plan.ik.outputs
+    )
     lines.append(f"Q = np.stack(({outputs}), axis=-1)")
     if same_joints(plan):
         lines.append(f"e = _fk_from_cs({cs_arguments(plan)})")
@@ -213,21 +223,26 @@ def ik_batch_lines(plan: Plan, printer: CodePrinter) -> tuple[str, ...]:
     return tuple(lines)
 
 
-def step_arguments(step: Solve, names: sp.utilities.iterables.numbered_symbols,
-                   printer: CodePrinter, depth: int) -> tuple[list[Line], list[str]]:
+def step_arguments(
+    step: Solve, names: sp.utilities.iterables.numbered_symbols, printer: CodePrinter, depth: int
+) -> tuple[list[Line], list[str]]:
     """A Solve step's note and the CSE'd temporaries of its arguments, and the arguments'
     printed expressions (in terms of those temporaries)."""
     arg_names = tuple(sym.named(f"arg{k}") for k in range(len(step.args)))
     temps = assign_lines(arg_names, step.args, names, printer, depth)
     lines = [Line(depth, f"# {step.note}")]
     lines += [ln for ln in temps if not ln.text.startswith("arg")]
-    args = {ln.text.split(" = ")[0]: ln.text.split(" = ", 1)[1] for ln in temps
-            if ln.text.startswith("arg")}
+    args = {
+        ln.text.split(" = ")[0]: ln.text.split(" = ", 1)[1]
+        for ln in temps
+        if ln.text.startswith("arg")
+    }
     return lines, [args[str(a)] for a in arg_names]
 
 
-def batch_solve_lines(step: Solve, names: sp.utilities.iterables.numbered_symbols,
-                      printer: CodePrinter, level: int) -> list[str]:
+def batch_solve_lines(
+    step: Solve, names: sp.utilities.iterables.numbered_symbols, printer: CodePrinter, level: int
+) -> list[str]:
     """One Solve step of the vectorised IK: its values along axis `level`, validity combined."""
     head, values = step_arguments(step, names, printer, 0)
     lines = [ln.text for ln in head]
@@ -244,15 +259,19 @@ def batch_solve_lines(step: Solve, names: sp.utilities.iterables.numbered_symbol
         "cs2r": f"_vcs2_reach({joined}, {ref}, {level}, valid)",
         "atan2": f"_vatan2({joined}, {ref}, {level}, valid)",
     }[step.kind]
-    lines += [f"{var}, ok, free{level} = {call}", "valid = valid & ok",
-              f"free{level} = free{level} & valid"]
+    lines += [
+        f"{var}, ok, free{level} = {call}",
+        "valid = valid & ok",
+        f"free{level} = free{level} & valid",
+    ]
     if step.kind != "polyd":
         lines += [f"c{step.joint} = np.cos({var})", f"s{step.joint} = np.sin({var})"]
     return lines
 
 
-def solve_lines(step: Solve, names: sp.utilities.iterables.numbered_symbols,
-                printer: CodePrinter, depth: int) -> list[Line]:
+def solve_lines(
+    step: Solve, names: sp.utilities.iterables.numbered_symbols, printer: CodePrinter, depth: int
+) -> list[Line]:
     """The loop header of one Solve step, with its arguments CSE'd before it."""
     lines, values = step_arguments(step, names, printer, depth)
     ref = printer.doprint(step.ref)
@@ -326,6 +345,7 @@ def world_names() -> str:
 def print_plan(plan: Plan) -> PrintedModule:
     """The printed IR of a plan."""
     from derive import kernel  # kernel prints with this module's helpers: imported late
+
     arm = plan.arm
     scalar, vector = CodePrinter(), CodePrinter("np.")
     fk_pose_body, outputs = fk_pose_lines(plan)
@@ -344,8 +364,8 @@ def print_plan(plan: Plan) -> PrintedModule:
         limits_const=_tuple_of_tuples(arm.limits),
         offsets_const=_tuple(offsets),
         revolute_const=_tuple(tuple(k == "R" for k in arm.joint_types)),
-        base_const=_tuple_of_tuples(tuple(arm.base[4 * i:4 * i + 4] for i in range(4))),
-        tool_const=_tuple_of_tuples(tuple(arm.tool[4 * i:4 * i + 4] for i in range(4))),
+        base_const=_tuple_of_tuples(tuple(arm.base[4 * i : 4 * i + 4] for i in range(4))),
+        tool_const=_tuple_of_tuples(tuple(arm.tool[4 * i : 4 * i + 4] for i in range(4))),
         reach=_float(arm.reach),
         fk_pose_body=fk_pose_body,
         fk_joints=fk_joint_lines(plan, scalar, columns=False),
@@ -368,13 +388,14 @@ def print_plan(plan: Plan) -> PrintedModule:
     )
 
 
-def _tuple(values: tuple) -> str:
-    def one(v: object) -> str:
+def _tuple(values: tuple[float | bool, ...]) -> str:
+    def one(v: float | bool) -> str:
         if isinstance(v, bool):
             return repr(v)
         if math.isinf(float(v)):
             return "math.inf" if float(v) > 0 else "-math.inf"
         return repr(float(v))
+
     inner = ", ".join(one(v) for v in values)
     return f"({inner},)" if len(values) == 1 else f"({inner})"
 
@@ -421,5 +442,8 @@ def environment() -> jinja2.Environment:
 def render_module(plan: Plan) -> str:
     """The generated Python module of an arm."""
     printed = print_plan(plan)
-    return environment().get_template("module.py.j2").render(
-        m=printed, generator=GENERATOR, regenerate=REGENERATE)
+    return (
+        environment()
+        .get_template("module.py.j2")
+        .render(m=printed, generator=GENERATOR, regenerate=REGENERATE)
+    )

@@ -35,12 +35,16 @@ def linear_coeffs(expr: sp.Expr, cs: sp.Symbol, sn: sp.Symbol) -> tuple[sp.Expr,
     if poly.total_degree() > 1:
         raise ValueError(f"not linear in {cs}, {sn}")
     get = poly.as_dict()
-    return (get.get((1, 0), sp.Integer(0)), get.get((0, 1), sp.Integer(0)),
-            get.get((0, 0), sp.Integer(0)))
+    return (
+        get.get((1, 0), sp.Integer(0)),
+        get.get((0, 1), sp.Integer(0)),
+        get.get((0, 0), sp.Integer(0)),
+    )
 
 
-def half_angle_poly(expr: sp.Expr, cs: sp.Symbol, sn: sp.Symbol,
-                    u: sp.Symbol) -> tuple[sp.Expr, ...]:
+def half_angle_poly(
+    expr: sp.Expr, cs: sp.Symbol, sn: sp.Symbol, u: sp.Symbol
+) -> tuple[sp.Expr, ...]:
     """Coefficients (highest degree first) of (1 + u^2)^m expr(cos, sin) as a polynomial in u.
 
     Args:

@@ -12,8 +12,16 @@ import math
 
 import sympy as sp
 
-from derive.emit import (CodePrinter, Line, assign_lines, cs_arguments, match_expression,
-                         same_joints, step_arguments, world_names)
+from derive.emit import (
+    CodePrinter,
+    Line,
+    assign_lines,
+    cs_arguments,
+    match_expression,
+    same_joints,
+    step_arguments,
+    world_names,
+)
 from derive.plan import Assign, Plan, Solve
 
 
@@ -26,9 +34,13 @@ def kernel_lines(plan: Plan, printer: CodePrinter) -> tuple[tuple[int, str], ...
     assert plan.ik is not None
     names = sp.numbered_symbols("x")
     dof = plan.arm.dof
-    lines = [Line(0, f"{', '.join(f'{v}{i}' for i in range(1, dof + 1))}, = "
-                     f"ref[{k * dof}:{(k + 1) * dof}]")
-             for k, v in enumerate(("qr", "cr", "sr"))]
+    lines = [
+        Line(
+            0,
+            f"{', '.join(f'{v}{i}' for i in range(1, dof + 1))}, = ref[{k * dof}:{(k + 1) * dof}]",
+        )
+        for k, v in enumerate(("qr", "cr", "sr"))
+    ]
     lines += [Line(0, "ptol = tol * REACH"), Line(0, "n = 0"), Line(0, f"t = ({world_names()})")]
     depth = 0
     checks: list[tuple[int, int]] = []
@@ -57,8 +69,9 @@ def kernel_lines(plan: Plan, printer: CodePrinter) -> tuple[tuple[int, str], ...
     return tuple((ln.depth, ln.text) for ln in lines)
 
 
-def kernel_solve_lines(step: Solve, names: sp.utilities.iterables.numbered_symbols,
-                       printer: CodePrinter, depth: int) -> list[Line]:
+def kernel_solve_lines(
+    step: Solve, names: sp.utilities.iterables.numbered_symbols, printer: CodePrinter, depth: int
+) -> list[Line]:
     """One Solve step of _ksolve: its values (a loop for polynomials and a c + b s = e, one
     value otherwise), ref where the joint is free (_f{joint}), n marked before (_m{joint})."""
     lines, values = step_arguments(step, names, printer, depth)
@@ -72,29 +85,51 @@ def kernel_solve_lines(step: Solve, names: sp.utilities.iterables.numbered_symbo
         unit = 1.0 if angles else step.unit
         at = 32 * (j - 1)
         call = f"_kpoly(({', '.join(values)},), {angles}, {free}, {unit!r}, buf[{at}:{at + 32}])"
-        head = [f"_n{j} = {call}", f"_f{j} = _n{j} == -2", f"if _f{j}:", f"    _n{j} = 1",
-                f"    buf[{at}] = {ref}"]
+        head = [
+            f"_n{j} = {call}",
+            f"_f{j} = _n{j} == -2",
+            f"if _f{j}:",
+            f"    _n{j} = 1",
+            f"    buf[{at}] = {ref}",
+        ]
         if angles:
             head += [f"    buf[{at + 20}], buf[{at + 24}] = {cos_ref}, {sin_ref}"]
-        head += [f"elif _n{j} < 0:", "    return -1", f"_m{j} = n",
-                 f"for _k{j} in range(_n{j}):", f"    {var} = buf[{at} + _k{j}]"]
+        head += [
+            f"elif _n{j} < 0:",
+            "    return -1",
+            f"_m{j} = n",
+            f"for _k{j} in range(_n{j}):",
+            f"    {var} = buf[{at} + _k{j}]",
+        ]
         if angles:
             head += [f"    c{j} = buf[{at + 20} + _k{j}]", f"    s{j} = buf[{at + 24} + _k{j}]"]
     elif step.kind in ("cs1", "cs1r"):
-        call = (f"_kcs1({', '.join(values[:3])}, {step.scale!r})" if step.kind == "cs1"
-                else f"_kcs1r({', '.join(values)}, {step.scale!r}, {ref})")
+        call = (
+            f"_kcs1({', '.join(values[:3])}, {step.scale!r})"
+            if step.kind == "cs1"
+            else f"_kcs1r({', '.join(values)}, {step.scale!r}, {ref})"
+        )
         first, second = f"(_a{j}, _ac{j}, _as{j})", f"(_b{j}, _bc{j}, _bs{j})"
-        head = [f"_n{j}, _a{j}, _ac{j}, _as{j}, _b{j}, _bc{j}, _bs{j}, _st = {call}",
-                f"_f{j} = _st == 1"]
+        head = [
+            f"_n{j}, _a{j}, _ac{j}, _as{j}, _b{j}, _bc{j}, _bs{j}, _st = {call}",
+            f"_f{j} = _st == 1",
+        ]
         if step.kind == "cs1":  # _kcs1r gives a free angle's value itself
-            head += [f"if _f{j}:",
-                     f"    _n{j}, _a{j}, _ac{j}, _as{j} = 1, {ref}, {cos_ref}, {sin_ref}"]
-        head += [f"_m{j} = n", f"for _k{j} in range(_n{j}):",
-                 f"    {var}, c{j}, s{j} = {first} if _k{j} == 0 else {second}"]
+            head += [
+                f"if _f{j}:",
+                f"    _n{j}, _a{j}, _ac{j}, _as{j} = 1, {ref}, {cos_ref}, {sin_ref}",
+            ]
+        head += [
+            f"_m{j} = n",
+            f"for _k{j} in range(_n{j}):",
+            f"    {var}, c{j}, s{j} = {first} if _k{j} == 0 else {second}",
+        ]
     else:
-        call = {"atan2": f"_katan2({', '.join(values)})",
-                "cs2": f"_kcs2({', '.join(values)})",
-                "cs2r": f"_kcs2r({', '.join(values)}, {ref})"}[step.kind]
+        call = {
+            "atan2": f"_katan2({', '.join(values)})",
+            "cs2": f"_kcs2({', '.join(values)})",
+            "cs2r": f"_kcs2r({', '.join(values)}, {ref})",
+        }[step.kind]
         head = [f"{var}, c{j}, s{j}, _st = {call}", f"_f{j} = _st == 1"]
         if step.kind != "cs2r":  # _kcs2r gives a free angle's value itself
             head += [f"if _f{j}:", f"    {var}, c{j}, s{j} = {ref}, {cos_ref}, {sin_ref}"]

@@ -70,8 +70,11 @@ def arm_info(spec: ArmSpec, chain: Chain) -> ArmInfo:
         else:
             limits.append(j.limits)
     reach = sum(abs(j.a) + abs(j.d) for j in spec.joints)
-    reach += sum(max(abs(lo), abs(hi)) for (lo, hi), j in zip(limits, spec.joints)
-                 if j.kind == "P" and math.isfinite(lo) and math.isfinite(hi))
+    reach += sum(
+        max(abs(lo), abs(hi))
+        for (lo, hi), j in zip(limits, spec.joints)
+        if j.kind == "P" and math.isfinite(lo) and math.isfinite(hi)
+    )
     for frame in (chain.base, chain.tool):
         reach += sum(abs(float(v)) for v in frame[:3, 3])
     example_q = None

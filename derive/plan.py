@@ -110,7 +110,7 @@ class Solve:
     args: tuple[sp.Expr, ...]
     note: str
     fanout: int
-    ref: sp.Expr = sp.Integer(0)
+    ref: sp.Expr = sp.S.Zero
     scale: float = 0.0
     unit: float = 1.0
 

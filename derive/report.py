@@ -63,8 +63,9 @@ def tex(expr: sp.Basic) -> str:
         subs[sym.cos_alpha(i)] = sp.cos(alpha)
         subs[sym.sin_alpha(i)] = sp.sin(alpha)
     expr = sp.sympify(expr).xreplace(subs)
-    expr = expr.xreplace({r: sp.Float(float(r), 15) for r in expr.atoms(sp.Rational)
-                          if not r.is_Integer})
+    expr = expr.xreplace(
+        {r: sp.Float(float(r), 15) for r in expr.atoms(sp.Rational) if not r.is_Integer}
+    )
     return sp.latex(expr)
 
 
@@ -84,21 +85,33 @@ def arm_blocks(plan: Plan) -> list[Block]:
     """The DH table, the convention's link transform, base and tool."""
     arm = plan.arm
     modified = arm.convention == "modified"
-    general = ("R_X(\\alpha_{i-1}) D_X(a_{i-1}) R_Z(\\theta_i) D_Z(d_i)" if modified
-               else "R_Z(\\theta_i) D_Z(d_i) D_X(a_i) R_X(\\alpha_i)")
+    general = (
+        "R_X(\\alpha_{i-1}) D_X(a_{i-1}) R_Z(\\theta_i) D_Z(d_i)"
+        if modified
+        else "R_Z(\\theta_i) D_Z(d_i) D_X(a_i) R_X(\\alpha_i)"
+    )
     head = ("alpha_{i-1} [deg]", "a_{i-1}") if modified else ("alpha_i [deg]", "a_i")
     rows = [("i", "type", head[0], head[1], "d_i", "theta_i [deg]")]
     for k, (alpha, a, d, theta) in enumerate(arm.dh, start=1):
         kind = arm.joint_types[k - 1]
-        rows.append((str(k), kind, f"{math.degrees(alpha):g}", f"{a:g}",
-                     f"q{k} + {d:g}" if kind == "P" else f"{d:g}",
-                     f"q{k} + {math.degrees(theta):g}" if kind == "R" else
-                     f"{math.degrees(theta):g}"))
+        rows.append(
+            (
+                str(k),
+                kind,
+                f"{math.degrees(alpha):g}",
+                f"{a:g}",
+                f"q{k} + {d:g}" if kind == "P" else f"{d:g}",
+                f"q{k} + {math.degrees(theta):g}" if kind == "R" else f"{math.degrees(theta):g}",
+            )
+        )
     out = [
         Block("h2", "1. The arm"),
-        Block("p", f"{arm.convention.capitalize()} DH parameters (lengths in {arm.length_unit}); "
-              f"the link transform is {CRAIG if modified else 'the standard one'}, "
-              f"${{}}^{{i-1}}_{{i}}T = {general}$:"),
+        Block(
+            "p",
+            f"{arm.convention.capitalize()} DH parameters (lengths in {arm.length_unit}); "
+            f"the link transform is {CRAIG if modified else 'the standard one'}, "
+            f"${{}}^{{i-1}}_{{i}}T = {general}$:",
+        ),
         Block("table", rows=tuple(rows)),
     ]
     base = np.array(arm.base).reshape(4, 4)
@@ -112,8 +125,10 @@ def arm_blocks(plan: Plan) -> list[Block]:
 
 def link_blocks(plan: Plan) -> list[Block]:
     """Every link transform with this arm's numbers, and 0_nT."""
-    out = [Block("h2", "2. Link transforms"),
-           Block("p", "With $c_i = \\cos\\theta_i$, $s_i = \\sin\\theta_i$:")]
+    out = [
+        Block("h2", "2. Link transforms"),
+        Block("p", "With $c_i = \\cos\\theta_i$, $s_i = \\sin\\theta_i$:"),
+    ]
     for k, link in enumerate(plan.links, start=1):
         out.append(Block("math", f"{{}}^{{{k - 1}}}_{{{k}}}T", tex(link)))
     total = sp.eye(4)
@@ -125,14 +140,21 @@ def link_blocks(plan: Plan) -> list[Block]:
 
 def method_blocks(plan: Plan) -> list[Block]:
     """Structure, method, and the method's derivation facts."""
-    out = [Block("h2", "3. Structure and method"),
-           Block("p", "Structure found from the DH table: " + "; ".join(plan.structure) + ".")]
+    out = [
+        Block("h2", "3. Structure and method"),
+        Block("p", "Structure found from the DH table: " + "; ".join(plan.structure) + "."),
+    ]
     if plan.ik is None:
         out.append(Block("p", f"No closed-form method applies: {plan.refusal}."))
         return out
     ik = plan.ik
-    out.append(Block("p", f"Method: {ik.method}; case: {ik.case}. At most {ik.max_solutions} "
-                     f"solutions; the solver is defined on {ik.solves_for}."))
+    out.append(
+        Block(
+            "p",
+            f"Method: {ik.method}; case: {ik.case}. At most {ik.max_solutions} "
+            f"solutions; the solver is defined on {ik.solves_for}.",
+        )
+    )
     details = dict(ik.details)
     if "general_f1" in details:
         out.append(Block("h3", "Pieper's functions, general form (lecture, Pieper -2 to -4)"))
@@ -143,9 +165,14 @@ def method_blocks(plan: Plan) -> list[Block]:
         out.append(Block("math", "g", tex(sp.Matrix([details[k] for k in ("g1", "g2", "g3")]))))
         for name in ("k1", "k2", "k3", "k4"):
             out.append(Block("math", f"k_{{{name[1]}}}", tex(details[name])))
-        out.append(Block("p", "$r = x^2 + y^2 + z^2 = 2 a_1 (k_1 c_2 + k_2 s_2) + k_3$ and "
-                         "$z = \\sin\\alpha_1 (k_1 s_2 - k_2 c_2) + k_4$; the case's equation, "
-                         "reduced with $s_3^2 = 1 - c_3^2$:"))
+        out.append(
+            Block(
+                "p",
+                "$r = x^2 + y^2 + z^2 = 2 a_1 (k_1 c_2 + k_2 s_2) + k_3$ and "
+                "$z = \\sin\\alpha_1 (k_1 s_2 - k_2 c_2) + k_4$; the case's equation, "
+                "reduced with $s_3^2 = 1 - c_3^2$:",
+            )
+        )
         out.append(Block("math", "0", tex(details["joint3_equation"])))
     return out
 
@@ -153,9 +180,14 @@ def method_blocks(plan: Plan) -> list[Block]:
 def step_blocks(plan: Plan) -> list[Block]:
     """Every step of the plan as the equation it solves, in order."""
     assert plan.ik is not None
-    out = [Block("h2", "4. The solution, step by step"),
-           Block("p", "Each step below is one block of the generated `ik`; a step that solves a "
-                 "joint is a loop over its values.")]
+    out = [
+        Block("h2", "4. The solution, step by step"),
+        Block(
+            "p",
+            "Each step below is one block of the generated `ik`; a step that solves a "
+            "joint is a loop over its values.",
+        ),
+    ]
     for step in plan.ik.steps:
         out.append(Block("h3", step.note))
         if isinstance(step, Assign):
@@ -215,8 +247,12 @@ def walk(plan: Plan, pose: np.ndarray, q: tuple[float, ...]) -> list[tuple[str, 
         env[t] = value
         if step.kind != "polyd":
             env[sym.c(step.joint)], env[sym.s(step.joint)] = math.cos(value), math.sin(value)
-            lines.append((f"{tex(t)} / ^\\circ\\ (\\text{{{step.kind}}}: {shown})",
-                          number(math.degrees(value))))
+            lines.append(
+                (
+                    f"{tex(t)} / ^\\circ\\ (\\text{{{step.kind}}}: {shown})",
+                    number(math.degrees(value)),
+                )
+            )
         else:
             lines.append((f"{tex(t)}\\ (\\text{{{step.kind}}}: {shown})", number(value)))
     return lines
@@ -239,29 +275,54 @@ def example_blocks(plan: Plan, example: Example) -> list[Block]:
     pose = np.array(example.pose).reshape(4, 4)
     base, tool = np.array(arm.base).reshape(4, 4), np.array(arm.tool).reshape(4, 4)
     flange = np.linalg.inv(base) @ pose @ np.linalg.inv(tool)
-    out = [Block("h2", "5. Worked example"),
-           Block("p", f"The target is {example.how}:"),
-           Block("math", "T", matrix_of(pose)),
-           Block("math", f"{{}}^{{0}}_{{{arm.dof}}}T = ({{}}^{{W}}_{{0}}T)^{{-1}} T "
-                 f"({{}}^{{{arm.dof}}}_{{E}}T)^{{-1}}", matrix_of(flange))]
+    out = [
+        Block("h2", "5. Worked example"),
+        Block("p", f"The target is {example.how}:"),
+        Block("math", "T", matrix_of(pose)),
+        Block(
+            "math",
+            f"{{}}^{{0}}_{{{arm.dof}}}T = ({{}}^{{W}}_{{0}}T)^{{-1}} T "
+            f"({{}}^{{{arm.dof}}}_{{E}}T)^{{-1}}",
+            matrix_of(flange),
+        ),
+    ]
     if plan.ik is None:
         return out
     if not example.solutions:
         out.append(Block("p", "The pose is out of reach: no solution."))
         return out
     first = example.solutions[0]
-    out.append(Block("p", "Every intermediate quantity along the first solution's branch "
-                     "(solve steps show their numeric arguments):"))
+    out.append(
+        Block(
+            "p",
+            "Every intermediate quantity along the first solution's branch "
+            "(solve steps show their numeric arguments):",
+        )
+    )
     out += [Block("math", lhs, rhs) for lhs, rhs in walk(plan, pose, first)]
     if arm.dof == 6:
         out += wrist_matrices(plan, first, flange)
-    rows = [("#",) + tuple(f"q{k + 1}" + (" [deg]" if t == "R" else "")
-                           for k, t in enumerate(arm.joint_types))]
+    rows = [
+        (
+            "#",
+            *tuple(
+                f"q{k + 1}" + (" [deg]" if t == "R" else "") for k, t in enumerate(arm.joint_types)
+            ),
+        )
+    ]
     for n, sol in enumerate(example.solutions, start=1):
-        rows.append((str(n),) + tuple(number(math.degrees(v)) if t == "R" else number(v)
-                                      for v, t in zip(sol, arm.joint_types)))
-    out.append(Block("p", f"All {len(example.solutions)} solutions, each certified by forward "
-                     "kinematics:"))
+        rows.append(
+            (
+                str(n),
+                *tuple(
+                    number(math.degrees(v)) if t == "R" else number(v)
+                    for v, t in zip(sol, arm.joint_types)
+                ),
+            )
+        )
+    out.append(
+        Block("p", f"All {len(example.solutions)} solutions, each certified by forward kinematics:")
+    )
     out.append(Block("table", rows=tuple(rows)))
     return out
 
@@ -279,8 +340,12 @@ def wrist_matrices(plan: Plan, q: tuple[float, ...], flange: np.ndarray) -> list
     for link in plan.links[:3]:
         t03 = t03 * link
     r03 = np.array(t03[:3, :3].xreplace(subs).evalf(), dtype=float)
-    return [Block("math", "{}^{0}_{3}R", matrix_of(r03)),
-            Block("math", "{}^{3}_{6}R = ({}^{0}_{3}R)^T {}^{0}_{6}R", matrix_of(r03.T @ flange[:3, :3]))]
+    return [
+        Block("math", "{}^{0}_{3}R", matrix_of(r03)),
+        Block(
+            "math", "{}^{3}_{6}R = ({}^{0}_{3}R)^T {}^{0}_{6}R", matrix_of(r03.T @ flange[:3, :3])
+        ),
+    ]
 
 
 def report_blocks(plan: Plan, example: Example) -> tuple[Block, ...]:
@@ -291,8 +356,17 @@ def report_blocks(plan: Plan, example: Example) -> tuple[Block, ...]:
     return tuple(blocks + example_blocks(plan, example))
 
 
-TEX_SPECIALS = {"\\": "\\textbackslash{}", "_": "\\_", "^": "\\^{}", "#": "\\#",
-                "%": "\\%", "&": "\\&", "{": "\\{", "}": "\\}", "~": "\\~{}"}
+TEX_SPECIALS = {
+    "\\": "\\textbackslash{}",
+    "_": "\\_",
+    "^": "\\^{}",
+    "#": "\\#",
+    "%": "\\%",
+    "&": "\\&",
+    "{": "\\{",
+    "}": "\\}",
+    "~": "\\~{}",
+}
 
 
 def latex_text(text: str) -> str:
@@ -318,5 +392,10 @@ def render_report(plan: Plan, example: Example, fmt: str = "md") -> str:
     if fmt == "tex":
         blocks = tuple(for_tex(b) for b in blocks)
     template = environment().get_template(f"report.{fmt}.j2")
-    return template.render(name=plan.arm.name, name_tex=latex_text(plan.arm.name),
-                           digest=plan.arm.digest, generator=GENERATOR, blocks=blocks)
+    return template.render(
+        name=plan.arm.name,
+        name_tex=latex_text(plan.arm.name),
+        digest=plan.arm.digest,
+        generator=GENERATOR,
+        blocks=blocks,
+    )

@@ -47,11 +47,29 @@ MIN_MAGNITUDE = 1e-9
 MAX_MAGNITUDE = 1e9
 # Modules a generated module or its users import besides the standard library's
 # (sys.stdlib_module_names): a generated <name>.py must not shadow them in its folder.
-SHADOWED_MODULES = frozenset({
-    "numpy", "numba", "llvmlite", "scipy", "sympy", "mpmath", "jinja2", "markupsafe",
-    "derive", "pytest", "hypothesis", "setuptools", "pip", "pkg_resources", "matplotlib",
-    "yaml", "six", "typing_extensions", "conftest",
-})
+SHADOWED_MODULES = frozenset(
+    {
+        "numpy",
+        "numba",
+        "llvmlite",
+        "scipy",
+        "sympy",
+        "mpmath",
+        "jinja2",
+        "markupsafe",
+        "derive",
+        "pytest",
+        "hypothesis",
+        "setuptools",
+        "pip",
+        "pkg_resources",
+        "matplotlib",
+        "yaml",
+        "six",
+        "typing_extensions",
+        "conftest",
+    }
+)
 TOP_KEYS = ("name", "convention", "angle_unit", "length_unit", "joint", "base", "tool", "example")
 JOINT_KEYS = ("type", "alpha", "a", "d", "theta", "limits")
 FRAME_KEYS = ("matrix", "translation", "rpy")
@@ -137,6 +155,7 @@ class ArmSpec:
 
     def canonical(self) -> dict:
         """The spec as plain data with a fixed key order (source excluded)."""
+
         def frame(f: Frame | None) -> dict | None:
             if f is None:
                 return None
@@ -148,8 +167,14 @@ class ArmSpec:
             "angle_unit": self.angle_unit,
             "length_unit": self.length_unit,
             "joints": [
-                {"type": j.kind, "alpha": j.alpha, "a": j.a, "d": j.d, "theta": j.theta,
-                 "limits": j.limits}
+                {
+                    "type": j.kind,
+                    "alpha": j.alpha,
+                    "a": j.a,
+                    "d": j.d,
+                    "theta": j.theta,
+                    "limits": j.limits,
+                }
                 for j in self.joints
             ],
             "base": frame(self.base),
@@ -216,18 +241,22 @@ def _validate(data: dict, where: str) -> ArmSpec:
     if not NAME_PATTERN.fullmatch(name) or len(name) > NAME_MAX or keyword.iskeyword(name):
         raise SpecError(
             f"{where}: name: {name[:40]!r} is not allowed; use [a-z][a-z0-9_]* "
-            f"(at most {NAME_MAX} characters, not a Python keyword)")
+            f"(at most {NAME_MAX} characters, not a Python keyword)"
+        )
     if name in SHADOWED_MODULES or name in sys.stdlib_module_names:
         raise SpecError(
             f"{where}: name: {name!r} is the name of a module the generated code or Python "
             f"uses; {name}.py would shadow it for every import in its folder; choose another "
-            f"name (e.g. {name}_arm)")
+            f"name (e.g. {name}_arm)"
+        )
     convention = _choice_or_text(data, "convention", where, ("standard", "modified"))
     angle_unit = _choice_or_text(data, "angle_unit", where, ("deg", "rad"))
     length_unit = _choice_or_text(data, "length_unit", where)
     if not re.fullmatch(r"[A-Za-z]{1,16}", length_unit):
-        raise SpecError(f"{where}: length_unit: {length_unit[:40]!r} is not allowed; "
-                        "use a unit label of 1 to 16 letters, e.g. \"m\" or \"mm\"")
+        raise SpecError(
+            f"{where}: length_unit: {length_unit[:40]!r} is not allowed; "
+            'use a unit label of 1 to 16 letters, e.g. "m" or "mm"'
+        )
     rows = data.get("joint")
     if rows is None:
         raise SpecError(f"{where}: joint: missing; give one [[joint]] table per joint")
@@ -239,17 +268,28 @@ def _validate(data: dict, where: str) -> ArmSpec:
     base = _frame(data.get("base"), where, "base", angle_unit)
     tool = _frame(data.get("tool"), where, "tool", angle_unit)
     example_q, example_pose = _example(data.get("example"), where, len(joints))
-    return ArmSpec(name, convention, angle_unit, length_unit, joints, base, tool,
-                   example_q, example_pose, where)
+    return ArmSpec(
+        name,
+        convention,
+        angle_unit,
+        length_unit,
+        joints,
+        base,
+        tool,
+        example_q,
+        example_pose,
+        where,
+    )
 
 
-def _example(table: object, where: str, dof: int) -> tuple[tuple[float, ...] | None,
-                                                            Frame | None]:
+def _example(table: object, where: str, dof: int) -> tuple[tuple[float, ...] | None, Frame | None]:
     if table is None:
         return None, None
     if not isinstance(table, dict):
-        raise SpecError(f"{where}: example: must be a table with `q`, or a pose (`matrix`, or "
-                        "`translation` and optional `rpy`)")
+        raise SpecError(
+            f"{where}: example: must be a table with `q`, or a pose (`matrix`, or "
+            "`translation` and optional `rpy`)"
+        )
     if "q" in table:
         if len(table) != 1:
             raise SpecError(f"{where}: example: give either `q` or a pose, not both")
@@ -260,8 +300,9 @@ def _example(table: object, where: str, dof: int) -> tuple[tuple[float, ...] | N
 def _no_unknown_keys(table: dict, allowed: tuple[str, ...], where: str, prefix: str) -> None:
     for key in table:
         if key not in allowed:
-            raise SpecError(f"{where}: {prefix}{str(key)[:40]}: unknown key; allowed keys: "
-                            f"{', '.join(allowed)}")
+            raise SpecError(
+                f"{where}: {prefix}{str(key)[:40]}: unknown key; allowed keys: {', '.join(allowed)}"
+            )
 
 
 def _choice_or_text(data: dict, key: str, where: str, choices: tuple[str, ...] = ()) -> str:
@@ -282,12 +323,19 @@ def _number(value: object, where: str, field: str) -> float:
     try:
         number = float(value)
     except OverflowError:
-        raise SpecError(f"{where}: {field}: number too large; allowed: 0 or finite numbers "
-                        f"of magnitude {MIN_MAGNITUDE:g} to {MAX_MAGNITUDE:g}") from None
-    if not math.isfinite(number) or abs(number) > MAX_MAGNITUDE or (
-            number != 0.0 and abs(number) < MIN_MAGNITUDE):
-        raise SpecError(f"{where}: {field}: {str(value)[:40]} is not allowed; allowed: 0 or "
-                        f"finite numbers of magnitude {MIN_MAGNITUDE:g} to {MAX_MAGNITUDE:g}")
+        raise SpecError(
+            f"{where}: {field}: number too large; allowed: 0 or finite numbers "
+            f"of magnitude {MIN_MAGNITUDE:g} to {MAX_MAGNITUDE:g}"
+        ) from None
+    if (
+        not math.isfinite(number)
+        or abs(number) > MAX_MAGNITUDE
+        or (number != 0.0 and abs(number) < MIN_MAGNITUDE)
+    ):
+        raise SpecError(
+            f"{where}: {field}: {str(value)[:40]} is not allowed; allowed: 0 or "
+            f"finite numbers of magnitude {MIN_MAGNITUDE:g} to {MAX_MAGNITUDE:g}"
+        )
     return number
 
 
@@ -313,8 +361,10 @@ def _joint(row: dict, where: str, index: int) -> Joint:
     if "limits" in row:
         lo, hi = _numbers(row["limits"], where, prefix + "limits", 2)
         if not lo < hi:
-            raise SpecError(f"{where}: {prefix}limits: [{lo}, {hi}] is reversed or empty; "
-                            "give [lower, upper] with lower < upper")
+            raise SpecError(
+                f"{where}: {prefix}limits: [{lo}, {hi}] is reversed or empty; "
+                "give [lower, upper] with lower < upper"
+            )
         limits = (lo, hi)
     return Joint(kind, values["alpha"], values["a"], values["d"], values["theta"], limits)
 
@@ -323,27 +373,26 @@ def _frame(table: object, where: str, field: str, angle_unit: str) -> Frame | No
     if table is None:
         return None
     if not isinstance(table, dict):
-        raise SpecError(f"{where}: {field}: must be a table with `matrix`, or `translation` "
-                        "and optional `rpy`")
+        raise SpecError(
+            f"{where}: {field}: must be a table with `matrix`, or `translation` and optional `rpy`"
+        )
     _no_unknown_keys(table, FRAME_KEYS, where, field + ".")
     if "matrix" in table:
         if len(table) != 1:
-            raise SpecError(f"{where}: {field}: give either `matrix` or `translation`/`rpy`, "
-                            "not both")
+            raise SpecError(
+                f"{where}: {field}: give either `matrix` or `translation`/`rpy`, not both"
+            )
         rows = table["matrix"]
         if not isinstance(rows, list) or len(rows) != 4:
             raise SpecError(f"{where}: {field}.matrix: must be 4 rows of 4 numbers")
-        flat = sum((_numbers(r, where, f"{field}.matrix[{i}]", 4) for i, r in enumerate(rows)),
-                   ())
+        flat = sum((_numbers(r, where, f"{field}.matrix[{i}]", 4) for i, r in enumerate(rows)), ())
         _check_rigid(flat, where, field)
         return Frame(flat, None, (0.0, 0.0, 0.0))
     if "translation" not in table:
         raise SpecError(f"{where}: {field}: give `matrix` (4x4) or `translation` [x, y, z]")
-    translation = _numbers(table["translation"], where, field + ".translation", 3)
-    rpy = (0.0, 0.0, 0.0)
-    if "rpy" in table:
-        rpy = _numbers(table["rpy"], where, field + ".rpy", 3)
-    return Frame(None, translation, rpy)
+    x, y, z = _numbers(table["translation"], where, field + ".translation", 3)
+    roll, pitch, yaw = _numbers(table.get("rpy", [0.0, 0.0, 0.0]), where, field + ".rpy", 3)
+    return Frame(None, (x, y, z), (roll, pitch, yaw))
 
 
 def _check_rigid(flat: tuple[float, ...], where: str, field: str) -> None:
@@ -355,11 +404,17 @@ def _check_rigid(flat: tuple[float, ...], where: str, field: str) -> None:
         for j in range(3):
             dot = sum(rot[k][i] * rot[k][j] for k in range(3))
             if abs(dot - (1.0 if i == j else 0.0)) > RIGID_TOL:
-                raise SpecError(f"{where}: {field}.matrix: rotation part is not orthonormal "
-                                f"(tolerance {RIGID_TOL}); a rigid transform is required")
-    det = (rot[0][0] * (rot[1][1] * rot[2][2] - rot[1][2] * rot[2][1])
-           - rot[0][1] * (rot[1][0] * rot[2][2] - rot[1][2] * rot[2][0])
-           + rot[0][2] * (rot[1][0] * rot[2][1] - rot[1][1] * rot[2][0]))
+                raise SpecError(
+                    f"{where}: {field}.matrix: rotation part is not orthonormal "
+                    f"(tolerance {RIGID_TOL}); a rigid transform is required"
+                )
+    det = (
+        rot[0][0] * (rot[1][1] * rot[2][2] - rot[1][2] * rot[2][1])
+        - rot[0][1] * (rot[1][0] * rot[2][2] - rot[1][2] * rot[2][0])
+        + rot[0][2] * (rot[1][0] * rot[2][1] - rot[1][1] * rot[2][0])
+    )
     if det < 0:
-        raise SpecError(f"{where}: {field}.matrix: rotation part is a reflection (det -1); "
-                        "a rigid transform is required")
+        raise SpecError(
+            f"{where}: {field}.matrix: rotation part is a reflection (det -1); "
+            "a rigid transform is required"
+        )

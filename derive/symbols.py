@@ -25,50 +25,50 @@ exact multiples of pi (so cos(-90 deg) is exactly 0), other angles as floats.
 from __future__ import annotations
 
 import math
-from functools import lru_cache
+from functools import cache
 
 import sympy as sp
 
 ANGLE_SNAP = 1e-12
 
 
-@lru_cache(maxsize=None)
+@cache
 def q(i: int) -> sp.Symbol:
     """Joint variable q_i."""
     return sp.Symbol(f"q{i}", real=True)
 
 
-@lru_cache(maxsize=None)
+@cache
 def q_ref(i: int) -> sp.Symbol:
     """Reference value of q_i, taken by a joint that a singular pose leaves free."""
     return sp.Symbol(f"qr{i}", real=True)
 
 
-@lru_cache(maxsize=None)
+@cache
 def theta(i: int) -> sp.Symbol:
     """Joint angle theta_i."""
     return sp.Symbol(f"theta{i}", real=True)
 
 
-@lru_cache(maxsize=None)
+@cache
 def c(i: int) -> sp.Symbol:
     """cos(theta_i)."""
     return sp.Symbol(f"c{i}", real=True)
 
 
-@lru_cache(maxsize=None)
+@cache
 def s(i: int) -> sp.Symbol:
     """sin(theta_i)."""
     return sp.Symbol(f"s{i}", real=True)
 
 
-@lru_cache(maxsize=None)
+@cache
 def d(i: int) -> sp.Symbol:
     """Prismatic joint offset d_i."""
     return sp.Symbol(f"d{i}", real=True)
 
 
-@lru_cache(maxsize=None)
+@cache
 def named(name: str) -> sp.Symbol:
     """A real symbol for an intermediate quantity (u, r, z, ...)."""
     return sp.Symbol(name, real=True)
@@ -85,9 +85,10 @@ def flange_pose() -> sp.Matrix:
 
 
 def _pose_matrix(prefix: str, position: tuple[str, str, str]) -> sp.Matrix:
-    rows = [[named(f"{prefix}{i}{j}") for j in (1, 2, 3)] + [named(position[i - 1])]
-            for i in (1, 2, 3)]
-    return sp.Matrix(rows + [[0, 0, 0, 1]])
+    rows = [
+        [named(f"{prefix}{i}{j}") for j in (1, 2, 3)] + [named(position[i - 1])] for i in (1, 2, 3)
+    ]
+    return sp.Matrix([*rows, [0, 0, 0, 1]])
 
 
 def length(value: float) -> sp.Expr:
@@ -120,19 +121,19 @@ def cos_sin(rad: sp.Expr) -> tuple[sp.Expr, sp.Expr]:
     return sp.cos(rad), sp.sin(rad)
 
 
-@lru_cache(maxsize=None)
+@cache
 def link_a(i: int) -> sp.Symbol:
     """Link length a_i (general form, before the arm's numbers are substituted)."""
     return sp.Symbol(f"a{i}", real=True)
 
 
-@lru_cache(maxsize=None)
+@cache
 def cos_alpha(i: int) -> sp.Symbol:
     """cos(alpha_i) (general form)."""
     return sp.Symbol(f"calpha{i}", real=True)
 
 
-@lru_cache(maxsize=None)
+@cache
 def sin_alpha(i: int) -> sp.Symbol:
     """sin(alpha_i) (general form)."""
     return sp.Symbol(f"salpha{i}", real=True)

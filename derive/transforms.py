@@ -75,18 +75,25 @@ def chain_from_spec(spec: ArmSpec) -> Chain:
     n = spec.dof
     rows = [_twist(j.alpha, j.a, spec.angle_unit) for j in spec.joints]
     identity = Twist(sp.Integer(1), sp.Integer(0), sp.Integer(0))
-    twists = rows + [identity] if spec.convention == "modified" else [identity] + rows
+    twists = [*rows, identity] if spec.convention == "modified" else [identity, *rows]
     joints = []
     for i, j in enumerate(spec.joints, start=1):
         if j.kind == "R":
-            joints.append(JointZ(i, "R", sym.angle(j.theta, spec.angle_unit),
-                                 sym.theta(i), sym.length(j.d)))
+            joints.append(
+                JointZ(i, "R", sym.angle(j.theta, spec.angle_unit), sym.theta(i), sym.length(j.d))
+            )
         else:
-            joints.append(JointZ(i, "P", sym.length(j.d),
-                                 sym.angle(j.theta, spec.angle_unit), sym.d(i)))
+            joints.append(
+                JointZ(i, "P", sym.length(j.d), sym.angle(j.theta, spec.angle_unit), sym.d(i))
+            )
     assert len(twists) == n + 1
-    return Chain(tuple(twists), tuple(joints), frame_matrix(spec.base, spec.angle_unit),
-                 frame_matrix(spec.tool, spec.angle_unit), spec.convention)
+    return Chain(
+        tuple(twists),
+        tuple(joints),
+        frame_matrix(spec.base, spec.angle_unit),
+        frame_matrix(spec.tool, spec.angle_unit),
+        spec.convention,
+    )
 
 
 def _twist(alpha: float, a: float, unit: str) -> Twist:
@@ -100,6 +107,7 @@ def frame_matrix(frame: Frame | None, unit: str) -> sp.Matrix:
         return sp.eye(4)
     if frame.matrix is not None:
         return sp.Matrix(4, 4, [sym.length(v) for v in frame.matrix])
+    assert frame.translation is not None  # a frame is a matrix or a translation
     roll, pitch, yaw = (sym.cos_sin(sym.angle(v, unit)) for v in frame.rpy)
     rot = rot_z(*yaw) * rot_y(*pitch) * rot_x(*roll)
     rot[:3, 3] = sp.Matrix([sym.length(v) for v in frame.translation])
@@ -248,5 +256,4 @@ def reverse_chain(chain: Chain) -> Chain:
         else:
             joints.append(JointZ(k, "P", -j.offset, -j.theta, sym.d(k)))
     assert len(joints) == n
-    return Chain(twists, tuple(joints), inverse(chain.tool), inverse(chain.base),
-                 chain.convention)
+    return Chain(twists, tuple(joints), inverse(chain.tool), inverse(chain.base), chain.convention)

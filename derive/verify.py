@@ -72,16 +72,19 @@ class RoundTrip:
     def summary(self) -> str:
         """One line with every figure."""
         counts = ", ".join(f"{k}: {v}" for k, v in sorted(self.counts.items()))
-        return (f"{self.samples} samples ({self.singular} singular): completeness "
-                f"{self.found}/{self.samples - self.singular} = {100 * self.completeness:.3f}%, "
-                f"singular: strict {self.singular_found}/{self.singular}, pose kept "
-                f"{self.singular_posed}/{self.singular}; unsound {len(self.unsound)}; "
-                f"worst rot {self.worst_rot:.1e} rad, pos {self.worst_pos:.1e} x reach, "
-                f"singular {self.worst_singular:.1e}; solution counts {{{counts}}}")
+        return (
+            f"{self.samples} samples ({self.singular} singular): completeness "
+            f"{self.found}/{self.samples - self.singular} = {100 * self.completeness:.3f}%, "
+            f"singular: strict {self.singular_found}/{self.singular}, pose kept "
+            f"{self.singular_posed}/{self.singular}; unsound {len(self.unsound)}; "
+            f"worst rot {self.worst_rot:.1e} rad, pos {self.worst_pos:.1e} x reach, "
+            f"singular {self.worst_singular:.1e}; solution counts {{{counts}}}"
+        )
 
 
-def sample_joints(module: ModuleType, n: int, rng: np.random.Generator,
-                  degenerate_share: float = 0.2) -> np.ndarray:
+def sample_joints(
+    module: ModuleType, n: int, rng: np.random.Generator, degenerate_share: float = 0.2
+) -> np.ndarray:
     """n joint vectors: revolute uniform in (-pi, pi], prismatic within limits (or +-REACH)."""
     revolute = np.array([k == "R" for k in module.JOINT_TYPES])
     Q = np.empty((n, module.DOF))
@@ -163,8 +166,10 @@ def roundtrip(module: ModuleType, Q: np.ndarray, backend: str | None = None) -> 
             mask = np.abs(null) < 0.1
             if any(max(e) <= SINGULAR_TOL for e in errors):
                 out.singular_posed += 1
-            if any(same_joints(s, q, revolute, mask) and max(e) <= SINGULAR_TOL
-                   for s, e in zip(sols, errors)):
+            if any(
+                same_joints(s, q, revolute, mask) and max(e) <= SINGULAR_TOL
+                for s, e in zip(sols, errors)
+            ):
                 out.singular_found += 1
             continue
         out.worst_rot = max([out.worst_rot] + [e[0] for e in errors])

@@ -25,17 +25,25 @@ _counter = itertools.count()
 # Property-test profiles: "ci" (the default) keeps the suite to minutes, with a fixed seed
 # and no shrinking (a failure prints its arm at once); "long" is the thorough run,
 # `python -m pytest tests/test_properties.py --hypothesis-profile=long`.
-settings.register_profile("ci", max_examples=30, deadline=None, derandomize=True,
-                          phases=[Phase.explicit, Phase.reuse, Phase.generate],
-                          suppress_health_check=[HealthCheck.too_slow])
-settings.register_profile("long", max_examples=2000, deadline=None,
-                          suppress_health_check=[HealthCheck.too_slow])
+settings.register_profile(
+    "ci",
+    max_examples=30,
+    deadline=None,
+    derandomize=True,
+    phases=[Phase.explicit, Phase.reuse, Phase.generate],
+    suppress_health_check=[HealthCheck.too_slow],
+)
+settings.register_profile(
+    "long", max_examples=2000, deadline=None, suppress_health_check=[HealthCheck.too_slow]
+)
 settings.load_profile("ci")
 
 
 # tests of the compiled solvers need numba, which the test extra installs
-needs_numba = pytest.mark.skipif(importlib.util.find_spec("numba") is None,
-                                 reason="numba is not installed (the test extra installs it)")
+needs_numba = pytest.mark.skipif(
+    importlib.util.find_spec("numba") is None,
+    reason="numba is not installed (the test extra installs it)",
+)
 
 
 def import_path(path: Path) -> ModuleType:
@@ -73,15 +81,24 @@ def build_module(text: str, folder: Path) -> ModuleType:
     return module
 
 
-def spec_text(name: str, convention: str, rows: list[tuple], unit: str = "deg",
-              kinds: str | None = None, extra: str = "") -> str:
+def spec_text(
+    name: str,
+    convention: str,
+    rows: list[tuple],
+    unit: str = "deg",
+    kinds: str | None = None,
+    extra: str = "",
+) -> str:
     """TOML for an arm; rows are (alpha, a, d, theta) in the spec's unit."""
     kinds = kinds or "R" * len(rows)
-    out = (f'name = "{name}"\nconvention = "{convention}"\nangle_unit = "{unit}"\n'
-           f'length_unit = "m"\n')
+    out = (
+        f'name = "{name}"\nconvention = "{convention}"\nangle_unit = "{unit}"\nlength_unit = "m"\n'
+    )
     for kind, (alpha, a, d, theta) in zip(kinds, rows):
-        out += (f'[[joint]]\ntype = "{kind}"\nalpha = {float(alpha)!r}\na = {float(a)!r}\n'
-                f'd = {float(d)!r}\ntheta = {float(theta)!r}\n')
+        out += (
+            f'[[joint]]\ntype = "{kind}"\nalpha = {float(alpha)!r}\na = {float(a)!r}\n'
+            f"d = {float(d)!r}\ntheta = {float(theta)!r}\n"
+        )
     return out + extra
 
 
@@ -101,8 +118,14 @@ def tr(x: float, y: float, z: float) -> np.ndarray:
     return m
 
 
-def reference_fk(convention: str, dh_rad: list[tuple], kinds: str, q: np.ndarray,
-                 base: np.ndarray | None = None, tool: np.ndarray | None = None) -> np.ndarray:
+def reference_fk(
+    convention: str,
+    dh_rad: list[tuple],
+    kinds: str,
+    q: np.ndarray,
+    base: np.ndarray | None = None,
+    tool: np.ndarray | None = None,
+) -> np.ndarray:
     """Textbook FK written independently of derive: Craig's or the standard link transform."""
     T = np.eye(4) if base is None else base.copy()
     for (alpha, a, d, theta), kind, qi in zip(dh_rad, kinds, q):
@@ -127,7 +150,9 @@ sys.path.insert(0, str(ROOT / "tests"))
 def pytest_terminal_summary(terminalreporter) -> None:
     """The worst pose error the degenerate-pose suites met in this run (for the notes)."""
     from degenerate import WORST
+
     if WORST["error"]:
         terminalreporter.write_line(
             f"degenerate-pose suites: worst pose error {WORST['error']:.1e} "
-            "(rotation entries; position / REACH)")
+            "(rotation entries; position / REACH)"
+        )

@@ -92,8 +92,14 @@ def elbow_singularities(m: ModuleType, q: np.ndarray, joint: int) -> list[np.nda
     return found
 
 
-def run_suite(m: ModuleType, elbow: int, pi_joints: list[int], wrist: int | None,
-              rng: np.random.Generator, backend: str | None = None) -> dict:
+def run_suite(
+    m: ModuleType,
+    elbow: int,
+    pi_joints: list[int],
+    wrist: int | None,
+    rng: np.random.Generator,
+    backend: str | None = None,
+) -> dict:
     """Every degenerate construction for one solver (solved with `backend`); returns counts of
     what was checked."""
     counts = {"wrist": 0, "elbow": 0, "pi": 0, "boundary": 0}

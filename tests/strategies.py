@@ -6,17 +6,22 @@ Lengths are O(1) numbers times a per-arm scale from 1e-3 to 1e3; twists and offs
 
 from __future__ import annotations
 
-from hypothesis import assume, strategies as st
+from hypothesis import assume
+from hypothesis import strategies as st
 
 from conftest import spec_text
 
-TWISTS = st.one_of(st.sampled_from([90.0, -90.0]), st.floats(15.0, 165.0).map(round),
-                   st.floats(-165.0, -15.0).map(round))
-OFFSETS = st.one_of(st.sampled_from([0.0, 90.0, -90.0, 180.0]),
-                    st.floats(-180.0, 180.0).map(lambda v: round(v, 3)))
+TWISTS = st.one_of(
+    st.sampled_from([90.0, -90.0]),
+    st.floats(15.0, 165.0).map(round),
+    st.floats(-165.0, -15.0).map(round),
+)
+OFFSETS = st.one_of(
+    st.sampled_from([0.0, 90.0, -90.0, 180.0]), st.floats(-180.0, 180.0).map(lambda v: round(v, 3))
+)
 LENGTH = st.floats(0.1, 1.0) | st.floats(-1.0, -0.1)
 MAYBE_ZERO = st.one_of(st.just(0.0), LENGTH)
-SCALE = st.integers(-3, 3).map(lambda k: 10.0 ** k)
+SCALE = st.integers(-3, 3).map(lambda k: 10.0**k)
 
 
 def rows_for(convention: str, alpha: list, a: list, d: list, theta: list) -> list[tuple]:
@@ -67,7 +72,9 @@ def pieper_arms(draw) -> str:
     return text
 
 
-def reverse_rows_text(convention: str, rows: list, kinds: str, scale: float, prismatic: bool) -> str:
+def reverse_rows_text(
+    convention: str, rows: list, kinds: str, scale: float, prismatic: bool
+) -> str:
     """An arm whose axes 1-3 meet: the reversed chain of `rows` (ALGORITHMS.md section 1)."""
     n = len(rows)
     if convention == "modified":
@@ -107,7 +114,8 @@ def parallel_arms(draw) -> str:
     rows = rows_for(convention, alpha, scaled(a, scale), scaled(d, scale), theta)
     if draw(st.booleans()):
         return reverse_rows_text(convention, rows, "RRRRRR", scale, False).replace(
-            "pieper_arm_reversed", "parallel_arm_reversed")
+            "pieper_arm_reversed", "parallel_arm_reversed"
+        )
     return spec_text("parallel_arm", convention, rows)
 
 
@@ -124,10 +132,19 @@ def planar_arms(draw) -> str:
     needed = (0, 1) if convention == "standard" else (1, 2)
     rows = []
     for k, kind in enumerate(kinds):
-        length = draw(LENGTH) if k in needed else (0.0 if convention == "modified" and k == 0
-                                                     else draw(MAYBE_ZERO))
-        rows.append((0.0, round(length * scale, 6), round(draw(MAYBE_ZERO) * scale, 6),
-                     draw(OFFSETS) if kind == "R" else 0.0))
+        length = (
+            draw(LENGTH)
+            if k in needed
+            else (0.0 if convention == "modified" and k == 0 else draw(MAYBE_ZERO))
+        )
+        rows.append(
+            (
+                0.0,
+                round(length * scale, 6),
+                round(draw(MAYBE_ZERO) * scale, 6),
+                draw(OFFSETS) if kind == "R" else 0.0,
+            )
+        )
     if kinds == "RRPR":
         # the prismatic joint does not turn the plane, so the links before and after it add
         # up: where they cancel, joint 2 does not move the tool point (it only turns the

@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 
 from derive.verify import sample_joints
+
 from conftest import BUNDLED, needs_numba
 
 
@@ -118,12 +119,15 @@ def test_ik_batch_slot_count_is_the_maximum(generated):
     assert generated("planar_2r").ik_batch(np.eye(4)[None])[0].shape == (1, 2, 2)
 
 
-@pytest.mark.parametrize("coeffs, roots", [
-    ((1.0, -4.0, 6.0, -4.0, 1.0), [1.0]),                       # (x - 1)^4: a cluster of four
-    ((1.0, 0.0, -2.0, 0.0, 1.0), [-1.0, 1.0]),                  # (x^2 - 1)^2: two double roots
-    ((1.0, -2.0, 2.0, -2.0, 1.0), [1.0]),                       # (x - 1)^2 (x^2 + 1)
-    ((1.0, 0.0, 1.0, 0.0, 0.25), []),                           # (x^2 + 1/2)^2: no real root
-])
+@pytest.mark.parametrize(
+    "coeffs, roots",
+    [
+        ((1.0, -4.0, 6.0, -4.0, 1.0), [1.0]),  # (x - 1)^4: a cluster of four
+        ((1.0, 0.0, -2.0, 0.0, 1.0), [-1.0, 1.0]),  # (x^2 - 1)^2: two double roots
+        ((1.0, -2.0, 2.0, -2.0, 1.0), [1.0]),  # (x - 1)^2 (x^2 + 1)
+        ((1.0, 0.0, 1.0, 0.0, 0.25), []),  # (x^2 + 1/2)^2: no real root
+    ],
+)
 def test_multiple_roots_are_found_by_scalar_and_vectorised_routines(generated, coeffs, roots):
     m = generated("puma560")
     scalar = m._poly_real(coeffs)
@@ -141,14 +145,27 @@ def kangle_cases() -> list[tuple[float, float]]:
     return list(zip(ys.tolist(), xs.tolist()))
 
 
-SIGNED_EDGES = [(0.0, 0.0), (-0.0, 0.0), (0.0, -0.0), (-0.0, -0.0), (0.0, -1.0), (-0.0, -1.0),
-                (1e-310, 1.0), (1.0, 1e-310), (math.inf, 1.0), (1.0, -math.inf),
-                (-math.inf, -math.inf), (3.0, 3.0), (-3.0, -3.0), (1.0, 8.0), (8.0, -1.0)]
+SIGNED_EDGES = [
+    (0.0, 0.0),
+    (-0.0, 0.0),
+    (0.0, -0.0),
+    (-0.0, -0.0),
+    (0.0, -1.0),
+    (-0.0, -1.0),
+    (1e-310, 1.0),
+    (1.0, 1e-310),
+    (math.inf, 1.0),
+    (1.0, -math.inf),
+    (-math.inf, -math.inf),
+    (3.0, 3.0),
+    (-3.0, -3.0),
+    (1.0, 8.0),
+    (8.0, -1.0),
+]
 
 
 @pytest.mark.parametrize("compiled", [False, pytest.param(True, marks=needs_numba)])
-def test_compiled_solvers_atan2_is_accurate_to_a_few_units_in_the_last_place(generated,
-                                                                            compiled):
+def test_compiled_solvers_atan2_is_accurate_to_a_few_units_in_the_last_place(generated, compiled):
     """_kangle, the kernel's own atan2, against the library's (correctly rounded): within
     1e-15 absolute and relative on random quadrants and magnitudes, exactly equal on zeros of
     either sign, infinities and the segment boundaries; nan stays nan."""

@@ -9,16 +9,27 @@ from pathlib import Path
 import pytest
 
 from derive.cli import main
+
 from conftest import ROOT, spec_text
 
-USER_ARM = spec_text("user_arm", "modified",
-                     [(0, 0, 0, 0), (-90, 0.1, 0, 0), (0, 0.5, 0.05, 0), (-90, 0.04, 0.45, 0),
-                      (90, 0, 0, 0), (-90, 0, 0, 0)])
+USER_ARM = spec_text(
+    "user_arm",
+    "modified",
+    [
+        (0, 0, 0, 0),
+        (-90, 0.1, 0, 0),
+        (0, 0.5, 0.05, 0),
+        (-90, 0.04, 0.45, 0),
+        (90, 0, 0, 0),
+        (-90, 0, 0, 0),
+    ],
+)
 
 
 def run(*args: str, cwd: Path | None = None) -> subprocess.CompletedProcess:
-    return subprocess.run([sys.executable, "-m", "derive", *args], capture_output=True,
-                          text=True, cwd=cwd or ROOT)
+    return subprocess.run(
+        [sys.executable, "-m", "derive", *args], capture_output=True, text=True, cwd=cwd or ROOT
+    )
 
 
 def test_generate_writes_module_and_reports_structure(tmp_path, capsys):
@@ -33,7 +44,7 @@ def test_generate_writes_module_and_reports_structure(tmp_path, capsys):
 
 def test_bad_spec_exits_2_without_traceback_or_file(tmp_path):
     spec = tmp_path / "bad.toml"
-    spec.write_text(USER_ARM.replace("a = 0.5", "a = \"0.5\""))
+    spec.write_text(USER_ARM.replace("a = 0.5", 'a = "0.5"'))
     result = run("generate", str(spec), "--out", str(tmp_path / "out"))
     assert result.returncode == 2
     assert "Traceback" not in result.stderr
@@ -77,7 +88,11 @@ def test_check_detects_edited_removed_and_extra_files(tmp_path, capsys):
     capsys.readouterr()
     assert main(["check", "--out", str(out)]) == 1
     report = capsys.readouterr().out
-    assert f"{target}: differs" in report and "-DOF = 7" in report and "to update: derive generate" in report
+    assert (
+        f"{target}: differs" in report
+        and "-DOF = 7" in report
+        and "to update: derive generate" in report
+    )
     assert target.read_bytes() == before
     target.unlink()
     assert main(["check", "--out", str(out)]) == 1
@@ -92,7 +107,9 @@ def test_fk_command_prints_report_pose():
     result = run("fk", "puma560", "20", "20", "20", "20", "20", "20")
     assert result.returncode == 0
     first = [float(x) for x in result.stdout.splitlines()[0].split()]
-    assert first == pytest.approx([0.1057541557, -0.6425141384, 0.7589411311, 0.5776495331], abs=1e-9)
+    assert first == pytest.approx(
+        [0.1057541557, -0.6425141384, 0.7589411311, 0.5776495331], abs=1e-9
+    )
 
 
 def test_solve_command_lists_eight_solutions_with_limits():
@@ -113,6 +130,7 @@ def test_solve_rejects_non_rigid_pose():
 
 def test_bench_reports_round_trip_figures(capsys):
     import json
+
     assert main(["bench", "puma560", "--n", "30", "--json"]) == 0  # --n: --samples
     figures = json.loads(capsys.readouterr().out)[0]
     assert figures["name"] == "puma560" and figures["samples"] == 30

@@ -12,14 +12,16 @@ from pathlib import Path
 import pytest
 
 from derive.cli import main
+
 from conftest import ROOT, spec_text
 
 ARM = spec_text("edge_arm", "standard", [(0, 1, 0, 0), (0, 1, 0, 0)])
 
 
 def run(*args: str, cwd: Path, env: dict[str, str] | None = None) -> subprocess.CompletedProcess:
-    return subprocess.run([sys.executable, "-m", "derive", *args], capture_output=True,
-                          text=True, cwd=cwd, env=env)
+    return subprocess.run(
+        [sys.executable, "-m", "derive", *args], capture_output=True, text=True, cwd=cwd, env=env
+    )
 
 
 def mode(path: Path) -> int:
@@ -58,7 +60,9 @@ def test_leftovers_of_a_killed_run_are_removed(tmp_path):
     assert main(["generate", str(spec), "--out", str(out)]) == 0
     assert not leftover.exists() and other.exists()
     assert sorted(p.name for p in out.iterdir() if not p.name.startswith(".")) == [
-        "edge_arm.md", "edge_arm.py"]
+        "edge_arm.md",
+        "edge_arm.py",
+    ]
 
 
 def test_a_spec_with_a_byte_order_mark_loads(tmp_path):
@@ -101,8 +105,9 @@ def test_one_bad_spec_is_one_line(tmp_path):
 
 
 def test_report_to_an_unwritable_path_is_one_line(tmp_path):
-    result = run("report", "planar_2r", "-o", str(tmp_path / "missing" / "x" / "r.md"),
-                 cwd=tmp_path)
+    result = run(
+        "report", "planar_2r", "-o", str(tmp_path / "missing" / "x" / "r.md"), cwd=tmp_path
+    )
     # the folder is created; a path under a file cannot be
     assert result.returncode == 0
     blocker = tmp_path / "file"
@@ -115,9 +120,25 @@ def test_report_to_an_unwritable_path_is_one_line(tmp_path):
 
 def test_a_closed_pipe_is_no_traceback(tmp_path):
     """`derive solve ... | head -1`: the reader is gone before the output is written."""
-    proc = subprocess.Popen([sys.executable, "-m", "derive", "solve", "puma560", "--q", "20",
-                             "20", "20", "20", "20", "20"], cwd=tmp_path,
-                            stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    proc = subprocess.Popen(
+        [
+            sys.executable,
+            "-m",
+            "derive",
+            "solve",
+            "puma560",
+            "--q",
+            "20",
+            "20",
+            "20",
+            "20",
+            "20",
+            "20",
+        ],
+        cwd=tmp_path,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+    )
     proc.stdout.close()
     err = proc.stderr.read().decode()
     assert proc.wait() == 141

@@ -8,8 +8,8 @@ import math
 import numpy as np
 import pytest
 
-from degenerate import WORST, contains, run_suite, solve_checked
 from conftest import build_module, needs_numba, spec_text
+from degenerate import WORST, contains, run_suite, solve_checked
 
 # arm -> (elbow joint, joints solved by a half-angle step or a cs1 step, wrist joint)
 BUNDLED_SUITES = {
@@ -25,16 +25,21 @@ BUNDLED_SUITES = {
 @pytest.mark.parametrize("name", sorted(BUNDLED_SUITES))
 def test_degenerate_suite_of_bundled_arm(generated, name, backend):
     elbow, pi_joints, wrist = BUNDLED_SUITES[name]
-    counts = run_suite(generated(name), elbow, pi_joints, wrist, np.random.default_rng(3),
-                       backend)
+    counts = run_suite(generated(name), elbow, pi_joints, wrist, np.random.default_rng(3), backend)
     print(name, counts, f"worst error so far {WORST['error']:.1e}")
     assert counts["elbow"] >= 2 and counts["boundary"] >= 12
     assert counts["pi"] == len(pi_joints)
 
 
 def test_wrist_centre_on_axis_1_of_an_offset_free_puma(tmp_path):
-    rows = [(-90.0, 0.0, 0.0, 0.0), (0.0, 0.432, 0.0, 0.0), (90.0, -0.02, 0.0, 0.0),
-            (-90.0, 0.0, 0.433, 0.0), (90.0, 0.0, 0.0, 0.0), (0.0, 0.0, 0.0, 0.0)]
+    rows = [
+        (-90.0, 0.0, 0.0, 0.0),
+        (0.0, 0.432, 0.0, 0.0),
+        (90.0, -0.02, 0.0, 0.0),
+        (-90.0, 0.0, 0.433, 0.0),
+        (90.0, 0.0, 0.0, 0.0),
+        (0.0, 0.0, 0.0, 0.0),
+    ]
     m = build_module(spec_text("puma_no_offset", "standard", rows), tmp_path)
     q = np.array([0.4, 0.0, 0.3, 0.5, 0.6, 0.7])
     lo, hi = -math.pi / 2, math.pi / 2

@@ -11,7 +11,15 @@ import sympy as sp
 from derive import symbols as sym
 from derive.methods.pieper import general_f_g
 from derive.spec import load_spec
-from derive.transforms import chain_from_spec, link_transform, numbers_of, to_angles, x_factor, z_factor
+from derive.transforms import (
+    chain_from_spec,
+    link_transform,
+    numbers_of,
+    to_angles,
+    x_factor,
+    z_factor,
+)
+
 from conftest import BUNDLED, ROOT, reference_fk
 
 
@@ -21,10 +29,12 @@ def chain(name):
 
 def test_puma_fk_matches_report_pose(generated):
     m = generated("puma560")
-    report = np.array([
-        [0.105754155679965, -0.642514138372515, 0.758941131147761, 0.577649533099654],
-        [0.701905312986400, 0.588858820882606, 0.4007171329881, 0.368809723984954],
-    ])
+    report = np.array(
+        [
+            [0.105754155679965, -0.642514138372515, 0.758941131147761, 0.577649533099654],
+            [0.701905312986400, 0.588858820882606, 0.4007171329881, 0.368809723984954],
+        ]
+    )
     T = m.fk(np.radians([20.0] * 6))
     assert np.abs(T[:2] - report).max() < 2e-9
 
@@ -39,19 +49,23 @@ def test_puma_zyz_angles_match_report(generated):
 
 def test_lecture_f_and_g_equal_the_lectures():
     ch = chain("lecture_6r")
-    c2, s2, c3, s3 = sym.c(2), sym.s(2), sym.c(3), sym.s(3)
-    p4 = sp.Matrix([ch.twists[3].a, -ch.twists[3].sa * ch.joints[3].d,
-                    ch.twists[3].ca * ch.joints[3].d, 1])
+    c3, s3 = sym.c(3), sym.s(3)
+    p4 = sp.Matrix(
+        [ch.twists[3].a, -ch.twists[3].sa * ch.joints[3].d, ch.twists[3].ca * ch.joints[3].d, 1]
+    )
     f = link_transform(ch, 3) * p4
     lecture_f = sp.Matrix([340 - 338 * s3 - 40 * c3, 338 * c3 - 40 * s3, 0, 1])
     assert sp.simplify(f - lecture_f) == sp.zeros(4, 1)
     g = link_transform(ch, 2) * f
     t2, t3 = sym.theta(2), sym.theta(3)
-    lecture_g = sp.Matrix([
-        340 * sp.cos(t2) - 40 * sp.cos(t2 + t3) - 338 * sp.sin(t2 + t3) - 30,
-        0,
-        40 * sp.sin(t2 + t3) - 338 * sp.cos(t2 + t3) - 340 * sp.sin(t2),
-        1])
+    lecture_g = sp.Matrix(
+        [
+            340 * sp.cos(t2) - 40 * sp.cos(t2 + t3) - 338 * sp.sin(t2 + t3) - 30,
+            0,
+            40 * sp.sin(t2 + t3) - 338 * sp.cos(t2 + t3) - 340 * sp.sin(t2),
+            1,
+        ]
+    )
     assert sp.simplify(to_angles(g, ch) - lecture_g) == sp.zeros(4, 1)
 
 
@@ -98,8 +112,9 @@ def test_parallel_6r_link_transforms_equal_the_blog_posts():
 def test_lecture_answer_reaches_the_cup_pose(generated):
     m = generated("lecture_6r")
     c, s = math.cos(math.radians(35)), math.sin(math.radians(35))
-    world_cup = (np.array([[1, 0, 0, 830], [0, 1, 0, 20], [0, 0, 1, 330], [0, 0, 0, 1.0]])
-                 @ np.array([[c, -s, 0, -280], [s, c, 0, 250], [0, 0, 1, 62.5], [0, 0, 0, 1]]))
+    world_cup = np.array(
+        [[1, 0, 0, 830], [0, 1, 0, 20], [0, 0, 1, 330], [0, 0, 0, 1.0]]
+    ) @ np.array([[c, -s, 0, -280], [s, c, 0, 250], [0, 0, 1, 62.5], [0, 0, 0, 1]])
     T = m.fk(np.radians([21.8, -52.2, 2.5, -20, -42, 15]))
     # the answer is rounded to 0.1 deg: 0.1 deg at ~700 mm reach is ~1.2 mm, and ~2e-3 in rotation
     assert np.abs(T[:3, 3] - world_cup[:3, 3]).max() < 1.5
@@ -108,7 +123,11 @@ def test_lecture_answer_reaches_the_cup_pose(generated):
 
 def test_lecture_flange_pose_matches_lectures_0_6T(generated):
     m = generated("lecture_6r")
-    flange = np.linalg.inv(m.BASE) @ m.fk(np.radians([21.8, -52.2, 2.5, -20, -42, 15])) @ np.linalg.inv(m.TOOL)
+    flange = (
+        np.linalg.inv(m.BASE)
+        @ m.fk(np.radians([21.8, -52.2, 2.5, -20, -42, 15]))
+        @ np.linalg.inv(m.TOOL)
+    )
     lecture = np.array([[0, 0.5736, 0.8192, 381.3], [0, -0.8192, 0.5736, 151.8], [1, 0, 0, 19.5]])
     assert np.abs(flange[:3, :3] - lecture[:, :3]).max() < 3e-3
     assert np.abs(flange[:3, 3] - lecture[:, 3]).max() < 1.0
@@ -136,16 +155,31 @@ def test_fk_batch_equals_fk(generated, name):
 
 def test_both_conventions_with_prismatic_joints_and_frames(tmp_path):
     from conftest import build_module, spec_text
+
     rows = [(30, 0.1, 0.2, 10), (-90, 0.3, 0.0, 45), (17, -0.2, 0.4, 0)]
-    frames = ("[base]\ntranslation = [0.1, -0.2, 0.3]\nrpy = [10.0, 20.0, 30.0]\n"
-              "[tool]\ntranslation = [0.0, 0.0, 0.05]\nrpy = [0.0, 90.0, 0.0]\n")
+    frames = (
+        "[base]\ntranslation = [0.1, -0.2, 0.3]\nrpy = [10.0, 20.0, 30.0]\n"
+        "[tool]\ntranslation = [0.0, 0.0, 0.05]\nrpy = [0.0, 90.0, 0.0]\n"
+    )
     for convention in ("standard", "modified"):
         m = build_module(spec_text("arm", convention, rows, kinds="RPR", extra=frames), tmp_path)
         for q in np.random.default_rng(1).uniform(-2, 2, (20, 3)):
             expected = reference_fk(convention, m.DH, "RPR", q, m.BASE, m.TOOL)
             assert np.abs(m.fk(q) - expected).max() < 1e-12
-        from conftest import rz, rx
-        R = rz(math.radians(30)) @ np.array([[math.cos(math.radians(20)), 0, math.sin(math.radians(20)), 0], [0, 1, 0, 0], [-math.sin(math.radians(20)), 0, math.cos(math.radians(20)), 0], [0, 0, 0, 1]]) @ rx(math.radians(10))
+        from conftest import rx, rz
+
+        R = (
+            rz(math.radians(30))
+            @ np.array(
+                [
+                    [math.cos(math.radians(20)), 0, math.sin(math.radians(20)), 0],
+                    [0, 1, 0, 0],
+                    [-math.sin(math.radians(20)), 0, math.cos(math.radians(20)), 0],
+                    [0, 0, 0, 1],
+                ]
+            )
+            @ rx(math.radians(10))
+        )
         assert np.abs(m.BASE[:3, :3] - R[:3, :3]).max() < 1e-15
 
 

@@ -10,16 +10,24 @@ import pytest
 
 from conftest import build_module, needs_numba
 
-UR5_ROWS = [(90.0, 0.0, 0.089159), (0.0, -0.425, 0.0), (0.0, -0.39225, 0.0),
-            (90.0, 0.0, 0.10915), (-90.0, 0.0, 0.09465), (0.0, 0.0, 0.0823)]
+UR5_ROWS = [
+    (90.0, 0.0, 0.089159),
+    (0.0, -0.425, 0.0),
+    (0.0, -0.39225, 0.0),
+    (90.0, 0.0, 0.10915),
+    (-90.0, 0.0, 0.09465),
+    (0.0, 0.0, 0.0823),
+]
 
 
 def spec_with_limits(name: str, rows: list[tuple[float, float, float]], limit: float) -> str:
     """Standard-DH revolute arm (degrees, metres) with limits +-limit on every joint."""
     out = f'name = "{name}"\nconvention = "standard"\nangle_unit = "deg"\nlength_unit = "m"\n'
     for alpha, a, d in rows:
-        out += (f"[[joint]]\ntype = \"R\"\nalpha = {alpha!r}\na = {a!r}\nd = {d!r}\n"
-                f"theta = 0.0\nlimits = [{-limit!r}, {limit!r}]\n")
+        out += (
+            f'[[joint]]\ntype = "R"\nalpha = {alpha!r}\na = {a!r}\nd = {d!r}\n'
+            f"theta = 0.0\nlimits = [{-limit!r}, {limit!r}]\n"
+        )
     return out
 
 
@@ -92,14 +100,15 @@ def test_chunk_must_be_a_positive_integer(ur5, chunk):
 
 
 def test_numpy_integer_chunk_is_fine(ur5):
-    Q, valid = ur5.ik_batch(ur5.fk(np.zeros(6))[None], chunk=np.int64(3))
+    _, valid = ur5.ik_batch(ur5.fk(np.zeros(6))[None], chunk=np.int64(3))
     assert valid.sum() >= 1
 
 
-@pytest.mark.parametrize("weights", [[1.0] * 5, [1.0] * 5 + [math.nan], [1.0] * 5 + [-1.0],
-                                     [1j] * 6])
+@pytest.mark.parametrize(
+    "weights", [[1.0] * 5, [1.0] * 5 + [math.nan], [1.0] * 5 + [-1.0], [1j] * 6]
+)
 def test_weights_must_be_finite_and_non_negative(ur5, weights):
-    with pytest.raises(ValueError, match="weights must be 6 finite non-negative numbers|real"):
+    with pytest.raises(ValueError, match=r"weights must be 6 finite non-negative numbers|real"):
         ur5.nearest(ur5.fk(np.zeros(6)), np.zeros(6), weights=weights)
 
 
@@ -116,8 +125,9 @@ def test_complex_input_is_refused(ur5):
         ur5.ik(ur5.fk(np.zeros(6)), q_ref=np.zeros(6, dtype=complex))
 
 
-@pytest.mark.parametrize("q_ref", [np.zeros((1, 6)), np.zeros(5), [0.0] * 5 + [math.inf],
-                                   "abcdef", [[0.0] * 6]])
+@pytest.mark.parametrize(
+    "q_ref", [np.zeros((1, 6)), np.zeros(5), [0.0] * 5 + [math.inf], "abcdef", [[0.0] * 6]]
+)
 def test_q_ref_shape_and_values_are_checked(ur5, q_ref):
     T = ur5.fk(np.zeros(6))
     with pytest.raises(ValueError, match=r"q_ref must be 6 finite real numbers"):
@@ -133,8 +143,7 @@ def test_compiled_limits_and_nearest_match_python(ur5):
     for q in rng.uniform(-2 * math.pi, 2 * math.pi, (50, 6)):
         T = ur5.fk(q)
         ref = q + rng.normal(0.0, 0.01, 6)
-        rows = {b: ur5.ik(T, within_limits=True, q_ref=ref, backend=b)
-                for b in ("python", "numba")}
+        rows = {b: ur5.ik(T, within_limits=True, q_ref=ref, backend=b) for b in ("python", "numba")}
         assert rows["python"].shape == rows["numba"].shape
         assert np.abs(rows["python"] - rows["numba"]).max(initial=0.0) < 1e-9
         ur5.BACKEND = "numba"

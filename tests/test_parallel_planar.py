@@ -10,13 +10,22 @@ import pytest
 from derive.pipeline import build_plan
 from derive.spec import parse_spec
 from derive.verify import roundtrip, sample_joints
+
 from conftest import build_module, spec_text, wrapped_close
 
-UR_COURSE_ARM = [(0.0, 0.0, 0.0), (-90.0, 0.0, 116.5), (0.0, 203.5, 0.0), (0.0, 173.0, 0.0),
-                 (90.0, 0.0, 79.2), (-90.0, 0.0, 0.0)]
-UR_COURSE_T = [[0.519298147546, 0.0070239512832, 0.854564273805, 347.392802557],
-               [-0.822517374485, -0.267282955241, 0.502020906445, 57.0424762899],
-               [0.231936634936, -0.963592489565, -0.133022221559, 6.3589802627]]
+UR_COURSE_ARM = [
+    (0.0, 0.0, 0.0),
+    (-90.0, 0.0, 116.5),
+    (0.0, 203.5, 0.0),
+    (0.0, 173.0, 0.0),
+    (90.0, 0.0, 79.2),
+    (-90.0, 0.0, 0.0),
+]
+UR_COURSE_T = [
+    [0.519298147546, 0.0070239512832, 0.854564273805, 347.392802557],
+    [-0.822517374485, -0.267282955241, 0.502020906445, 57.0424762899],
+    [0.231936634936, -0.963592489565, -0.133022221559, 6.3589802627],
+]
 UR_COURSE_SOLUTIONS = [
     [-151.350299159, -166.220157444, -57.9793650055, -143.448405678, 91.766911907, -13.7708675391],
     [-151.350299159, -147.440857125, -40.7552306896, 0.548159687357, -91.766911907, 166.229132461],
@@ -27,8 +36,14 @@ UR_COURSE_SOLUTIONS = [
     [-10.0, 3.71110633032, -38.0261164468, -135.684989884, 50.0, 160.0],
     [-10.0, 40.0, -60.0, 30.0, -50.0, -20.0],
 ]
-UR5 = [(90.0, 0.0, 0.089159, 0.0), (0.0, -0.425, 0.0, 0.0), (0.0, -0.39225, 0.0, 0.0),
-       (90.0, 0.0, 0.10915, 0.0), (-90.0, 0.0, 0.09465, 0.0), (0.0, 0.0, 0.0823, 0.0)]
+UR5 = [
+    (90.0, 0.0, 0.089159, 0.0),
+    (0.0, -0.425, 0.0, 0.0),
+    (0.0, -0.39225, 0.0, 0.0),
+    (90.0, 0.0, 0.10915, 0.0),
+    (-90.0, 0.0, 0.09465, 0.0),
+    (0.0, 0.0, 0.0823, 0.0),
+]
 
 
 def check(m, rng, samples):
@@ -44,6 +59,7 @@ def test_parallel_6r_follows_the_blog_posts_order(generated):
     m = generated("parallel_6r")
     assert "three-parallel method" in m.__doc__ and "a5 = 0" in m.__doc__
     from derive.cli import resolve_spec
+
     plan = build_plan(resolve_spec("parallel_6r"))
     order = [s.joint for s in plan.ik.steps if hasattr(s, "joint")]
     assert order == [1, 5, 6, 3, 2, 4]
@@ -73,9 +89,14 @@ def test_ur5_published_dh_round_trips(tmp_path):
 
 
 def test_axes_3_4_5_parallel_use_the_reversed_chain(tmp_path):
-    reversed_ur5 = [(0.0, 0.0, 0.0823, 0.0), (-90.0, 0.0, 0.09465, 0.0),
-                    (90.0, 0.0, 0.10915, 0.0), (0.0, -0.39225, 0.0, 0.0),
-                    (0.0, -0.425, 0.0, 0.0), (90.0, 0.0, 0.089159, 0.0)]
+    reversed_ur5 = [
+        (0.0, 0.0, 0.0823, 0.0),
+        (-90.0, 0.0, 0.09465, 0.0),
+        (90.0, 0.0, 0.10915, 0.0),
+        (0.0, -0.39225, 0.0, 0.0),
+        (0.0, -0.425, 0.0, 0.0),
+        (90.0, 0.0, 0.089159, 0.0),
+    ]
     m = build_module(spec_text("rev_ur", "modified", reversed_ur5), tmp_path)
     assert "axes 3-5 parallel: reversed chain" in m.__doc__
     check(m, np.random.default_rng(6), 200)
@@ -84,11 +105,19 @@ def test_axes_3_4_5_parallel_use_the_reversed_chain(tmp_path):
 def test_random_three_parallel_arms_with_a5_nonzero_give_a_quartic(tmp_path):
     rng = np.random.default_rng(8)
     for _ in range(3):
-        rows = [(0.0, 0.0, 0.0, 0.0), (-90.0, 0.1, float(rng.uniform(0.1, 0.3)), 0.0),
-                (0.0, float(rng.uniform(0.3, 0.6)), 0.0, 0.0),
-                (0.0, float(rng.uniform(0.3, 0.6)), float(rng.uniform(-0.1, 0.1)), 0.0),
-                (float(rng.uniform(30, 80)), float(rng.uniform(-0.2, 0.2)), float(rng.uniform(0.05, 0.2)), 0.0),
-                (float(rng.uniform(-80, -30)), float(rng.uniform(0.05, 0.2)), 0.0, 0.0)]
+        rows = [
+            (0.0, 0.0, 0.0, 0.0),
+            (-90.0, 0.1, float(rng.uniform(0.1, 0.3)), 0.0),
+            (0.0, float(rng.uniform(0.3, 0.6)), 0.0, 0.0),
+            (0.0, float(rng.uniform(0.3, 0.6)), float(rng.uniform(-0.1, 0.1)), 0.0),
+            (
+                float(rng.uniform(30, 80)),
+                float(rng.uniform(-0.2, 0.2)),
+                float(rng.uniform(0.05, 0.2)),
+                0.0,
+            ),
+            (float(rng.uniform(-80, -30)), float(rng.uniform(0.05, 0.2)), 0.0, 0.0),
+        ]
         m = build_module(spec_text("ur_a5", "modified", rows), tmp_path)
         assert "a5 != 0: quartic" in m.__doc__
         check(m, rng, 80)
@@ -143,8 +172,12 @@ def test_planar_2r_ignores_the_rotation_but_not_z(generated):
 
 
 def test_scara_rrpr_round_trips(tmp_path):
-    rows = [(0.0, 0.325, 0.4, 0.0), (0.0, 0.275, 0.0, 0.0), (0.0, 0.0, 0.0, 0.0),
-            (0.0, 0.0, 0.05, 0.0)]
+    rows = [
+        (0.0, 0.325, 0.4, 0.0),
+        (0.0, 0.275, 0.0, 0.0),
+        (0.0, 0.0, 0.0, 0.0),
+        (0.0, 0.0, 0.05, 0.0),
+    ]
     text = spec_text("scara", "standard", rows, kinds="RRPR")
     text = text.replace('type = "P"\n', 'type = "P"\nlimits = [-0.2, 0.0]\n')
     m = build_module(text, tmp_path)
@@ -153,8 +186,14 @@ def test_scara_rrpr_round_trips(tmp_path):
 
 
 def test_arm_no_method_covers_gets_a_one_line_reason():
-    rows = [(90.0, 0.3, 0.1, 0.0), (1.0, 1.0, 0.0, 0.0), (90.0, 0.0, 0.2, 0.0),
-            (1.0, 1.5, 0.0, 0.0), (90.0, 0.0, 0.0, 0.0), (1.0, 0.0, 0.0, 0.0)]
+    rows = [
+        (90.0, 0.3, 0.1, 0.0),
+        (1.0, 1.0, 0.0, 0.0),
+        (90.0, 0.0, 0.2, 0.0),
+        (1.0, 1.5, 0.0, 0.0),
+        (90.0, 0.0, 0.0, 0.0),
+        (1.0, 0.0, 0.0, 0.0),
+    ]
     plan = build_plan(parse_spec(spec_text("general6r", "standard", rows)))
     assert plan.ik is None
     assert "Pieper: neither axes 4, 5, 6 nor axes 1, 2, 3 meet in a point" in plan.refusal

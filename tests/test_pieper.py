@@ -10,6 +10,7 @@ import pytest
 from derive.pipeline import build_plan
 from derive.spec import parse_spec
 from derive.verify import roundtrip, sample_joints
+
 from cases import PIEPER_CASES, PUMA_REPORT_FLAGS, PUMA_REPORT_SOLUTIONS
 from conftest import build_module, needs_numba, spec_text, wrapped_close
 
@@ -36,9 +37,10 @@ def test_lecture_cup_example_contains_the_published_answer(generated):
 
 def test_lecture_arm_uses_the_general_case_quartic(generated):
     from derive.cli import resolve_spec
+
     plan = build_plan(resolve_spec("lecture_6r"))
     assert plan.ik.case.startswith("general")
-    poly = [s for s in plan.ik.steps if getattr(s, "kind", "") == "poly"][0]
+    poly = next(s for s in plan.ik.steps if getattr(s, "kind", "") == "poly")
     assert poly.joint == 3 and len(poly.args) == 5
     assert "degree 4 in u = tan(theta3/2)" in generated("lecture_6r").__doc__
 
@@ -48,8 +50,9 @@ def test_puma_report_pose_has_the_reports_eight_solutions(generated):
     sols = np.degrees(m.ik(m.fk(np.radians([20.0] * 6))))
     assert len(sols) == 8
     for row in PUMA_REPORT_SOLUTIONS:
-        assert any(wrapped_close(np.radians(s), np.radians(row), math.radians(2e-3))
-                   for s in sols), row
+        assert any(
+            wrapped_close(np.radians(s), np.radians(row), math.radians(2e-3)) for s in sols
+        ), row
 
 
 def test_puma_limits_with_wrapping_versus_the_reports_flags(generated):
@@ -176,10 +179,13 @@ def test_bundled_round_trips(generated, name):
 
 def canonical_rows(rng, case):
     """Random canonical Pieper arm: alpha_i, a_i for i = 0..6, d_i for i = 1..6 (degrees)."""
+
     def twist():
         return float(rng.choice([90.0, -90.0, rng.uniform(15, 165) * rng.choice([-1, 1])]))
+
     def length(zero_share=0.3):
         return 0.0 if rng.random() < zero_share else float(rng.uniform(-1, 1))
+
     alpha = [twist() for _ in range(7)]
     a = [length() for _ in range(7)]
     d = [None] + [length() for _ in range(6)]
@@ -206,9 +212,14 @@ def rows_for(convention, alpha, a, d, theta):
 @pytest.mark.parametrize("convention", ["standard", "modified"])
 @pytest.mark.parametrize("case", ["general", "a1=0", "salpha1=0"])
 def test_random_pieper_arms_round_trip(convention, case, tmp_path):
-    rng = np.random.default_rng(["standard", "modified"].index(convention) * 10
-                                + ["general", "a1=0", "salpha1=0"].index(case))
-    extra = "[base]\ntranslation = [0.1, 0.2, 0.3]\nrpy = [5.0, 10.0, 15.0]\n[tool]\ntranslation = [0.0, 0.05, 0.1]\n"
+    rng = np.random.default_rng(
+        ["standard", "modified"].index(convention) * 10
+        + ["general", "a1=0", "salpha1=0"].index(case)
+    )
+    extra = (
+        "[base]\ntranslation = [0.1, 0.2, 0.3]\nrpy = [5.0, 10.0, 15.0]\n"
+        "[tool]\ntranslation = [0.0, 0.05, 0.1]\n"
+    )
     for _ in range(4):
         rows = rows_for(convention, *canonical_rows(rng, case))
         m = build_module(spec_text("random_arm", convention, rows, extra=extra), tmp_path)
@@ -236,19 +247,27 @@ def test_spherical_joint_at_the_base_is_solved_on_the_reversed_chain(convention,
         a[1] = a[2] = d[2] = 0.0
         a[4], a[5], d[5] = (float(rng.uniform(0.2, 0.8)) for _ in range(3))
         a[3] = float(rng.uniform(0.3, 1.0))
-        m = build_module(spec_text("base_wrist", convention,
-                                   rows_for(convention, alpha, a, d, theta)), tmp_path)
+        m = build_module(
+            spec_text("base_wrist", convention, rows_for(convention, alpha, a, d, theta)), tmp_path
+        )
         assert "axes 1-3 meet: reversed chain" in m.__doc__
         check_round_trips(m, rng)
 
 
 def test_stanford_arm_prismatic_joint_3(tmp_path):
-    rows = [(-90.0, 0.0, 0.412, 0.0), (90.0, 0.0, 0.154, 0.0), (0.0, 0.0, 0.0, 0.0),
-            (-90.0, 0.0, 0.0, 0.0), (90.0, 0.0, 0.0, 0.0), (0.0, 0.0, 0.263, 0.0)]
+    rows = [
+        (-90.0, 0.0, 0.412, 0.0),
+        (90.0, 0.0, 0.154, 0.0),
+        (0.0, 0.0, 0.0, 0.0),
+        (-90.0, 0.0, 0.0, 0.0),
+        (90.0, 0.0, 0.0, 0.0),
+        (0.0, 0.0, 0.263, 0.0),
+    ]
     text = spec_text("stanford", "standard", rows, kinds="RRPRRR")
-    text = text.replace('type = "P"\nalpha = 0.0\na = 0.0\nd = 0.0\ntheta = 0.0\n',
-                        'type = "P"\nalpha = 0.0\na = 0.0\nd = 0.0\ntheta = 0.0\n'
-                        'limits = [0.1, 0.8]\n')
+    text = text.replace(
+        'type = "P"\nalpha = 0.0\na = 0.0\nd = 0.0\ntheta = 0.0\n',
+        'type = "P"\nalpha = 0.0\na = 0.0\nd = 0.0\ntheta = 0.0\nlimits = [0.1, 0.8]\n',
+    )
     m = build_module(text, tmp_path)
     assert "degree 2 in d3" in m.__doc__
     result = check_round_trips(m, np.random.default_rng(2), 150)
@@ -272,8 +291,14 @@ def test_random_prismatic_joint_3_arms(case, tmp_path):
 
 
 def test_degenerate_prismatic_arm_is_refused_with_a_reason(tmp_path):
-    rows = [(0.0, 0.5, 0.0, 0.0), (90.0, 0.4, 0.1, 0.0), (-90.0, 0.0, 0.0, 0.0),
-            (90.0, 0.0, 0.3, 0.0), (-90.0, 0.0, 0.0, 0.0), (0.0, 0.0, 0.0, 0.0)]
+    rows = [
+        (0.0, 0.5, 0.0, 0.0),
+        (90.0, 0.4, 0.1, 0.0),
+        (-90.0, 0.0, 0.0, 0.0),
+        (90.0, 0.0, 0.3, 0.0),
+        (-90.0, 0.0, 0.0, 0.0),
+        (0.0, 0.0, 0.0, 0.0),
+    ]
     plan = build_plan(parse_spec(spec_text("flat", "standard", rows, kinds="RRPRRR")))
     assert plan.ik is None
     assert "does not involve joint 3" in plan.refusal

@@ -10,6 +10,7 @@ import subprocess
 import sys
 
 from derive.cli import main
+
 from conftest import ROOT
 
 
@@ -24,8 +25,13 @@ def test_output_is_identical_under_different_hash_seeds(tmp_path):
     for seed in ("0", "12345"):
         folder = tmp_path / seed
         env = {**os.environ, "PYTHONHASHSEED": seed}
-        subprocess.run([sys.executable, "-m", "derive", "generate", "--out", str(folder)],
-                       check=True, env=env, cwd=ROOT, capture_output=True)
+        subprocess.run(
+            [sys.executable, "-m", "derive", "generate", "--out", str(folder)],
+            check=True,
+            env=env,
+            cwd=ROOT,
+            capture_output=True,
+        )
         outputs.append({p.name: p.read_bytes() for p in sorted(folder.iterdir())})
     assert outputs[0] == outputs[1]
     assert len(outputs[0]) >= 5

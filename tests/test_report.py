@@ -13,6 +13,7 @@ from derive.cli import import_source, main, resolve_spec, worked_example
 from derive.emit import render_module
 from derive.pipeline import build_plan
 from derive.report import report_blocks
+
 from conftest import BUNDLED, GENERATED
 
 MATRIX = re.compile(r"^\\left\[\\begin\{matrix\}(.*)\\end\{matrix\}\\right\]$", re.S)
@@ -25,8 +26,9 @@ def parse(text: str) -> sp.Basic:
         rows = [[parse(cell) for cell in row.split("&")] for row in found.group(1).split(r"\\")]
         return sp.Matrix(rows)
     expr = parse_latex(text)
-    return expr.xreplace({s: sp.Symbol(s.name.replace("_{", "").replace("}", ""))
-                          for s in expr.free_symbols})
+    return expr.xreplace(
+        {s: sp.Symbol(s.name.replace("_{", "").replace("}", "")) for s in expr.free_symbols}
+    )
 
 
 def math_lines(name: str) -> dict[str, str]:
@@ -49,9 +51,13 @@ def test_lecture_report_shows_the_lectures_f_and_g():
     lines = math_lines("lecture_6r")
     c2, s2, c3, s3 = sp.symbols("c2 s2 c3 s3")
     f = parse(lines["f"])
-    assert sp.expand(f - sp.Matrix([340 - 338 * s3 - 40 * c3, 338 * c3 - 40 * s3, 0])) == sp.zeros(3, 1)
+    assert sp.expand(f - sp.Matrix([340 - 338 * s3 - 40 * c3, 338 * c3 - 40 * s3, 0])) == sp.zeros(
+        3, 1
+    )
     c23, s23 = c2 * c3 - s2 * s3, s2 * c3 + c2 * s3
-    lecture_g = sp.Matrix([340 * c2 - 40 * c23 - 338 * s23 - 30, 0, 40 * s23 - 338 * c23 - 340 * s2])
+    lecture_g = sp.Matrix(
+        [340 * c2 - 40 * c23 - 338 * s23 - 30, 0, 40 * s23 - 338 * c23 - 340 * s2]
+    )
     assert sp.expand(parse(lines["g"]) - lecture_g) == sp.zeros(3, 1)
 
 
@@ -59,16 +65,22 @@ def test_lecture_report_follows_the_general_case_to_the_lectures_answer():
     text = (GENERATED / "lecture_6r.md").read_text()
     assert "(r - k3)^2/(4 a1^2) + (z - k4)^2/s(alpha1)^2 = k1^2 + k2^2" in text
     lines = math_lines("lecture_6r")
+
     def value(prefix):
         (rhs,) = [v for k, v in lines.items() if k.startswith(prefix)]
         return float(rhs)
+
     assert value(r"\theta_{3} / ^\circ") == pytest.approx(2.5, abs=0.1)
     assert value(r"\theta_{2} / ^\circ") == pytest.approx(-52.2, abs=0.1)
     assert value(r"\theta_{1} / ^\circ") == pytest.approx(21.8, abs=0.1)
     assert float(lines["r"]) == pytest.approx(168813.18, rel=2e-4)
     # the slides evaluate 0_3R at the rounded angles (21.8, -52.2, 2.5) deg: agreement to 2e-3
-    lecture_r03 = np.array([[0.6006, 0.7082, -0.3710], [0.24, 0.2830, 0.9286], [0.7627, -0.6468, 0]])
-    lecture_r36 = np.array([[0.7627, 0.1477, 0.6297], [-0.6468, 0.1744, 0.7424], [0, -0.9735, 0.2286]])
+    lecture_r03 = np.array(
+        [[0.6006, 0.7082, -0.3710], [0.24, 0.2830, 0.9286], [0.7627, -0.6468, 0]]
+    )
+    lecture_r36 = np.array(
+        [[0.7627, 0.1477, 0.6297], [-0.6468, 0.1744, 0.7424], [0, -0.9735, 0.2286]]
+    )
     r03 = np.array(parse(lines["{}^{0}_{3}R"]), dtype=float)
     (r36_text,) = [v for k, v in lines.items() if k.startswith("{}^{3}_{6}R")]
     assert np.abs(r03 - lecture_r03).max() < 2e-3
@@ -80,6 +92,7 @@ def test_lecture_report_follows_the_general_case_to_the_lectures_answer():
 
 def test_puma_report_lists_the_eight_solutions():
     from cases import PUMA_REPORT_SOLUTIONS
+
     solutions = table("puma560")
     assert len(solutions) == 8
     for row in PUMA_REPORT_SOLUTIONS:
@@ -106,7 +119,9 @@ def test_tex_report_is_a_standalone_document(tmp_path):
     assert text.count(r"\begin{document}") == 1 and text.rstrip().endswith(r"\end{document}")
     assert text.count(r"\begin{equation*}") == text.count(r"\end{equation*}") > 20
     body = text.split(r"\begin{document}")[1]
-    outside_math = re.sub(r"\\begin\{equation\*\}.*?\\end\{equation\*\}|\$[^$]*\$", "", body, flags=re.S)
+    outside_math = re.sub(
+        r"\\begin\{equation\*\}.*?\\end\{equation\*\}|\$[^$]*\$", "", body, flags=re.S
+    )
     assert not re.search(r"(?<!\\)_", outside_math)
 
 

@@ -5,23 +5,24 @@ from __future__ import annotations
 import os
 import subprocess
 import sys
-from pathlib import Path
 
 import pytest
-from hypothesis import HealthCheck, given, settings, strategies as st
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
 
 from derive.cli import main
+
 from conftest import ROOT, spec_text
 
 ARMS = ROOT / "derive" / "arms"
 GOOD = spec_text("arm", "standard", [(-90, 0, 0.5, 0), (0, 1, 0, 0)])
 
 HOSTILE = [
-    ('name = "__import__(\'os\').system(\'touch PWNED\')"\n' + GOOD.split("\n", 1)[1], "name"),
+    ("name = \"__import__('os').system('touch PWNED')\"\n" + GOOD.split("\n", 1)[1], "name"),
     (GOOD.replace('name = "arm"', 'name = "../../etc/passwd"'), "name"),
     (GOOD.replace('name = "arm"', 'name = "a/b"'), "name"),
     (GOOD.replace('name = "arm"', 'name = "' + "a" * 200 + '"'), "name"),
-    (GOOD.replace("a = 1.0", 'a = "__import__(\'os\').system(\'touch PWNED\')"'), "joint 2: a"),
+    (GOOD.replace("a = 1.0", "a = \"__import__('os').system('touch PWNED')\""), "joint 2: a"),
     (GOOD.replace("a = 1.0", "a = 1e300"), "joint 2: a"),
     (GOOD.replace("a = 1.0", "a = 1e-300"), "joint 2: a"),
     (GOOD.replace("a = 1.0", "a = 1" + "0" * 400), "joint 2: a"),
@@ -37,8 +38,12 @@ def test_hostile_spec_is_refused_without_side_effects(text, field, tmp_path):
     spec = tmp_path / "hostile.toml"
     spec.write_bytes(text.encode("utf-8", "surrogateescape") if isinstance(text, str) else text)
     out = tmp_path / "out"
-    result = subprocess.run([sys.executable, "-m", "derive", "generate", str(spec), "--out", str(out)],
-                            capture_output=True, text=True, cwd=tmp_path)
+    result = subprocess.run(
+        [sys.executable, "-m", "derive", "generate", str(spec), "--out", str(out)],
+        capture_output=True,
+        text=True,
+        cwd=tmp_path,
+    )
     assert result.returncode == 2
     assert "Traceback" not in result.stderr
     assert field in result.stderr and str(spec) in result.stderr
@@ -51,8 +56,10 @@ def test_check_never_writes_into_the_folder(tmp_path):
     assert main(["generate", "planar_2r", "--out", str(out)]) == 0
     before = {p.name: (p.read_bytes(), p.stat().st_mtime_ns) for p in out.iterdir()}
     (out / "planar_2r.py").write_text("edited")
-    before["planar_2r.py"] = ((out / "planar_2r.py").read_bytes(),
-                              (out / "planar_2r.py").stat().st_mtime_ns)
+    before["planar_2r.py"] = (
+        (out / "planar_2r.py").read_bytes(),
+        (out / "planar_2r.py").stat().st_mtime_ns,
+    )
     assert main(["check", "planar_2r", "--out", str(out)]) == 1
     after = {p.name: (p.read_bytes(), p.stat().st_mtime_ns) for p in out.iterdir()}
     assert after == before
@@ -60,6 +67,7 @@ def test_check_never_writes_into_the_folder(tmp_path):
 
 def test_no_partial_file_when_rendering_fails(tmp_path, monkeypatch):
     import derive.cli as cli
+
     out = tmp_path / "out"
     assert main(["generate", "planar_2r", "--out", str(out)]) == 0
     original = (out / "planar_2r.py").read_bytes()
@@ -73,25 +81,34 @@ def test_no_partial_file_when_rendering_fails(tmp_path, monkeypatch):
     assert sorted(p.name for p in out.iterdir()) == ["planar_2r.md", "planar_2r.py"]
 
 
-MUTATIONS = st.lists(st.tuples(st.sampled_from(["flip", "insert", "delete"]),
-                               st.floats(0, 1), st.binary(min_size=1, max_size=3)),
-                     min_size=1, max_size=4)
+MUTATIONS = st.lists(
+    st.tuples(
+        st.sampled_from(["flip", "insert", "delete"]),
+        st.floats(0, 1),
+        st.binary(min_size=1, max_size=3),
+    ),
+    min_size=1,
+    max_size=4,
+)
 
 
 def mutate(data: bytes, edits: list) -> bytes:
     for kind, where, payload in edits:
         k = int(where * len(data))
         if kind == "flip":
-            data = data[:k] + payload[:1] + data[k + 1:]
+            data = data[:k] + payload[:1] + data[k + 1 :]
         elif kind == "insert":
             data = data[:k] + payload + data[k:]
         else:
-            data = data[:k] + data[k + len(payload):]
+            data = data[:k] + data[k + len(payload) :]
     return data
 
 
-@settings(max_examples=int(os.environ.get("DERIVE_FUZZ_EXAMPLES", "40")), deadline=None,
-          suppress_health_check=[HealthCheck.function_scoped_fixture])
+@settings(
+    max_examples=int(os.environ.get("DERIVE_FUZZ_EXAMPLES", "40")),
+    deadline=None,
+    suppress_health_check=[HealthCheck.function_scoped_fixture],
+)
 @given(name=st.sampled_from(sorted(p.name for p in ARMS.glob("*.toml"))), edits=MUTATIONS)
 def test_mutated_bundled_specs_succeed_or_fail_cleanly(name, edits, tmp_path_factory, capsys):
     folder = tmp_path_factory.mktemp("fuzz")

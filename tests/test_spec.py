@@ -7,6 +7,7 @@ import math
 import pytest
 
 from derive.spec import SpecError, load_spec, parse_spec
+
 from conftest import ROOT, spec_text
 
 GOOD = spec_text("arm", "standard", [(-90, 0, 0.5, 0), (0, 1, 0, 0)])
@@ -35,7 +36,7 @@ BAD = [
     (GOOD.replace('angle_unit = "deg"', 'angle_unit = "grad"'), "angle_unit"),
     (GOOD + "colour = 1\n", "colour: unknown key"),
     (GOOD.replace("a = 1.0", "a = 1.0\nb = 2.0"), "joint 2: b: unknown key"),
-    (GOOD.replace("a = 1.0", "a = \"1.0\""), "joint 2: a: must be a number"),
+    (GOOD.replace("a = 1.0", 'a = "1.0"'), "joint 2: a: must be a number"),
     (GOOD.replace("a = 1.0", "a = \"__import__('os')\""), "joint 2: a: must be a number"),
     (GOOD.replace("a = 1.0", "a = true"), "joint 2: a: must be a number"),
     (GOOD.replace("a = 1.0", "a = nan"), "joint 2: a"),
@@ -45,7 +46,10 @@ BAD = [
     (GOOD.replace('type = "R"', 'type = "X"', 1), "joint 1: type"),
     (GOOD + "limits = [10.0, -10.0]\n", "joint 2: limits"),
     (GOOD + "limits = [1.0]\n", "joint 2: limits"),
-    ('name = "arm"\nconvention = "standard"\nangle_unit = "deg"\nlength_unit = "m"\n', "joint: missing"),
+    (
+        'name = "arm"\nconvention = "standard"\nangle_unit = "deg"\nlength_unit = "m"\n',
+        "joint: missing",
+    ),
     (GOOD + "[base]\nmatrix = [[1,0,0,0],[0,1,0,0],[0,0,2,0],[0,0,0,1]]\n", "base.matrix"),
     (GOOD + "[tool]\nmatrix = [[1,0,0,0],[0,1,0,0],[0,0,-1,0],[0,0,0,1]]\n", "tool.matrix"),
     (GOOD + "[tool]\nmatrix = [[1,0,0,0],[0,1,0,0],[0,0,1,0],[0,0,1,1]]\n", "tool.matrix"),
@@ -75,7 +79,8 @@ def test_missing_file_is_a_spec_error(tmp_path):
 
 
 def test_units_convert_to_radians():
-    rad = parse_spec(spec_text("arm", "standard", [(-math.pi / 2, 0, 0.5, 0), (0, 1, 0, 0)],
-                               unit="rad"))
+    rad = parse_spec(
+        spec_text("arm", "standard", [(-math.pi / 2, 0, 0.5, 0), (0, 1, 0, 0)], unit="rad")
+    )
     deg = parse_spec(GOOD)
     assert rad.joints[0].alpha == pytest.approx(math.radians(deg.joints[0].alpha))

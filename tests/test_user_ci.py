@@ -1,4 +1,4 @@
-"""Regeneration checks in a user's project: `derive check SPEC --out DIR` and the pre-commit hook."""
+"""Regeneration checks in a user's project: `derive check SPEC --out DIR`, the pre-commit hook."""
 
 from __future__ import annotations
 
@@ -14,11 +14,21 @@ import pytest
 import yaml
 
 from derive.cli import main
+
 from conftest import ROOT, spec_text
 
-USER_ARM = spec_text("user_arm", "standard",
-                     [(-90, 0, 0.3, 0), (0, 0.4, 0, 0), (-90, 0.05, 0, 0), (90, 0, 0.35, 0),
-                      (-90, 0, 0, 0), (0, 0, 0.08, 0)])
+USER_ARM = spec_text(
+    "user_arm",
+    "standard",
+    [
+        (-90, 0, 0.3, 0),
+        (0, 0.4, 0, 0),
+        (-90, 0.05, 0, 0),
+        (90, 0, 0.35, 0),
+        (-90, 0, 0, 0),
+        (0, 0, 0.08, 0),
+    ],
+)
 OTHER_ARM = spec_text("other_arm", "standard", [(0, 0.3, 0, 0), (0, 0.2, 0, 0)])
 
 
@@ -28,8 +38,18 @@ def project(tmp_path: Path) -> tuple[Path, Path, Path]:
     arms.mkdir()
     (arms / "user_arm.toml").write_text(USER_ARM)
     (arms / "other_arm.toml").write_text(OTHER_ARM)
-    assert main(["generate", str(arms / "user_arm.toml"), str(arms / "other_arm.toml"),
-                 "--out", str(out)]) == 0
+    assert (
+        main(
+            [
+                "generate",
+                str(arms / "user_arm.toml"),
+                str(arms / "other_arm.toml"),
+                "--out",
+                str(out),
+            ]
+        )
+        == 0
+    )
     return arms / "user_arm.toml", arms / "other_arm.toml", out
 
 
@@ -109,12 +129,16 @@ ISOLATED = textwrap.dedent("""
 
 
 def test_generated_module_runs_where_derive_is_not_importable(tmp_path):
-    spec, _, out = project(tmp_path)
+    _, _, out = project(tmp_path)
     elsewhere = tmp_path / "robot_package" / "kinematics"
     elsewhere.mkdir(parents=True)
     shutil.copy(out / "user_arm.py", elsewhere / "user_arm.py")
-    result = subprocess.run([sys.executable, "-I", "-c", ISOLATED, str(elsewhere)],
-                            capture_output=True, text=True, cwd=tmp_path)
+    result = subprocess.run(
+        [sys.executable, "-I", "-c", ISOLATED, str(elsewhere)],
+        capture_output=True,
+        text=True,
+        cwd=tmp_path,
+    )
     assert result.returncode == 0, result.stderr
     count, hit, residual = result.stdout.split()
     assert int(count) >= 1 and float(hit) < 1e-9 and float(residual) < 1e-9
@@ -137,8 +161,13 @@ def hook() -> dict:
 
 
 def git(repo: Path, *args: str) -> str:
-    result = subprocess.run(["git", "-c", "user.name=t", "-c", "user.email=t@t", *args],
-                            cwd=repo, capture_output=True, text=True, check=True)
+    result = subprocess.run(
+        ["git", "-c", "user.name=t", "-c", "user.email=t@t", *args],
+        cwd=repo,
+        capture_output=True,
+        text=True,
+        check=True,
+    )
     return result.stdout
 
 
@@ -161,22 +190,26 @@ def test_pre_commit_hook_entry_on_a_temporary_repository(tmp_path):
     (repo / "arms" / "user_arm.toml").write_text(USER_ARM)
     (repo / "pyproject.toml").write_text("[project]\nname = 'robot'\n")
     git(repo, "add", "arms/user_arm.toml", "pyproject.toml")
-    stale = run_hook(repo, entry)                      # spec committed, nothing generated
+    stale = run_hook(repo, entry)  # spec committed, nothing generated
     assert stale is not None and stale.returncode == 1, stale.stderr
     assert "generated/user_arm.py: missing" in stale.stdout
     assert "Traceback" not in stale.stderr
-    subprocess.run(derive_command() + ["generate", "arms/user_arm.toml"], cwd=repo, check=True,
-                   capture_output=True)
+    subprocess.run(
+        [*derive_command(), "generate", "arms/user_arm.toml"],
+        cwd=repo,
+        check=True,
+        capture_output=True,
+    )
     git(repo, "add", "generated")
     fresh = run_hook(repo, entry)
     assert fresh is not None and fresh.returncode == 0, fresh.stdout + fresh.stderr
     git(repo, "commit", "-q", "-m", "arm")
     (repo / "arms" / "user_arm.toml").write_text(USER_ARM.replace("d = 0.35", "d = 0.36"))
     git(repo, "add", "arms/user_arm.toml")
-    edited = run_hook(repo, entry)                     # spec changed, solver not regenerated
+    edited = run_hook(repo, entry)  # spec changed, solver not regenerated
     assert edited is not None and edited.returncode == 1
     assert "generated/user_arm.py: differs" in edited.stdout
     git(repo, "reset", "-q", "--hard")
     (repo / "README.md").write_text("robot\n")
     git(repo, "add", "README.md")
-    assert run_hook(repo, entry) is None               # no spec touched: the hook is not run
+    assert run_hook(repo, entry) is None  # no spec touched: the hook is not run

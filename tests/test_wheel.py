@@ -12,15 +12,23 @@ import pytest
 
 from conftest import ROOT, spec_text
 
-USER_ARM = spec_text("wheel_arm", "modified",
-                     [(0, 0, 0, 0), (-90, 0.1, 0, 0), (0, 0.5, 0.05, 0), (-90, 0.04, 0.45, 0),
-                      (90, 0, 0, 0), (-90, 0, 0, 0)])
+USER_ARM = spec_text(
+    "wheel_arm",
+    "modified",
+    [
+        (0, 0, 0, 0),
+        (-90, 0.1, 0, 0),
+        (0, 0.5, 0.05, 0),
+        (-90, 0.04, 0.45, 0),
+        (90, 0, 0, 0),
+        (-90, 0, 0, 0),
+    ],
+)
 
 
 def call(command: list[str], cwd: Path) -> subprocess.CompletedProcess:
     env = {k: v for k, v in os.environ.items() if k not in ("PYTHONPATH", "VIRTUAL_ENV")}
-    return subprocess.run(command, capture_output=True, text=True, cwd=cwd, env=env,
-                          timeout=900)
+    return subprocess.run(command, capture_output=True, text=True, cwd=cwd, env=env, timeout=900)
 
 
 @pytest.fixture(scope="module")
@@ -28,18 +36,47 @@ def venv(tmp_path_factory) -> Path:
     """A fresh virtual environment with the wheel built from this checkout installed, and a
     poisoned top-level `templates/` folder in its site-packages."""
     base = tmp_path_factory.mktemp("wheel")
-    built = call([sys.executable, "-m", "pip", "wheel", "--no-deps", "--quiet",
-                  "--disable-pip-version-check", str(ROOT), "-w", str(base / "dist")], base)
+    built = call(
+        [
+            sys.executable,
+            "-m",
+            "pip",
+            "wheel",
+            "--no-deps",
+            "--quiet",
+            "--disable-pip-version-check",
+            str(ROOT),
+            "-w",
+            str(base / "dist"),
+        ],
+        base,
+    )
     assert built.returncode == 0, built.stderr
     wheels = list((base / "dist").glob("derive_ik-*.whl"))
     assert len(wheels) == 1
     env = base / "env"
     assert call([sys.executable, "-m", "venv", str(env)], base).returncode == 0
-    installed = call([str(env / "bin" / "python"), "-m", "pip", "install", "--quiet",
-                      "--disable-pip-version-check", str(wheels[0])], base)
+    installed = call(
+        [
+            str(env / "bin" / "python"),
+            "-m",
+            "pip",
+            "install",
+            "--quiet",
+            "--disable-pip-version-check",
+            str(wheels[0]),
+        ],
+        base,
+    )
     assert installed.returncode == 0, installed.stderr
-    purelib = call([str(env / "bin" / "python"), "-c",
-                    "import sysconfig; print(sysconfig.get_paths()['purelib'])"], base)
+    purelib = call(
+        [
+            str(env / "bin" / "python"),
+            "-c",
+            "import sysconfig; print(sysconfig.get_paths()['purelib'])",
+        ],
+        base,
+    )
     poisoned = Path(purelib.stdout.strip()) / "templates"
     poisoned.mkdir()
     for name in ("module.py.j2", "report.md.j2", "__init__.py"):
@@ -51,8 +88,9 @@ def test_the_wheel_generates_checks_reports_and_solves(venv, tmp_path):
     derive = str(venv / "bin" / "derive")
     work = tmp_path / "project"
     work.mkdir()
-    where = call([str(venv / "bin" / "python"), "-c", "import derive; print(derive.__file__)"],
-                 work)
+    where = call(
+        [str(venv / "bin" / "python"), "-c", "import derive; print(derive.__file__)"], work
+    )
     assert str(ROOT) not in where.stdout and "site-packages" in where.stdout
     # a bundled arm: the same bytes as the committed files, poisoned templates ignored
     result = call([derive, "generate", "puma560", "--out", "g"], work)
@@ -85,11 +123,13 @@ def test_the_generated_module_works_from_another_folder(venv, tmp_path):
     assert call([derive, "generate", "puma560", "--out", "vendored"], tmp_path).returncode == 0
     elsewhere = tmp_path / "robot_code"
     elsewhere.mkdir()
-    script = ("import sys; sys.path.insert(0, sys.argv[1]); import numpy as np, puma560 as m;"
-              "q = np.radians([20.0] * 6); sols = m.ik(m.fk(q), backend='python');"
-              "print(len(sols), min(np.abs(s - q).max() for s in sols) < 1e-9)")
-    result = call([str(venv / "bin" / "python"), "-c", script, str(tmp_path / "vendored")],
-                  elsewhere)
+    script = (
+        "import sys; sys.path.insert(0, sys.argv[1]); import numpy as np, puma560 as m;"
+        "q = np.radians([20.0] * 6); sols = m.ik(m.fk(q), backend='python');"
+        "print(len(sols), min(np.abs(s - q).max() for s in sols) < 1e-9)"
+    )
+    result = call(
+        [str(venv / "bin" / "python"), "-c", script, str(tmp_path / "vendored")], elsewhere
+    )
     assert result.returncode == 0, result.stderr
     assert result.stdout.split() == ["8", "True"]
-

@@ -29,14 +29,19 @@ def flange_target(chain: Chain, target: sp.Matrix) -> Assign:
     flange = product([inverse(product(head)), target, inverse(product(tail))])
     names = sym.flange_pose()
     pairs = [(names[i, j], flange[i, j]) for i in range(3) for j in range(4)]
-    return Assign(tuple(p[0] for p in pairs), tuple(p[1] for p in pairs),
-                  "flange target 0_nT = (B X0 Tz(d1))^-1 T (Tz(dn) Xn E)^-1")
+    return Assign(
+        tuple(p[0] for p in pairs),
+        tuple(p[1] for p in pairs),
+        "flange target 0_nT = (B X0 Tz(d1))^-1 T (Tz(dn) Xn E)^-1",
+    )
 
 
 def joint_outputs(chain: Chain) -> tuple[sp.Expr, ...]:
     """q_i = theta_i - offset (R) or d_i - offset (P), offsets as floats."""
-    return tuple((sym.theta(j.index) if j.kind == "R" else sym.d(j.index)) - _number(j.offset)
-                 for j in chain.joints)
+    return tuple(
+        (sym.theta(j.index) if j.kind == "R" else sym.d(j.index)) - _number(j.offset)
+        for j in chain.joints
+    )
 
 
 def joint_refs(chain: Chain) -> tuple[sp.Expr, ...]:
@@ -47,8 +52,7 @@ def joint_refs(chain: Chain) -> tuple[sp.Expr, ...]:
 def reversed_refs(rev: Chain) -> tuple[sp.Expr, ...]:
     """Reference values for a reversed chain, whose joint k is q'_k = -q_{n+1-k}."""
     n = rev.dof
-    return tuple(-sym.q_ref(n + 1 - k) + _number(rev.joints[k - 1].offset)
-                 for k in range(1, n + 1))
+    return tuple(-sym.q_ref(n + 1 - k) + _number(rev.joints[k - 1].offset) for k in range(1, n + 1))
 
 
 def unreverse_outputs(outputs: tuple[sp.Expr, ...]) -> tuple[sp.Expr, ...]:
@@ -67,8 +71,15 @@ def typical_magnitude(exprs: tuple[sp.Expr, ...], length: float) -> float:
     """
     pose = sym.flange_pose()
     subs = {pose[i, j]: float(i == j) for i in range(3) for j in range(3)}
-    subs.update({sym.named("px"): length / 2, sym.named("py"): length / 3,
-                 sym.named("pz"): length / 4, sym.named("x"): length / 2,
-                 sym.named("y"): length / 3, sym.named("z"): length / 4,
-                 sym.named("r"): length**2 * (1 / 4 + 1 / 9 + 1 / 16)})
+    subs.update(
+        {
+            sym.named("px"): length / 2,
+            sym.named("py"): length / 3,
+            sym.named("pz"): length / 4,
+            sym.named("x"): length / 2,
+            sym.named("y"): length / 3,
+            sym.named("z"): length / 4,
+            sym.named("r"): length**2 * (1 / 4 + 1 / 9 + 1 / 16),
+        }
+    )
     return max(abs(float(e.xreplace(subs))) for e in exprs)

@@ -25,7 +25,12 @@ from derive import symbols as sym
 from derive.classify import Structure
 from derive.halfangle import half_angle_poly, linear_coeffs, reduce_pairs
 from derive.methods.common import (
-    NotApplicable, flange_target, joint_outputs, joint_refs, reversed_refs, typical_magnitude,
+    NotApplicable,
+    flange_target,
+    joint_outputs,
+    joint_refs,
+    reversed_refs,
+    typical_magnitude,
     unreverse_outputs,
 )
 from derive.methods.planar import flange_factors, heading_step, planar_steps
@@ -53,27 +58,31 @@ def derive(chain: Chain, structure: Structure) -> IkPlan | str:
             return derive_234(chain, sym.world_pose(), refs, "")
         if 3 in triples:
             rev = reverse_chain(chain)
-            plan = derive_234(rev, inverse(sym.world_pose()), reversed_refs(rev),
-                              "axes 3-5 parallel: reversed chain (joint k is joint 7 - k, "
-                              "q'_k = -q_{7-k}), solved for T^-1; ")
+            plan = derive_234(
+                rev,
+                inverse(sym.world_pose()),
+                reversed_refs(rev),
+                "axes 3-5 parallel: reversed chain (joint k is joint 7 - k, "
+                "q'_k = -q_{7-k}), solved for T^-1; ",
+            )
             return replace(plan, outputs=unreverse_outputs(plan.outputs))
     except NotApplicable as exc:
         return str(exc)
     return "three-parallel: axes 2, 3, 4 (or 3, 4, 5) are not parallel"
 
 
-def derive_234(chain: Chain, target: sp.Matrix, refs: tuple[sp.Expr, ...],
-               prefix: str) -> IkPlan:
+def derive_234(chain: Chain, target: sp.Matrix, refs: tuple[sp.Expr, ...], prefix: str) -> IkPlan:
     """The plan for axes 2, 3, 4 parallel (section 3.1-3.4)."""
     numbers = numbers_of(chain)
     mats = [m.xreplace(numbers) for m in flange_factors(chain)]
-    base_part = product(mats[0:2])            # Z1 X1
-    planar_part = product(mats[2:7])          # Z2 X2 Z3 X3 Z4
-    wrist_part = product(mats[7:])            # X4 Z5 X5 Z6
+    base_part = product(mats[0:2])  # Z1 X1
+    planar_part = product(mats[2:7])  # Z2 X2 Z3 X3 Z4
+    wrist_part = product(mats[7:])  # X4 Z5 X5 Z6
     row = planar_part[2, :]
     if row.has(*(f(i) for i in (2, 3, 4) for f in (sym.c, sym.s))):
-        raise NotApplicable("three-parallel: the third row of Z2 X2 Z3 X3 Z4 depends on the "
-                            "parallel joints")
+        raise NotApplicable(
+            "three-parallel: the third row of Z2 X2 Z3 X3 Z4 depends on the parallel joints"
+        )
     lhs = (inverse(base_part) * sym.flange_pose())[2, :].applyfunc(sp.expand)
     rhs = (row * wrist_part).applyfunc(sp.expand)
     equations = [sp.expand(lhs[k] - rhs[k]) for k in range(4)]
@@ -85,21 +94,31 @@ def derive_234(chain: Chain, target: sp.Matrix, refs: tuple[sp.Expr, ...],
     planar = planar_steps(position[0], position[1], 2, 3, g[0, 3], g[1, 3], refs, length)
     steps: list[Step] = [flange_target(chain, target)]
     steps += theta1_theta5_steps(equations[3], equations[2], refs, length)
-    steps += theta6_steps(equations[0], equations[1], g_value, planar[0], refs)
-    steps.append(Assign(tuple(g), tuple(g_value),
-                        "G = (Z1 X1)^-1 0_6T (X4 Z5 X5 Z6)^-1 = Z2 X2 Z3 X3 Z4 (planar)"))
+    first_planar = planar[0]
+    assert isinstance(first_planar, Solve)
+    steps += theta6_steps(equations[0], equations[1], g_value, first_planar, refs)
+    steps.append(
+        Assign(
+            tuple(g),
+            tuple(g_value),
+            "G = (Z1 X1)^-1 0_6T (X4 Z5 X5 Z6)^-1 = Z2 X2 Z3 X3 Z4 (planar)",
+        )
+    )
     steps += planar
     before = product(mats[2:6])[:3, :3]
     steps.append(heading_step(before, sp.eye(3), 4, refs, g[:, :3]))
     outputs = joint_outputs(chain)
-    case = prefix + ("a5 = 0: theta1 from one a cos + b sin = c equation"
-                     if not equations[3].has(sym.c(5), sym.s(5))
-                     else "a5 != 0: quartic in tan(theta1/2)")
+    case = prefix + (
+        "a5 = 0: theta1 from one a cos + b sin = c equation"
+        if not equations[3].has(sym.c(5), sym.s(5))
+        else "a5 != 0: quartic in tan(theta1/2)"
+    )
     return IkPlan(NAME, case, 8, tuple(steps), outputs)
 
 
-def theta1_theta5_steps(pos_eq: sp.Expr, z6_eq: sp.Expr, refs: tuple[sp.Expr, ...],
-                        length: float) -> list[Step]:
+def theta1_theta5_steps(
+    pos_eq: sp.Expr, z6_eq: sp.Expr, refs: tuple[sp.Expr, ...], length: float
+) -> list[Step]:
     """theta1 and theta5 from entries (3,4) and (3,3) of the invariant equation."""
     c1, s1, c5, s5, u = sym.c(1), sym.s(1), sym.c(5), sym.s(5), sym.named("u")
     if not pos_eq.has(c5, s5):
@@ -110,8 +129,15 @@ def theta1_theta5_steps(pos_eq: sp.Expr, z6_eq: sp.Expr, refs: tuple[sp.Expr, ..
         if a5 == 0 and b5 == 0:
             raise NotApplicable("three-parallel: entry (3,3) does not involve theta5")
         return [
-            Solve(1, "cs1", (a, b, -c), "theta1: translation entry (3,4) of the invariant "
-                  "equation, a c1 + b s1 = c", 2, refs[0], length**2),
+            Solve(
+                1,
+                "cs1",
+                (a, b, -c),
+                "theta1: translation entry (3,4) of the invariant equation, a c1 + b s1 = c",
+                2,
+                refs[0],
+                length**2,
+            ),
             Solve(5, "cs1", (a5, b5, -c5_), "theta5: entry (3,3) of the invariant equation", 2),
         ]
     pa, pb, pc = linear_coeffs(pos_eq, c5, s5)
@@ -126,16 +152,29 @@ def theta1_theta5_steps(pos_eq: sp.Expr, z6_eq: sp.Expr, refs: tuple[sp.Expr, ..
     equation = reduce_pairs(cos5**2 + sin5**2 - det**2, [(s1, c1)])
     coeffs = half_angle_poly(equation, c1, s1, u)
     return [
-        Solve(1, "poly", coeffs, f"theta1: (c5, s5) eliminated from entries (3,3), (3,4): "
-              f"polynomial of degree {len(coeffs) - 1} in u = tan(theta1/2)", len(coeffs) - 1,
-              refs[0], typical_magnitude(coeffs, length)),
-        Solve(5, "cs2", (pa, pb, -pc, za, zb, -zc, sp.Integer(0), sp.Integer(0)),
-              "theta5: entries (3,3) and (3,4), linear in (c5, s5)", 1),
+        Solve(
+            1,
+            "poly",
+            coeffs,
+            f"theta1: (c5, s5) eliminated from entries (3,3), (3,4): "
+            f"polynomial of degree {len(coeffs) - 1} in u = tan(theta1/2)",
+            len(coeffs) - 1,
+            refs[0],
+            typical_magnitude(coeffs, length),
+        ),
+        Solve(
+            5,
+            "cs2",
+            (pa, pb, -pc, za, zb, -zc, sp.Integer(0), sp.Integer(0)),
+            "theta5: entries (3,3) and (3,4), linear in (c5, s5)",
+            1,
+        ),
     ]
 
 
-def theta6_steps(e1: sp.Expr, e2: sp.Expr, g_value: sp.Matrix, elbow: Solve,
-                 refs: tuple[sp.Expr, ...]) -> list[Step]:
+def theta6_steps(
+    e1: sp.Expr, e2: sp.Expr, g_value: sp.Matrix, elbow: Solve, refs: tuple[sp.Expr, ...]
+) -> list[Step]:
     """theta6 from entries (3,1), (3,2): h^T Rz(theta6) = m^T (section 3.3).
 
     Where h vanishes (z6 parallel to axes 2-4, e.g. theta5 = 0) theta6 is free, but not every
@@ -154,10 +193,28 @@ def theta6_steps(e1: sp.Expr, e2: sp.Expr, g_value: sp.Matrix, elbow: Solve,
     rad_a = (names[0] + names[2]) / 2
     return [
         Assign(names, tuple(at), "squared radius of the planar target at theta6 = 0, 90, 180 deg"),
-        Solve(6, "cs2r", (a1, b1, -r1, a2, b2, -r2, SIN5_FREE, sp.Integer(0), rad_a,
-                          names[0] - rad_a, names[1] - rad_a, *bound),
-              "theta6: entries (3,1), (3,2), h^T Rz(theta6) = m^T; free when h vanishes, then "
-              "chosen so that the planar 3R can reach", 1, refs[5]),
+        Solve(
+            6,
+            "cs2r",
+            (
+                a1,
+                b1,
+                -r1,
+                a2,
+                b2,
+                -r2,
+                SIN5_FREE,
+                sp.Integer(0),
+                rad_a,
+                names[0] - rad_a,
+                names[1] - rad_a,
+                *bound,
+            ),
+            "theta6: entries (3,1), (3,2), h^T Rz(theta6) = m^T; free when h vanishes, then "
+            "chosen so that the planar 3R can reach",
+            1,
+            refs[5],
+        ),
     ]
 
 

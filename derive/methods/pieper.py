@@ -29,13 +29,29 @@ from derive import symbols as sym
 from derive.classify import Structure, is_zero
 from derive.halfangle import half_angle_poly, linear_coeffs, reduce_pairs
 from derive.methods.common import (
-    NotApplicable, flange_target, joint_outputs, joint_refs, reversed_refs, typical_magnitude,
+    NotApplicable,
+    flange_target,
+    joint_outputs,
+    joint_refs,
+    reversed_refs,
+    typical_magnitude,
     unreverse_outputs,
 )
 from derive.plan import Assign, IkPlan, Solve, Step
 from derive.transforms import (
-    Chain, general_joint, general_pairs, general_twist, inverse, numbers_of, product,
-    reverse_chain, rot_x, rot_z, trans, x_factor, z_factor,
+    Chain,
+    general_joint,
+    general_pairs,
+    general_twist,
+    inverse,
+    numbers_of,
+    product,
+    reverse_chain,
+    rot_x,
+    rot_z,
+    trans,
+    x_factor,
+    z_factor,
 )
 
 NAME = "pieper"
@@ -54,17 +70,22 @@ def derive(chain: Chain, structure: Structure) -> IkPlan | str:
         return derive_wrist_last(chain, sym.world_pose(), refs, "")
     if 1 in structure.concurrent:
         rev = reverse_chain(chain)
-        plan = derive_wrist_last(rev, inverse(sym.world_pose()), reversed_refs(rev),
-                                 "axes 1-3 meet: reversed chain (joint k is joint 7 - k, "
-                                 "q'_k = -q_{7-k}), solved for T^-1; ")
+        plan = derive_wrist_last(
+            rev,
+            inverse(sym.world_pose()),
+            reversed_refs(rev),
+            "axes 1-3 meet: reversed chain (joint k is joint 7 - k, "
+            "q'_k = -q_{7-k}), solved for T^-1; ",
+        )
         if isinstance(plan, str):
             return plan
         return replace(plan, outputs=unreverse_outputs(plan.outputs))
     return "Pieper: neither axes 4, 5, 6 nor axes 1, 2, 3 meet in a point"
 
 
-def derive_wrist_last(chain: Chain, target: sp.Matrix, refs: tuple[sp.Expr, ...],
-                      prefix: str) -> IkPlan | str:
+def derive_wrist_last(
+    chain: Chain, target: sp.Matrix, refs: tuple[sp.Expr, ...], prefix: str
+) -> IkPlan | str:
     """Pieper plan for a chain whose axes 4, 5, 6 meet in a point.
 
     Args:
@@ -129,12 +150,23 @@ def k_functions() -> dict[str, sp.Expr]:
     k1, k2 = sp.cancel(rc / (2 * a1)), sp.cancel(rs / (2 * a1))
     assert sp.expand(zs - sa1 * k1) == 0 and sp.expand(zc + sa1 * k2) == 0
     assert sp.expand(k1 - f[0]) == 0 and sp.expand(k2 + f[1]) == 0
-    return {"f1": f[0], "f2": f[1], "f3": f[2], "g1": g[0], "g2": g[1], "g3": g[2],
-            "k1": k1, "k2": k2, "k3": k3, "k4": k4}
+    return {
+        "f1": f[0],
+        "f2": f[1],
+        "f3": f[2],
+        "g1": g[0],
+        "g2": g[1],
+        "g3": g[2],
+        "k1": k1,
+        "k2": k2,
+        "k3": k3,
+        "k4": k4,
+    }
 
 
-def position_equations(numbers: dict, length: float, refs: tuple[sp.Expr, ...],
-                       prismatic3: bool) -> PositionResult:
+def position_equations(
+    numbers: dict, length: float, refs: tuple[sp.Expr, ...], prismatic3: bool
+) -> PositionResult:
     """Joint 3 from the case's polynomial, then theta2, then theta1 (lecture, Pieper -4, -5).
 
     Args:
@@ -161,8 +193,11 @@ def position_equations(numbers: dict, length: float, refs: tuple[sp.Expr, ...],
         case, equation, theta2_eq = "sin(alpha1) = 0: z = k4", k4 - z, r_eq
     else:
         case = "general: (r - k3)^2/(4 a1^2) + (z - k4)^2/s(alpha1)^2 = k1^2 + k2^2"
-        equation = (sa1**2 * (r - k3) ** 2 + 4 * a1**2 * (z - k4) ** 2
-                    - 4 * a1**2 * sa1**2 * (k1**2 + k2**2))
+        equation = (
+            sa1**2 * (r - k3) ** 2
+            + 4 * a1**2 * (z - k4) ** 2
+            - 4 * a1**2 * sa1**2 * (k1**2 + k2**2)
+        )
         theta2_eq = None
     if prismatic3:
         equation = sp.expand(equation)
@@ -174,44 +209,97 @@ def position_equations(numbers: dict, length: float, refs: tuple[sp.Expr, ...],
         kind = "poly"
     degree = len(coeffs) - 1
     if degree < 1:
-        raise NotApplicable(f"Pieper: the {case.split(':')[0]} case's equation does not involve "
-                            "joint 3, so the wrist centre cannot move in 3D (degenerate arm)")
+        raise NotApplicable(
+            f"Pieper: the {case.split(':')[0]} case's equation does not involve "
+            "joint 3, so the wrist centre cannot move in 3D (degenerate arm)"
+        )
     case = f"{case}, degree {degree} in {var}"
-    details = {**{f"general_{k}": v for k, v in general.items()},
-               **{k: v for k, v in spec.items()},
-               "joint3_equation": equation}
+    details = {
+        **{f"general_{k}": v for k, v in general.items()},
+        **dict(spec.items()),
+        "joint3_equation": equation,
+    }
     name = "d3" if prismatic3 else "theta3"
     steps: list[Step] = [
-        Assign((sym.named("x"), sym.named("y"), z, r),
-               (sym.named("px"), sym.named("py"), sym.named("pz"),
-                sym.named("px")**2 + sym.named("py")**2 + sym.named("pz")**2),
-               "wrist centre (x, y, z) = 0P_4org and r = x^2 + y^2 + z^2"),
-        Solve(3, kind, coeffs, f"{name}: Pieper {case.split(':')[0]} case, polynomial "
-              f"of degree {degree} in {var}; free when it vanishes identically", degree,
-              refs[2], typical_magnitude(coeffs, length), length if prismatic3 else 1.0),
+        Assign(
+            (sym.named("x"), sym.named("y"), z, r),
+            (
+                sym.named("px"),
+                sym.named("py"),
+                sym.named("pz"),
+                sym.named("px") ** 2 + sym.named("py") ** 2 + sym.named("pz") ** 2,
+            ),
+            "wrist centre (x, y, z) = 0P_4org and r = x^2 + y^2 + z^2",
+        ),
+        Solve(
+            3,
+            kind,
+            coeffs,
+            f"{name}: Pieper {case.split(':')[0]} case, polynomial "
+            f"of degree {degree} in {var}; free when it vanishes identically",
+            degree,
+            refs[2],
+            typical_magnitude(coeffs, length),
+            length if prismatic3 else 1.0,
+        ),
     ]
     if theta2_eq is None:
         ra, rb, rc = linear_coeffs(r_eq, c2, s2)
         za, zb, zc = linear_coeffs(z_eq, c2, s2)
         scale = abs(float(2 * a1 * sa1)) * length**2
-        steps.append(Solve(2, "cs2", (ra, rb, -rc, za, zb, -zc, sp.Float(scale), sp.Integer(0)),
-                           "theta2: r and z equations, linear in (c2, s2)", 1, refs[1]))
+        steps.append(
+            Solve(
+                2,
+                "cs2",
+                (ra, rb, -rc, za, zb, -zc, sp.Float(scale), sp.Integer(0)),
+                "theta2: r and z equations, linear in (c2, s2)",
+                1,
+                refs[1],
+            )
+        )
         fan2 = 1
     else:
         ta, tb, tc = linear_coeffs(theta2_eq, c2, s2)
         size = length if is_zero(a1, 1e-12) else 2 * abs(float(a1)) * length
-        steps.append(Solve(2, "cs1", (ta, tb, -tc),
-                           "theta2: a c2 + b s2 = c by the half-angle method; free when the "
-                           "equation vanishes identically", 2, refs[1], size**2))
+        steps.append(
+            Solve(
+                2,
+                "cs1",
+                (ta, tb, -tc),
+                "theta2: a c2 + b s2 = c by the half-angle method; free when the "
+                "equation vanishes identically",
+                2,
+                refs[1],
+                size**2,
+            )
+        )
         fan2 = 2
     g1, g2 = spec["g1"], spec["g2"]
-    steps.append(Assign((sym.named("g1"), sym.named("g2")), (g1, g2),
-                        "g1(theta2, theta3), g2(theta2, theta3)"))
+    steps.append(
+        Assign(
+            (sym.named("g1"), sym.named("g2")), (g1, g2), "g1(theta2, theta3), g2(theta2, theta3)"
+        )
+    )
     gs1, gs2 = sym.named("g1"), sym.named("g2")
-    steps.append(Solve(1, "cs2", (gs1, -gs2, sym.named("x"), gs2, gs1, sym.named("y"),
-                                  sp.Float(length**2), sp.Float(length**2)),
-                       "theta1: x = c1 g1 - s1 g2, y = s1 g1 + c1 g2; free with the wrist "
-                       "centre on axis 1", 1, refs[0]))
+    steps.append(
+        Solve(
+            1,
+            "cs2",
+            (
+                gs1,
+                -gs2,
+                sym.named("x"),
+                gs2,
+                gs1,
+                sym.named("y"),
+                sp.Float(length**2),
+                sp.Float(length**2),
+            ),
+            "theta1: x = c1 g1 - s1 g2, y = s1 g1 + c1 g2; free with the wrist centre on axis 1",
+            1,
+            refs[0],
+        )
+    )
     return PositionResult(steps, case, degree * fan2, details)
 
 
@@ -227,6 +315,7 @@ def reach_guided(position: list[Step], wrist: list[Step]) -> list[Step]:
     kinds.
     """
     w_assign, theta5 = wrist[0], wrist[1]
+    assert isinstance(w_assign, Assign) and isinstance(theta5, Solve)
     a5, b5, e5 = theta5.args
     e5 = -(e5 - sym.named("W33"))
     rho = sp.sqrt(a5**2 + b5**2)
@@ -241,40 +330,73 @@ def reach_guided(position: list[Step], wrist: list[Step]) -> list[Step]:
     out = []
     for step in position:
         if isinstance(step, Solve) and step.joint == 1 and step.kind == "cs2":
-            step = replace(step, kind="cs2r", args=(*step.args, we, wa, wb, *bounds),
-                           note=step.note + "; then chosen so that the wrist reaches W33")
+            step = replace(
+                step,
+                kind="cs2r",
+                args=(*step.args, we, wa, wb, *bounds),
+                note=step.note + "; then chosen so that the wrist reaches W33",
+            )
         elif isinstance(step, Solve) and step.joint == 2 and step.kind == "cs1":
-            step = replace(step, kind="cs1r", args=(*step.args, *m, *bounds),
-                           note=step.note + "; then chosen so that a theta1 lets the wrist "
-                           "reach W33")
+            step = replace(
+                step,
+                kind="cs1r",
+                args=(*step.args, *m, *bounds),
+                note=step.note + "; then chosen so that a theta1 lets the wrist reach W33",
+            )
         out.append(step)
     return out
 
 
 def wrist_equations(numbers: dict, refs: tuple[sp.Expr, ...]) -> list[Step]:
     """theta5, theta4, theta6 from W = Rz(t4) Rx(alpha4) Rz(t5) Rx(alpha5) Rz(t6) (section 2.6)."""
-    rot03 = product([(z_factor(general_joint(i)) * x_factor(general_twist(i))).xreplace(numbers)
-                     for i in (1, 2, 3)], expand=False)[:3, :3]
+    rot03 = product(
+        [
+            (z_factor(general_joint(i)) * x_factor(general_twist(i))).xreplace(numbers)
+            for i in (1, 2, 3)
+        ],
+        expand=False,
+    )[:3, :3]
     flange = sym.flange_pose()[:3, :3]
     w_names = sp.Matrix(3, 3, lambda i, j: sym.named(f"W{i + 1}{j + 1}"))
     w_value = rot03.T * flange
     c4, s4, c5, s5 = sym.c(4), sym.s(4), sym.c(5), sym.s(5)
-    inner = (rot_x(sym.cos_alpha(4), sym.sin_alpha(4)) * rot_z(c5, s5)
-             * rot_x(sym.cos_alpha(5), sym.sin_alpha(5)))[:3, :3].xreplace(numbers)
+    inner = (
+        rot_x(sym.cos_alpha(4), sym.sin_alpha(4))
+        * rot_z(c5, s5)
+        * rot_x(sym.cos_alpha(5), sym.sin_alpha(5))
+    )[:3, :3].xreplace(numbers)
     v = inner[:, 2].applyfunc(sp.expand)
     a5, b5, e5 = linear_coeffs(v[2], c5, s5)
     m = (inner.T * rot_z(c4, s4)[:3, :3].T * w_names).applyfunc(sp.expand)
     v1, v2 = sym.named("v1"), sym.named("v2")
     return [
-        Assign(tuple(w_names), tuple(w_value),
-               "wrist W = (0_3R Rx(alpha3))^T 0_6R = Rz(t4) Rx(alpha4) Rz(t5) Rx(alpha5) Rz(t6)"),
-        Solve(5, "cs1", (a5, b5, sym.named("W33") - e5),
-              "theta5: W33 = e3^T Rx(alpha4) Rz(theta5) Rx(alpha5) e3", 2),
+        Assign(
+            tuple(w_names),
+            tuple(w_value),
+            "wrist W = (0_3R Rx(alpha3))^T 0_6R = Rz(t4) Rx(alpha4) Rz(t5) Rx(alpha5) Rz(t6)",
+        ),
+        Solve(
+            5,
+            "cs1",
+            (a5, b5, sym.named("W33") - e5),
+            "theta5: W33 = e3^T Rx(alpha4) Rz(theta5) Rx(alpha5) e3",
+            2,
+        ),
         Assign((v1, v2), (v[0], v[1]), "v = Rx(alpha4) Rz(theta5) Rx(alpha5) e3"),
-        Solve(4, "cs2", (v1, -v2, sym.named("W13"), v2, v1, sym.named("W23"), sp.Integer(1),
-                          sp.Integer(1)),
-              "theta4: (W13, W23) = Rz(theta4) (v1, v2); free at a singular wrist", 1, refs[3]),
-        Solve(6, "atan2", (m[1, 0], m[0, 0]),
-              "theta6: Rz(theta6) = (Rx(alpha4) Rz(theta5) Rx(alpha5))^T Rz(theta4)^T W", 1,
-              refs[5]),
+        Solve(
+            4,
+            "cs2",
+            (v1, -v2, sym.named("W13"), v2, v1, sym.named("W23"), sp.Integer(1), sp.Integer(1)),
+            "theta4: (W13, W23) = Rz(theta4) (v1, v2); free at a singular wrist",
+            1,
+            refs[3],
+        ),
+        Solve(
+            6,
+            "atan2",
+            (m[1, 0], m[0, 0]),
+            "theta6: Rz(theta6) = (Rx(alpha4) Rz(theta5) Rx(alpha5))^T Rz(theta4)^T W",
+            1,
+            refs[5],
+        ),
     ]

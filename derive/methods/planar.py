@@ -36,8 +36,10 @@ def derive(chain: Chain, structure: Structure) -> IkPlan | str:
     revolute = [j.index for j in chain.joints if j.kind == "R"]
     prismatic = [j.index for j in chain.joints if j.kind == "P"]
     if len(revolute) not in (2, 3) or len(prismatic) > 1:
-        return (f"planar: needs 2 or 3 revolute joints and at most one prismatic joint, "
-                f"the arm has {len(revolute)} and {len(prismatic)}")
+        return (
+            f"planar: needs 2 or 3 revolute joints and at most one prismatic joint, "
+            f"the arm has {len(revolute)} and {len(prismatic)}"
+        )
     refs = joint_refs(chain)
     try:
         if len(revolute) == 2:
@@ -49,8 +51,9 @@ def derive(chain: Chain, structure: Structure) -> IkPlan | str:
 
 def arm_length(chain: Chain) -> float:
     """Sum of |a_i| and the constant |d_i|: the scale of the singularity tests."""
-    return (sum(abs(float(t.a)) for t in chain.twists)
-            + sum(abs(float(j.d)) for j in chain.joints if j.kind == "R"))
+    return sum(abs(float(t.a)) for t in chain.twists) + sum(
+        abs(float(j.d)) for j in chain.joints if j.kind == "R"
+    )
 
 
 def flange_factors(chain: Chain) -> list[sp.Matrix]:
@@ -68,8 +71,9 @@ def flange_factors(chain: Chain) -> list[sp.Matrix]:
     return mats[:-1]
 
 
-def position_mode(chain: Chain, revolute: list[int], prismatic: list[int],
-                  refs: tuple[sp.Expr, ...]) -> IkPlan:
+def position_mode(
+    chain: Chain, revolute: list[int], prismatic: list[int], refs: tuple[sp.Expr, ...]
+) -> IkPlan:
     """Two revolute joints: the arm controls the tool point's position (x, y and maybe z)."""
     numbers = numbers_of(chain)
     mats = [z_factor(j) * x_factor(t) for j, t in zip(chain.joints, chain.twists[1:])]
@@ -77,20 +81,40 @@ def position_mode(chain: Chain, revolute: list[int], prismatic: list[int],
     head = product([chain.base, x_factor(chain.twists[0])])
     local = (inverse(head) * sym.world_pose()[:, 3]).applyfunc(sp.expand)
     target = tuple(sym.named(f"p{axis}") for axis in "xyz")
-    steps: list[Step] = [Assign(target, tuple(local[:3]),
-                                "tool point in frame 0: (B X0)^-1 p; the arm controls a position")]
+    steps: list[Step] = [
+        Assign(
+            target,
+            tuple(local[:3]),
+            "tool point in frame 0: (B X0)^-1 p; the arm controls a position",
+        )
+    ]
     position = to_tool.applyfunc(lambda e: sp.expand(e.xreplace(numbers)))
     steps += prismatic_steps(position[2], prismatic, target[2])
-    steps += planar_steps(position[0], position[1], revolute[0], revolute[1], target[0],
-                          target[1], refs, arm_length(chain))
+    steps += planar_steps(
+        position[0],
+        position[1],
+        revolute[0],
+        revolute[1],
+        target[0],
+        target[1],
+        refs,
+        arm_length(chain),
+    )
     solves_for = "the tool point's x and y" + (" and z" if prismatic else "") + " in frame 0"
-    return IkPlan(NAME, f"{arm_kind(chain)}: position of the tool point (law of cosines, then "
-                  "k1, k2)", 2, tuple(steps), joint_outputs(chain), solves_for=solves_for,
-                  certify="position")
+    return IkPlan(
+        NAME,
+        f"{arm_kind(chain)}: position of the tool point (law of cosines, then k1, k2)",
+        2,
+        tuple(steps),
+        joint_outputs(chain),
+        solves_for=solves_for,
+        certify="position",
+    )
 
 
-def pose_mode(chain: Chain, revolute: list[int], prismatic: list[int],
-              refs: tuple[sp.Expr, ...]) -> IkPlan:
+def pose_mode(
+    chain: Chain, revolute: list[int], prismatic: list[int], refs: tuple[sp.Expr, ...]
+) -> IkPlan:
     """Three revolute joints: position in the plane and the heading (the lecture's x, y, phi)."""
     numbers = numbers_of(chain)
     last = revolute[2]
@@ -101,16 +125,29 @@ def pose_mode(chain: Chain, revolute: list[int], prismatic: list[int],
         raise NotApplicable("planar: the last revolute joint moves the flange in the plane")
     steps: list[Step] = [flange_target(chain, sym.world_pose())]
     steps += prismatic_steps(position[2], prismatic, sym.named("pz"))
-    steps += planar_steps(position[0], position[1], revolute[0], revolute[1],
-                          sym.named("px"), sym.named("py"), refs, arm_length(chain))
+    steps += planar_steps(
+        position[0],
+        position[1],
+        revolute[0],
+        revolute[1],
+        sym.named("px"),
+        sym.named("py"),
+        refs,
+        arm_length(chain),
+    )
     at = 2 * (last - 1)
     before = product(mats[:at])[:3, :3].xreplace(numbers)
-    after = product(mats[at + 1:])[:3, :3].xreplace(numbers)
+    after = product(mats[at + 1 :])[:3, :3].xreplace(numbers)
     steps.append(heading_step(before, after, last, refs))
-    return IkPlan(NAME, f"{arm_kind(chain)}: position by the law of cosines and k1, k2, then "
-                  "the heading", 2, tuple(steps), joint_outputs(chain),
-                  solves_for="x, y and the heading about z of the flange (z and the tilt must "
-                  "match the arm's plane)")
+    return IkPlan(
+        NAME,
+        f"{arm_kind(chain)}: position by the law of cosines and k1, k2, then the heading",
+        2,
+        tuple(steps),
+        joint_outputs(chain),
+        solves_for="x, y and the heading about z of the flange (z and the tilt must "
+        "match the arm's plane)",
+    )
 
 
 def arm_kind(chain: Chain) -> str:
@@ -130,8 +167,16 @@ def prismatic_steps(z_expr: sp.Expr, prismatic: list[int], z_target: sp.Symbol) 
     return [Solve(k, "polyd", coeffs, f"d{k}: the z equation, linear in d{k}", 1)]
 
 
-def planar_steps(x_expr: sp.Expr, y_expr: sp.Expr, a: int, b: int, x: sp.Symbol,
-                 y: sp.Symbol, refs: tuple[sp.Expr, ...], length: float) -> list[Step]:
+def planar_steps(
+    x_expr: sp.Expr,
+    y_expr: sp.Expr,
+    a: int,
+    b: int,
+    x: sp.Symbol,
+    y: sp.Symbol,
+    refs: tuple[sp.Expr, ...],
+    length: float,
+) -> list[Step]:
     """theta_b from x^2 + y^2 (law of cosines), then theta_a from x and y (k1, k2).
 
     Args:
@@ -154,17 +199,33 @@ def planar_steps(x_expr: sp.Expr, y_expr: sp.Expr, a: int, b: int, x: sp.Symbol,
     ya, yb, yc = linear_coeffs(y_expr, ca, sa)
     k1, k2 = sym.named("k1"), sym.named("k2")
     return [
-        Solve(b, "cs1", (ea, eb, x**2 + y**2 - ec),
-              f"theta{b}: law of cosines, x^2 + y^2 = {sp.sstr(radius)} (elbow up / down)", 2),
+        Solve(
+            b,
+            "cs1",
+            (ea, eb, x**2 + y**2 - ec),
+            f"theta{b}: law of cosines, x^2 + y^2 = {sp.sstr(radius)} (elbow up / down)",
+            2,
+        ),
         Assign((k1, k2), (xa, -xb), f"k1, k2 with x = k1 c{a} - k2 s{a} (+ const)"),
-        Solve(a, "cs2", (k1, -k2, x - xc, ya, yb, y - yc, scale, scale),
-              f"theta{a}: x = k1 c{a} - k2 s{a}, y = k1 s{a} + k2 c{a}, i.e. "
-              f"atan2(y, x) - atan2(k2, k1)", 1, refs[a - 1]),
+        Solve(
+            a,
+            "cs2",
+            (k1, -k2, x - xc, ya, yb, y - yc, scale, scale),
+            f"theta{a}: x = k1 c{a} - k2 s{a}, y = k1 s{a} + k2 c{a}, i.e. "
+            f"atan2(y, x) - atan2(k2, k1)",
+            1,
+            refs[a - 1],
+        ),
     ]
 
 
-def heading_step(before: sp.Matrix, after: sp.Matrix, joint: int,
-                 refs: tuple[sp.Expr, ...], target: sp.Matrix | None = None) -> Solve:
+def heading_step(
+    before: sp.Matrix,
+    after: sp.Matrix,
+    joint: int,
+    refs: tuple[sp.Expr, ...],
+    target: sp.Matrix | None = None,
+) -> Solve:
     """theta_joint from the rotation R = A Rz(theta) B: Rz(theta) = A^T R B^T.
 
     Args:
@@ -176,5 +237,11 @@ def heading_step(before: sp.Matrix, after: sp.Matrix, joint: int,
     """
     rotation = sym.flange_pose()[:3, :3] if target is None else target
     m = (before.T * rotation * after.T).applyfunc(sp.expand)
-    return Solve(joint, "atan2", (m[1, 0], m[0, 0]),
-                 f"theta{joint}: heading, Rz(theta{joint}) = A^T R B^T", 1, refs[joint - 1])
+    return Solve(
+        joint,
+        "atan2",
+        (m[1, 0], m[0, 0]),
+        f"theta{joint}: heading, Rz(theta{joint}) = A^T R B^T",
+        1,
+        refs[joint - 1],
+    )
