@@ -830,28 +830,31 @@ def _accept(p, zs, check=True):
     A double root comes out split, as a complex pair or as two reals about sqrt(eps) apart;
     roots closer than _MERGE_TOL are replaced by their mean, which is accurate. A root of
     multiplicity k splits by about eps^(1/k) (1e-4 for k = 4) into a cluster, not all real,
-    whose mean is accurate too: such a cluster within _CLUSTER_TOL gives its mean.
+    whose mean is accurate too: such a cluster within _CLUSTER_TOL gives its mean. Merged
+    roots and cluster means are not Newton-polished: at a multiple root p and p' both
+    vanish, and Newton's step is rounding noise divided by rounding noise (it moved a double
+    root by 3.5e-5).
     """
     xs = []
     split = False
     for z in zs:
         z = complex(z)
         if abs(z.imag) <= _ROOT_IMAG_TOL * (1.0 + abs(z)):
-            xs.append(z.real)
+            xs.append((z.real, True))
         elif abs(z.imag) <= _CLUSTER_TOL * (1.0 + abs(z)):
             split = True
     if split:
-        xs = [z.real for z in _clusters([complex(z) for z in zs])
+        xs = [(z.real, simple) for z, simple in _clusters([complex(z) for z in zs])
               if abs(z.imag) <= _ROOT_IMAG_TOL * (1.0 + abs(z))]
     xs.sort()
     out = []
     k = 0
     while k < len(xs):
-        x = xs[k]
-        if k + 1 < len(xs) and xs[k + 1] - x <= _MERGE_TOL * (1.0 + abs(x)):
-            x = 0.5 * (x + xs[k + 1])
+        x, simple = xs[k]
+        if k + 1 < len(xs) and xs[k + 1][0] - x <= _MERGE_TOL * (1.0 + abs(x)):
+            x = 0.5 * (x + xs[k + 1][0])
             k += 1
-        else:
+        elif simple:
             x = _newton(p, x)
         if check and not _small_residual(p, x):
             return None
@@ -861,7 +864,8 @@ def _accept(p, zs, check=True):
 
 
 def _clusters(zs):
-    """zs with each cluster of nearby roots that are not all real replaced by its mean."""
+    """zs with each cluster of nearby roots that are not all real replaced by its mean, as
+    (root, whether it is a simple root rather than a cluster's mean)."""
     out = []
     left = list(zs)
     while left:
@@ -869,9 +873,9 @@ def _clusters(zs):
         group = [z] + [w for w in left if abs(w - z) <= _CLUSTER_TOL * (1.0 + abs(z))]
         if len(group) > 1 and any(abs(w.imag) > _ROOT_IMAG_TOL * (1.0 + abs(w)) for w in group):
             left = [w for w in left if all(w is not g for g in group)]
-            out.append(sum(group) / len(group))
+            out.append((sum(group) / len(group), False))
         else:
-            out.append(z)
+            out.append((z, True))
     return out
 
 

@@ -245,7 +245,7 @@ def test_regression_arms(convention, kinds, travel, rows, backend):
     verify_family(text, ("pieper", "three-parallel"), 3, 5, backend)
 
 
-KNOWN_GAP = (
+A5_SINGULAR_WRIST = (
     "modified",
     "RRRRRR",
     0.0,
@@ -260,18 +260,12 @@ KNOWN_GAP = (
 )
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason=(
-        "known gap, found by the long profile: a three-parallel arm with a5 != 0 and a "
-        "non-orthogonal wrist at theta5 = pi. theta1 is a double root of its quartic there; its "
-        "error (~1e-5 rad after theta5) leaves theta5 3.8e-5 from pi, theta6 is then not free "
-        "and the candidates miss the pose by 3e-6 > tol. Needs Newton polishing of theta1 "
-        "against the unsquared equations; see the closing note of issue 7"
-    ),
-)
-def test_known_gap_three_parallel_a5_singular_wrist_at_pi():
-    convention, kinds, _, rows = KNOWN_GAP
+def test_three_parallel_a5_singular_wrist_at_pi():
+    """Found by the long profile (a known gap until issue 15): a three-parallel arm with
+    a5 != 0 and a non-orthogonal wrist at theta5 = pi. theta1 is a double root of its quartic
+    there; Newton's steps on the split pair's mean moved it by 5.8e-5 rad and no candidate
+    reached the pose. The mean is now kept as it is (1.4e-10 from the true theta1)."""
+    convention, kinds, _, rows = A5_SINGULAR_WRIST
     verify_family(
         spec_text("parallel_arm", convention, rows, kinds=kinds), ("three-parallel",), 3, 5
     )
