@@ -134,8 +134,30 @@ def link_blocks(plan: Plan) -> list[Block]:
     total = sp.eye(4)
     for link in plan.links:
         total = (total * link).applyfunc(sp.expand)
-    out.append(Block("math", f"{{}}^{{0}}_{{{plan.arm.dof}}}T", tex(total)))
+    n = plan.arm.dof
+    names = sp.Matrix(4, 4, lambda i, j: sp.Symbol(ENTRY_NAMES[i][j]) if i < 3 else total[i, j])
+    out.append(
+        Block(
+            "p",
+            "Their product, entry by entry (one equation per entry, so that a "
+            "long one stays on its own line):",
+        )
+    )
+    out.append(Block("math", f"{{}}^{{0}}_{{{n}}}T", tex(names)))
+    out += [
+        Block("math", tex(sp.Symbol(ENTRY_NAMES[i][j])), tex(total[i, j]))
+        for j in range(4)
+        for i in range(3)
+    ]
     return out
+
+
+# the names of 0_nT's top three rows: rotation entries r_ij and the position p_x, p_y, p_z
+ENTRY_NAMES = (
+    ("r_{11}", "r_{12}", "r_{13}", "p_{x}"),
+    ("r_{21}", "r_{22}", "r_{23}", "p_{y}"),
+    ("r_{31}", "r_{32}", "r_{33}", "p_{z}"),
+)
 
 
 def method_blocks(plan: Plan) -> list[Block]:
