@@ -25,11 +25,12 @@ homogeneous transforms of the tool frame in the world (base and tool frames incl
 API:
     fk(q) -> (4, 4) ndarray
     fk_batch(Q: (N, DOF)) -> (N, 4, 4) ndarray
-    ik(T, *, within_limits=False, q_ref=None, tol=CERTIFY_TOL, backend=None)
+    ik(T, *, within_limits=False, q_ref=None, tol=CERTIFY_TOL, backend=None, all_turns=False)
         -> (n, DOF) ndarray, all solutions
-    ik_batch(T: (N, 4, 4), *, q_ref=None, tol=CERTIFY_TOL, backend=None)
+    ik_batch(T: (N, 4, 4), *, q_ref=None, tol=CERTIFY_TOL, chunk=4096, backend=None)
         -> (Q (N, M, DOF), valid (N, M))
     nearest(T, q_ref, *, within_limits=True, weights=None) -> (DOF,) ndarray or None
+    warmup() -> bool: compile the solver (or load numba's cache) now
 
 Every solution `ik` returns has been checked by forward kinematics against T (tolerance
 CERTIFY_TOL in rotation and CERTIFY_TOL * REACH in position). Revolute values are wrapped to
@@ -46,6 +47,7 @@ import cmath
 import math
 import sys
 import threading
+import types
 from math import acos, atan2, cos, sin, sqrt
 from operator import sub as _sub
 
@@ -271,7 +273,8 @@ def ik(T, *, within_limits=False, q_ref=None, tol=CERTIFY_TOL, backend=None, all
             that does not control every pose component this is also the test that T's other
             components are reachable: if they are not, the result is empty.
         backend: "numba" runs the solver compiled (numba compiles it on the first call of a
-            process and caches the machine code beside this file), "python" runs it as
+            process, or at warmup(), and caches the machine code beside this file), "python"
+            runs it as
             Python; "auto" is "numba" when numba is installed; None (default): BACKEND,
             which is "auto" unless you set it. The two agree to
             rounding (far below tol); poses the compiled closed forms do not settle (a free
@@ -2023,6 +2026,9 @@ _KERNEL = ("_kpose_ok", "_kcs1", "_kcs2", "_reach_first1", "_reach_first2", "_kc
            "_ksmall_residual", "_kfk", "_kfk_q")
 _compiled = None
 _BATCH_LOCK = threading.Lock()
+_COMPILE_LOCK = threading.Lock()
+# the name under which the compiled kernels' namespace is registered in sys.modules
+_KERNEL_SPACE = "_derive_ik_kernels_puma560_df600d054893f7c1"
 
 
 def _kernels(backend):
@@ -2040,31 +2046,58 @@ def _kernels(backend):
 
 
 def _compile():
-    """(_kbatch, _kone, _kpick) compiled by numba, once per process (numba caches the machine code
-    beside this file when the module was imported by its name and the folder is writable;
-    otherwise it compiles without a cache); None without numba."""
+    """(_kbatch, _kone, _kpick) compiled by numba, once per process; None without numba."""
     global _compiled
-    if _compiled is None:
-        try:
-            import numba
-        except ImportError:
-            _compiled = False
-            return None
-        names = globals()
-        names["_prange"] = numba.prange
-        # numba's cache can reload only a module importable by its name
-        importable = getattr(sys.modules.get(__name__), "__dict__", None) is names
-        for cache in (True, False) if importable else (False,):
-            options = dict(cache=cache, nogil=True, error_model="numpy")
-            try:
-                for name in _KERNEL:
-                    source = getattr(names[name], "py_func", names[name])
-                    fast = set() if name in _KSTRICT else _FASTMATH
-                    names[name] = numba.njit(fastmath=fast, **options)(source)
-                names["_kbatch"] = numba.njit(parallel=True, fastmath=_FASTMATH, **options)(
-                    names["_kbatch"].py_func)
-                break
-            except RuntimeError:
-                continue
-        _compiled = (names["_kbatch"], names["_kone"], names["_kpick"])
+    with _COMPILE_LOCK:
+        if _compiled is None:
+            _compiled = _build_kernels() or False
     return _compiled or None
+
+
+def _build_kernels():
+    """The kernel functions compiled by numba as copies that call each other in a namespace of
+    their own, so that this module's functions stay Python whatever ran before.
+
+    The namespace is registered as the module _KERNEL_SPACE: numba reloads machine code
+    from its cache (in __pycache__ beside this file, when that folder is writable) only for
+    functions whose module it can import by name, and this file may have been imported by
+    path under any name.
+    """
+    try:
+        import numba
+    except ImportError:
+        return None
+    space = sys.modules.get(_KERNEL_SPACE)
+    if space is None or getattr(space, "_KERNEL_SOURCE", None) != __file__:
+        space = types.ModuleType(_KERNEL_SPACE)
+        sys.modules[_KERNEL_SPACE] = space
+    for cache in (True, False):
+        names = space.__dict__
+        names.update({k: v for k, v in globals().items() if not k.startswith("__")})
+        names.update(_prange=numba.prange, _KERNEL_SOURCE=__file__)
+        try:
+            for name in _KERNEL:
+                python = globals()[name]
+                copy = types.FunctionType(python.__code__, names, python.__name__,
+                                          python.__defaults__, python.__closure__)
+                copy.__qualname__ = python.__qualname__
+                fast = set() if name in _KSTRICT else _FASTMATH
+                names[name] = numba.njit(fastmath=fast, parallel=name == "_kbatch", cache=cache,
+                                         nogil=True, error_model="numpy")(copy)
+            return names["_kbatch"], names["_kone"], names["_kpick"]
+        except RuntimeError:  # no cache where numba cannot write one: compile without
+            continue
+    return None
+
+
+def warmup():
+    """Compile (or load from numba's cache) the compiled solver now, not at the first ik:
+    call it at a program's start. Returns whether the compiled solver is available."""
+    kernels = _compile()
+    if kernels is None:
+        return False
+    T = fk(_ZEROS)
+    ik(T, backend="numba")
+    ik_batch(T[None], backend="numba")
+    kernels[2](np.zeros((1, DOF)), _ZEROS, _ONES, True)
+    return True
