@@ -679,6 +679,8 @@ _ZEROS = (0.0,) * DOF
 
 def _tolerance(tol):
     """tol as a float, if it is a positive finite number."""
+    if type(tol) is float and 0.0 < tol < math.inf:
+        return tol
     try:
         value = float(tol)
     except (TypeError, ValueError):
@@ -2048,6 +2050,8 @@ def _kernels(backend):
 def _compile():
     """(_kbatch, _kone, _kpick) compiled by numba, once per process; None without numba."""
     global _compiled
+    if _compiled is not None:  # the hot path: no lock
+        return _compiled or None
     with _COMPILE_LOCK:
         if _compiled is None:
             _compiled = _build_kernels() or False
