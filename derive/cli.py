@@ -23,7 +23,7 @@ from typing import TYPE_CHECKING
 if TYPE_CHECKING:
     from collections.abc import Iterable
 
-from derive.emit import render_module
+from derive.emit import GenerationError, render_module
 from derive.pipeline import build_plan
 from derive.plan import Plan
 from derive.report import Example, render_report
@@ -151,7 +151,7 @@ def cmd_generate(args: argparse.Namespace) -> int:
             plan, files = outputs_for(spec)
             for name, content in files.items():
                 write_atomic(out / name, content)
-        except (SpecError, UsageError, OSError) as exc:
+        except (SpecError, UsageError, GenerationError, OSError) as exc:
             print(f"error: {exc}", file=sys.stderr)
             failed.append(text)
             continue
@@ -454,7 +454,7 @@ def main(argv: list[str] | None = None) -> int:
         code: int = args.run(args)
         sys.stdout.flush()  # a closed pipe shows here, inside the handler, not at exit
         return code
-    except (SpecError, UsageError) as exc:
+    except (SpecError, UsageError, GenerationError) as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 2
     except BrokenPipeError:

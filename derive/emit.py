@@ -14,79 +14,50 @@ from importlib import resources
 
 import jinja2
 import sympy as sp
-from sympy.printing.str import StrPrinter
 
+from derive import kernel
 from derive import symbols as sym
 from derive.plan import Assign, Plan, Solve
+from derive.printing import (
+    SCALAR_FUNCTIONS,
+    CodePrinter,
+    Line,
+    UnprintableError,
+    assign_lines,
+    cs_arguments,
+    float_literal,
+    match_expression,
+    same_joints,
+    step_arguments,
+    world_names,
+)
 
 GENERATOR = "derive-ik"
 REGENERATE = "derive generate"
 
 
-class CodePrinter(StrPrinter):
-    """Python source for SymPy expressions: float literals, ``prefix``-qualified functions."""
-
-    def __init__(self, prefix: str = "") -> None:
-        super().__init__({"order": None})
-        self.prefix = prefix
-
-    def _print_Rational(self, expr: sp.Rational) -> str:
-        return _float(float(expr))
-
-    def _print_Integer(self, expr: sp.Integer) -> str:
-        return _float(float(expr))
-
-    def _print_Float(self, expr: sp.Float) -> str:
-        return _float(float(expr))
-
-    def _print_Pi(self, expr: sp.Expr) -> str:
-        return _float(math.pi)
-
-    def _print_Mul(self, expr: sp.Mul) -> str:
-        coeff, rest = expr.as_coeff_Mul()
-        if coeff.is_Rational and not coeff.is_Integer and rest is not sp.S.One:
-            if coeff < 0:
-                return f"-{float(-coeff)!r}*{self.parenthesize(rest, 49)}"
-            return f"{float(coeff)!r}*{self.parenthesize(rest, 49)}"
-        return super()._print_Mul(expr)
-
-    def _print_Function(self, expr: sp.Function) -> str:
-        args = ", ".join(self._print(a) for a in expr.args)
-        return f"{self.prefix}{expr.func.__name__}({args})"
-
-    def _print_Pow(self, expr: sp.Pow, rational: bool = False) -> str:
-        base, exp = expr.as_base_exp()
-        if exp == sp.S.Half:
-            return f"{self.prefix}sqrt({self._print(base)})"
-        if exp.is_Integer and exp == 2 and base.is_Symbol:
-            return f"{self._print(base)}*{self._print(base)}"
-        return super()._print_Pow(expr, rational)
+class GenerationError(ValueError):
+    """The plan holds something the generated code cannot evaluate; the message (one line)
+    names the arm, the step and what is missing."""
 
 
-def _float(value: float) -> str:
-    return repr(value)
-
-
-@dataclass(frozen=True)
-class Line:
-    """One line of generated code at an indentation depth (in 4-space units)."""
-
-    depth: int
-    text: str
-
-
-def assign_lines(
-    targets: tuple[sp.Symbol, ...],
-    exprs: tuple[sp.Expr, ...],
-    names: sp.utilities.iterables.numbered_symbols,
-    printer: CodePrinter,
-    depth: int,
-) -> list[Line]:
-    """CSE'd straight-line code for targets = exprs."""
-    temps, reduced = sp.cse(list(exprs), symbols=names, order="canonical")
-    lines = [Line(depth, f"{t} = {printer.doprint(e)}") for t, e in temps]
-    lines += [Line(depth, f"{t} = {printer.doprint(e)}") for t, e in zip(targets, reduced)]
-    return lines
+def check_printable(plan: Plan) -> None:
+    """Every expression of the plan prints in scalar and vectorised code, or a
+    GenerationError names the arm, the step and the function (before any code is written)."""
+    parts: list[tuple[str, tuple[sp.Basic, ...]]] = [("forward kinematics", tuple(plan.fk_pose))]
+    for step in plan.ik.steps if plan.ik else ():
+        exprs = step.exprs if isinstance(step, Assign) else (*step.args, step.ref)
+        parts.append((step.note, tuple(exprs)))
+    for where, exprs in parts:
+        for printer in (CodePrinter(), CodePrinter("np.")):
+            try:
+                for expr in exprs:
+                    printer.doprint(expr)
+            except UnprintableError as exc:
+                raise GenerationError(
+                    f"{plan.arm.name}: {where}: the generated code has no function {exc}; "
+                    f"it calls only {', '.join(sorted(SCALAR_FUNCTIONS))}"
+                ) from None
 
 
 def fk_pose_lines(plan: Plan) -> tuple[tuple[str, ...], tuple[str, ...]]:
@@ -105,15 +76,6 @@ def fk_pose_lines(plan: Plan) -> tuple[tuple[str, ...], tuple[str, ...]]:
     return tuple(lines), tuple(str(t) for t in targets)
 
 
-def cs_arguments(plan: Plan) -> str:
-    """The arguments of _fk_from_cs: c1, s1, ... for R joints, d_i for P joints, in order."""
-    out = []
-    for target, _ in plan.joint_defs:
-        name = str(target)
-        out += [f"c{name[5:]}", f"s{name[5:]}"] if name.startswith("theta") else [name]
-    return ", ".join(out)
-
-
 def fk_joint_lines(plan: Plan, printer: CodePrinter, columns: bool) -> tuple[str, ...]:
     """theta_i = q_i + offset with c_i, s_i (or d_i = q_i + offset) from q or from Q's columns."""
     lines = []
@@ -126,25 +88,6 @@ def fk_joint_lines(plan: Plan, printer: CodePrinter, columns: bool) -> tuple[str
             lines.append(f"c{i} = {printer.prefix}cos({target})")
             lines.append(f"s{i} = {printer.prefix}sin({target})")
     return tuple(lines)
-
-
-def same_joints(plan: Plan) -> bool:
-    """The plan's theta_i / d_i are the arm's (not a reversed chain's): q_i = theta_i - offset."""
-    assert plan.ik is not None
-    for (target, _), out in zip(plan.joint_defs, plan.ik.outputs):
-        if out.free_symbols != {target} or out.coeff(target) != 1:
-            return False
-    return True
-
-
-def match_expression(certify: str, vector: bool = False) -> str:
-    """The certification test of entries e against target t, unrolled (elementwise if vector)."""
-    rotation = () if certify == "position" else (0, 1, 2, 4, 5, 6, 8, 9, 10)
-    tests = [f"abs(e[{k}] - t[{k}]) <= tol" for k in rotation]
-    tests += [f"abs(e[{k}] - t[{k}]) <= ptol" for k in (3, 7, 11)]
-    if vector:
-        return " & ".join(f"({t})" for t in tests)
-    return " and ".join(tests)
 
 
 def ik_lines(plan: Plan, printer: CodePrinter) -> tuple[tuple[int, str], ...]:
@@ -221,23 +164,6 @@ def ik_batch_lines(plan: Plan, printer: CodePrinter) -> tuple[str, ...]:
         lines.append(f"retry |= (free{k} & ~{below}).reshape(T.shape[0], -1).any(axis=1)")
     lines.append("return Q, valid.reshape(T.shape[0], -1), retry")
     return tuple(lines)
-
-
-def step_arguments(
-    step: Solve, names: sp.utilities.iterables.numbered_symbols, printer: CodePrinter, depth: int
-) -> tuple[list[Line], list[str]]:
-    """A Solve step's note and the CSE'd temporaries of its arguments, and the arguments'
-    printed expressions (in terms of those temporaries)."""
-    arg_names = tuple(sym.named(f"arg{k}") for k in range(len(step.args)))
-    temps = assign_lines(arg_names, step.args, names, printer, depth)
-    lines = [Line(depth, f"# {step.note}")]
-    lines += [ln for ln in temps if not ln.text.startswith("arg")]
-    args = {
-        ln.text.split(" = ")[0]: ln.text.split(" = ", 1)[1]
-        for ln in temps
-        if ln.text.startswith("arg")
-    }
-    return lines, [args[str(a)] for a in arg_names]
 
 
 def batch_solve_lines(
@@ -336,16 +262,13 @@ class PrintedModule:
     components: str
 
 
-def world_names() -> str:
-    """The names of the world pose's 12 top entries, row by row (w11, w12, w13, wx, ...)."""
-    world = sym.world_pose()
-    return ", ".join(str(world[i, j]) for i in range(3) for j in range(4))
-
-
 def print_plan(plan: Plan) -> PrintedModule:
-    """The printed IR of a plan."""
-    from derive import kernel  # kernel prints with this module's helpers: imported late
+    """The printed IR of a plan.
 
+    Raises:
+        GenerationError: an expression holds a function the generated code cannot call.
+    """
+    check_printable(plan)
     arm = plan.arm
     scalar, vector = CodePrinter(), CodePrinter("np.")
     fk_pose_body, outputs = fk_pose_lines(plan)
@@ -366,7 +289,7 @@ def print_plan(plan: Plan) -> PrintedModule:
         revolute_const=_tuple(tuple(k == "R" for k in arm.joint_types)),
         base_const=_tuple_of_tuples(tuple(arm.base[4 * i : 4 * i + 4] for i in range(4))),
         tool_const=_tuple_of_tuples(tuple(arm.tool[4 * i : 4 * i + 4] for i in range(4))),
-        reach=_float(arm.reach),
+        reach=float_literal(arm.reach),
         fk_pose_body=fk_pose_body,
         fk_joints=fk_joint_lines(plan, scalar, columns=False),
         fk_batch_joints=fk_joint_lines(plan, vector, columns=True),

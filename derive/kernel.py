@@ -12,7 +12,8 @@ import math
 
 import sympy as sp
 
-from derive.emit import (
+from derive.plan import Assign, Plan, Solve
+from derive.printing import (
     CodePrinter,
     Line,
     assign_lines,
@@ -22,7 +23,6 @@ from derive.emit import (
     step_arguments,
     world_names,
 )
-from derive.plan import Assign, Plan, Solve
 
 
 def kernel_lines(plan: Plan, printer: CodePrinter) -> tuple[tuple[int, str], ...]:

@@ -1,0 +1,156 @@
+"""Printing SymPy expressions and plan pieces as Python source, shared by the module's
+printers (emit: scalar and vectorised code; kernel: the compiled kernel).
+
+Printing is deterministic: numbers print as Python float literals (the shortest repr), terms
+in SymPy's canonical order, CSE with ``order="canonical"`` and a fresh ``x0, x1, ...``
+stream per function.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import sympy as sp
+from sympy.printing.str import StrPrinter
+
+from derive import symbols as sym
+from derive.plan import Plan, Solve
+
+
+class UnprintableError(Exception):
+    """An expression holds a function the generated code has no name for (the function's
+    name is the message); emit turns it into a GenerationError naming the arm and step."""
+
+
+# SymPy function -> the name the generated code calls it by: from `math` in scalar code,
+# `np.` in vectorised code (the module imports exactly these)
+SCALAR_FUNCTIONS = {"sin": "sin", "cos": "cos", "sqrt": "sqrt", "atan2": "atan2", "acos": "acos"}
+VECTOR_FUNCTIONS = {
+    "sin": "sin",
+    "cos": "cos",
+    "sqrt": "sqrt",
+    "atan2": "arctan2",
+    "acos": "arccos",
+}
+
+
+class CodePrinter(StrPrinter):
+    """Python source for SymPy expressions: float literals, ``prefix``-qualified functions."""
+
+    def __init__(self, prefix: str = "") -> None:
+        super().__init__({"order": None})
+        self.prefix = prefix
+
+    def _print_Rational(self, expr: sp.Rational) -> str:
+        return float_literal(float(expr))
+
+    def _print_Integer(self, expr: sp.Integer) -> str:
+        return float_literal(float(expr))
+
+    def _print_Float(self, expr: sp.Float) -> str:
+        return float_literal(float(expr))
+
+    def _print_Pi(self, expr: sp.Expr) -> str:
+        return float_literal(math.pi)
+
+    def _print_Mul(self, expr: sp.Mul) -> str:
+        coeff, rest = expr.as_coeff_Mul()
+        if coeff.is_Rational and not coeff.is_Integer and rest is not sp.S.One:
+            if coeff < 0:
+                return f"-{float(-coeff)!r}*{self.parenthesize(rest, 49)}"
+            return f"{float(coeff)!r}*{self.parenthesize(rest, 49)}"
+        return super()._print_Mul(expr)
+
+    def _print_Function(self, expr: sp.Function) -> str:
+        names = VECTOR_FUNCTIONS if self.prefix else SCALAR_FUNCTIONS
+        name = expr.func.__name__
+        if name not in names:
+            raise UnprintableError(name)
+        args = ", ".join(self._print(a) for a in expr.args)
+        return f"{self.prefix}{names[name]}({args})"
+
+    def _print_Pow(self, expr: sp.Pow, rational: bool = False) -> str:
+        base, exp = expr.as_base_exp()
+        if exp == sp.S.Half:
+            return f"{self.prefix}sqrt({self._print(base)})"
+        if exp.is_Integer and exp == 2 and base.is_Symbol:
+            return f"{self._print(base)}*{self._print(base)}"
+        return super()._print_Pow(expr, rational)
+
+
+def float_literal(value: float) -> str:
+    return repr(value)
+
+
+@dataclass(frozen=True)
+class Line:
+    """One line of generated code at an indentation depth (in 4-space units)."""
+
+    depth: int
+    text: str
+
+
+def assign_lines(
+    targets: tuple[sp.Symbol, ...],
+    exprs: tuple[sp.Expr, ...],
+    names: sp.utilities.iterables.numbered_symbols,
+    printer: CodePrinter,
+    depth: int,
+) -> list[Line]:
+    """CSE'd straight-line code for targets = exprs."""
+    temps, reduced = sp.cse(list(exprs), symbols=names, order="canonical")
+    lines = [Line(depth, f"{t} = {printer.doprint(e)}") for t, e in temps]
+    lines += [Line(depth, f"{t} = {printer.doprint(e)}") for t, e in zip(targets, reduced)]
+    return lines
+
+
+def cs_arguments(plan: Plan) -> str:
+    """The arguments of _fk_from_cs: c1, s1, ... for R joints, d_i for P joints, in order."""
+    out = []
+    for target, _ in plan.joint_defs:
+        name = str(target)
+        out += [f"c{name[5:]}", f"s{name[5:]}"] if name.startswith("theta") else [name]
+    return ", ".join(out)
+
+
+def same_joints(plan: Plan) -> bool:
+    """The plan's theta_i / d_i are the arm's (not a reversed chain's): q_i = theta_i - offset."""
+    assert plan.ik is not None
+    for (target, _), out in zip(plan.joint_defs, plan.ik.outputs):
+        if out.free_symbols != {target} or out.coeff(target) != 1:
+            return False
+    return True
+
+
+def match_expression(certify: str, vector: bool = False) -> str:
+    """The certification test of entries e against target t, unrolled (elementwise if vector)."""
+    rotation = () if certify == "position" else (0, 1, 2, 4, 5, 6, 8, 9, 10)
+    tests = [f"abs(e[{k}] - t[{k}]) <= tol" for k in rotation]
+    tests += [f"abs(e[{k}] - t[{k}]) <= ptol" for k in (3, 7, 11)]
+    if vector:
+        return " & ".join(f"({t})" for t in tests)
+    return " and ".join(tests)
+
+
+def step_arguments(
+    step: Solve, names: sp.utilities.iterables.numbered_symbols, printer: CodePrinter, depth: int
+) -> tuple[list[Line], list[str]]:
+    """A Solve step's note and the CSE'd temporaries of its arguments, and the arguments'
+    printed expressions (in terms of those temporaries)."""
+    arg_names = tuple(sym.named(f"arg{k}") for k in range(len(step.args)))
+    temps = assign_lines(arg_names, step.args, names, printer, depth)
+    lines = [Line(depth, f"# {step.note}")]
+    lines += [ln for ln in temps if not ln.text.startswith("arg")]
+    args = {
+        ln.text.split(" = ")[0]: ln.text.split(" = ", 1)[1]
+        for ln in temps
+        if ln.text.startswith("arg")
+    }
+    return lines, [args[str(a)] for a in arg_names]
+
+
+def world_names() -> str:
+    """The names of the world pose's 12 top entries, row by row (w11, w12, w13, wx, ...)."""
+    world = sym.world_pose()
+    return ", ".join(str(world[i, j]) for i in range(3) for j in range(4))
