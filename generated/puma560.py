@@ -43,6 +43,8 @@ centre on axis 1, a singular wrist) takes its value from q_ref (0 by default) an
 after it absorb the rest: one representative per branch.
 """
 
+from __future__ import annotations
+
 import cmath
 import math
 import sys
@@ -52,6 +54,7 @@ from math import acos, atan2, cos, sin, sqrt
 from operator import sub as _sub
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 NAME = "puma560"
 DOF = 6
@@ -161,7 +164,7 @@ def _fk_q(q):
     return _fk_from_cs(c1, s1, c2, s2, c3, s3, c4, s4, c5, s5, c6, s6)
 
 
-def fk(q):
+def fk(q: ArrayLike) -> np.ndarray:
     """World pose of the tool frame (base and tool included) for joint vector q."""
     q = _real(q, "q")
     if q.shape != (DOF,):
@@ -206,7 +209,7 @@ def _real(x, name):
         raise ValueError(f"{name} must be an array of real numbers") from None
 
 
-def fk_batch(Q):
+def fk_batch(Q: ArrayLike) -> np.ndarray:
     """World poses (N, 4, 4) for joint vectors Q of shape (N, DOF), without a Python loop."""
     Q = _real(Q, "Q")
     if Q.ndim != 2 or Q.shape[1] != DOF:
@@ -257,7 +260,15 @@ _SEAM = math.pi - _SEAM_BAND
 MAX_TURN_ROWS = 100_000
 
 
-def ik(T, *, within_limits=False, q_ref=None, tol=CERTIFY_TOL, backend=None, all_turns=False):
+def ik(
+    T: ArrayLike,
+    *,
+    within_limits: bool = False,
+    q_ref: ArrayLike | None = None,
+    tol: float = CERTIFY_TOL,
+    backend: str | None = None,
+    all_turns: bool = False,
+) -> np.ndarray:
     """All solutions for the world pose T, as an (n, DOF) array; empty (0, DOF) if unreachable.
 
     Args:
@@ -412,7 +423,14 @@ def _ik_scalar(target, qr1, qr2, qr3, qr4, qr5, qr6, tol):
     return found
 
 
-def ik_batch(T, *, q_ref=None, tol=CERTIFY_TOL, chunk=4096, backend=None):
+def ik_batch(
+    T: ArrayLike,
+    *,
+    q_ref: ArrayLike | None = None,
+    tol: float = CERTIFY_TOL,
+    chunk: int = 4096,
+    backend: str | None = None,
+) -> tuple[np.ndarray, np.ndarray]:
     """All solutions for many world poses at once, without a Python loop over poses.
 
     Args:
@@ -595,7 +613,13 @@ def _ik_candidates(T, qr1, qr2, qr3, qr4, qr5, qr6, tol):
     return Q, valid.reshape(T.shape[0], -1), retry
 
 
-def nearest(T, q_ref, *, within_limits=True, weights=None):
+def nearest(
+    T: ArrayLike,
+    q_ref: ArrayLike,
+    *,
+    within_limits: bool = True,
+    weights: ArrayLike | None = None,
+) -> np.ndarray | None:
     """The solution closest to q_ref (weighted squared joint distance), or None.
 
     With within_limits=True each revolute joint takes its value q + 2 pi k inside LIMITS
@@ -2094,7 +2118,7 @@ def _build_kernels():
     return None
 
 
-def warmup():
+def warmup() -> bool:
     """Compile (or load from numba's cache) the compiled solver now, not at the first ik:
     call it at a program's start. Returns whether the compiled solver is available."""
     kernels = _compile()

@@ -4,6 +4,8 @@ evaluate stop generation with a message instead of becoming invalid code."""
 from __future__ import annotations
 
 import ast
+import inspect
+import typing
 from dataclasses import replace
 from pathlib import Path
 
@@ -16,7 +18,7 @@ from derive.pipeline import build_plan
 from derive.plan import Solve
 from derive.spec import load_spec
 
-from conftest import ROOT
+from conftest import BUNDLED, ROOT
 
 
 def derive_imports() -> dict[str, set[str]]:
@@ -71,3 +73,16 @@ def test_an_unprintable_function_stops_generation_with_its_name(function):
     assert message.startswith("planar_2r: ") and broken.note in message
     assert f"no function {function.__name__}" in message
     assert "\n" not in message
+
+
+@pytest.mark.parametrize("name", BUNDLED)
+def test_public_functions_of_generated_modules_carry_type_hints(generated, name):
+    m = generated(name)
+    public = ["fk", "fk_batch"] + (
+        ["ik", "ik_batch", "nearest", "warmup"] if hasattr(m, "ik") else []
+    )
+    for function in public:
+        hints = typing.get_type_hints(getattr(m, function))
+        assert "return" in hints, function
+        params = inspect.signature(getattr(m, function)).parameters
+        assert set(params) <= set(hints), function
