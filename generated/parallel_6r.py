@@ -287,12 +287,11 @@ def ik(
             that does not control every pose component this is also the test that T's other
             components are reachable: if they are not, the result is empty.
         backend: "numba" runs the solver compiled (numba compiles it on the first call of a
-            process, or at warmup(), and caches the machine code beside this file), "python"
-            runs it as
-            Python; "auto" is "numba" when numba is installed; None (default): BACKEND,
-            which is "auto" unless you set it. The two agree to
-            rounding (far below tol); poses the compiled closed forms do not settle (a free
-            joint, a split multiple root) are solved in Python either way.
+            process, or at warmup(), and caches the machine code beside this file); "python"
+            runs it as Python; "auto" is "numba" when numba is installed; None (default):
+            BACKEND, which is "auto" unless you set it. The two agree to rounding (far below
+            tol); poses the compiled closed forms do not settle (a free joint, a split
+            multiple root) are solved in Python either way.
         all_turns: with within_limits, every variant of every solution inside the limits
             (all k per joint, as a product; at most MAX_TURN_ROWS rows, else ValueError).
 
