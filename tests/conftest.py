@@ -81,6 +81,17 @@ def build_module(text: str, folder: Path) -> ModuleType:
     return module
 
 
+# A user's arm (modified DH, metres, spherical wrist): the CLI and wheel tests generate it
+USER_ROWS = [
+    (0, 0, 0, 0),
+    (-90, 0.1, 0, 0),
+    (0, 0.5, 0.05, 0),
+    (-90, 0.04, 0.45, 0),
+    (90, 0, 0, 0),
+    (-90, 0, 0, 0),
+]
+
+
 def spec_text(
     name: str,
     convention: str,

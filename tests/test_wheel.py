@@ -10,20 +10,9 @@ from pathlib import Path
 
 import pytest
 
-from conftest import ROOT, spec_text
+from conftest import ROOT, USER_ROWS, spec_text
 
-USER_ARM = spec_text(
-    "wheel_arm",
-    "modified",
-    [
-        (0, 0, 0, 0),
-        (-90, 0.1, 0, 0),
-        (0, 0.5, 0.05, 0),
-        (-90, 0.04, 0.45, 0),
-        (90, 0, 0, 0),
-        (-90, 0, 0, 0),
-    ],
-)
+USER_ARM = spec_text("wheel_arm", "modified", USER_ROWS)
 
 
 def call(command: list[str], cwd: Path) -> subprocess.CompletedProcess:
