@@ -17,6 +17,8 @@ import sympy as sp
 
 from derive import kernel
 from derive import symbols as sym
+from derive.assemble import assemble, import_block
+from derive.layout import wrap_code
 from derive.plan import Assign, Plan, Solve
 from derive.printing import (
     SCALAR_FUNCTIONS,
@@ -80,7 +82,7 @@ def fk_joint_lines(plan: Plan, printer: CodePrinter, columns: bool) -> tuple[str
     """theta_i = q_i + offset with c_i, s_i (or d_i = q_i + offset) from q or from Q's columns."""
     lines = []
     for k, (target, expr) in enumerate(plan.joint_defs):
-        source = f"Q[:, {k}]" if columns else f"q[{k}]"
+        source = f"Q[..., {k}]" if columns else f"q[{k}]"
         value = printer.doprint(expr.xreplace({sym.q(k + 1): sym.named("QQ")}))
         lines.append(f"{target} = {value.replace('QQ', source)}")
         if str(target).startswith("theta"):
@@ -257,6 +259,8 @@ class PrintedModule:
     qref_names: str
     ik_batch_body: tuple[str, ...]
     kernel_body: tuple[tuple[int, str], ...]
+    kernel_buffer: int
+    kernel_reference: str
     world_names: str
     match: str
     components: str
@@ -274,6 +278,7 @@ def print_plan(plan: Plan) -> PrintedModule:
     fk_pose_body, outputs = fk_pose_lines(plan)
     ik = plan.ik
     offsets = tuple(float(e.subs(sym.q(k + 1), 0)) for k, (_, e) in enumerate(plan.joint_defs))
+    kernel_body, kernel_buffer = kernel.kernel_lines(plan, scalar) if ik else ((), 0)
     return PrintedModule(
         name=arm.name,
         digest=arm.digest,
@@ -304,7 +309,9 @@ def print_plan(plan: Plan) -> PrintedModule:
         ik_body=ik_lines(plan, scalar) if ik else (),
         qref_names=", ".join(f"qr{i}" for i in range(1, arm.dof + 1)),
         ik_batch_body=ik_batch_lines(plan, vector) if ik else (),
-        kernel_body=kernel.kernel_lines(plan, scalar) if ik else (),
+        kernel_body=kernel_body,
+        kernel_buffer=kernel_buffer,
+        kernel_reference=kernel.reference_tuple(arm.dof),
         world_names=world_names(),
         match=match_expression(ik.certify) if ik else "",
         components=ik.certify if ik else "",
@@ -363,10 +370,32 @@ def environment() -> jinja2.Environment:
 
 
 def render_module(plan: Plan) -> str:
-    """The generated Python module of an arm."""
+    """The generated Python module of an arm: the layout (module.py.j2) around the arm's
+    printed code (arm.py.j2) and the runtime routines that code uses (derive.assemble)."""
     printed = print_plan(plan)
-    return (
-        environment()
-        .get_template("module.py.j2")
-        .render(m=printed, generator=GENERATOR, regenerate=REGENERATE)
-    )
+    env = environment()
+    arm = env.get_template("arm.py.j2")
+    # the kernel's function list is part of the arm's code and follows from it: print the
+    # code once without it to find the routines it calls
+    draft = arm.render(m=printed, kernel_names="()")
+    parts = assemble(draft, bool(printed.has_ik))
+    layout = env.get_template("module.py.j2")
+    arm_code = wrap_code(arm.render(m=printed, kernel_names=_names_tuple(parts.kernel)))
+
+    def render(imports: str) -> str:
+        return layout.render(
+            m=printed,
+            generator=GENERATOR,
+            regenerate=REGENERATE,
+            imports=imports,
+            runtime=parts.runtime,
+            arm=arm_code.rstrip("\n"),
+        )
+
+    # the imports are those the module's code uses, constants included
+    return render(import_block(render("")))
+
+
+def _names_tuple(names: tuple[str, ...]) -> str:
+    """A tuple of strings as Python source, one per line."""
+    return "(\n" + "".join(f"    {name!r},\n" for name in names) + ")"

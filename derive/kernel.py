@@ -1,4 +1,5 @@
-"""The compiled kernel's solver for one pose, printed from the plan (see kernel_helpers.py.j2).
+"""The compiled kernel's solver for one pose, printed from the plan (the routines it
+calls are in derive/runtime/kernel.py).
 
 It follows the scalar solver's steps (emit.ik_lines) with fixed-size results, so that numba
 can compile it: a Solve step gives a count and values and whether the joint is free; a root
@@ -25,7 +26,7 @@ from derive.printing import (
 )
 
 
-def kernel_lines(plan: Plan, printer: CodePrinter) -> tuple[tuple[int, str], ...]:
+def kernel_lines(plan: Plan, printer: CodePrinter) -> tuple[tuple[tuple[int, str], ...], int]:
     """Body of _ksolve, the compiled kernel's solver for one pose: the scalar solver's steps
     with fixed-size results. A free joint takes its first value (from q_ref), as the scalar
     solver does; if no solution follows from it, or a root is one the closed forms cannot
@@ -44,20 +45,23 @@ def kernel_lines(plan: Plan, printer: CodePrinter) -> tuple[tuple[int, str], ...
     lines += [Line(0, "ptol = tol * REACH"), Line(0, "n = 0"), Line(0, f"t = ({world_names()})")]
     depth = 0
     checks: list[tuple[int, int]] = []
+    buffer = 0
     for step in plan.ik.steps:
         if isinstance(step, Assign):
             lines.append(Line(depth, f"# {step.note}"))
             lines += assign_lines(step.targets, step.exprs, names, printer, depth)
             continue
-        lines += kernel_solve_lines(step, names, printer, depth)
+        lines += kernel_solve_lines(step, names, printer, depth, buffer)
+        if step.kind in ("poly", "polyd"):
+            buffer += poly_slots(len(step.args) - 1)
         checks.append((depth, step.joint))
         if step.kind in ("poly", "polyd", "cs1", "cs1r"):
             depth += 1
     outputs = [printer.doprint(e) for e in plan.ik.outputs]
     if same_joints(plan):
-        lines.append(Line(depth, f"e = _kfk({cs_arguments(plan)})"))
+        lines.append(Line(depth, f"e = _fk_from_cs({cs_arguments(plan)})"))
     else:
-        lines.append(Line(depth, f"e = _kfk_q(({', '.join(outputs)},))"))
+        lines.append(Line(depth, f"e = _fk_q(({', '.join(outputs)},))"))
     lines.append(Line(depth, f"if {match_expression(plan.ik.certify)}:"))
     lines += [Line(depth + 1, f"found[n, {k}] = {v}") for k, v in enumerate(outputs)]
     lines.append(Line(depth + 1, "n += 1"))
@@ -66,14 +70,30 @@ def kernel_lines(plan: Plan, printer: CodePrinter) -> tuple[tuple[int, str], ...
         lines.append(Line(level, f"if _f{joint} and n == _m{joint}:"))
         lines.append(Line(level + 1, "return -1"))
     lines.append(Line(0, "return n"))
-    return tuple((ln.depth, ln.text) for ln in lines)
+    return tuple((ln.depth, ln.text) for ln in lines), max(buffer, 1)
+
+
+def reference_tuple(dof: int) -> str:
+    """_kreference's result: q, then the cosines and the sines of its values, as one tuple."""
+    cosines, sines = (", ".join(f"{f}(q[{k}])" for k in range(dof)) for f in ("cos", "sin"))
+    return f"q + ({cosines},) + ({sines},)"
+
+
+def poly_slots(degree: int) -> int:
+    """The scratch _kpoly takes for a polynomial of this degree (see its docstring)."""
+    return 6 * degree + 1
 
 
 def kernel_solve_lines(
-    step: Solve, names: sp.utilities.iterables.numbered_symbols, printer: CodePrinter, depth: int
+    step: Solve,
+    names: sp.utilities.iterables.numbered_symbols,
+    printer: CodePrinter,
+    depth: int,
+    at: int,
 ) -> list[Line]:
     """One Solve step of _ksolve: its values (a loop for polynomials and a c + b s = e, one
-    value otherwise), ref where the joint is free (_f{joint}), n marked before (_m{joint})."""
+    value otherwise), ref where the joint is free (_f{joint}), n marked before (_m{joint});
+    a polynomial's values at buf[at:]."""
     lines, values = step_arguments(step, names, printer, depth)
     j = step.joint
     var = f"d{j}" if step.kind == "polyd" else f"theta{j}"
@@ -83,8 +103,9 @@ def kernel_solve_lines(
     if step.kind in ("poly", "polyd"):
         angles = step.kind == "poly"
         unit = 1.0 if angles else step.unit
-        at = 32 * (j - 1)
-        call = f"_kpoly(({', '.join(values)},), {angles}, {free}, {unit!r}, buf[{at}:{at + 32}])"
+        d = len(values) - 1
+        end = at + poly_slots(d)
+        call = f"_kpoly(({', '.join(values)},), {angles}, {free}, {unit!r}, buf[{at}:{end}])"
         head = [
             f"_n{j} = {call}",
             f"_f{j} = _n{j} == -2",
@@ -93,7 +114,7 @@ def kernel_solve_lines(
             f"    buf[{at}] = {ref}",
         ]
         if angles:
-            head += [f"    buf[{at + 20}], buf[{at + 24}] = {cos_ref}, {sin_ref}"]
+            head += [f"    buf[{at + 4 * d + 1}], buf[{at + 5 * d + 1}] = {cos_ref}, {sin_ref}"]
         head += [
             f"elif _n{j} < 0:",
             "    return -1",
@@ -102,7 +123,10 @@ def kernel_solve_lines(
             f"    {var} = buf[{at} + _k{j}]",
         ]
         if angles:
-            head += [f"    c{j} = buf[{at + 20} + _k{j}]", f"    s{j} = buf[{at + 24} + _k{j}]"]
+            head += [
+                f"    c{j} = buf[{at + 4 * d + 1} + _k{j}]",
+                f"    s{j} = buf[{at + 5 * d + 1} + _k{j}]",
+            ]
     elif step.kind in ("cs1", "cs1r"):
         call = (
             f"_kcs1({', '.join(values[:3])}, {step.scale!r})"

@@ -16,7 +16,8 @@ Arm: lecture_6r, modified DH, lengths in mm, angles of the table in degrees.
     6  R     -90                0        0    q6 + 0
 
 Structure: spherical wrist at joints 4-6.
-Inverse kinematics: pieper method, case general: (r - k3)^2/(4 a1^2) + (z - k4)^2/s(alpha1)^2 = k1^2 + k2^2, degree 4 in u = tan(theta3/2).
+Inverse kinematics: pieper method, case general: (r - k3)^2/(4 a1^2) + (z - k4)^2/s(alpha1)^2 =
+k1^2 + k2^2, degree 4 in u = tan(theta3/2).
 At most 8 solutions per pose. The solver is defined on the full pose (rotation and position).
 
 Joint variables q are radians for R joints and length units for P joints. Poses are 4x4
@@ -92,172 +93,105 @@ TOOL = np.array((
 REACH = 1327.0
 _OFFSETS = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
 _REVOLUTE = (True, True, True, True, True, True)
-_PERIODS = tuple(2.0 * math.pi if r else math.inf for r in _REVOLUTE)
-
-
-def _fk_from_cs(c1, s1, c2, s2, c3, s3, c4, s4, c5, s5, c6, s6):
-    """Top three rows of the world pose, row-major, from cos and sin of the joint angles
-    (and d of prismatic joints); works on floats and on numpy arrays alike."""
-    x0 = c2*s3
-    x1 = c1*x0
-    x2 = c3*s2
-    x3 = c1*x2
-    x4 = -x1 - x3
-    x5 = c2*c3
-    x6 = c1*x5
-    x7 = s2*s3
-    x8 = -c1*x7 + x6
-    x9 = c4*x8 + s1*s4
-    x10 = s5*x9
-    x11 = c4*s1 - s4*x8
-    x12 = c5*x9 + s5*x4
-    x13 = s1*x0
-    x14 = s1*x2
-    x15 = -x13 - x14
-    x16 = s1*x5
-    x17 = -s1*x7 + x16
-    x18 = -c1*s4 + c4*x17
-    x19 = s5*x18
-    x20 = -c1*c4 - s4*x17
-    x21 = c5*x18 + s5*x15
-    x22 = s2*s3 - x5
-    x23 = -x0 - x2
-    x24 = c4*x23
-    x25 = s5*x24
-    x26 = s4*x23
-    x27 = c5*x24 + s5*x22
-    t00 = c5*x4 - x10
-    t01 = -c6*x11 + s6*x12
-    t02 = c6*x12 + s6*x11
-    t03 = 340.0*c1*c2 + 40.0*c1*s2*s3 - 30.0*c1 + 206.0*c5*x4 - 338.0*x1 - 206.0*x10 - 338.0*x3 - 40.0*x6
-    t10 = c5*x15 - x19
-    t11 = -c6*x20 + s6*x21
-    t12 = c6*x21 + s6*x20
-    t13 = 340.0*c2*s1 + 206.0*c5*x15 + 40.0*s1*s2*s3 - 30.0*s1 - 338.0*x13 - 338.0*x14 - 40.0*x16 - 206.0*x19
-    t20 = c5*x22 - x25
-    t21 = c6*x26 + s6*x27
-    t22 = c6*x27 - s6*x26
-    t23 = 206.0*c5*x22 - 340.0*s2 + 40.0*x0 + 40.0*x2 - 206.0*x25 - 338.0*x5 + 338.0*x7 + 373.0
-    return (t00, t01, t02, t03, t10, t11, t12, t13, t20, t21, t22, t23)
-
-
-def _fk_q(q):
-    """Top three rows of the world pose for one joint vector (a sequence of floats)."""
-    theta1 = q[0]
-    c1 = cos(theta1)
-    s1 = sin(theta1)
-    theta2 = q[1]
-    c2 = cos(theta2)
-    s2 = sin(theta2)
-    theta3 = q[2]
-    c3 = cos(theta3)
-    s3 = sin(theta3)
-    theta4 = q[3]
-    c4 = cos(theta4)
-    s4 = sin(theta4)
-    theta5 = q[4]
-    c5 = cos(theta5)
-    s5 = sin(theta5)
-    theta6 = q[5]
-    c6 = cos(theta6)
-    s6 = sin(theta6)
-    return _fk_from_cs(c1, s1, c2, s2, c3, s3, c4, s4, c5, s5, c6, s6)
-
-
-def fk(q: ArrayLike) -> np.ndarray:
-    """World pose of the tool frame (base and tool included) for joint vector q."""
-    q = _real(q, "q")
-    if q.shape != (DOF,):
-        raise ValueError(f"q must have shape ({DOF},), got {q.shape}")
-    e = _fk_q(q.tolist())
-    return np.array([e[0:4], e[4:8], e[8:12], (0.0, 0.0, 0.0, 1.0)])
-
-
-def _cs_columns(Q):
-    """Arguments of _fk_from_cs from joint vectors Q (..., DOF)."""
-    theta1 = Q[..., 0]
-    c1 = np.cos(theta1)
-    s1 = np.sin(theta1)
-    theta2 = Q[..., 1]
-    c2 = np.cos(theta2)
-    s2 = np.sin(theta2)
-    theta3 = Q[..., 2]
-    c3 = np.cos(theta3)
-    s3 = np.sin(theta3)
-    theta4 = Q[..., 3]
-    c4 = np.cos(theta4)
-    s4 = np.sin(theta4)
-    theta5 = Q[..., 4]
-    c5 = np.cos(theta5)
-    s5 = np.sin(theta5)
-    theta6 = Q[..., 5]
-    c6 = np.cos(theta6)
-    s6 = np.sin(theta6)
-    return (c1, s1, c2, s2, c3, s3, c4, s4, c5, s5, c6, s6,)
-
-
-def _real(x, name):
-    """x as a float64 array; ValueError for complex or non-numeric input."""
-    if type(x) is np.ndarray and x.dtype == np.float64:
-        return x
-    try:
-        a = np.asarray(x)
-        if a.dtype.kind == "c":
-            raise TypeError
-        return a.astype(float)
-    except (TypeError, ValueError):
-        raise ValueError(f"{name} must be an array of real numbers") from None
-
-
-def fk_batch(Q: ArrayLike) -> np.ndarray:
-    """World poses (N, 4, 4) for joint vectors Q of shape (N, DOF), without a Python loop."""
-    Q = _real(Q, "Q")
-    if Q.ndim != 2 or Q.shape[1] != DOF:
-        raise ValueError(f"Q must have shape (N, {DOF}), got {Q.shape}")
-    out = np.zeros((Q.shape[0], 4, 4))
-    entries = _fk_from_cs(*_cs_columns(Q))
-    for k, value in enumerate(entries):
-        out[:, k // 4, k % 4] = value
-    out[:, 3, 3] = 1.0
-    return out
-
-
 # "pose": solutions reproduce the whole pose; "position": the tool point only.
 IK_COMPONENTS = "pose"
+# the most solutions a pose can have by this derivation (ik_batch's M)
+MAX_SOLUTIONS = 8
+
+# --- routines shared by every generated module (derive/runtime) ----------------------------
+
 # the backend of ik and ik_batch calls that name none: "auto" (numba when installed),
 # "numba" or "python"
 BACKEND = "auto"
+
+
 CERTIFY_TOL = 1e-6
+
+
 POSE_TOL = 1e-6
+
+
 DEDUP_TOL = 1e-6
+
+
 _ROOT_IMAG_TOL = 1e-6
+
+
 _RESIDUAL_TOL = 1e-8
+
+
 _MERGE_TOL = 1e-6
+
+
 _CLUSTER_TOL = 1e-3
+
+
 # a cos + b sin = e with |e| up to (1 + _CLAMP_TOL) sqrt(a^2 + b^2) is solved at the boundary:
 # earlier joints from a double root (elbow stretched) carry errors of ~1e-8
 _CLAMP_TOL = 1e-7
+
+
 # ... and from |e| down to (1 - _FOLD_TOL) sqrt(a^2 + b^2) as the double root acos(+-1): there
 # the angle moves by up to acos(1 - _FOLD_TOL) ~ 1.4e-7 while the equation's residual stays
 # below _FOLD_TOL sqrt(a^2 + b^2), and every backend gives the same value (acos near +-1 turns
 # one rounding of its argument into 1e-8 of angle)
 _FOLD_TOL = 1e-14
+
+
 _LEAD_TOL = 1e-10
+
+
 _OMEGA = (1.0, complex(-0.5, math.sqrt(3.0) / 2.0), complex(-0.5, -math.sqrt(3.0) / 2.0))
+
+
 _FREE_TOL = 1e-14  # squared sizes: a joint is free below 1e-7 of its equation's scale
+
+
 # the values a free joint tries, as offsets from its preferred value: 0, +5, -5, +10, ... deg
 _FREE_STEPS = tuple(math.radians(5.0 * ((k + 1) // 2) * (1 if k % 2 else -1)) for k in range(72))
+
+
 _TWO_PI = 2.0 * math.pi
+
+
 # The seam: rounding puts a joint at pi on either side of it, and one solution would get two
 # values a full turn apart. A revolute value within _SEAM_BAND above -pi is returned as its
 # equivalent just above pi (the value is kept; only the turn changes), and one within
 # _SEAM_SNAP of pi as pi itself, in every backend: returned values lie in
 # (-pi + _SEAM_BAND, pi + _SEAM_BAND].
 _SEAM_BAND = 1e-9
+
+
 _SEAM_SNAP = 1e-12
+
+
 _SEAM = math.pi - _SEAM_BAND
+
+
 # all_turns=True returns at most this many rows (every 2 pi variant of every joint)
 MAX_TURN_ROWS = 100_000
+
+
+def fk(q: ArrayLike) -> np.ndarray:
+    """World pose of the tool frame (base and tool included) for joint vector q."""
+    values = _real(q, "q")
+    if values.shape != (DOF,):
+        raise ValueError(f"q must have shape ({DOF},), got {values.shape}")
+    e = _fk_q(values.tolist())
+    return np.array([e[0:4], e[4:8], e[8:12], (0.0, 0.0, 0.0, 1.0)])
+
+
+def fk_batch(Q: ArrayLike) -> np.ndarray:
+    """World poses (N, 4, 4) for joint vectors Q of shape (N, DOF), without a Python loop."""
+    values = _real(Q, "Q")
+    if values.ndim != 2 or values.shape[1] != DOF:
+        raise ValueError(f"Q must have shape (N, {DOF}), got {values.shape}")
+    out = np.zeros((values.shape[0], 4, 4))
+    entries = _fk_from_cs(*_cs_columns(values))
+    for k, value in enumerate(entries):
+        out[:, k // 4, k % 4] = value
+    out[:, 3, 3] = 1.0
+    return out
 
 
 def ik(
@@ -300,6 +234,7 @@ def ik(
     refs = _reference(q_ref)
     tol = _tolerance(tol)
     if within_limits:
+
         def result(rows):
             return _in_limits(rows, refs, all_turns)
     else:
@@ -327,105 +262,6 @@ def _array44(T):
     return T if T.shape == (4, 4) else None
 
 
-def _ik_scalar(target, qr1, qr2, qr3, qr4, qr5, qr6, tol):
-    """The scalar solver in Python: every certified solution of target (the 12 top entries of
-    the pose), in branch order, before wrapping and dropping repeats."""
-    (w11, w12, w13, wx, w21, w22, w23, wy, w31, w32, w33, wz) = target
-    found = []
-    # flange target 0_nT = (B X0 Tz(d1))^-1 T (Tz(dn) Xn E)^-1
-    r11 = w13
-    r12 = -w12
-    r13 = w11
-    px = -206.0*w11 + wx
-    r21 = w23
-    r22 = -w22
-    r23 = w21
-    py = -206.0*w21 + wy
-    r31 = w33
-    r32 = -w32
-    r33 = w31
-    pz = -206.0*w31 + wz - 373.0
-    # wrist centre (x, y, z) = 0P_4org and r = x^2 + y^2 + z^2
-    x = px
-    y = py
-    z = pz
-    r = px*px + py*py + pz*pz
-    # theta3: Pieper general case, polynomial of degree 4 in u = tan(theta3/2); free when it vanishes identically
-    x0 = r*r
-    x1 = z*z
-    x2 = x0 + 3600.0*x1
-    x3 = 919360.0*r
-    _n3 = len(found)
-    for theta3 in (_v3 := _poly_angles((-519088.0*r + x2 + 66431969536.0, x3 - 236959523840.0, -929376.0*r + 2.0*x0 + 7200.0*x1 + 316127094272.0, x3 - 186946339840.0, -410288.0*r + x2 + 41348782336.0,), qr3, 20.845498492269137)):
-        c3 = cos(theta3)
-        s3 = sin(theta3)
-        # theta2: r and z equations, linear in (c2, s2)
-        _n2 = len(found)
-        for theta2 in (_v2 := _cs2(2400.0*c3 + 20280.0*s3 - 20400.0, 20280.0*c3 - 2400.0*s3, 27200.0*c3 + r + 229840.0*s3 - 232344.0, -338.0*c3 + 40.0*s3, 40.0*c3 + 338.0*s3 - 340.0, z, 33570240.0, 0.0, qr2)):
-            c2 = cos(theta2)
-            s2 = sin(theta2)
-            # g1(theta2, theta3), g2(theta2, theta3)
-            g1 = -40.0*c2*c3 - 338.0*c2*s3 + 340.0*c2 - 338.0*c3*s2 + 40.0*s2*s3 - 30.0
-            g2 = 0.0
-            # theta1: x = c1 g1 - s1 g2, y = s1 g1 + c1 g2; free with the wrist centre on axis 1
-            _n1 = len(found)
-            for theta1 in (_v1 := _cs2(g1, -g2, x, g2, g1, y, 559504.0, 559504.0, qr1)):
-                c1 = cos(theta1)
-                s1 = sin(theta1)
-                # wrist W = (0_3R Rx(alpha3))^T 0_6R = Rz(t4) Rx(alpha4) Rz(t5) Rx(alpha5) Rz(t6)
-                x4 = c2*s3
-                x5 = c3*s2
-                x6 = -x4 - x5
-                x7 = c2*c3
-                x8 = s2*s3
-                x9 = c1*x7 - c1*x8
-                x10 = s1*x7 - s1*x8
-                x11 = s2*s3 - x7
-                x12 = -c1*x4 - c1*x5
-                x13 = -s1*x4 - s1*x5
-                W11 = r11*x9 + r21*x10 + r31*x6
-                W12 = r12*x9 + r22*x10 + r32*x6
-                W13 = r13*x9 + r23*x10 + r33*x6
-                W21 = -c1*r21 + r11*s1
-                W22 = -c1*r22 + r12*s1
-                W23 = -c1*r23 + r13*s1
-                W31 = r11*x12 + r21*x13 + r31*x11
-                W32 = r12*x12 + r22*x13 + r32*x11
-                W33 = r13*x12 + r23*x13 + r33*x11
-                # theta5: W33 = e3^T Rx(alpha4) Rz(theta5) Rx(alpha5) e3
-                _n5 = len(found)
-                for theta5 in (_v5 := _cs1(1.0, 0.0, W33, 0.0, 0.0)):
-                    c5 = cos(theta5)
-                    s5 = sin(theta5)
-                    # v = Rx(alpha4) Rz(theta5) Rx(alpha5) e3
-                    v1 = -s5
-                    v2 = 0.0
-                    # theta4: (W13, W23) = Rz(theta4) (v1, v2); free at a singular wrist
-                    _n4 = len(found)
-                    for theta4 in (_v4 := _cs2(v1, -v2, W13, v2, v1, W23, 1.0, 1.0, qr4)):
-                        c4 = cos(theta4)
-                        s4 = sin(theta4)
-                        # theta6: Rz(theta6) = (Rx(alpha4) Rz(theta5) Rx(alpha5))^T Rz(theta4)^T W
-                        _n6 = len(found)
-                        for theta6 in (_v6 := _atan2(-W11*s4 + W21*c4, W11*c4*c5 + W21*c5*s4 + W31*s5, qr6)):
-                            c6 = cos(theta6)
-                            s6 = sin(theta6)
-                            _keep(found, target, (theta1, theta2, theta3, theta4, theta5, theta6,), _fk_from_cs(c1, s1, c2, s2, c3, s3, c4, s4, c5, s5, c6, s6), tol)
-                            if _v6.__class__ is _Free and len(found) > _n6:
-                                break
-                        if _v4.__class__ is _Free and len(found) > _n4:
-                            break
-                    if _v5.__class__ is _Free and len(found) > _n5:
-                        break
-                if _v1.__class__ is _Free and len(found) > _n1:
-                    break
-            if _v2.__class__ is _Free and len(found) > _n2:
-                break
-        if _v3.__class__ is _Free and len(found) > _n3:
-            break
-    return found
-
-
 def ik_batch(
     T: ArrayLike,
     *,
@@ -446,7 +282,7 @@ def ik_batch(
             give ik's solutions.
 
     Returns:
-        (Q, valid): Q (N, M, DOF) with M = 8, the most solutions a pose can
+        (Q, valid): Q (N, M, DOF) with M = MAX_SOLUTIONS, the most solutions a pose can
         have; valid (N, M) marks the slots that hold a solution: for each pose the first
         slots, holding the rows ik returns, in the same order; the other slots are zero.
         within_limits is not offered here. Poses the closed forms alone do not settle (a
@@ -467,8 +303,8 @@ def ik_batch(
     n = T.shape[0]
     # np.full writes its memory here: np.zeros would leave the page faults to the kernel's
     # threads, which contend for them (about a third of the kernel's time)
-    Q = np.full((n, 8, DOF), 0.0)
-    valid = np.full((n, 8), False)
+    Q = np.full((n, MAX_SOLUTIONS, DOF), 0.0)
+    valid = np.full((n, MAX_SOLUTIONS), False)
     retry = np.zeros(n, dtype=bool)
     with _BATCH_LOCK:  # numba's default thread pool must not be entered twice at once
         kernels[0](T, float(tol), refs, Q, valid, retry)
@@ -480,13 +316,13 @@ def ik_batch(
 def _ik_batch_numpy(T, q_ref, tol, chunk):
     """ik_batch's numpy backend: chunks of poses, every branch along its own array axis."""
     T, good = _vpose(T)
-    qr1, qr2, qr3, qr4, qr5, qr6, = _reference(q_ref)
+    refs = _reference(q_ref)
     n = T.shape[0]
-    Q = np.zeros((n, 8, DOF))
-    valid = np.zeros((n, 8), dtype=bool)
+    Q = np.zeros((n, MAX_SOLUTIONS, DOF))
+    valid = np.zeros((n, MAX_SOLUTIONS), dtype=bool)
     for start in range(0, n, chunk):
         part = slice(start, min(n, start + chunk))
-        cand, ok, retry = _ik_candidates(T[part], qr1, qr2, qr3, qr4, qr5, qr6, tol)
+        cand, ok, retry = _ik_candidates(T[part], *refs, tol)
         Q[part], valid[part] = _vfinish(cand, ok & good[part, None])
         for i in start + np.flatnonzero(retry & good[part]):
             # a free joint whose first value left a branch without solution (rare): the
@@ -497,127 +333,9 @@ def _ik_batch_numpy(T, q_ref, tol, chunk):
 
 def _settle(Q, valid, i, sols):
     """Pose i's slots set to the rows sols."""
-    sols = sols[:8]
+    sols = sols[:MAX_SOLUTIONS]
     Q[i], valid[i] = 0.0, False
-    Q[i, :len(sols)], valid[i, :len(sols)] = sols, True
-
-
-def _ik_candidates(T, qr1, qr2, qr3, qr4, qr5, qr6, tol):
-    """Every branch of the solution for poses T (n, 4, 4): (n, M, DOF) values, (n, M)
-    validity, certified by forward kinematics (tol as for ik), and (n,) the poses to retry
-    with the scalar solver (a free joint's value left its branch without solution)."""
-    shape = (T.shape[0],) + (1,) * 6
-    w11 = T[:, 0, 0].reshape(shape)
-    w12 = T[:, 0, 1].reshape(shape)
-    w13 = T[:, 0, 2].reshape(shape)
-    wx = T[:, 0, 3].reshape(shape)
-    w21 = T[:, 1, 0].reshape(shape)
-    w22 = T[:, 1, 1].reshape(shape)
-    w23 = T[:, 1, 2].reshape(shape)
-    wy = T[:, 1, 3].reshape(shape)
-    w31 = T[:, 2, 0].reshape(shape)
-    w32 = T[:, 2, 1].reshape(shape)
-    w33 = T[:, 2, 2].reshape(shape)
-    wz = T[:, 2, 3].reshape(shape)
-    valid = np.ones(shape, dtype=bool)
-    # flange target 0_nT = (B X0 Tz(d1))^-1 T (Tz(dn) Xn E)^-1
-    r11 = w13
-    r12 = -w12
-    r13 = w11
-    px = -206.0*w11 + wx
-    r21 = w23
-    r22 = -w22
-    r23 = w21
-    py = -206.0*w21 + wy
-    r31 = w33
-    r32 = -w32
-    r33 = w31
-    pz = -206.0*w31 + wz - 373.0
-    # wrist centre (x, y, z) = 0P_4org and r = x^2 + y^2 + z^2
-    x = px
-    y = py
-    z = pz
-    r = px*px + py*py + pz*pz
-    # theta3: Pieper general case, polynomial of degree 4 in u = tan(theta3/2); free when it vanishes identically
-    x0 = r*r
-    x1 = z*z
-    x2 = x0 + 3600.0*x1
-    x3 = 919360.0*r
-    theta3, ok, free1 = _vpoly((-519088.0*r + x2 + 66431969536.0, x3 - 236959523840.0, -929376.0*r + 2.0*x0 + 7200.0*x1 + 316127094272.0, x3 - 186946339840.0, -410288.0*r + x2 + 41348782336.0,), 1, valid, True, qr3, 20.845498492269137)
-    valid = valid & ok
-    free1 = free1 & valid
-    c3 = np.cos(theta3)
-    s3 = np.sin(theta3)
-    # theta2: r and z equations, linear in (c2, s2)
-    theta2, ok, free2 = _vcs2(2400.0*c3 + 20280.0*s3 - 20400.0, 20280.0*c3 - 2400.0*s3, 27200.0*c3 + r + 229840.0*s3 - 232344.0, -338.0*c3 + 40.0*s3, 40.0*c3 + 338.0*s3 - 340.0, z, 33570240.0, 0.0, qr2, 2, valid)
-    valid = valid & ok
-    free2 = free2 & valid
-    c2 = np.cos(theta2)
-    s2 = np.sin(theta2)
-    # g1(theta2, theta3), g2(theta2, theta3)
-    g1 = -40.0*c2*c3 - 338.0*c2*s3 + 340.0*c2 - 338.0*c3*s2 + 40.0*s2*s3 - 30.0
-    g2 = 0.0
-    # theta1: x = c1 g1 - s1 g2, y = s1 g1 + c1 g2; free with the wrist centre on axis 1
-    theta1, ok, free3 = _vcs2(g1, -g2, x, g2, g1, y, 559504.0, 559504.0, qr1, 3, valid)
-    valid = valid & ok
-    free3 = free3 & valid
-    c1 = np.cos(theta1)
-    s1 = np.sin(theta1)
-    # wrist W = (0_3R Rx(alpha3))^T 0_6R = Rz(t4) Rx(alpha4) Rz(t5) Rx(alpha5) Rz(t6)
-    x4 = c2*s3
-    x5 = c3*s2
-    x6 = -x4 - x5
-    x7 = c2*c3
-    x8 = s2*s3
-    x9 = c1*x7 - c1*x8
-    x10 = s1*x7 - s1*x8
-    x11 = s2*s3 - x7
-    x12 = -c1*x4 - c1*x5
-    x13 = -s1*x4 - s1*x5
-    W11 = r11*x9 + r21*x10 + r31*x6
-    W12 = r12*x9 + r22*x10 + r32*x6
-    W13 = r13*x9 + r23*x10 + r33*x6
-    W21 = -c1*r21 + r11*s1
-    W22 = -c1*r22 + r12*s1
-    W23 = -c1*r23 + r13*s1
-    W31 = r11*x12 + r21*x13 + r31*x11
-    W32 = r12*x12 + r22*x13 + r32*x11
-    W33 = r13*x12 + r23*x13 + r33*x11
-    # theta5: W33 = e3^T Rx(alpha4) Rz(theta5) Rx(alpha5) e3
-    theta5, ok, free4 = _vcs1(1.0, 0.0, W33, 0.0, 0.0, 4, valid)
-    valid = valid & ok
-    free4 = free4 & valid
-    c5 = np.cos(theta5)
-    s5 = np.sin(theta5)
-    # v = Rx(alpha4) Rz(theta5) Rx(alpha5) e3
-    v1 = -s5
-    v2 = 0.0
-    # theta4: (W13, W23) = Rz(theta4) (v1, v2); free at a singular wrist
-    theta4, ok, free5 = _vcs2(v1, -v2, W13, v2, v1, W23, 1.0, 1.0, qr4, 5, valid)
-    valid = valid & ok
-    free5 = free5 & valid
-    c4 = np.cos(theta4)
-    s4 = np.sin(theta4)
-    # theta6: Rz(theta6) = (Rx(alpha4) Rz(theta5) Rx(alpha5))^T Rz(theta4)^T W
-    theta6, ok, free6 = _vatan2(-W11*s4 + W21*c4, W11*c4*c5 + W21*c5*s4 + W31*s5, qr6, 6, valid)
-    valid = valid & ok
-    free6 = free6 & valid
-    c6 = np.cos(theta6)
-    s6 = np.sin(theta6)
-    Q = np.stack((np.broadcast_to(theta1, valid.shape), np.broadcast_to(theta2, valid.shape), np.broadcast_to(theta3, valid.shape), np.broadcast_to(theta4, valid.shape), np.broadcast_to(theta5, valid.shape), np.broadcast_to(theta6, valid.shape)), axis=-1)
-    e = _fk_from_cs(c1, s1, c2, s2, c3, s3, c4, s4, c5, s5, c6, s6)
-    Q = Q.reshape(T.shape[0], -1, DOF)
-    t = (w11, w12, w13, wx, w21, w22, w23, wy, w31, w32, w33, wz)
-    ptol = tol * REACH
-    valid = valid & (abs(e[0] - t[0]) <= tol) & (abs(e[1] - t[1]) <= tol) & (abs(e[2] - t[2]) <= tol) & (abs(e[4] - t[4]) <= tol) & (abs(e[5] - t[5]) <= tol) & (abs(e[6] - t[6]) <= tol) & (abs(e[8] - t[8]) <= tol) & (abs(e[9] - t[9]) <= tol) & (abs(e[10] - t[10]) <= tol) & (abs(e[3] - t[3]) <= ptol) & (abs(e[7] - t[7]) <= ptol) & (abs(e[11] - t[11]) <= ptol)
-    retry = np.zeros(T.shape[0], dtype=bool)
-    retry |= (free1 & ~valid.any(axis=(2, 3, 4, 5, 6), keepdims=True)).reshape(T.shape[0], -1).any(axis=1)
-    retry |= (free2 & ~valid.any(axis=(3, 4, 5, 6), keepdims=True)).reshape(T.shape[0], -1).any(axis=1)
-    retry |= (free3 & ~valid.any(axis=(4, 5, 6), keepdims=True)).reshape(T.shape[0], -1).any(axis=1)
-    retry |= (free4 & ~valid.any(axis=(5, 6), keepdims=True)).reshape(T.shape[0], -1).any(axis=1)
-    retry |= (free5 & ~valid.any(axis=(6,), keepdims=True)).reshape(T.shape[0], -1).any(axis=1)
-    retry |= (free6 & ~valid).reshape(T.shape[0], -1).any(axis=1)
-    return Q, valid.reshape(T.shape[0], -1), retry
+    Q[i, : len(sols)], valid[i, : len(sols)] = sols, True
 
 
 def nearest(
@@ -652,9 +370,6 @@ def nearest(
     return sols[pick(sols, refs, w, not within_limits)]
 
 
-_ONES = np.ones(DOF)
-
-
 def _pose(T):
     """The 12 top entries of a validated pose, as floats (plain Python: this is the hot path)."""
     if type(T) is np.ndarray and T.shape == (4, 4) and T.dtype == np.float64:
@@ -672,65 +387,22 @@ def _pose(T):
     if max(abs(v[12]), abs(v[13]), abs(v[14]), abs(v[15] - 1.0)) > POSE_TOL:
         raise ValueError("T's last row must be [0, 0, 0, 1]")
     a, b, c = v[0:3], v[4:7], v[8:11]
-    worst = max(abs(a[0] * a[0] + a[1] * a[1] + a[2] * a[2] - 1.0),
-                abs(b[0] * b[0] + b[1] * b[1] + b[2] * b[2] - 1.0),
-                abs(c[0] * c[0] + c[1] * c[1] + c[2] * c[2] - 1.0),
-                abs(a[0] * b[0] + a[1] * b[1] + a[2] * b[2]),
-                abs(a[0] * c[0] + a[1] * c[1] + a[2] * c[2]),
-                abs(b[0] * c[0] + b[1] * c[1] + b[2] * c[2]))
-    det = (a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0])
-           + a[2] * (b[0] * c[1] - b[1] * c[0]))
+    worst = max(
+        abs(a[0] * a[0] + a[1] * a[1] + a[2] * a[2] - 1.0),
+        abs(b[0] * b[0] + b[1] * b[1] + b[2] * b[2] - 1.0),
+        abs(c[0] * c[0] + c[1] * c[1] + c[2] * c[2] - 1.0),
+        abs(a[0] * b[0] + a[1] * b[1] + a[2] * b[2]),
+        abs(a[0] * c[0] + a[1] * c[1] + a[2] * c[2]),
+        abs(b[0] * c[0] + b[1] * c[1] + b[2] * c[2]),
+    )
+    det = (
+        a[0] * (b[1] * c[2] - b[2] * c[1])
+        - a[1] * (b[0] * c[2] - b[2] * c[0])
+        + a[2] * (b[0] * c[1] - b[1] * c[0])
+    )
     if worst > POSE_TOL or det < 0.0:
         raise ValueError(f"T's rotation is not orthonormal within {POSE_TOL}")
     return tuple(v[:12])
-
-
-def _reference(q_ref, required=False):
-    """q_ref as a tuple of DOF floats (zeros for None unless required)."""
-    if q_ref is None and not required:
-        return _ZEROS
-    if type(q_ref) is tuple and len(q_ref) == DOF and all(type(x) is float for x in q_ref):
-        values = q_ref
-    else:
-        try:
-            a = _real(q_ref, "q_ref")
-        except ValueError:
-            a = None
-        if a is None or a.shape != (DOF,):
-            shape = "" if a is None else f", got shape {a.shape}"
-            raise ValueError(f"q_ref must be {DOF} finite real numbers, shape ({DOF},){shape}")
-        values = tuple(a.tolist())
-    if not all(map(math.isfinite, values)):
-        raise ValueError(f"q_ref must be {DOF} finite real numbers, got {values}")
-    return values
-
-
-_ZEROS = (0.0,) * DOF
-
-
-def _tolerance(tol):
-    """tol as a float, if it is a positive finite number."""
-    if type(tol) is float and 0.0 < tol < math.inf:
-        return tol
-    try:
-        value = float(tol)
-    except (TypeError, ValueError):
-        value = math.nan
-    if type(tol) is bool or not (0.0 < value < math.inf):
-        raise ValueError(f"tol must be a positive finite number, got {tol!r}")
-    return value
-
-
-def _keep(found, t, q, e, tol):
-    """Append q if its forward kinematics e reproduces the target t (certification)."""
-    ptol = tol * REACH
-    if abs(e[0] - t[0]) <= tol and abs(e[1] - t[1]) <= tol and abs(e[2] - t[2]) <= tol and abs(e[4] - t[4]) <= tol and abs(e[5] - t[5]) <= tol and abs(e[6] - t[6]) <= tol and abs(e[8] - t[8]) <= tol and abs(e[9] - t[9]) <= tol and abs(e[10] - t[10]) <= tol and abs(e[3] - t[3]) <= ptol and abs(e[7] - t[7]) <= ptol and abs(e[11] - t[11]) <= ptol:
-        found.append(q)
-
-
-def _wrap(x):
-    w = math.remainder(x, _TWO_PI)
-    return math.pi if w <= -math.pi else w
 
 
 def _finish(found):
@@ -740,27 +412,22 @@ def _finish(found):
     Repeats are found by comparing the last joint first, then all joints; the first of
     equal candidates is kept.
     """
-    rows = []
+    rows: list[tuple[float, ...]] = []
     for q in found:
         q = tuple(map(math.remainder, q, _PERIODS))
         if max(map(abs, q)) > _SEAM:
-            q = tuple(_seam(x) if abs(x) > _SEAM and p != math.inf else x
-                      for x, p in zip(q, _PERIODS))
+            q = tuple(
+                _seam(x) if abs(x) > _SEAM and p != math.inf else x for x, p in zip(q, _PERIODS)
+            )
         for p in rows:
-            if (abs(math.remainder(q[-1] - p[-1], _PERIODS[-1])) <= DEDUP_TOL
-                    and max(map(abs, map(math.remainder, map(_sub, q, p), _PERIODS))) <= DEDUP_TOL):
+            if (
+                abs(math.remainder(q[-1] - p[-1], _PERIODS[-1])) <= DEDUP_TOL
+                and max(map(abs, map(math.remainder, map(_sub, q, p), _PERIODS))) <= DEDUP_TOL
+            ):
                 break
         else:
             rows.append(q)
     return rows
-
-
-def _seam(x):
-    """A wrapped revolute value near +-pi: above pi if it is within _SEAM_BAND above -pi, pi
-    itself within _SEAM_SNAP of pi."""
-    if x < 0.0:
-        x += _TWO_PI
-    return math.pi if abs(x - math.pi) <= _SEAM_SNAP else x
 
 
 def _as_rows(rows):
@@ -791,20 +458,17 @@ def _every_turn(rows):
     options = [_turns(q) for q in rows]
     total = sum(math.prod(len(o) for o in opts) for opts in options)
     if total > MAX_TURN_ROWS:
-        raise ValueError(f"all_turns: the limits allow {total} variants of the solutions; "
-                         f"at most MAX_TURN_ROWS = {MAX_TURN_ROWS} are returned")
+        raise ValueError(
+            f"all_turns: the limits allow {total} variants of the solutions; "
+            f"at most MAX_TURN_ROWS = {MAX_TURN_ROWS} are returned"
+        )
     out = []
     for opts in options:
-        combos = [()]
+        combos: list[tuple[float, ...]] = [()]
         for values in opts:
-            combos = [c + (v,) for c in combos for v in values]
+            combos = [(*c, v) for c in combos for v in values]
         out += combos if opts else []
     return _as_rows(out)
-
-
-_REV = np.array([1.0 if r else 0.0 for r in _REVOLUTE])
-_LOWER = np.array([lo - 1e-12 for lo, _ in LIMITS])
-_UPPER = np.array([hi + 1e-12 for _, hi in LIMITS])
 
 
 def _turn_range(x, lo, hi):
@@ -820,833 +484,201 @@ def _turns(q):
     options = []
     for x, r, (lo, hi) in zip(q, _REVOLUTE, LIMITS):
         first, last = _turn_range(x, lo, hi) if r else (0, 0)
-        if not r and not lo - 1e-12 <= x <= hi + 1e-12 or first > last:
+        if (not r and not lo - 1e-12 <= x <= hi + 1e-12) or first > last:
             return []
         if math.isinf(first) or math.isinf(last):
             options.append([x])
             continue
         if last - first >= MAX_TURN_ROWS:
-            raise ValueError(f"all_turns: joint limits allow more than MAX_TURN_ROWS = "
-                             f"{MAX_TURN_ROWS} turns")
+            raise ValueError(
+                f"all_turns: joint limits allow more than MAX_TURN_ROWS = {MAX_TURN_ROWS} turns"
+            )
         options.append(sorted((x + k * _TWO_PI for k in range(first, last + 1)), key=abs))
     return options
 
 
-class _Free(tuple):
-    """The values a free joint tries, first the preferred one, then 5 degree steps out from
-    it in both directions. The solver stops at the first value that gives a certified
-    solution: a later joint may not reach from every value (a wrist whose twists are not
-    +-90 deg reaches only part of the orientations)."""
+_compiled = None
 
 
-def _free(t):
-    return _Free([t + step for step in _FREE_STEPS])
+_BATCH_LOCK = threading.Lock()
 
 
-def _cs1(a, b, e, scale=0.0, ref=0.0):
-    """Angles t with a cos t + b sin t = e: atan2(b, a) +- acos(e / sqrt(a^2 + b^2)), the
-    acos argument clamped when it exceeds 1 by at most _CLAMP_TOL, and taken as +-1 within
-    _FOLD_TOL below (the double root).
+_COMPILE_LOCK = threading.Lock()
 
-    When a^2 + b^2 and e^2 are both at most _FREE_TOL * scale the equation holds for every
-    t (the angle is free; e.g. the elbow folded onto axis 1): _free(ref).
+
+def _kernels(backend):
+    """The compiled (_kbatch, _kone) for a backend argument, or None for the Python solver."""
+    if backend is None:
+        backend = BACKEND
+    if backend == "python":
+        return None
+    if backend not in ("auto", "numba"):
+        raise ValueError(f"backend must be 'auto', 'numba' or 'python', got {backend!r}")
+    kernels = _compile()
+    if kernels is None and backend == "numba":
+        raise ImportError("backend='numba' needs numba (pip install numba)")
+    return kernels
+
+
+def _compile():
+    """(_kbatch, _kone, _kpick) compiled by numba, once per process; None without numba."""
+    global _compiled
+    if _compiled is not None:  # the hot path: no lock
+        return _compiled or None
+    with _COMPILE_LOCK:
+        if _compiled is None:
+            _compiled = _build_kernels() or False
+    return _compiled or None
+
+
+def _build_kernels():
+    """The kernel functions compiled by numba as copies that call each other in a namespace of
+    their own, so that this module's functions stay Python whatever ran before.
+
+    The namespace is registered as the module _KERNEL_SPACE: numba reloads machine code
+    from its cache (in __pycache__ beside this file, when that folder is writable) only for
+    functions whose module it can import by name, and this file may have been imported by
+    path under any name.
     """
-    rho = sqrt(a * a + b * b)
-    if rho * rho <= _FREE_TOL * scale:
-        return _free(ref) if e * e <= _FREE_TOL * scale else ()
-    if rho == 0.0:
-        return ()
-    ratio = e / rho
-    if abs(ratio) > 1.0 + _CLAMP_TOL:
-        return ()
-    base = atan2(b, a)
-    if abs(ratio) >= 1.0 - _FOLD_TOL:
-        delta = 0.0 if ratio > 0.0 else math.pi
+    try:
+        import numba
+    except ImportError:
+        return None
+    space = sys.modules.get(_KERNEL_SPACE)
+    if space is None or getattr(space, "_KERNEL_SOURCE", None) != __file__:
+        space = types.ModuleType(_KERNEL_SPACE)
+        sys.modules[_KERNEL_SPACE] = space
+    for cache in (True, False):
+        names = space.__dict__
+        names.update({k: v for k, v in globals().items() if not k.startswith("__")})
+        names.update(_prange=numba.prange, _KERNEL_SOURCE=__file__)
+        try:
+            for name in _KERNEL:
+                python = globals()[name]
+                copy = types.FunctionType(
+                    python.__code__, names, python.__name__, python.__defaults__, python.__closure__
+                )
+                copy.__qualname__ = python.__qualname__
+                fast = set() if name in _KSTRICT else _FASTMATH
+                names[name] = numba.njit(
+                    fastmath=fast,
+                    parallel=name == "_kbatch",
+                    cache=cache,
+                    nogil=True,
+                    error_model="numpy",
+                )(copy)
+            return names["_kbatch"], names["_kone"], names["_kpick"]
+        except RuntimeError:  # no cache where numba cannot write one: compile without
+            continue
+    return None
+
+
+def warmup() -> bool:
+    """Compile (or load from numba's cache) the compiled solver now, not at the first ik:
+    call it at a program's start. Returns whether the compiled solver is available."""
+    kernels = _compile()
+    if kernels is None:
+        return False
+    T = fk(_ZEROS)
+    ik(T, backend="numba")
+    ik_batch(T[None], backend="numba")
+    kernels[2](np.zeros((1, DOF)), _ZEROS, _ONES, True)
+    return True
+
+
+_PERIODS = tuple(2.0 * math.pi if r else math.inf for r in _REVOLUTE)
+
+
+def _real(x: object, name: str) -> np.ndarray:
+    """x as a float64 array; ValueError for complex or non-numeric input."""
+    if type(x) is np.ndarray and x.dtype == np.float64:
+        return x
+    try:
+        a = np.asarray(x)
+        if a.dtype.kind == "c":
+            raise TypeError
+        return a.astype(float)
+    except (TypeError, ValueError):
+        raise ValueError(f"{name} must be an array of real numbers") from None
+
+
+_ONES = np.ones(DOF)
+
+
+def _reference(q_ref: object, required: bool = False) -> tuple[float, ...]:
+    """q_ref as a tuple of DOF floats (zeros for None unless required)."""
+    if q_ref is None and not required:
+        return _ZEROS
+    if type(q_ref) is tuple and len(q_ref) == DOF and all(type(x) is float for x in q_ref):
+        values = q_ref
     else:
-        delta = acos(ratio)
-    return (base + delta, base - delta)
+        try:
+            a = _real(q_ref, "q_ref")
+        except ValueError:
+            a = None
+        if a is None or a.shape != (DOF,):
+            shape = "" if a is None else f", got shape {a.shape}"
+            raise ValueError(f"q_ref must be {DOF} finite real numbers, shape ({DOF},){shape}")
+        values = tuple(a.tolist())
+    if not all(map(math.isfinite, values)):
+        raise ValueError(f"q_ref must be {DOF} finite real numbers, got {values}")
+    return values
 
 
-def _cs1_reach(a, b, e, m00, m01, m02, m10, m11, m12, m20, m21, m22, lo, hi, scale, ref):
-    """As _cs1; a free t starts at the first value _reach_first1 finds (the next joint must
-    still let the wrist reach)."""
-    rho = sqrt(a * a + b * b)
-    if rho * rho > _FREE_TOL * scale or e * e > _FREE_TOL * scale:
-        return _cs1(a, b, e, scale, ref)
-    return _free(_reach_first1(m00, m01, m02, m10, m11, m12, m20, m21, m22, lo, hi, ref))
+_ZEROS = (0.0,) * DOF
 
 
-def _cs2(a1, b1, e1, a2, b2, e2, det_scale, rhs_scale, ref):
-    """The angle t with a1 c + b1 s = e1 and a2 c + b2 s = e2; ref where t is free.
+def _tolerance(tol: float) -> float:
+    """tol as a float, if it is a positive finite number."""
+    if type(tol) is float and 0.0 < tol < math.inf:
+        return tol
+    try:
+        value = float(tol)
+    except (TypeError, ValueError):
+        value = math.nan
+    if type(tol) is bool or not (0.0 < value < math.inf):
+        raise ValueError(f"tol must be a positive finite number, got {tol!r}")
+    return value
 
-    t is free when the system is singular or, for a consistent system, when its right-hand
-    side vanishes (then so does the determinant, up to the errors of earlier joints).
-    """
-    det = a1 * b2 - a2 * b1
-    if abs(det) <= _FREE_TOL * det_scale or e1 * e1 + e2 * e2 <= _FREE_TOL * rhs_scale:
-        return _free(ref)
-    return (atan2((a1 * e2 - a2 * e1) / det, (e1 * b2 - b1 * e2) / det),)
 
+def _wrap(x: float) -> float:
+    w = math.remainder(x, _TWO_PI)
+    return math.pi if w <= -math.pi else w
 
-def _cs2_reach(a1, b1, e1, a2, b2, e2, det_scale, rhs_scale, A, B, C, lo, hi, ref):
-    """As _cs2; a free t starts at _reach_first2's value (reachability of later joints)."""
-    det = a1 * b2 - a2 * b1
-    if abs(det) > _FREE_TOL * det_scale and e1 * e1 + e2 * e2 > _FREE_TOL * rhs_scale:
-        return (atan2((a1 * e2 - a2 * e1) / det, (e1 * b2 - b1 * e2) / det),)
-    return _free(_reach_first2(A, B, C, lo, hi, ref))
 
+def _seam(x: float) -> float:
+    """A wrapped revolute value near +-pi: above pi if it is within _SEAM_BAND above -pi, pi
+    itself within _SEAM_SNAP of pi."""
+    if x < 0.0:
+        x += _TWO_PI
+    return math.pi if abs(x - math.pi) <= _SEAM_SNAP else x
 
-def _atan2(y, x, ref):
-    """atan2(y, x), or ref when both vanish (the angle is free)."""
-    if abs(y) + abs(x) <= 1e-12:
-        return _free(ref)
-    return (atan2(y, x),)
 
+_REV = np.array([1.0 if r else 0.0 for r in _REVOLUTE])
 
 
-def _poly_real(coeffs, ref=0.0, free=0.0, unit=1.0):
-    """Real roots of the polynomial (highest degree first), polished, ascending, distinct;
-    (ref,) when every coefficient is at most `free` (the polynomial vanishes: d is free).
+_LOWER = np.array([lo - 1e-12 for lo, _ in LIMITS])
 
-    The roots are found for x / unit, unit being the arm's length, so that coefficients of a
-    polynomial in a length are compared at their proper scale (a constant leading coefficient
-    is small beside r^2 in metres squared to the fourth, yet never negligible).
-    """
-    c = [float(x) for x in coeffs]
-    scale = max(abs(x) for x in c)
-    if scale <= free:
-        return (ref,)
-    if scale == 0.0:
-        return ()
-    n = len(c) - 1
-    c = [x * unit ** (n - k) for k, x in enumerate(c)]
-    scale = max(abs(x) for x in c)
-    while len(c) > 1 and abs(c[0]) <= _LEAD_TOL * scale:
-        c.pop(0)
-    if len(c) < 2:
-        return ()
-    roots = sorted(_real_roots(c))
-    out = []
-    for x in roots:
-        if not out or abs(x - out[-1]) > 1e-12 * (1.0 + abs(x)):
-            out.append(x)
-    return [x * unit for x in out]
 
-
-def _poly_angles(coeffs, ref=0.0, free=0.0):
-    """Angles t whose u = tan(t/2) is a real root of the polynomial (highest degree first).
-
-    The polynomial is solved in u, or in v = 1/u when its last coefficient is the larger
-    end, so that a vanishing leading coefficient (a root at u = infinity, t = pi; ALGORITHMS.md
-    2.4) is an ordinary root v = 0. When both ends vanish (below _LEAD_TOL of the largest
-    coefficient) the leading one is deflated as its exact root. Angles are wrapped to (-pi, pi] (within 1e-12 of +-pi:
-    pi), sorted, and equal ones (1e-12) merged. Near-double roots come out as complex pairs
-    with a small imaginary part; they are accepted and polished. Every candidate is certified
-    by forward kinematics afterwards, so a spurious angle costs time, never correctness.
-    When every coefficient is at most `free` the polynomial vanishes identically: the angle
-    is free: _free(ref).
-    """
-    c = [float(x) for x in coeffs]
-    size = max(abs(x) for x in c)
-    if size <= free:
-        return _free(ref)
-    if size == 0.0:
-        return ()
-    flip = abs(c[0]) < abs(c[-1])
-    if flip:
-        c.reverse()
-    angles = []
-    while len(c) > 1 and abs(c[0]) <= _LEAD_TOL * size:
-        # both ends vanish (roots at u = 0 and u = infinity): the one at this end is exact
-        c.pop(0)
-        angles.append(0.0 if flip else math.pi)
-    for x in _real_roots(c) if len(c) > 1 else ():
-        angles.append(_wrap_snap(2.0 * atan2(1.0, x) if flip else 2.0 * math.atan(x)))
-    angles.sort()
-    out = []
-    for t in angles:
-        if not out or t - out[-1] > 1e-12:
-            out.append(t)
-    return out
-
-
-def _wrap_snap(t):
-    t = _wrap(t)
-    return math.pi if math.pi - abs(t) <= 1e-12 else t
-
-
-def _real_roots(p):
-    """Real roots of p (highest degree first, p[0] != 0), Newton-polished.
-
-    Closed forms for degrees 1, 2 and 4 (Ferrari); the companion matrix (numpy.roots) for
-    other degrees and whenever a closed-form root fails the residual test.
-    """
-    d = len(p) - 1
-    lead = p[0]
-    if d == 1:
-        return [-p[1] / lead]
-    if d == 2:
-        zs = _kquadratic(p[1] / lead, p[2] / lead)
-    elif d == 4:
-        zs = _kquartic(p[1] / lead, p[2] / lead, p[3] / lead, p[4] / lead)
-    else:
-        zs = None
-    if zs is not None:
-        roots = _accept(p, zs)
-        if roots is not None:
-            return roots
-    return _accept(p, np.roots(p).tolist(), check=False)
-
-
-def _accept(p, zs, check=True):
-    """Polished real parts of the near-real zs; None if one fails the residual test.
-
-    A double root comes out split, as a complex pair or as two reals about sqrt(eps) apart;
-    roots closer than _MERGE_TOL are replaced by their mean, which is accurate. A root of
-    multiplicity k splits by about eps^(1/k) (1e-4 for k = 4) into a cluster, not all real,
-    whose mean is accurate too: such a cluster within _CLUSTER_TOL gives its mean. Merged
-    roots and cluster means are not Newton-polished: at a multiple root p and p' both
-    vanish, and Newton's step is rounding noise divided by rounding noise (it moved a double
-    root by 3.5e-5).
-    """
-    xs = []
-    split = False
-    for z in zs:
-        z = complex(z)
-        if abs(z.imag) <= _ROOT_IMAG_TOL * (1.0 + abs(z)):
-            xs.append((z.real, True))
-        elif abs(z.imag) <= _CLUSTER_TOL * (1.0 + abs(z)):
-            split = True
-    if split:
-        xs = [(z.real, simple) for z, simple in _clusters([complex(z) for z in zs])
-              if abs(z.imag) <= _ROOT_IMAG_TOL * (1.0 + abs(z))]
-    xs.sort()
-    out = []
-    k = 0
-    while k < len(xs):
-        x, simple = xs[k]
-        if k + 1 < len(xs) and xs[k + 1][0] - x <= _MERGE_TOL * (1.0 + abs(x)):
-            x = 0.5 * (x + xs[k + 1][0])
-            k += 1
-        elif simple:
-            x = _newton(p, x)
-        if check and not _small_residual(p, x):
-            return None
-        out.append(x)
-        k += 1
-    return out
-
-
-def _clusters(zs):
-    """zs with each cluster of nearby roots that are not all real replaced by its mean, as
-    (root, whether it is a simple root rather than a cluster's mean)."""
-    out = []
-    left = list(zs)
-    while left:
-        z = left.pop(0)
-        group = [z] + [w for w in left if abs(w - z) <= _CLUSTER_TOL * (1.0 + abs(z))]
-        if len(group) > 1 and any(abs(w.imag) > _ROOT_IMAG_TOL * (1.0 + abs(w)) for w in group):
-            left = [w for w in left if all(w is not g for g in group)]
-            out.append((sum(group) / len(group), False))
-        else:
-            out.append((z, True))
-    return out
-
-
-def _small_residual(p, x):
-    """p(x) is negligible against the size of its terms, or Newton's step from x is."""
-    value = size = slope = 0.0
-    ax = abs(x)
-    for k in p:
-        slope = slope * x + value
-        value = value * x + k
-        size = size * ax + abs(k)
-    return (abs(value) <= _RESIDUAL_TOL * size
-            or abs(value) <= _RESIDUAL_TOL * (1.0 + ax) * abs(slope))
-
-
-def _newton(c, x):
-    """Two Newton steps on the polynomial c (highest degree first), skipped if unstable."""
-    for _ in range(2):
-        p = dp = 0.0
-        for k in c:
-            dp = dp * x + p
-            p = p * x + k
-        if dp == 0.0:
-            break
-        step = p / dp
-        if not math.isfinite(step) or abs(step) > 1e-3 * (1.0 + abs(x)):
-            break
-        x -= step
-    return x
-
-
-def _vnew_axis(values, ok, like, axis, free=False):
-    """Broadcast a step's result (no branching) to the shape of `like`: values, validity and
-    where the joint was free."""
-    values, ok, free, _ = np.broadcast_arrays(values, ok, free, like)
-    return values, ok, free
-
-
-def _vcs1(a, b, e, scale, ref, axis, like):
-    """Vectorised _cs1: two values along `axis` (+acos, then -acos), their validity and where
-    the joint was free (ref as the first value, the second invalid)."""
-    a, b, e, ref, _ = np.broadcast_arrays(a, b, e, ref, like)
-    rho = np.sqrt(a * a + b * b)
-    small = rho * rho <= _FREE_TOL * scale
-    free = small & (e * e <= _FREE_TOL * scale)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        ratio = e / rho
-    ok = ~small & (rho > 0.0) & (np.abs(ratio) <= 1.0 + _CLAMP_TOL)
-    base = np.arctan2(b, a)
-    ratio = np.where(ok, ratio, 0.0)
-    fold = np.abs(ratio) >= 1.0 - _FOLD_TOL
-    delta = np.where(fold, np.where(ratio > 0.0, 0.0, math.pi),
-                     np.arccos(np.clip(ratio, -1.0, 1.0)))
-    return (np.concatenate((np.where(free, ref, base + delta), base - delta), axis),
-            np.concatenate((ok | free, ok), axis),
-            np.concatenate((free, np.zeros_like(free)), axis))
-
-
-def _vcs1_reach(a, b, e, m00, m01, m02, m10, m11, m12, m20, m21, m22, lo, hi, scale, ref,
-                axis, like):
-    """Vectorised _cs1_reach: _vcs1, with the (rare) free rows settled by the scalar routine."""
-    values, ok, free = _vcs1(a, b, e, scale, ref, axis, like)
-    args = np.broadcast_arrays(a, b, e, m00, m01, m02, m10, m11, m12, m20, m21, m22, ref, like)
-    for index in zip(*np.nonzero(free)):
-        row = [float(x[index]) for x in args[:12]]
-        values[index] = _cs1_reach(*row, lo, hi, scale, float(args[12][index]))[0]
-    return values, ok, free
-
-
-def _vcs2(a1, b1, e1, a2, b2, e2, det_scale, rhs_scale, ref, axis, like):
-    """Vectorised _cs2 (one value; ref where the angle is free)."""
-    det = a1 * b2 - a2 * b1
-    free = (np.abs(det) <= _FREE_TOL * det_scale) | (e1 * e1 + e2 * e2 <= _FREE_TOL * rhs_scale)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        value = np.arctan2((a1 * e2 - a2 * e1) / det, (e1 * b2 - b1 * e2) / det)
-    return _vnew_axis(np.where(free, ref, value), True, like, axis, free)
-
-
-def _vcs2_reach(a1, b1, e1, a2, b2, e2, det_scale, rhs_scale, A, B, C, lo, hi, ref, axis, like):
-    """Vectorised _cs2_reach."""
-    det = a1 * b2 - a2 * b1
-    free = (np.abs(det) <= _FREE_TOL * det_scale) | (e1 * e1 + e2 * e2 <= _FREE_TOL * rhs_scale)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        value = np.arctan2((a1 * e2 - a2 * e1) / det, (e1 * b2 - b1 * e2) / det)
-        radius = A + B * np.cos(ref) + C * np.sin(ref)
-        rho = np.sqrt(B * B + C * C)
-        delta = np.arccos(np.clip((0.5 * (lo + hi) - A) / rho, -1.0, 1.0))
-    base = np.arctan2(C, B)
-    plus, minus = base + delta, base - delta
-    nearer = np.where(np.abs(_vwrap(plus - ref)) <= np.abs(_vwrap(minus - ref)), plus, minus)
-    keep_ref = ((lo <= radius) & (radius <= hi)) | (rho == 0.0)
-    chosen = np.where(keep_ref, ref, nearer)
-    return _vnew_axis(np.where(free, chosen, value), True, like, axis, free)
-
-
-def _vatan2(y, x, ref, axis, like):
-    """Vectorised _atan2."""
-    free = np.abs(y) + np.abs(x) <= 1e-12
-    return _vnew_axis(np.where(free, ref, np.arctan2(y, x)), True, like, axis, free)
-
-
-def _vwrap(t):
-    """Angles wrapped to (-pi, pi] (as _wrap: a value rounding to -pi becomes pi)."""
-    w = t - _TWO_PI * np.round(t / _TWO_PI)
-    return np.where(w <= -math.pi, w + _TWO_PI, w)
-
-
-def _vroots(p):
-    """Real roots of the rows of p (m, d+1), p[:, 0] != 0, as _real_roots does per row.
-
-    Returns (roots (m, d), valid (m, d), fallback (m,)): rows marked fallback (other degrees,
-    a leading coefficient below _LEAD_TOL, a closed-form root failing the residual test, a multiple root
-    split into a cluster) are to be solved by the scalar routine.
-    """
-    m, d = p.shape[0], p.shape[1] - 1
-    lead = p[:, 0]
-    fallback = np.abs(lead) <= _LEAD_TOL * np.abs(p).max(axis=1)
-    mon = p[:, 1:] / np.where(fallback, 1.0, lead)[:, None]
-    if d == 2:
-        zs = np.stack(_vquadratic(mon[:, 0].astype(complex), mon[:, 1].astype(complex)), axis=1)
-    elif d == 4:
-        zs = np.stack(_vquartic(*(mon[:, k].astype(complex) for k in range(4))), axis=1)
-    elif d == 1:
-        zs = (-mon[:, :1]).astype(complex)
-    else:
-        return np.zeros((m, d)), np.zeros((m, d), bool), np.ones(m, bool)
-    with np.errstate(all="ignore"):
-        ok = np.abs(zs.imag) <= _ROOT_IMAG_TOL * (1.0 + np.abs(zs))
-        # a split multiple root (imaginary parts up to _CLUSTER_TOL): the scalar routine
-        fallback |= (~ok & (np.abs(zs.imag) <= _CLUSTER_TOL * (1.0 + np.abs(zs)))).any(axis=1)
-        x = np.where(ok, zs.real, np.inf)
-        x.sort(axis=1)
-        ok = np.isfinite(x)
-        head = np.zeros_like(ok)
-        consumed = np.zeros_like(ok)
-        for k in range(d - 1):
-            pair = (ok[:, k] & ok[:, k + 1] & ~consumed[:, k]
-                    & (x[:, k + 1] - x[:, k] <= _MERGE_TOL * (1.0 + np.abs(x[:, k]))))
-            x[:, k] = np.where(pair, 0.5 * (x[:, k] + x[:, k + 1]), x[:, k])
-            head[:, k] |= pair
-            consumed[:, k + 1] |= pair
-        ok &= ~consumed
-        x = np.where(ok, x, 0.0)
-        x = np.where(ok & ~head, _vnewton(p, x), x)
-        value = np.zeros_like(x)
-        size = np.zeros_like(x)
-        slope = np.zeros_like(x)
-        ax = np.abs(x)
-        for k in range(d + 1):
-            slope = slope * x + value
-            value = value * x + p[:, k:k + 1]
-            size = size * ax + np.abs(p[:, k:k + 1])
-        small = ((np.abs(value) <= _RESIDUAL_TOL * size)
-                 | (np.abs(value) <= _RESIDUAL_TOL * (1.0 + ax) * np.abs(slope)))
-        bad = ok & ~small
-    fallback |= bad.any(axis=1)
-    return x, ok, fallback
-
-
-def _vnewton(p, x):
-    """Two guarded Newton steps on the rows' polynomials, elementwise."""
-    with np.errstate(all="ignore"):
-        for _ in range(2):
-            val = np.zeros_like(x)
-            der = np.zeros_like(x)
-            for k in range(p.shape[1]):
-                der = der * x + val
-                val = val * x + p[:, k:k + 1]
-            step = val / der
-            good = np.isfinite(step) & (np.abs(step) <= 1e-3 * (1.0 + np.abs(x)))
-            x = np.where(good, x - step, x)
-    return x
-
-
-def _vquadratic(b, c):
-    """Both roots of x^2 + b x + c (complex arrays), as _kquadratic."""
-    t = np.sqrt(b * b - 4.0 * c)
-    t = np.where((np.conj(b) * t).real < 0.0, -t, t)
-    q = -0.5 * (b + t)
-    with np.errstate(all="ignore"):
-        other = np.where(q == 0, q, c / q)
-    return q, other
-
-
-def _vcubic_largest(a2, a1, a0):
-    """The root of largest modulus of m^3 + a2 m^2 + a1 m + a0, as _kcubic_largest."""
-    P = a1 - a2 * a2 / 3.0
-    Q = 2.0 * a2 ** 3 / 27.0 - a2 * a1 / 3.0 + a0
-    w = np.sqrt(Q * Q / 4.0 + P ** 3 / 27.0)
-    u3 = np.where(np.abs(-Q / 2.0 + w) < np.abs(-Q / 2.0 - w), -Q / 2.0 - w, -Q / 2.0 + w)
-    zero = u3 == 0
-    u = np.where(zero, 1.0, u3) ** (1.0 / 3.0)
-    best = np.zeros(u.shape, dtype=complex)
-    best_abs = np.full(u.shape, -1.0)
-    for w_k in _OMEGA:
-        uk = u * w_k
-        mk = uk - P / (3.0 * uk) - a2 / 3.0
-        better = np.abs(mk) > best_abs
-        best = np.where(better, mk, best)
-        best_abs = np.where(better, np.abs(mk), best_abs)
-    return np.where(zero, -a2 / 3.0, best)
-
-
-def _vquartic(B, C, D, E):
-    """The four roots of x^4 + B x^3 + C x^2 + D x + E (complex arrays), as _kquartic."""
-    a = B / 4.0
-    p = C - 6.0 * a * a
-    q = D - 2.0 * a * C + 8.0 * a ** 3
-    r = E - a * D + a * a * C - 3.0 * a ** 4
-    with np.errstate(all="ignore"):
-        m = _vcubic_largest(p, p * p / 4.0 - r, -q * q / 8.0)
-        s = np.sqrt(2.0 * m)
-        zero = s == 0
-        h = np.where(zero, 0.0, q / np.where(zero, 1.0, 2.0 * s))
-        y1, y2 = _vquadratic(-s, p / 2.0 + m + h)
-        y3, y4 = _vquadratic(s, p / 2.0 + m - h)
-        t = np.sqrt(p * p - 4.0 * r)
-        b1, b2 = np.sqrt((-p + t) / 2.0), np.sqrt((-p - t) / 2.0)
-    y1, y2, y3, y4 = (np.where(zero, alt, y) for y, alt in ((y1, b1), (y2, -b1), (y3, b2), (y4, -b2)))
-    return y1 - a, y2 - a, y3 - a, y4 - a
-
-
-def _vpoly(coeffs, axis, like, angles, ref=0.0, free=0.0, unit=1.0):
-    """Vectorised _poly_angles (angles=True) or _poly_real: values along `axis`, validity and
-    where the joint was free.
-
-    Rows the closed forms cannot settle are solved by the scalar routine, one by one.
-    """
-    cs = np.broadcast_arrays(*coeffs, like)[:-1]
-    shape = cs[0].shape
-    raw = np.stack([np.asarray(x, dtype=float).ravel() for x in cs], axis=1)
-    m, d = raw.shape[0], raw.shape[1] - 1
-    if angles:
-        c = raw
-        flip = np.abs(c[:, 0]) < np.abs(c[:, -1])
-        p = np.where(flip[:, None], c[:, ::-1], c)
-    else:
-        c = raw * unit ** np.arange(d, -1, -1.0)  # the polynomial in x / unit, as _poly_real
-        flip = np.zeros(m, bool)
-        p = c
-    x, ok, fallback = _vroots(p)
-    if not angles:
-        fallback |= np.abs(c[:, 0]) <= _LEAD_TOL * np.abs(c).max(axis=1)
-    if angles:
-        with np.errstate(all="ignore"):
-            t = np.where(flip[:, None], 2.0 * np.arctan2(1.0, x), 2.0 * np.arctan(x))
-        t = _vwrap(t)
-        t = np.where(math.pi - np.abs(t) <= 1e-12, math.pi, t)
-        t = np.where(ok, t, np.inf)
-        t.sort(axis=1)
-        ok = np.isfinite(t)
-        with np.errstate(invalid="ignore"):
-            ok[:, 1:] &= ~(t[:, 1:] - t[:, :-1] <= 1e-12)
-        order = np.argsort(~ok, axis=1, kind="stable")
-        x = np.take_along_axis(np.where(ok, t, 0.0), order, axis=1)
-        ok = np.take_along_axis(ok, order, axis=1)
-    else:
-        close = np.zeros_like(ok)
-        close[:, 1:] = ok[:, 1:] & ok[:, :-1] & (x[:, 1:] - x[:, :-1] <= 1e-12 * (1.0 + np.abs(x[:, 1:])))
-        ok &= ~close
-        order = np.argsort(~ok, axis=1, kind="stable")
-        x = np.take_along_axis(x, order, axis=1) * unit
-        ok = np.take_along_axis(ok, order, axis=1)
-    scale = np.abs(raw).max(axis=1)
-    ok &= (scale > 0.0)[:, None]
-    vanishing = scale <= free
-    fallback |= vanishing
-    refs = np.broadcast_to(ref, shape).ravel()
-    freed = np.zeros_like(ok)
-    for i in np.flatnonzero(fallback & ((scale > 0.0) | vanishing)):
-        if angles:
-            values = _poly_angles(raw[i], float(refs[i]), free)
-        else:
-            values = _poly_real(raw[i], float(refs[i]), free, unit)
-        x[i] = 0.0
-        ok[i] = False
-        if values.__class__ is _Free:
-            values = values[:1]
-            freed[i, 0] = True
-        x[i, :len(values)] = values
-        ok[i, :len(values)] = True
-    inner = shape[:axis] + shape[axis + 1:]
-    x, ok, freed = (np.moveaxis(v.reshape(inner + (d,)), -1, axis) for v in (x, ok, freed))
-    return x, ok, freed
-
-
-def _vpose(T):
-    """Per-row validity of poses (N, 4, 4) and the poses with invalid rows replaced."""
-    T = _real(T, "T")
-    if T.ndim != 3 or T.shape[1:] != (4, 4):
-        raise ValueError(f"T must have shape (N, 4, 4), got {T.shape}")
-    flat = T.reshape(-1, 16)
-    with np.errstate(invalid="ignore", over="ignore"):
-        (a0, a1, a2, _, b0, b1, b2, _, c0, c1, c2, _, z0, z1, z2, z3) = flat.T
-        worst = np.abs(a0 * a0 + a1 * a1 + a2 * a2 - 1.0)
-        for dot in (b0 * b0 + b1 * b1 + b2 * b2 - 1.0, c0 * c0 + c1 * c1 + c2 * c2 - 1.0,
-                    a0 * b0 + a1 * b1 + a2 * b2, a0 * c0 + a1 * c1 + a2 * c2,
-                    b0 * c0 + b1 * c1 + b2 * c2, z0, z1, z2, z3 - 1.0):
-            worst = np.maximum(worst, np.abs(dot))
-        det = (a0 * (b1 * c2 - b2 * c1) - a1 * (b0 * c2 - b2 * c0) + a2 * (b0 * c1 - b1 * c0))
-        good = (worst <= POSE_TOL) & (det > 0.0) & np.isfinite(flat).all(axis=1)
-    if good.all():
-        return T, good
-    return np.where(good[:, None, None], T, np.eye(4)), good
-
-
-def _vfinish(Q, valid):
-    """Wrap revolute values (as _finish: pi at the seam) and drop repeats within each pose
-    (vectorised).
-
-    Pairs are compared on their last joint first; only the few rows where that agrees are
-    compared in full.
-    """
-    count = Q.shape[1]
-    rev = np.array(_REVOLUTE)
-    Q = Q.copy()
-    W = _vwrap(Q[:, :, rev])
-    W = np.where(W < -_SEAM, W + _TWO_PI, W)  # _seam, vectorised
-    Q[:, :, rev] = np.where(np.abs(W - math.pi) <= _SEAM_SNAP, math.pi, W)
-    ok = valid.copy()
-    period = _PERIODS[-1]
-    for j in range(1, count):
-        for i in range(j):
-            last = np.abs(Q[:, j, -1] - Q[:, i, -1])
-            if period != math.inf:
-                last = np.minimum(last, _TWO_PI - last)
-            rows = np.flatnonzero(ok[:, i] & ok[:, j] & (last <= DEDUP_TOL))
-            if rows.size == 0:
-                continue
-            d = np.abs(Q[rows, j, :] - Q[rows, i, :])
-            d[:, rev] = np.minimum(d[:, rev], _TWO_PI - d[:, rev])
-            ok[rows[d.max(axis=1) <= DEDUP_TOL], j] = False
-    # the kept slots first, in order (as the compiled kernel writes them)
-    order = np.argsort(~ok, axis=1, kind="stable")
-    ok = np.take_along_axis(ok, order, axis=1)
-    Q = np.take_along_axis(Q, order[:, :, None], axis=1)
-    return np.where(ok[:, :, None], Q, 0.0), ok
-
-
-def _ksolve(w11, w12, w13, wx, w21, w22, w23, wy, w31, w32, w33, wz, tol, ref, found, buf):
-    """The solutions of one pose into found (rows in ik's branch order, before wrapping and
-    dropping repeats): their count, or -1 where the scalar solver must settle the pose.
-    ref: q_ref's values, then their cosines, then their sines (_kreference)."""
-    qr1, qr2, qr3, qr4, qr5, qr6, = ref[0:6]
-    cr1, cr2, cr3, cr4, cr5, cr6, = ref[6:12]
-    sr1, sr2, sr3, sr4, sr5, sr6, = ref[12:18]
-    ptol = tol * REACH
-    n = 0
-    t = (w11, w12, w13, wx, w21, w22, w23, wy, w31, w32, w33, wz)
-    # flange target 0_nT = (B X0 Tz(d1))^-1 T (Tz(dn) Xn E)^-1
-    r11 = w13
-    r12 = -w12
-    r13 = w11
-    px = -206.0*w11 + wx
-    r21 = w23
-    r22 = -w22
-    r23 = w21
-    py = -206.0*w21 + wy
-    r31 = w33
-    r32 = -w32
-    r33 = w31
-    pz = -206.0*w31 + wz - 373.0
-    # wrist centre (x, y, z) = 0P_4org and r = x^2 + y^2 + z^2
-    x = px
-    y = py
-    z = pz
-    r = px*px + py*py + pz*pz
-    # theta3: Pieper general case, polynomial of degree 4 in u = tan(theta3/2); free when it vanishes identically
-    x0 = r*r
-    x1 = z*z
-    x2 = x0 + 3600.0*x1
-    x3 = 919360.0*r
-    _n3 = _kpoly((-519088.0*r + x2 + 66431969536.0, x3 - 236959523840.0, -929376.0*r + 2.0*x0 + 7200.0*x1 + 316127094272.0, x3 - 186946339840.0, -410288.0*r + x2 + 41348782336.0,), True, 20.845498492269137, 1.0, buf[64:96])
-    _f3 = _n3 == -2
-    if _f3:
-        _n3 = 1
-        buf[64] = qr3
-        buf[84], buf[88] = cr3, sr3
-    elif _n3 < 0:
-        return -1
-    _m3 = n
-    for _k3 in range(_n3):
-        theta3 = buf[64 + _k3]
-        c3 = buf[84 + _k3]
-        s3 = buf[88 + _k3]
-        # theta2: r and z equations, linear in (c2, s2)
-        theta2, c2, s2, _st = _kcs2(2400.0*c3 + 20280.0*s3 - 20400.0, 20280.0*c3 - 2400.0*s3, 27200.0*c3 + r + 229840.0*s3 - 232344.0, -338.0*c3 + 40.0*s3, 40.0*c3 + 338.0*s3 - 340.0, z, 33570240.0, 0.0)
-        _f2 = _st == 1
-        if _f2:
-            theta2, c2, s2 = qr2, cr2, sr2
-        _m2 = n
-        # g1(theta2, theta3), g2(theta2, theta3)
-        g1 = -40.0*c2*c3 - 338.0*c2*s3 + 340.0*c2 - 338.0*c3*s2 + 40.0*s2*s3 - 30.0
-        g2 = 0.0
-        # theta1: x = c1 g1 - s1 g2, y = s1 g1 + c1 g2; free with the wrist centre on axis 1
-        theta1, c1, s1, _st = _kcs2(g1, -g2, x, g2, g1, y, 559504.0, 559504.0)
-        _f1 = _st == 1
-        if _f1:
-            theta1, c1, s1 = qr1, cr1, sr1
-        _m1 = n
-        # wrist W = (0_3R Rx(alpha3))^T 0_6R = Rz(t4) Rx(alpha4) Rz(t5) Rx(alpha5) Rz(t6)
-        x4 = c2*s3
-        x5 = c3*s2
-        x6 = -x4 - x5
-        x7 = c2*c3
-        x8 = s2*s3
-        x9 = c1*x7 - c1*x8
-        x10 = s1*x7 - s1*x8
-        x11 = s2*s3 - x7
-        x12 = -c1*x4 - c1*x5
-        x13 = -s1*x4 - s1*x5
-        W11 = r11*x9 + r21*x10 + r31*x6
-        W12 = r12*x9 + r22*x10 + r32*x6
-        W13 = r13*x9 + r23*x10 + r33*x6
-        W21 = -c1*r21 + r11*s1
-        W22 = -c1*r22 + r12*s1
-        W23 = -c1*r23 + r13*s1
-        W31 = r11*x12 + r21*x13 + r31*x11
-        W32 = r12*x12 + r22*x13 + r32*x11
-        W33 = r13*x12 + r23*x13 + r33*x11
-        # theta5: W33 = e3^T Rx(alpha4) Rz(theta5) Rx(alpha5) e3
-        _n5, _a5, _ac5, _as5, _b5, _bc5, _bs5, _st = _kcs1(1.0, 0.0, W33, 0.0)
-        _f5 = _st == 1
-        if _f5:
-            _n5, _a5, _ac5, _as5 = 1, 0.0, 1.0, 0.0
-        _m5 = n
-        for _k5 in range(_n5):
-            theta5, c5, s5 = (_a5, _ac5, _as5) if _k5 == 0 else (_b5, _bc5, _bs5)
-            # v = Rx(alpha4) Rz(theta5) Rx(alpha5) e3
-            v1 = -s5
-            v2 = 0.0
-            # theta4: (W13, W23) = Rz(theta4) (v1, v2); free at a singular wrist
-            theta4, c4, s4, _st = _kcs2(v1, -v2, W13, v2, v1, W23, 1.0, 1.0)
-            _f4 = _st == 1
-            if _f4:
-                theta4, c4, s4 = qr4, cr4, sr4
-            _m4 = n
-            # theta6: Rz(theta6) = (Rx(alpha4) Rz(theta5) Rx(alpha5))^T Rz(theta4)^T W
-            theta6, c6, s6, _st = _katan2(-W11*s4 + W21*c4, W11*c4*c5 + W21*c5*s4 + W31*s5)
-            _f6 = _st == 1
-            if _f6:
-                theta6, c6, s6 = qr6, cr6, sr6
-            _m6 = n
-            e = _kfk(c1, s1, c2, s2, c3, s3, c4, s4, c5, s5, c6, s6)
-            if abs(e[0] - t[0]) <= tol and abs(e[1] - t[1]) <= tol and abs(e[2] - t[2]) <= tol and abs(e[4] - t[4]) <= tol and abs(e[5] - t[5]) <= tol and abs(e[6] - t[6]) <= tol and abs(e[8] - t[8]) <= tol and abs(e[9] - t[9]) <= tol and abs(e[10] - t[10]) <= tol and abs(e[3] - t[3]) <= ptol and abs(e[7] - t[7]) <= ptol and abs(e[11] - t[11]) <= ptol:
-                found[n, 0] = theta1
-                found[n, 1] = theta2
-                found[n, 2] = theta3
-                found[n, 3] = theta4
-                found[n, 4] = theta5
-                found[n, 5] = theta6
-                n += 1
-            if _f4 and n == _m4:
-                return -1
-            if _f6 and n == _m6:
-                return -1
-        if _f2 and n == _m2:
-            return -1
-        if _f1 and n == _m1:
-            return -1
-        if _f5 and n == _m5:
-            return -1
-    if _f3 and n == _m3:
-        return -1
-    return n
-
-
-# --- compiled kernel -------------------------------------------------------------------------
-# The functions below are plain Python written in the subset numba compiles. With numba
-# installed, ik and ik_batch compile them once per process and solve each pose (ik_batch:
-# every pose, on every core) in compiled code. They follow the Python solver step by step,
-# free joints included (a free joint takes its first value; the Python solver's further
-# values are its business). A pose they cannot settle with the closed forms (a polynomial
-# of another degree, a root failing the residual test, a split multiple root, a free joint
-# whose first value gives no solution) goes to the Python solver, so the solutions are its.
-# Real polynomials are solved in real arithmetic (about four times faster than the complex
-# closed forms the Python solver uses, which remain the fallback).
-
-def _kpose_ok(T, i):
-    """Whether T[i] is a finite rigid transform within POSE_TOL (as _vpose)."""
-    for r in range(4):
-        for c in range(4):
-            if not math.isfinite(T[i, r, c]):
-                return False
-    worst = max(abs(T[i, 3, 0]), abs(T[i, 3, 1]), abs(T[i, 3, 2]), abs(T[i, 3, 3] - 1.0))
-    for r in range(3):
-        for s in range(r, 3):
-            dot = T[i, r, 0] * T[i, s, 0] + T[i, r, 1] * T[i, s, 1] + T[i, r, 2] * T[i, s, 2]
-            worst = max(worst, abs(dot - 1.0) if r == s else abs(dot))
-    det = (T[i, 0, 0] * (T[i, 1, 1] * T[i, 2, 2] - T[i, 1, 2] * T[i, 2, 1])
-           - T[i, 0, 1] * (T[i, 1, 0] * T[i, 2, 2] - T[i, 1, 2] * T[i, 2, 0])
-           + T[i, 0, 2] * (T[i, 1, 0] * T[i, 2, 1] - T[i, 1, 1] * T[i, 2, 0]))
-    return worst <= POSE_TOL and det > 0.0
-
-
-def _kcs1(a, b, e, scale):
-    """_cs1 as (count, t0, cos t0, sin t0, t1, cos t1, sin t1, status); status 1: the angle
-    is free. The cosines and sines come from a, b and e, not from cos and
-    sin of the angles: they agree with them to rounding, and cost no transcendental call."""
-    rho = sqrt(a * a + b * b)
-    if rho * rho <= _FREE_TOL * scale:
-        return 0, 0.0, 1.0, 0.0, 0.0, 1.0, 0.0, 1 if e * e <= _FREE_TOL * scale else 0
-    if rho == 0.0:
-        return 0, 0.0, 1.0, 0.0, 0.0, 1.0, 0.0, 0
-    ratio = e / rho
-    if abs(ratio) > 1.0 + _CLAMP_TOL:
-        return 0, 0.0, 1.0, 0.0, 0.0, 1.0, 0.0, 0
-    if abs(ratio) >= 1.0 - _FOLD_TOL:
-        ratio = 1.0 if ratio > 0.0 else -1.0
-    base = _kangle(b, a)
-    sd = sqrt((1.0 - ratio) * (1.0 + ratio))
-    delta = _kangle(sd, ratio)
-    cb, sb = a / rho, b / rho
-    return (2, base + delta, cb * ratio - sb * sd, sb * ratio + cb * sd,
-            base - delta, cb * ratio + sb * sd, sb * ratio - cb * sd, 0)
-
-
-def _kcs2(a1, b1, e1, a2, b2, e2, det_scale, rhs_scale):
-    """_cs2 as (t, cos t, sin t, status); status 1: the angle is free."""
-    det = a1 * b2 - a2 * b1
-    if abs(det) <= _FREE_TOL * det_scale or e1 * e1 + e2 * e2 <= _FREE_TOL * rhs_scale:
-        return 0.0, 1.0, 0.0, 1
-    # (cos t, sin t) = (x, y) / det: the direction of (x, y), reversed where det < 0
-    sign = math.copysign(1.0, det)
-    x, y = sign * (e1 * b2 - b1 * e2), sign * (a1 * e2 - a2 * e1)
-    h = sqrt(x * x + y * y)
-    if h == 0.0:
-        return 0.0, 1.0, 0.0, 0
-    return _kangle(y, x), x / h, y / h, 0
-
-
-def _reach_first1(m00, m01, m02, m10, m11, m12, m20, m21, m22, lo, hi, ref):
-    """The first value of a free t, in 5 degree steps out from ref, at which some t' keeps
-    W = (m00 + m01 c + m02 s) + (m10 + m11 c + m12 s) c' + (m20 + m21 c + m22 s) s' in
-    [lo, hi] (c, s of t and c', s' of t': the next joint must still let the wrist reach);
-    ref if there is none."""
-    for step in _FREE_STEPS:
-        t = ref + step
-        c, s = cos(t), sin(t)
-        A = m00 + m01 * c + m02 * s
-        B = m10 + m11 * c + m12 * s
-        C = m20 + m21 * c + m22 * s
-        r = sqrt(B * B + C * C)
-        if A - r <= hi and A + r >= lo:
-            return t
-    return ref
-
-
-def _reach_first2(A, B, C, lo, hi, ref):
-    """The first value of a free t: ref if it keeps A + B cos t + C sin t in [lo, hi], else
-    the nearer to ref of the two t at which it is mid-range."""
-    rho = sqrt(B * B + C * C)
-    if lo <= A + B * cos(ref) + C * sin(ref) <= hi or rho == 0.0:
-        return ref
-    base = _kangle(C, B)
-    ratio = max(-1.0, min(1.0, (0.5 * (lo + hi) - A) / rho))
-    delta = _kangle(sqrt((1.0 - ratio) * (1.0 + ratio)), ratio)
-    if abs(_kwrap(base - delta - ref)) < abs(_kwrap(base + delta - ref)):
-        return base - delta
-    return base + delta
-
-
-def _kcs1r(a, b, e, m00, m01, m02, m10, m11, m12, m20, m21, m22, lo, hi, scale, ref):
-    """_cs1_reach as _kcs1 does _cs1; a free angle comes as its one first value."""
-    n, t0, c0, s0, t1, c1, s1, status = _kcs1(a, b, e, scale)
-    if status == 0:
-        return n, t0, c0, s0, t1, c1, s1, 0
-    t = _reach_first1(m00, m01, m02, m10, m11, m12, m20, m21, m22, lo, hi, ref)
-    return 1, t, cos(t), sin(t), 0.0, 1.0, 0.0, 1
-
-
-def _kcs2r(a1, b1, e1, a2, b2, e2, det_scale, rhs_scale, A, B, C, lo, hi, ref):
-    """_cs2_reach as _kcs2 does _cs2; a free angle comes as its first value."""
-    t, c, s, status = _kcs2(a1, b1, e1, a2, b2, e2, det_scale, rhs_scale)
-    if status == 0:
-        return t, c, s, 0
-    t = _reach_first2(A, B, C, lo, hi, ref)
-    return t, cos(t), sin(t), 1
-
-
-def _katan2(y, x):
-    """_atan2 as (t, cos t, sin t, status); status 1: the angle is free."""
-    h = sqrt(x * x + y * y)
-    if abs(y) + abs(x) <= 1e-12 or h == 0.0:
-        return 0.0, 1.0, 0.0, 1
-    return _kangle(y, x), x / h, y / h, 0
+_UPPER = np.array([hi + 1e-12 for _, hi in LIMITS])
 
 
 # _kangle's segments: t = min(|x|, |y|) / max(|x|, |y|) in [0, 1] falls in segment
 # k = int(8 t + 0.5); its angle is _ANGLE_AT[k] + atan(r), r = tan of the offset from it
 # (|r| <= 0.0625), from the series r - r^3/3 + ... - r^15/15 (truncated below 1e-19 of r)
-_ANGLE_AT = np.array([0.0] + [
-    (math.atan((k - 0.5) / 8.0) + math.atan(min(1.0, (k + 0.5) / 8.0))) / 2.0 for k in range(1, 9)])
+_ANGLE_AT = np.array(
+    [0.0]
+    + [
+        (math.atan((k - 0.5) / 8.0) + math.atan(min(1.0, (k + 0.5) / 8.0))) / 2.0
+        for k in range(1, 9)
+    ]
+)
+
+
 _TAN_AT = np.tan(_ANGLE_AT)
 
 
-def _kangle(y, x):
+def _kangle(y: float, x: float) -> float:
     """atan2(y, x) to within a few units in the last place, about twice as fast as the
     library's (which rounds correctly): the octant, one of nine segments of it, and an odd
     series. Zeros, infinities and nan go to the library's."""
@@ -1660,8 +692,23 @@ def _kangle(y, x):
     c = _TAN_AT[k]
     r = (t - c) / (1.0 + t * c)
     r2 = r * r
-    a = _ANGLE_AT[k] + (r + r * r2 * (-1.0 / 3.0 + r2 * (1.0 / 5.0 + r2 * (-1.0 / 7.0 + r2 * (
-        1.0 / 9.0 + r2 * (-1.0 / 11.0 + r2 * (1.0 / 13.0 + r2 * (-1.0 / 15.0))))))))
+    a = _ANGLE_AT[k] + (
+        r
+        + r
+        * r2
+        * (
+            -1.0 / 3.0
+            + r2
+            * (
+                1.0 / 5.0
+                + r2
+                * (
+                    -1.0 / 7.0
+                    + r2 * (1.0 / 9.0 + r2 * (-1.0 / 11.0 + r2 * (1.0 / 13.0 + r2 * (-1.0 / 15.0))))
+                )
+            )
+        )
+    )
     if steep:
         a = 0.5 * math.pi - a
     if x < 0.0:
@@ -1669,7 +716,7 @@ def _kangle(y, x):
     return math.copysign(a, y)
 
 
-def _kwrap(t):
+def _kwrap(t: float) -> float:
     """t wrapped to (-pi, pi]."""
     if -math.pi < t <= math.pi:
         return t
@@ -1723,17 +770,6 @@ def _kquartic(B, C, D, E):
     y1, y2 = _kquadratic(-s, p / 2.0 + m + h)
     y3, y4 = _kquadratic(s, p / 2.0 + m - h)
     return y1 - a, y2 - a, y3 - a, y4 - a
-
-
-def _ksort(x, n):
-    """x[:n] sorted in place (insertion sort: n is at most 4)."""
-    for k in range(1, n):
-        v = x[k]
-        j = k - 1
-        while j >= 0 and x[j] > v:
-            x[j + 1] = x[j]
-            j -= 1
-        x[j + 1] = v
 
 
 def _kquadratic_real(b, c):
@@ -1792,6 +828,638 @@ def _kquartic_real(B, C, D, E):
     return y1 - a, y2 - a, y3 - a, y4 - a
 
 
+def _small_residual(p: list[float] | np.ndarray, x: float) -> bool:
+    """p(x) is negligible against the size of its terms, or Newton's step from x is."""
+    value = size = slope = 0.0
+    ax = abs(x)
+    for k in p:
+        slope = slope * x + value
+        value = value * x + k
+        size = size * ax + abs(k)
+    return abs(value) <= _RESIDUAL_TOL * size or abs(value) <= _RESIDUAL_TOL * (1.0 + ax) * abs(
+        slope
+    )
+
+
+def _newton(c: list[float] | np.ndarray, x: float) -> float:
+    """Two Newton steps on the polynomial c (highest degree first), skipped if unstable."""
+    for _ in range(2):
+        p = dp = 0.0
+        for k in c:
+            dp = dp * x + p
+            p = p * x + k
+        if dp == 0.0:
+            break
+        step = p / dp
+        if not math.isfinite(step) or abs(step) > 1e-3 * (1.0 + abs(x)):
+            break
+        x -= step
+    return x
+
+
+class _Free(tuple):
+    """The values a free joint tries, first the preferred one, then 5 degree steps out from
+    it in both directions. The solver stops at the first value that gives a certified
+    solution: a later joint may not reach from every value (a wrist whose twists are not
+    +-90 deg reaches only part of the orientations)."""
+
+
+def _free(t: float) -> _Free:
+    return _Free([t + step for step in _FREE_STEPS])
+
+
+def _cs1(a: float, b: float, e: float, scale: float = 0.0, ref: float = 0.0) -> tuple[float, ...]:
+    """Angles t with a cos t + b sin t = e: atan2(b, a) +- acos(e / sqrt(a^2 + b^2)), the
+    acos argument clamped when it exceeds 1 by at most _CLAMP_TOL, and taken as +-1 within
+    _FOLD_TOL below (the double root).
+
+    When a^2 + b^2 and e^2 are both at most _FREE_TOL * scale the equation holds for every
+    t (the angle is free; e.g. the elbow folded onto axis 1): _free(ref).
+    """
+    rho = sqrt(a * a + b * b)
+    if rho * rho <= _FREE_TOL * scale:
+        return _free(ref) if e * e <= _FREE_TOL * scale else ()
+    if rho == 0.0:
+        return ()
+    ratio = e / rho
+    if abs(ratio) > 1.0 + _CLAMP_TOL:
+        return ()
+    base = atan2(b, a)
+    if abs(ratio) >= 1.0 - _FOLD_TOL:
+        delta = 0.0 if ratio > 0.0 else math.pi
+    else:
+        delta = acos(ratio)
+    return (base + delta, base - delta)
+
+
+def _cs2(
+    a1: float,
+    b1: float,
+    e1: float,
+    a2: float,
+    b2: float,
+    e2: float,
+    det_scale: float,
+    rhs_scale: float,
+    ref: float,
+) -> tuple[float, ...]:
+    """The angle t with a1 c + b1 s = e1 and a2 c + b2 s = e2; ref where t is free.
+
+    t is free when the system is singular or, for a consistent system, when its right-hand
+    side vanishes (then so does the determinant, up to the errors of earlier joints).
+    """
+    det = a1 * b2 - a2 * b1
+    if abs(det) <= _FREE_TOL * det_scale or e1 * e1 + e2 * e2 <= _FREE_TOL * rhs_scale:
+        return _free(ref)
+    return (atan2((a1 * e2 - a2 * e1) / det, (e1 * b2 - b1 * e2) / det),)
+
+
+def _atan2(y: float, x: float, ref: float) -> tuple[float, ...]:
+    """atan2(y, x), or ref when both vanish (the angle is free)."""
+    if abs(y) + abs(x) <= 1e-12:
+        return _free(ref)
+    return (atan2(y, x),)
+
+
+def _poly_real(
+    coeffs: tuple[float, ...] | np.ndarray, ref: float = 0.0, free: float = 0.0, unit: float = 1.0
+) -> tuple[float, ...] | list[float]:
+    """Real roots of the polynomial (highest degree first), polished, ascending, distinct;
+    (ref,) when every coefficient is at most `free` (the polynomial vanishes: d is free).
+
+    The roots are found for x / unit, unit being the arm's length, so that coefficients of a
+    polynomial in a length are compared at their proper scale (a constant leading coefficient
+    is small beside r^2 in metres squared to the fourth, yet never negligible).
+    """
+    c = [float(x) for x in coeffs]
+    scale = max(abs(x) for x in c)
+    if scale <= free:
+        return (ref,)
+    if scale == 0.0:
+        return ()
+    n = len(c) - 1
+    c = [x * unit ** (n - k) for k, x in enumerate(c)]
+    scale = max(abs(x) for x in c)
+    while len(c) > 1 and abs(c[0]) <= _LEAD_TOL * scale:
+        c.pop(0)
+    if len(c) < 2:
+        return ()
+    roots = sorted(_real_roots(c))
+    out: list[float] = []
+    for x in roots:
+        if not out or abs(x - out[-1]) > 1e-12 * (1.0 + abs(x)):
+            out.append(x)
+    return [x * unit for x in out]
+
+
+def _poly_angles(
+    coeffs: tuple[float, ...] | np.ndarray, ref: float = 0.0, free: float = 0.0
+) -> tuple[float, ...] | list[float]:
+    """Angles t whose u = tan(t/2) is a real root of the polynomial (highest degree first).
+
+    The polynomial is solved in u, or in v = 1/u when its last coefficient is the larger
+    end, so that a vanishing leading coefficient (a root at u = infinity, t = pi; ALGORITHMS.md
+    2.4) is an ordinary root v = 0. When both ends vanish (below _LEAD_TOL of the largest
+    coefficient) the leading one is deflated as its exact root. Angles are wrapped to
+    (-pi, pi] (within 1e-12 of +-pi: pi), sorted, and equal ones (1e-12) merged. Near-double
+    roots come out as complex pairs with a small imaginary part; they are accepted and
+    polished. Every candidate is certified by forward kinematics afterwards, so a spurious
+    angle costs time, never correctness.
+    When every coefficient is at most `free` the polynomial vanishes identically: the angle
+    is free: _free(ref).
+    """
+    c = [float(x) for x in coeffs]
+    size = max(abs(x) for x in c)
+    if size <= free:
+        return _free(ref)
+    if size == 0.0:
+        return ()
+    flip = abs(c[0]) < abs(c[-1])
+    if flip:
+        c.reverse()
+    angles = []
+    while len(c) > 1 and abs(c[0]) <= _LEAD_TOL * size:
+        # both ends vanish (roots at u = 0 and u = infinity): the one at this end is exact
+        c.pop(0)
+        angles.append(0.0 if flip else math.pi)
+    for x in _real_roots(c) if len(c) > 1 else ():
+        angles.append(_wrap_snap(2.0 * atan2(1.0, x) if flip else 2.0 * math.atan(x)))
+    angles.sort()
+    out: list[float] = []
+    for t in angles:
+        if not out or t - out[-1] > 1e-12:
+            out.append(t)
+    return out
+
+
+def _wrap_snap(t: float) -> float:
+    t = _wrap(t)
+    return math.pi if math.pi - abs(t) <= 1e-12 else t
+
+
+def _real_roots(p: list[float]) -> list[float]:
+    """Real roots of p (highest degree first, p[0] != 0), Newton-polished.
+
+    Closed forms for degrees 1, 2 and 4 (Ferrari); the companion matrix (numpy.roots) for
+    other degrees and whenever a closed-form root fails the residual test.
+    """
+    d = len(p) - 1
+    lead = p[0]
+    if d == 1:
+        return [-p[1] / lead]
+    if d == 2:
+        zs = _kquadratic(p[1] / lead, p[2] / lead)
+    elif d == 4:
+        zs = _kquartic(p[1] / lead, p[2] / lead, p[3] / lead, p[4] / lead)
+    else:
+        zs = None
+    if zs is not None:
+        roots = _accept(p, zs)
+        if roots is not None:
+            return roots
+    return _accept(p, np.roots(p).tolist(), check=False) or []
+
+
+def _accept(p: list[float], zs: list[complex], check: bool = True) -> list[float] | None:
+    """Polished real parts of the near-real zs; None if one fails the residual test.
+
+    A double root comes out split, as a complex pair or as two reals about sqrt(eps) apart;
+    roots closer than _MERGE_TOL are replaced by their mean, which is accurate. A root of
+    multiplicity k splits by about eps^(1/k) (1e-4 for k = 4) into a cluster, not all real,
+    whose mean is accurate too: such a cluster within _CLUSTER_TOL gives its mean. Merged
+    roots and cluster means are not Newton-polished: at a multiple root p and p' both
+    vanish, and Newton's step is rounding noise divided by rounding noise (it moved a double
+    root by 3.5e-5).
+    """
+    xs = []
+    split = False
+    for z in zs:
+        z = complex(z)
+        if abs(z.imag) <= _ROOT_IMAG_TOL * (1.0 + abs(z)):
+            xs.append((z.real, True))
+        elif abs(z.imag) <= _CLUSTER_TOL * (1.0 + abs(z)):
+            split = True
+    if split:
+        xs = [
+            (z.real, simple)
+            for z, simple in _clusters([complex(z) for z in zs])
+            if abs(z.imag) <= _ROOT_IMAG_TOL * (1.0 + abs(z))
+        ]
+    xs.sort()
+    out = []
+    k = 0
+    while k < len(xs):
+        x, simple = xs[k]
+        if k + 1 < len(xs) and xs[k + 1][0] - x <= _MERGE_TOL * (1.0 + abs(x)):
+            x = 0.5 * (x + xs[k + 1][0])
+            k += 1
+        elif simple:
+            x = _newton(p, x)
+        if check and not _small_residual(p, x):
+            return None
+        out.append(x)
+        k += 1
+    return out
+
+
+def _clusters(zs: list[complex]) -> list[tuple[complex, bool]]:
+    """zs with each cluster of nearby roots that are not all real replaced by its mean, as
+    (root, whether it is a simple root rather than a cluster's mean)."""
+    out = []
+    left = list(zs)
+    while left:
+        z = left.pop(0)
+        group = [z] + [w for w in left if abs(w - z) <= _CLUSTER_TOL * (1.0 + abs(z))]
+        if len(group) > 1 and any(abs(w.imag) > _ROOT_IMAG_TOL * (1.0 + abs(w)) for w in group):
+            left = [w for w in left if all(w is not g for g in group)]
+            out.append((sum(group) / len(group), False))
+        else:
+            out.append((z, True))
+    return out
+
+
+def _vnew_axis(values, ok, like, axis, free=False):
+    """Broadcast a step's result (no branching) to the shape of `like`: values, validity and
+    where the joint was free."""
+    values, ok, free, _ = np.broadcast_arrays(values, ok, free, like)
+    return values, ok, free
+
+
+def _vcs1(a, b, e, scale, ref, axis, like):
+    """Vectorised _cs1: two values along `axis` (+acos, then -acos), their validity and where
+    the joint was free (ref as the first value, the second invalid)."""
+    a, b, e, ref, _ = np.broadcast_arrays(a, b, e, ref, like)
+    rho = np.sqrt(a * a + b * b)
+    small = rho * rho <= _FREE_TOL * scale
+    free = small & (e * e <= _FREE_TOL * scale)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        ratio = e / rho
+    ok = ~small & (rho > 0.0) & (np.abs(ratio) <= 1.0 + _CLAMP_TOL)
+    base = np.arctan2(b, a)
+    ratio = np.where(ok, ratio, 0.0)
+    fold = np.abs(ratio) >= 1.0 - _FOLD_TOL
+    delta = np.where(
+        fold, np.where(ratio > 0.0, 0.0, math.pi), np.arccos(np.clip(ratio, -1.0, 1.0))
+    )
+    return (
+        np.concatenate((np.where(free, ref, base + delta), base - delta), axis),
+        np.concatenate((ok | free, ok), axis),
+        np.concatenate((free, np.zeros_like(free)), axis),
+    )
+
+
+def _vcs2(a1, b1, e1, a2, b2, e2, det_scale, rhs_scale, ref, axis, like):
+    """Vectorised _cs2 (one value; ref where the angle is free)."""
+    det = a1 * b2 - a2 * b1
+    free = (np.abs(det) <= _FREE_TOL * det_scale) | (e1 * e1 + e2 * e2 <= _FREE_TOL * rhs_scale)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        value = np.arctan2((a1 * e2 - a2 * e1) / det, (e1 * b2 - b1 * e2) / det)
+    return _vnew_axis(np.where(free, ref, value), True, like, axis, free)
+
+
+def _vatan2(y, x, ref, axis, like):
+    """Vectorised _atan2."""
+    free = np.abs(y) + np.abs(x) <= 1e-12
+    return _vnew_axis(np.where(free, ref, np.arctan2(y, x)), True, like, axis, free)
+
+
+def _vwrap(t):
+    """Angles wrapped to (-pi, pi] (as _wrap: a value rounding to -pi becomes pi)."""
+    w = t - _TWO_PI * np.round(t / _TWO_PI)
+    return np.where(w <= -math.pi, w + _TWO_PI, w)
+
+
+def _vroots(p):
+    """Real roots of the rows of p (m, d+1), p[:, 0] != 0, as _real_roots does per row.
+
+    Returns (roots (m, d), valid (m, d), fallback (m,)): rows marked fallback (other degrees,
+    a leading coefficient below _LEAD_TOL, a closed-form root failing the residual test, a
+    multiple root split into a cluster) are to be solved by the scalar routine.
+    """
+    m, d = p.shape[0], p.shape[1] - 1
+    lead = p[:, 0]
+    fallback = np.abs(lead) <= _LEAD_TOL * np.abs(p).max(axis=1)
+    mon = p[:, 1:] / np.where(fallback, 1.0, lead)[:, None]
+    if d == 2:
+        zs = np.stack(_vquadratic(mon[:, 0].astype(complex), mon[:, 1].astype(complex)), axis=1)
+    elif d == 4:
+        zs = np.stack(_vquartic(*(mon[:, k].astype(complex) for k in range(4))), axis=1)
+    elif d == 1:
+        zs = (-mon[:, :1]).astype(complex)
+    else:
+        return np.zeros((m, d)), np.zeros((m, d), bool), np.ones(m, bool)
+    with np.errstate(all="ignore"):
+        ok = np.abs(zs.imag) <= _ROOT_IMAG_TOL * (1.0 + np.abs(zs))
+        # a split multiple root (imaginary parts up to _CLUSTER_TOL): the scalar routine
+        fallback |= (~ok & (np.abs(zs.imag) <= _CLUSTER_TOL * (1.0 + np.abs(zs)))).any(axis=1)
+        x = np.where(ok, zs.real, np.inf)
+        x.sort(axis=1)
+        ok = np.isfinite(x)
+        head = np.zeros_like(ok)
+        consumed = np.zeros_like(ok)
+        for k in range(d - 1):
+            pair = (
+                ok[:, k]
+                & ok[:, k + 1]
+                & ~consumed[:, k]
+                & (x[:, k + 1] - x[:, k] <= _MERGE_TOL * (1.0 + np.abs(x[:, k])))
+            )
+            x[:, k] = np.where(pair, 0.5 * (x[:, k] + x[:, k + 1]), x[:, k])
+            head[:, k] |= pair
+            consumed[:, k + 1] |= pair
+        ok &= ~consumed
+        x = np.where(ok, x, 0.0)
+        x = np.where(ok & ~head, _vnewton(p, x), x)
+        value = np.zeros_like(x)
+        size = np.zeros_like(x)
+        slope = np.zeros_like(x)
+        ax = np.abs(x)
+        for k in range(d + 1):
+            slope = slope * x + value
+            value = value * x + p[:, k : k + 1]
+            size = size * ax + np.abs(p[:, k : k + 1])
+        small = (np.abs(value) <= _RESIDUAL_TOL * size) | (
+            np.abs(value) <= _RESIDUAL_TOL * (1.0 + ax) * np.abs(slope)
+        )
+        bad = ok & ~small
+    fallback |= bad.any(axis=1)
+    return x, ok, fallback
+
+
+def _vnewton(p, x):
+    """Two guarded Newton steps on the rows' polynomials, elementwise."""
+    with np.errstate(all="ignore"):
+        for _ in range(2):
+            val = np.zeros_like(x)
+            der = np.zeros_like(x)
+            for k in range(p.shape[1]):
+                der = der * x + val
+                val = val * x + p[:, k : k + 1]
+            step = val / der
+            good = np.isfinite(step) & (np.abs(step) <= 1e-3 * (1.0 + np.abs(x)))
+            x = np.where(good, x - step, x)
+    return x
+
+
+def _vquadratic(b, c):
+    """Both roots of x^2 + b x + c (complex arrays), as _kquadratic."""
+    t = np.sqrt(b * b - 4.0 * c)
+    t = np.where((np.conj(b) * t).real < 0.0, -t, t)
+    q = -0.5 * (b + t)
+    with np.errstate(all="ignore"):
+        other = np.where(q == 0, q, c / q)
+    return q, other
+
+
+def _vcubic_largest(a2, a1, a0):
+    """The root of largest modulus of m^3 + a2 m^2 + a1 m + a0, as _kcubic_largest."""
+    P = a1 - a2 * a2 / 3.0
+    Q = 2.0 * a2**3 / 27.0 - a2 * a1 / 3.0 + a0
+    w = np.sqrt(Q * Q / 4.0 + P**3 / 27.0)
+    u3 = np.where(np.abs(-Q / 2.0 + w) < np.abs(-Q / 2.0 - w), -Q / 2.0 - w, -Q / 2.0 + w)
+    zero = u3 == 0
+    u = np.where(zero, 1.0, u3) ** (1.0 / 3.0)
+    best = np.zeros(u.shape, dtype=complex)
+    best_abs = np.full(u.shape, -1.0)
+    for w_k in _OMEGA:
+        uk = u * w_k
+        mk = uk - P / (3.0 * uk) - a2 / 3.0
+        better = np.abs(mk) > best_abs
+        best = np.where(better, mk, best)
+        best_abs = np.where(better, np.abs(mk), best_abs)
+    return np.where(zero, -a2 / 3.0, best)
+
+
+def _vquartic(B, C, D, E):
+    """The four roots of x^4 + B x^3 + C x^2 + D x + E (complex arrays), as _kquartic."""
+    a = B / 4.0
+    p = C - 6.0 * a * a
+    q = D - 2.0 * a * C + 8.0 * a**3
+    r = E - a * D + a * a * C - 3.0 * a**4
+    with np.errstate(all="ignore"):
+        m = _vcubic_largest(p, p * p / 4.0 - r, -q * q / 8.0)
+        s = np.sqrt(2.0 * m)
+        zero = s == 0
+        h = np.where(zero, 0.0, q / np.where(zero, 1.0, 2.0 * s))
+        y1, y2 = _vquadratic(-s, p / 2.0 + m + h)
+        y3, y4 = _vquadratic(s, p / 2.0 + m - h)
+        t = np.sqrt(p * p - 4.0 * r)
+        b1, b2 = np.sqrt((-p + t) / 2.0), np.sqrt((-p - t) / 2.0)
+    y1, y2, y3, y4 = (
+        np.where(zero, alt, y) for y, alt in ((y1, b1), (y2, -b1), (y3, b2), (y4, -b2))
+    )
+    return y1 - a, y2 - a, y3 - a, y4 - a
+
+
+def _vpoly(coeffs, axis, like, angles, ref=0.0, free=0.0, unit=1.0):
+    """Vectorised _poly_angles (angles=True) or _poly_real: values along `axis`, validity and
+    where the joint was free.
+
+    Rows the closed forms cannot settle are solved by the scalar routine, one by one.
+    """
+    cs = np.broadcast_arrays(*coeffs, like)[:-1]
+    shape = cs[0].shape
+    raw = np.stack([np.asarray(x, dtype=float).ravel() for x in cs], axis=1)
+    m, d = raw.shape[0], raw.shape[1] - 1
+    if angles:
+        c = raw
+        flip = np.abs(c[:, 0]) < np.abs(c[:, -1])
+        p = np.where(flip[:, None], c[:, ::-1], c)
+    else:
+        c = raw * unit ** np.arange(d, -1, -1.0)  # the polynomial in x / unit, as _poly_real
+        flip = np.zeros(m, bool)
+        p = c
+    x, ok, fallback = _vroots(p)
+    if not angles:
+        fallback |= np.abs(c[:, 0]) <= _LEAD_TOL * np.abs(c).max(axis=1)
+    if angles:
+        with np.errstate(all="ignore"):
+            t = np.where(flip[:, None], 2.0 * np.arctan2(1.0, x), 2.0 * np.arctan(x))
+        t = _vwrap(t)
+        t = np.where(math.pi - np.abs(t) <= 1e-12, math.pi, t)
+        t = np.where(ok, t, np.inf)
+        t.sort(axis=1)
+        ok = np.isfinite(t)
+        with np.errstate(invalid="ignore"):
+            ok[:, 1:] &= ~(t[:, 1:] - t[:, :-1] <= 1e-12)
+        order = np.argsort(~ok, axis=1, kind="stable")
+        x = np.take_along_axis(np.where(ok, t, 0.0), order, axis=1)
+        ok = np.take_along_axis(ok, order, axis=1)
+    else:
+        close = np.zeros_like(ok)
+        close[:, 1:] = (
+            ok[:, 1:] & ok[:, :-1] & (x[:, 1:] - x[:, :-1] <= 1e-12 * (1.0 + np.abs(x[:, 1:])))
+        )
+        ok &= ~close
+        order = np.argsort(~ok, axis=1, kind="stable")
+        x = np.take_along_axis(x, order, axis=1) * unit
+        ok = np.take_along_axis(ok, order, axis=1)
+    scale = np.abs(raw).max(axis=1)
+    ok &= (scale > 0.0)[:, None]
+    vanishing = scale <= free
+    fallback |= vanishing
+    refs = np.broadcast_to(ref, shape).ravel()
+    freed = np.zeros_like(ok)
+    for i in np.flatnonzero(fallback & ((scale > 0.0) | vanishing)):
+        if angles:
+            values = _poly_angles(raw[i], float(refs[i]), free)
+        else:
+            values = _poly_real(raw[i], float(refs[i]), free, unit)
+        x[i] = 0.0
+        ok[i] = False
+        if values.__class__ is _Free:
+            values = values[:1]
+            freed[i, 0] = True
+        x[i, : len(values)] = values
+        ok[i, : len(values)] = True
+    inner = shape[:axis] + shape[axis + 1 :]
+    x, ok, freed = (np.moveaxis(v.reshape((*inner, d)), -1, axis) for v in (x, ok, freed))
+    return x, ok, freed
+
+
+def _vpose(T):
+    """Per-row validity of poses (N, 4, 4) and the poses with invalid rows replaced."""
+    T = _real(T, "T")
+    if T.ndim != 3 or T.shape[1:] != (4, 4):
+        raise ValueError(f"T must have shape (N, 4, 4), got {T.shape}")
+    flat = T.reshape(-1, 16)
+    with np.errstate(invalid="ignore", over="ignore"):
+        (a0, a1, a2, _, b0, b1, b2, _, c0, c1, c2, _, z0, z1, z2, z3) = flat.T
+        worst = np.abs(a0 * a0 + a1 * a1 + a2 * a2 - 1.0)
+        for dot in (
+            b0 * b0 + b1 * b1 + b2 * b2 - 1.0,
+            c0 * c0 + c1 * c1 + c2 * c2 - 1.0,
+            a0 * b0 + a1 * b1 + a2 * b2,
+            a0 * c0 + a1 * c1 + a2 * c2,
+            b0 * c0 + b1 * c1 + b2 * c2,
+            z0,
+            z1,
+            z2,
+            z3 - 1.0,
+        ):
+            worst = np.maximum(worst, np.abs(dot))
+        det = a0 * (b1 * c2 - b2 * c1) - a1 * (b0 * c2 - b2 * c0) + a2 * (b0 * c1 - b1 * c0)
+        good = (worst <= POSE_TOL) & (det > 0.0) & np.isfinite(flat).all(axis=1)
+    if good.all():
+        return T, good
+    return np.where(good[:, None, None], T, np.eye(4)), good
+
+
+def _vfinish(Q, valid):
+    """Wrap revolute values (as _finish: pi at the seam) and drop repeats within each pose
+    (vectorised).
+
+    Pairs are compared on their last joint first; only the few rows where that agrees are
+    compared in full.
+    """
+    count = Q.shape[1]
+    rev = np.array(_REVOLUTE)
+    Q = Q.copy()
+    W = _vwrap(Q[:, :, rev])
+    W = np.where(W < -_SEAM, W + _TWO_PI, W)  # _seam, vectorised
+    Q[:, :, rev] = np.where(np.abs(W - math.pi) <= _SEAM_SNAP, math.pi, W)
+    ok = valid.copy()
+    period = _PERIODS[-1]
+    for j in range(1, count):
+        for i in range(j):
+            last = np.abs(Q[:, j, -1] - Q[:, i, -1])
+            if period != math.inf:
+                last = np.minimum(last, _TWO_PI - last)
+            rows = np.flatnonzero(ok[:, i] & ok[:, j] & (last <= DEDUP_TOL))
+            if rows.size == 0:
+                continue
+            d = np.abs(Q[rows, j, :] - Q[rows, i, :])
+            d[:, rev] = np.minimum(d[:, rev], _TWO_PI - d[:, rev])
+            ok[rows[d.max(axis=1) <= DEDUP_TOL], j] = False
+    # the kept slots first, in order (as the compiled kernel writes them)
+    order = np.argsort(~ok, axis=1, kind="stable")
+    ok = np.take_along_axis(ok, order, axis=1)
+    Q = np.take_along_axis(Q, order[:, :, None], axis=1)
+    return np.where(ok[:, :, None], Q, 0.0), ok
+
+
+def _kpose_ok(T, i):
+    """Whether T[i] is a finite rigid transform within POSE_TOL (as _vpose)."""
+    for r in range(4):
+        for c in range(4):
+            if not math.isfinite(T[i, r, c]):
+                return False
+    worst = max(abs(T[i, 3, 0]), abs(T[i, 3, 1]), abs(T[i, 3, 2]), abs(T[i, 3, 3] - 1.0))
+    for r in range(3):
+        for s in range(r, 3):
+            dot = T[i, r, 0] * T[i, s, 0] + T[i, r, 1] * T[i, s, 1] + T[i, r, 2] * T[i, s, 2]
+            worst = max(worst, abs(dot - 1.0) if r == s else abs(dot))
+    det = (
+        T[i, 0, 0] * (T[i, 1, 1] * T[i, 2, 2] - T[i, 1, 2] * T[i, 2, 1])
+        - T[i, 0, 1] * (T[i, 1, 0] * T[i, 2, 2] - T[i, 1, 2] * T[i, 2, 0])
+        + T[i, 0, 2] * (T[i, 1, 0] * T[i, 2, 1] - T[i, 1, 1] * T[i, 2, 0])
+    )
+    return worst <= POSE_TOL and det > 0.0
+
+
+def _kcs1(a, b, e, scale):
+    """_cs1 as (count, t0, cos t0, sin t0, t1, cos t1, sin t1, status); status 1: the angle
+    is free. The cosines and sines come from a, b and e, not from cos and
+    sin of the angles: they agree with them to rounding, and cost no transcendental call."""
+    rho = sqrt(a * a + b * b)
+    if rho * rho <= _FREE_TOL * scale:
+        return 0, 0.0, 1.0, 0.0, 0.0, 1.0, 0.0, 1 if e * e <= _FREE_TOL * scale else 0
+    if rho == 0.0:
+        return 0, 0.0, 1.0, 0.0, 0.0, 1.0, 0.0, 0
+    ratio = e / rho
+    if abs(ratio) > 1.0 + _CLAMP_TOL:
+        return 0, 0.0, 1.0, 0.0, 0.0, 1.0, 0.0, 0
+    if abs(ratio) >= 1.0 - _FOLD_TOL:
+        ratio = 1.0 if ratio > 0.0 else -1.0
+    base = _kangle(b, a)
+    sd = sqrt((1.0 - ratio) * (1.0 + ratio))
+    delta = _kangle(sd, ratio)
+    cb, sb = a / rho, b / rho
+    return (
+        2,
+        base + delta,
+        cb * ratio - sb * sd,
+        sb * ratio + cb * sd,
+        base - delta,
+        cb * ratio + sb * sd,
+        sb * ratio - cb * sd,
+        0,
+    )
+
+
+def _kcs2(a1, b1, e1, a2, b2, e2, det_scale, rhs_scale):
+    """_cs2 as (t, cos t, sin t, status); status 1: the angle is free."""
+    det = a1 * b2 - a2 * b1
+    if abs(det) <= _FREE_TOL * det_scale or e1 * e1 + e2 * e2 <= _FREE_TOL * rhs_scale:
+        return 0.0, 1.0, 0.0, 1
+    # (cos t, sin t) = (x, y) / det: the direction of (x, y), reversed where det < 0
+    sign = math.copysign(1.0, det)
+    x, y = sign * (e1 * b2 - b1 * e2), sign * (a1 * e2 - a2 * e1)
+    h = sqrt(x * x + y * y)
+    if h == 0.0:
+        return 0.0, 1.0, 0.0, 0
+    return _kangle(y, x), x / h, y / h, 0
+
+
+def _katan2(y, x):
+    """_atan2 as (t, cos t, sin t, status); status 1: the angle is free."""
+    h = sqrt(x * x + y * y)
+    if abs(y) + abs(x) <= 1e-12 or h == 0.0:
+        return 0.0, 1.0, 0.0, 1
+    return _kangle(y, x), x / h, y / h, 0
+
+
+def _ksort(x, n):
+    """x[:n] sorted in place (insertion sort: n is at most 4)."""
+    for k in range(1, n):
+        v = x[k]
+        j = k - 1
+        while j >= 0 and x[j] > v:
+            x[j + 1] = x[j]
+            j -= 1
+        x[j + 1] = v
+
+
 def _kroots(p, out, xs):
     """_real_roots for the closed forms (degrees 1, 2 and 4): the count of ascending roots
     written to out, or -1 where _real_roots would need numpy.roots or clusters. xs: scratch."""
@@ -1826,8 +1494,8 @@ def _kroots(p, out, xs):
             x = 0.5 * (x + xs[k + 1])
             k += 1
         else:
-            x = _knewton(p, x)
-        if not _ksmall_residual(p, x):
+            x = _newton(p, x)
+        if not _small_residual(p, x):
             return -1
         out[count] = x
         count += 1
@@ -1838,8 +1506,9 @@ def _kroots(p, out, xs):
 def _kpoly(coeffs, angles, free, unit, buf):
     """_poly_angles (angles) or _poly_real: the count of values written to buf[:d]; -2 where
     the polynomial vanishes (the joint is free), -1 where the closed forms do not apply.
-    buf (32 long) is the step's own scratch: the values stay there (for angles, their cos
-    and sin at buf[20 + k] and buf[24 + k]) while later steps run."""
+    buf (6 d + 1 long, d the degree: _kpoly_slots) is the step's own scratch: the values stay
+    there (for angles, their cos and sin at buf[4 d + 1 + k] and buf[5 d + 1 + k]) while
+    later steps run."""
     d = len(coeffs) - 1
     size = 0.0
     for k in range(d + 1):
@@ -1848,7 +1517,8 @@ def _kpoly(coeffs, angles, free, unit, buf):
         return -2
     if not (d == 1 or d == 2 or d == 4):
         return -1
-    values, p, x, xs = buf[:d], buf[d:2 * d + 1], buf[2 * d + 1:3 * d + 1], buf[3 * d + 1:]
+    values, p, x = buf[:d], buf[d : 2 * d + 1], buf[2 * d + 1 : 3 * d + 1]
+    xs = buf[3 * d + 1 : 4 * d + 1]
     if size == 0.0:
         return 0
     flip = angles and abs(coeffs[0]) < abs(coeffs[d])
@@ -1859,9 +1529,9 @@ def _kpoly(coeffs, angles, free, unit, buf):
         return -1
     count = 0
     if angles:
-        # cos and sin of t = 2 atan(u) (u = 1 / v when flipped) from u itself, at buf[20:24]
-        # and buf[24:28], kept beside the angles through sorting and merging
-        cos_t, sin_t = buf[20:24], buf[24:28]
+        # cos and sin of t = 2 atan(u) (u = 1 / v when flipped) from u itself, kept beside
+        # the angles through sorting and merging
+        cos_t, sin_t = buf[4 * d + 1 : 5 * d + 1], buf[5 * d + 1 : 6 * d + 1]
         for k in range(n):
             u = x[k]
             t = _kwrap(2.0 * (_kangle(1.0, u) if flip else _kangle(u, 1.0)))
@@ -1923,19 +1593,26 @@ def _kfinish(found, count, rows, q):
     return m
 
 
-def _kreference(q):
-    """_ksolve's ref argument: q_ref's values, then their cosines, then their sines (one flat
-    tuple: numba's parallel loop takes no nested ones)."""
-    cosines = (cos(q[0]), cos(q[1]), cos(q[2]), cos(q[3]), cos(q[4]), cos(q[5]),)
-    sines = (sin(q[0]), sin(q[1]), sin(q[2]), sin(q[3]), sin(q[4]), sin(q[5]),)
-    return q + cosines + sines
-
-
 def _ksolve_pose(T, i, tol, ref, found, buf):
     """_ksolve on the pose T[i]."""
-    return _ksolve(T[i, 0, 0], T[i, 0, 1], T[i, 0, 2], T[i, 0, 3], T[i, 1, 0], T[i, 1, 1],
-                   T[i, 1, 2], T[i, 1, 3], T[i, 2, 0], T[i, 2, 1], T[i, 2, 2], T[i, 2, 3], tol,
-                   ref, found, buf)
+    return _ksolve(
+        T[i, 0, 0],
+        T[i, 0, 1],
+        T[i, 0, 2],
+        T[i, 0, 3],
+        T[i, 1, 0],
+        T[i, 1, 1],
+        T[i, 1, 2],
+        T[i, 1, 3],
+        T[i, 2, 0],
+        T[i, 2, 1],
+        T[i, 2, 2],
+        T[i, 2, 3],
+        tol,
+        ref,
+        found,
+        buf,
+    )
 
 
 def _kvariants(rows, m, ref):
@@ -1981,11 +1658,11 @@ def _kone(T, tol, qref, limited):
     """ik's solutions of the pose T[0] as (rows, status): status 0 where they are settled,
     1 where the scalar solver must settle the pose, 2 where T[0] is no valid pose. limited:
     as ik's within_limits (without all_turns)."""
-    rows = np.zeros((8, DOF))
+    rows = np.zeros((MAX_SOLUTIONS, DOF))
     if not _kpose_ok(T, 0):
         return rows[:0], 2
-    found = np.zeros((8, DOF))
-    count = _ksolve_pose(T, 0, tol, _kreference(qref), found, np.zeros(32 * DOF))
+    found = np.zeros((MAX_SOLUTIONS, DOF))
+    count = _ksolve_pose(T, 0, tol, _kreference(qref), found, np.zeros(_KBUF))
     if count < 0:
         return rows[:0], 1
     m = _kfinish(found, count, rows, np.zeros(DOF))
@@ -2002,8 +1679,8 @@ def _kbatch(T, tol, qref, Q, valid, retry):
     n = T.shape[0]
     ref = _kreference(qref)
     for part in _prange(_KPARTS):
-        found = np.zeros((8, DOF))
-        buf = np.zeros(32 * DOF)
+        found = np.zeros((MAX_SOLUTIONS, DOF))
+        buf = np.zeros(_KBUF)
         q = np.zeros(DOF)
         for i in range(part * n // _KPARTS, (part + 1) * n // _KPARTS):
             if not _kpose_ok(T, i):
@@ -2012,27 +1689,88 @@ def _kbatch(T, tol, qref, Q, valid, retry):
             if count < 0:
                 retry[i] = True
                 continue
-            valid[i, :_kfinish(found, count, Q[i], q)] = True
+            valid[i, : _kfinish(found, count, Q[i], q)] = True
 
 
 _KPARTS = 64
+
+
 # LLVM may fuse multiply-adds, reorder sums and divide by reciprocals in the kernel (about a
 # fifth of its time; the results move by rounding only: the certification and every test of
 # the compiled solver run on this arithmetic). nan and inf stay IEEE: poses are checked
 # with isfinite, and fallbacks test for them.
 _FASTMATH = {"contract", "arcp", "nsz", "reassoc"}
+
+
 # except in the polynomial roots: near a multiple root they move by far more than rounding,
 # and whether two roots merge must not depend on how LLVM ordered the arithmetic
-_KSTRICT = ("_kquadratic", "_kcubic_largest", "_kquartic", "_kquadratic_real", "_kquartic_real",
-            "_kroots", "_knewton", "_ksmall_residual")
+_KSTRICT = (
+    "_kquadratic",
+    "_kcubic_largest",
+    "_kquartic",
+    "_kquadratic_real",
+    "_kquartic_real",
+    "_kroots",
+    "_newton",
+    "_small_residual",
+)
+
+
 _prange = range
-_knewton = _newton
-_ksmall_residual = _small_residual
-_kfk = _fk_from_cs
 
 
-def _kfk_q(q):
-    """_fk_q for the kernel."""
+# --- the arm's own code, printed from its plan ------------------------------------------------
+
+def _fk_from_cs(c1, s1, c2, s2, c3, s3, c4, s4, c5, s5, c6, s6):
+    """Top three rows of the world pose, row-major, from cos and sin of the joint angles
+    (and d of prismatic joints); works on floats and on numpy arrays alike."""
+    x0 = c2*s3
+    x1 = c1*x0
+    x2 = c3*s2
+    x3 = c1*x2
+    x4 = -x1 - x3
+    x5 = c2*c3
+    x6 = c1*x5
+    x7 = s2*s3
+    x8 = -c1*x7 + x6
+    x9 = c4*x8 + s1*s4
+    x10 = s5*x9
+    x11 = c4*s1 - s4*x8
+    x12 = c5*x9 + s5*x4
+    x13 = s1*x0
+    x14 = s1*x2
+    x15 = -x13 - x14
+    x16 = s1*x5
+    x17 = -s1*x7 + x16
+    x18 = -c1*s4 + c4*x17
+    x19 = s5*x18
+    x20 = -c1*c4 - s4*x17
+    x21 = c5*x18 + s5*x15
+    x22 = s2*s3 - x5
+    x23 = -x0 - x2
+    x24 = c4*x23
+    x25 = s5*x24
+    x26 = s4*x23
+    x27 = c5*x24 + s5*x22
+    t00 = c5*x4 - x10
+    t01 = -c6*x11 + s6*x12
+    t02 = c6*x12 + s6*x11
+    t03 = (340.0*c1*c2 + 40.0*c1*s2*s3 - 30.0*c1 + 206.0*c5*x4 - 338.0*x1 - 206.0*x10 - 338.0*x3 -
+        40.0*x6)
+    t10 = c5*x15 - x19
+    t11 = -c6*x20 + s6*x21
+    t12 = c6*x21 + s6*x20
+    t13 = (340.0*c2*s1 + 206.0*c5*x15 + 40.0*s1*s2*s3 - 30.0*s1 - 338.0*x13 - 338.0*x14 - 40.0*x16 -
+        206.0*x19)
+    t20 = c5*x22 - x25
+    t21 = c6*x26 + s6*x27
+    t22 = c6*x27 - s6*x26
+    t23 = 206.0*c5*x22 - 340.0*s2 + 40.0*x0 + 40.0*x2 - 206.0*x25 - 338.0*x5 + 338.0*x7 + 373.0
+    return (t00, t01, t02, t03, t10, t11, t12, t13, t20, t21, t22, t23)
+
+
+def _fk_q(q):
+    """Top three rows of the world pose for one joint vector (a sequence of floats)."""
     theta1 = q[0]
     c1 = cos(theta1)
     s1 = sin(theta1)
@@ -2051,90 +1789,451 @@ def _kfk_q(q):
     theta6 = q[5]
     c6 = cos(theta6)
     s6 = sin(theta6)
-    return _kfk(c1, s1, c2, s2, c3, s3, c4, s4, c5, s5, c6, s6)
+    return _fk_from_cs(c1, s1, c2, s2, c3, s3, c4, s4, c5, s5, c6, s6)
 
 
-_KERNEL = ("_kpose_ok", "_kcs1", "_kcs2", "_reach_first1", "_reach_first2", "_kcs1r", "_kcs2r",
-           "_katan2", "_kangle", "_kwrap", "_kquadratic", "_kcubic_largest", "_kquartic",
-           "_kquadratic_real", "_kquartic_real", "_ksort", "_kroots", "_kpoly", "_kdistinct",
-           "_kfinish", "_kreference", "_ksolve_pose", "_kvariants", "_kpick", "_kone", "_ksolve", "_kbatch", "_knewton",
-           "_ksmall_residual", "_kfk", "_kfk_q")
-_compiled = None
-_BATCH_LOCK = threading.Lock()
-_COMPILE_LOCK = threading.Lock()
-# the name under which the compiled kernels' namespace is registered in sys.modules
+def _cs_columns(Q):
+    """Arguments of _fk_from_cs from joint vectors Q (..., DOF)."""
+    theta1 = Q[..., 0]
+    c1 = np.cos(theta1)
+    s1 = np.sin(theta1)
+    theta2 = Q[..., 1]
+    c2 = np.cos(theta2)
+    s2 = np.sin(theta2)
+    theta3 = Q[..., 2]
+    c3 = np.cos(theta3)
+    s3 = np.sin(theta3)
+    theta4 = Q[..., 3]
+    c4 = np.cos(theta4)
+    s4 = np.sin(theta4)
+    theta5 = Q[..., 4]
+    c5 = np.cos(theta5)
+    s5 = np.sin(theta5)
+    theta6 = Q[..., 5]
+    c6 = np.cos(theta6)
+    s6 = np.sin(theta6)
+    return (c1, s1, c2, s2, c3, s3, c4, s4, c5, s5, c6, s6,)
+
+
+def _keep(found, t, q, e, tol):
+    """Append q if its forward kinematics e reproduces the target t (certification)."""
+    ptol = tol * REACH
+    if (abs(e[0] - t[0]) <= tol and abs(e[1] - t[1]) <= tol and abs(e[2] - t[2]) <= tol and abs(e[4]
+        - t[4]) <= tol and abs(e[5] - t[5]) <= tol and abs(e[6] - t[6]) <= tol and abs(e[8] - t[8])
+        <= tol and abs(e[9] - t[9]) <= tol and abs(e[10] - t[10]) <= tol and abs(e[3] - t[3]) <=
+        ptol and abs(e[7] - t[7]) <= ptol and abs(e[11] - t[11]) <= ptol):
+        found.append(q)
+
+
+def _ik_scalar(target, qr1, qr2, qr3, qr4, qr5, qr6, tol):
+    """The scalar solver in Python: every certified solution of target (the 12 top entries of
+    the pose), in branch order, before wrapping and dropping repeats."""
+    (w11, w12, w13, wx, w21, w22, w23, wy, w31, w32, w33, wz) = target
+    found = []
+    # flange target 0_nT = (B X0 Tz(d1))^-1 T (Tz(dn) Xn E)^-1
+    r11 = w13
+    r12 = -w12
+    r13 = w11
+    px = -206.0*w11 + wx
+    r21 = w23
+    r22 = -w22
+    r23 = w21
+    py = -206.0*w21 + wy
+    r31 = w33
+    r32 = -w32
+    r33 = w31
+    pz = -206.0*w31 + wz - 373.0
+    # wrist centre (x, y, z) = 0P_4org and r = x^2 + y^2 + z^2
+    x = px
+    y = py
+    z = pz
+    r = px*px + py*py + pz*pz
+    # theta3: Pieper general case, polynomial of degree 4 in u = tan(theta3/2); free when it
+    # vanishes identically
+    x0 = r*r
+    x1 = z*z
+    x2 = x0 + 3600.0*x1
+    x3 = 919360.0*r
+    _n3 = len(found)
+    for theta3 in (_v3 := _poly_angles((-519088.0*r + x2 + 66431969536.0, x3 - 236959523840.0,
+        -929376.0*r + 2.0*x0 + 7200.0*x1 + 316127094272.0, x3 - 186946339840.0, -410288.0*r + x2 +
+        41348782336.0,), qr3, 20.845498492269137)):
+        c3 = cos(theta3)
+        s3 = sin(theta3)
+        # theta2: r and z equations, linear in (c2, s2)
+        _n2 = len(found)
+        for theta2 in (_v2 := _cs2(2400.0*c3 + 20280.0*s3 - 20400.0, 20280.0*c3 - 2400.0*s3,
+            27200.0*c3 + r + 229840.0*s3 - 232344.0, -338.0*c3 + 40.0*s3, 40.0*c3 + 338.0*s3 -
+            340.0, z, 33570240.0, 0.0, qr2)):
+            c2 = cos(theta2)
+            s2 = sin(theta2)
+            # g1(theta2, theta3), g2(theta2, theta3)
+            g1 = -40.0*c2*c3 - 338.0*c2*s3 + 340.0*c2 - 338.0*c3*s2 + 40.0*s2*s3 - 30.0
+            g2 = 0.0
+            # theta1: x = c1 g1 - s1 g2, y = s1 g1 + c1 g2; free with the wrist centre on axis 1
+            _n1 = len(found)
+            for theta1 in (_v1 := _cs2(g1, -g2, x, g2, g1, y, 559504.0, 559504.0, qr1)):
+                c1 = cos(theta1)
+                s1 = sin(theta1)
+                # wrist W = (0_3R Rx(alpha3))^T 0_6R = Rz(t4) Rx(alpha4) Rz(t5) Rx(alpha5) Rz(t6)
+                x4 = c2*s3
+                x5 = c3*s2
+                x6 = -x4 - x5
+                x7 = c2*c3
+                x8 = s2*s3
+                x9 = c1*x7 - c1*x8
+                x10 = s1*x7 - s1*x8
+                x11 = s2*s3 - x7
+                x12 = -c1*x4 - c1*x5
+                x13 = -s1*x4 - s1*x5
+                W11 = r11*x9 + r21*x10 + r31*x6
+                W12 = r12*x9 + r22*x10 + r32*x6
+                W13 = r13*x9 + r23*x10 + r33*x6
+                W21 = -c1*r21 + r11*s1
+                W22 = -c1*r22 + r12*s1
+                W23 = -c1*r23 + r13*s1
+                W31 = r11*x12 + r21*x13 + r31*x11
+                W32 = r12*x12 + r22*x13 + r32*x11
+                W33 = r13*x12 + r23*x13 + r33*x11
+                # theta5: W33 = e3^T Rx(alpha4) Rz(theta5) Rx(alpha5) e3
+                _n5 = len(found)
+                for theta5 in (_v5 := _cs1(1.0, 0.0, W33, 0.0, 0.0)):
+                    c5 = cos(theta5)
+                    s5 = sin(theta5)
+                    # v = Rx(alpha4) Rz(theta5) Rx(alpha5) e3
+                    v1 = -s5
+                    v2 = 0.0
+                    # theta4: (W13, W23) = Rz(theta4) (v1, v2); free at a singular wrist
+                    _n4 = len(found)
+                    for theta4 in (_v4 := _cs2(v1, -v2, W13, v2, v1, W23, 1.0, 1.0, qr4)):
+                        c4 = cos(theta4)
+                        s4 = sin(theta4)
+                        # theta6: Rz(theta6) = (Rx(alpha4) Rz(theta5) Rx(alpha5))^T Rz(theta4)^T W
+                        _n6 = len(found)
+                        for theta6 in (_v6 := _atan2(-W11*s4 + W21*c4, W11*c4*c5 + W21*c5*s4 +
+                            W31*s5, qr6)):
+                            c6 = cos(theta6)
+                            s6 = sin(theta6)
+                            _keep(found, target, (theta1, theta2, theta3, theta4, theta5, theta6,),
+                                _fk_from_cs(c1, s1, c2, s2, c3, s3, c4, s4, c5, s5, c6, s6), tol)
+                            if _v6.__class__ is _Free and len(found) > _n6:
+                                break
+                        if _v4.__class__ is _Free and len(found) > _n4:
+                            break
+                    if _v5.__class__ is _Free and len(found) > _n5:
+                        break
+                if _v1.__class__ is _Free and len(found) > _n1:
+                    break
+            if _v2.__class__ is _Free and len(found) > _n2:
+                break
+        if _v3.__class__ is _Free and len(found) > _n3:
+            break
+    return found
+
+
+def _ik_candidates(T, qr1, qr2, qr3, qr4, qr5, qr6, tol):
+    """Every branch of the solution for poses T (n, 4, 4): (n, M, DOF) values, (n, M)
+    validity, certified by forward kinematics (tol as for ik), and (n,) the poses to retry
+    with the scalar solver (a free joint's value left its branch without solution)."""
+    shape = (T.shape[0],) + (1,) * 6
+    w11 = T[:, 0, 0].reshape(shape)
+    w12 = T[:, 0, 1].reshape(shape)
+    w13 = T[:, 0, 2].reshape(shape)
+    wx = T[:, 0, 3].reshape(shape)
+    w21 = T[:, 1, 0].reshape(shape)
+    w22 = T[:, 1, 1].reshape(shape)
+    w23 = T[:, 1, 2].reshape(shape)
+    wy = T[:, 1, 3].reshape(shape)
+    w31 = T[:, 2, 0].reshape(shape)
+    w32 = T[:, 2, 1].reshape(shape)
+    w33 = T[:, 2, 2].reshape(shape)
+    wz = T[:, 2, 3].reshape(shape)
+    valid = np.ones(shape, dtype=bool)
+    # flange target 0_nT = (B X0 Tz(d1))^-1 T (Tz(dn) Xn E)^-1
+    r11 = w13
+    r12 = -w12
+    r13 = w11
+    px = -206.0*w11 + wx
+    r21 = w23
+    r22 = -w22
+    r23 = w21
+    py = -206.0*w21 + wy
+    r31 = w33
+    r32 = -w32
+    r33 = w31
+    pz = -206.0*w31 + wz - 373.0
+    # wrist centre (x, y, z) = 0P_4org and r = x^2 + y^2 + z^2
+    x = px
+    y = py
+    z = pz
+    r = px*px + py*py + pz*pz
+    # theta3: Pieper general case, polynomial of degree 4 in u = tan(theta3/2); free when it
+    # vanishes identically
+    x0 = r*r
+    x1 = z*z
+    x2 = x0 + 3600.0*x1
+    x3 = 919360.0*r
+    theta3, ok, free1 = (_vpoly((-519088.0*r + x2 + 66431969536.0, x3 - 236959523840.0, -929376.0*r
+        + 2.0*x0 + 7200.0*x1 + 316127094272.0, x3 - 186946339840.0, -410288.0*r + x2 +
+        41348782336.0,), 1, valid, True, qr3, 20.845498492269137))
+    valid = valid & ok
+    free1 = free1 & valid
+    c3 = np.cos(theta3)
+    s3 = np.sin(theta3)
+    # theta2: r and z equations, linear in (c2, s2)
+    theta2, ok, free2 = (_vcs2(2400.0*c3 + 20280.0*s3 - 20400.0, 20280.0*c3 - 2400.0*s3, 27200.0*c3
+        + r + 229840.0*s3 - 232344.0, -338.0*c3 + 40.0*s3, 40.0*c3 + 338.0*s3 - 340.0, z,
+        33570240.0, 0.0, qr2, 2, valid))
+    valid = valid & ok
+    free2 = free2 & valid
+    c2 = np.cos(theta2)
+    s2 = np.sin(theta2)
+    # g1(theta2, theta3), g2(theta2, theta3)
+    g1 = -40.0*c2*c3 - 338.0*c2*s3 + 340.0*c2 - 338.0*c3*s2 + 40.0*s2*s3 - 30.0
+    g2 = 0.0
+    # theta1: x = c1 g1 - s1 g2, y = s1 g1 + c1 g2; free with the wrist centre on axis 1
+    theta1, ok, free3 = _vcs2(g1, -g2, x, g2, g1, y, 559504.0, 559504.0, qr1, 3, valid)
+    valid = valid & ok
+    free3 = free3 & valid
+    c1 = np.cos(theta1)
+    s1 = np.sin(theta1)
+    # wrist W = (0_3R Rx(alpha3))^T 0_6R = Rz(t4) Rx(alpha4) Rz(t5) Rx(alpha5) Rz(t6)
+    x4 = c2*s3
+    x5 = c3*s2
+    x6 = -x4 - x5
+    x7 = c2*c3
+    x8 = s2*s3
+    x9 = c1*x7 - c1*x8
+    x10 = s1*x7 - s1*x8
+    x11 = s2*s3 - x7
+    x12 = -c1*x4 - c1*x5
+    x13 = -s1*x4 - s1*x5
+    W11 = r11*x9 + r21*x10 + r31*x6
+    W12 = r12*x9 + r22*x10 + r32*x6
+    W13 = r13*x9 + r23*x10 + r33*x6
+    W21 = -c1*r21 + r11*s1
+    W22 = -c1*r22 + r12*s1
+    W23 = -c1*r23 + r13*s1
+    W31 = r11*x12 + r21*x13 + r31*x11
+    W32 = r12*x12 + r22*x13 + r32*x11
+    W33 = r13*x12 + r23*x13 + r33*x11
+    # theta5: W33 = e3^T Rx(alpha4) Rz(theta5) Rx(alpha5) e3
+    theta5, ok, free4 = _vcs1(1.0, 0.0, W33, 0.0, 0.0, 4, valid)
+    valid = valid & ok
+    free4 = free4 & valid
+    c5 = np.cos(theta5)
+    s5 = np.sin(theta5)
+    # v = Rx(alpha4) Rz(theta5) Rx(alpha5) e3
+    v1 = -s5
+    v2 = 0.0
+    # theta4: (W13, W23) = Rz(theta4) (v1, v2); free at a singular wrist
+    theta4, ok, free5 = _vcs2(v1, -v2, W13, v2, v1, W23, 1.0, 1.0, qr4, 5, valid)
+    valid = valid & ok
+    free5 = free5 & valid
+    c4 = np.cos(theta4)
+    s4 = np.sin(theta4)
+    # theta6: Rz(theta6) = (Rx(alpha4) Rz(theta5) Rx(alpha5))^T Rz(theta4)^T W
+    theta6, ok, free6 = _vatan2(-W11*s4 + W21*c4, W11*c4*c5 + W21*c5*s4 + W31*s5, qr6, 6, valid)
+    valid = valid & ok
+    free6 = free6 & valid
+    c6 = np.cos(theta6)
+    s6 = np.sin(theta6)
+    Q = (np.stack((np.broadcast_to(theta1, valid.shape), np.broadcast_to(theta2, valid.shape),
+        np.broadcast_to(theta3, valid.shape), np.broadcast_to(theta4, valid.shape),
+        np.broadcast_to(theta5, valid.shape), np.broadcast_to(theta6, valid.shape)), axis=-1))
+    e = _fk_from_cs(c1, s1, c2, s2, c3, s3, c4, s4, c5, s5, c6, s6)
+    Q = Q.reshape(T.shape[0], -1, DOF)
+    t = (w11, w12, w13, wx, w21, w22, w23, wy, w31, w32, w33, wz)
+    ptol = tol * REACH
+    valid = (valid & (abs(e[0] - t[0]) <= tol) & (abs(e[1] - t[1]) <= tol) & (abs(e[2] - t[2]) <=
+        tol) & (abs(e[4] - t[4]) <= tol) & (abs(e[5] - t[5]) <= tol) & (abs(e[6] - t[6]) <= tol) &
+        (abs(e[8] - t[8]) <= tol) & (abs(e[9] - t[9]) <= tol) & (abs(e[10] - t[10]) <= tol) &
+        (abs(e[3] - t[3]) <= ptol) & (abs(e[7] - t[7]) <= ptol) & (abs(e[11] - t[11]) <= ptol))
+    retry = np.zeros(T.shape[0], dtype=bool)
+    retry |= (free1 & ~valid.any(axis=(2, 3, 4, 5, 6), keepdims=True)).reshape(T.shape[0],
+        -1).any(axis=1)
+    retry |= (free2 & ~valid.any(axis=(3, 4, 5, 6), keepdims=True)).reshape(T.shape[0],
+        -1).any(axis=1)
+    retry |= (free3 & ~valid.any(axis=(4, 5, 6), keepdims=True)).reshape(T.shape[0], -1).any(axis=1)
+    retry |= (free4 & ~valid.any(axis=(5, 6), keepdims=True)).reshape(T.shape[0], -1).any(axis=1)
+    retry |= (free5 & ~valid.any(axis=(6,), keepdims=True)).reshape(T.shape[0], -1).any(axis=1)
+    retry |= (free6 & ~valid).reshape(T.shape[0], -1).any(axis=1)
+    return Q, valid.reshape(T.shape[0], -1), retry
+
+
+def _kreference(q):
+    """_ksolve's ref argument: q_ref's values, then their cosines, then their sines (one flat
+    tuple: numba's parallel loop takes no nested ones)."""
+    return (q + (cos(q[0]), cos(q[1]), cos(q[2]), cos(q[3]), cos(q[4]), cos(q[5]),) + (sin(q[0]),
+        sin(q[1]), sin(q[2]), sin(q[3]), sin(q[4]), sin(q[5]),))
+
+
+def _ksolve(w11, w12, w13, wx, w21, w22, w23, wy, w31, w32, w33, wz, tol, ref, found, buf):
+    """The solutions of one pose into found (rows in ik's branch order, before wrapping and
+    dropping repeats): their count, or -1 where the scalar solver must settle the pose.
+    ref: q_ref's values, then their cosines, then their sines (_kreference); buf: scratch for
+    the polynomial steps (_KBUF)."""
+    qr1, qr2, qr3, qr4, qr5, qr6, = ref[0:6]
+    cr1, cr2, cr3, cr4, cr5, cr6, = ref[6:12]
+    sr1, sr2, sr3, sr4, sr5, sr6, = ref[12:18]
+    ptol = tol * REACH
+    n = 0
+    t = (w11, w12, w13, wx, w21, w22, w23, wy, w31, w32, w33, wz)
+    # flange target 0_nT = (B X0 Tz(d1))^-1 T (Tz(dn) Xn E)^-1
+    r11 = w13
+    r12 = -w12
+    r13 = w11
+    px = -206.0*w11 + wx
+    r21 = w23
+    r22 = -w22
+    r23 = w21
+    py = -206.0*w21 + wy
+    r31 = w33
+    r32 = -w32
+    r33 = w31
+    pz = -206.0*w31 + wz - 373.0
+    # wrist centre (x, y, z) = 0P_4org and r = x^2 + y^2 + z^2
+    x = px
+    y = py
+    z = pz
+    r = px*px + py*py + pz*pz
+    # theta3: Pieper general case, polynomial of degree 4 in u = tan(theta3/2); free when it
+    # vanishes identically
+    x0 = r*r
+    x1 = z*z
+    x2 = x0 + 3600.0*x1
+    x3 = 919360.0*r
+    _n3 = (_kpoly((-519088.0*r + x2 + 66431969536.0, x3 - 236959523840.0, -929376.0*r + 2.0*x0 +
+        7200.0*x1 + 316127094272.0, x3 - 186946339840.0, -410288.0*r + x2 + 41348782336.0,), True,
+        20.845498492269137, 1.0, buf[0:25]))
+    _f3 = _n3 == -2
+    if _f3:
+        _n3 = 1
+        buf[0] = qr3
+        buf[17], buf[21] = cr3, sr3
+    elif _n3 < 0:
+        return -1
+    _m3 = n
+    for _k3 in range(_n3):
+        theta3 = buf[0 + _k3]
+        c3 = buf[17 + _k3]
+        s3 = buf[21 + _k3]
+        # theta2: r and z equations, linear in (c2, s2)
+        theta2, c2, s2, _st = (_kcs2(2400.0*c3 + 20280.0*s3 - 20400.0, 20280.0*c3 - 2400.0*s3,
+            27200.0*c3 + r + 229840.0*s3 - 232344.0, -338.0*c3 + 40.0*s3, 40.0*c3 + 338.0*s3 -
+            340.0, z, 33570240.0, 0.0))
+        _f2 = _st == 1
+        if _f2:
+            theta2, c2, s2 = qr2, cr2, sr2
+        _m2 = n
+        # g1(theta2, theta3), g2(theta2, theta3)
+        g1 = -40.0*c2*c3 - 338.0*c2*s3 + 340.0*c2 - 338.0*c3*s2 + 40.0*s2*s3 - 30.0
+        g2 = 0.0
+        # theta1: x = c1 g1 - s1 g2, y = s1 g1 + c1 g2; free with the wrist centre on axis 1
+        theta1, c1, s1, _st = _kcs2(g1, -g2, x, g2, g1, y, 559504.0, 559504.0)
+        _f1 = _st == 1
+        if _f1:
+            theta1, c1, s1 = qr1, cr1, sr1
+        _m1 = n
+        # wrist W = (0_3R Rx(alpha3))^T 0_6R = Rz(t4) Rx(alpha4) Rz(t5) Rx(alpha5) Rz(t6)
+        x4 = c2*s3
+        x5 = c3*s2
+        x6 = -x4 - x5
+        x7 = c2*c3
+        x8 = s2*s3
+        x9 = c1*x7 - c1*x8
+        x10 = s1*x7 - s1*x8
+        x11 = s2*s3 - x7
+        x12 = -c1*x4 - c1*x5
+        x13 = -s1*x4 - s1*x5
+        W11 = r11*x9 + r21*x10 + r31*x6
+        W12 = r12*x9 + r22*x10 + r32*x6
+        W13 = r13*x9 + r23*x10 + r33*x6
+        W21 = -c1*r21 + r11*s1
+        W22 = -c1*r22 + r12*s1
+        W23 = -c1*r23 + r13*s1
+        W31 = r11*x12 + r21*x13 + r31*x11
+        W32 = r12*x12 + r22*x13 + r32*x11
+        W33 = r13*x12 + r23*x13 + r33*x11
+        # theta5: W33 = e3^T Rx(alpha4) Rz(theta5) Rx(alpha5) e3
+        _n5, _a5, _ac5, _as5, _b5, _bc5, _bs5, _st = _kcs1(1.0, 0.0, W33, 0.0)
+        _f5 = _st == 1
+        if _f5:
+            _n5, _a5, _ac5, _as5 = 1, 0.0, 1.0, 0.0
+        _m5 = n
+        for _k5 in range(_n5):
+            theta5, c5, s5 = (_a5, _ac5, _as5) if _k5 == 0 else (_b5, _bc5, _bs5)
+            # v = Rx(alpha4) Rz(theta5) Rx(alpha5) e3
+            v1 = -s5
+            v2 = 0.0
+            # theta4: (W13, W23) = Rz(theta4) (v1, v2); free at a singular wrist
+            theta4, c4, s4, _st = _kcs2(v1, -v2, W13, v2, v1, W23, 1.0, 1.0)
+            _f4 = _st == 1
+            if _f4:
+                theta4, c4, s4 = qr4, cr4, sr4
+            _m4 = n
+            # theta6: Rz(theta6) = (Rx(alpha4) Rz(theta5) Rx(alpha5))^T Rz(theta4)^T W
+            theta6, c6, s6, _st = _katan2(-W11*s4 + W21*c4, W11*c4*c5 + W21*c5*s4 + W31*s5)
+            _f6 = _st == 1
+            if _f6:
+                theta6, c6, s6 = qr6, cr6, sr6
+            _m6 = n
+            e = _fk_from_cs(c1, s1, c2, s2, c3, s3, c4, s4, c5, s5, c6, s6)
+            if (abs(e[0] - t[0]) <= tol and abs(e[1] - t[1]) <= tol and abs(e[2] - t[2]) <= tol and
+                abs(e[4] - t[4]) <= tol and abs(e[5] - t[5]) <= tol and abs(e[6] - t[6]) <= tol and
+                abs(e[8] - t[8]) <= tol and abs(e[9] - t[9]) <= tol and abs(e[10] - t[10]) <= tol
+                and abs(e[3] - t[3]) <= ptol and abs(e[7] - t[7]) <= ptol and abs(e[11] - t[11]) <=
+                ptol):
+                found[n, 0] = theta1
+                found[n, 1] = theta2
+                found[n, 2] = theta3
+                found[n, 3] = theta4
+                found[n, 4] = theta5
+                found[n, 5] = theta6
+                n += 1
+            if _f4 and n == _m4:
+                return -1
+            if _f6 and n == _m6:
+                return -1
+        if _f2 and n == _m2:
+            return -1
+        if _f1 and n == _m1:
+            return -1
+        if _f5 and n == _m5:
+            return -1
+    if _f3 and n == _m3:
+        return -1
+    return n
+
+
+# the scratch of _ksolve's polynomial steps, and the functions the compiled kernel is built from
+_KBUF = 25
 _KERNEL_SPACE = "_derive_ik_kernels_lecture_6r_17f09a8cee3e336f"
-
-
-def _kernels(backend):
-    """The compiled (_kbatch, _kone) for a backend argument, or None for the Python solver."""
-    if backend is None:
-        backend = BACKEND
-    if backend == "python":
-        return None
-    if backend not in ("auto", "numba"):
-        raise ValueError(f"backend must be 'auto', 'numba' or 'python', got {backend!r}")
-    kernels = _compile()
-    if kernels is None and backend == "numba":
-        raise ImportError("backend='numba' needs numba (pip install numba)")
-    return kernels
-
-
-def _compile():
-    """(_kbatch, _kone, _kpick) compiled by numba, once per process; None without numba."""
-    global _compiled
-    if _compiled is not None:  # the hot path: no lock
-        return _compiled or None
-    with _COMPILE_LOCK:
-        if _compiled is None:
-            _compiled = _build_kernels() or False
-    return _compiled or None
-
-
-def _build_kernels():
-    """The kernel functions compiled by numba as copies that call each other in a namespace of
-    their own, so that this module's functions stay Python whatever ran before.
-
-    The namespace is registered as the module _KERNEL_SPACE: numba reloads machine code
-    from its cache (in __pycache__ beside this file, when that folder is writable) only for
-    functions whose module it can import by name, and this file may have been imported by
-    path under any name.
-    """
-    try:
-        import numba
-    except ImportError:
-        return None
-    space = sys.modules.get(_KERNEL_SPACE)
-    if space is None or getattr(space, "_KERNEL_SOURCE", None) != __file__:
-        space = types.ModuleType(_KERNEL_SPACE)
-        sys.modules[_KERNEL_SPACE] = space
-    for cache in (True, False):
-        names = space.__dict__
-        names.update({k: v for k, v in globals().items() if not k.startswith("__")})
-        names.update(_prange=numba.prange, _KERNEL_SOURCE=__file__)
-        try:
-            for name in _KERNEL:
-                python = globals()[name]
-                copy = types.FunctionType(python.__code__, names, python.__name__,
-                                          python.__defaults__, python.__closure__)
-                copy.__qualname__ = python.__qualname__
-                fast = set() if name in _KSTRICT else _FASTMATH
-                names[name] = numba.njit(fastmath=fast, parallel=name == "_kbatch", cache=cache,
-                                         nogil=True, error_model="numpy")(copy)
-            return names["_kbatch"], names["_kone"], names["_kpick"]
-        except RuntimeError:  # no cache where numba cannot write one: compile without
-            continue
-    return None
-
-
-def warmup() -> bool:
-    """Compile (or load from numba's cache) the compiled solver now, not at the first ik:
-    call it at a program's start. Returns whether the compiled solver is available."""
-    kernels = _compile()
-    if kernels is None:
-        return False
-    T = fk(_ZEROS)
-    ik(T, backend="numba")
-    ik_batch(T[None], backend="numba")
-    kernels[2](np.zeros((1, DOF)), _ZEROS, _ONES, True)
-    return True
+_KERNEL = (
+    '_kangle',
+    '_kwrap',
+    '_kquadratic',
+    '_kcubic_largest',
+    '_kquartic',
+    '_kquadratic_real',
+    '_kquartic_real',
+    '_small_residual',
+    '_newton',
+    '_kpose_ok',
+    '_kcs1',
+    '_kcs2',
+    '_katan2',
+    '_ksort',
+    '_kroots',
+    '_kpoly',
+    '_kdistinct',
+    '_kfinish',
+    '_ksolve_pose',
+    '_kvariants',
+    '_kpick',
+    '_kone',
+    '_kbatch',
+    '_fk_from_cs',
+    '_kreference',
+    '_ksolve',
+)

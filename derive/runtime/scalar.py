@@ -1,3 +1,34 @@
+"""The Python solver's step routines: the values of one joint, as a tuple (a _Free tuple when
+the pose leaves the joint free, whose values the solver tries in turn)."""
+
+from __future__ import annotations
+
+import math
+from math import acos, atan2, sqrt
+
+import numpy as np
+
+from derive.runtime.closed import (
+    _kquadratic,
+    _kquartic,
+    _newton,
+    _reach_first1,
+    _reach_first2,
+    _small_residual,
+)
+from derive.runtime.common import _wrap
+from derive.runtime.constants import (
+    _CLAMP_TOL,
+    _CLUSTER_TOL,
+    _FOLD_TOL,
+    _FREE_STEPS,
+    _FREE_TOL,
+    _LEAD_TOL,
+    _MERGE_TOL,
+    _ROOT_IMAG_TOL,
+)
+
+
 class _Free(tuple):
     """The values a free joint tries, first the preferred one, then 5 degree steps out from
     it in both directions. The solver stops at the first value that gives a certified
@@ -5,11 +36,11 @@ class _Free(tuple):
     +-90 deg reaches only part of the orientations)."""
 
 
-def _free(t):
+def _free(t: float) -> _Free:
     return _Free([t + step for step in _FREE_STEPS])
 
 
-def _cs1(a, b, e, scale=0.0, ref=0.0):
+def _cs1(a: float, b: float, e: float, scale: float = 0.0, ref: float = 0.0) -> tuple[float, ...]:
     """Angles t with a cos t + b sin t = e: atan2(b, a) +- acos(e / sqrt(a^2 + b^2)), the
     acos argument clamped when it exceeds 1 by at most _CLAMP_TOL, and taken as +-1 within
     _FOLD_TOL below (the double root).
@@ -33,7 +64,24 @@ def _cs1(a, b, e, scale=0.0, ref=0.0):
     return (base + delta, base - delta)
 
 
-def _cs1_reach(a, b, e, m00, m01, m02, m10, m11, m12, m20, m21, m22, lo, hi, scale, ref):
+def _cs1_reach(
+    a: float,
+    b: float,
+    e: float,
+    m00: float,
+    m01: float,
+    m02: float,
+    m10: float,
+    m11: float,
+    m12: float,
+    m20: float,
+    m21: float,
+    m22: float,
+    lo: float,
+    hi: float,
+    scale: float,
+    ref: float,
+) -> tuple[float, ...]:
     """As _cs1; a free t starts at the first value _reach_first1 finds (the next joint must
     still let the wrist reach)."""
     rho = sqrt(a * a + b * b)
@@ -42,7 +90,17 @@ def _cs1_reach(a, b, e, m00, m01, m02, m10, m11, m12, m20, m21, m22, lo, hi, sca
     return _free(_reach_first1(m00, m01, m02, m10, m11, m12, m20, m21, m22, lo, hi, ref))
 
 
-def _cs2(a1, b1, e1, a2, b2, e2, det_scale, rhs_scale, ref):
+def _cs2(
+    a1: float,
+    b1: float,
+    e1: float,
+    a2: float,
+    b2: float,
+    e2: float,
+    det_scale: float,
+    rhs_scale: float,
+    ref: float,
+) -> tuple[float, ...]:
     """The angle t with a1 c + b1 s = e1 and a2 c + b2 s = e2; ref where t is free.
 
     t is free when the system is singular or, for a consistent system, when its right-hand
@@ -54,7 +112,22 @@ def _cs2(a1, b1, e1, a2, b2, e2, det_scale, rhs_scale, ref):
     return (atan2((a1 * e2 - a2 * e1) / det, (e1 * b2 - b1 * e2) / det),)
 
 
-def _cs2_reach(a1, b1, e1, a2, b2, e2, det_scale, rhs_scale, A, B, C, lo, hi, ref):
+def _cs2_reach(
+    a1: float,
+    b1: float,
+    e1: float,
+    a2: float,
+    b2: float,
+    e2: float,
+    det_scale: float,
+    rhs_scale: float,
+    A: float,
+    B: float,
+    C: float,
+    lo: float,
+    hi: float,
+    ref: float,
+) -> tuple[float, ...]:
     """As _cs2; a free t starts at _reach_first2's value (reachability of later joints)."""
     det = a1 * b2 - a2 * b1
     if abs(det) > _FREE_TOL * det_scale and e1 * e1 + e2 * e2 > _FREE_TOL * rhs_scale:
@@ -62,15 +135,16 @@ def _cs2_reach(a1, b1, e1, a2, b2, e2, det_scale, rhs_scale, A, B, C, lo, hi, re
     return _free(_reach_first2(A, B, C, lo, hi, ref))
 
 
-def _atan2(y, x, ref):
+def _atan2(y: float, x: float, ref: float) -> tuple[float, ...]:
     """atan2(y, x), or ref when both vanish (the angle is free)."""
     if abs(y) + abs(x) <= 1e-12:
         return _free(ref)
     return (atan2(y, x),)
 
 
-
-def _poly_real(coeffs, ref=0.0, free=0.0, unit=1.0):
+def _poly_real(
+    coeffs: tuple[float, ...] | np.ndarray, ref: float = 0.0, free: float = 0.0, unit: float = 1.0
+) -> tuple[float, ...] | list[float]:
     """Real roots of the polynomial (highest degree first), polished, ascending, distinct;
     (ref,) when every coefficient is at most `free` (the polynomial vanishes: d is free).
 
@@ -92,23 +166,26 @@ def _poly_real(coeffs, ref=0.0, free=0.0, unit=1.0):
     if len(c) < 2:
         return ()
     roots = sorted(_real_roots(c))
-    out = []
+    out: list[float] = []
     for x in roots:
         if not out or abs(x - out[-1]) > 1e-12 * (1.0 + abs(x)):
             out.append(x)
     return [x * unit for x in out]
 
 
-def _poly_angles(coeffs, ref=0.0, free=0.0):
+def _poly_angles(
+    coeffs: tuple[float, ...] | np.ndarray, ref: float = 0.0, free: float = 0.0
+) -> tuple[float, ...] | list[float]:
     """Angles t whose u = tan(t/2) is a real root of the polynomial (highest degree first).
 
     The polynomial is solved in u, or in v = 1/u when its last coefficient is the larger
     end, so that a vanishing leading coefficient (a root at u = infinity, t = pi; ALGORITHMS.md
     2.4) is an ordinary root v = 0. When both ends vanish (below _LEAD_TOL of the largest
-    coefficient) the leading one is deflated as its exact root. Angles are wrapped to (-pi, pi] (within 1e-12 of +-pi:
-    pi), sorted, and equal ones (1e-12) merged. Near-double roots come out as complex pairs
-    with a small imaginary part; they are accepted and polished. Every candidate is certified
-    by forward kinematics afterwards, so a spurious angle costs time, never correctness.
+    coefficient) the leading one is deflated as its exact root. Angles are wrapped to
+    (-pi, pi] (within 1e-12 of +-pi: pi), sorted, and equal ones (1e-12) merged. Near-double
+    roots come out as complex pairs with a small imaginary part; they are accepted and
+    polished. Every candidate is certified by forward kinematics afterwards, so a spurious
+    angle costs time, never correctness.
     When every coefficient is at most `free` the polynomial vanishes identically: the angle
     is free: _free(ref).
     """
@@ -129,19 +206,19 @@ def _poly_angles(coeffs, ref=0.0, free=0.0):
     for x in _real_roots(c) if len(c) > 1 else ():
         angles.append(_wrap_snap(2.0 * atan2(1.0, x) if flip else 2.0 * math.atan(x)))
     angles.sort()
-    out = []
+    out: list[float] = []
     for t in angles:
         if not out or t - out[-1] > 1e-12:
             out.append(t)
     return out
 
 
-def _wrap_snap(t):
+def _wrap_snap(t: float) -> float:
     t = _wrap(t)
     return math.pi if math.pi - abs(t) <= 1e-12 else t
 
 
-def _real_roots(p):
+def _real_roots(p: list[float]) -> list[float]:
     """Real roots of p (highest degree first, p[0] != 0), Newton-polished.
 
     Closed forms for degrees 1, 2 and 4 (Ferrari); the companion matrix (numpy.roots) for
@@ -161,10 +238,10 @@ def _real_roots(p):
         roots = _accept(p, zs)
         if roots is not None:
             return roots
-    return _accept(p, np.roots(p).tolist(), check=False)
+    return _accept(p, np.roots(p).tolist(), check=False) or []
 
 
-def _accept(p, zs, check=True):
+def _accept(p: list[float], zs: list[complex], check: bool = True) -> list[float] | None:
     """Polished real parts of the near-real zs; None if one fails the residual test.
 
     A double root comes out split, as a complex pair or as two reals about sqrt(eps) apart;
@@ -184,8 +261,11 @@ def _accept(p, zs, check=True):
         elif abs(z.imag) <= _CLUSTER_TOL * (1.0 + abs(z)):
             split = True
     if split:
-        xs = [(z.real, simple) for z, simple in _clusters([complex(z) for z in zs])
-              if abs(z.imag) <= _ROOT_IMAG_TOL * (1.0 + abs(z))]
+        xs = [
+            (z.real, simple)
+            for z, simple in _clusters([complex(z) for z in zs])
+            if abs(z.imag) <= _ROOT_IMAG_TOL * (1.0 + abs(z))
+        ]
     xs.sort()
     out = []
     k = 0
@@ -203,7 +283,7 @@ def _accept(p, zs, check=True):
     return out
 
 
-def _clusters(zs):
+def _clusters(zs: list[complex]) -> list[tuple[complex, bool]]:
     """zs with each cluster of nearby roots that are not all real replaced by its mean, as
     (root, whether it is a simple root rather than a cluster's mean)."""
     out = []
@@ -217,31 +297,3 @@ def _clusters(zs):
         else:
             out.append((z, True))
     return out
-
-
-def _small_residual(p, x):
-    """p(x) is negligible against the size of its terms, or Newton's step from x is."""
-    value = size = slope = 0.0
-    ax = abs(x)
-    for k in p:
-        slope = slope * x + value
-        value = value * x + k
-        size = size * ax + abs(k)
-    return (abs(value) <= _RESIDUAL_TOL * size
-            or abs(value) <= _RESIDUAL_TOL * (1.0 + ax) * abs(slope))
-
-
-def _newton(c, x):
-    """Two Newton steps on the polynomial c (highest degree first), skipped if unstable."""
-    for _ in range(2):
-        p = dp = 0.0
-        for k in c:
-            dp = dp * x + p
-            p = p * x + k
-        if dp == 0.0:
-            break
-        step = p / dp
-        if not math.isfinite(step) or abs(step) > 1e-3 * (1.0 + abs(x)):
-            break
-        x -= step
-    return x

@@ -1,3 +1,34 @@
+"""The numpy batch solver's step routines: each Solve step's values along an array axis of
+their own, so that broadcasting does the branching (rows the closed forms cannot settle go to
+the scalar routines one by one)."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from derive.runtime.arm import _REVOLUTE
+from derive.runtime.common import _PERIODS, _real
+from derive.runtime.constants import (
+    _CLAMP_TOL,
+    _CLUSTER_TOL,
+    _FOLD_TOL,
+    _FREE_TOL,
+    _LEAD_TOL,
+    _MERGE_TOL,
+    _OMEGA,
+    _RESIDUAL_TOL,
+    _ROOT_IMAG_TOL,
+    _SEAM,
+    _SEAM_SNAP,
+    _TWO_PI,
+    DEDUP_TOL,
+    POSE_TOL,
+)
+from derive.runtime.scalar import _cs1_reach, _Free, _poly_angles, _poly_real
+
+
 def _vnew_axis(values, ok, like, axis, free=False):
     """Broadcast a step's result (no branching) to the shape of `like`: values, validity and
     where the joint was free."""
@@ -18,21 +49,29 @@ def _vcs1(a, b, e, scale, ref, axis, like):
     base = np.arctan2(b, a)
     ratio = np.where(ok, ratio, 0.0)
     fold = np.abs(ratio) >= 1.0 - _FOLD_TOL
-    delta = np.where(fold, np.where(ratio > 0.0, 0.0, math.pi),
-                     np.arccos(np.clip(ratio, -1.0, 1.0)))
-    return (np.concatenate((np.where(free, ref, base + delta), base - delta), axis),
-            np.concatenate((ok | free, ok), axis),
-            np.concatenate((free, np.zeros_like(free)), axis))
+    delta = np.where(
+        fold, np.where(ratio > 0.0, 0.0, math.pi), np.arccos(np.clip(ratio, -1.0, 1.0))
+    )
+    return (
+        np.concatenate((np.where(free, ref, base + delta), base - delta), axis),
+        np.concatenate((ok | free, ok), axis),
+        np.concatenate((free, np.zeros_like(free)), axis),
+    )
 
 
-def _vcs1_reach(a, b, e, m00, m01, m02, m10, m11, m12, m20, m21, m22, lo, hi, scale, ref,
-                axis, like):
+def _vcs1_reach(
+    a, b, e, m00, m01, m02, m10, m11, m12, m20, m21, m22, lo, hi, scale, ref, axis, like
+):
     """Vectorised _cs1_reach: _vcs1, with the (rare) free rows settled by the scalar routine."""
     values, ok, free = _vcs1(a, b, e, scale, ref, axis, like)
     args = np.broadcast_arrays(a, b, e, m00, m01, m02, m10, m11, m12, m20, m21, m22, ref, like)
     for index in zip(*np.nonzero(free)):
-        row = [float(x[index]) for x in args[:12]]
-        values[index] = _cs1_reach(*row, lo, hi, scale, float(args[12][index]))[0]
+        a0, b0, e0, n00, n01, n02, n10, n11, n12, n20, n21, n22, r0 = (
+            float(x[index]) for x in args[:13]
+        )
+        values[index] = _cs1_reach(
+            a0, b0, e0, n00, n01, n02, n10, n11, n12, n20, n21, n22, lo, hi, scale, r0
+        )[0]
     return values, ok, free
 
 
@@ -78,8 +117,8 @@ def _vroots(p):
     """Real roots of the rows of p (m, d+1), p[:, 0] != 0, as _real_roots does per row.
 
     Returns (roots (m, d), valid (m, d), fallback (m,)): rows marked fallback (other degrees,
-    a leading coefficient below _LEAD_TOL, a closed-form root failing the residual test, a multiple root
-    split into a cluster) are to be solved by the scalar routine.
+    a leading coefficient below _LEAD_TOL, a closed-form root failing the residual test, a
+    multiple root split into a cluster) are to be solved by the scalar routine.
     """
     m, d = p.shape[0], p.shape[1] - 1
     lead = p[:, 0]
@@ -103,8 +142,12 @@ def _vroots(p):
         head = np.zeros_like(ok)
         consumed = np.zeros_like(ok)
         for k in range(d - 1):
-            pair = (ok[:, k] & ok[:, k + 1] & ~consumed[:, k]
-                    & (x[:, k + 1] - x[:, k] <= _MERGE_TOL * (1.0 + np.abs(x[:, k]))))
+            pair = (
+                ok[:, k]
+                & ok[:, k + 1]
+                & ~consumed[:, k]
+                & (x[:, k + 1] - x[:, k] <= _MERGE_TOL * (1.0 + np.abs(x[:, k])))
+            )
             x[:, k] = np.where(pair, 0.5 * (x[:, k] + x[:, k + 1]), x[:, k])
             head[:, k] |= pair
             consumed[:, k + 1] |= pair
@@ -117,10 +160,11 @@ def _vroots(p):
         ax = np.abs(x)
         for k in range(d + 1):
             slope = slope * x + value
-            value = value * x + p[:, k:k + 1]
-            size = size * ax + np.abs(p[:, k:k + 1])
-        small = ((np.abs(value) <= _RESIDUAL_TOL * size)
-                 | (np.abs(value) <= _RESIDUAL_TOL * (1.0 + ax) * np.abs(slope)))
+            value = value * x + p[:, k : k + 1]
+            size = size * ax + np.abs(p[:, k : k + 1])
+        small = (np.abs(value) <= _RESIDUAL_TOL * size) | (
+            np.abs(value) <= _RESIDUAL_TOL * (1.0 + ax) * np.abs(slope)
+        )
         bad = ok & ~small
     fallback |= bad.any(axis=1)
     return x, ok, fallback
@@ -134,7 +178,7 @@ def _vnewton(p, x):
             der = np.zeros_like(x)
             for k in range(p.shape[1]):
                 der = der * x + val
-                val = val * x + p[:, k:k + 1]
+                val = val * x + p[:, k : k + 1]
             step = val / der
             good = np.isfinite(step) & (np.abs(step) <= 1e-3 * (1.0 + np.abs(x)))
             x = np.where(good, x - step, x)
@@ -154,8 +198,8 @@ def _vquadratic(b, c):
 def _vcubic_largest(a2, a1, a0):
     """The root of largest modulus of m^3 + a2 m^2 + a1 m + a0, as _kcubic_largest."""
     P = a1 - a2 * a2 / 3.0
-    Q = 2.0 * a2 ** 3 / 27.0 - a2 * a1 / 3.0 + a0
-    w = np.sqrt(Q * Q / 4.0 + P ** 3 / 27.0)
+    Q = 2.0 * a2**3 / 27.0 - a2 * a1 / 3.0 + a0
+    w = np.sqrt(Q * Q / 4.0 + P**3 / 27.0)
     u3 = np.where(np.abs(-Q / 2.0 + w) < np.abs(-Q / 2.0 - w), -Q / 2.0 - w, -Q / 2.0 + w)
     zero = u3 == 0
     u = np.where(zero, 1.0, u3) ** (1.0 / 3.0)
@@ -174,8 +218,8 @@ def _vquartic(B, C, D, E):
     """The four roots of x^4 + B x^3 + C x^2 + D x + E (complex arrays), as _kquartic."""
     a = B / 4.0
     p = C - 6.0 * a * a
-    q = D - 2.0 * a * C + 8.0 * a ** 3
-    r = E - a * D + a * a * C - 3.0 * a ** 4
+    q = D - 2.0 * a * C + 8.0 * a**3
+    r = E - a * D + a * a * C - 3.0 * a**4
     with np.errstate(all="ignore"):
         m = _vcubic_largest(p, p * p / 4.0 - r, -q * q / 8.0)
         s = np.sqrt(2.0 * m)
@@ -185,7 +229,9 @@ def _vquartic(B, C, D, E):
         y3, y4 = _vquadratic(s, p / 2.0 + m - h)
         t = np.sqrt(p * p - 4.0 * r)
         b1, b2 = np.sqrt((-p + t) / 2.0), np.sqrt((-p - t) / 2.0)
-    y1, y2, y3, y4 = (np.where(zero, alt, y) for y, alt in ((y1, b1), (y2, -b1), (y3, b2), (y4, -b2)))
+    y1, y2, y3, y4 = (
+        np.where(zero, alt, y) for y, alt in ((y1, b1), (y2, -b1), (y3, b2), (y4, -b2))
+    )
     return y1 - a, y2 - a, y3 - a, y4 - a
 
 
@@ -225,7 +271,9 @@ def _vpoly(coeffs, axis, like, angles, ref=0.0, free=0.0, unit=1.0):
         ok = np.take_along_axis(ok, order, axis=1)
     else:
         close = np.zeros_like(ok)
-        close[:, 1:] = ok[:, 1:] & ok[:, :-1] & (x[:, 1:] - x[:, :-1] <= 1e-12 * (1.0 + np.abs(x[:, 1:])))
+        close[:, 1:] = (
+            ok[:, 1:] & ok[:, :-1] & (x[:, 1:] - x[:, :-1] <= 1e-12 * (1.0 + np.abs(x[:, 1:])))
+        )
         ok &= ~close
         order = np.argsort(~ok, axis=1, kind="stable")
         x = np.take_along_axis(x, order, axis=1) * unit
@@ -246,10 +294,10 @@ def _vpoly(coeffs, axis, like, angles, ref=0.0, free=0.0, unit=1.0):
         if values.__class__ is _Free:
             values = values[:1]
             freed[i, 0] = True
-        x[i, :len(values)] = values
-        ok[i, :len(values)] = True
-    inner = shape[:axis] + shape[axis + 1:]
-    x, ok, freed = (np.moveaxis(v.reshape(inner + (d,)), -1, axis) for v in (x, ok, freed))
+        x[i, : len(values)] = values
+        ok[i, : len(values)] = True
+    inner = shape[:axis] + shape[axis + 1 :]
+    x, ok, freed = (np.moveaxis(v.reshape((*inner, d)), -1, axis) for v in (x, ok, freed))
     return x, ok, freed
 
 
@@ -262,11 +310,19 @@ def _vpose(T):
     with np.errstate(invalid="ignore", over="ignore"):
         (a0, a1, a2, _, b0, b1, b2, _, c0, c1, c2, _, z0, z1, z2, z3) = flat.T
         worst = np.abs(a0 * a0 + a1 * a1 + a2 * a2 - 1.0)
-        for dot in (b0 * b0 + b1 * b1 + b2 * b2 - 1.0, c0 * c0 + c1 * c1 + c2 * c2 - 1.0,
-                    a0 * b0 + a1 * b1 + a2 * b2, a0 * c0 + a1 * c1 + a2 * c2,
-                    b0 * c0 + b1 * c1 + b2 * c2, z0, z1, z2, z3 - 1.0):
+        for dot in (
+            b0 * b0 + b1 * b1 + b2 * b2 - 1.0,
+            c0 * c0 + c1 * c1 + c2 * c2 - 1.0,
+            a0 * b0 + a1 * b1 + a2 * b2,
+            a0 * c0 + a1 * c1 + a2 * c2,
+            b0 * c0 + b1 * c1 + b2 * c2,
+            z0,
+            z1,
+            z2,
+            z3 - 1.0,
+        ):
             worst = np.maximum(worst, np.abs(dot))
-        det = (a0 * (b1 * c2 - b2 * c1) - a1 * (b0 * c2 - b2 * c0) + a2 * (b0 * c1 - b1 * c0))
+        det = a0 * (b1 * c2 - b2 * c1) - a1 * (b0 * c2 - b2 * c0) + a2 * (b0 * c1 - b1 * c0)
         good = (worst <= POSE_TOL) & (det > 0.0) & np.isfinite(flat).all(axis=1)
     if good.all():
         return T, good

@@ -1,0 +1,172 @@
+"""The runtime routines a generated module needs, copied from :mod:`derive.runtime`.
+
+Each runtime module is read as source (from the installed package) and split into its
+top-level pieces: a function, a class or an assignment, with the comment lines just above it.
+A piece knows the global names it defines and the names it uses. The emitter asks for the
+pieces that the arm's printed code and the module's public functions use, and everything those
+use in turn; they are copied in the runtime's order (:data:`derive.runtime.MODULES`, then
+source order), which keeps every module-level statement after the names it reads. Imports are
+not copied: the module gets one import block holding exactly the names its code uses.
+"""
+
+from __future__ import annotations
+
+import ast
+from collections.abc import Iterable
+from dataclasses import dataclass
+from functools import cache
+from importlib import resources
+
+from derive.runtime import MODULES
+
+# the names the generated module imports, as (import statement, name bound), in the order
+# ruff's isort puts them (standard library, then numpy)
+IMPORTS = (
+    ("import cmath", "cmath"),
+    ("import math", "math"),
+    ("import sys", "sys"),
+    ("import threading", "threading"),
+    ("import types", "types"),
+    ("from math import {}", "acos"),
+    ("from math import {}", "atan2"),
+    ("from math import {}", "cos"),
+    ("from math import {}", "sin"),
+    ("from math import {}", "sqrt"),
+    ("from operator import sub as _sub", "_sub"),
+    ("import numpy as np", "np"),
+    ("from numpy.typing import ArrayLike", "ArrayLike"),
+)
+# the public names of a module with forward kinematics only, and with inverse kinematics
+FK_ROOTS = ("fk", "fk_batch")
+IK_ROOTS = (*FK_ROOTS, "ik", "ik_batch", "nearest", "warmup", "CERTIFY_TOL", "BACKEND")
+# the compiled kernel's entry points (_compile builds them and what they call)
+KERNEL_ROOTS = ("_kbatch", "_kone", "_kpick")
+
+
+@dataclass(frozen=True)
+class Piece:
+    """One top-level statement of a runtime module (or of the arm's printed code).
+
+    Attributes:
+        module: the runtime module's name ("arm" for the printed code).
+        defines: the global names it binds.
+        uses: every name it reads (globals and, harmlessly, locals).
+        source: its text, with the comment lines just above it.
+        function: whether it is a function definition (the compiled kernel takes those).
+    """
+
+    module: str
+    defines: frozenset[str]
+    uses: frozenset[str]
+    source: str
+    function: bool
+
+
+def split(module: str, source: str) -> tuple[Piece, ...]:
+    """The pieces of a module's source, in order; imports, docstrings and ``if`` blocks are
+    left out."""
+    tree = ast.parse(source)
+    lines = source.split("\n")
+    pieces = []
+    for node in tree.body:
+        if isinstance(node, ast.FunctionDef | ast.ClassDef):
+            defines = {node.name}
+        elif isinstance(node, ast.Assign | ast.AnnAssign):
+            targets = node.targets if isinstance(node, ast.Assign) else [node.target]
+            defines = {n.id for t in targets for n in ast.walk(t) if isinstance(n, ast.Name)}
+        else:
+            continue
+        start = node.lineno - 1
+        while start > 0 and lines[start - 1].startswith("#"):
+            start -= 1
+        assert node.end_lineno is not None
+        uses = {n.id for n in ast.walk(node) if isinstance(n, ast.Name)} - defines
+        pieces.append(
+            Piece(
+                module=module,
+                defines=frozenset(defines),
+                uses=frozenset(uses),
+                source="\n".join(lines[start : node.end_lineno]),
+                function=isinstance(node, ast.FunctionDef),
+            )
+        )
+    return tuple(pieces)
+
+
+@cache
+def runtime_pieces() -> tuple[Piece, ...]:
+    """Every piece of the runtime, in copy order."""
+    package = resources.files("derive.runtime")
+    pieces: list[Piece] = []
+    for module in MODULES:
+        pieces += split(module, package.joinpath(f"{module}.py").read_text(encoding="utf-8"))
+    return tuple(pieces)
+
+
+def closure(roots: Iterable[str], pieces: tuple[Piece, ...]) -> tuple[Piece, ...]:
+    """The pieces defining the roots and, in turn, every name they use, in the pieces' order."""
+    by_name = {name: p for p in pieces for name in p.defines}
+    wanted: set[int] = set()
+    todo = [n for n in roots if n in by_name]
+    while todo:
+        piece = by_name[todo.pop()]
+        if id(piece) in wanted:
+            continue
+        wanted.add(id(piece))
+        todo += [n for n in piece.uses if n in by_name]
+    return tuple(p for p in pieces if id(p) in wanted)
+
+
+def import_block(source: str) -> str:
+    """The import statements binding exactly the imported names a module's source uses."""
+    used = {n.id for n in ast.walk(ast.parse(source)) if isinstance(n, ast.Name)}
+    lines: list[str] = []
+    from_math = [name for stmt, name in IMPORTS if stmt.startswith("from math") and name in used]
+    for stmt, name in IMPORTS:
+        if name not in used:
+            continue
+        if stmt.startswith("from math"):
+            if name == from_math[0]:
+                lines.append(stmt.format(", ".join(from_math)))
+            continue
+        if stmt.startswith("import numpy") and lines:
+            lines.append("")
+        lines.append(stmt)
+    return "\n".join(lines)
+
+
+@dataclass(frozen=True)
+class Assembly:
+    """What a generated module is made of beside its layout.
+
+    Attributes:
+        runtime: the copied runtime pieces' source, separated by two blank lines.
+        kernel: the names of the compiled kernel's functions, in copy order.
+    """
+
+    runtime: str
+    kernel: tuple[str, ...]
+
+
+def assemble(arm_source: str, has_ik: bool) -> Assembly:
+    """The runtime pieces for a module whose arm-specific code is arm_source."""
+    runtime = runtime_pieces()
+    arm = split("arm", arm_source)
+    everything = runtime + arm
+    roots = set(IK_ROOTS if has_ik else FK_ROOTS)
+    for piece in arm:
+        roots |= piece.uses
+    kernel: tuple[str, ...] = ()
+    if has_ik:
+        roots |= set(KERNEL_ROOTS)
+        kernel = tuple(
+            name
+            for p in closure(KERNEL_ROOTS, everything)
+            if p.function
+            for name in sorted(p.defines)
+        )
+    copied = tuple(p for p in closure(roots, everything) if p.module != "arm")
+    return Assembly(
+        runtime="\n\n\n".join(p.source for p in copied),
+        kernel=kernel,
+    )

@@ -1,0 +1,28 @@
+"""The generated modules' runtime: every routine a generated solver calls that is not about
+one arm, as ordinary Python that is linted, type-checked and tested here.
+
+A generated module is standalone (math and numpy; numba optional): the emitter
+(:mod:`derive.assemble`) copies into it the source of exactly the routines its arm's code
+calls, with everything they call, in the order of :data:`MODULES`, and prints the names of
+:mod:`derive.runtime.arm` from the arm's plan. In a generated module everything lives in one
+namespace; here each module imports what it uses from the modules before it.
+
+Modules, in copy order:
+
+=============  ==========================================================================
+``constants``  tolerances and settings (CERTIFY_TOL, BACKEND, the seam, ...)
+``api``        fk, fk_batch, ik, ik_batch, nearest, warmup: wrapping and dropping
+               repeats, joint limits, the choice of backend and the kernels' build
+``common``     argument checks and joint-value helpers the others share
+``closed``     closed forms shared by the Python and compiled solvers (quadratic,
+               quartic, atan2, Newton steps, the free-joint reach searches)
+``scalar``     the Python solver's step routines (``a cos + b sin = e``, polynomials)
+``vector``     the numpy batch solver's step routines (one array axis per branch)
+``kernel``     the compiled solver's routines, in the subset of Python numba compiles
+=============  ==========================================================================
+
+``arm`` is never copied: it stands in for the names each generated module prints for its
+arm (DOF, LIMITS, the forward kinematics, the solver bodies), so that this package imports.
+"""
+
+MODULES = ("constants", "api", "common", "closed", "scalar", "vector", "kernel")

@@ -1,0 +1,461 @@
+"""The generated module's public functions and their plumbing: argument checks, wrapping and
+dropping repeats, joint limits, the choice of backend and the compiled kernels' build."""
+
+from __future__ import annotations
+
+import math
+import sys
+import threading
+import types
+from operator import sub as _sub
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from derive.runtime.arm import (
+    _KERNEL,
+    _KERNEL_SPACE,
+    _REVOLUTE,
+    DOF,
+    LIMITS,
+    MAX_SOLUTIONS,
+    _cs_columns,
+    _fk_from_cs,
+    _fk_q,
+    _ik_candidates,
+    _ik_scalar,
+)
+from derive.runtime.common import (
+    _LOWER,
+    _ONES,
+    _PERIODS,
+    _REV,
+    _UPPER,
+    _ZEROS,
+    _real,
+    _reference,
+    _seam,
+    _tolerance,
+)
+from derive.runtime.constants import (
+    _SEAM,
+    _TWO_PI,
+    BACKEND,
+    CERTIFY_TOL,
+    DEDUP_TOL,
+    MAX_TURN_ROWS,
+    POSE_TOL,
+)
+from derive.runtime.kernel import _FASTMATH, _KSTRICT, _kpick
+from derive.runtime.vector import _vfinish, _vpose
+
+
+def fk(q: ArrayLike) -> np.ndarray:
+    """World pose of the tool frame (base and tool included) for joint vector q."""
+    values = _real(q, "q")
+    if values.shape != (DOF,):
+        raise ValueError(f"q must have shape ({DOF},), got {values.shape}")
+    e = _fk_q(values.tolist())
+    return np.array([e[0:4], e[4:8], e[8:12], (0.0, 0.0, 0.0, 1.0)])
+
+
+def fk_batch(Q: ArrayLike) -> np.ndarray:
+    """World poses (N, 4, 4) for joint vectors Q of shape (N, DOF), without a Python loop."""
+    values = _real(Q, "Q")
+    if values.ndim != 2 or values.shape[1] != DOF:
+        raise ValueError(f"Q must have shape (N, {DOF}), got {values.shape}")
+    out = np.zeros((values.shape[0], 4, 4))
+    entries = _fk_from_cs(*_cs_columns(values))
+    for k, value in enumerate(entries):
+        out[:, k // 4, k % 4] = value
+    out[:, 3, 3] = 1.0
+    return out
+
+
+def ik(
+    T: ArrayLike,
+    *,
+    within_limits: bool = False,
+    q_ref: ArrayLike | None = None,
+    tol: float = CERTIFY_TOL,
+    backend: str | None = None,
+    all_turns: bool = False,
+) -> np.ndarray:
+    """All solutions for the world pose T, as an (n, DOF) array; empty (0, DOF) if unreachable.
+
+    Args:
+        T: 4x4 homogeneous transform of the tool frame in the world.
+        within_limits: keep only solutions inside LIMITS. Each solution comes once, each
+            revolute joint at the value q + 2 pi k inside its limits nearest q_ref's (joints
+            without limits too: by default the wrapped value). A solution with a joint that
+            no such k brings inside its limits is dropped.
+        q_ref: joint vector whose values free joints take at singular poses, and that
+            within_limits picks variants near (default zeros).
+        tol: certification tolerance: a solution is returned only if its forward kinematics
+            matches T within tol in rotation entries and tol * REACH in position. For an arm
+            that does not control every pose component this is also the test that T's other
+            components are reachable: if they are not, the result is empty.
+        backend: "numba" runs the solver compiled (numba compiles it on the first call of a
+            process, or at warmup(), and caches the machine code beside this file); "python"
+            runs it as Python; "auto" is "numba" when numba is installed; None (default):
+            BACKEND, which is "auto" unless you set it. The two agree to rounding (far below
+            tol); poses the compiled closed forms do not settle (a free joint, a split
+            multiple root) are solved in Python either way.
+        all_turns: with within_limits, every variant of every solution inside the limits
+            (all k per joint, as a product; at most MAX_TURN_ROWS rows, else ValueError).
+
+    Raises:
+        ValueError: T is not 4x4, has non-finite or complex entries, or its rotation is not
+            orthonormal within POSE_TOL; q_ref is not DOF finite numbers; tol is not a
+            positive finite number; all_turns would give more than MAX_TURN_ROWS rows.
+    """
+    refs = _reference(q_ref)
+    tol = _tolerance(tol)
+    if within_limits:
+
+        def result(rows):
+            return _in_limits(rows, refs, all_turns)
+    else:
+        result = _as_rows
+    kernels = _kernels(backend)
+    if kernels is not None:
+        A = _array44(T)
+        if A is not None:  # else _pose says what is wrong with T
+            limited = within_limits and not all_turns
+            rows, status = kernels[1](A[None], tol, refs, limited)
+            if status == 0:
+                return rows if not within_limits or limited else result(rows)
+    # the Python solver; for the compiled one a pose it did not settle, or an invalid one
+    target = _pose(T)
+    return result(_finish(_ik_scalar(target, *refs, tol)))
+
+
+def _array44(T):
+    """T as a float64 array if it is 4x4, else None."""
+    if type(T) is not np.ndarray or T.dtype != np.float64:
+        try:
+            T = _real(T, "T")
+        except ValueError:
+            return None
+    return T if T.shape == (4, 4) else None
+
+
+def ik_batch(
+    T: ArrayLike,
+    *,
+    q_ref: ArrayLike | None = None,
+    tol: float = CERTIFY_TOL,
+    chunk: int = 4096,
+    backend: str | None = None,
+) -> tuple[np.ndarray, np.ndarray]:
+    """All solutions for many world poses at once, without a Python loop over poses.
+
+    Args:
+        T: (N, 4, 4) poses.
+        q_ref: as for ik (one joint vector for all poses).
+        tol: as for ik.
+        chunk: poses the python backend solves together; memory grows with it, not with N.
+        backend: "numba" solves the poses in a compiled loop, on every core (compiled as for
+            ik); "python" solves them with vectorised numpy; "auto" and None as for ik. Both
+            give ik's solutions.
+
+    Returns:
+        (Q, valid): Q (N, M, DOF) with M = MAX_SOLUTIONS, the most solutions a pose can
+        have; valid (N, M) marks the slots that hold a solution: for each pose the first
+        slots, holding the rows ik returns, in the same order; the other slots are zero.
+        within_limits is not offered here. Poses the closed forms alone do not settle (a
+        free joint, a split multiple root) are solved by ik. A pose that is not a valid
+        transform (not finite, rotation not orthonormal within POSE_TOL) gets no valid slot
+        instead of an exception.
+    """
+    tol = _tolerance(tol)
+    if type(chunk) is bool or not isinstance(chunk, (int, np.integer)) or chunk < 1:
+        raise ValueError(f"chunk must be a positive integer, got {chunk!r}")
+    kernels = _kernels(backend)
+    if kernels is None:
+        return _ik_batch_numpy(T, q_ref, tol, int(chunk))
+    T = np.ascontiguousarray(_real(T, "T"))
+    if T.ndim != 3 or T.shape[1:] != (4, 4):
+        raise ValueError(f"T must have shape (N, 4, 4), got {T.shape}")
+    refs = _reference(q_ref)
+    n = T.shape[0]
+    # np.full writes its memory here: np.zeros would leave the page faults to the kernel's
+    # threads, which contend for them (about a third of the kernel's time)
+    Q = np.full((n, MAX_SOLUTIONS, DOF), 0.0)
+    valid = np.full((n, MAX_SOLUTIONS), False)
+    retry = np.zeros(n, dtype=bool)
+    with _BATCH_LOCK:  # numba's default thread pool must not be entered twice at once
+        kernels[0](T, float(tol), refs, Q, valid, retry)
+    for i in np.flatnonzero(retry):
+        _settle(Q, valid, i, ik(T[i], q_ref=q_ref, tol=tol, backend="python"))
+    return Q, valid
+
+
+def _ik_batch_numpy(T, q_ref, tol, chunk):
+    """ik_batch's numpy backend: chunks of poses, every branch along its own array axis."""
+    T, good = _vpose(T)
+    refs = _reference(q_ref)
+    n = T.shape[0]
+    Q = np.zeros((n, MAX_SOLUTIONS, DOF))
+    valid = np.zeros((n, MAX_SOLUTIONS), dtype=bool)
+    for start in range(0, n, chunk):
+        part = slice(start, min(n, start + chunk))
+        cand, ok, retry = _ik_candidates(T[part], *refs, tol)
+        Q[part], valid[part] = _vfinish(cand, ok & good[part, None])
+        for i in start + np.flatnonzero(retry & good[part]):
+            # a free joint whose first value left a branch without solution (rare): the
+            # scalar solver tries its further values
+            _settle(Q, valid, i, ik(T[i], q_ref=q_ref, tol=tol, backend="python"))
+    return Q, valid
+
+
+def _settle(Q, valid, i, sols):
+    """Pose i's slots set to the rows sols."""
+    sols = sols[:MAX_SOLUTIONS]
+    Q[i], valid[i] = 0.0, False
+    Q[i, : len(sols)], valid[i, : len(sols)] = sols, True
+
+
+def nearest(
+    T: ArrayLike,
+    q_ref: ArrayLike,
+    *,
+    within_limits: bool = True,
+    weights: ArrayLike | None = None,
+) -> np.ndarray | None:
+    """The solution closest to q_ref (weighted squared joint distance), or None.
+
+    With within_limits=True each revolute joint takes its value q + 2 pi k inside LIMITS
+    nearest q_ref's (the distance is a sum over joints, so this is the nearest variant of
+    the whole vector); with within_limits=False revolute differences are wrapped to
+    (-pi, pi] and the solution is returned wrapped.
+
+    Args:
+        weights: DOF finite non-negative numbers (default ones).
+    """
+    refs = _reference(q_ref, required=True)
+    if weights is None:
+        w = _ONES
+    else:
+        w = _real(weights, "weights")
+        if w.shape != (DOF,) or not np.isfinite(w).all() or (w < 0.0).any():
+            raise ValueError(f"weights must be {DOF} finite non-negative numbers")
+    sols = ik(T, within_limits=within_limits, q_ref=refs)
+    if len(sols) == 0:
+        return None
+    kernels = _kernels(None)
+    pick = _kpick if kernels is None else kernels[2]
+    return sols[pick(sols, refs, w, not within_limits)]
+
+
+def _pose(T):
+    """The 12 top entries of a validated pose, as floats (plain Python: this is the hot path)."""
+    if type(T) is np.ndarray and T.shape == (4, 4) and T.dtype == np.float64:
+        v = T.ravel().tolist()
+    else:
+        try:
+            A = _real(T, "T")
+        except ValueError:
+            raise ValueError("T must be a 4x4 array of real numbers") from None
+        if A.shape != (4, 4):
+            raise ValueError(f"T must have shape (4, 4), got {A.shape}")
+        v = A.ravel().tolist()
+    if not all(map(math.isfinite, v)):
+        raise ValueError("T has non-finite entries")
+    if max(abs(v[12]), abs(v[13]), abs(v[14]), abs(v[15] - 1.0)) > POSE_TOL:
+        raise ValueError("T's last row must be [0, 0, 0, 1]")
+    a, b, c = v[0:3], v[4:7], v[8:11]
+    worst = max(
+        abs(a[0] * a[0] + a[1] * a[1] + a[2] * a[2] - 1.0),
+        abs(b[0] * b[0] + b[1] * b[1] + b[2] * b[2] - 1.0),
+        abs(c[0] * c[0] + c[1] * c[1] + c[2] * c[2] - 1.0),
+        abs(a[0] * b[0] + a[1] * b[1] + a[2] * b[2]),
+        abs(a[0] * c[0] + a[1] * c[1] + a[2] * c[2]),
+        abs(b[0] * c[0] + b[1] * c[1] + b[2] * c[2]),
+    )
+    det = (
+        a[0] * (b[1] * c[2] - b[2] * c[1])
+        - a[1] * (b[0] * c[2] - b[2] * c[0])
+        + a[2] * (b[0] * c[1] - b[1] * c[0])
+    )
+    if worst > POSE_TOL or det < 0.0:
+        raise ValueError(f"T's rotation is not orthonormal within {POSE_TOL}")
+    return tuple(v[:12])
+
+
+def _finish(found):
+    """Revolute values wrapped to (-pi, pi] (at the seam: _seam) and repeats
+    (DEDUP_TOL, revolute differences modulo 2 pi) dropped.
+
+    Repeats are found by comparing the last joint first, then all joints; the first of
+    equal candidates is kept.
+    """
+    rows: list[tuple[float, ...]] = []
+    for q in found:
+        q = tuple(map(math.remainder, q, _PERIODS))
+        if max(map(abs, q)) > _SEAM:
+            q = tuple(
+                _seam(x) if abs(x) > _SEAM and p != math.inf else x for x, p in zip(q, _PERIODS)
+            )
+        for p in rows:
+            if (
+                abs(math.remainder(q[-1] - p[-1], _PERIODS[-1])) <= DEDUP_TOL
+                and max(map(abs, map(math.remainder, map(_sub, q, p), _PERIODS))) <= DEDUP_TOL
+            ):
+                break
+        else:
+            rows.append(q)
+    return rows
+
+
+def _as_rows(rows):
+    """ik's (n, DOF) array of rows."""
+    if type(rows) is np.ndarray:
+        return rows
+    return np.array(rows, dtype=float).reshape(len(rows), DOF)
+
+
+def _in_limits(rows, refs, all_turns):
+    """The rows inside LIMITS: each once, every revolute joint at its variant q + 2 pi k
+    nearest refs (vectorised over the rows); with all_turns, every variant (a bounded
+    product)."""
+    if all_turns:
+        return _every_turn(rows.tolist() if type(rows) is np.ndarray else rows)
+    Q = _as_rows(rows)
+    k = np.rint((np.array(refs) - Q) / _TWO_PI) * _REV
+    # for a prismatic joint first <= 0 <= last says it is inside its limits
+    first = np.ceil((_LOWER - Q) / _TWO_PI)
+    last = np.floor((_UPPER - Q) / _TWO_PI)
+    k = np.minimum(np.maximum(k, first), last) * _REV
+    ok = ((first <= k) & (k <= last)).all(axis=1)
+    return (Q + k * _TWO_PI)[ok]
+
+
+def _every_turn(rows):
+    """Every variant of the rows inside LIMITS, at most MAX_TURN_ROWS of them."""
+    options = [_turns(q) for q in rows]
+    total = sum(math.prod(len(o) for o in opts) for opts in options)
+    if total > MAX_TURN_ROWS:
+        raise ValueError(
+            f"all_turns: the limits allow {total} variants of the solutions; "
+            f"at most MAX_TURN_ROWS = {MAX_TURN_ROWS} are returned"
+        )
+    out = []
+    for opts in options:
+        combos: list[tuple[float, ...]] = [()]
+        for values in opts:
+            combos = [(*c, v) for c in combos for v in values]
+        out += combos if opts else []
+    return _as_rows(out)
+
+
+def _turn_range(x, lo, hi):
+    """The k with lo <= x + 2 pi k <= hi (1e-12 slack): (first, last), empty if first > last."""
+    first = -math.inf if lo == -math.inf else math.ceil((lo - 1e-12 - x) / _TWO_PI)
+    last = math.inf if hi == math.inf else math.floor((hi + 1e-12 - x) / _TWO_PI)
+    return first, last
+
+
+def _turns(q):
+    """Per joint, every value of q's joint inside LIMITS (revolute: x + 2 pi k, nearest to
+    zero first; an unlimited revolute joint only its wrapped value); [] if some has none."""
+    options = []
+    for x, r, (lo, hi) in zip(q, _REVOLUTE, LIMITS):
+        first, last = _turn_range(x, lo, hi) if r else (0, 0)
+        if (not r and not lo - 1e-12 <= x <= hi + 1e-12) or first > last:
+            return []
+        if math.isinf(first) or math.isinf(last):
+            options.append([x])
+            continue
+        if last - first >= MAX_TURN_ROWS:
+            raise ValueError(
+                f"all_turns: joint limits allow more than MAX_TURN_ROWS = {MAX_TURN_ROWS} turns"
+            )
+        options.append(sorted((x + k * _TWO_PI for k in range(first, last + 1)), key=abs))
+    return options
+
+
+_compiled = None
+_BATCH_LOCK = threading.Lock()
+_COMPILE_LOCK = threading.Lock()
+# the name under which the compiled kernels' namespace is registered in sys.modules
+
+
+def _kernels(backend):
+    """The compiled (_kbatch, _kone) for a backend argument, or None for the Python solver."""
+    if backend is None:
+        backend = BACKEND
+    if backend == "python":
+        return None
+    if backend not in ("auto", "numba"):
+        raise ValueError(f"backend must be 'auto', 'numba' or 'python', got {backend!r}")
+    kernels = _compile()
+    if kernels is None and backend == "numba":
+        raise ImportError("backend='numba' needs numba (pip install numba)")
+    return kernels
+
+
+def _compile():
+    """(_kbatch, _kone, _kpick) compiled by numba, once per process; None without numba."""
+    global _compiled
+    if _compiled is not None:  # the hot path: no lock
+        return _compiled or None
+    with _COMPILE_LOCK:
+        if _compiled is None:
+            _compiled = _build_kernels() or False
+    return _compiled or None
+
+
+def _build_kernels():
+    """The kernel functions compiled by numba as copies that call each other in a namespace of
+    their own, so that this module's functions stay Python whatever ran before.
+
+    The namespace is registered as the module _KERNEL_SPACE: numba reloads machine code
+    from its cache (in __pycache__ beside this file, when that folder is writable) only for
+    functions whose module it can import by name, and this file may have been imported by
+    path under any name.
+    """
+    try:
+        import numba
+    except ImportError:
+        return None
+    space = sys.modules.get(_KERNEL_SPACE)
+    if space is None or getattr(space, "_KERNEL_SOURCE", None) != __file__:
+        space = types.ModuleType(_KERNEL_SPACE)
+        sys.modules[_KERNEL_SPACE] = space
+    for cache in (True, False):
+        names = space.__dict__
+        names.update({k: v for k, v in globals().items() if not k.startswith("__")})
+        names.update(_prange=numba.prange, _KERNEL_SOURCE=__file__)
+        try:
+            for name in _KERNEL:
+                python = globals()[name]
+                copy = types.FunctionType(
+                    python.__code__, names, python.__name__, python.__defaults__, python.__closure__
+                )
+                copy.__qualname__ = python.__qualname__
+                fast = set() if name in _KSTRICT else _FASTMATH
+                names[name] = numba.njit(
+                    fastmath=fast,
+                    parallel=name == "_kbatch",
+                    cache=cache,
+                    nogil=True,
+                    error_model="numpy",
+                )(copy)
+            return names["_kbatch"], names["_kone"], names["_kpick"]
+        except RuntimeError:  # no cache where numba cannot write one: compile without
+            continue
+    return None
+
+
+def warmup() -> bool:
+    """Compile (or load from numba's cache) the compiled solver now, not at the first ik:
+    call it at a program's start. Returns whether the compiled solver is available."""
+    kernels = _compile()
+    if kernels is None:
+        return False
+    T = fk(_ZEROS)
+    ik(T, backend="numba")
+    ik_batch(T[None], backend="numba")
+    kernels[2](np.zeros((1, DOF)), _ZEROS, _ONES, True)
+    return True

@@ -1,0 +1,41 @@
+"""Stand-ins for the names a generated module prints for its arm; never copied.
+
+The runtime's routines refer to these names as globals. A generated module defines them from
+the arm's plan (constants, forward kinematics, the bodies of the three solvers); here they
+describe a sample arm of one revolute and one prismatic joint, and the arm's functions raise,
+so that the runtime imports, type-checks and its routines can be tested on their own.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+
+NAME = "sample"
+DOF = 2
+JOINT_TYPES = "RP"
+# (lower, upper) per joint: radians for R joints, length for P joints
+LIMITS = ((-math.pi, math.pi), (-1.0, 1.0))
+REACH = 1.0
+# the most solutions a pose can have by the arm's derivation
+MAX_SOLUTIONS = 2
+# "pose" or "position": what certification compares
+IK_COMPONENTS = "pose"
+_REVOLUTE = (True, False)
+# the compiled kernel's functions (the closure of _kbatch, _kone and _kpick)
+_KERNEL: tuple[str, ...] = ()
+# the name of the compiled kernels' namespace in sys.modules
+_KERNEL_SPACE = "_derive_ik_kernels_sample"
+# the compiled solver's scratch per pose (for the values of polynomial steps)
+_KBUF = 1
+
+
+def _missing(*args: Any) -> Any:
+    raise NotImplementedError("printed per arm by derive's emitter")
+
+
+_fk_from_cs = _fk_q = _cs_columns = _keep = _ik_scalar = _ik_candidates = _missing
+_ksolve = _kreference = _kfk_q = _missing
+BASE = TOOL = np.eye(4)

@@ -1,0 +1,86 @@
+"""Argument checks and joint-value helpers shared by the generated module's solvers."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from derive.runtime.arm import _REVOLUTE, DOF, LIMITS
+from derive.runtime.constants import _SEAM_SNAP, _TWO_PI
+
+_PERIODS = tuple(2.0 * math.pi if r else math.inf for r in _REVOLUTE)
+
+
+def _real(x: object, name: str) -> np.ndarray:
+    """x as a float64 array; ValueError for complex or non-numeric input."""
+    if type(x) is np.ndarray and x.dtype == np.float64:
+        return x
+    try:
+        a = np.asarray(x)
+        if a.dtype.kind == "c":
+            raise TypeError
+        return a.astype(float)
+    except (TypeError, ValueError):
+        raise ValueError(f"{name} must be an array of real numbers") from None
+
+
+_ONES = np.ones(DOF)
+
+
+def _reference(q_ref: object, required: bool = False) -> tuple[float, ...]:
+    """q_ref as a tuple of DOF floats (zeros for None unless required)."""
+    if q_ref is None and not required:
+        return _ZEROS
+    if type(q_ref) is tuple and len(q_ref) == DOF and all(type(x) is float for x in q_ref):
+        values = q_ref
+    else:
+        try:
+            a = _real(q_ref, "q_ref")
+        except ValueError:
+            a = None
+        if a is None or a.shape != (DOF,):
+            shape = "" if a is None else f", got shape {a.shape}"
+            raise ValueError(f"q_ref must be {DOF} finite real numbers, shape ({DOF},){shape}")
+        values = tuple(a.tolist())
+    if not all(map(math.isfinite, values)):
+        raise ValueError(f"q_ref must be {DOF} finite real numbers, got {values}")
+    return values
+
+
+_ZEROS = (0.0,) * DOF
+
+
+def _tolerance(tol: float) -> float:
+    """tol as a float, if it is a positive finite number."""
+    if type(tol) is float and 0.0 < tol < math.inf:
+        return tol
+    try:
+        value = float(tol)
+    except (TypeError, ValueError):
+        value = math.nan
+    if type(tol) is bool or not (0.0 < value < math.inf):
+        raise ValueError(f"tol must be a positive finite number, got {tol!r}")
+    return value
+
+
+def _wrap(x: float) -> float:
+    w = math.remainder(x, _TWO_PI)
+    return math.pi if w <= -math.pi else w
+
+
+def _seam(x: float) -> float:
+    """A wrapped revolute value near +-pi: above pi if it is within _SEAM_BAND above -pi, pi
+    itself within _SEAM_SNAP of pi."""
+    if x < 0.0:
+        x += _TWO_PI
+    return math.pi if abs(x - math.pi) <= _SEAM_SNAP else x
+
+
+_REV = np.array([1.0 if r else 0.0 for r in _REVOLUTE])
+
+
+_LOWER = np.array([lo - 1e-12 for lo, _ in LIMITS])
+
+
+_UPPER = np.array([hi + 1e-12 for _, hi in LIMITS])

@@ -1,0 +1,38 @@
+"""Tolerances and settings of the generated solvers (copied into each module that uses them)."""
+
+import math
+
+# the backend of ik and ik_batch calls that name none: "auto" (numba when installed),
+# "numba" or "python"
+BACKEND = "auto"
+CERTIFY_TOL = 1e-6
+POSE_TOL = 1e-6
+DEDUP_TOL = 1e-6
+_ROOT_IMAG_TOL = 1e-6
+_RESIDUAL_TOL = 1e-8
+_MERGE_TOL = 1e-6
+_CLUSTER_TOL = 1e-3
+# a cos + b sin = e with |e| up to (1 + _CLAMP_TOL) sqrt(a^2 + b^2) is solved at the boundary:
+# earlier joints from a double root (elbow stretched) carry errors of ~1e-8
+_CLAMP_TOL = 1e-7
+# ... and from |e| down to (1 - _FOLD_TOL) sqrt(a^2 + b^2) as the double root acos(+-1): there
+# the angle moves by up to acos(1 - _FOLD_TOL) ~ 1.4e-7 while the equation's residual stays
+# below _FOLD_TOL sqrt(a^2 + b^2), and every backend gives the same value (acos near +-1 turns
+# one rounding of its argument into 1e-8 of angle)
+_FOLD_TOL = 1e-14
+_LEAD_TOL = 1e-10
+_OMEGA = (1.0, complex(-0.5, math.sqrt(3.0) / 2.0), complex(-0.5, -math.sqrt(3.0) / 2.0))
+_FREE_TOL = 1e-14  # squared sizes: a joint is free below 1e-7 of its equation's scale
+# the values a free joint tries, as offsets from its preferred value: 0, +5, -5, +10, ... deg
+_FREE_STEPS = tuple(math.radians(5.0 * ((k + 1) // 2) * (1 if k % 2 else -1)) for k in range(72))
+_TWO_PI = 2.0 * math.pi
+# The seam: rounding puts a joint at pi on either side of it, and one solution would get two
+# values a full turn apart. A revolute value within _SEAM_BAND above -pi is returned as its
+# equivalent just above pi (the value is kept; only the turn changes), and one within
+# _SEAM_SNAP of pi as pi itself, in every backend: returned values lie in
+# (-pi + _SEAM_BAND, pi + _SEAM_BAND].
+_SEAM_BAND = 1e-9
+_SEAM_SNAP = 1e-12
+_SEAM = math.pi - _SEAM_BAND
+# all_turns=True returns at most this many rows (every 2 pi variant of every joint)
+MAX_TURN_ROWS = 100_000
