@@ -15,22 +15,19 @@ from importlib import resources
 import jinja2
 import sympy as sp
 
-from derive import kernel
 from derive import symbols as sym
 from derive.assemble import assemble, import_block
 from derive.layout import wrap_code
-from derive.plan import Assign, Plan, Solve
-from derive.printing import (
+from derive.plan import Assign, Plan
+from derive.printers import kernel, scalar, vector
+from derive.printers.common import (
     SCALAR_FUNCTIONS,
     CodePrinter,
-    Line,
     UnprintableError,
     assign_lines,
     cs_arguments,
     float_literal,
     match_expression,
-    same_joints,
-    step_arguments,
     world_names,
 )
 
@@ -82,147 +79,13 @@ def fk_joint_lines(plan: Plan, printer: CodePrinter, columns: bool) -> tuple[str
     """theta_i = q_i + offset with c_i, s_i (or d_i = q_i + offset) from q or from Q's columns."""
     lines = []
     for k, (target, expr) in enumerate(plan.joint_defs):
-        source = f"Q[..., {k}]" if columns else f"q[{k}]"
-        value = printer.doprint(expr.xreplace({sym.q(k + 1): sym.named("QQ")}))
-        lines.append(f"{target} = {value.replace('QQ', source)}")
+        source = sp.Symbol(f"Q[..., {k}]" if columns else f"q[{k}]")
+        lines.append(f"{target} = {printer.doprint(expr.xreplace({sym.q(k + 1): source}))}")
         if str(target).startswith("theta"):
             i = k + 1
             lines.append(f"c{i} = {printer.prefix}cos({target})")
             lines.append(f"s{i} = {printer.prefix}sin({target})")
     return tuple(lines)
-
-
-def ik_lines(plan: Plan, printer: CodePrinter) -> tuple[tuple[int, str], ...]:
-    """Body of the scalar IK: one block per step, each Solve opening a loop over its values."""
-    assert plan.ik is not None
-    names = sp.numbered_symbols("x")
-    lines: list[Line] = []
-    depth = 0
-    loops = []
-    for step in plan.ik.steps:
-        if isinstance(step, Assign):
-            lines.append(Line(depth, f"# {step.note}"))
-            lines += assign_lines(step.targets, step.exprs, names, printer, depth)
-            continue
-        lines += solve_lines(step, names, printer, depth)
-        loops.append((depth, step.joint))
-        depth += 1
-    outputs = ", ".join(printer.doprint(e) for e in plan.ik.outputs)
-    if same_joints(plan):
-        lines.append(
-            Line(
-                depth, f"_keep(found, target, ({outputs},), _fk_from_cs({cs_arguments(plan)}), tol)"
-            )
-        )
-    else:
-        lines.append(Line(depth, f"q = ({outputs},)"))
-        lines.append(Line(depth, "_keep(found, target, q, _fk_q(q), tol)"))
-    for level, joint in reversed(loops):
-        # a free joint's loop (over _Free values) ends at its first value that gave a solution
-        lines.append(
-            Line(level + 1, f"if _v{joint}.__class__ is _Free and len(found) > _n{joint}:")
-        )
-        lines.append(Line(level + 2, "break"))
-    return tuple((ln.depth, ln.text) for ln in lines)
-
-
-def ik_batch_lines(plan: Plan, printer: CodePrinter) -> tuple[str, ...]:
-    """Body of the vectorised IK: one array axis per Solve step, so broadcasting does the
-    branching and flattening the axes gives the scalar solver's loop order."""
-    assert plan.ik is not None
-    names = sp.numbered_symbols("x")
-    solves = [s for s in plan.ik.steps if isinstance(s, Solve)]
-    lines = [f"shape = (T.shape[0],) + (1,) * {len(solves)}"]
-    world = sym.world_pose()
-    lines += [f"{world[i, j]} = T[:, {i}, {j}].reshape(shape)" for i in range(3) for j in range(4)]
-    lines.append("valid = np.ones(shape, dtype=bool)")
-    level = 0
-    for step in plan.ik.steps:
-        if isinstance(step, Assign):
-            lines.append(f"# {step.note}")
-            lines += [ln.text for ln in assign_lines(step.targets, step.exprs, names, printer, 0)]
-            continue
-        level += 1
-        lines += batch_solve_lines(step, names, printer, level)
-    outputs = ", ".join(
-        f"np.broadcast_to({printer.doprint(e)}, valid.shape)" for e in plan.ik.outputs
-    )
-    lines.append(f"Q = np.stack(({outputs}), axis=-1)")
-    if same_joints(plan):
-        lines.append(f"e = _fk_from_cs({cs_arguments(plan)})")
-    else:
-        lines.append("e = _fk_from_cs(*_cs_columns(Q))")
-    lines.append("Q = Q.reshape(T.shape[0], -1, DOF)")
-    world = ", ".join(str(world[i, j]) for i in range(3) for j in range(4))
-    lines.append(f"t = ({world})")
-    lines.append("ptol = tol * REACH")
-    lines.append(f"valid = valid & {match_expression(plan.ik.certify, vector=True)}")
-    # a free joint's first value without a certified solution below it: the scalar solver,
-    # which tries further values, settles that pose
-    lines.append("retry = np.zeros(T.shape[0], dtype=bool)")
-    for k in range(1, level + 1):
-        rest = tuple(range(k + 1, level + 1))
-        below = f"valid.any(axis={rest}, keepdims=True)" if rest else "valid"
-        lines.append(f"retry |= (free{k} & ~{below}).reshape(T.shape[0], -1).any(axis=1)")
-    lines.append("return Q, valid.reshape(T.shape[0], -1), retry")
-    return tuple(lines)
-
-
-def batch_solve_lines(
-    step: Solve, names: sp.utilities.iterables.numbered_symbols, printer: CodePrinter, level: int
-) -> list[str]:
-    """One Solve step of the vectorised IK: its values along axis `level`, validity combined."""
-    head, values = step_arguments(step, names, printer, 0)
-    lines = [ln.text for ln in head]
-    joined = ", ".join(values)
-    ref = printer.doprint(step.ref)
-    free = repr(1e-10 * step.scale)
-    var = f"d{step.joint}" if step.kind == "polyd" else f"theta{step.joint}"
-    call = {
-        "poly": f"_vpoly(({joined},), {level}, valid, True, {ref}, {free})",
-        "polyd": f"_vpoly(({joined},), {level}, valid, False, {ref}, {free}, {step.unit!r})",
-        "cs1": f"_vcs1({joined}, {step.scale!r}, {ref}, {level}, valid)",
-        "cs1r": f"_vcs1_reach({joined}, {step.scale!r}, {ref}, {level}, valid)",
-        "cs2": f"_vcs2({joined}, {ref}, {level}, valid)",
-        "cs2r": f"_vcs2_reach({joined}, {ref}, {level}, valid)",
-        "atan2": f"_vatan2({joined}, {ref}, {level}, valid)",
-    }[step.kind]
-    lines += [
-        f"{var}, ok, free{level} = {call}",
-        "valid = valid & ok",
-        f"free{level} = free{level} & valid",
-    ]
-    if step.kind != "polyd":
-        lines += [f"c{step.joint} = np.cos({var})", f"s{step.joint} = np.sin({var})"]
-    return lines
-
-
-def solve_lines(
-    step: Solve, names: sp.utilities.iterables.numbered_symbols, printer: CodePrinter, depth: int
-) -> list[Line]:
-    """The loop header of one Solve step, with its arguments CSE'd before it."""
-    lines, values = step_arguments(step, names, printer, depth)
-    ref = printer.doprint(step.ref)
-    free = repr(1e-10 * step.scale)
-    joined = ", ".join(values)
-    call = {
-        "poly": f"_poly_angles(({joined},), {ref}, {free})",
-        "polyd": f"_poly_real(({joined},), {ref}, {free}, {step.unit!r})",
-        "cs1": f"_cs1({joined}, {step.scale!r}, {ref})",
-        "cs1r": f"_cs1_reach({joined}, {step.scale!r}, {ref})",
-        "cs2": f"_cs2({joined}, {ref})",
-        "cs2r": f"_cs2_reach({joined}, {ref})",
-        "atan2": f"_atan2({joined}, {ref})",
-    }[step.kind]
-    lines.append(Line(depth, f"_n{step.joint} = len(found)"))
-    if step.kind == "polyd":
-        lines.append(Line(depth, f"for d{step.joint} in (_v{step.joint} := {call}):"))
-        return lines
-    var = f"theta{step.joint}"
-    lines.append(Line(depth, f"for {var} in (_v{step.joint} := {call}):"))
-    lines.append(Line(depth + 1, f"c{step.joint} = cos({var})"))
-    lines.append(Line(depth + 1, f"s{step.joint} = sin({var})"))
-    return lines
 
 
 @dataclass(frozen=True)
@@ -274,11 +137,11 @@ def print_plan(plan: Plan) -> PrintedModule:
     """
     check_printable(plan)
     arm = plan.arm
-    scalar, vector = CodePrinter(), CodePrinter("np.")
+    python, numpy = CodePrinter(), CodePrinter("np.")
     fk_pose_body, outputs = fk_pose_lines(plan)
     ik = plan.ik
     offsets = tuple(float(e.subs(sym.q(k + 1), 0)) for k, (_, e) in enumerate(plan.joint_defs))
-    kernel_body, kernel_buffer = kernel.kernel_lines(plan, scalar) if ik else ((), 0)
+    kernel_body, kernel_buffer = kernel.kernel_lines(plan) if ik else ((), 0)
     return PrintedModule(
         name=arm.name,
         digest=arm.digest,
@@ -296,8 +159,8 @@ def print_plan(plan: Plan) -> PrintedModule:
         tool_const=_tuple_of_tuples(tuple(arm.tool[4 * i : 4 * i + 4] for i in range(4))),
         reach=float_literal(arm.reach),
         fk_pose_body=fk_pose_body,
-        fk_joints=fk_joint_lines(plan, scalar, columns=False),
-        fk_batch_joints=fk_joint_lines(plan, vector, columns=True),
+        fk_joints=fk_joint_lines(plan, python, columns=False),
+        fk_batch_joints=fk_joint_lines(plan, numpy, columns=True),
         fk_outputs=outputs,
         cs_args=cs_arguments(plan),
         has_ik=int(ik is not None),
@@ -306,13 +169,13 @@ def print_plan(plan: Plan) -> PrintedModule:
         max_solutions=ik.max_solutions if ik else 0,
         solves_for=ik.solves_for if ik else "",
         refusal=plan.refusal,
-        ik_body=ik_lines(plan, scalar) if ik else (),
+        ik_body=scalar.ik_lines(plan) if ik else (),
         qref_names=", ".join(f"qr{i}" for i in range(1, arm.dof + 1)),
-        ik_batch_body=ik_batch_lines(plan, vector) if ik else (),
+        ik_batch_body=vector.ik_batch_lines(plan) if ik else (),
         kernel_body=kernel_body,
         kernel_buffer=kernel_buffer,
         kernel_reference=kernel.reference_tuple(arm.dof),
-        world_names=world_names(),
+        world_names=", ".join(world_names()),
         match=match_expression(ik.certify) if ik else "",
         components=ik.certify if ik else "",
     )

@@ -19,11 +19,35 @@ INDENT = "    "
 
 
 def wrap_code(code: str, width: int = WIDTH) -> str:
-    """Every line of code longer than width laid out over several lines (see the module)."""
+    """Every line of code longer than width laid out over several lines (see the module).
+
+    Only lines that hold a whole statement or a comment are touched: never a line inside a
+    string or a statement that already spans several lines.
+    """
+    whole = _single_lines(code)
     out: list[str] = []
-    for line in code.split("\n"):
-        out += wrap_line(line, width) if len(line) > width else [line]
+    for row, line in enumerate(code.split("\n"), start=1):
+        out += wrap_line(line, width) if len(line) > width and row in whole else [line]
     return "\n".join(out)
+
+
+def _single_lines(code: str) -> set[int]:
+    """The rows (1-based) of code holding a whole logical line or only a comment."""
+    rows: set[int] = set()
+    first = None
+    try:
+        for tok in tokenize.generate_tokens(io.StringIO(code).readline):
+            if tok.type == tokenize.COMMENT and first is None:
+                rows.add(tok.start[0])
+            elif tok.type == tokenize.NEWLINE:
+                if first is not None and first == tok.start[0]:
+                    rows.add(first)
+                first = None
+            elif tok.type not in (tokenize.NL, tokenize.INDENT, tokenize.DEDENT) and first is None:
+                first = tok.start[0]
+    except (tokenize.TokenError, SyntaxError):
+        return set()
+    return rows
 
 
 def wrap_line(line: str, width: int = WIDTH) -> list[str]:
@@ -33,6 +57,12 @@ def wrap_line(line: str, width: int = WIDTH) -> list[str]:
     indent = line[: len(line) - len(body)]
     if body.startswith("#"):
         return _refill_comment(indent, body[1:].strip(), width)
+    tokens = _tokens(body, comments=True)
+    comments = [t for t in tokens or () if t.type == tokenize.COMMENT]
+    if comments:  # a trailing comment goes on a line of its own, above the statement
+        code = body[: comments[0].start[1]].rstrip()
+        above = _refill_comment(indent, comments[0].string[1:].strip(), width)
+        return above + wrap_line(indent + code, width)
     text = _bracketed(body)
     if text is None:
         return [line]
@@ -108,13 +138,16 @@ def _closing(tokens: list[tokenize.TokenInfo]) -> int:
     return -1
 
 
-def _tokens(text: str) -> list[tokenize.TokenInfo] | None:
-    """The tokens of one line of code (no newlines, comments or end marker), or None."""
+def _tokens(text: str, comments: bool = False) -> list[tokenize.TokenInfo] | None:
+    """The tokens of one line of code (no newlines or end marker, and no comments unless
+    asked), or None if the line is not a whole logical line."""
     try:
         tokens = list(tokenize.generate_tokens(io.StringIO(text).readline))
     except (tokenize.TokenError, SyntaxError):
         return None
-    skip = (tokenize.NEWLINE, tokenize.NL, tokenize.ENDMARKER, tokenize.COMMENT)
+    skip = {tokenize.NEWLINE, tokenize.NL, tokenize.ENDMARKER}
+    if not comments:
+        skip.add(tokenize.COMMENT)
     kept = [t for t in tokens if t.type not in skip]
     if any(t.start[0] != 1 for t in kept) or any(t.type == tokenize.INDENT for t in kept):
         return None

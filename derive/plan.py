@@ -6,30 +6,15 @@ ordered list of steps. An :class:`Assign` computes intermediate quantities; a
 them: every later step runs once per value. After the last step the joint values are
 complete and the solver certifies them by forward kinematics.
 
-Solve kinds (the generated module implements each once, as a helper):
-
-=========  =========================================================================
-``cs1``    a cos t + b sin t = e: t = atan2(b, a) +- acos(e / sqrt(a^2 + b^2)); args (a, b, e);
-           t is free (reference value) when the equation vanishes identically (Solve.scale)
-``cs1r``   cs1 whose free value must leave the next joint t' a value keeping
-           W = sum M_ij u_i(t') u_j(t) inside [lo, hi], u = (1, cos, sin); args (a, b, e,
-           M00, M01, M02, M10, M11, M12, M20, M21, M22, lo, hi): the first value in 5 degree
-           steps out from the reference value that allows it
-``cs2``    a1 c + b1 s = e1, a2 c + b2 s = e2: one t from the 2x2 system; args (a1, b1, e1,
-           a2, b2, e2, det_scale, rhs_scale): t is free (reference value) when the determinant
-           is below 1e-14 det_scale or e1^2 + e2^2 below 1e-14 rhs_scale
-``cs2r``   cs2 whose free value must keep a radius A + B cos t + C sin t inside [lo, hi]; args
-           (the cs2 args, A, B, C, lo, hi): q_ref's value if inside, else the nearest one
-           putting the radius mid-range
-``atan2``  t = atan2(y, x); args (y, x); both vanishing leaves t free (reference value)
-``poly``   polynomial in u = tan(t/2), coefficients highest degree first; u = inf is t = pi
-``polyd``  polynomial in a prismatic joint's d_i, coefficients highest degree first
-=========  =========================================================================
+Each kind of Solve step is a subclass of :class:`Solve` (Cs1, Cs1Reach, Cs2, Cs2Reach,
+Atan2, Poly, PolyD: :data:`SOLVE_KINDS`) naming its arguments; each backend's printer in
+derive/printers/ prints every kind, and the runtime routine it calls solves it.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, fields
+from typing import Any, ClassVar
 
 import sympy as sp
 
@@ -86,12 +71,12 @@ class Assign:
 
 @dataclass(frozen=True)
 class Solve:
-    """Values of one joint variable.
+    """Values of one joint variable; each kind of equation is a subclass (below).
 
     Attributes:
         joint: 1-based joint index.
-        kind: one of the kinds in the module docstring.
-        args: the kind's arguments, expressions in earlier quantities.
+        args: the kind's arguments (named by the subclass's ARGS), expressions in earlier
+            quantities.
         note: the derivation step, printed as a comment ("Pieper r/z ellipse, ...").
         fanout: the most values this step can produce.
         ref: the value the joint takes where the pose leaves it free (``cs2``, ``atan2``, and
@@ -106,13 +91,104 @@ class Solve:
     """
 
     joint: int
-    kind: str
     args: tuple[sp.Expr, ...]
     note: str
     fanout: int
     ref: sp.Expr = sp.S.Zero
     scale: float = 0.0
     unit: float = 1.0
+
+    # the kind's short name (in the report and the module docstring's table)
+    kind: ClassVar[str] = ""
+    # the arguments' names; () for a polynomial's coefficients (any number, at least two)
+    ARGS: ClassVar[tuple[str, ...]] = ()
+    # whether the joint is revolute (the step gives theta_i; else d_i)
+    angle: ClassVar[bool] = True
+
+    def __post_init__(self) -> None:
+        if type(self) is Solve:
+            raise TypeError("Solve is abstract: use one of its kinds (Cs1, Poly, ...)")
+        if self.ARGS and len(self.args) != len(self.ARGS):
+            raise ValueError(f"{self.kind} takes {len(self.ARGS)} arguments, got {len(self.args)}")
+        if not self.ARGS and len(self.args) < 2:
+            raise ValueError(f"{self.kind} takes at least two coefficients")
+
+    def as_kind(self, kind: type[Solve], **changes: Any) -> Solve:
+        """This step as another kind, with some fields changed."""
+        values = {f.name: getattr(self, f.name) for f in fields(self)}
+        return kind(**(values | changes))
+
+    @property
+    def variable(self) -> str:
+        """The name of the joint variable the step solves: theta_i or d_i."""
+        return f"theta{self.joint}" if self.angle else f"d{self.joint}"
+
+
+@dataclass(frozen=True)
+class Cs1(Solve):
+    """a cos t + b sin t = e: t = atan2(b, a) +- acos(e / sqrt(a^2 + b^2)); t is free
+    (reference value) when the equation vanishes identically (scale)."""
+
+    kind: ClassVar[str] = "cs1"
+    ARGS: ClassVar[tuple[str, ...]] = ("a", "b", "e")
+
+
+@dataclass(frozen=True)
+class Cs1Reach(Solve):
+    """Cs1 whose free value must leave the next joint t' a value keeping
+    W = sum M_ij u_i(t') u_j(t) inside [lo, hi], u = (1, cos, sin): the first value in 5
+    degree steps out from the reference value that allows it."""
+
+    kind: ClassVar[str] = "cs1r"
+    ARGS: ClassVar[tuple[str, ...]] = (
+        "a", "b", "e", "M00", "M01", "M02", "M10", "M11", "M12", "M20", "M21", "M22", "lo", "hi",
+    )  # fmt: skip
+
+
+@dataclass(frozen=True)
+class Cs2(Solve):
+    """a1 c + b1 s = e1, a2 c + b2 s = e2: one t from the 2x2 system; t is free (reference
+    value) when the determinant is below 1e-14 det_scale or e1^2 + e2^2 below 1e-14
+    rhs_scale."""
+
+    kind: ClassVar[str] = "cs2"
+    ARGS: ClassVar[tuple[str, ...]] = ("a1", "b1", "e1", "a2", "b2", "e2", "det_scale", "rhs_scale")
+
+
+@dataclass(frozen=True)
+class Cs2Reach(Solve):
+    """Cs2 whose free value must keep a radius A + B cos t + C sin t inside [lo, hi]: q_ref's
+    value if inside, else the nearest one putting the radius mid-range."""
+
+    kind: ClassVar[str] = "cs2r"
+    ARGS: ClassVar[tuple[str, ...]] = (*Cs2.ARGS, "A", "B", "C", "lo", "hi")
+
+
+@dataclass(frozen=True)
+class Atan2(Solve):
+    """t = atan2(y, x); both vanishing leaves t free (reference value)."""
+
+    kind: ClassVar[str] = "atan2"
+    ARGS: ClassVar[tuple[str, ...]] = ("y", "x")
+
+
+@dataclass(frozen=True)
+class Poly(Solve):
+    """A polynomial in u = tan(t/2), coefficients highest degree first; u = inf is t = pi."""
+
+    kind: ClassVar[str] = "poly"
+
+
+@dataclass(frozen=True)
+class PolyD(Solve):
+    """A polynomial in a prismatic joint's d_i, coefficients highest degree first."""
+
+    kind: ClassVar[str] = "polyd"
+    angle: ClassVar[bool] = False
+
+
+# every kind of Solve step: each backend's printer has a function for each (a test checks it)
+SOLVE_KINDS: tuple[type[Solve], ...] = (Cs1, Cs1Reach, Cs2, Cs2Reach, Atan2, Poly, PolyD)
 
 
 Step = Assign | Solve

@@ -1828,19 +1828,16 @@ def _keep(found, t, q, e, tol):
 def _ik_scalar(target, qr1, qr2, qr3, qr4, qr5, qr6, tol):
     """The scalar solver in Python: every certified solution of target (the 12 top entries of
     the pose), in branch order, before wrapping and dropping repeats."""
-    (w11, w12, w13, wx, w21, w22, w23, wy, w31, w32, w33, wz) = target
+    (w11, _, w13, wx, w21, _, w23, wy, w31, _, w33, wz) = target
     found = []
     # flange target 0_nT = (B X0 Tz(d1))^-1 T (Tz(dn) Xn E)^-1
     r11 = w13
-    r12 = -w12
     r13 = w11
     px = -206.0*w11 + wx
     r21 = w23
-    r22 = -w22
     r23 = w21
     py = -206.0*w21 + wy
     r31 = w33
-    r32 = -w32
     r33 = w31
     pz = -206.0*w31 + wz - 373.0
     # wrist centre (x, y, z) = 0P_4org and r = x^2 + y^2 + z^2
@@ -1887,13 +1884,10 @@ def _ik_scalar(target, qr1, qr2, qr3, qr4, qr5, qr6, tol):
                 x12 = -c1*x4 - c1*x5
                 x13 = -s1*x4 - s1*x5
                 W11 = r11*x9 + r21*x10 + r31*x6
-                W12 = r12*x9 + r22*x10 + r32*x6
                 W13 = r13*x9 + r23*x10 + r33*x6
                 W21 = -c1*r21 + r11*s1
-                W22 = -c1*r22 + r12*s1
                 W23 = -c1*r23 + r13*s1
                 W31 = r11*x12 + r21*x13 + r31*x11
-                W32 = r12*x12 + r22*x13 + r32*x11
                 W33 = r13*x12 + r23*x13 + r33*x11
                 # theta5: W33 = e3^T Rx(alpha4) Rz(theta5) Rx(alpha5) e3
                 _n5 = len(found)
@@ -1951,15 +1945,12 @@ def _ik_candidates(T, qr1, qr2, qr3, qr4, qr5, qr6, tol):
     valid = np.ones(shape, dtype=bool)
     # flange target 0_nT = (B X0 Tz(d1))^-1 T (Tz(dn) Xn E)^-1
     r11 = w13
-    r12 = -w12
     r13 = w11
     px = -206.0*w11 + wx
     r21 = w23
-    r22 = -w22
     r23 = w21
     py = -206.0*w21 + wy
     r31 = w33
-    r32 = -w32
     r33 = w31
     pz = -206.0*w31 + wz - 373.0
     # wrist centre (x, y, z) = 0P_4org and r = x^2 + y^2 + z^2
@@ -2009,13 +2000,10 @@ def _ik_candidates(T, qr1, qr2, qr3, qr4, qr5, qr6, tol):
     x12 = -c1*x4 - c1*x5
     x13 = -s1*x4 - s1*x5
     W11 = r11*x9 + r21*x10 + r31*x6
-    W12 = r12*x9 + r22*x10 + r32*x6
     W13 = r13*x9 + r23*x10 + r33*x6
     W21 = -c1*r21 + r11*s1
-    W22 = -c1*r22 + r12*s1
     W23 = -c1*r23 + r13*s1
     W31 = r11*x12 + r21*x13 + r31*x11
-    W32 = r12*x12 + r22*x13 + r32*x11
     W33 = r13*x12 + r23*x13 + r33*x11
     # theta5: W33 = e3^T Rx(alpha4) Rz(theta5) Rx(alpha5) e3
     theta5, ok, free4 = _vcs1(1.0, 0.0, W33, 0.0, 0.0, 4, valid)
@@ -2064,8 +2052,8 @@ def _ik_candidates(T, qr1, qr2, qr3, qr4, qr5, qr6, tol):
 def _kreference(q):
     """_ksolve's ref argument: q_ref's values, then their cosines, then their sines (one flat
     tuple: numba's parallel loop takes no nested ones)."""
-    return (q + (cos(q[0]), cos(q[1]), cos(q[2]), cos(q[3]), cos(q[4]), cos(q[5]),) + (sin(q[0]),
-        sin(q[1]), sin(q[2]), sin(q[3]), sin(q[4]), sin(q[5]),))
+    return (q[0], q[1], q[2], q[3], q[4], q[5], cos(q[0]), cos(q[1]), cos(q[2]), cos(q[3]),
+        cos(q[4]), cos(q[5]), sin(q[0]), sin(q[1]), sin(q[2]), sin(q[3]), sin(q[4]), sin(q[5]))
 
 
 def _ksolve(w11, w12, w13, wx, w21, w22, w23, wy, w31, w32, w33, wz, tol, ref, found, buf):
@@ -2073,23 +2061,32 @@ def _ksolve(w11, w12, w13, wx, w21, w22, w23, wy, w31, w32, w33, wz, tol, ref, f
     dropping repeats): their count, or -1 where the scalar solver must settle the pose.
     ref: q_ref's values, then their cosines, then their sines (_kreference); buf: scratch for
     the polynomial steps (_KBUF)."""
-    qr1, qr2, qr3, qr4, qr5, qr6, = ref[0:6]
-    cr1, cr2, cr3, cr4, cr5, cr6, = ref[6:12]
-    sr1, sr2, sr3, sr4, sr5, sr6, = ref[12:18]
+    qr1 = ref[0]
+    qr2 = ref[1]
+    qr3 = ref[2]
+    qr4 = ref[3]
+    qr6 = ref[5]
+    cr1 = ref[6]
+    cr2 = ref[7]
+    cr3 = ref[8]
+    cr4 = ref[9]
+    cr6 = ref[11]
+    sr1 = ref[12]
+    sr2 = ref[13]
+    sr3 = ref[14]
+    sr4 = ref[15]
+    sr6 = ref[17]
     ptol = tol * REACH
     n = 0
     t = (w11, w12, w13, wx, w21, w22, w23, wy, w31, w32, w33, wz)
     # flange target 0_nT = (B X0 Tz(d1))^-1 T (Tz(dn) Xn E)^-1
     r11 = w13
-    r12 = -w12
     r13 = w11
     px = -206.0*w11 + wx
     r21 = w23
-    r22 = -w22
     r23 = w21
     py = -206.0*w21 + wy
     r31 = w33
-    r32 = -w32
     r33 = w31
     pz = -206.0*w31 + wz - 373.0
     # wrist centre (x, y, z) = 0P_4org and r = x^2 + y^2 + z^2
@@ -2147,13 +2144,10 @@ def _ksolve(w11, w12, w13, wx, w21, w22, w23, wy, w31, w32, w33, wz, tol, ref, f
         x12 = -c1*x4 - c1*x5
         x13 = -s1*x4 - s1*x5
         W11 = r11*x9 + r21*x10 + r31*x6
-        W12 = r12*x9 + r22*x10 + r32*x6
         W13 = r13*x9 + r23*x10 + r33*x6
         W21 = -c1*r21 + r11*s1
-        W22 = -c1*r22 + r12*s1
         W23 = -c1*r23 + r13*s1
         W31 = r11*x12 + r21*x13 + r31*x11
-        W32 = r12*x12 + r22*x13 + r32*x11
         W33 = r13*x12 + r23*x13 + r33*x11
         # theta5: W33 = e3^T Rx(alpha4) Rz(theta5) Rx(alpha5) e3
         _n5, _a5, _ac5, _as5, _b5, _bc5, _bs5, _st = _kcs1(1.0, 0.0, W33, 0.0)

@@ -1170,21 +1170,13 @@ def _keep(found, t, q, e, tol):
 def _ik_scalar(target, qr1, qr2, qr3, tol):
     """The scalar solver in Python: every certified solution of target (the 12 top entries of
     the pose), in branch order, before wrapping and dropping repeats."""
-    (w11, w12, w13, wx, w21, w22, w23, wy, w31, w32, w33, wz) = target
+    (w11, _, _, wx, w21, _, _, wy, _, _, _, _) = target
     found = []
     # flange target 0_nT = (B X0 Tz(d1))^-1 T (Tz(dn) Xn E)^-1
     r11 = w11
-    r12 = w12
-    r13 = w13
     px = wx
     r21 = w21
-    r22 = w22
-    r23 = w23
     py = wy
-    r31 = w31
-    r32 = w32
-    r33 = w33
-    pz = wz
     # theta2: law of cosines, x^2 + y^2 = 4*c2/5 + 29/25 (elbow up / down)
     _n2 = len(found)
     for theta2 in (_v2 := _cs1(0.8, 0.0, px*px + py*py - 1.16, 0.0, 0.0)):
@@ -1239,17 +1231,9 @@ def _ik_candidates(T, qr1, qr2, qr3, tol):
     valid = np.ones(shape, dtype=bool)
     # flange target 0_nT = (B X0 Tz(d1))^-1 T (Tz(dn) Xn E)^-1
     r11 = w11
-    r12 = w12
-    r13 = w13
     px = wx
     r21 = w21
-    r22 = w22
-    r23 = w23
     py = wy
-    r31 = w31
-    r32 = w32
-    r33 = w33
-    pz = wz
     # theta2: law of cosines, x^2 + y^2 = 4*c2/5 + 29/25 (elbow up / down)
     theta2, ok, free1 = _vcs1(0.8, 0.0, px*px + py*py - 1.16, 0.0, 0.0, 1, valid)
     valid = valid & ok
@@ -1296,7 +1280,7 @@ def _ik_candidates(T, qr1, qr2, qr3, tol):
 def _kreference(q):
     """_ksolve's ref argument: q_ref's values, then their cosines, then their sines (one flat
     tuple: numba's parallel loop takes no nested ones)."""
-    return q + (cos(q[0]), cos(q[1]), cos(q[2]),) + (sin(q[0]), sin(q[1]), sin(q[2]),)
+    return (q[0], q[1], q[2], cos(q[0]), cos(q[1]), cos(q[2]), sin(q[0]), sin(q[1]), sin(q[2]))
 
 
 def _ksolve(w11, w12, w13, wx, w21, w22, w23, wy, w31, w32, w33, wz, tol, ref, found, buf):
@@ -1304,25 +1288,20 @@ def _ksolve(w11, w12, w13, wx, w21, w22, w23, wy, w31, w32, w33, wz, tol, ref, f
     dropping repeats): their count, or -1 where the scalar solver must settle the pose.
     ref: q_ref's values, then their cosines, then their sines (_kreference); buf: scratch for
     the polynomial steps (_KBUF)."""
-    qr1, qr2, qr3, = ref[0:3]
-    cr1, cr2, cr3, = ref[3:6]
-    sr1, sr2, sr3, = ref[6:9]
+    qr1 = ref[0]
+    qr3 = ref[2]
+    cr1 = ref[3]
+    cr3 = ref[5]
+    sr1 = ref[6]
+    sr3 = ref[8]
     ptol = tol * REACH
     n = 0
     t = (w11, w12, w13, wx, w21, w22, w23, wy, w31, w32, w33, wz)
     # flange target 0_nT = (B X0 Tz(d1))^-1 T (Tz(dn) Xn E)^-1
     r11 = w11
-    r12 = w12
-    r13 = w13
     px = wx
     r21 = w21
-    r22 = w22
-    r23 = w23
     py = wy
-    r31 = w31
-    r32 = w32
-    r33 = w33
-    pz = wz
     # theta2: law of cosines, x^2 + y^2 = 4*c2/5 + 29/25 (elbow up / down)
     _n2, _a2, _ac2, _as2, _b2, _bc2, _bs2, _st = _kcs1(0.8, 0.0, px*px + py*py - 1.16, 0.0)
     _f2 = _st == 1

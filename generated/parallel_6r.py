@@ -1343,28 +1343,10 @@ def _ik_scalar(target, qr1, qr2, qr3, qr4, qr5, qr6, tol):
                 x21 = c6*r31
                 x22 = c6*r32
                 x23 = r31*s6
-                x24 = r13*s1
-                x25 = c1*r23
-                x26 = r21*x15
-                x27 = r12*x13
-                x28 = r22*x11
-                x29 = r11*x18
-                x30 = r22*x15
-                x31 = r21*x11
-                x32 = r12*x18
-                x33 = r11*x13
                 G11 = c1*c5*c6*r11 + c5*c6*r21*s1 - c5*x12 - c5*x14 - s5*x10 - s5*x9
-                G12 = x16 + x17 + x19 + x20
-                G13 = c5*x10 + c5*x9 + r11*s5*x15 + r21*s5*x18 - s5*x12 - s5*x14
                 G14 = c1*px + py*s1 + 79.2*x16 + 79.2*x17 + 79.2*x19 + 79.2*x20
                 G21 = c5*r32*s6 - c5*x21 + r33*s5
-                G22 = -x22 - x23
-                G23 = -c5*r33 + r32*s5*s6 - s5*x21
                 G24 = -pz - 79.2*x22 - 79.2*x23
-                G31 = c5*x26 + c5*x27 - c5*x28 - c5*x29 + s5*x24 - s5*x25
-                G32 = x30 + x31 - x32 - x33
-                G33 = -c5*x24 + c5*x25 + s5*x26 + s5*x27 - s5*x28 - s5*x29
-                G34 = c1*py - px*s1 + 79.2*x30 + 79.2*x31 - 79.2*x32 - 79.2*x33
                 # theta3: law of cosines, x^2 + y^2 = 70411*c3 + 285365/4 (elbow up / down)
                 _n3 = len(found)
                 for theta3 in (_v3 := _cs1(70411.0, 0.0, G14*G14 + G24*G24 - 71341.25, 0.0, 0.0)):
@@ -1486,28 +1468,10 @@ def _ik_candidates(T, qr1, qr2, qr3, qr4, qr5, qr6, tol):
     x21 = c6*r31
     x22 = c6*r32
     x23 = r31*s6
-    x24 = r13*s1
-    x25 = c1*r23
-    x26 = r21*x15
-    x27 = r12*x13
-    x28 = r22*x11
-    x29 = r11*x18
-    x30 = r22*x15
-    x31 = r21*x11
-    x32 = r12*x18
-    x33 = r11*x13
     G11 = c1*c5*c6*r11 + c5*c6*r21*s1 - c5*x12 - c5*x14 - s5*x10 - s5*x9
-    G12 = x16 + x17 + x19 + x20
-    G13 = c5*x10 + c5*x9 + r11*s5*x15 + r21*s5*x18 - s5*x12 - s5*x14
     G14 = c1*px + py*s1 + 79.2*x16 + 79.2*x17 + 79.2*x19 + 79.2*x20
     G21 = c5*r32*s6 - c5*x21 + r33*s5
-    G22 = -x22 - x23
-    G23 = -c5*r33 + r32*s5*s6 - s5*x21
     G24 = -pz - 79.2*x22 - 79.2*x23
-    G31 = c5*x26 + c5*x27 - c5*x28 - c5*x29 + s5*x24 - s5*x25
-    G32 = x30 + x31 - x32 - x33
-    G33 = -c5*x24 + c5*x25 + s5*x26 + s5*x27 - s5*x28 - s5*x29
-    G34 = c1*py - px*s1 + 79.2*x30 + 79.2*x31 - 79.2*x32 - 79.2*x33
     # theta3: law of cosines, x^2 + y^2 = 70411*c3 + 285365/4 (elbow up / down)
     theta3, ok, free4 = _vcs1(70411.0, 0.0, G14*G14 + G24*G24 - 71341.25, 0.0, 0.0, 4, valid)
     valid = valid & ok
@@ -1561,8 +1525,8 @@ def _ik_candidates(T, qr1, qr2, qr3, qr4, qr5, qr6, tol):
 def _kreference(q):
     """_ksolve's ref argument: q_ref's values, then their cosines, then their sines (one flat
     tuple: numba's parallel loop takes no nested ones)."""
-    return (q + (cos(q[0]), cos(q[1]), cos(q[2]), cos(q[3]), cos(q[4]), cos(q[5]),) + (sin(q[0]),
-        sin(q[1]), sin(q[2]), sin(q[3]), sin(q[4]), sin(q[5]),))
+    return (q[0], q[1], q[2], q[3], q[4], q[5], cos(q[0]), cos(q[1]), cos(q[2]), cos(q[3]),
+        cos(q[4]), cos(q[5]), sin(q[0]), sin(q[1]), sin(q[2]), sin(q[3]), sin(q[4]), sin(q[5]))
 
 
 def _ksolve(w11, w12, w13, wx, w21, w22, w23, wy, w31, w32, w33, wz, tol, ref, found, buf):
@@ -1570,9 +1534,12 @@ def _ksolve(w11, w12, w13, wx, w21, w22, w23, wy, w31, w32, w33, wz, tol, ref, f
     dropping repeats): their count, or -1 where the scalar solver must settle the pose.
     ref: q_ref's values, then their cosines, then their sines (_kreference); buf: scratch for
     the polynomial steps (_KBUF)."""
-    qr1, qr2, qr3, qr4, qr5, qr6, = ref[0:6]
-    cr1, cr2, cr3, cr4, cr5, cr6, = ref[6:12]
-    sr1, sr2, sr3, sr4, sr5, sr6, = ref[12:18]
+    qr1 = ref[0]
+    qr2 = ref[1]
+    qr4 = ref[3]
+    qr6 = ref[5]
+    cr1 = ref[6]
+    sr1 = ref[12]
     ptol = tol * REACH
     n = 0
     t = (w11, w12, w13, wx, w21, w22, w23, wy, w31, w32, w33, wz)
@@ -1640,28 +1607,10 @@ def _ksolve(w11, w12, w13, wx, w21, w22, w23, wy, w31, w32, w33, wz, tol, ref, f
             x21 = c6*r31
             x22 = c6*r32
             x23 = r31*s6
-            x24 = r13*s1
-            x25 = c1*r23
-            x26 = r21*x15
-            x27 = r12*x13
-            x28 = r22*x11
-            x29 = r11*x18
-            x30 = r22*x15
-            x31 = r21*x11
-            x32 = r12*x18
-            x33 = r11*x13
             G11 = c1*c5*c6*r11 + c5*c6*r21*s1 - c5*x12 - c5*x14 - s5*x10 - s5*x9
-            G12 = x16 + x17 + x19 + x20
-            G13 = c5*x10 + c5*x9 + r11*s5*x15 + r21*s5*x18 - s5*x12 - s5*x14
             G14 = c1*px + py*s1 + 79.2*x16 + 79.2*x17 + 79.2*x19 + 79.2*x20
             G21 = c5*r32*s6 - c5*x21 + r33*s5
-            G22 = -x22 - x23
-            G23 = -c5*r33 + r32*s5*s6 - s5*x21
             G24 = -pz - 79.2*x22 - 79.2*x23
-            G31 = c5*x26 + c5*x27 - c5*x28 - c5*x29 + s5*x24 - s5*x25
-            G32 = x30 + x31 - x32 - x33
-            G33 = -c5*x24 + c5*x25 + s5*x26 + s5*x27 - s5*x28 - s5*x29
-            G34 = c1*py - px*s1 + 79.2*x30 + 79.2*x31 - 79.2*x32 - 79.2*x33
             # theta3: law of cosines, x^2 + y^2 = 70411*c3 + 285365/4 (elbow up / down)
             _n3, _a3, _ac3, _as3, _b3, _bc3, _bs3, _st = (_kcs1(70411.0, 0.0, G14*G14 + G24*G24 -
                 71341.25, 0.0))

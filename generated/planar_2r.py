@@ -1129,12 +1129,11 @@ def _keep(found, t, q, e, tol):
 def _ik_scalar(target, qr1, qr2, tol):
     """The scalar solver in Python: every certified solution of target (the 12 top entries of
     the pose), in branch order, before wrapping and dropping repeats."""
-    (w11, w12, w13, wx, w21, w22, w23, wy, w31, w32, w33, wz) = target
+    (_, _, _, wx, _, _, _, wy, _, _, _, _) = target
     found = []
     # tool point in frame 0: (B X0)^-1 p; the arm controls a position
     px = wx
     py = wy
-    pz = wz
     # theta2: law of cosines, x^2 + y^2 = 2*c2 + 2 (elbow up / down)
     _n2 = len(found)
     for theta2 in (_v2 := _cs1(2.0, 0.0, px*px + py*py - 2.0, 0.0, 0.0)):
@@ -1177,7 +1176,6 @@ def _ik_candidates(T, qr1, qr2, tol):
     # tool point in frame 0: (B X0)^-1 p; the arm controls a position
     px = wx
     py = wy
-    pz = wz
     # theta2: law of cosines, x^2 + y^2 = 2*c2 + 2 (elbow up / down)
     theta2, ok, free1 = _vcs1(2.0, 0.0, px*px + py*py - 2.0, 0.0, 0.0, 1, valid)
     valid = valid & ok
@@ -1210,7 +1208,7 @@ def _ik_candidates(T, qr1, qr2, tol):
 def _kreference(q):
     """_ksolve's ref argument: q_ref's values, then their cosines, then their sines (one flat
     tuple: numba's parallel loop takes no nested ones)."""
-    return q + (cos(q[0]), cos(q[1]),) + (sin(q[0]), sin(q[1]),)
+    return (q[0], q[1], cos(q[0]), cos(q[1]), sin(q[0]), sin(q[1]))
 
 
 def _ksolve(w11, w12, w13, wx, w21, w22, w23, wy, w31, w32, w33, wz, tol, ref, found, buf):
@@ -1218,16 +1216,15 @@ def _ksolve(w11, w12, w13, wx, w21, w22, w23, wy, w31, w32, w33, wz, tol, ref, f
     dropping repeats): their count, or -1 where the scalar solver must settle the pose.
     ref: q_ref's values, then their cosines, then their sines (_kreference); buf: scratch for
     the polynomial steps (_KBUF)."""
-    qr1, qr2, = ref[0:2]
-    cr1, cr2, = ref[2:4]
-    sr1, sr2, = ref[4:6]
+    qr1 = ref[0]
+    cr1 = ref[2]
+    sr1 = ref[4]
     ptol = tol * REACH
     n = 0
     t = (w11, w12, w13, wx, w21, w22, w23, wy, w31, w32, w33, wz)
     # tool point in frame 0: (B X0)^-1 p; the arm controls a position
     px = wx
     py = wy
-    pz = wz
     # theta2: law of cosines, x^2 + y^2 = 2*c2 + 2 (elbow up / down)
     _n2, _a2, _ac2, _as2, _b2, _bc2, _bs2, _st = _kcs1(2.0, 0.0, px*px + py*py - 2.0, 0.0)
     _f2 = _st == 1

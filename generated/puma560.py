@@ -1825,19 +1825,16 @@ def _keep(found, t, q, e, tol):
 def _ik_scalar(target, qr1, qr2, qr3, qr4, qr5, qr6, tol):
     """The scalar solver in Python: every certified solution of target (the 12 top entries of
     the pose), in branch order, before wrapping and dropping repeats."""
-    (w11, w12, w13, wx, w21, w22, w23, wy, w31, w32, w33, wz) = target
+    (w11, _, w13, wx, w21, _, w23, wy, w31, _, w33, wz) = target
     found = []
     # flange target 0_nT = (B X0 Tz(d1))^-1 T (Tz(dn) Xn E)^-1
     r11 = w11
-    r12 = w12
     r13 = w13
     px = wx
     r21 = w21
-    r22 = w22
     r23 = w23
     py = wy
     r31 = w31
-    r32 = w32
     r33 = w33
     pz = wz
     # wrist centre (x, y, z) = 0P_4org and r = x^2 + y^2 + z^2
@@ -1879,13 +1876,10 @@ def _ik_scalar(target, qr1, qr2, qr3, qr4, qr5, qr6, tol):
                 x8 = c1*x0 + c1*x1
                 x9 = s1*x0 + s1*x1
                 W11 = r11*x5 + r21*x6 + r31*x2
-                W12 = r12*x5 + r22*x6 + r32*x2
                 W13 = r13*x5 + r23*x6 + r33*x2
                 W21 = c1*r21 - r11*s1
-                W22 = c1*r22 - r12*s1
                 W23 = c1*r23 - r13*s1
                 W31 = r11*x8 + r21*x9 + r31*x7
-                W32 = r12*x8 + r22*x9 + r32*x7
                 W33 = r13*x8 + r23*x9 + r33*x7
                 # theta5: W33 = e3^T Rx(alpha4) Rz(theta5) Rx(alpha5) e3
                 _n5 = len(found)
@@ -1943,15 +1937,12 @@ def _ik_candidates(T, qr1, qr2, qr3, qr4, qr5, qr6, tol):
     valid = np.ones(shape, dtype=bool)
     # flange target 0_nT = (B X0 Tz(d1))^-1 T (Tz(dn) Xn E)^-1
     r11 = w11
-    r12 = w12
     r13 = w13
     px = wx
     r21 = w21
-    r22 = w22
     r23 = w23
     py = wy
     r31 = w31
-    r32 = w32
     r33 = w33
     pz = wz
     # wrist centre (x, y, z) = 0P_4org and r = x^2 + y^2 + z^2
@@ -1995,13 +1986,10 @@ def _ik_candidates(T, qr1, qr2, qr3, qr4, qr5, qr6, tol):
     x8 = c1*x0 + c1*x1
     x9 = s1*x0 + s1*x1
     W11 = r11*x5 + r21*x6 + r31*x2
-    W12 = r12*x5 + r22*x6 + r32*x2
     W13 = r13*x5 + r23*x6 + r33*x2
     W21 = c1*r21 - r11*s1
-    W22 = c1*r22 - r12*s1
     W23 = c1*r23 - r13*s1
     W31 = r11*x8 + r21*x9 + r31*x7
-    W32 = r12*x8 + r22*x9 + r32*x7
     W33 = r13*x8 + r23*x9 + r33*x7
     # theta5: W33 = e3^T Rx(alpha4) Rz(theta5) Rx(alpha5) e3
     theta5, ok, free4 = _vcs1(1.0, 0.0, W33, 0.0, 0.0, 4, valid)
@@ -2050,8 +2038,8 @@ def _ik_candidates(T, qr1, qr2, qr3, qr4, qr5, qr6, tol):
 def _kreference(q):
     """_ksolve's ref argument: q_ref's values, then their cosines, then their sines (one flat
     tuple: numba's parallel loop takes no nested ones)."""
-    return (q + (cos(q[0]), cos(q[1]), cos(q[2]), cos(q[3]), cos(q[4]), cos(q[5]),) + (sin(q[0]),
-        sin(q[1]), sin(q[2]), sin(q[3]), sin(q[4]), sin(q[5]),))
+    return (q[0], q[1], q[2], q[3], q[4], q[5], cos(q[0]), cos(q[1]), cos(q[2]), cos(q[3]),
+        cos(q[4]), cos(q[5]), sin(q[0]), sin(q[1]), sin(q[2]), sin(q[3]), sin(q[4]), sin(q[5]))
 
 
 def _ksolve(w11, w12, w13, wx, w21, w22, w23, wy, w31, w32, w33, wz, tol, ref, found, buf):
@@ -2059,23 +2047,32 @@ def _ksolve(w11, w12, w13, wx, w21, w22, w23, wy, w31, w32, w33, wz, tol, ref, f
     dropping repeats): their count, or -1 where the scalar solver must settle the pose.
     ref: q_ref's values, then their cosines, then their sines (_kreference); buf: scratch for
     the polynomial steps (_KBUF)."""
-    qr1, qr2, qr3, qr4, qr5, qr6, = ref[0:6]
-    cr1, cr2, cr3, cr4, cr5, cr6, = ref[6:12]
-    sr1, sr2, sr3, sr4, sr5, sr6, = ref[12:18]
+    qr1 = ref[0]
+    qr2 = ref[1]
+    qr3 = ref[2]
+    qr4 = ref[3]
+    qr6 = ref[5]
+    cr1 = ref[6]
+    cr2 = ref[7]
+    cr3 = ref[8]
+    cr4 = ref[9]
+    cr6 = ref[11]
+    sr1 = ref[12]
+    sr2 = ref[13]
+    sr3 = ref[14]
+    sr4 = ref[15]
+    sr6 = ref[17]
     ptol = tol * REACH
     n = 0
     t = (w11, w12, w13, wx, w21, w22, w23, wy, w31, w32, w33, wz)
     # flange target 0_nT = (B X0 Tz(d1))^-1 T (Tz(dn) Xn E)^-1
     r11 = w11
-    r12 = w12
     r13 = w13
     px = wx
     r21 = w21
-    r22 = w22
     r23 = w23
     py = wy
     r31 = w31
-    r32 = w32
     r33 = w33
     pz = wz
     # wrist centre (x, y, z) = 0P_4org and r = x^2 + y^2 + z^2
@@ -2130,13 +2127,10 @@ def _ksolve(w11, w12, w13, wx, w21, w22, w23, wy, w31, w32, w33, wz, tol, ref, f
             x8 = c1*x0 + c1*x1
             x9 = s1*x0 + s1*x1
             W11 = r11*x5 + r21*x6 + r31*x2
-            W12 = r12*x5 + r22*x6 + r32*x2
             W13 = r13*x5 + r23*x6 + r33*x2
             W21 = c1*r21 - r11*s1
-            W22 = c1*r22 - r12*s1
             W23 = c1*r23 - r13*s1
             W31 = r11*x8 + r21*x9 + r31*x7
-            W32 = r12*x8 + r22*x9 + r32*x7
             W33 = r13*x8 + r23*x9 + r33*x7
             # theta5: W33 = e3^T Rx(alpha4) Rz(theta5) Rx(alpha5) e3
             _n5, _a5, _ac5, _as5, _b5, _bc5, _bs5, _st = _kcs1(1.0, 0.0, W33, 0.0)

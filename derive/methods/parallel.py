@@ -34,7 +34,7 @@ from derive.methods.common import (
     unreverse_outputs,
 )
 from derive.methods.planar import flange_factors, heading_step, planar_steps
-from derive.plan import Assign, IkPlan, Solve, Step
+from derive.plan import Assign, Cs1, Cs2, Cs2Reach, IkPlan, Poly, Solve, Step
 from derive.transforms import Chain, inverse, numbers_of, product, reverse_chain
 
 NAME = "three-parallel"
@@ -129,16 +129,15 @@ def theta1_theta5_steps(
         if a5 == 0 and b5 == 0:
             raise NotApplicable("three-parallel: entry (3,3) does not involve theta5")
         return [
-            Solve(
+            Cs1(
                 1,
-                "cs1",
                 (a, b, -c),
                 "theta1: translation entry (3,4) of the invariant equation, a c1 + b s1 = c",
                 2,
                 refs[0],
                 length**2,
             ),
-            Solve(5, "cs1", (a5, b5, -c5_), "theta5: entry (3,3) of the invariant equation", 2),
+            Cs1(5, (a5, b5, -c5_), "theta5: entry (3,3) of the invariant equation", 2),
         ]
     pa, pb, pc = linear_coeffs(pos_eq, c5, s5)
     za, zb, zc = linear_coeffs(z6_eq, c5, s5)
@@ -152,9 +151,8 @@ def theta1_theta5_steps(
     equation = reduce_pairs(cos5**2 + sin5**2 - det**2, [(s1, c1)])
     coeffs = half_angle_poly(equation, c1, s1, u)
     return [
-        Solve(
+        Poly(
             1,
-            "poly",
             coeffs,
             f"theta1: (c5, s5) eliminated from entries (3,3), (3,4): "
             f"polynomial of degree {len(coeffs) - 1} in u = tan(theta1/2)",
@@ -162,9 +160,8 @@ def theta1_theta5_steps(
             refs[0],
             typical_magnitude(coeffs, length),
         ),
-        Solve(
+        Cs2(
             5,
-            "cs2",
             (pa, pb, -pc, za, zb, -zc, sp.Integer(0), sp.Integer(0)),
             "theta5: entries (3,3) and (3,4), linear in (c5, s5)",
             1,
@@ -193,9 +190,8 @@ def theta6_steps(
     rad_a = (names[0] + names[2]) / 2
     return [
         Assign(names, tuple(at), "squared radius of the planar target at theta6 = 0, 90, 180 deg"),
-        Solve(
+        Cs2Reach(
             6,
-            "cs2r",
             (
                 a1,
                 b1,

@@ -37,7 +37,19 @@ from derive.methods.common import (
     typical_magnitude,
     unreverse_outputs,
 )
-from derive.plan import Assign, IkPlan, Solve, Step
+from derive.plan import (
+    Assign,
+    Atan2,
+    Cs1,
+    Cs1Reach,
+    Cs2,
+    Cs2Reach,
+    IkPlan,
+    Poly,
+    PolyD,
+    Solve,
+    Step,
+)
 from derive.transforms import (
     Chain,
     general_joint,
@@ -202,11 +214,11 @@ def position_equations(
     if prismatic3:
         equation = sp.expand(equation)
         coeffs = tuple(sp.Poly(equation, sym.d(3)).all_coeffs())
-        kind = "polyd"
+        kind: type[Solve] = PolyD
     else:
         equation = reduce_pairs(equation, [(s3, c3)])
         coeffs = half_angle_poly(equation, c3, s3, u)
-        kind = "poly"
+        kind = Poly
     degree = len(coeffs) - 1
     if degree < 1:
         raise NotApplicable(
@@ -231,9 +243,8 @@ def position_equations(
             ),
             "wrist centre (x, y, z) = 0P_4org and r = x^2 + y^2 + z^2",
         ),
-        Solve(
+        kind(
             3,
-            kind,
             coeffs,
             f"{name}: Pieper {case.split(':')[0]} case, polynomial "
             f"of degree {degree} in {var}; free when it vanishes identically",
@@ -248,9 +259,8 @@ def position_equations(
         za, zb, zc = linear_coeffs(z_eq, c2, s2)
         scale = abs(float(2 * a1 * sa1)) * length**2
         steps.append(
-            Solve(
+            Cs2(
                 2,
-                "cs2",
                 (ra, rb, -rc, za, zb, -zc, sp.Float(scale), sp.Integer(0)),
                 "theta2: r and z equations, linear in (c2, s2)",
                 1,
@@ -262,9 +272,8 @@ def position_equations(
         ta, tb, tc = linear_coeffs(theta2_eq, c2, s2)
         size = length if is_zero(a1, 1e-12) else 2 * abs(float(a1)) * length
         steps.append(
-            Solve(
+            Cs1(
                 2,
-                "cs1",
                 (ta, tb, -tc),
                 "theta2: a c2 + b s2 = c by the half-angle method; free when the "
                 "equation vanishes identically",
@@ -282,9 +291,8 @@ def position_equations(
     )
     gs1, gs2 = sym.named("g1"), sym.named("g2")
     steps.append(
-        Solve(
+        Cs2(
             1,
-            "cs2",
             (
                 gs1,
                 -gs2,
@@ -330,16 +338,14 @@ def reach_guided(position: list[Step], wrist: list[Step]) -> list[Step]:
     out = []
     for step in position:
         if isinstance(step, Solve) and step.joint == 1 and step.kind == "cs2":
-            step = replace(
-                step,
-                kind="cs2r",
+            step = step.as_kind(
+                Cs2Reach,
                 args=(*step.args, we, wa, wb, *bounds),
                 note=step.note + "; then chosen so that the wrist reaches W33",
             )
         elif isinstance(step, Solve) and step.joint == 2 and step.kind == "cs1":
-            step = replace(
-                step,
-                kind="cs1r",
+            step = step.as_kind(
+                Cs1Reach,
                 args=(*step.args, *m, *bounds),
                 note=step.note + "; then chosen so that a theta1 lets the wrist reach W33",
             )
@@ -375,25 +381,22 @@ def wrist_equations(numbers: dict, refs: tuple[sp.Expr, ...]) -> list[Step]:
             tuple(w_value),
             "wrist W = (0_3R Rx(alpha3))^T 0_6R = Rz(t4) Rx(alpha4) Rz(t5) Rx(alpha5) Rz(t6)",
         ),
-        Solve(
+        Cs1(
             5,
-            "cs1",
             (a5, b5, sym.named("W33") - e5),
             "theta5: W33 = e3^T Rx(alpha4) Rz(theta5) Rx(alpha5) e3",
             2,
         ),
         Assign((v1, v2), (v[0], v[1]), "v = Rx(alpha4) Rz(theta5) Rx(alpha5) e3"),
-        Solve(
+        Cs2(
             4,
-            "cs2",
             (v1, -v2, sym.named("W13"), v2, v1, sym.named("W23"), sp.Integer(1), sp.Integer(1)),
             "theta4: (W13, W23) = Rz(theta4) (v1, v2); free at a singular wrist",
             1,
             refs[3],
         ),
-        Solve(
+        Atan2(
             6,
-            "atan2",
             (m[1, 0], m[0, 0]),
             "theta6: Rz(theta6) = (Rx(alpha4) Rz(theta5) Rx(alpha5))^T Rz(theta4)^T W",
             1,

@@ -22,7 +22,7 @@ from derive import symbols as sym
 from derive.classify import Structure
 from derive.halfangle import linear_coeffs, reduce_pairs
 from derive.methods.common import NotApplicable, flange_target, joint_outputs, joint_refs
-from derive.plan import Assign, IkPlan, Solve, Step
+from derive.plan import Assign, Atan2, Cs1, Cs2, IkPlan, PolyD, Solve, Step
 from derive.transforms import Chain, inverse, numbers_of, product, x_factor, z_factor
 
 NAME = "planar"
@@ -164,7 +164,7 @@ def prismatic_steps(z_expr: sp.Expr, prismatic: list[int], z_target: sp.Symbol) 
     coeffs = tuple(sp.Poly(sp.expand(z_expr - z_target), sym.d(k)).all_coeffs())
     if len(coeffs) != 2:
         raise NotApplicable(f"planar: z does not depend linearly on d{k}")
-    return [Solve(k, "polyd", coeffs, f"d{k}: the z equation, linear in d{k}", 1)]
+    return [PolyD(k, coeffs, f"d{k}: the z equation, linear in d{k}", 1)]
 
 
 def planar_steps(
@@ -199,17 +199,15 @@ def planar_steps(
     ya, yb, yc = linear_coeffs(y_expr, ca, sa)
     k1, k2 = sym.named("k1"), sym.named("k2")
     return [
-        Solve(
+        Cs1(
             b,
-            "cs1",
             (ea, eb, x**2 + y**2 - ec),
             f"theta{b}: law of cosines, x^2 + y^2 = {sp.sstr(radius)} (elbow up / down)",
             2,
         ),
         Assign((k1, k2), (xa, -xb), f"k1, k2 with x = k1 c{a} - k2 s{a} (+ const)"),
-        Solve(
+        Cs2(
             a,
-            "cs2",
             (k1, -k2, x - xc, ya, yb, y - yc, scale, scale),
             f"theta{a}: x = k1 c{a} - k2 s{a}, y = k1 s{a} + k2 c{a}, i.e. "
             f"atan2(y, x) - atan2(k2, k1)",
@@ -237,9 +235,8 @@ def heading_step(
     """
     rotation = sym.flange_pose()[:3, :3] if target is None else target
     m = (before.T * rotation * after.T).applyfunc(sp.expand)
-    return Solve(
+    return Atan2(
         joint,
-        "atan2",
         (m[1, 0], m[0, 0]),
         f"theta{joint}: heading, Rz(theta{joint}) = A^T R B^T",
         1,

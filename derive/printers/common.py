@@ -1,5 +1,5 @@
-"""Printing SymPy expressions and plan pieces as Python source, shared by the module's
-printers (emit: scalar and vectorised code; kernel: the compiled kernel).
+"""Printing SymPy expressions and plan pieces as Python source, shared by the backends'
+printers (scalar, vector, kernel) and emit (forward kinematics).
 
 Printing is deterministic: numbers print as Python float literals (the shortest repr), terms
 in SymPy's canonical order, CSE with ``order="canonical"`` and a fresh ``x0, x1, ...``
@@ -15,7 +15,7 @@ import sympy as sp
 from sympy.printing.str import StrPrinter
 
 from derive import symbols as sym
-from derive.plan import Plan, Solve
+from derive.plan import Assign, Plan, Solve, Step
 
 
 class UnprintableError(Exception):
@@ -97,12 +97,25 @@ def assign_lines(
     names: sp.utilities.iterables.numbered_symbols,
     printer: CodePrinter,
     depth: int,
+    live: frozenset[str] | None = None,
 ) -> list[Line]:
-    """CSE'd straight-line code for targets = exprs."""
+    """CSE'd straight-line code for targets = exprs; with live, only the lines whose value
+    something in live reads, directly or through later lines.
+
+    The CSE runs on all the expressions either way, so that the arithmetic of the lines kept
+    does not depend on which others are read.
+    """
     temps, reduced = sp.cse(list(exprs), symbols=names, order="canonical")
-    lines = [Line(depth, f"{t} = {printer.doprint(e)}") for t, e in temps]
-    lines += [Line(depth, f"{t} = {printer.doprint(e)}") for t, e in zip(targets, reduced)]
-    return lines
+    pairs = [*temps, *zip(targets, reduced)]
+    if live is not None:
+        needed = set(live)
+        kept = []
+        for target, expr in reversed(pairs):
+            if str(target) in needed:
+                kept.append((target, expr))
+                needed |= {str(s) for s in expr.free_symbols}
+        pairs = kept[::-1]
+    return [Line(depth, f"{t} = {printer.doprint(e)}") for t, e in pairs]
 
 
 def cs_arguments(plan: Plan) -> str:
@@ -138,19 +151,48 @@ def step_arguments(
 ) -> tuple[list[Line], list[str]]:
     """A Solve step's note and the CSE'd temporaries of its arguments, and the arguments'
     printed expressions (in terms of those temporaries)."""
-    arg_names = tuple(sym.named(f"arg{k}") for k in range(len(step.args)))
-    temps = assign_lines(arg_names, step.args, names, printer, depth)
+    temps, reduced = sp.cse(list(step.args), symbols=names, order="canonical")
     lines = [Line(depth, f"# {step.note}")]
-    lines += [ln for ln in temps if not ln.text.startswith("arg")]
-    args = {
-        ln.text.split(" = ")[0]: ln.text.split(" = ", 1)[1]
-        for ln in temps
-        if ln.text.startswith("arg")
-    }
-    return lines, [args[str(a)] for a in arg_names]
+    lines += [Line(depth, f"{t} = {printer.doprint(e)}") for t, e in temps]
+    return lines, [printer.doprint(e) for e in reduced]
 
 
-def world_names() -> str:
+def world_names() -> tuple[str, ...]:
     """The names of the world pose's 12 top entries, row by row (w11, w12, w13, wx, ...)."""
     world = sym.world_pose()
-    return ", ".join(str(world[i, j]) for i in range(3) for j in range(4))
+    return tuple(str(world[i, j]) for i in range(3) for j in range(4))
+
+
+@dataclass(frozen=True)
+class Live:
+    """An IK step and the names read after it (by later steps and by the certification): the
+    printers leave out the assignments nothing reads (assign_lines with live=after) and the
+    cos and sin of an angle that nothing reads."""
+
+    step: Step
+    after: frozenset[str]
+
+
+def live_steps(plan: Plan) -> tuple[tuple[Live, ...], frozenset[str]]:
+    """The plan's IK steps without the assignments nothing reads, each with the names read
+    after it; and the names the first step reads (the target's entries and q_ref's values
+    the solver uses)."""
+    assert plan.ik is not None
+    live = {str(s) for e in plan.ik.outputs for s in e.free_symbols}
+    if same_joints(plan):
+        live |= set(cs_arguments(plan).split(", "))
+    out = []
+    for step in reversed(plan.ik.steps):
+        after = frozenset(live)
+        if isinstance(step, Assign):
+            read = False
+            for target, expr in reversed(tuple(zip(step.targets, step.exprs))):
+                if str(target) in live:
+                    read = True
+                    live |= {str(s) for s in expr.free_symbols}
+            if read:
+                out.append(Live(step, after))
+            continue
+        out.append(Live(step, after))
+        live |= {str(s) for e in (*step.args, step.ref) for s in e.free_symbols}
+    return tuple(reversed(out)), frozenset(live)

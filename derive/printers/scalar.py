@@ -1,0 +1,99 @@
+"""The Python solver's printer: _ik_scalar's body, one loop per Solve step.
+
+Each Solve kind has one function here (SOLVES) that prints the call giving the joint's values;
+the loop over them, the cos and sin later steps read, and the break after a free joint's first
+value that gave a solution are the same for every kind.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+import sympy as sp
+
+from derive.plan import Assign, Atan2, Cs1, Cs1Reach, Cs2, Cs2Reach, Plan, Poly, PolyD, Solve
+from derive.printers.common import (
+    CodePrinter,
+    Line,
+    assign_lines,
+    cs_arguments,
+    live_steps,
+    same_joints,
+    step_arguments,
+)
+
+# Solve kind -> the call giving the joint's values, from the step and its printed arguments,
+# reference value and free-polynomial threshold
+SolvePrinter = Callable[[Solve, str, str, str], str]
+SOLVES: dict[type[Solve], SolvePrinter] = {
+    Poly: lambda step, args, ref, free: f"_poly_angles(({args},), {ref}, {free})",
+    PolyD: lambda step, args, ref, free: f"_poly_real(({args},), {ref}, {free}, {step.unit!r})",
+    Cs1: lambda step, args, ref, free: f"_cs1({args}, {step.scale!r}, {ref})",
+    Cs1Reach: lambda step, args, ref, free: f"_cs1_reach({args}, {step.scale!r}, {ref})",
+    Cs2: lambda step, args, ref, free: f"_cs2({args}, {ref})",
+    Cs2Reach: lambda step, args, ref, free: f"_cs2_reach({args}, {ref})",
+    Atan2: lambda step, args, ref, free: f"_atan2({args}, {ref})",
+}
+
+
+def ik_lines(plan: Plan) -> tuple[tuple[int, str], ...]:
+    """Body of the scalar IK: one block per step, each Solve opening a loop over its values."""
+    assert plan.ik is not None
+    printer = CodePrinter()
+    names = sp.numbered_symbols("x")
+    lines: list[Line] = []
+    depth = 0
+    loops = []
+    steps, inputs = live_steps(plan)
+    world = ", ".join(name if name in inputs else "_" for name in WORLD)
+    lines.append(Line(0, f"({world}) = target"))
+    lines.append(Line(0, "found = []"))
+    for live in steps:
+        step = live.step
+        if isinstance(step, Assign):
+            lines.append(Line(depth, f"# {step.note}"))
+            lines += assign_lines(step.targets, step.exprs, names, printer, depth, live.after)
+            continue
+        lines += solve_lines(step, live.after, names, printer, depth)
+        loops.append((depth, step.joint))
+        depth += 1
+    outputs = ", ".join(printer.doprint(e) for e in plan.ik.outputs)
+    if same_joints(plan):
+        fk = f"_fk_from_cs({cs_arguments(plan)})"
+        lines.append(Line(depth, f"_keep(found, target, ({outputs},), {fk}, tol)"))
+    else:
+        lines.append(Line(depth, f"q = ({outputs},)"))
+        lines.append(Line(depth, "_keep(found, target, q, _fk_q(q), tol)"))
+    for level, joint in reversed(loops):
+        # a free joint's loop (over _Free values) ends at its first value that gave a solution
+        lines.append(
+            Line(level + 1, f"if _v{joint}.__class__ is _Free and len(found) > _n{joint}:")
+        )
+        lines.append(Line(level + 2, "break"))
+    lines.append(Line(0, "return found"))
+    return tuple((ln.depth, ln.text) for ln in lines)
+
+
+WORLD = ("w11", "w12", "w13", "wx", "w21", "w22", "w23", "wy", "w31", "w32", "w33", "wz")
+
+
+def solve_lines(
+    step: Solve,
+    after: frozenset[str],
+    names: sp.utilities.iterables.numbered_symbols,
+    printer: CodePrinter,
+    depth: int,
+) -> list[Line]:
+    """The loop header of one Solve step, with its arguments CSE'd before it, and the cos
+    and sin of an angle where later steps read them."""
+    lines, values = step_arguments(step, names, printer, depth)
+    call = SOLVES[type(step)](
+        step, ", ".join(values), printer.doprint(step.ref), repr(1e-10 * step.scale)
+    )
+    j = step.joint
+    lines.append(Line(depth, f"_n{j} = len(found)"))
+    lines.append(Line(depth, f"for {step.variable} in (_v{j} := {call}):"))
+    for name, function in ((f"c{j}", "cos"), (f"s{j}", "sin")):
+        if step.angle and name in after:
+            lines.append(Line(depth + 1, f"{name} = {function}({step.variable})"))
+    return lines

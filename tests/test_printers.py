@@ -1,0 +1,151 @@
+"""The printers and the generated module's form: every step kind printed by every backend,
+modules that pass ruff with no finding, hold no function they never call, keep lines within
+100 characters, and whose layout changes nothing but the layout."""
+
+from __future__ import annotations
+
+import ast
+import importlib
+import shutil
+import subprocess
+import sys
+
+import pytest
+
+from derive.layout import wrap_code
+from derive.plan import SOLVE_KINDS, Solve
+from derive.printers import BACKENDS
+
+from conftest import BUNDLED, ROOT
+
+
+def all_subclasses(cls: type) -> set[type]:
+    out = set()
+    for sub in cls.__subclasses__():
+        out |= {sub} | all_subclasses(sub)
+    return out
+
+
+def test_every_step_kind_is_listed_and_has_a_printer_in_every_backend():
+    assert set(SOLVE_KINDS) == all_subclasses(Solve)
+    for backend in BACKENDS:
+        module = importlib.import_module(f"derive.printers.{backend}")
+        missing = [k.__name__ for k in SOLVE_KINDS if k not in module.SOLVES]
+        assert not missing, f"derive/printers/{backend}.py has no printer for {missing}"
+
+
+def test_solve_is_abstract_and_checks_its_arguments():
+    import sympy as sp
+
+    from derive.plan import Atan2, Poly
+
+    with pytest.raises(TypeError):
+        Solve(1, (sp.S.One, sp.S.One), "", 1)
+    with pytest.raises(ValueError, match="atan2 takes 2 arguments"):
+        Atan2(1, (sp.S.One,), "", 1)
+    with pytest.raises(ValueError, match="at least two"):
+        Poly(1, (sp.S.One,), "", 1)
+
+
+def module_source(name: str) -> str:
+    return (ROOT / "generated" / f"{name}.py").read_text()
+
+
+@pytest.mark.parametrize("name", BUNDLED)
+def test_generated_lines_fit_in_100_characters(name):
+    long = [n for n, line in enumerate(module_source(name).split("\n"), 1) if len(line) > 100]
+    assert not long, f"{name}.py lines {long[:5]} are longer than 100 characters"
+
+
+@pytest.mark.parametrize("name", BUNDLED)
+def test_generated_modules_hold_no_function_they_never_call(name):
+    tree = ast.parse(module_source(name))
+    defined = {n.name for n in tree.body if isinstance(n, ast.FunctionDef | ast.ClassDef)}
+    used = {n.id for n in ast.walk(tree) if isinstance(n, ast.Name)}
+    # the compiled kernel's functions are named in _KERNEL (strings), the public API by users
+    named = {n.value for n in ast.walk(tree) if isinstance(n, ast.Constant)}
+    public = {"fk", "fk_batch", "ik", "ik_batch", "nearest", "warmup"}
+    unused = sorted(defined - used - named - public)
+    assert not unused, f"{name}.py never calls {unused}"
+
+
+@pytest.mark.parametrize("name", BUNDLED)
+def test_wrapping_changes_only_the_layout(name):
+    source = module_source(name)
+    narrow = wrap_code(source, width=60)
+    assert ast.dump(ast.parse(narrow)) == ast.dump(ast.parse(source))
+    assert narrow.count("\n") > source.count("\n")  # and it did wrap
+
+
+def test_generated_modules_pass_ruff(tmp_path, generated_user_modules):
+    """ruff check with the project's configuration finds nothing in the bundled arms' modules
+    and in user arms' (copied out of the checkout, so the configuration is passed along)."""
+    ruff = shutil.which("ruff") or (shutil.which("ruff", path=str(ROOT / ".venv" / "bin")))
+    if ruff is None:
+        pytest.skip("ruff is not installed (pip install -e '.[lint]')")
+    files = [ROOT / "generated" / f"{name}.py" for name in BUNDLED] + generated_user_modules
+    result = subprocess.run(
+        [ruff, "check", "--no-cache", "--config", str(ROOT / "pyproject.toml")]
+        + [str(f) for f in files],
+        capture_output=True,
+        text=True,
+    )
+    assert result.returncode == 0, result.stdout + result.stderr
+
+
+@pytest.fixture
+def generated_user_modules(tmp_path):
+    """Modules of user arms (a prismatic Pieper arm and a three-parallel arm), written to tmp."""
+    from conftest import USER_ROWS, spec_text
+
+    paths = []
+    for name, rows, kinds in (
+        ("user_six", USER_ROWS, None),
+        ("user_prismatic", USER_ROWS, "RRPRRR"),
+    ):
+        spec = tmp_path / f"{name}.toml"
+        spec.write_text(spec_text(name, "modified", rows, kinds=kinds))
+        out = tmp_path / "out"
+        result = subprocess.run(
+            [sys.executable, "-m", "derive", "generate", str(spec), "--out", str(out)],
+            capture_output=True,
+            text=True,
+        )
+        assert result.returncode == 0, result.stderr
+        paths.append(out / f"{name}.py")
+    return paths
+
+
+def test_a_new_method_is_one_file_and_one_registration_line(tmp_path, monkeypatch):
+    """tests/example_method.py is a method as a file under derive/methods/ would be; the
+    monkeypatch below is the one line that registers it in derive/pipeline.py's METHODS."""
+    import importlib.util
+
+    import example_method
+    import numpy as np
+
+    from derive import pipeline
+    from derive.emit import render_module
+    from derive.spec import load_spec
+
+    from conftest import spec_text
+
+    monkeypatch.setattr(pipeline, "METHODS", (*pipeline.METHODS, example_method.derive))
+    spec = tmp_path / "pan_tilt.toml"
+    spec.write_text(spec_text("pan_tilt", "modified", [(0, 0, 0, 0), (-90, 0.05, 0.1, 30)]))
+    plan = pipeline.build_plan(load_spec(spec))
+    assert plan.ik is not None and plan.ik.method == "pan-tilt", plan.refusal
+    path = tmp_path / "pan_tilt.py"
+    path.write_text(render_module(plan))
+    loaded = importlib.util.spec_from_file_location("pan_tilt", path)
+    assert loaded is not None and loaded.loader is not None
+    module = importlib.util.module_from_spec(loaded)
+    loaded.loader.exec_module(module)
+    Q = np.random.default_rng(3).uniform(-np.pi, np.pi, size=(200, 2))
+    T = module.fk_batch(Q)
+    for backend in ("python", "auto"):
+        for q, pose in zip(Q, T):
+            sols = module.ik(pose, backend=backend)
+            assert len(sols) == 1 and np.allclose(sols[0], q, atol=1e-9), (q, sols)
+        found, valid = module.ik_batch(T, backend=backend)
+        assert valid[:, 0].all() and np.allclose(found[:, 0], Q, atol=1e-9)
