@@ -23,6 +23,7 @@ from typing import TYPE_CHECKING
 if TYPE_CHECKING:
     from collections.abc import Iterable
 
+from derive import urdf
 from derive.emit import GenerationError, render_module
 from derive.pipeline import build_plan
 from derive.plan import Plan
@@ -46,9 +47,11 @@ def bundled_specs() -> list[Path]:
     )
 
 
-def resolve_spec(text: str) -> ArmSpec:
-    """A spec from a file path, or a bundled arm by name."""
+def resolve_spec(text: str, options: urdf.Options | None = None) -> ArmSpec:
+    """A spec from a file path (a URDF with options' base and tip), or a bundled arm by name."""
     path = Path(text)
+    if path.suffix.lower() == ".urdf":
+        return urdf.load_urdf(path, options or urdf.Options())
     if path.suffix == ".toml" or path.exists():
         return load_spec(path)
     for candidate in bundled_specs():
@@ -126,9 +129,25 @@ def current_umask() -> int:
     return mask
 
 
-def load_specs(texts: list[str]) -> list[ArmSpec]:
+def urdf_options(args: argparse.Namespace) -> urdf.Options:
+    """The URDF conversion options of a command line."""
+    return urdf.Options(
+        base=args.base,
+        tip=args.tip,
+        name=args.name,
+        angle_tol=args.angle_tol,
+        length_tol=args.length_tol,
+        exact=args.exact,
+        max_deviation=args.max_deviation,
+    )
+
+
+def load_specs(texts: list[str], options: urdf.Options | None = None) -> list[ArmSpec]:
     """Specs named on the command line (all bundled arms if none), with unique names."""
-    specs = [resolve_spec(t) for t in texts] if texts else [load_spec(p) for p in bundled_specs()]
+    if texts:
+        specs = [resolve_spec(t, options) for t in texts]
+    else:
+        specs = [load_spec(p) for p in bundled_specs()]
     seen: dict[str, str] = {}
     for spec in specs:
         if spec.name in seen:
@@ -147,7 +166,7 @@ def cmd_generate(args: argparse.Namespace) -> int:
     for text in args.specs or [str(p) for p in bundled_specs()]:
         start = time.perf_counter()
         try:
-            spec = resolve_spec(text)
+            spec = resolve_spec(text, urdf_options(args))
             plan, files = outputs_for(spec)
             for name, content in files.items():
                 write_atomic(out / name, content)
@@ -180,7 +199,7 @@ def cmd_generate(args: argparse.Namespace) -> int:
 def cmd_check(args: argparse.Namespace) -> int:
     """Compare DIR with a fresh generation; never writes into DIR."""
     out = Path(args.out)
-    specs = load_specs(args.specs)
+    specs = load_specs(args.specs, urdf_options(args))
     expected: dict[str, bytes] = {}
     with tempfile.TemporaryDirectory() as tmp:
         for spec in specs:
@@ -274,7 +293,7 @@ def format_pose(pose: Iterable[Iterable[float]]) -> str:
 
 def cmd_fk(args: argparse.Namespace) -> int:
     """Print the pose of a joint vector."""
-    spec = resolve_spec(args.arm)
+    spec = resolve_spec(args.arm, urdf_options(args))
     module = load_module(spec)
     q = joint_vector(spec, parse_numbers(args.q, "q"), args.rad)
     print(format_pose(module.fk(q)))
@@ -285,7 +304,7 @@ def cmd_solve(args: argparse.Namespace) -> int:
     """Print every IK solution of a pose, its FK residual and the joints outside limits."""
     import numpy as np
 
-    spec = resolve_spec(args.arm)
+    spec = resolve_spec(args.arm, urdf_options(args))
     module = load_module(spec)
     if not hasattr(module, "ik"):
         raise UsageError(f"{spec.name}: no IK method applies to this arm")
@@ -325,7 +344,7 @@ def cmd_bench(args: argparse.Namespace) -> int:
     from derive.bench import measure
 
     results = []
-    for spec in load_specs(args.specs):
+    for spec in load_specs(args.specs, urdf_options(args)):
         start = time.perf_counter()
         render_module(build_plan(spec))
         generation = time.perf_counter() - start
@@ -344,7 +363,7 @@ def cmd_bench(args: argparse.Namespace) -> int:
 
 def cmd_report(args: argparse.Namespace) -> int:
     """Write (or print) the derivation report of one arm."""
-    spec = resolve_spec(args.arm)
+    spec = resolve_spec(args.arm, urdf_options(args))
     plan = build_plan(spec)
     module = import_source(spec.name, render_module(plan))
     text = render_report(plan, worked_example(plan, module), args.format)
@@ -444,7 +463,59 @@ def parser() -> argparse.ArgumentParser:
     )
     bench.add_argument("--json", action="store_true", help="print figures as JSON")
     bench.set_defaults(run=cmd_bench)
+    imp = sub.add_parser("import-urdf", help="write the spec of a URDF's chain from base to tip")
+    imp.add_argument("urdf", help="the URDF file (xacro expanded)")
+    imp.add_argument(
+        "--convention", choices=("modified",), default="modified", help="DH convention (modified)"
+    )
+    imp.add_argument("-o", "--output", help="write the spec here (default: standard output)")
+    imp.set_defaults(run=cmd_import_urdf)
+    for command in (gen, chk, fk, solve, report, bench, imp):
+        add_urdf_arguments(command, required=command is imp)
     return top
+
+
+def add_urdf_arguments(command: argparse.ArgumentParser, required: bool) -> None:
+    """The options of a URDF's conversion (used where an arm is a .urdf file)."""
+    group = command.add_argument_group("URDF input (ARM.urdf)")
+    group.add_argument("--base", required=required, help="the URDF link the chain starts from")
+    group.add_argument("--tip", required=required, help="the URDF link the chain ends at")
+    group.add_argument("--name", help="the arm's name (default: the URDF robot's)")
+    group.add_argument(
+        "--angle-tol",
+        type=float,
+        default=urdf.ANGLE_TOL,
+        help=f"snap angles this close (rad) to parallel / 0 / 90 / 180 deg ({urdf.ANGLE_TOL:g})",
+    )
+    group.add_argument(
+        "--length-tol",
+        type=float,
+        default=urdf.LENGTH_TOL,
+        help=f"snap lengths this close to 0, relative to the arm's size ({urdf.LENGTH_TOL:g})",
+    )
+    group.add_argument("--exact", action="store_true", help="no snapping")
+    group.add_argument(
+        "--max-deviation",
+        type=float,
+        default=urdf.MAX_DEVIATION,
+        help=f"refuse if snapping moves FK more than this, of the reach ({urdf.MAX_DEVIATION:g})",
+    )
+
+
+def cmd_import_urdf(args: argparse.Namespace) -> int:
+    """Write (or print) the spec of a URDF chain; say what the conversion did on stderr."""
+    text, conversion = urdf.import_urdf(Path(args.urdf), urdf_options(args))
+    if args.output:
+        write_atomic(Path(args.output), text)
+    else:
+        sys.stdout.write(text)
+    snaps = f"{len(conversion.snaps)} snap(s)" if conversion.snaps else "no snapping"
+    print(
+        f"{args.urdf}: {len(conversion.rows)} joints; {snaps}; FK deviation from the URDF "
+        f"{conversion.deviation:.2g} (of the reach, {urdf.SAMPLES} random joint vectors)",
+        file=sys.stderr,
+    )
+    return 0
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -121,13 +121,13 @@ def test_a_new_method_is_one_file_and_one_registration_line(tmp_path, monkeypatc
     monkeypatch below is the one line that registers it in derive/pipeline.py's METHODS."""
     import importlib.util
 
-    import example_method
     import numpy as np
 
     from derive import pipeline
     from derive.emit import render_module
     from derive.spec import load_spec
 
+    import example_method
     from conftest import spec_text
 
     monkeypatch.setattr(pipeline, "METHODS", (*pipeline.METHODS, example_method.derive))

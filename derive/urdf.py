@@ -1,0 +1,697 @@
+"""URDF in: the kinematic chain between two links as a spec (modified DH, base and tool frames).
+
+Reading: a hardened XML parser (defusedxml: no DTDs, no entities, nothing fetched), a size
+limit, and only the elements kinematics needs (``joint``: type, parent, child, origin, axis,
+limit, mimic; ``link`` names). Meshes, transmissions, gazebo and other tags are never looked at.
+
+Converting (plain Python floats throughout, so that the output is the same on every machine):
+at q = 0 every moving joint's axis is a line in the base link's frame, z along the URDF axis
+direction so that joint values keep their meaning. Frame i of Craig's convention sits on axis i
+where the common normal to axis i + 1 meets it, x along that normal; for parallel axes the
+normal goes through the point where the previous normal meets axis i (d = 0 there). Frame 0 is
+frame 1 at q = 0; the base link to frame 0 is the spec's [base], frame n to the tip link its
+[tool]. Fixed joints only move these lines and frames. Number noise: axes within an angle
+tolerance of parallel are taken as parallel, lines within a length tolerance of meeting as
+meeting, and DH angles within the angle tolerance of a multiple of 90 deg and lengths within
+the length tolerance of 0 are snapped. What that changed is measured: the spec's forward
+kinematics against the URDF's on random joint vectors. A deviation above a bound is refused.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import math
+import random
+import re
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import defusedxml.ElementTree as SafeET
+from defusedxml import DefusedXmlException
+
+from derive.spec import ArmSpec, SpecError, parse_spec
+
+MAX_BYTES = 10_000_000
+MOVING = ("revolute", "continuous", "prismatic")
+KNOWN_TYPES = (*MOVING, "fixed", "floating", "planar")
+# the defaults: about 1e-5 rad, 1e-6 of the arm's size, and the FK deviation allowed after
+# snapping (relative to the reach for positions; rotation entries as they are)
+ANGLE_TOL = 1e-5
+LENGTH_TOL = 1e-6
+MAX_DEVIATION = 1e-4
+SAMPLES = 200
+# a link offset beyond this many reaches comes from nearly parallel axes (never a real arm)
+OFFSET_LIMIT = 100.0
+
+Matrix = list[list[float]]
+Vector = tuple[float, float, float]
+
+
+class UrdfError(SpecError):
+    """The URDF cannot be converted; the message (one line) names the file, the element and
+    the problem."""
+
+
+@dataclass(frozen=True)
+class UrdfJoint:
+    """A joint as the URDF states it (origin as a 4x4 matrix, axis normalised)."""
+
+    name: str
+    kind: str
+    parent: str
+    child: str
+    origin: Matrix
+    axis: Vector
+    limits: tuple[float, float] | None
+    mimic: bool
+
+
+@dataclass(frozen=True)
+class Robot:
+    """The kinematic part of a URDF."""
+
+    name: str
+    links: frozenset[str]
+    joints: tuple[UrdfJoint, ...]
+    digest: str
+
+
+@dataclass
+class Conversion:
+    """A chain as DH rows, with what the conversion did.
+
+    Attributes:
+        rows: (type, alpha, a, d, theta, limits) per moving joint; radians and URDF lengths.
+        joint_names: the URDF joint name of each row.
+        base, tool: 4x4 matrices.
+        snaps: one line per snap applied.
+        deviation: the largest FK difference of the spec from the URDF over the samples.
+        reach: the arm's size.
+    """
+
+    rows: list[tuple[str, float, float, float, float, tuple[float, float] | None]]
+    joint_names: list[str]
+    base: Matrix
+    tool: Matrix
+    snaps: list[str] = field(default_factory=list)
+    deviation: float = 0.0
+    reach: float = 1.0
+    rounded: bool = True
+
+
+# --- reading ---------------------------------------------------------------------------------
+
+
+def read_urdf(path: Path) -> Robot:
+    """The links and joints of a URDF file."""
+    where = str(path)
+    try:
+        size = path.stat().st_size
+        if size > MAX_BYTES:
+            raise UrdfError(f"{where}: {size} bytes; a URDF may have at most {MAX_BYTES}")
+        data = path.read_bytes()
+    except OSError as exc:
+        raise UrdfError(f"{where}: cannot read: {exc.strerror}") from None
+    if b"xmlns:xacro" in data or b"<xacro:" in data:
+        raise UrdfError(
+            f"{where}: a xacro file; expand it first: `xacro {path.name} > robot.urdf` "
+            "(ROS's xacro, or `pip install xacro`)"
+        )
+    try:
+        root = SafeET.fromstring(data, forbid_dtd=True)
+    except DefusedXmlException as exc:
+        raise UrdfError(f"{where}: refused: {type(exc).__name__} (DTDs and entities)") from None
+    except SafeET.ParseError as exc:
+        raise UrdfError(f"{where}: not well-formed XML: {exc}") from None
+    if root.tag != "robot":
+        raise UrdfError(f"{where}: the root element is <{root.tag[:40]}>, not <robot>")
+    links: set[str] = set()
+    for link in root.findall("link"):
+        name = _name(link, where, "link")
+        if name in links:
+            raise UrdfError(f"{where}: link {name!r}: defined twice")
+        links.add(name)
+    joints: list[UrdfJoint] = []
+    above: dict[str, UrdfJoint] = {}
+    for element in root.findall("joint"):
+        joint = _joint(element, where)
+        if any(j.name == joint.name for j in joints):
+            raise UrdfError(f"{where}: joint {joint.name!r}: defined twice")
+        for end in (joint.parent, joint.child):
+            if end not in links:
+                raise UrdfError(f"{where}: joint {joint.name!r}: unknown link {end!r}")
+        if joint.child in above:
+            raise UrdfError(
+                f"{where}: joint {joint.name!r}: link {joint.child!r} is already the child of "
+                f"joint {above[joint.child].name!r}; a URDF is a tree"
+            )
+        above[joint.child] = joint
+        joints.append(joint)
+    for start in sorted(above):
+        link, seen = start, set()
+        while link in above:
+            if link in seen:
+                raise UrdfError(
+                    f"{where}: joint {above[link].name!r}: the links form a cycle; a URDF is a tree"
+                )
+            seen.add(link)
+            link = above[link].parent
+    return Robot(
+        name=root.get("name", ""),
+        links=frozenset(links),
+        joints=tuple(joints),
+        digest=hashlib.sha256(data).hexdigest()[:16],
+    )
+
+
+def _name(element, where: str, what: str) -> str:
+    name = element.get("name")
+    if not name:
+        raise UrdfError(f"{where}: a <{what}> without a name")
+    return str(name)
+
+
+def _numbers(text: str | None, count: int, where: str, default: tuple[float, ...]) -> list[float]:
+    if text is None:
+        return list(default)
+    parts = text.split()
+    try:
+        values = [float(p) for p in parts]
+    except ValueError:
+        raise UrdfError(f"{where}: {text[:40]!r} is not {count} numbers") from None
+    if len(values) != count or not all(map(math.isfinite, values)):
+        raise UrdfError(f"{where}: {text[:40]!r} is not {count} finite numbers")
+    return values
+
+
+def _joint(element, where: str) -> UrdfJoint:
+    name = _name(element, where, "joint")
+    at = f"{where}: joint {name!r}"
+    kind = element.get("type", "")
+    if kind not in KNOWN_TYPES:
+        raise UrdfError(f"{at}: type {kind[:20]!r}; allowed: {', '.join(KNOWN_TYPES)}")
+    ends = []
+    for tag in ("parent", "child"):
+        node = element.find(tag)
+        if node is None or not node.get("link"):
+            raise UrdfError(f"{at}: <{tag} link=...> missing")
+        ends.append(str(node.get("link")))
+    origin = element.find("origin")
+    xyz = _numbers(None if origin is None else origin.get("xyz"), 3, f"{at}: origin xyz", (0,) * 3)
+    rpy = _numbers(None if origin is None else origin.get("rpy"), 3, f"{at}: origin rpy", (0,) * 3)
+    axis_node = element.find("axis")
+    axis = _numbers(
+        None if axis_node is None else axis_node.get("xyz"), 3, f"{at}: axis xyz", (1.0, 0.0, 0.0)
+    )
+    norm = math.sqrt(sum(x * x for x in axis))
+    if kind in MOVING and norm < 1e-9:
+        raise UrdfError(f"{at}: axis xyz is zero")
+    limits = None
+    limit = element.find("limit")
+    if kind in ("revolute", "prismatic") and limit is not None:
+        lo = _numbers(limit.get("lower"), 1, f"{at}: limit lower", (0.0,))[0]
+        hi = _numbers(limit.get("upper"), 1, f"{at}: limit upper", (0.0,))[0]
+        if lo > hi:
+            raise UrdfError(f"{at}: limit lower {lo} is above upper {hi}")
+        limits = (lo, hi) if lo < hi else None  # lower = upper = 0: URDF's "no limits given"
+    return UrdfJoint(
+        name=name,
+        kind=kind,
+        parent=ends[0],
+        child=ends[1],
+        origin=pose(xyz, rpy),
+        axis=(axis[0] / norm, axis[1] / norm, axis[2] / norm) if norm else (1.0, 0.0, 0.0),
+        limits=limits,
+        mimic=element.find("mimic") is not None,
+    )
+
+
+def chain_between(robot: Robot, base: str, tip: str, where: str) -> list[UrdfJoint]:
+    """The joints from base down to tip, in order."""
+    for link, what in ((base, "--base"), (tip, "--tip")):
+        if link not in robot.links:
+            known = ", ".join(sorted(robot.links)[:8])
+            raise UrdfError(f"{where}: {what} {link!r}: no such link; links: {known}, ...")
+    above = {j.child: j for j in robot.joints}
+    path: list[UrdfJoint] = []
+    link = tip
+    seen = {tip}
+    while link != base:
+        joint = above.get(link)
+        if joint is None:
+            raise UrdfError(f"{where}: --tip {tip!r} is not below --base {base!r}")
+        if joint.parent in seen:
+            raise UrdfError(f"{where}: joint {joint.name!r}: the links form a cycle")
+        seen.add(joint.parent)
+        path.append(joint)
+        link = joint.parent
+    path.reverse()
+    for joint in path:
+        if joint.kind in ("floating", "planar"):
+            raise UrdfError(
+                f"{where}: joint {joint.name!r}: a {joint.kind} joint between base and tip; "
+                "allowed: revolute, continuous, prismatic, fixed"
+            )
+        if joint.mimic and joint.kind in MOVING:
+            raise UrdfError(
+                f"{where}: joint {joint.name!r}: a mimic joint between base and tip is not "
+                "supported (its value follows another joint's)"
+            )
+    if not any(j.kind in MOVING for j in path):
+        raise UrdfError(f"{where}: no moving joint between {base!r} and {tip!r}")
+    return path
+
+
+# --- plain-Python geometry -------------------------------------------------------------------
+
+
+def pose(xyz: list[float], rpy: list[float]) -> Matrix:
+    """The URDF origin: translation xyz, rotation Rz(yaw) Ry(pitch) Rx(roll)."""
+    r, p, y = rpy
+    cr, sr, cp, sp = math.cos(r), math.sin(r), math.cos(p), math.sin(p)
+    cy, sy = math.cos(y), math.sin(y)
+    return [
+        [cy * cp, cy * sp * sr - sy * cr, cy * sp * cr + sy * sr, xyz[0]],
+        [sy * cp, sy * sp * sr + cy * cr, sy * sp * cr - cy * sr, xyz[1]],
+        [-sp, cp * sr, cp * cr, xyz[2]],
+        [0.0, 0.0, 0.0, 1.0],
+    ]
+
+
+def matmul(a: Matrix, b: Matrix) -> Matrix:
+    return [[sum(a[i][k] * b[k][j] for k in range(4)) for j in range(4)] for i in range(4)]
+
+
+def inverse(m: Matrix) -> Matrix:
+    """The inverse of a rigid transform."""
+    rt = [[m[j][i] for j in range(3)] for i in range(3)]
+    p = [-sum(rt[i][k] * m[k][3] for k in range(3)) for i in range(3)]
+    return [[*rt[i], p[i]] for i in range(3)] + [[0.0, 0.0, 0.0, 1.0]]
+
+
+def motion(joint: UrdfJoint, q: float) -> Matrix:
+    """The joint's motion by q: a rotation about its axis, or a translation along it."""
+    x, y, z = joint.axis
+    if joint.kind == "prismatic":
+        return [[1.0, 0, 0, x * q], [0, 1.0, 0, y * q], [0, 0, 1.0, z * q], [0, 0, 0, 1.0]]
+    if joint.kind == "fixed":
+        return [[1.0, 0, 0, 0], [0, 1.0, 0, 0], [0, 0, 1.0, 0], [0, 0, 0, 1.0]]
+    c, s = math.cos(q), math.sin(q)
+    t = 1.0 - c
+    return [
+        [t * x * x + c, t * x * y - s * z, t * x * z + s * y, 0.0],
+        [t * x * y + s * z, t * y * y + c, t * y * z - s * x, 0.0],
+        [t * x * z - s * y, t * y * z + s * x, t * z * z + c, 0.0],
+        [0.0, 0.0, 0.0, 1.0],
+    ]
+
+
+def urdf_fk(path: list[UrdfJoint], q: list[float]) -> Matrix:
+    """The tip link's pose in the base link for the moving joints' values q."""
+    out = [[float(i == j) for j in range(4)] for i in range(4)]
+    values = iter(q)
+    for joint in path:
+        out = matmul(out, joint.origin)
+        if joint.kind in MOVING:
+            out = matmul(out, motion(joint, next(values)))
+    return out
+
+
+def dh_modified(alpha: float, a: float, theta: float, d: float) -> Matrix:
+    """Craig's A_i = Rx(alpha_{i-1}) Tx(a_{i-1}) Rz(theta_i) Tz(d_i)."""
+    ca, sa, ct, st = math.cos(alpha), math.sin(alpha), math.cos(theta), math.sin(theta)
+    return [
+        [ct, -st, 0.0, a],
+        [st * ca, ct * ca, -sa, -sa * d],
+        [st * sa, ct * sa, ca, ca * d],
+        [0.0, 0.0, 0.0, 1.0],
+    ]
+
+
+def _sub(a: Vector, b: Vector) -> Vector:
+    return (a[0] - b[0], a[1] - b[1], a[2] - b[2])
+
+
+def _add(a: Vector, b: Vector, k: float = 1.0) -> Vector:
+    return (a[0] + k * b[0], a[1] + k * b[1], a[2] + k * b[2])
+
+
+def _dot(a: Vector, b: Vector) -> float:
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+
+
+def _cross(a: Vector, b: Vector) -> Vector:
+    return (a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0])
+
+
+def _unit(a: Vector) -> Vector:
+    n = math.sqrt(_dot(a, a))
+    return (a[0] / n, a[1] / n, a[2] / n)
+
+
+def _angle(u: Vector, v: Vector, about: Vector) -> float:
+    """The angle from u to v about the unit vector `about` (u, v perpendicular to it)."""
+    return math.atan2(_dot(_cross(u, v), about), _dot(u, v))
+
+
+# --- converting ------------------------------------------------------------------------------
+
+
+# rounding noise: what --exact still takes as parallel, meeting, 0 or 90 deg (and never reports)
+NOISE = 1e-12
+
+
+def convert(
+    path: list[UrdfJoint],
+    where: str,
+    angle_tol: float = ANGLE_TOL,
+    length_tol: float = LENGTH_TOL,
+    exact: bool = False,
+) -> Conversion:
+    """The chain as modified-DH rows, base and tool, snapping within the tolerances (exact:
+    rounding noise only); the deviation is measured by :func:`measure`."""
+    if exact:
+        angle_tol = length_tol = NOISE
+    moving = [j for j in path if j.kind in MOVING]
+    reach = sum(math.sqrt(sum(j.origin[i][3] ** 2 for i in range(3))) for j in path) or 1.0
+    ltol = length_tol * reach
+    # the axis lines at q = 0 in the base link: a point and the direction
+    frame = [[float(i == j) for j in range(4)] for i in range(4)]
+    lines: list[tuple[Vector, Vector]] = []
+    for joint in path:
+        frame = matmul(frame, joint.origin)
+        if joint.kind in MOVING:
+            point = (frame[0][3], frame[1][3], frame[2][3])
+            turned = [sum(frame[i][k] * joint.axis[k] for k in range(3)) for i in range(3)]
+            lines.append((point, _unit((turned[0], turned[1], turned[2]))))
+    tip_pose = frame
+    snaps: list[str] = []
+    n = len(moving)
+    # origins O_i and x axes of frames 1..n at q = 0
+    origins: list[Vector] = []
+    xs: list[Vector] = []
+    for i in range(n):
+        p, z = lines[i]
+        if i == n - 1:  # the last frame: on its axis where the previous normal meets it
+            if n == 1:
+                origins.append(p)
+                xs.append(_perpendicular(z))
+            else:
+                origins.append(_foot(origins[-1], xs[-1], lines[i]))
+                xs.append(xs[-1])
+            break
+        q_point, z_next = lines[i + 1]
+        cross = _cross(z, z_next)
+        sine = math.sqrt(_dot(cross, cross))
+        start = p if i == 0 else _foot(origins[-1], xs[-1], lines[i])
+        if sine <= math.sin(angle_tol):
+            if sine > NOISE:
+                snaps.append(
+                    f"axes {i + 1} and {i + 2}: {math.asin(min(sine, 1.0)):.3g} rad from "
+                    "parallel: taken as parallel"
+                )
+            # parallel: the normal through `start` (d = 0 for this joint)
+            offset = _sub(q_point, start)
+            normal = _add(offset, z, -_dot(offset, z))
+            length = math.sqrt(_dot(normal, normal))
+            origins.append(start)
+            xs.append(_unit(normal) if length > ltol else _perpendicular(z))
+            continue
+        # skew or intersecting: the feet of the common normal
+        w = _sub(p, q_point)
+        b = _dot(z, z_next)
+        denom = sine * sine  # 1 - b^2, without its cancellation
+        s = (b * _dot(z_next, w) - _dot(z, w)) / denom
+        t = (_dot(z_next, w) - b * _dot(z, w)) / denom
+        foot_i = _add(p, z, s)
+        foot_next = _add(q_point, z_next, t)
+        gap = _sub(foot_next, foot_i)
+        distance = math.sqrt(_dot(gap, gap))
+        origins.append(foot_i)
+        if distance <= ltol:
+            if distance > NOISE * reach:
+                snaps.append(f"axes {i + 1} and {i + 2}: {distance:.3g} apart: taken as meeting")
+            xs.append(_unit(cross))
+        else:
+            xs.append(_unit(gap))
+    # DH rows from consecutive frames (frame 0 = frame 1 at q = 0)
+    rows = []
+    for i, joint in enumerate(moving):
+        z = lines[i][1]
+        if i == 0:
+            alpha = a = d = theta = 0.0
+        else:
+            z_prev, x_prev, o_prev = lines[i - 1][1], xs[i - 1], origins[i - 1]
+            alpha = _angle(z_prev, z, x_prev)
+            foot = _add(o_prev, x_prev, _dot(_sub(origins[i], o_prev), x_prev))
+            a = _dot(_sub(foot, o_prev), x_prev)
+            d = _dot(_sub(origins[i], foot), z)
+            theta = _angle(x_prev, xs[i], z)
+        kind = "P" if joint.kind == "prismatic" else "R"
+        row = f"row {i + 1} ({joint.name})"
+        alpha = _snap_angle(alpha, angle_tol, snaps, f"{row} alpha")
+        theta = _snap_angle(theta, angle_tol, snaps, f"{row} theta")
+        a = _snap_length(a, ltol, snaps, f"{row} a", NOISE * reach)
+        d = _snap_length(d, ltol, snaps, f"{row} d", NOISE * reach)
+        for value, what in ((a, "a"), (d, "d")):
+            if abs(value) > OFFSET_LIMIT * reach:
+                raise UrdfError(
+                    f"{where}: joint {joint.name!r}: DH {what} = {value:.4g} "
+                    f"({abs(value) / reach:.3g} times the arm's size): its axis is nearly "
+                    "parallel to the previous one; take them as parallel with --angle-tol "
+                    "above the angle between them, and check the deviation it reports"
+                )
+        limits = joint.limits if joint.kind != "continuous" else None
+        rows.append((kind, alpha, a, d, theta, limits))
+    first = _frame(origins[0], xs[0], lines[0][1])
+    # frame n at q = 0 as the (snapped) rows build it: the tool closes the chain from there
+    built = first
+    for _kind, alpha, a, d, theta, _limits in rows:
+        built = matmul(built, dh_modified(alpha, a, theta, d))
+    tool = matmul(inverse(built), tip_pose)
+    first = _snap_frame(first, angle_tol, ltol, snaps, "base")
+    tool = _snap_frame(tool, angle_tol, ltol, snaps, "tool")
+    for matrix, what in ((first, "base"), (tool, "tool")):
+        away = math.sqrt(sum(matrix[i][3] ** 2 for i in range(3)))
+        if away > OFFSET_LIMIT * reach:
+            raise UrdfError(
+                f"{where}: the {what} frame lies {away:.4g} away ({away / reach:.3g} times "
+                "the arm's size): two consecutive axes nearly parallel meet far away; take them "
+                "as parallel with --angle-tol above the angle between them, and check the "
+                "deviation it reports"
+            )
+    return Conversion(
+        rows=rows,
+        joint_names=[j.name for j in moving],
+        base=first,
+        tool=tool,
+        snaps=snaps,
+        reach=reach,
+        rounded=not exact,
+    )
+
+
+def _snap_frame(m: Matrix, angle_tol: float, ltol: float, snaps: list[str], what: str) -> Matrix:
+    """m with a rotation within angle_tol of a right-angle one (entries 0, +-1) made exact,
+    and translations within ltol of 0 made 0."""
+    out = [row[:] for row in m]
+    rotation = [[round(m[i][j]) for j in range(3)] for i in range(3)]
+    near = all(abs(m[i][j] - rotation[i][j]) <= angle_tol for i in range(3) for j in range(3))
+    if near and sorted(abs(v) for row in rotation for v in row) == [0] * 6 + [1] * 3:
+        for i in range(3):
+            out[i][:3] = [float(v) for v in rotation[i]]
+        if any(abs(out[i][j] - m[i][j]) > NOISE for i in range(3) for j in range(3)):
+            snaps.append(f"{what}: rotation taken as a right-angle rotation")
+    for i in range(3):
+        if out[i][3] != 0.0 and abs(out[i][3]) <= ltol:
+            if abs(out[i][3]) > NOISE:
+                snaps.append(f"{what}: translation {'xyz'[i]} {out[i][3]!r} -> 0")
+            out[i][3] = 0.0
+    return out
+
+
+def _perpendicular(z: Vector) -> Vector:
+    """A unit vector perpendicular to z (the x axis where nothing else chooses one)."""
+    helper = (1.0, 0.0, 0.0) if abs(z[0]) < 0.9 else (0.0, 1.0, 0.0)
+    return _unit(_cross(_cross(z, helper), z))
+
+
+def _foot(origin: Vector, x: Vector, line: tuple[Vector, Vector]) -> Vector:
+    """Where the line through origin along x comes nearest the axis line (its point there)."""
+    p, z = line
+    return _add(p, z, _dot(_sub(origin, p), z))
+
+
+def _frame(origin: Vector, x: Vector, z: Vector) -> Matrix:
+    y = _cross(z, x)
+    return [[x[i], y[i], z[i], origin[i]] for i in range(3)] + [[0.0, 0.0, 0.0, 1.0]]
+
+
+def _snap_angle(value: float, tol: float, snaps: list[str], what: str) -> float:
+    quarter = round(value / (math.pi / 2))
+    target = quarter * (math.pi / 2)
+    if quarter == -2:
+        target = math.pi
+    if value != target and abs(value - target) <= tol:
+        if abs(value - target) > NOISE:
+            snaps.append(f"{what}: {math.degrees(value)!r} deg -> {math.degrees(target):g} deg")
+        return target
+    return value
+
+
+def _snap_length(value: float, tol: float, snaps: list[str], what: str, noise: float) -> float:
+    if value != 0.0 and abs(value) <= tol:
+        if abs(value) > noise:
+            snaps.append(f"{what}: {value!r} -> 0")
+        return 0.0
+    return value
+
+
+def spec_fk(spec: ArmSpec, q: list[float]) -> Matrix:
+    """The pose of a spec this module wrote (modified DH, degrees, base and tool matrices)."""
+    out = _matrix(spec.base.matrix if spec.base and spec.base.matrix else None)
+    for joint, value in zip(spec.joints, q):
+        alpha, theta = math.radians(joint.alpha), math.radians(joint.theta)
+        if joint.kind == "R":
+            out = matmul(out, dh_modified(alpha, joint.a, theta + value, joint.d))
+        else:
+            out = matmul(out, dh_modified(alpha, joint.a, theta, joint.d + value))
+    return matmul(out, _matrix(spec.tool.matrix if spec.tool and spec.tool.matrix else None))
+
+
+def _matrix(flat: tuple[float, ...] | None) -> Matrix:
+    if flat is None:
+        return [[float(i == j) for j in range(4)] for i in range(4)]
+    return [list(flat[4 * i : 4 * i + 4]) for i in range(4)]
+
+
+def measure(spec: ArmSpec, path: list[UrdfJoint], reach: float, samples: int = SAMPLES) -> float:
+    """The largest difference between the spec's FK and the URDF's over random joint values
+    (within limits; +-pi, or +-reach for prismatic joints without them): rotation entries, and
+    positions relative to the reach."""
+    rng = random.Random(0)
+    worst = 0.0
+    moving = [j for j in path if j.kind in MOVING]
+    for _ in range(samples):
+        q = []
+        for joint in moving:
+            if joint.limits is not None and joint.kind != "continuous":
+                lo, hi = joint.limits
+            else:
+                lo, hi = (-reach, reach) if joint.kind == "prismatic" else (-math.pi, math.pi)
+            q.append(rng.uniform(lo, hi))
+        expected = urdf_fk(path, q)
+        got = spec_fk(spec, q)
+        for i in range(3):
+            for j in range(4):
+                scale = reach if j == 3 else 1.0
+                worst = max(worst, abs(got[i][j] - expected[i][j]) / scale)
+    return worst
+
+
+def spec_name(text: str) -> str:
+    """A spec name ([a-z][a-z0-9_]*) from a robot's name."""
+    name = re.sub(r"[^a-z0-9_]+", "_", text.lower()).strip("_")
+    if not name or not name[0].isalpha():
+        name = "arm_" + name
+    return name[:60]
+
+
+def spec_text(
+    conversion: Conversion,
+    robot: Robot,
+    source: str,
+    base: str,
+    tip: str,
+    name: str,
+) -> str:
+    """The spec as canonical TOML, with the conversion's record as comments."""
+
+    def number(x: float) -> str:
+        # the spec takes 0 or magnitudes from 1e-9 (rounding noise below that is 0), and
+        # 15 significant digits when snapping (0.39225000000000004 is 0.39225)
+        x = float(x) + 0.0
+        if abs(x) < 1e-9:
+            return "0.0"
+        return repr(float(f"{x:.15g}")) if conversion.snaps or conversion.rounded else repr(x)
+
+    lines = [
+        f"# Converted by derive-ik from the URDF {source!r} (sha256 {robot.digest}...),",
+        f"# robot {robot.name!r}, from link {base!r} to link {tip!r}. Joint values mean what",
+        "# they mean in the URDF (same axis direction, same zero).",
+    ]
+    for snap in conversion.snaps:
+        lines.append(f"# snapped: {snap}")
+    lines.append(
+        f"# FK of this spec against the URDF's on {SAMPLES} random joint vectors: largest "
+        f"difference {conversion.deviation:.2g}"
+    )
+    lines.append("# (rotation entries, and positions divided by the arm's size)")
+    lines += [
+        f'name = "{name}"',
+        'convention = "modified"',
+        'angle_unit = "deg"',
+        'length_unit = "m"',
+    ]
+    for k, (kind, alpha, a, d, theta, limits) in enumerate(conversion.rows):
+        lines += [
+            "",
+            f"# row {k + 1}: URDF joint {conversion.joint_names[k]!r}",
+            "[[joint]]",
+            f'type = "{kind}"',
+            f"alpha = {number(math.degrees(alpha))}",
+            f"a = {number(a)}",
+            f"d = {number(d)}",
+            f"theta = {number(math.degrees(theta))}",
+        ]
+        if limits is not None:
+            lo, hi = (math.degrees(v) for v in limits) if kind == "R" else limits
+            lines.append(f"limits = [{number(lo)}, {number(hi)}]")
+    for title, matrix in (("base", conversion.base), ("tool", conversion.tool)):
+        rows = ", ".join("[" + ", ".join(number(v) for v in row) + "]" for row in matrix)
+        lines += ["", f"[{title}]", f"matrix = [{rows}]"]
+    return "\n".join(lines) + "\n"
+
+
+@dataclass(frozen=True)
+class Options:
+    """How a URDF becomes a spec (the command line's --base, --tip, ...)."""
+
+    base: str | None = None
+    tip: str | None = None
+    name: str | None = None
+    angle_tol: float = ANGLE_TOL
+    length_tol: float = LENGTH_TOL
+    exact: bool = False
+    max_deviation: float = MAX_DEVIATION
+
+
+def import_urdf(path: Path, options: Options) -> tuple[str, Conversion]:
+    """The spec text of the chain options.base .. options.tip of a URDF, and the conversion's
+    record. The spec's FK is checked against the URDF's: within 1e-9 without snapping (else
+    the converter is wrong), within max_deviation with it (else the user must decide)."""
+    where = str(path)
+    if not options.base or not options.tip:
+        raise UrdfError(f"{where}: a URDF needs --base LINK and --tip LINK")
+    robot = read_urdf(path)
+    chain = chain_between(robot, options.base, options.tip, where)
+    conversion = convert(chain, where, options.angle_tol, options.length_tol, options.exact)
+    name = options.name or spec_name(robot.name or path.stem)
+    draft = spec_text(conversion, robot, path.name, options.base, options.tip, name)
+    spec = parse_spec(draft, where=f"{where} (converted)")
+    conversion.deviation = measure(spec, chain, conversion.reach)
+    bound = options.max_deviation if conversion.snaps else 1e-9
+    if not conversion.deviation <= bound:
+        cause = "after snapping" if conversion.snaps else "without snapping (a converter error)"
+        raise UrdfError(
+            f"{where}: the spec's FK differs from the URDF's by {conversion.deviation:.3g} "
+            f"{cause}; allowed {bound:g} (--max-deviation; --exact to switch snapping off)"
+        )
+    text = spec_text(conversion, robot, path.name, options.base, options.tip, name)
+    return text, conversion
+
+
+def load_urdf(path: Path, options: Options) -> ArmSpec:
+    """The spec of a URDF chain, as load_spec gives it for a spec file."""
+    text, _ = import_urdf(path, options)
+    return parse_spec(text, where=f"{path} ({options.base} .. {options.tip})")

@@ -1,0 +1,301 @@
+"""URDF in: real robots' URDFs (kinematics-only copies in tests/data/urdf) convert to specs
+whose FK is the URDF's, generate solvers that find the URDF's joint values, and bad or hostile
+files get one line and exit 2 with nothing written."""
+
+from __future__ import annotations
+
+import math
+import os
+import random
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from derive import urdf
+from derive.emit import render_module
+from derive.pipeline import build_plan
+
+from conftest import ROOT
+
+DATA = ROOT / "tests" / "data" / "urdf"
+# (file, base link, tip link, a method solves it)
+FIXTURES = (
+    ("ur3", "world", "tool0", True),
+    ("ur5", "world", "tool0", True),
+    ("ur10", "world", "tool0", True),
+    ("kr16_2", "base_link", "tool0", True),
+    ("kr120r2500pro", "base_link", "tool0", True),
+    ("kr210l150", "base_link", "tool0", True),
+    ("puma560", "link1", "link7", True),
+    ("kinova_j2s6s200", "base", "j2s6s200_end_effector", True),
+    # joint 6's axis is 0.02 off the wrist centre in this file: no special structure (general 6R)
+    ("irb140", "base_link", "tool0", False),
+    ("al5d", "base", "link4", False),
+    ("panda", "panda_link0", "panda_hand_tcp", False),
+    ("lbr_iiwa_14_r820", "base_link", "tool0", False),
+    ("xarm7", "world", "link_eef", False),
+    ("z1", "world", "gripperMover", False),
+)
+# fixtures whose exact conversion is refused (nearly parallel axes give offsets of 1e8 m)
+NOT_EXACT = ("al5d",)
+
+
+def options(base: str, tip: str, **kw) -> urdf.Options:
+    return urdf.Options(base=base, tip=tip, **kw)
+
+
+@pytest.mark.parametrize(("name", "base", "tip", "solved"), FIXTURES)
+def test_every_fixture_converts_with_fk_equal_to_the_urdf(name, base, tip, solved):
+    path = DATA / f"{name}.urdf"
+    if name in NOT_EXACT:  # pi written as 3.14159265: axes 1e-9 rad from parallel
+        with pytest.raises(urdf.UrdfError, match="nearly parallel"):
+            urdf.import_urdf(path, options(base, tip, exact=True))
+    else:
+        _, exact = urdf.import_urdf(path, options(base, tip, exact=True))
+        assert exact.deviation <= 1e-9 and not exact.snaps
+    text, snapped = urdf.import_urdf(path, options(base, tip))
+    assert snapped.deviation <= urdf.MAX_DEVIATION
+    assert f"largest difference {snapped.deviation:.2g}\n" in text
+    for snap in snapped.snaps:
+        assert f"# snapped: {snap}" in text
+
+
+def random_joint_values(chain: list[urdf.UrdfJoint], rng: random.Random) -> list[float]:
+    q = []
+    for joint in chain:
+        if joint.kind not in urdf.MOVING:
+            continue
+        lo, hi = (
+            joint.limits if joint.limits and joint.kind != "continuous" else (-math.pi, math.pi)
+        )
+        q.append(rng.uniform(max(lo, -math.pi), min(hi, math.pi)))
+    return q
+
+
+def generated_module(path: Path, base: str, tip: str, tmp_path: Path):
+    import importlib.util
+
+    spec = urdf.load_urdf(path, options(base, tip))
+    file = tmp_path / f"{spec.name}.py"
+    file.write_text(render_module(build_plan(spec)))
+    loaded = importlib.util.spec_from_file_location(f"urdf_{spec.name}", file)
+    assert loaded is not None and loaded.loader is not None
+    module = importlib.util.module_from_spec(loaded)
+    loaded.loader.exec_module(module)
+    return module
+
+
+@pytest.mark.parametrize(("name", "base", "tip"), [f[:3] for f in FIXTURES if f[3]])
+def test_the_solver_of_a_urdf_finds_the_urdf_joint_values(name, base, tip, tmp_path):
+    """ik(FK_urdf(q)) contains q (to 1e-4) on 1,000 random q within the limits; where it does
+    not (a singular pose, whose free joint takes q_ref's value) every solution reproduces the
+    pose. The generated FK, derived by SymPy from the spec, is the URDF's own to 1e-6."""
+    path = DATA / f"{name}.urdf"
+    chain = urdf.chain_between(urdf.read_urdf(path), base, tip, str(path))
+    module = generated_module(path, base, tip, tmp_path)
+    assert module.IK_COMPONENTS == "pose"
+    # the generated FK (derived by SymPy from the spec) against the URDF's own
+    rng = random.Random(5)
+    revolute = np.array([c == "R" for c in module.JOINT_TYPES])
+    missed = []
+    for _ in range(1000):
+        q = random_joint_values(chain, rng)
+        T = np.array(urdf.urdf_fk(chain, q))
+        assert np.abs(module.fk(q) - T).max() <= 1e-6 * max(1.0, module.REACH)
+        sols = module.ik(T)
+        d = sols - np.array(q)
+        d[:, revolute] = np.remainder(d[:, revolute] + np.pi, 2 * np.pi) - np.pi
+        # 1e-4: the spec is the URDF snapped (PUMA: pi/2 written as 1.570796325, 5e-9 of
+        # the reach), and near a singularity that moves a joint by far more than the pose
+        if len(sols) == 0 or np.abs(d).max(axis=1).min() > 1e-4:
+            missed.append((q, T, sols))
+    for _q, T, sols in missed:
+        assert len(sols) > 0
+        for s in sols:
+            assert np.abs(module.fk(s) - T).max() <= 1e-6 * max(1.0, module.REACH)
+    assert len(missed) <= 5, f"{len(missed)} of 1000 joint vectors not among the solutions"
+
+
+def run(*args: str, cwd: Path, env: dict | None = None) -> subprocess.CompletedProcess:
+    return subprocess.run(
+        [sys.executable, "-m", "derive", *args], cwd=cwd, capture_output=True, text=True, env=env
+    )
+
+
+def test_import_urdf_is_byte_identical_across_hash_seeds(tmp_path):
+    outs = []
+    for seed in ("0", "12345"):
+        env = {**os.environ, "PYTHONHASHSEED": seed}
+        out = tmp_path / f"ur5_{seed}.toml"
+        result = run(
+            "import-urdf", str(DATA / "ur5.urdf"), "--base", "world", "--tip", "tool0", "-o",
+            str(out), cwd=tmp_path, env=env,
+        )  # fmt: skip
+        assert result.returncode == 0, result.stderr
+        outs.append(out.read_bytes())
+    assert outs[0] == outs[1]
+    generated = run(
+        "generate", str(DATA / "ur5.urdf"), "--base", "world", "--tip", "tool0", "--out", "g",
+        cwd=tmp_path,
+    )  # fmt: skip
+    assert generated.returncode == 0, generated.stderr
+    from_spec = run("generate", str(tmp_path / "ur5_0.toml"), "--out", "h", cwd=tmp_path)
+    assert from_spec.returncode == 0, from_spec.stderr
+    assert (tmp_path / "g" / "ur5.py").read_bytes() == (tmp_path / "h" / "ur5.py").read_bytes()
+
+
+JOINT = (
+    '<joint name="{name}" type="{type}"><parent link="{parent}"/><child link="{child}"/>'
+    '<origin xyz="{xyz}" rpy="0 0 0"/><axis xyz="0 0 1"/>'
+    '<limit lower="-1" upper="1"/>{extra}</joint>'
+)
+
+
+def urdf_text(joints: list[dict], links: list[str], head: str = "") -> str:
+    body = "".join(f'<link name="{name}"/>' for name in links)
+    for j in joints:
+        body += JOINT.format(**{"type": "revolute", "xyz": "0 0 0.1", "extra": "", **j})
+    return f'<?xml version="1.0"?>{head}<robot name="bad">{body}</robot>'
+
+
+def two_joints(**changes) -> list[dict]:
+    joints = [
+        {"name": "j1", "parent": "a", "child": "b"},
+        {"name": "j2", "parent": "b", "child": "c"},
+    ]
+    joints[1].update(changes)
+    return joints
+
+
+BOMB = (
+    '<!DOCTYPE robot [<!ENTITY a "aaaaaaaaaa"><!ENTITY b "&a;&a;&a;&a;&a;&a;&a;&a;&a;&a;">'
+    '<!ENTITY c "&b;&b;&b;&b;&b;&b;&b;&b;&b;&b;">]>'
+)
+HOSTILE = {
+    "entity bomb": (urdf_text(two_joints(), ["a", "b", "c"], BOMB), "c", "DTDs and entities"),
+    "external entity": (
+        urdf_text(
+            two_joints(), ["a", "b", "c"], '<!DOCTYPE r [<!ENTITY x SYSTEM "file:///etc/passwd">]>'
+        ),
+        "c",
+        "DTDs and entities",
+    ),
+    "missing tip": (urdf_text(two_joints(), ["a", "b", "c"]), "nowhere", "no such link"),
+    "cycle": (
+        urdf_text([*two_joints(), {"name": "j3", "parent": "c", "child": "a"}], ["a", "b", "c"]),
+        "c",
+        "cycle",
+    ),
+    "mimic joint in the chain": (
+        urdf_text(two_joints(extra='<mimic joint="j1"/>'), ["a", "b", "c"]),
+        "c",
+        "mimic",
+    ),
+    "NaN origin": (urdf_text(two_joints(xyz="0 nan 0"), ["a", "b", "c"]), "c", "finite"),
+    "non-numeric origin": (urdf_text(two_joints(xyz="0 x 0"), ["a", "b", "c"]), "c", "numbers"),
+    "floating joint": (urdf_text(two_joints(type="floating"), ["a", "b", "c"]), "c", "floating"),
+    "unknown link": (urdf_text(two_joints(child="zz"), ["a", "b", "c"]), "c", "unknown link"),
+    "duplicate link": (urdf_text(two_joints(), ["a", "b", "c", "a"]), "c", "defined twice"),
+    "not below the base": (urdf_text(two_joints(), ["a", "b", "c", "d"]), "d", "not below"),
+    "xacro": (
+        '<robot xmlns:xacro="http://www.ros.org/wiki/xacro" name="x">'
+        '<xacro:macro name="m"/></robot>',
+        "c",
+        "xacro",
+    ),
+}
+
+
+@pytest.mark.parametrize("case", sorted(HOSTILE))
+def test_bad_and_hostile_urdfs_get_one_line_and_exit_2(case, tmp_path):
+    text, tip, words = HOSTILE[case]
+    path = tmp_path / "robot.urdf"
+    path.write_text(text)
+    out = tmp_path / "out.toml"
+    for args in (
+        ("import-urdf", str(path), "--base", "a", "--tip", tip, "-o", str(out)),
+        ("generate", str(path), "--base", "a", "--tip", tip, "--out", str(tmp_path / "g")),
+    ):
+        result = run(*args, cwd=tmp_path)
+        assert result.returncode == 2, (case, result.stdout, result.stderr)
+        lines = result.stderr.strip().split("\n")
+        assert len(lines) == 1 and words in lines[0] and "Traceback" not in result.stderr, lines
+    assert not out.exists() and not (tmp_path / "g").exists()
+
+
+def test_a_50_mb_urdf_is_refused_unread(tmp_path):
+    path = tmp_path / "big.urdf"
+    with path.open("wb") as f:
+        f.write(b"<robot>" + b" " * 50_000_000 + b"</robot>")
+    result = run("import-urdf", str(path), "--base", "a", "--tip", "b", cwd=tmp_path)
+    assert result.returncode == 2 and "at most" in result.stderr
+    assert len(result.stderr.strip().split("\n")) == 1
+
+
+def test_nearly_parallel_axes_are_snapped_or_refused_never_huge_offsets(tmp_path):
+    """A calibrated arm: axes 2 and 3 are 1e-3 rad from parallel. Without snapping the
+    common normal is hundreds of lengths away: refused with the reason; with --angle-tol above
+    1e-3 they are parallel, and the deviation is reported (and bounded by --max-deviation)."""
+    joints = [
+        {"name": "j1", "parent": "a", "child": "b"},
+        {"name": "j2", "parent": "b", "child": "c", "xyz": "0.4 0 0"},
+    ]
+    text = urdf_text(joints, ["a", "b", "c"]).replace(
+        '<axis xyz="0 0 1"/><limit lower="-1" upper="1"/></joint></robot>',
+        '<axis xyz="0.001 0 1"/><limit lower="-1" upper="1"/></joint></robot>',
+    )
+    path = tmp_path / "cal.urdf"
+    path.write_text(text)
+    with pytest.raises(urdf.UrdfError, match="nearly parallel"):
+        urdf.import_urdf(path, options("a", "c"))
+    with pytest.raises(urdf.UrdfError, match="differs from the URDF's"):
+        urdf.import_urdf(path, options("a", "c", angle_tol=2e-3))
+    spec, conversion = urdf.import_urdf(path, options("a", "c", angle_tol=2e-3, max_deviation=1e-2))
+    assert conversion.deviation > 1e-4 and "taken as parallel" in spec
+    assert all(abs(row[2]) < 1.0 and abs(row[3]) < 1.0 for row in conversion.rows)
+
+
+def random_chain(rng: random.Random) -> tuple[str, str, str]:
+    """A random URDF chain: 2-7 moving joints (revolute, continuous, prismatic) with fixed
+    joints between; consecutive axes parallel, antiparallel, intersecting or skew; random link
+    frames."""
+    links = ["l0"]
+    joints = []
+    axes = [(0, 0, 1), (0, 0, -1), (1, 0, 0), (0, 1, 0)]
+    for k in range(rng.randint(2, 7)):
+        if rng.random() < 0.3:
+            links.append(f"f{k}")
+            joints.append(("fixed", links[-2], links[-1], (1, 0, 0)))
+        links.append(f"l{k + 1}")
+        kind = rng.choice(("revolute", "revolute", "continuous", "prismatic"))
+        axis = rng.choice(axes) if rng.random() < 0.7 else tuple(rng.gauss(0, 1) for _ in range(3))
+        joints.append((kind, links[-2], links[-1], axis))
+    body = "".join(f'<link name="{n}"/>' for n in links)
+    for k, (kind, parent, child, axis) in enumerate(joints):
+        special = rng.random() < 0.6
+        xyz = [rng.choice((0.0, 0.0, 0.3)) if special else rng.uniform(-0.5, 0.5) for _ in range(3)]
+        rpy = [
+            rng.choice((0.0, math.pi / 2, -math.pi / 2, math.pi)) if special else rng.uniform(-3, 3)
+            for _ in range(3)
+        ]
+        limit = '<limit lower="-2" upper="2"/>' if kind != "continuous" else ""
+        body += (
+            f'<joint name="j{k}" type="{kind}"><parent link="{parent}"/><child link="{child}"/>'
+            f'<origin xyz="{" ".join(map(repr, xyz))}" rpy="{" ".join(map(repr, rpy))}"/>'
+            f'<axis xyz="{" ".join(map(repr, axis))}"/>{limit}</joint>'
+        )
+    return f'<robot name="chain">{body}</robot>', links[0], links[-1]
+
+
+@pytest.mark.parametrize("seed", range(60))
+def test_random_chains_convert_with_equal_fk(seed, tmp_path):
+    text, base, tip = random_chain(random.Random(seed))
+    path = tmp_path / "random.urdf"
+    path.write_text(text)
+    _, exact = urdf.import_urdf(path, options(base, tip, exact=True))
+    assert exact.deviation <= 1e-9
+    _, snapped = urdf.import_urdf(path, options(base, tip))
+    assert snapped.deviation <= urdf.MAX_DEVIATION
