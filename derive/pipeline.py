@@ -98,4 +98,5 @@ def arm_info(spec: ArmSpec, chain: Chain) -> ArmInfo:
         reach=max(reach, 1e-12),
         example_q=example_q,
         example_pose=example_pose,
+        origin=spec.origin,
     )

@@ -18,6 +18,8 @@ from typing import Any, ClassVar
 
 import sympy as sp
 
+from derive.spec import Source
+
 
 @dataclass(frozen=True)
 class ArmInfo:
@@ -38,6 +40,7 @@ class ArmInfo:
             used to scale position tolerances.
         example_q: joint values of the worked example (radians / length), or None.
         example_pose: world pose of the worked example (16 floats, row-major), or None.
+        origin: the URDF the spec was converted from, or None.
     """
 
     name: str
@@ -53,6 +56,7 @@ class ArmInfo:
     reach: float
     example_q: tuple[float, ...] | None = None
     example_pose: tuple[float, ...] | None = None
+    origin: Source | None = None
 
     @property
     def dof(self) -> int:

@@ -120,7 +120,33 @@ def arm_blocks(plan: Plan) -> list[Block]:
         out.append(Block("math", "{}^{W}_{0}T", matrix_of(base)))
     if not np.array_equal(tool, np.eye(4)):
         out.append(Block("math", "{}^{n}_{E}T", matrix_of(tool)))
-    return out
+    return out + urdf_blocks(plan)
+
+
+def urdf_blocks(plan: Plan) -> list[Block]:
+    """Where the arm came from, when it was converted from a URDF: the URDF joint of each
+    row, the links, the snaps and the measured FK deviation."""
+    origin = plan.arm.origin
+    if origin is None:
+        return []
+    rows = [("row", "URDF joint")] + [(str(k), name) for k, name in enumerate(origin.joints, 1)]
+    snaps = "; ".join(origin.snaps) if origin.snaps else "none"
+    return [
+        Block("h3", "From the URDF"),
+        Block(
+            "p",
+            f"Converted from {origin.urdf} (sha256 {origin.sha256}...), the chain from link "
+            f"{origin.base} to link {origin.tip}: base and tool frames above close it. Joint "
+            "values mean what they mean in the URDF.",
+        ),
+        Block("table", rows=tuple(rows)),
+        Block(
+            "p",
+            f"Snaps applied: {snaps}. FK of this table against the URDF's on 200 random joint "
+            f"vectors: largest difference {origin.deviation:.2g} (rotation entries, and "
+            "positions divided by the arm's size).",
+        ),
+    ]
 
 
 def link_blocks(plan: Plan) -> list[Block]:

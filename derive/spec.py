@@ -34,7 +34,7 @@ import math
 import re
 import sys
 import tomllib
-from dataclasses import dataclass
+from dataclasses import asdict, dataclass
 from pathlib import Path
 
 NAME_PATTERN = re.compile(r"[a-z][a-z0-9_]*")
@@ -70,7 +70,12 @@ SHADOWED_MODULES = frozenset(
         "conftest",
     }
 )
-TOP_KEYS = ("name", "convention", "angle_unit", "length_unit", "joint", "base", "tool", "example")
+TOP_KEYS = (
+    "name", "convention", "angle_unit", "length_unit", "joint", "base", "tool", "example", "source",
+)  # fmt: skip
+SOURCE_KEYS = ("urdf", "sha256", "base", "tip", "joints", "snaps", "deviation")
+# the text a [source] table may hold (it reaches the report, never the generated code)
+SOURCE_TEXT = re.compile(r"[A-Za-z0-9_ .,:;()+\-<>'=/]{1,200}")
 JOINT_KEYS = ("type", "alpha", "a", "d", "theta", "limits")
 FRAME_KEYS = ("matrix", "translation", "rpy")
 
@@ -116,6 +121,29 @@ class Frame:
 
 
 @dataclass(frozen=True)
+class Source:
+    """Where a spec came from, when derive wrote it from a URDF (the [source] table).
+
+    Attributes:
+        urdf: the URDF's file name.
+        sha256: the first 16 hex digits of the URDF's SHA-256.
+        base, tip: the links the chain runs between.
+        joints: the URDF joint name of each row.
+        snaps: the snaps the conversion applied, one line each.
+        deviation: the largest FK difference of the spec from the URDF (rotation entries,
+            positions divided by the arm's size) on random joint values.
+    """
+
+    urdf: str
+    sha256: str
+    base: str
+    tip: str
+    joints: tuple[str, ...]
+    snaps: tuple[str, ...]
+    deviation: float
+
+
+@dataclass(frozen=True)
 class ArmSpec:
     """A validated arm description.
 
@@ -142,6 +170,7 @@ class ArmSpec:
     example_q: tuple[float, ...] | None = None
     example_pose: Frame | None = None
     source: str = "<memory>"
+    origin: Source | None = None
 
     @property
     def dof(self) -> int:
@@ -161,7 +190,7 @@ class ArmSpec:
                 return None
             return {"matrix": f.matrix, "translation": f.translation, "rpy": f.rpy}
 
-        return {
+        data = {
             "name": self.name,
             "convention": self.convention,
             "angle_unit": self.angle_unit,
@@ -181,6 +210,9 @@ class ArmSpec:
             "tool": frame(self.tool),
             "example": {"q": self.example_q, "pose": frame(self.example_pose)},
         }
+        if self.origin is not None:  # (absent from the digests of specs without one)
+            data["source"] = asdict(self.origin)
+        return data
 
     def digest(self) -> str:
         """SHA-256 (first 16 hex digits) of the canonical spec; independent of file layout."""
@@ -279,6 +311,54 @@ def _validate(data: dict, where: str) -> ArmSpec:
         example_q,
         example_pose,
         where,
+        _source(data.get("source"), where, len(joints)),
+    )
+
+
+def _source(table: object, where: str, dof: int) -> Source | None:
+    """The optional [source] table (written by derive import-urdf)."""
+    if table is None:
+        return None
+    if not isinstance(table, dict):
+        raise SpecError(f"{where}: source: must be a table ({', '.join(SOURCE_KEYS)})")
+    _no_unknown_keys(table, SOURCE_KEYS, where, "source.")
+
+    def text(key: str, value: object) -> str:
+        if not isinstance(value, str) or not SOURCE_TEXT.fullmatch(value):
+            raise SpecError(
+                f"{where}: source.{key}: {str(value)[:40]!r} is not allowed; allowed: 1 to 200 "
+                "letters, digits, spaces and _ . , : ; ( ) + - < > ' = /"
+            )
+        return value
+
+    def texts(key: str, count: int | None) -> tuple[str, ...]:
+        values = table.get(key, [])
+        if not isinstance(values, list) or (count is not None and len(values) != count):
+            size = f"{count} " if count is not None else ""
+            raise SpecError(f"{where}: source.{key}: must be an array of {size}strings")
+        if len(values) > 100:
+            raise SpecError(f"{where}: source.{key}: at most 100 entries")
+        return tuple(text(key, v) for v in values)
+
+    for key in ("urdf", "sha256", "base", "tip", "joints", "deviation"):
+        if key not in table:
+            raise SpecError(f"{where}: source.{key}: missing")
+    sha = text("sha256", table["sha256"])
+    if not re.fullmatch(r"[0-9a-f]{16}", sha):
+        raise SpecError(f"{where}: source.sha256: {sha[:40]!r}; allowed: 16 hex digits")
+    deviation = table["deviation"]
+    if type(deviation) not in (int, float) or not 0 <= deviation < math.inf:
+        raise SpecError(
+            f"{where}: source.deviation: {str(deviation)[:40]}; allowed: a number, 0 or more"
+        )
+    return Source(
+        urdf=text("urdf", table["urdf"]),
+        sha256=sha,
+        base=text("base", table["base"]),
+        tip=text("tip", table["tip"]),
+        joints=texts("joints", dof),
+        snaps=texts("snaps", None),
+        deviation=deviation,
     )
 
 

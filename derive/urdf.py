@@ -505,7 +505,7 @@ def _snap_frame(m: Matrix, angle_tol: float, ltol: float, snaps: list[str], what
     for i in range(3):
         if out[i][3] != 0.0 and abs(out[i][3]) <= ltol:
             if abs(out[i][3]) > NOISE:
-                snaps.append(f"{what}: translation {'xyz'[i]} {out[i][3]!r} -> 0")
+                snaps.append(f"{what}: translation {'xyz'[i]} {out[i][3]!r} to 0")
             out[i][3] = 0.0
     return out
 
@@ -534,7 +534,7 @@ def _snap_angle(value: float, tol: float, snaps: list[str], what: str) -> float:
         target = math.pi
     if value != target and abs(value - target) <= tol:
         if abs(value - target) > NOISE:
-            snaps.append(f"{what}: {math.degrees(value)!r} deg -> {math.degrees(target):g} deg")
+            snaps.append(f"{what}: {math.degrees(value)!r} deg to {math.degrees(target):g} deg")
         return target
     return value
 
@@ -542,7 +542,7 @@ def _snap_angle(value: float, tol: float, snaps: list[str], what: str) -> float:
 def _snap_length(value: float, tol: float, snaps: list[str], what: str, noise: float) -> float:
     if value != 0.0 and abs(value) <= tol:
         if abs(value) > noise:
-            snaps.append(f"{what}: {value!r} -> 0")
+            snaps.append(f"{what}: {value!r} to 0")
         return 0.0
     return value
 
@@ -650,7 +650,28 @@ def spec_text(
     for title, matrix in (("base", conversion.base), ("tool", conversion.tool)):
         rows = ", ".join("[" + ", ".join(number(v) for v in row) + "]" for row in matrix)
         lines += ["", f"[{title}]", f"matrix = [{rows}]"]
+
+    def strings(values: list[str]) -> str:
+        return "[" + ", ".join(f'"{_label(v)}"' for v in values) + "]"
+
+    lines += [
+        "",
+        "# where this spec came from (the report shows it)",
+        "[source]",
+        f'urdf = "{_label(source)}"',
+        f'sha256 = "{robot.digest}"',
+        f'base = "{_label(base)}"',
+        f'tip = "{_label(tip)}"',
+        f"joints = {strings(conversion.joint_names)}",
+        f"snaps = {strings(conversion.snaps)}",
+        f"deviation = {float(f'{conversion.deviation:.2g}')!r}",
+    ]
     return "\n".join(lines) + "\n"
+
+
+def _label(text: str) -> str:
+    """text with every character a spec's [source] strings may not hold replaced by _."""
+    return re.sub(r"[^A-Za-z0-9_ .,:;()+\-<>'=/]", "_", text)[:200] or "_"
 
 
 @dataclass(frozen=True)

@@ -299,3 +299,36 @@ def test_random_chains_convert_with_equal_fk(seed, tmp_path):
     assert exact.deviation <= 1e-9
     _, snapped = urdf.import_urdf(path, options(base, tip))
     assert snapped.deviation <= urdf.MAX_DEVIATION
+
+
+def test_the_report_of_a_urdf_arm_says_where_it_came_from(tmp_path):
+    result = run(
+        "report", str(DATA / "ur5.urdf"), "--base", "world", "--tip", "tool0", cwd=tmp_path
+    )
+    assert result.returncode == 0, result.stderr
+    section = result.stdout.split("### From the URDF", 1)[1]
+    assert "| 2 | shoulder_lift_joint |" in section and "link world to link tool0" in section
+    assert "Snaps applied: row 2 (shoulder_lift_joint) theta:" in section
+    assert "largest difference 1.4e-11" in section
+
+
+@pytest.mark.parametrize(
+    ("change", "words"),
+    [
+        ('joints = ["a"]', "array of 6 strings"),
+        ('urdf = "x$y"', "source.urdf"),
+        ('sha256 = "xyz"', "16 hex digits"),
+        ("deviation = -1.0", "0 or more"),
+        ('color = "red"', "unknown key"),
+    ],
+)
+def test_a_bad_source_table_is_refused_naming_the_field(change, words, tmp_path):
+    from derive.spec import SpecError, parse_spec
+
+    text, _ = urdf.import_urdf(DATA / "ur5.urdf", options("world", "tool0"))
+    key = change.split(" = ")[0]
+    lines = [ln for ln in text.split("\n") if not ln.startswith(f"{key} = ")]
+    at = lines.index("[source]") + 1
+    lines.insert(at, change)
+    with pytest.raises(SpecError, match=words):
+        parse_spec("\n".join(lines), "ur5.toml")
