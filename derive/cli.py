@@ -139,6 +139,7 @@ def urdf_options(args: argparse.Namespace) -> urdf.Options:
         length_tol=args.length_tol,
         exact=args.exact,
         max_deviation=args.max_deviation,
+        convention=getattr(args, "convention", "modified"),
     )
 
 
@@ -466,7 +467,10 @@ def parser() -> argparse.ArgumentParser:
     imp = sub.add_parser("import-urdf", help="write the spec of a URDF's chain from base to tip")
     imp.add_argument("urdf", help="the URDF file (xacro expanded)")
     imp.add_argument(
-        "--convention", choices=("modified",), default="modified", help="DH convention (modified)"
+        "--convention",
+        choices=("modified", "standard"),
+        default="modified",
+        help="DH convention of the spec (modified)",
     )
     imp.add_argument("-o", "--output", help="write the spec here (default: standard output)")
     imp.set_defaults(run=cmd_import_urdf)

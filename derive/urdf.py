@@ -548,14 +548,19 @@ def _snap_length(value: float, tol: float, snaps: list[str], what: str, noise: f
 
 
 def spec_fk(spec: ArmSpec, q: list[float]) -> Matrix:
-    """The pose of a spec this module wrote (modified DH, degrees, base and tool matrices)."""
+    """The pose of a spec this module wrote (degrees, base and tool matrices)."""
     out = _matrix(spec.base.matrix if spec.base and spec.base.matrix else None)
     for joint, value in zip(spec.joints, q):
-        alpha, theta = math.radians(joint.alpha), math.radians(joint.theta)
+        alpha, theta, d = math.radians(joint.alpha), math.radians(joint.theta), joint.d
         if joint.kind == "R":
-            out = matmul(out, dh_modified(alpha, joint.a, theta + value, joint.d))
+            theta += value
         else:
-            out = matmul(out, dh_modified(alpha, joint.a, theta, joint.d + value))
+            d += value
+        if spec.convention == "modified":
+            out = matmul(out, dh_modified(alpha, joint.a, theta, d))
+        else:  # Rz(theta) Tz(d) Tx(a) Rx(alpha) = Tz(d) Rz(theta) then the twist
+            out = matmul(out, dh_modified(0.0, 0.0, theta, d))
+            out = matmul(out, dh_modified(alpha, joint.a, 0.0, 0.0))
     return matmul(out, _matrix(spec.tool.matrix if spec.tool and spec.tool.matrix else None))
 
 
@@ -604,8 +609,14 @@ def spec_text(
     base: str,
     tip: str,
     name: str,
+    convention: str = "modified",
 ) -> str:
-    """The spec as canonical TOML, with the conversion's record as comments."""
+    """The spec as canonical TOML, with the conversion's record as comments and [source].
+
+    The standard convention's rows are the same numbers regrouped: with alpha_0 = a_0 = 0
+    (frame 0 is frame 1 at q = 0), Craig's X0 Z1 X1 Z2 ... Zn is Z1 X1 Z2 X2 ... Zn, and
+    Rx Tx commute, so standard row i holds (alpha_i, a_i) of modified row i + 1 with its own
+    (d_i, theta_i), and the last row a_n = alpha_n = 0; base and tool stay."""
 
     def number(x: float) -> str:
         # the spec takes 0 or magnitudes from 1e-9 (rounding noise below that is 0), and
@@ -629,11 +640,15 @@ def spec_text(
     lines.append("# (rotation entries, and positions divided by the arm's size)")
     lines += [
         f'name = "{name}"',
-        'convention = "modified"',
+        f'convention = "{convention}"',
         'angle_unit = "deg"',
         'length_unit = "m"',
     ]
-    for k, (kind, alpha, a, d, theta, limits) in enumerate(conversion.rows):
+    rows = conversion.rows
+    if convention == "standard":
+        twists = [(r[1], r[2]) for r in rows[1:]] + [(0.0, 0.0)]
+        rows = [(r[0], t[0], t[1], r[3], r[4], r[5]) for r, t in zip(rows, twists)]
+    for k, (kind, alpha, a, d, theta, limits) in enumerate(rows):
         lines += [
             "",
             f"# row {k + 1}: URDF joint {conversion.joint_names[k]!r}",
@@ -648,8 +663,8 @@ def spec_text(
             lo, hi = (math.degrees(v) for v in limits) if kind == "R" else limits
             lines.append(f"limits = [{number(lo)}, {number(hi)}]")
     for title, matrix in (("base", conversion.base), ("tool", conversion.tool)):
-        rows = ", ".join("[" + ", ".join(number(v) for v in row) + "]" for row in matrix)
-        lines += ["", f"[{title}]", f"matrix = [{rows}]"]
+        entries = ", ".join("[" + ", ".join(number(v) for v in row) + "]" for row in matrix)
+        lines += ["", f"[{title}]", f"matrix = [{entries}]"]
 
     def strings(values: list[str]) -> str:
         return "[" + ", ".join(f'"{_label(v)}"' for v in values) + "]"
@@ -685,6 +700,7 @@ class Options:
     length_tol: float = LENGTH_TOL
     exact: bool = False
     max_deviation: float = MAX_DEVIATION
+    convention: str = "modified"
 
 
 def import_urdf(path: Path, options: Options) -> tuple[str, Conversion]:
@@ -698,7 +714,8 @@ def import_urdf(path: Path, options: Options) -> tuple[str, Conversion]:
     chain = chain_between(robot, options.base, options.tip, where)
     conversion = convert(chain, where, options.angle_tol, options.length_tol, options.exact)
     name = options.name or spec_name(robot.name or path.stem)
-    draft = spec_text(conversion, robot, path.name, options.base, options.tip, name)
+    args = (conversion, robot, path.name, options.base, options.tip, name, options.convention)
+    draft = spec_text(*args)
     spec = parse_spec(draft, where=f"{where} (converted)")
     conversion.deviation = measure(spec, chain, conversion.reach)
     bound = options.max_deviation if conversion.snaps else 1e-9
@@ -708,8 +725,7 @@ def import_urdf(path: Path, options: Options) -> tuple[str, Conversion]:
             f"{where}: the spec's FK differs from the URDF's by {conversion.deviation:.3g} "
             f"{cause}; allowed {bound:g} (--max-deviation; --exact to switch snapping off)"
         )
-    text = spec_text(conversion, robot, path.name, options.base, options.tip, name)
-    return text, conversion
+    return spec_text(*args), conversion
 
 
 def load_urdf(path: Path, options: Options) -> ArmSpec:

@@ -332,3 +332,31 @@ def test_a_bad_source_table_is_refused_naming_the_field(change, words, tmp_path)
     lines.insert(at, change)
     with pytest.raises(SpecError, match=words):
         parse_spec("\n".join(lines), "ur5.toml")
+
+
+@pytest.mark.parametrize(
+    ("name", "base", "tip"), [("ur5", "world", "tool0"), ("puma560", "link1", "link7")]
+)
+def test_the_standard_convention_gives_the_same_arm(name, base, tip, tmp_path):
+    """--convention standard: the same FK as the URDF and as the modified spec's module."""
+    path = DATA / f"{name}.urdf"
+    modules = []
+    for convention in ("modified", "standard"):
+        text, conversion = urdf.import_urdf(path, options(base, tip, convention=convention))
+        assert f'convention = "{convention}"' in text and conversion.deviation <= 1e-8
+        spec = tmp_path / f"{name}_{convention}.toml"
+        spec.write_text(text.replace(f'name = "{name}"', f'name = "{name}_{convention}"'))
+        import importlib.util
+
+        from derive.spec import load_spec
+
+        file = tmp_path / f"{name}_{convention}.py"
+        file.write_text(render_module(build_plan(load_spec(spec))))
+        loaded = importlib.util.spec_from_file_location(file.stem, file)
+        assert loaded is not None and loaded.loader is not None
+        module = importlib.util.module_from_spec(loaded)
+        loaded.loader.exec_module(module)
+        modules.append(module)
+    Q = np.random.default_rng(2).uniform(-np.pi, np.pi, size=(50, 6))
+    assert np.abs(modules[0].fk_batch(Q) - modules[1].fk_batch(Q)).max() <= 1e-12
+    assert modules[1].ik(modules[1].fk(Q[0])).shape[0] >= 1
