@@ -1,0 +1,65 @@
+"""The general 6R method's first step: the 14 fundamental equations, derived in symbols, hold
+for random arms at random joint values (the general method itself is issue 17's next step)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+import sympy as sp
+
+from derive import raghavan_roth as rr
+
+
+def standard_link(theta: float, d: float, a: float, alpha: float) -> np.ndarray:
+    ct, st, ca, sa = np.cos(theta), np.sin(theta), np.cos(alpha), np.sin(alpha)
+    return np.array(
+        [
+            [ct, -st * ca, st * sa, a * ct],
+            [st, ct * ca, -ct * sa, a * st],
+            [0, sa, ca, d],
+            [0, 0, 0, 1],
+        ]
+    )
+
+
+@pytest.fixture(scope="module")
+def matrices():
+    f = rr.fundamental()
+    args = (*rr.c[:5], *rr.s[:5], *rr.a[:5], *rr.d[:5], *rr.lam[:5], *rr.mu[:5], *rr.L, *rr.P)
+    return [sp.lambdify(args, m, "numpy") for m in (f.P0, f.Ps, f.Pc, f.Q)], f
+
+
+def test_the_shape_the_literature_gives(matrices):
+    _, f = matrices
+    assert (f.P0.shape, f.Ps.shape, f.Pc.shape, f.Q.shape) == ((14, 9), (14, 9), (14, 9), (14, 8))
+    # l_z, p_z, p.p, p.l, (p x l)_z, v_z do not involve theta3 (ALGORITHMS.md 4.2)
+    free_of_theta3 = [i for i in range(14) if not any(f.Ps.row(i)) and not any(f.Pc.row(i))]
+    assert free_of_theta3 == [2, 5, 6, 7, 10, 13]
+    operations = sum(e.count_ops() for m in (f.P0, f.Ps, f.Pc, f.Q) for e in m)
+    assert 4000 < operations < 6000  # "about 4 800 operations"
+
+
+@pytest.mark.parametrize("seed", range(20))
+def test_the_fourteen_equations_hold_at_random_arms_and_joint_values(matrices, seed):
+    functions, _ = matrices
+    rng = np.random.default_rng(seed)
+    theta = rng.uniform(-np.pi, np.pi, 6)
+    d = rng.uniform(-1, 1, 6)
+    a = rng.uniform(-1, 1, 6)
+    alpha = rng.uniform(-np.pi, np.pi, 6)
+    if seed % 4 == 0:  # right angles and zeros, as real arms have them
+        alpha = np.round(alpha / (np.pi / 2)) * (np.pi / 2)
+        a[rng.random(6) < 0.5] = 0.0
+    links = [standard_link(*row) for row in zip(theta, d, a, alpha)]
+    T = np.linalg.multi_dot(links)
+    M = T @ np.linalg.inv(links[5])
+    args = (
+        *np.cos(theta[:5]), *np.sin(theta[:5]), *a[:5], *d[:5], *np.cos(alpha[:5]),
+        *np.sin(alpha[:5]), *M[:3, 2], *M[:3, 3],
+    )  # fmt: skip
+    P0, Ps, Pc, Q = (np.array(f(*args), dtype=float) for f in functions)
+    c, s = np.cos(theta), np.sin(theta)
+    m45 = np.array([s[3] * s[4], s[3] * c[4], c[3] * s[4], c[3] * c[4], s[3], c[3], s[4], c[4], 1])
+    m12 = np.array([s[0] * s[1], s[0] * c[1], c[0] * s[1], c[0] * c[1], s[0], c[0], s[1], c[1]])
+    residual = (P0 + Ps * s[2] + Pc * c[2]) @ m45 - Q @ m12
+    assert np.abs(residual).max() <= 1e-12 * (1 + np.abs(Q @ m12).max())
