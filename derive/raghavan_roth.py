@@ -19,9 +19,11 @@ constant terms go into P0's last column with their sign changed (ALGORITHMS.md 4
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from functools import cache
 
+import numpy as np
 import sympy as sp
 
 # the symbols of the derivation
@@ -149,3 +151,157 @@ def _column(exponents: tuple[int, ...], basis: tuple[sp.Expr, ...], gens: tuple)
     if term not in basis:
         raise AssertionError(f"{term} is not in the basis (degree above 1 in a pair)")
     return basis.index(term)
+
+
+# --- the numeric steps for one pose (a numpy reference; the printed solvers follow it) -------
+
+# coefficients over (x^0, x^1, x^2) of s (1 + x^2), c (1 + x^2) and (1 + x^2), x = tan(t/2)
+_S, _C, _O = (0.0, 2.0, 0.0), (1.0, 0.0, -1.0), (1.0, 0.0, 1.0)
+# m45 (1 + x4^2)(1 + x5^2) = H45 [x4^i x5^j], column 3 i + j
+_H45_ROWS = (
+    (_S, _S), (_S, _C), (_C, _S), (_C, _C), (_S, _O), (_C, _O), (_O, _S), (_O, _C), (_O, _O),
+)  # fmt: skip
+
+
+def h45() -> list[list[float]]:
+    """The 9 x 9 map from m45 to the monomials x4^i x5^j (i, j in 0..2)."""
+    return [[u[i] * w[j] for i in range(3) for j in range(3)] for u, w in _H45_ROWS]
+
+
+def eliminate(P0, Ps, Pc, Q, moebius=(1.0, 0.3, -0.4, 1.0)):
+    """The 12 x 12 matrix polynomial A y^2 + B y + C in y, x3 = (a y + b) / (c y + d), whose
+    real roots give theta3 (numpy arrays in, out). Q's left null space N (generically 6 x 14)
+    removes theta1, theta2; the half-angle substitution and the dialytic lift (stack and times
+    x4) give 12 x 12 (M-C eqs 13-14); the Moebius map keeps theta3 = pi (x3 = inf) finite."""
+    import numpy as np
+
+    U, S, _ = np.linalg.svd(Q)
+    rank = int((1e-10 * max(S[0], 1.0) < S).sum())
+    N = U[:, rank:].T
+    if N.shape[0] > 6:  # a rank-deficient Q: six fixed combinations of the rows
+        mix = np.random.default_rng(0).normal(size=(6, N.shape[0]))
+        N = mix @ N
+    H = np.array(h45())
+    A6, B6, C6 = (N @ M @ H for M in (P0 - Pc, 2.0 * Ps, P0 + Pc))
+    a_, b_, c_, d_ = moebius
+    # x3 = (a y + b) / (c y + d); times (c y + d)^2
+    A6, B6, C6 = (
+        a_ * a_ * A6 + a_ * c_ * B6 + c_ * c_ * C6,
+        2 * a_ * b_ * A6 + (a_ * d_ + b_ * c_) * B6 + 2 * c_ * d_ * C6,
+        b_ * b_ * A6 + b_ * d_ * B6 + d_ * d_ * C6,
+    )
+
+    def lift(M6):
+        M = np.zeros((12, 12))
+        for i in range(3):
+            for j in range(3):
+                M[:6, 3 * i + j] = M6[:, 3 * i + j]
+                M[6:, 3 * (i + 1) + j] = M6[:, 3 * i + j]
+        return M
+
+    return lift(A6), lift(B6), lift(C6)
+
+
+def theta3_candidates(A, B, C, moebius=(1.0, 0.3, -0.4, 1.0), imag_tol=1e-6):
+    """Real roots y of det(A y^2 + B y + C) as theta3 values, with their null vectors v
+    (12, proportional to x4^i x5^j), from the companion matrix [[0, I], [-A^-1 C, -A^-1 B]]."""
+    Ainv = np.linalg.inv(A)
+    top = np.hstack((np.zeros((12, 12)), np.eye(12)))
+    bottom = np.hstack((-Ainv @ C, -Ainv @ B))
+    values, vectors = np.linalg.eig(np.vstack((top, bottom)))
+    a_, b_, c_, d_ = moebius
+    out = []
+    for y, z in zip(values, vectors.T):
+        if abs(y.imag) > imag_tol * (1 + abs(y)):
+            continue
+        y = y.real
+        x3 = (a_ * y + b_) / (c_ * y + d_)
+        v = z[:12].real if abs(z[:12]).max() >= abs(z[12:]).max() else (z[12:] / y).real
+        out.append((2.0 * np.arctan(x3), v))
+    return out
+
+
+def half_angle_ratio(v, step):
+    """The angle t whose x = tan(t/2) relates the entries of v (12, proportional to
+    x4^i x5^j at 3 i + j) that are `step` apart (1: x5, 3: x4), by least squares; x = inf
+    (t = pi) is fine."""
+    if step == 1:
+        lo = np.array([v[3 * i + j] for i in range(4) for j in range(2)])
+        hi = np.array([v[3 * i + j + 1] for i in range(4) for j in range(2)])
+    else:
+        lo, hi = v[:9], v[3:]
+    across, low, high = float(hi @ lo), float(lo @ lo), float(hi @ hi)
+    if low >= high:
+        return 2.0 * np.arctan2(across, low)
+    return 2.0 * np.arctan2(high, across)
+
+
+def back_substitute(theta3, v, P0, Ps, Pc, Q, rows, T):
+    """The joint angles of one theta3 candidate: theta4, theta5 from v, theta1, theta2 from
+    Q m12 = P(theta3) m45 (least squares), theta6 from the pose. rows: standard-DH (offset,
+    d, a, alpha) per joint, the angles here being the full theta_i."""
+    t4, t5 = half_angle_ratio(v, 3), half_angle_ratio(v, 1)
+    s3, c3, s4, c4, s5, c5 = (f(t) for t in (theta3, t4, t5) for f in (np.sin, np.cos))
+    m45 = np.array([s4 * s5, s4 * c5, c4 * s5, c4 * c5, s4, c4, s5, c5, 1.0])
+    m12 = np.linalg.lstsq(Q, (P0 + Ps * s3 + Pc * c3) @ m45, rcond=None)[0]
+    t1, t2 = np.arctan2(m12[4], m12[5]), np.arctan2(m12[6], m12[7])
+    thetas = [t1, t2, theta3, t4, t5]
+    front = np.eye(4)
+    for t, (_, di, ai, alpha) in zip(thetas, rows):
+        front = front @ _standard(t, di, ai, alpha)
+    last = np.linalg.inv(front) @ T @ np.linalg.inv(_standard(0.0, 0.0, rows[5][2], rows[5][3]))
+    # last = Rz(theta6) Tz(d6): its first column is (c6, s6, 0)
+    return [*thetas, float(np.arctan2(last[1, 0], last[0, 0]))]
+
+
+def _standard(theta, d, a, alpha):
+    ct, st, ca, sa = np.cos(theta), np.sin(theta), np.cos(alpha), np.sin(alpha)
+    return np.array(
+        [
+            [ct, -st * ca, st * sa, a * ct],
+            [st, ct * ca, -ct * sa, a * st],
+            [0, sa, ca, d],
+            [0, 0, 0, 1],
+        ]
+    )
+
+
+def dh_numbers(rows: list[tuple[float, float, float, float]]) -> dict[sp.Symbol, float]:
+    """The derivation's arm symbols for standard-DH rows (theta offset, d, a, alpha)."""
+    values: dict[sp.Symbol, float] = {}
+    for i, (_theta, di, ai, alpha) in enumerate(rows):
+        values.update({d[i]: di, a[i]: ai, lam[i]: math.cos(alpha), mu[i]: math.sin(alpha)})
+    return values
+
+
+def pose_numbers(rows, T):
+    """The six pose numbers: columns 3 and 4 of T A6^-1 (free of theta6)."""
+    M = T @ np.linalg.inv(_standard(0.0, *rows[5][1:]))
+    return (*M[:3, 2], *M[:3, 3])
+
+
+@cache
+def _numeric_matrices():
+    f = fundamental()
+    args = (*a[:5], *d[:5], *lam[:5], *mu[:5], *L, *P)
+    return [sp.lambdify(args, m, "numpy") for m in (f.P0, f.Ps, f.Pc, f.Q)]
+
+
+def solve_reference(rows, T, tol=1e-6):
+    """Every certified solution of a standard-DH 6R arm for the pose T (numpy 4x4): the
+    general method's steps in numpy, as the printed solvers will run them (no polish, no
+    rescue yet). rows: (theta offset, d, a, alpha) per joint; angles returned are theta_i."""
+    numbers = (
+        *(r[2] for r in rows[:5]), *(r[1] for r in rows[:5]),
+        *(math.cos(r[3]) for r in rows[:5]), *(math.sin(r[3]) for r in rows[:5]),
+        *pose_numbers(rows, T),
+    )  # fmt: skip
+    P0, Ps, Pc, Q = (np.array(fn(*numbers), dtype=float) for fn in _numeric_matrices())
+    A, B, C = eliminate(P0, Ps, Pc, Q)
+    out = []
+    for theta3, v in theta3_candidates(A, B, C):
+        q = back_substitute(theta3, v, P0, Ps, Pc, Q, rows, T)
+        pose = np.linalg.multi_dot([_standard(t, *r[1:]) for t, r in zip(q, rows)])
+        if np.abs(pose - T).max() <= tol:
+            out.append(q)
+    return out
