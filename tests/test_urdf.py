@@ -360,3 +360,36 @@ def test_the_standard_convention_gives_the_same_arm(name, base, tip, tmp_path):
     Q = np.random.default_rng(2).uniform(-np.pi, np.pi, size=(50, 6))
     assert np.abs(modules[0].fk_batch(Q) - modules[1].fk_batch(Q)).max() <= 1e-12
     assert modules[1].ik(modules[1].fk(Q[0])).shape[0] >= 1
+
+
+SCARA = """<robot name="scara"><link name="base"/><link name="l1"/><link name="l2"/>
+<link name="l3"/><link name="l4"/><link name="flange"/>
+<joint name="j1" type="revolute"><parent link="base"/><child link="l1"/>
+<origin xyz="0 0 0.4" rpy="0 0 0"/><axis xyz="0 0 1"/><limit lower="-2" upper="2"/></joint>
+<joint name="j2" type="revolute"><parent link="l1"/><child link="l2"/>
+<origin xyz="0.35 0 0" rpy="0 0 0"/><axis xyz="0 0 1"/><limit lower="-2" upper="2"/></joint>
+<joint name="j3" type="prismatic"><parent link="l2"/><child link="l3"/>
+<origin xyz="0.3 0.05 -0.1" rpy="0 0 0"/><axis xyz="0 0 -1"/><limit lower="0" upper="0.2"/></joint>
+<joint name="j4" type="revolute"><parent link="l3"/><child link="l4"/>
+<origin xyz="0 0 0" rpy="0 0 0"/><axis xyz="0 0 1"/><limit lower="-3" upper="3"/></joint>
+<joint name="tool" type="fixed"><parent link="l4"/><child link="flange"/>
+<origin xyz="0.02 0 -0.05" rpy="3.141592653589793 0 0"/></joint>
+</robot>"""
+
+
+def test_a_scara_urdf_with_a_prismatic_joint_gets_its_solver(tmp_path):
+    """A SCARA (RRPR, the sliding axis pointing down, a fixed flange after it): the planar
+    method solves the converted spec, and ik(FK_urdf(q)) contains q."""
+    path = tmp_path / "scara.urdf"
+    path.write_text(SCARA)
+    module = generated_module(path, "base", "flange", tmp_path)
+    assert module.JOINT_TYPES == "RRPR" and hasattr(module, "ik")
+    chain = urdf.chain_between(urdf.read_urdf(path), "base", "flange", str(path))
+    rng = random.Random(9)
+    for _ in range(200):
+        q = [rng.uniform(-2, 2), rng.uniform(-2, 2), rng.uniform(0, 0.2), rng.uniform(-3, 3)]
+        T = np.array(urdf.urdf_fk(chain, q))
+        sols = module.ik(T, backend="python")
+        d = sols - np.array(q)
+        d[:, [0, 1, 3]] = np.remainder(d[:, [0, 1, 3]] + np.pi, 2 * np.pi) - np.pi
+        assert len(sols) and np.abs(d).max(axis=1).min() <= 1e-9, (q, sols)
