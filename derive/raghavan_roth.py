@@ -266,14 +266,6 @@ def _standard(theta, d, a, alpha):
     )
 
 
-def dh_numbers(rows: list[tuple[float, float, float, float]]) -> dict[sp.Symbol, float]:
-    """The derivation's arm symbols for standard-DH rows (theta offset, d, a, alpha)."""
-    values: dict[sp.Symbol, float] = {}
-    for i, (_theta, di, ai, alpha) in enumerate(rows):
-        values.update({d[i]: di, a[i]: ai, lam[i]: math.cos(alpha), mu[i]: math.sin(alpha)})
-    return values
-
-
 def pose_numbers(rows, T):
     """The six pose numbers: columns 3 and 4 of T A6^-1 (free of theta6)."""
     M = T @ np.linalg.inv(_standard(0.0, *rows[5][1:]))

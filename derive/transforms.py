@@ -176,11 +176,6 @@ def arm_factors(chain: Chain) -> list[sp.Matrix]:
     return mats
 
 
-def arm_transform(chain: Chain, expand: bool = True) -> sp.Matrix:
-    """0_nT = X_0 Z_1 X_1 ... Z_n X_n (base and tool not included)."""
-    return product(arm_factors(chain), expand)
-
-
 def world_transform(chain: Chain, expand: bool = True) -> sp.Matrix:
     """B 0_nT E: the pose of the tool frame in the world."""
     return product([chain.base, *arm_factors(chain), chain.tool], expand)
