@@ -30,6 +30,7 @@ from derive.printers.common import (
     match_expression,
     world_names,
 )
+from derive.printers.general import general_code
 
 GENERATOR = "derive-ik"
 REGENERATE = "derive generate"
@@ -127,6 +128,7 @@ class PrintedModule:
     world_names: str
     match: str
     components: str
+    general: str
 
 
 def print_plan(plan: Plan) -> PrintedModule:
@@ -178,6 +180,7 @@ def print_plan(plan: Plan) -> PrintedModule:
         world_names=", ".join(world_names()),
         match=match_expression(ik.certify) if ik else "",
         components=ik.certify if ik else "",
+        general=general_code(plan),
     )
 
 

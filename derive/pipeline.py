@@ -8,20 +8,29 @@ import sympy as sp
 
 from derive import symbols as sym
 from derive.classify import Structure, classify
-from derive.methods import parallel, pieper, planar
+from derive.methods import general, parallel, pieper, planar
 from derive.plan import ArmInfo, IkPlan, Plan
 from derive.spec import ArmSpec
 from derive.transforms import Chain, chain_from_spec, frame_matrix, link_transform, world_transform
 
 # Tried in order; each returns a plan, or a one-line reason why it does not apply.
-METHODS = (pieper.derive, parallel.derive, planar.derive)
+METHODS = {
+    pieper.NAME: pieper.derive,
+    parallel.NAME: parallel.derive,
+    planar.NAME: planar.derive,
+    general.NAME: general.derive,
+}
 
 
-def build_plan(spec: ArmSpec) -> Plan:
-    """Derive everything the generated module and the report need for one arm."""
+def build_plan(spec: ArmSpec, method: str | None = None) -> Plan:
+    """Derive everything the generated module and the report need for one arm; with method
+    (a key of METHODS), that method only (the general one also solves special arms: the tests
+    compare it with the closed forms)."""
     chain = chain_from_spec(spec)
     structure = classify(chain)
-    ik, refusal = choose_method(chain, structure)
+    if method is not None and method not in METHODS:
+        raise ValueError(f"no method {method!r}; methods: {', '.join(METHODS)}")
+    ik, refusal = choose_method(chain, structure, (method,) if method else tuple(METHODS))
     return Plan(
         arm=arm_info(spec, chain),
         structure=structure.describe(chain.dof),
@@ -33,14 +42,16 @@ def build_plan(spec: ArmSpec) -> Plan:
     )
 
 
-def choose_method(chain: Chain, structure: Structure) -> tuple[IkPlan | None, str]:
-    """The first method that applies, or None and the reasons none does (one line)."""
+def choose_method(
+    chain: Chain, structure: Structure, names: tuple[str, ...]
+) -> tuple[IkPlan | None, str]:
+    """The first of the named methods that applies, or None and the reasons none does."""
     if structure.coincident:
         i = structure.coincident[0]
         return None, f"axes {i} and {i + 1} coincide: the arm has a redundant joint"
     reasons = []
-    for method in METHODS:
-        result = method(chain, structure)
+    for name in names:
+        result = METHODS[name](chain, structure)
         if isinstance(result, IkPlan):
             return result, ""
         reasons.append(result)

@@ -191,8 +191,60 @@ class PolyD(Solve):
     angle: ClassVar[bool] = False
 
 
+@dataclass(frozen=True)
+class Split:
+    """One way of writing a 6R arm's loop for the general method (ALGORITHMS.md 4.1): the
+    arm's chain or its reversal, in standard DH from the flange frame (d1 = d6 = 0, a6 =
+    alpha6 = 0), lengths in units of the Eigen step's unit.
+
+    Attributes:
+        reversed: the chain read from the tool (joint k is joint 7 - k, theta'_k = -theta_7-k).
+        fill: the 490 entries of P0, Ps, Pc (14 x 9 each) and Q (14 x 8), row-major, in the
+            flange target's columns l = (lx, ly, lz) and p = (px, py, pz) (p in units).
+        fill_rows: the rows (d, a, cos alpha, sin alpha) the entries were derived from: the
+            arm's, or a slightly perturbed table where the arm's gives a singular pencil.
+        true_rows: the arm's rows (Newton steps polish on them).
+        recovered: at generation, of `poses` random poses, those whose generating joint values
+            this split found.
+        poses: the number of poses measured.
+        cond: the median condition number of the pencil's leading matrix on them.
+        singular: the arm's own table gives a singular pencil (fill_rows are perturbed).
+    """
+
+    reversed: bool
+    fill: tuple[sp.Expr, ...]
+    fill_rows: tuple[tuple[float, float, float, float], ...]
+    true_rows: tuple[tuple[float, float, float, float], ...]
+    recovered: int
+    poses: int
+    cond: float
+    singular: bool
+
+    @property
+    def name(self) -> str:
+        """In words, for the report and comments."""
+        chain = "the reversed chain" if self.reversed else "the arm's chain"
+        return chain + (" (perturbed table)" if self.singular else "")
+
+
+@dataclass(frozen=True)
+class Eigen(Solve):
+    """The general 6R method (Raghavan-Roth, Manocha-Canny): all six joints at once, from the
+    eigenvalues of a 24 x 24 companion matrix (theta3) and back-substitution. args: the flange
+    targets of the splits, 12 entries each (row-major), best split first; unit: the length
+    the splits' lengths are measured in."""
+
+    kind: ClassVar[str] = "eigen"
+    splits: tuple[Split, ...] = ()
+
+    @property
+    def variables(self) -> tuple[str, ...]:
+        """The joint angles the step gives (the arm's)."""
+        return tuple(f"theta{i}" for i in range(1, 7))
+
+
 # every kind of Solve step: each backend's printer has a function for each (a test checks it)
-SOLVE_KINDS: tuple[type[Solve], ...] = (Cs1, Cs1Reach, Cs2, Cs2Reach, Atan2, Poly, PolyD)
+SOLVE_KINDS: tuple[type[Solve], ...] = (Cs1, Cs1Reach, Cs2, Cs2Reach, Atan2, Poly, PolyD, Eigen)
 
 
 Step = Assign | Solve

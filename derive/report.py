@@ -15,9 +15,11 @@ from dataclasses import dataclass
 import numpy as np
 import sympy as sp
 
+from derive import raghavan_roth as rr
 from derive import symbols as sym
 from derive.emit import GENERATOR, environment
-from derive.plan import Assign, Plan, Solve
+from derive.plan import Assign, Eigen, Plan, Solve
+from derive.runtime import general as runtime_general
 
 DIGITS = 4
 CRAIG = "Craig's"
@@ -222,7 +224,121 @@ def method_blocks(plan: Plan) -> list[Block]:
             )
         )
         out.append(Block("math", "0", tex(details["joint3_equation"])))
+    for step in ik.steps:
+        if isinstance(step, Eigen):
+            out += general_blocks(step)
     return out
+
+
+def general_blocks(step: Eigen) -> list[Block]:
+    """The general method's derivation (ALGORITHMS.md 4.1-4.6): the split, the 14 equations
+    in general form, the elimination, the matrix polynomial."""
+    f = rr.fundamental()
+    out = [
+        Block("h3", "The split (Raghavan and Roth)"),
+        Block(
+            "p",
+            "The chain is written in standard DH from the flange frame ($d_1 = d_6 = 0$, "
+            "$A_6 = R_z(\\theta_6)$; lengths divided by "
+            f"{number(step.unit)}), and the loop $A_1 \\cdots A_6 = F$ is split as "
+            "$A_3 A_4 A_5 = A_2^{-1} A_1^{-1} F A_6^{-1}$. The third and fourth columns of "
+            "both sides (a direction $l$ and a point $p$) do not involve $\\theta_6$. Two "
+            "splits were measured on random poses (generating joint values found; median "
+            "condition number of the pencil's leading matrix); the first is used, the second "
+            "is the fallback:",
+        ),
+    ]
+    rows = [("split", "rows (d, a, alpha [deg]) i = 1..5", "found", "cond")]
+    for split in step.splits:
+        table = "; ".join(
+            f"({number(r[0])}, {number(r[1])}, {number(math.degrees(math.atan2(r[3], r[2])))})"
+            for r in split.fill_rows[:5]
+        )
+        found = f"{split.recovered}/{split.poses}"
+        rows.append((split.name, table, found, f"{split.cond:.2g}"))
+    out.append(Block("table", rows=tuple(rows)))
+    out += [
+        Block("h3", "The 14 fundamental equations, general form"),
+        Block(
+            "p",
+            "Per side: $l$ (3), $p$ (3), $p \\cdot p$, $p \\cdot l$, $p \\times l$ (3) and "
+            "$v = (p \\cdot p) l - 2 (p \\cdot l) p$ (3), equated, with $s_i^2 = 1 - c_i^2$ "
+            "and $\\mu_i^2 = 1 - \\lambda_i^2$ ($\\lambda_i = \\cos\\alpha_i$, "
+            "$\\mu_i = \\sin\\alpha_i$) applied until no even power is left:",
+        ),
+        Block("math", "(P_0 + P_s s_3 + P_c c_3)\\, m_{45}", "Q\\, m_{12}"),
+        Block("math", "m_{45}", tex(sp.Matrix(rr.M45).T)),
+        Block("math", "m_{12}", tex(sp.Matrix(rr.M12).T)),
+        Block(
+            "p",
+            "$P_0, P_s, P_c$ are 14 x 9 and $Q$ 14 x 8, polynomials in the DH parameters of "
+            "joints 1-5 and the six numbers $l_x, l_y, l_z, p_x, p_y, p_z$ "
+            f"({sum(e.count_ops() for m in (f.P0, f.Ps, f.Pc, f.Q) for e in m):,} operations "
+            "in all, derived once for every arm). Their third row ($l_z$) for example:",
+        ),
+        Block("math", "P_0[3, :]", tex(f.P0.row(2))),
+        Block("math", "Q[3, :]", tex(f.Q.row(2))),
+    ]
+    ops = [sum(sp.count_ops(e) for e in split.fill) for split in step.splits]
+    out += [
+        Block(
+            "p",
+            "With this arm's numbers the 490 entries come to "
+            + " and ".join(f"{n:,}" for n in ops)
+            + " operations (the splits), printed after CSE in `_rr_fill`.",
+        ),
+        Block("h3", "Elimination and the matrix polynomial (Manocha and Canny)"),
+        Block(
+            "p",
+            "$N$, six rows spanning the left null space of $Q$ (from its SVD), removes "
+            "$\\theta_1, \\theta_2$: $N (P_0 + P_s s_3 + P_c c_3) m_{45} = 0$. With "
+            "$x_i = \\tan(\\theta_i / 2)$, times $(1 + x_3^2)(1 + x_4^2)(1 + x_5^2)$, "
+            "$m_{45}$ becomes the monomials $x_4^i x_5^j$ ($i, j \\le 2$) and the six "
+            "equations $\\Sigma_6(x_3) = A_6 x_3^2 + B_6 x_3 + C_6$ (6 x 9); stacked with "
+            "$x_4 \\Sigma_6$ they give the 12 x 12 quadratic matrix polynomial "
+            "$\\Sigma(x_3) v = 0$, $v = [x_4^i x_5^j]$, $i \\le 3$, $j \\le 2$. "
+            "$\\det \\Sigma$ has degree 24: 16 genuine roots and 8 at $x_3 = \\pm i$. "
+            "A Moebius map $x_3 = (a y + b)/(c y + d)$ keeps $\\theta_3 = \\pi$ finite; "
+            "the real eigenvalues $y$ of the 24 x 24 companion matrix give $\\theta_3$, "
+            "the null space of $\\Sigma$ at each gives $\\theta_4, \\theta_5$, and "
+            "$\\theta_1, \\theta_2, \\theta_6$ follow by back-substitution; Newton "
+            "steps polish every candidate and forward kinematics certifies it.",
+        ),
+    ]
+    return out
+
+
+def eigen_blocks(step: Eigen, env: dict[sp.Symbol, float]) -> list[Block]:
+    """The worked example's eigenvalues: the first split's companion matrix at the pose."""
+    split = step.splits[0]
+    F = np.eye(4)
+    for k, target in enumerate(step.args[:12]):
+        F[k // 4, k % 4] = env[target]
+    F[:3, 3] /= step.unit
+    rows = split.fill_rows[:5]
+    args = [r[1] for r in rows] + [r[0] for r in rows] + [r[2] for r in rows]
+    args += [r[3] for r in rows] + [*F[:3, 2], *F[:3, 3]]
+    f = rr.fundamental()
+    P0, Ps, Pc, Q = (
+        np.array(m.xreplace(dict(zip(rr.GENS, args))).evalf(), dtype=float)
+        for m in (f.P0, f.Ps, f.Pc, f.Q)
+    )
+    found = runtime_general._rr_eigenvalues(P0, Ps, Pc, Q)
+    if found is None:
+        return [Block("p", f"The pencil of {split.name} is singular at this pose.")]
+    values, _, (a, b, c, d) = found
+    real = sorted(v.real for v in values if abs(v.imag) <= 1e-6 * (1 + abs(v)))
+    thetas = [math.degrees(2 * math.atan2(a * y + b, c * y + d)) for y in real]
+    return [
+        Block(
+            "p",
+            f"The companion matrix of {split.name} at this pose has {len(values)} eigenvalues, "
+            f"{len(real)} of them real (y, with x3 = ({a:g} y + {b:g}) / ({c:g} y + {d:g})); "
+            "theta3 from each, in degrees:",
+        ),
+        Block("math", "y", ", ".join(number(y) for y in real)),
+        Block("math", "\\theta_3 / ^\\circ", ", ".join(number(t) for t in thetas)),
+    ]
 
 
 def step_blocks(plan: Plan) -> list[Block]:
@@ -241,6 +357,9 @@ def step_blocks(plan: Plan) -> list[Block]:
         if isinstance(step, Assign):
             for target, expr in zip(step.targets, step.exprs):
                 out.append(Block("math", tex(target), tex(expr)))
+            continue
+        if isinstance(step, Eigen):
+            out.append(Block("math", "(P_0 + P_s s_3 + P_c c_3)\\, m_{45}", "Q\\, m_{12}"))
             continue
         for lhs, rhs in solve_equations(step):
             out.append(Block("math", lhs, rhs))
@@ -288,6 +407,12 @@ def walk(plan: Plan, pose: np.ndarray, q: tuple[float, ...]) -> list[tuple[str, 
                 env[target] = float(expr.xreplace(env))
                 lines.append((tex(target), number(env[target])))
             continue
+        if isinstance(step, Eigen):
+            for k in range(1, 7):  # the solution's joint values, from the eigen-solve
+                t = sym.theta(k)
+                env[t] = values[t]
+                lines.append((f"{tex(t)} / ^\\circ", number(math.degrees(values[t]))))
+            continue
         args = [float(a.xreplace(env)) for a in step.args]
         shown = ", ".join(number(x) for x in args)
         t = joint_symbol(step)
@@ -304,6 +429,18 @@ def walk(plan: Plan, pose: np.ndarray, q: tuple[float, ...]) -> list[tuple[str, 
         else:
             lines.append((f"{tex(t)}\\ (\\text{{{step.kind}}}: {shown})", number(value)))
     return lines
+
+
+def assigned(plan: Plan, pose: np.ndarray) -> dict[sp.Symbol, float]:
+    """The values of the plan's assignments at the pose (world entries included)."""
+    assert plan.ik is not None
+    world = sym.world_pose()
+    env = {world[i, j]: float(pose[i, j]) for i in range(3) for j in range(4)}
+    for step in plan.ik.steps:
+        if isinstance(step, Assign):
+            for target, expr in zip(step.targets, step.exprs):
+                env[target] = float(expr.xreplace(env))
+    return env
 
 
 def plan_values(plan: Plan, q: tuple[float, ...]) -> dict[sp.Symbol, float]:
@@ -348,6 +485,9 @@ def example_blocks(plan: Plan, example: Example) -> list[Block]:
         )
     )
     out += [Block("math", lhs, rhs) for lhs, rhs in walk(plan, pose, first)]
+    for step in plan.ik.steps:
+        if isinstance(step, Eigen):
+            out += eigen_blocks(step, assigned(plan, pose))
     if arm.dof == 6:
         out += wrist_matrices(plan, first, flange)
     rows = [

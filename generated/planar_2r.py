@@ -82,6 +82,8 @@ _OFFSETS = (0.0, 0.0)
 _REVOLUTE = (True, True)
 # "pose": solutions reproduce the whole pose; "position": the tool point only.
 IK_COMPONENTS = "position"
+# the solution method (derive/methods/)
+METHOD = "planar"
 # the most solutions a pose can have by this derivation (ik_batch's M)
 MAX_SOLUTIONS = 2
 
@@ -1061,6 +1063,7 @@ _FASTMATH = {"contract", "arcp", "nsz", "reassoc"}
 # except in the polynomial roots: near a multiple root they move by far more than rounding,
 # and whether two roots merge must not depend on how LLVM ordered the arithmetic
 _KSTRICT = (
+    "_keigenvalues",
     "_kquadratic",
     "_kcubic_largest",
     "_kquartic",

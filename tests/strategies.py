@@ -155,3 +155,20 @@ def planar_arms(draw) -> str:
         extra = f"[tool]\ntranslation = [{round(draw(LENGTH) * scale, 6)}, 0.0, 0.0]\n"
     text = spec_text("planar_arm", convention, rows, kinds=kinds, extra=extra)
     return text.replace('type = "P"\n', f'type = "P"\nlimits = [{-scale}, {scale}]\n')
+
+
+@st.composite
+def general_arms(draw) -> str:
+    """6R arms of any geometry (most have no closed form): twists mix 0, +-90, 180 and
+    generic values, lengths and offsets are zero or not; the arm is solved by whichever
+    method applies (the general one where none of the others does)."""
+    convention = draw(st.sampled_from(["standard", "modified"]))
+    twist = st.one_of(TWISTS, st.sampled_from([0.0, 180.0]))
+    alpha = [draw(twist) for _ in range(7)]
+    a = [draw(MAYBE_ZERO) for _ in range(7)]
+    d = [None] + [draw(MAYBE_ZERO) for _ in range(6)]
+    theta = [None] + [draw(OFFSETS) for _ in range(6)]
+    a[draw(st.integers(1, 5))] = draw(LENGTH)  # at least one link with length
+    scale = draw(SCALE)
+    rows = rows_for(convention, alpha, scaled(a, scale), scaled(d, scale), theta)
+    return spec_text("general_arm", convention, rows)

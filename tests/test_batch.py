@@ -8,7 +8,7 @@ from concurrent.futures import ThreadPoolExecutor
 import numpy as np
 import pytest
 
-from derive.verify import sample_joints
+from derive.verify import SINGULAR_SIGMA, jacobian_nullity, sample_joints
 
 from conftest import BUNDLED, needs_numba
 
@@ -39,9 +39,14 @@ def test_ik_batch_equals_ik_pose_by_pose(generated, name):
 @pytest.mark.parametrize("name", BUNDLED)
 def test_backends_give_the_same_solutions(generated, name):
     """The compiled solver (numba) and the Python one: ik and ik_batch, the same rows in the
-    same order, on random poses (20% of joints at degenerate values)."""
+    same order, on random poses (20% of joints at degenerate values). The general method
+    has no reference value to give a free joint: at a singular pose (a self-motion, e.g.
+    theta3 + theta6 fixed when axes 3 and 6 line up) each backend returns its own certified
+    points of the curve, so those samples are left out for it."""
     m = generated(name)
     Q = sample_joints(m, 300, np.random.default_rng(37))
+    if m.METHOD == "general":
+        Q = np.array([q for q in Q if jacobian_nullity(m, q)[0] > SINGULAR_SIGMA])
     T = m.fk_batch(Q)
     revolute = np.array([k == "R" for k in m.JOINT_TYPES])
     compiled, valid_c = m.ik_batch(T, backend="numba")

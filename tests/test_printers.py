@@ -130,7 +130,9 @@ def test_a_new_method_is_one_file_and_one_registration_line(tmp_path, monkeypatc
     import example_method
     from conftest import spec_text
 
-    monkeypatch.setattr(pipeline, "METHODS", (*pipeline.METHODS, example_method.derive))
+    monkeypatch.setattr(
+        pipeline, "METHODS", pipeline.METHODS | {example_method.NAME: example_method.derive}
+    )
     spec = tmp_path / "pan_tilt.toml"
     spec.write_text(spec_text("pan_tilt", "modified", [(0, 0, 0, 0), (-90, 0.05, 0.1, 30)]))
     plan = pipeline.build_plan(load_spec(spec))

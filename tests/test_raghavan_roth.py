@@ -1,5 +1,5 @@
 """The general 6R method's first step: the 14 fundamental equations, derived in symbols, hold
-for random arms at random joint values (the general method itself is issue 17's next step)."""
+for random arms at random joint values, and the run-time steps find the joint values."""
 
 from __future__ import annotations
 
@@ -8,6 +8,7 @@ import pytest
 import sympy as sp
 
 from derive import raghavan_roth as rr
+from derive.runtime import general
 
 
 def standard_link(theta: float, d: float, a: float, alpha: float) -> np.ndarray:
@@ -65,137 +66,27 @@ def test_the_fourteen_equations_hold_at_random_arms_and_joint_values(matrices, s
     assert np.abs(residual).max() <= 1e-12 * (1 + np.abs(Q @ m12).max())
 
 
-def test_the_reference_solve_finds_all_16_solutions_of_manocha_and_canny():
-    """hard_cases.yaml's 16-real-solution arm (Manocha and Canny 1994, Table III), exact pose:
-    16 certified solutions, each one of the published exact ones to 1e-6 deg."""
-    rows = [(0.0, d, a, np.radians(alpha)) for a, alpha, d in MANOCHA_CANNY["standard_dh"]]
-    T = np.vstack((np.array(MANOCHA_CANNY["T"]), [0.0, 0.0, 0.0, 1.0]))
-    found = np.degrees(np.array(rr.solve_reference(rows, T)))
-    assert found.shape == (16, 6)
-    for expected in MANOCHA_CANNY["solutions"]:
-        gap = np.abs((found - np.array(expected) + 180.0) % 360.0 - 180.0).max(axis=1)
-        assert gap.min() <= 1e-6, expected
-
-
-@pytest.mark.parametrize("seed", range(50))
-def test_the_reference_solve_finds_the_joint_values_of_random_arms(seed):
+@pytest.mark.parametrize("seed", range(30))
+def test_the_run_time_steps_find_the_joint_values_of_random_arms(seed):
+    """derive/runtime/general.py's steps on the generic matrices: the generating joint
+    values are among the candidates (flange-frame rows: d1 = 0, A6 = Rz(theta6))."""
     rng = np.random.default_rng(100 + seed)
-    rows = list(zip([0.0] * 6, rng.uniform(-1, 1, 6), rng.uniform(-1, 1, 6), rng.uniform(-3, 3, 6)))
+    d, a, alpha = rng.uniform(-1, 1, 6), rng.uniform(-1, 1, 6), rng.uniform(-3, 3, 6)
+    d[0] = d[5] = a[5] = alpha[5] = 0.0
+    rows = [(d[i], a[i], np.cos(alpha[i]), np.sin(alpha[i])) for i in range(6)]
     theta = rng.uniform(-np.pi, np.pi, 6)
-    T = np.linalg.multi_dot([standard_link(t, *r[1:]) for t, r in zip(theta, rows)])
-    found = np.array(rr.solve_reference(rows, T))
-    gap = np.abs((found - theta + np.pi) % (2 * np.pi) - np.pi).max(axis=1)
-    assert gap.min() <= 1e-6
+    F = np.linalg.multi_dot([general._rr_link(t, r) for t, r in zip(theta, rows)])
+    args = (*a[:5], *d[:5], *np.cos(alpha[:5]), *np.sin(alpha[:5]), *F[:3, 2], *F[:3, 3])
+    f = rr.fundamental()
+    P0, Ps, Pc, Q = (
+        np.array(sp.lambdify(rr.GENS, m)(*args), dtype=float) for m in (f.P0, f.Ps, f.Pc, f.Q)
+    )
+    candidates, _ = general._rr_candidates(P0, Ps, Pc, Q, F, rows)
+    gap = [np.abs((c - theta + np.pi) % (2 * np.pi) - np.pi).max() for c in candidates]
+    assert min(gap) <= 1e-6
 
 
-# the published case (id manocha_canny_1994_16_real of the project's hard_cases.yaml), copied
-MANOCHA_CANNY = {
-    "standard_dh": [  # a_i, alpha_i [deg], d_i
-        [0.3, 90.0, 0.0],
-        [1.0, 1.0, 0.0],
-        [0.0, 90.0, 0.2],
-        [1.5, 1.0, 0.0],
-        [0.0, 90.0, 0.0],
-        [0.0, 1.0, 0.0],
-    ],
-    "T": [
-        [-0.760167736925, -0.641625873792, 0.102280251366, -1.14004797368],
-        [0.133406575395, -7.07052578278e-05, 0.991061390955, -2.70345826006e-05],
-        [-0.635883399202, 0.767017752781, 0.0856508583635, 0.00018235181416],
-    ],
-    "solutions": [  # exact.solutions, degrees
-        [
-            -178.116728776,
-            108.216824904,
-            -147.742673593,
-            -5.68734865359,
-            -164.66895011,
-            179.568452421,
-        ],
-        [
-            -178.116728776,
-            108.216824904,
-            32.2573264067,
-            -174.312651346,
-            -15.3310498899,
-            -0.43154757878,
-        ],
-        [
-            -120.801949611,
-            172.314182501,
-            -179.059098701,
-            31.3205465246,
-            -146.71555608,
-            142.830297525,
-        ],
-        [
-            -120.801949611,
-            172.314182501,
-            0.940901298608,
-            148.679453475,
-            -33.2844439204,
-            -37.1697024754,
-        ],
-        [-96.28, -6.27, -0.04, 141.52, 127.45, 140.6],
-        [-96.28, -6.27, 179.96, 38.48, 52.55, -39.4],
-        [-12.9480266402, -105.096580088, -114.984317234, 3.02708039963, 7.419653441, -79.425177447],
-        [-12.9480266402, -105.096580088, 65.0156827661, 176.9729196, 172.580346559, 100.574822553],
-        [
-            2.52381109702,
-            108.063424835,
-            -67.9496571909,
-            -169.473275632,
-            -179.999479315,
-            179.88966717,
-        ],
-        [
-            2.52381109702,
-            108.063424835,
-            112.050342809,
-            -10.5267243675,
-            -0.000520685313451,
-            -0.110332830362,
-        ],
-        [
-            88.6912679915,
-            -176.729863659,
-            -176.718584902,
-            -63.2313501358,
-            157.199437355,
-            140.439978619,
-        ],
-        [
-            88.6912679915,
-            -176.729863659,
-            3.28141509795,
-            -116.768649864,
-            22.8005626449,
-            -39.5600213805,
-        ],
-        [
-            113.840461788,
-            5.32280090165,
-            -177.754784522,
-            -55.9188937407,
-            -62.9880156485,
-            -43.374715635,
-        ],
-        [
-            113.840461788,
-            5.32280090165,
-            2.24521547793,
-            -124.081106259,
-            -117.011984351,
-            136.625284365,
-        ],
-        [
-            168.317514741,
-            -103.8879949,
-            -33.3885472678,
-            -162.755750262,
-            -8.11824513443,
-            -81.8409470238,
-        ],
-        [168.317514741, -103.8879949, 146.611452732, -17.2442497384, -171.881754866, 98.1590529762],
-    ],
-}
+def test_the_stored_derivation_is_the_one_derived_today():
+    """derive/data/fundamental.json (read at generation) equals a fresh derivation; rewrite
+    it with `python -m derive.raghavan_roth` when the derivation changes."""
+    assert rr.to_terms(rr.derive_fundamental()) == rr.to_terms(rr.fundamental())

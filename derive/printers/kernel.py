@@ -15,7 +15,19 @@ from dataclasses import dataclass
 
 import sympy as sp
 
-from derive.plan import Assign, Atan2, Cs1, Cs1Reach, Cs2, Cs2Reach, Plan, Poly, PolyD, Solve
+from derive.plan import (
+    Assign,
+    Atan2,
+    Cs1,
+    Cs1Reach,
+    Cs2,
+    Cs2Reach,
+    Eigen,
+    Plan,
+    Poly,
+    PolyD,
+    Solve,
+)
 from derive.printers.common import (
     CodePrinter,
     Line,
@@ -151,6 +163,32 @@ def _single(c: Context) -> Block:
     return Block(tuple(lines), loop=False, reads_cs=not isinstance(step, Cs2Reach))
 
 
+# the scratch of the general method's step: up to KGENERAL_ROWS joint vectors of six angles
+KGENERAL_ROWS = 16
+
+
+def _eigen(c: Context) -> Block:
+    step = c.step
+    assert isinstance(step, Eigen)
+    groups = [c.values[k : k + 12] for k in range(0, len(c.values), 12)]
+    flanges = ", ".join(f"({', '.join(g)})" for g in groups)
+    at, end = c.at, c.at + 6 * KGENERAL_ROWS
+    lines = [
+        Line(0, f"_n3 = _kgeneral(({flanges},), buf[{at}:{end}])"),
+        Line(0, "if _n3 < 0:"),
+        Line(1, "return -1"),
+        Line(0, "_f3 = False"),
+        Line(0, "_m3 = n"),
+        Line(0, "for _k3 in range(_n3):"),
+    ]
+    for k in range(1, 7):
+        lines.append(Line(1, f"theta{k} = buf[{at} + 6 * _k3 + {k - 1}]"))
+        for kind, function in (("c", "cos"), ("s", "sin")):
+            if f"{kind}{k}" in c.after:
+                lines.append(Line(1, f"{kind}{k} = {function}(theta{k})"))
+    return Block(tuple(lines), loop=True, reads_cs=False, slots=6 * KGENERAL_ROWS)
+
+
 SOLVES: dict[type[Solve], Callable[[Context], Block]] = {
     Poly: _poly,
     PolyD: _poly,
@@ -159,6 +197,7 @@ SOLVES: dict[type[Solve], Callable[[Context], Block]] = {
     Cs2: _single,
     Cs2Reach: _single,
     Atan2: _single,
+    Eigen: _eigen,
 }
 
 

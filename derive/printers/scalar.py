@@ -11,7 +11,19 @@ from collections.abc import Callable
 
 import sympy as sp
 
-from derive.plan import Assign, Atan2, Cs1, Cs1Reach, Cs2, Cs2Reach, Plan, Poly, PolyD, Solve
+from derive.plan import (
+    Assign,
+    Atan2,
+    Cs1,
+    Cs1Reach,
+    Cs2,
+    Cs2Reach,
+    Eigen,
+    Plan,
+    Poly,
+    PolyD,
+    Solve,
+)
 from derive.printers.common import (
     CodePrinter,
     Line,
@@ -33,6 +45,7 @@ SOLVES: dict[type[Solve], SolvePrinter] = {
     Cs2: lambda step, args, ref, free: f"_cs2({args}, {ref})",
     Cs2Reach: lambda step, args, ref, free: f"_cs2_reach({args}, {ref})",
     Atan2: lambda step, args, ref, free: f"_atan2({args}, {ref})",
+    Eigen: lambda step, args, ref, free: f"_general(({args},), tol)",
 }
 
 
@@ -55,7 +68,8 @@ def ik_lines(plan: Plan) -> tuple[tuple[int, str], ...]:
             lines += assign_lines(step.targets, step.exprs, names, printer, depth, live.after)
             continue
         lines += solve_lines(step, live.after, names, printer, depth)
-        loops.append((depth, step.joint))
+        if not isinstance(step, Eigen):  # it gives every joint: no free joint to step
+            loops.append((depth, step.joint))
         depth += 1
     outputs = ", ".join(printer.doprint(e) for e in plan.ik.outputs)
     if same_joints(plan):
@@ -87,6 +101,16 @@ def solve_lines(
     """The loop header of one Solve step, with its arguments CSE'd before it, and the cos
     and sin of an angle where later steps read them."""
     lines, values = step_arguments(step, names, printer, depth)
+    if isinstance(step, Eigen):
+        # the splits' flange targets, 12 entries each
+        groups = [values[k : k + 12] for k in range(0, len(values), 12)]
+        call = SOLVES[Eigen](step, ", ".join(f"({', '.join(g)})" for g in groups), "", "")
+        lines.append(Line(depth, f"for {', '.join(step.variables)} in {call}:"))
+        for k in range(1, 7):
+            for name, function in ((f"c{k}", "cos"), (f"s{k}", "sin")):
+                if name in after:
+                    lines.append(Line(depth + 1, f"{name} = {function}(theta{k})"))
+        return lines
     call = SOLVES[type(step)](
         step, ", ".join(values), printer.doprint(step.ref), repr(1e-10 * step.scale)
     )

@@ -12,7 +12,19 @@ from collections.abc import Callable
 import sympy as sp
 
 from derive import symbols as sym
-from derive.plan import Assign, Atan2, Cs1, Cs1Reach, Cs2, Cs2Reach, Plan, Poly, PolyD, Solve
+from derive.plan import (
+    Assign,
+    Atan2,
+    Cs1,
+    Cs1Reach,
+    Cs2,
+    Cs2Reach,
+    Eigen,
+    Plan,
+    Poly,
+    PolyD,
+    Solve,
+)
 from derive.printers.common import (
     CodePrinter,
     assign_lines,
@@ -41,6 +53,8 @@ SOLVES: dict[type[Solve], SolvePrinter] = {
     Cs2: lambda step, args, ref, free, axis: f"_vcs2({args}, {ref}, {axis}, valid)",
     Cs2Reach: lambda step, args, ref, free, axis: f"_vcs2_reach({args}, {ref}, {axis}, valid)",
     Atan2: lambda step, args, ref, free, axis: f"_vatan2({args}, {ref}, {axis}, valid)",
+    # one eigenproblem per pose: every pose goes to the scalar solver
+    Eigen: lambda step, args, ref, free, axis: "_vdefer(T.shape[0], DOF)",
 }
 
 
@@ -48,6 +62,12 @@ def ik_batch_lines(plan: Plan) -> tuple[str, ...]:
     """Body of the vectorised IK: one array axis per Solve step, validity combined, every
     branch certified by forward kinematics."""
     assert plan.ik is not None
+    for step in plan.ik.steps:
+        if isinstance(step, Eigen):
+            return (
+                f"# {step.note}: one eigenproblem per pose, in the scalar solver",
+                f"return {SOLVES[Eigen](step, '', '', '', 0)}",
+            )
     printer = CodePrinter("np.")
     names = sp.numbered_symbols("x")
     steps, _ = live_steps(plan)

@@ -16,6 +16,7 @@ Modules, in copy order:
 ``common``     argument checks and joint-value helpers the others share
 ``closed``     closed forms shared by the Python and compiled solvers (quadratic,
                quartic, atan2, Newton steps, the free-joint reach searches)
+``general``    the general 6R method in the Python solver (numpy's eigensolver)
 ``scalar``     the Python solver's step routines (``a cos + b sin = e``, polynomials)
 ``vector``     the numpy batch solver's step routines (one array axis per branch)
 ``kernel``     the compiled solver's routines, in the subset of Python numba compiles
@@ -25,4 +26,4 @@ Modules, in copy order:
 arm (DOF, LIMITS, the forward kinematics, the solver bodies), so that this package imports.
 """
 
-MODULES = ("constants", "api", "common", "closed", "scalar", "vector", "kernel")
+MODULES = ("constants", "api", "common", "closed", "general", "scalar", "vector", "kernel")

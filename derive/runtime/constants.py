@@ -36,3 +36,25 @@ _SEAM_SNAP = 1e-12
 _SEAM = math.pi - _SEAM_BAND
 # all_turns=True returns at most this many rows (every 2 pi variant of every joint)
 MAX_TURN_ROWS = 100_000
+# the general 6R method (derive/runtime/general.py): Q's rank counts singular values above
+# _RR_RANK_TOL of the largest; a Moebius map x3 = (a y + b) / (c y + d) is kept once the
+# leading matrix's condition number is below _RR_COND_LIMIT (else the best of the three);
+# an eigenvalue is real when |Im| <= _RR_IMAG_TOL (1 + |y|), and real ones closer than
+# _RR_CLUSTER_TOL (1 + |y|) are one cluster (the answer is then in doubt); a second singular
+# value below _RR_NULL2_TOL of the largest makes the null space two-dimensional; a candidate
+# is kept when _RR_NEWTON_STEPS Newton steps (each at most 0.5 rad per joint, started where
+# the pose error is below _RR_NEWTON_REACH) bring its pose error below _RR_GOOD (lengths in
+# units of the arm's size); the rescue solves the pose moved by each (angle, shift) of
+# _RR_RESCUE and polishes back
+_RR_RANK_TOL = 1e-10
+_RR_COND_LIMIT = 1e8
+_RR_MOEBIUS = ((1.0, 0.3, -0.4, 1.0), (1.0, -0.7, 0.5, 1.0), (0.6, 1.0, -1.0, 0.8))
+_RR_IMAG_TOL = 1e-6
+_RR_CLUSTER_TOL = 1e-6
+_RR_NULL2_TOL = 1e-5
+_RR_GOOD = 1e-10
+_RR_NEWTON_STEPS = 10
+_RR_NEWTON_REACH = 0.5
+# a perturbed table's candidates are polished on tables these shares of the way back first
+_RR_PATH = (0.3, 0.1, 0.03)
+_RR_RESCUE = ((1e-4, 1e-4), (-2e-4, 1.5e-4))

@@ -17,7 +17,17 @@ from math import cos, sin, sqrt
 
 import numpy as np
 
-from derive.runtime.arm import _KBUF, _REVOLUTE, DOF, MAX_SOLUTIONS, _kreference, _ksolve
+from derive.runtime.arm import (
+    _KBUF,
+    _REVOLUTE,
+    _RR_LENGTH,
+    _RR_SPLITS,
+    DOF,
+    MAX_SOLUTIONS,
+    _kreference,
+    _ksolve,
+    _rr_fill,
+)
 from derive.runtime.closed import (
     _kangle,
     _kquadratic_real,
@@ -37,12 +47,23 @@ from derive.runtime.constants import (
     _LEAD_TOL,
     _MERGE_TOL,
     _ROOT_IMAG_TOL,
+    _RR_CLUSTER_TOL,
+    _RR_COND_LIMIT,
+    _RR_GOOD,
+    _RR_IMAG_TOL,
+    _RR_MOEBIUS,
+    _RR_NEWTON_REACH,
+    _RR_NEWTON_STEPS,
+    _RR_NULL2_TOL,
+    _RR_PATH,
+    _RR_RANK_TOL,
     _SEAM,
     _SEAM_SNAP,
     _TWO_PI,
     DEDUP_TOL,
     POSE_TOL,
 )
+from derive.runtime.general import _RR_H45, _RR_MIX, _RR_MONOMIAL_RULES
 
 
 def _kpose_ok(T, i):
@@ -390,6 +411,7 @@ _FASTMATH = {"contract", "arcp", "nsz", "reassoc"}
 # except in the polynomial roots: near a multiple root they move by far more than rounding,
 # and whether two roots merge must not depend on how LLVM ordered the arithmetic
 _KSTRICT = (
+    "_keigenvalues",
     "_kquadratic",
     "_kcubic_largest",
     "_kquartic",
@@ -402,3 +424,696 @@ _KSTRICT = (
 
 
 _prange = range
+
+
+def _kgeneral(flanges, out):
+    """The general method's solutions of one pose into out (6 angles per row, at most
+    out.size // 6): their count, or -1 where the Python solver must settle the pose (an
+    answer in doubt in every split: the Python solver's fallback and rescue take over). The
+    steps of derive/runtime/general.py with small routines of its own instead of LAPACK."""
+    limit = out.size // 6
+    count = 0
+    values = np.zeros(490)
+    F = np.eye(4)
+    cands = np.zeros((4 * _KRR_MAX, 6))
+    for k in range(len(flanges)):
+        flange = flanges[k]
+        for r in range(3):
+            for c in range(4):
+                F[r, c] = flange[4 * r + c]
+            F[r, 3] /= _RR_LENGTH
+        fill = np.array(_RR_SPLITS[k][1])
+        true = np.array(_RR_SPLITS[k][2])
+        perturbed = False
+        for i in range(6):
+            for j in range(4):
+                if fill[i, j] != true[i, j]:
+                    perturbed = True
+        values[:] = 0.0
+        _rr_fill(k, F[0, 2], F[1, 2], F[2, 2], F[0, 3], F[1, 3], F[2, 3], values)
+        n, doubt = _krr_candidates(values, F, fill, cands)
+        for c in range(n):
+            q = cands[c].copy()
+            if perturbed:
+                for t in _RR_PATH:
+                    q, _ = _krr_newton(_krr_between(fill, true, t), F, q)
+            q, error = _krr_newton(true, F, q)
+            if error > _RR_GOOD:
+                if not perturbed:
+                    doubt = True
+                continue
+            if _RR_SPLITS[k][0]:  # the reversed chain: joint j is -theta_{7-j}
+                q = -q[::-1]
+            seen = False
+            for r in range(count):
+                gap = 0.0
+                for j in range(6):
+                    gap = max(gap, abs((q[j] - out[6 * r + j] + math.pi) % _TWO_PI - math.pi))
+                if gap <= 1e-7:
+                    seen = True
+                    break
+            if not seen:
+                if count == limit:
+                    return -1
+                out[6 * count : 6 * count + 6] = q
+                count += 1
+        if not doubt and count % 2 == 0 and count > 0:
+            return count
+    return -1
+
+
+# the most candidates of one split: 16 eigenvalues, each with up to 3 null vectors (one, and
+# two from a plane) and 2 values of theta2
+_KRR_MAX = 16
+
+
+def _krr_candidates(values, F, rows, out):
+    """_rr_candidates in the kernel: the count of candidate joint vectors written to out and
+    whether the answer is in doubt (clusters, or no usable pencil)."""
+    P0 = values[:126].reshape(14, 9)
+    Ps = values[126:252].reshape(14, 9)
+    Pc = values[252:378].reshape(14, 9)
+    Q = values[378:].reshape(14, 8)
+    N = _knull_left(Q)
+    if N.shape[0] == 0:
+        return 0, True
+    # N (P0 - Pc) H45, N (2 Ps) H45, N (P0 + Pc) H45
+    A6 = np.zeros((6, 9))
+    B6 = np.zeros((6, 9))
+    C6 = np.zeros((6, 9))
+    for i in range(6):
+        for m in range(9):
+            a = 0.0
+            b = 0.0
+            c = 0.0
+            for r in range(14):
+                a += N[i, r] * (P0[r, m] - Pc[r, m])
+                b += N[i, r] * 2.0 * Ps[r, m]
+                c += N[i, r] * (P0[r, m] + Pc[r, m])
+            for col in range(9):
+                h = _RR_H45[m, col]
+                if h != 0.0:
+                    A6[i, col] += a * h
+                    B6[i, col] += b * h
+                    C6[i, col] += c * h
+    best = math.inf
+    A = np.zeros((12, 12))
+    B = np.zeros((12, 12))
+    C = np.zeros((12, 12))
+    moebius = _RR_MOEBIUS[0]
+    for candidate in _RR_MOEBIUS:
+        Am, Bm, Cm = _krr_pencil(A6, B6, C6, candidate)
+        ratio = _kpivot_ratio(Am)
+        if ratio < best:
+            A, B, C, moebius, best = Am, Bm, Cm, candidate, ratio
+        if ratio < _RR_COND_LIMIT:
+            break
+    if not best < 1e16:
+        return 0, True
+    K = np.zeros((24, 24))
+    for i in range(12):
+        K[i, 12 + i] = 1.0
+    rhs = np.zeros((12, 24))
+    rhs[:, :12] = -C
+    rhs[:, 12:] = -B
+    if not _ksolve_into(A, rhs):
+        return 0, True
+    K[12:, :] = rhs
+    wr, wi, ok = _keigenvalues(K)
+    if not ok:
+        return 0, True
+    reals = np.zeros(24)
+    n_real = 0
+    for i in range(24):
+        if abs(wi[i]) <= _RR_IMAG_TOL * (1.0 + math.hypot(wr[i], wi[i])):
+            reals[n_real] = wr[i]
+            n_real += 1
+    reals = np.sort(reals[:n_real])
+    doubt = False
+    count = 0
+    ma, mb, mc, md = moebius
+    start = 0
+    V = np.zeros((3, 12))
+    while start < n_real:
+        stop = start + 1
+        while stop < n_real and reals[stop] - reals[stop - 1] <= _RR_CLUSTER_TOL * (
+            1.0 + abs(reals[stop])
+        ):
+            stop += 1
+        y = reals[start:stop].mean()
+        clustered = stop - start > 1
+        start = stop
+        theta3 = 2.0 * math.atan2(ma * y + mb, mc * y + md)
+        S = A * (y * y) + B * y + C
+        nv, plane = _knull_right(S, V)
+        if clustered or plane:
+            doubt = True
+            if nv == 2:
+                nv = 1 + _krr_unmix(V)
+        for v in range(nv):
+            t4 = _krr_ratio_angle(V[v], 3)
+            t5 = _krr_ratio_angle(V[v], 1)
+            pairs, t1a, t2a, t1b, t2b = _krr_joints12(rows, F, theta3, t4, t5)
+            for p in range(pairs):
+                if count == out.shape[0]:
+                    return count, True
+                t1 = t1a if p == 0 else t1b
+                t2 = t2a if p == 0 else t2b
+                out[count, 0] = t1
+                out[count, 1] = t2
+                out[count, 2] = theta3
+                out[count, 3] = t4
+                out[count, 4] = t5
+                out[count, 5] = _krr_theta6(rows, F, t1, t2, theta3, t4, t5)
+                count += 1
+    return count, doubt
+
+
+def _krr_pencil(A6, B6, C6, moebius):
+    """_rr_pencil in the kernel."""
+    a, b, c, d = moebius
+    out = np.zeros((3, 12, 12))
+    for i in range(6):
+        for j in range(9):
+            x, y, z = A6[i, j], B6[i, j], C6[i, j]
+            values = (
+                a * a * x + a * c * y + c * c * z,
+                2.0 * a * b * x + (a * d + b * c) * y + 2.0 * c * d * z,
+                b * b * x + b * d * y + d * d * z,
+            )
+            for m in range(3):
+                out[m, i, j] = values[m]
+                out[m, 6 + i, 3 + j] = values[m]
+    return out[0], out[1], out[2]
+
+
+def _kpivot_ratio(M):
+    """The ratio of the largest to the smallest pivot of M's LU factorisation with partial
+    pivoting: a cheap stand-in for its condition number (inf where singular)."""
+    A = M.copy()
+    n = A.shape[0]
+    big = 0.0
+    small = math.inf
+    for k in range(n):
+        p = k
+        for i in range(k + 1, n):
+            if abs(A[i, k]) > abs(A[p, k]):
+                p = i
+        if A[p, k] == 0.0:
+            return math.inf
+        if p != k:
+            for j in range(n):
+                A[k, j], A[p, j] = A[p, j], A[k, j]
+        big = max(big, abs(A[k, k]))
+        small = min(small, abs(A[k, k]))
+        for i in range(k + 1, n):
+            f = A[i, k] / A[k, k]
+            for j in range(k + 1, n):
+                A[i, j] -= f * A[k, j]
+    return big / small
+
+
+def _ksolve_into(M, X):
+    """X := M^-1 X by Gaussian elimination with partial pivoting; False where M is singular."""
+    A = M.copy()
+    n = A.shape[0]
+    m = X.shape[1]
+    for k in range(n):
+        p = k
+        for i in range(k + 1, n):
+            if abs(A[i, k]) > abs(A[p, k]):
+                p = i
+        if A[p, k] == 0.0:
+            return False
+        if p != k:
+            for j in range(n):
+                A[k, j], A[p, j] = A[p, j], A[k, j]
+            for j in range(m):
+                X[k, j], X[p, j] = X[p, j], X[k, j]
+        for i in range(k + 1, n):
+            f = A[i, k] / A[k, k]
+            if f != 0.0:
+                for j in range(k + 1, n):
+                    A[i, j] -= f * A[k, j]
+                for j in range(m):
+                    X[i, j] -= f * X[k, j]
+    for k in range(n - 1, -1, -1):
+        for j in range(m):
+            total = X[k, j]
+            for i in range(k + 1, n):
+                total -= A[k, i] * X[i, j]
+            X[k, j] = total / A[k, k]
+    return True
+
+
+def _knull_left(Q):
+    """Rows spanning the left null space of Q (14 x 8), six of them (fixed combinations
+    where Q's rank is below 8): the last columns of the orthogonal factor of Q's QR
+    factorisation with column pivoting (Householder reflections)."""
+    m, n = Q.shape
+    R = Q.copy()
+    U = np.eye(m)
+    norms = np.zeros(n)
+    for j in range(n):
+        norms[j] = np.sqrt((R[:, j] ** 2).sum())
+    top = norms.max()
+    rank = 0
+    v = np.zeros(m)
+    for k in range(n):
+        p = k
+        for j in range(k + 1, n):
+            if norms[j] > norms[p]:
+                p = j
+        if norms[p] <= _RR_RANK_TOL * max(top, 1.0):
+            break
+        if p != k:
+            for i in range(m):
+                R[i, k], R[i, p] = R[i, p], R[i, k]
+            norms[k], norms[p] = norms[p], norms[k]
+        # the reflection taking R[k:, k] onto the axis
+        alpha = np.sqrt((R[k:, k] ** 2).sum())
+        if R[k, k] > 0.0:
+            alpha = -alpha
+        v[:] = 0.0
+        v[k:] = R[k:, k]
+        v[k] -= alpha
+        vv = (v[k:] ** 2).sum()
+        if vv == 0.0:
+            rank += 1
+            continue
+        for j in range(k, n):
+            f = 2.0 * (v[k:] * R[k:, j]).sum() / vv
+            R[k:, j] -= f * v[k:]
+        for i in range(m):  # U := U H (columns of U: the orthogonal factor)
+            f = 2.0 * (U[i, k:] * v[k:]).sum() / vv
+            U[i, k:] -= f * v[k:]
+        for j in range(k + 1, n):
+            norms[j] = np.sqrt((R[k + 1 :, j] ** 2).sum())
+        rank += 1
+    free = m - rank
+    N = np.zeros((free, m))
+    for i in range(free):
+        N[i, :] = U[:, rank + i]
+    if free <= 6:
+        return N
+    out = np.zeros((6, m))
+    for i in range(6):
+        for r in range(free):
+            out[i, :] += _RR_MIX[i, r] * N[r, :]
+    return out
+
+
+def _knull_right(S, V):
+    """Null vectors of S (12 x 12) into V's rows by Gaussian elimination with complete
+    pivoting: (their number, whether the null space looks two-dimensional). One vector from
+    the smallest pivot; where the second smallest pivot is below _RR_NULL2_TOL of the
+    largest, two (a basis of the plane)."""
+    A = S.copy()
+    n = 12
+    cols = np.arange(n)
+    for k in range(n):
+        p, q = k, k
+        big = 0.0
+        for i in range(k, n):
+            for j in range(k, n):
+                if abs(A[i, j]) > big:
+                    big, p, q = abs(A[i, j]), i, j
+        if p != k:
+            for j in range(n):
+                A[k, j], A[p, j] = A[p, j], A[k, j]
+        if q != k:
+            for i in range(n):
+                A[i, k], A[i, q] = A[i, q], A[i, k]
+            cols[k], cols[q] = cols[q], cols[k]
+        if A[k, k] == 0.0:
+            continue
+        for i in range(k + 1, n):
+            f = A[i, k] / A[k, k]
+            for j in range(k + 1, n):
+                A[i, j] -= f * A[k, j]
+            A[i, k] = 0.0
+    top = abs(A[0, 0])
+    plane = abs(A[n - 2, n - 2]) <= _RR_NULL2_TOL * top
+    dims = 2 if plane else 1
+    for d in range(dims):
+        x = np.zeros(n)
+        x[n - 1 - d] = 1.0  # the free unknown(s) of the last pivots
+        for k in range(n - 1 - dims, -1, -1):
+            total = 0.0
+            for j in range(k + 1, n):
+                total += A[k, j] * x[j]
+            x[k] = -total / A[k, k] if A[k, k] != 0.0 else 0.0
+        for j in range(n):
+            V[d, cols[j]] = x[j]
+    return dims, plane
+
+
+def _krr_unmix(V):
+    """_rr_unmix in the kernel: the (one or two) monomial vectors of the plane of V[0] and
+    V[1] written to V[1] and V[2] (V[0] stays); their number."""
+    v1 = V[0].copy()
+    v2 = V[1].copy()
+    bp, bq, br = 0.0, 0.0, 0.0
+    size = -1.0
+    for rule in _RR_MONOMIAL_RULES:
+        i, j, k, l = rule
+        p = v1[i] * v1[j] - v1[k] * v1[l]
+        q = v1[i] * v2[j] + v2[i] * v1[j] - v1[k] * v2[l] - v2[k] * v1[l]
+        r = v2[i] * v2[j] - v2[k] * v2[l]
+        if abs(p) + abs(q) + abs(r) > size:
+            bp, bq, br, size = p, q, r, abs(p) + abs(q) + abs(r)
+    root = math.sqrt(max(bq * bq - 4.0 * bp * br, 0.0))
+    n = 0
+    for sign in (1.0, -1.0):
+        h = -bq - sign * root if bq >= 0.0 else -bq + sign * root
+        if abs(bp) >= abs(br):
+            u, w = h, 2.0 * bp
+        else:
+            u, w = 2.0 * br, h
+        if abs(u) + abs(w) > 0.0:
+            V[1 + n] = u * v1 + w * v2
+            n += 1
+    return n
+
+
+def _krr_ratio_angle(v, step):
+    """_rr_ratio_angle in the kernel: step 3 gives theta4, step 1 theta5."""
+    across = 0.0
+    low = 0.0
+    high = 0.0
+    for i in range(4):
+        for j in range(3):
+            k = 3 * i + j
+            if (step == 3 and i < 3) or (step == 1 and j < 2):
+                lo, hi = v[k], v[k + step]
+                across += lo * hi
+                low += lo * lo
+                high += hi * hi
+    if low >= high:
+        return 2.0 * math.atan2(across, low)
+    return 2.0 * math.atan2(high, across)
+
+
+def _krr_link(t, rows, i, M):
+    """M := M A_i(t) (standard DH row i: d, a, cos alpha, sin alpha)."""
+    d, a, ca, sa = rows[i, 0], rows[i, 1], rows[i, 2], rows[i, 3]
+    ct, st = cos(t), sin(t)
+    for r in range(4):
+        m0, m1, m2 = M[r, 0], M[r, 1], M[r, 2]
+        M[r, 0] = m0 * ct + m1 * st
+        M[r, 1] = (-m0 * st + m1 * ct) * ca + m2 * sa
+        M[r, 2] = -(-m0 * st + m1 * ct) * sa + m2 * ca
+        M[r, 3] += (m0 * ct + m1 * st) * a + m2 * d
+
+
+def _krr_joints12(rows, F, t3, t4, t5):
+    """_rr_joints12 in the kernel: (count, t1, t2, t1', t2')."""
+    M = np.eye(4)
+    _krr_link(t3, rows, 2, M)
+    _krr_link(t4, rows, 3, M)
+    _krr_link(t5, rows, 4, M)
+    d2, a2, ca2, sa2 = rows[1, 0], rows[1, 1], rows[1, 2], rows[1, 3]
+    a1, ca1, sa1 = rows[0, 1], rows[0, 2], rows[0, 3]
+    gl = np.array([M[0, 2], ca2 * M[1, 2] - sa2 * M[2, 2], sa2 * M[1, 2] + ca2 * M[2, 2]])
+    gp = np.array([M[0, 3] + a2, ca2 * M[1, 3] - sa2 * M[2, 3], sa2 * M[1, 3] + ca2 * M[2, 3] + d2])
+    fl = F[:3, 2].copy()
+    fp = F[:3, 3].copy()
+    system = np.empty((4, 3))
+    system[0, 0], system[0, 1], system[0, 2] = sa1 * gl[1], sa1 * gl[0], fl[2] - ca1 * gl[2]
+    system[1, 0], system[1, 1], system[1, 2] = sa1 * gp[1], sa1 * gp[0], fp[2] - ca1 * gp[2]
+    system[2, 0], system[2, 1] = 2.0 * a1 * gp[0], -2.0 * a1 * gp[1]
+    system[2, 2] = (fp * fp).sum() - (gp * gp).sum() - a1 * a1
+    system[3, 0], system[3, 1] = a1 * gl[0], -a1 * gl[1]
+    system[3, 2] = (fl * fp).sum() - (gl * gp).sum()
+    n, c2a, s2a, c2b, s2b = _kunit_solutions(system)
+    out = np.zeros(4)
+    for k in range(n):
+        c2 = c2a if k == 0 else c2b
+        s2 = s2a if k == 0 else s2b
+        wl0, wl1, wl2 = c2 * gl[0] - s2 * gl[1], s2 * gl[0] + c2 * gl[1], gl[2]
+        wp0, wp1, wp2 = c2 * gp[0] - s2 * gp[1] + a1, s2 * gp[0] + c2 * gp[1], gp[2]
+        wl1, wl2 = ca1 * wl1 - sa1 * wl2, sa1 * wl1 + ca1 * wl2
+        wp1, wp2 = ca1 * wp1 - sa1 * wp2, sa1 * wp1 + ca1 * wp2
+        across = wl0 * fl[1] - wl1 * fl[0] + wp0 * fp[1] - wp1 * fp[0]
+        along = wl0 * fl[0] + wl1 * fl[1] + wp0 * fp[0] + wp1 * fp[1]
+        out[2 * k] = math.atan2(across, along)
+        out[2 * k + 1] = math.atan2(s2, c2)
+    return n, out[0], out[1], out[2], out[3]
+
+
+def _kunit_solutions(system):
+    """_rr_unit_solutions in the kernel, from the normal equations' 2 x 2 eigenproblem:
+    (count, c, s, c', s')."""
+    g00 = (system[:, 0] * system[:, 0]).sum()
+    g01 = (system[:, 0] * system[:, 1]).sum()
+    g11 = (system[:, 1] * system[:, 1]).sum()
+    b0 = (system[:, 0] * system[:, 2]).sum()
+    b1 = (system[:, 1] * system[:, 2]).sum()
+    mean = 0.5 * (g00 + g11)
+    spread = math.hypot(0.5 * (g00 - g11), g01)
+    big, small = mean + spread, mean - spread
+    if big == 0.0:
+        return 1, 1.0, 0.0, 1.0, 0.0
+    if small > 1e-16 * big:  # singular values' ratio above 1e-8: one least-squares solution
+        det = g00 * g11 - g01 * g01
+        c = (g11 * b0 - g01 * b1) / det
+        s = (g00 * b1 - g01 * b0) / det
+        h = math.hypot(c, s)
+        if h == 0.0:
+            return 1, 1.0, 0.0, 1.0, 0.0
+        return 1, c / h, s / h, c / h, s / h
+    # one direction n (the large eigenvalue's eigenvector) fixed: n . (c, s) = along
+    if abs(g01) > 0.0 or g00 != g11:
+        angle = 0.5 * math.atan2(2.0 * g01, g00 - g11)
+    else:
+        angle = 0.0
+    n0, n1 = cos(angle), sin(angle)
+    along = (n0 * b0 + n1 * b1) / big
+    along = max(-1.0, min(1.0, along))
+    side = math.sqrt(1.0 - along * along)
+    return (
+        2,
+        along * n0 - side * n1,
+        along * n1 + side * n0,
+        along * n0 + side * n1,
+        along * n1 - side * n0,
+    )
+
+
+def _krr_theta6(rows, F, t1, t2, t3, t4, t5):
+    """_rr_theta6 in the kernel."""
+    M = np.eye(4)
+    _krr_link(t1, rows, 0, M)
+    _krr_link(t2, rows, 1, M)
+    _krr_link(t3, rows, 2, M)
+    _krr_link(t4, rows, 3, M)
+    _krr_link(t5, rows, 4, M)
+    r10 = M[0, 1] * F[0, 0] + M[1, 1] * F[1, 0] + M[2, 1] * F[2, 0]
+    r00 = M[0, 0] * F[0, 0] + M[1, 0] * F[1, 0] + M[2, 0] * F[2, 0]
+    return math.atan2(r10, r00)
+
+
+def _krr_between(fill, true, t):
+    """_rr_between in the kernel."""
+    out = np.zeros((6, 4))
+    for i in range(6):
+        out[i, 0] = true[i, 0] + t * (fill[i, 0] - true[i, 0])
+        out[i, 1] = true[i, 1] + t * (fill[i, 1] - true[i, 1])
+        ca = true[i, 2] + t * (fill[i, 2] - true[i, 2])
+        sa = true[i, 3] + t * (fill[i, 3] - true[i, 3])
+        h = math.hypot(ca, sa)
+        out[i, 2] = ca / h
+        out[i, 3] = sa / h
+    return out
+
+
+def _krr_newton(rows, F, q0):
+    """_rr_newton in the kernel."""
+    q = q0.copy()
+    best_q = q.copy()
+    best = math.inf
+    frames = np.zeros((7, 4, 4))
+    J = np.zeros((6, 6))
+    error = np.zeros((6, 1))
+    for _ in range(_RR_NEWTON_STEPS + 1):
+        frames[0] = np.eye(4)
+        for i in range(6):
+            frames[i + 1] = frames[i]
+            _krr_link(q[i], rows, i, frames[i + 1])
+        E = frames[6]
+        size = 0.0
+        for r in range(3):
+            for c in range(4):
+                size = max(size, abs(F[r, c] - E[r, c]))
+        if size < best:
+            best = size
+            best_q[:] = q
+        if size <= 1e-15 or size > _RR_NEWTON_REACH:
+            break
+        for r in range(3):
+            error[r, 0] = F[r, 3] - E[r, 3]
+        # 0.5 sum_k E_k x F_k
+        for r in range(3):
+            a, b = (r + 1) % 3, (r + 2) % 3
+            total = 0.0
+            for k in range(3):
+                total += E[a, k] * F[b, k] - E[b, k] * F[a, k]
+            error[3 + r, 0] = 0.5 * total
+        for i in range(6):
+            z = frames[i][:3, 2]
+            o = frames[i][:3, 3]
+            dx, dy, dz = E[0, 3] - o[0], E[1, 3] - o[1], E[2, 3] - o[2]
+            J[0, i] = z[1] * dz - z[2] * dy
+            J[1, i] = z[2] * dx - z[0] * dz
+            J[2, i] = z[0] * dy - z[1] * dx
+            J[3, i], J[4, i], J[5, i] = z[0], z[1], z[2]
+        step = error.copy()
+        if not _ksolve_into(J, step):
+            break
+        longest = np.abs(step).max()
+        scale = 1.0 if longest <= 0.5 else 0.5 / longest
+        for i in range(6):
+            q[i] += scale * step[i, 0]
+    return best_q, best
+
+
+def _keigenvalues(M):
+    """The eigenvalues (real parts, imaginary parts) of a real square matrix, and whether the
+    iteration converged: reduction to upper Hessenberg form by Householder reflections, then
+    the Francis double-shift QR iteration with deflation (Golub and Van Loan, Matrix
+    Computations, algorithms 7.4.2 and 7.5.2), eigenvalues only: the reflections of the QR
+    steps touch the active diagonal block alone."""
+    n = M.shape[0]
+    H = M.copy()
+    v = np.zeros(n)
+    for k in range(n - 2):
+        alpha = 0.0
+        for i in range(k + 1, n):
+            alpha += H[i, k] * H[i, k]
+        alpha = math.sqrt(alpha)
+        if alpha == 0.0:
+            continue
+        if H[k + 1, k] > 0.0:
+            alpha = -alpha
+        for i in range(k + 1, n):
+            v[i] = H[i, k]
+        v[k + 1] -= alpha
+        vv = 0.0
+        for i in range(k + 1, n):
+            vv += v[i] * v[i]
+        if vv == 0.0:
+            continue
+        for j in range(k, n):  # H := P H (columns before k are zero below row k + 1)
+            f = 0.0
+            for i in range(k + 1, n):
+                f += v[i] * H[i, j]
+            f *= 2.0 / vv
+            for i in range(k + 1, n):
+                H[i, j] -= f * v[i]
+        for i in range(n):  # H := H P
+            f = 0.0
+            for j in range(k + 1, n):
+                f += H[i, j] * v[j]
+            f *= 2.0 / vv
+            for j in range(k + 1, n):
+                H[i, j] -= f * v[j]
+        for i in range(k + 2, n):
+            H[i, k] = 0.0
+    wr = np.zeros(n)
+    wi = np.zeros(n)
+    eps = 2.220446049250313e-16
+    hi = n - 1
+    iterations = 0
+    while hi >= 0:
+        # the active block H[lo:hi+1, lo:hi+1]: the first negligible subdiagonal entry up
+        lo = hi
+        while lo > 0:
+            scale = abs(H[lo - 1, lo - 1]) + abs(H[lo, lo])
+            if scale == 0.0:
+                scale = np.abs(H[: hi + 1, : hi + 1]).max()
+            if abs(H[lo, lo - 1]) <= eps * scale:
+                H[lo, lo - 1] = 0.0
+                break
+            lo -= 1
+        if lo == hi:  # one real eigenvalue
+            wr[hi] = H[hi, hi]
+            hi -= 1
+            iterations = 0
+            continue
+        if lo == hi - 1:  # a 2 x 2 block: two real or a complex pair
+            a, b, c, d = H[hi - 1, hi - 1], H[hi - 1, hi], H[hi, hi - 1], H[hi, hi]
+            half = 0.5 * (a - d)
+            disc = half * half + b * c
+            mid = 0.5 * (a + d)
+            if disc >= 0.0:
+                root = math.sqrt(disc)
+                big = mid + root if mid >= 0.0 else mid - root
+                wr[hi - 1] = big
+                wr[hi] = (a * d - b * c) / big if big != 0.0 else mid - root
+            else:
+                root = math.sqrt(-disc)
+                wr[hi - 1] = wr[hi] = mid
+                wi[hi - 1], wi[hi] = root, -root
+            hi -= 2
+            iterations = 0
+            continue
+        iterations += 1
+        if iterations > 60:
+            return wr, wi, False
+        # the double shift: the eigenvalues of the trailing 2 x 2 block (exceptional shifts
+        # every 10 iterations)
+        if iterations % 10 == 0:
+            s = abs(H[hi, hi - 1]) + abs(H[hi - 1, hi - 2])
+            trace, det = 1.5 * s, s * s
+        else:
+            trace = H[hi - 1, hi - 1] + H[hi, hi]
+            det = H[hi - 1, hi - 1] * H[hi, hi] - H[hi - 1, hi] * H[hi, hi - 1]
+        x = H[lo, lo] * H[lo, lo] + H[lo, lo + 1] * H[lo + 1, lo] - trace * H[lo, lo] + det
+        y = H[lo + 1, lo] * (H[lo, lo] + H[lo + 1, lo + 1] - trace)
+        z = H[lo + 1, lo] * H[lo + 2, lo + 1]
+        for k in range(lo, hi - 1):
+            # the reflection taking (x, y, z) onto the axis, applied to rows and columns k..k+2
+            alpha = math.sqrt(x * x + y * y + z * z)
+            if alpha != 0.0:
+                if x > 0.0:
+                    alpha = -alpha
+                u0, u1, u2 = x - alpha, y, z
+                uu = u0 * u0 + u1 * u1 + u2 * u2
+                first = max(lo, k - 1)
+                for j in range(first, hi + 1):  # eigenvalues only: the active block
+                    f = 2.0 * (u0 * H[k, j] + u1 * H[k + 1, j] + u2 * H[k + 2, j]) / uu
+                    H[k, j] -= f * u0
+                    H[k + 1, j] -= f * u1
+                    H[k + 2, j] -= f * u2
+                last = min(k + 3, hi)
+                for i in range(lo, last + 1):
+                    f = 2.0 * (u0 * H[i, k] + u1 * H[i, k + 1] + u2 * H[i, k + 2]) / uu
+                    H[i, k] -= f * u0
+                    H[i, k + 1] -= f * u1
+                    H[i, k + 2] -= f * u2
+                if k > lo:
+                    H[k + 1, k - 1] = 0.0
+                    H[k + 2, k - 1] = 0.0
+            x = H[k + 1, k]
+            y = H[k + 2, k]
+            if k < hi - 2:
+                z = H[k + 3, k]
+        # the last 2-vector
+        k = hi - 1
+        alpha = math.sqrt(x * x + y * y)
+        if alpha != 0.0:
+            if x > 0.0:
+                alpha = -alpha
+            u0, u1 = x - alpha, y
+            uu = u0 * u0 + u1 * u1
+            for j in range(max(lo, k - 1), hi + 1):
+                f = 2.0 * (u0 * H[k, j] + u1 * H[k + 1, j]) / uu
+                H[k, j] -= f * u0
+                H[k + 1, j] -= f * u1
+            for i in range(lo, hi + 1):
+                f = 2.0 * (u0 * H[i, k] + u1 * H[i, k + 1]) / uu
+                H[i, k] -= f * u0
+                H[i, k + 1] -= f * u1
+            if k > lo:
+                H[k + 1, k - 1] = 0.0
+    return wr, wi, True

@@ -360,3 +360,8 @@ def _vfinish(Q, valid):
     ok = np.take_along_axis(ok, order, axis=1)
     Q = np.take_along_axis(Q, order[:, :, None], axis=1)
     return np.where(ok[:, :, None], Q, 0.0), ok
+
+
+def _vdefer(n, dof):
+    """_ik_candidates's result sending all n poses to the scalar solver (no branch values)."""
+    return np.zeros((n, 1, dof)), np.zeros((n, 1), dtype=bool), np.ones(n, dtype=bool)

@@ -1,0 +1,1 @@
+"""Data derived once and shipped with the package (see derive.raghavan_roth)."""

@@ -1,0 +1,231 @@
+"""The general method for any 6R arm: Raghavan and Roth's 14 equations, Manocha and Canny's
+eigen-solve (ALGORITHMS.md section 4).
+
+Per arm, at generation:
+
+1. The chain is written in standard DH from the flange frame (base, X_0, Tz(d1) and Tz(d6),
+   X_6, tool moved into the target, as for Pieper): A_i = Z_i X_i for i = 1..5, A_6 = Rz(theta6).
+   Lengths are divided by the arm's size (the largest |a|, |d|), which keeps the matrices'
+   entries of one scale whatever the unit.
+2. The 14 fundamental equations, derived once in symbols for every arm
+   (:func:`derive.raghavan_roth.fundamental`), get the arm's numbers; their 490 entries are
+   polynomials in the flange target's third and fourth columns, printed after CSE.
+3. Two splits are candidates: the arm's chain and its reversal (which eliminates other
+   joints). Each is measured on random poses (the share of generating joint values found,
+   and the conditioning of the pencil's leading matrix); the better one is used first, the
+   other is the fallback when a pose's answer is in doubt. Where both give a singular pencil
+   (special geometry: det Sigma(x3) = 0 for every x3), the matrices come from a table
+   perturbed by 1e-4 and Newton steps polish onto the true arm (ALGORITHMS.md 4.9).
+
+The run-time steps (null space of Q, pencil, eigenvalues, back-substitution, Newton, rescue)
+are in :mod:`derive.runtime.general` (Python) and :mod:`derive.runtime.kernel` (compiled).
+"""
+
+from __future__ import annotations
+
+import math
+from functools import cache
+
+import numpy as np
+import sympy as sp
+
+from derive import raghavan_roth as rr
+from derive import symbols as sym
+from derive.classify import Structure
+from derive.methods.common import flange_target, joint_outputs
+from derive.plan import Assign, Eigen, IkPlan, Split
+from derive.runtime import general as runtime
+from derive.transforms import Chain, inverse, reverse_chain
+
+NAME = "general"
+# the random poses each split is measured on at generation, and the relative perturbation of
+# a table whose pencil is singular
+POSES = 40
+PERTURBATION = 1e-4
+Row = tuple[float, float, float, float]
+
+
+def derive(chain: Chain, structure: Structure) -> IkPlan | str:
+    """The general method's plan, or why it does not apply (not 6 revolute joints)."""
+    if chain.dof != 6:
+        return f"general: needs 6 joints, the arm has {chain.dof}"
+    if any(j.kind != "R" for j in chain.joints):
+        return "general: revolute joints only (prismatic joints are not supported by it yet)"
+    length = max(
+        [abs(float(t.a)) for t in chain.twists[1:6]] + [abs(float(j.d)) for j in chain.joints[1:5]]
+    )
+    if length == 0.0:
+        return "general: every link length and offset is zero (the arm is a point)"
+    chains = (chain, reverse_chain(chain))
+    splits = [measure(c, reversed_, length, False) for reversed_, c in enumerate(chains)]
+    if max(s.recovered for s in splits) < POSES:
+        splits += [measure(c, reversed_, length, True) for reversed_, c in enumerate(chains)]
+    splits.sort(key=lambda s: (-s.recovered, s.singular, round(math.log10(s.cond), 1)))
+    chosen = tuple(splits[:2])
+    steps: list[Assign | Eigen] = []
+    args: list[sp.Expr] = []
+    for k, split in enumerate(chosen):
+        world = inverse(sym.world_pose()) if split.reversed else sym.world_pose()
+        assign = split_target(chains[split.reversed], world, k)
+        steps.append(assign)
+        args += assign.targets
+    first = chosen[0]
+    steps.append(
+        Eigen(
+            joint=3,
+            args=tuple(args),
+            note=f"general 6R: Raghavan-Roth equations of {first.name}, theta3 from a 24 x 24 "
+            "eigenproblem, the rest by back-substitution",
+            fanout=16,
+            unit=length,
+            splits=chosen,
+        )
+    )
+    return IkPlan(
+        method=NAME,
+        case=f"no closed form applies; split: {first.name} (fallback: {chosen[1].name})",
+        max_solutions=16,
+        steps=tuple(steps),
+        outputs=joint_outputs(chain),
+    )
+
+
+def split_target(chain: Chain, target: sp.Matrix, k: int) -> Assign:
+    """The flange target of a split's chain (target: the world target, or its inverse for the
+    reversed chain), in symbols F{k}_ij (k: the split's place)."""
+    flange = flange_target(chain, target)
+    names = tuple(sym.named(f"F{k}_{i}{j}") for i in range(1, 4) for j in range(1, 5))
+    return Assign(names, flange.exprs, f"split {k}: {flange.note}")
+
+
+def flange_rows(chain: Chain, length: float) -> tuple[Row, ...]:
+    """The standard-DH rows (d, a, cos alpha, sin alpha) of the chain from its flange frame,
+    lengths divided by `length`: A_i = Z_i X_i (i = 1..5), A_6 = Rz(theta6); d1 = d6 = 0."""
+    rows: list[Row] = []
+    for i in range(1, 7):
+        twist = chain.twists[i]
+        d = 0.0 if i in (1, 6) else float(chain.joints[i - 1].d) / length
+        if i == 6:
+            rows.append((0.0, 0.0, 1.0, 0.0))
+        else:
+            rows.append((d, float(twist.a) / length, float(twist.ca), float(twist.sa)))
+    return tuple(rows)
+
+
+def perturbed(rows: tuple[Row, ...]) -> tuple[Row, ...]:
+    """The rows with every d, a and alpha moved by about PERTURBATION (fixed numbers)."""
+    out: list[Row] = []
+    for i, (d, a, ca, sa) in enumerate(rows[:5]):
+        wobble = [math.sin(1.7 * i + 0.4 * k + 0.3) for k in range(3)]
+        alpha = math.atan2(sa, ca) + PERTURBATION * wobble[2]
+        out.append(
+            (
+                d + PERTURBATION * wobble[0] if i else d,
+                a + PERTURBATION * wobble[1],
+                math.cos(alpha),
+                math.sin(alpha),
+            )
+        )
+    return (*out, rows[5])
+
+
+def fill_expressions(rows: tuple[Row, ...], exact: dict[sp.Symbol, sp.Expr]) -> tuple[sp.Expr, ...]:
+    """The 490 entries of P0, Ps, Pc, Q for these rows (exact numbers where given)."""
+    f = rr.fundamental()
+    subs: dict[sp.Symbol, sp.Expr] = {}
+    for i, (d, a, ca, sa) in enumerate(rows[:5]):
+        subs[rr.a[i]] = sp.Float(a, 17)
+        subs[rr.d[i]] = sp.Float(d, 17)
+        subs[rr.lam[i]] = sp.Float(ca, 17)
+        subs[rr.mu[i]] = sp.Float(sa, 17)
+    subs.update(exact)
+    out = []
+    for m in (f.P0, f.Ps, f.Pc, f.Q):
+        out += [sp.expand(e.xreplace(subs)) for e in m]
+    return tuple(out)
+
+
+def exact_numbers(chain: Chain, length: float) -> dict[sp.Symbol, sp.Expr]:
+    """The exact twists of the chain (cos, sin of 0, 90, 180 deg stay exact integers)."""
+    subs: dict[sp.Symbol, sp.Expr] = {}
+    for i in range(1, 6):
+        t = chain.twists[i]
+        if t.ca.is_Integer and t.sa.is_Integer:
+            subs[rr.lam[i - 1]] = t.ca
+            subs[rr.mu[i - 1]] = t.sa
+        if t.a == 0:
+            subs[rr.a[i - 1]] = sp.Integer(0)
+        if i > 1 and chain.joints[i - 1].d == 0:
+            subs[rr.d[i - 1]] = sp.Integer(0)
+    return subs
+
+
+def measure(chain: Chain, reversed_: int, length: float, perturb: bool) -> Split:
+    """A split of the chain, measured on POSES random poses (fixed seed)."""
+    true_rows = flange_rows(chain, length)
+    fill_rows = perturbed(true_rows) if perturb else true_rows
+    fill = fill_expressions(fill_rows, {} if perturb else exact_numbers(chain, length))
+    recovered, conds = score(fill_rows, true_rows)
+    return Split(
+        reversed=bool(reversed_),
+        fill=fill,
+        fill_rows=fill_rows,
+        true_rows=true_rows,
+        recovered=recovered,
+        poses=POSES,
+        cond=float(np.median(conds)),
+        singular=perturb,
+    )
+
+
+def score(fill_rows: tuple[Row, ...], true_rows: tuple[Row, ...]) -> tuple[int, list[float]]:
+    """Of POSES random poses (a fifth of the joints at 0, +-90 or 180 deg), how many have their
+    generating joint values among the split's polished candidates; and the condition numbers
+    of the pencil's leading matrix."""
+    rng = np.random.default_rng(20261201)
+    functions = numeric_matrices()
+    numbers = [r[1] for r in fill_rows[:5]] + [r[0] for r in fill_rows[:5]]
+    numbers += [r[2] for r in fill_rows[:5]] + [r[3] for r in fill_rows[:5]]
+    recovered = 0
+    conds = []
+    for _ in range(POSES):
+        q = rng.uniform(-math.pi, math.pi, 6)
+        special = rng.random(6) < 0.2
+        q[special] = rng.choice([0.0, math.pi / 2, -math.pi / 2, math.pi], special.sum())
+        F = np.eye(4)
+        for t, row in zip(q, true_rows):
+            F = F @ runtime._rr_link(t, row)
+        args = [*numbers, *F[:3, 2], *F[:3, 3]]
+        P0, Ps, Pc, Q = (np.array(fn(*args), dtype=float) for fn in functions)
+        candidates, _ = runtime._rr_candidates(P0, Ps, Pc, Q, F, fill_rows)
+        conds.append(leading_condition(P0, Ps, Pc, Q))
+        for c in candidates:
+            p, error = runtime._rr_newton(true_rows, F, c)
+            gap = np.abs((p - q + math.pi) % (2 * math.pi) - math.pi)
+            if error <= runtime._RR_GOOD and gap.max() <= 1e-6:
+                recovered += 1
+                break
+    return recovered, conds
+
+
+def leading_condition(P0, Ps, Pc, Q) -> float:
+    """cond of the pencil's leading matrix under the first Moebius map (a finite stand-in
+    for a singular one: 1e20)."""
+    U, S, _ = np.linalg.svd(Q)
+    rank = int((runtime._RR_RANK_TOL * max(S[0], 1.0) < S).sum())
+    N = U[:, rank:].T
+    if N.shape[0] > 6:
+        N = runtime._RR_MIX[:, : N.shape[0]] @ N
+    H = runtime._RR_H45
+    A, _, _ = runtime._rr_pencil(
+        N @ (P0 - Pc) @ H, N @ (2.0 * Ps) @ H, N @ (P0 + Pc) @ H, runtime._RR_MOEBIUS[0]
+    )
+    return float(min(np.linalg.cond(A), 1e20))
+
+
+@cache
+def numeric_matrices():
+    """P0, Ps, Pc, Q as numpy functions of (a1..a5, d1..d5, cos alpha1..5, sin alpha1..5,
+    lx, ly, lz, px, py, pz): the generic matrices, for measuring splits."""
+    f = rr.fundamental()
+    return [sp.lambdify(rr.GENS, m, "numpy") for m in (f.P0, f.Ps, f.Pc, f.Q)]

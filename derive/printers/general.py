@@ -1,0 +1,64 @@
+"""The general method's printed pieces: the splits' constants and _rr_fill, the straight-line
+code giving the Raghavan-Roth matrices of a pose. The same text serves the Python solver and
+the compiled one (numba compiles it as it is)."""
+
+from __future__ import annotations
+
+import sympy as sp
+
+from derive import raghavan_roth as rr
+from derive.plan import Eigen, Plan
+from derive.printers.common import CodePrinter, float_literal
+
+
+def eigen_step(plan: Plan) -> Eigen | None:
+    """The plan's Eigen step, if it uses the general method."""
+    if plan.ik is None:
+        return None
+    for step in plan.ik.steps:
+        if isinstance(step, Eigen):
+            return step
+    return None
+
+
+def general_code(plan: Plan) -> str:
+    """_RR_SPLITS, _RR_LENGTH and _rr_fill for a plan of the general method ("" otherwise)."""
+    step = eigen_step(plan)
+    if step is None:
+        return ""
+    printer = CodePrinter()
+
+    def rows(table: tuple[tuple[float, ...], ...]) -> list[str]:
+        inner = [f"            ({', '.join(float_literal(v) for v in r)})," for r in table]
+        return ["        (", *inner, "        ),"]
+
+    lines = [
+        "# the general method's splits, best first: (reversed, the rows the matrices are filled",
+        "# from, the arm's rows); rows (d, a, cos alpha, sin alpha) of standard DH from the",
+        "# flange frame, lengths in units of _RR_LENGTH",
+        "_RR_SPLITS = (",
+    ]
+    for split in step.splits:
+        lines += ["    (", f"        {split.reversed},", *rows(split.fill_rows)]
+        lines += [*rows(split.true_rows), "    ),"]
+    lines += [")", f"_RR_LENGTH = {float_literal(step.unit)}", "", ""]
+    args = ", ".join(str(s) for s in (*rr.L, *rr.P))
+    lines += [
+        f"def _rr_fill(k, {args}, out):",
+        '    """The entries of P0, Ps, Pc (14 x 9 each) and Q (14 x 8), row-major, of split k at',
+        "    the flange target whose third and fourth columns are l and p (p in units of",
+        '    _RR_LENGTH), into out (490 zeros on entry)."""',
+    ]
+    for k, split in enumerate(step.splits):
+        names = sp.numbered_symbols("x")
+        entries = [(i, e) for i, e in enumerate(split.fill) if e != 0]
+        temps, reduced = sp.cse([e for _, e in entries], symbols=names, order="canonical")
+        last = k == len(step.splits) - 1
+        indent = "    " if last else "        "
+        if not last:
+            lines.append(f"    if k == {k}:")
+        lines += [f"{indent}{t} = {printer.doprint(e)}" for t, e in temps]
+        lines += [f"{indent}out[{i}] = {printer.doprint(e)}" for (i, _), e in zip(entries, reduced)]
+        if not last:
+            lines.append(f"{indent}return")
+    return "\n".join(lines) + "\n"

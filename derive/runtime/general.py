@@ -1,0 +1,410 @@
+"""The general 6R method at run time, in the Python solver (numpy's LAPACK).
+
+The arm's printed code gives, per split (the arm's chain, or its reversal), the flange target
+in the split's standard-DH frame (12 numbers) and fills the Raghavan-Roth matrices P0, Ps, Pc
+and Q (``_rr_fill``). From there the steps are the same for every arm (ALGORITHMS.md 4.4-4.7):
+
+1. the left null space N of Q (SVD) removes theta1 and theta2: N P(theta3) m45 = 0;
+2. the half-angle substitution and the dialytic lift give a 12 x 12 quadratic matrix
+   polynomial in y, x3 = tan(theta3 / 2) = (a y + b) / (c y + d) (a Moebius map, so that
+   theta3 = pi is a finite y); its real eigenvalues (24 x 24 companion matrix) give theta3;
+3. the null space of the matrix at each eigenvalue (SVD) gives theta4 and theta5; a
+   two-dimensional one (two solutions sharing theta3) is split by the monomial structure;
+4. theta1, theta2 by least squares from Q m12 = P m45, theta6 from the pose;
+5. Newton steps on the arm's forward kinematics polish every candidate.
+
+A pose whose answer is in doubt (a candidate that does not polish, eigenvalues in a cluster,
+an odd number of solutions, none at all) is solved again with the runner-up split and then
+from slightly moved poses (a rescue), every candidate polished back onto the true pose; the
+union of what certifies is returned.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from derive.runtime.arm import _RR_LENGTH, _RR_SPLITS, MAX_SOLUTIONS, _rr_fill
+from derive.runtime.constants import (
+    _RR_CLUSTER_TOL,
+    _RR_COND_LIMIT,
+    _RR_GOOD,
+    _RR_IMAG_TOL,
+    _RR_MOEBIUS,
+    _RR_NEWTON_REACH,
+    _RR_NEWTON_STEPS,
+    _RR_NULL2_TOL,
+    _RR_PATH,
+    _RR_RANK_TOL,
+    _RR_RESCUE,
+    _TWO_PI,
+)
+
+# m45 (1 + x4^2)(1 + x5^2) = _RR_H45 [x4^i x5^j], column 3 i + j (ALGORITHMS.md 4.5): rows
+# are outer products of the coefficients over (1, x, x^2) of 2x, 1 - x^2 and 1 + x^2
+_RR_S, _RR_C, _RR_O = (0.0, 2.0, 0.0), (1.0, 0.0, -1.0), (1.0, 0.0, 1.0)
+_RR_H45 = np.array(
+    [
+        [u[i] * w[j] for i in range(3) for j in range(3)]
+        for u, w in zip(
+            (_RR_S, _RR_S, _RR_C, _RR_C, _RR_S, _RR_C, _RR_O, _RR_O, _RR_O),
+            (_RR_S, _RR_C, _RR_S, _RR_C, _RR_O, _RR_O, _RR_S, _RR_C, _RR_O),
+        )
+    ]
+)
+# fixed combinations of the rows of a null space of Q with more than six rows (a Q of rank
+# below 8): deterministic numbers, any generic ones do
+_RR_MIX = np.sin(np.outer(np.arange(1, 7), np.arange(1, 15)) * 0.731 + 0.25)
+# the pairs (k, k') of null-vector entries whose ratio is x5 (k' = k + 1) and x4 (k' = k + 3)
+_RR_X5_PAIRS = (np.array([0, 1, 3, 4, 6, 7, 9, 10]), np.array([1, 2, 4, 5, 7, 8, 10, 11]))
+_RR_X4_PAIRS = (np.arange(9), np.arange(3, 12))
+# for a two-dimensional null space: the products v[i] v[j] - v[k] v[l] that vanish on a
+# vector of monomials x4^a x5^b (index 3 a + b)
+_RR_MONOMIAL_RULES = ((0, 4, 1, 3), (1, 5, 2, 4), (3, 7, 4, 6), (4, 8, 5, 7), (6, 10, 7, 9))
+
+
+def _general(flanges, tol):
+    """Every solution of the general method for one pose: a list of joint-angle tuples
+    (theta_1..theta_6 of the arm), each polished; the caller certifies them.
+
+    flanges: per split, the 12 top entries of the target in the split's frame (row-major).
+    """
+    found: list[np.ndarray] = []
+    targets = [_rr_target(f) for f in flanges]
+    doubt = True
+    for k, F in enumerate(targets):
+        candidates, doubt = _rr_split(k, F, F)
+        _rr_merge(found, [_rr_to_arm(k, q) for q in candidates])
+        if not doubt and len(found) % 2 == 0:
+            break
+    if doubt or not found or len(found) % 2:
+        # the rescue: solve slightly moved poses, polish back onto the true one
+        for move in _RR_RESCUE:
+            for k, F in enumerate(targets):
+                candidates, _ = _rr_split(k, F, F @ _rr_motion(*move))
+                _rr_merge(found, [_rr_to_arm(k, q) for q in candidates])
+    # a self-motion (a singular pose) has a curve of solutions: at most MAX_SOLUTIONS of them
+    return [tuple(float(t) for t in q) for q in found[:MAX_SOLUTIONS]]
+
+
+def _rr_target(flange):
+    """The 4 x 4 target of a split from its 12 numbers, positions divided by _RR_LENGTH."""
+    F = np.eye(4)
+    F[:3, :] = np.reshape(flange, (3, 4))
+    F[:3, 3] /= _RR_LENGTH
+    return F
+
+
+def _rr_motion(angle, shift):
+    """A small rigid motion: a rotation by angle about a fixed skew axis and a shift."""
+    axis = np.array([0.48, -0.6, 0.64])
+    c, s = math.cos(angle), math.sin(angle)
+    K = np.array([[0.0, -axis[2], axis[1]], [axis[2], 0.0, -axis[0]], [-axis[1], axis[0], 0.0]])
+    M = np.eye(4)
+    M[:3, :3] = np.eye(3) + s * K + (1.0 - c) * (K @ K)
+    M[:3, 3] = shift * np.array([0.36, 0.48, -0.8])
+    return M
+
+
+def _rr_to_arm(k, q):
+    """A split's joint angles as the arm's: the reversed chain's joint j is -theta_{7-j}."""
+    return -q[::-1] if _RR_SPLITS[k][0] else q
+
+
+def _rr_merge(found, candidates):
+    """Add the candidates not already in found (angles compared modulo 2 pi)."""
+    for q in candidates:
+        for p in found:
+            gap = np.abs((q - p + math.pi) % _TWO_PI - math.pi)
+            if gap.max() <= 1e-7:
+                break
+        else:
+            found.append(q)
+
+
+def _rr_split(k, F, moved):
+    """The polished candidates of split k for the target F, found from the pose `moved` (F
+    itself, or F slightly moved in a rescue), and whether the answer is in doubt."""
+    _, fill_rows, true_rows = _RR_SPLITS[k]
+    values = np.zeros(490)
+    _rr_fill(k, *moved[:3, 2], *moved[:3, 3], values)
+    P0 = values[:126].reshape(14, 9)
+    Ps = values[126:252].reshape(14, 9)
+    Pc = values[252:378].reshape(14, 9)
+    Q = values[378:].reshape(14, 8)
+    candidates, doubt = _rr_candidates(P0, Ps, Pc, Q, moved, fill_rows)
+    # a perturbed table's solutions are walked back to the arm's in steps (a continuation),
+    # so that Newton does not jump to another branch
+    path = (
+        [_rr_between(fill_rows, true_rows, t) for t in _RR_PATH] if fill_rows != true_rows else []
+    )
+    out = []
+    for q in candidates:
+        for rows in path:
+            q, _ = _rr_newton(rows, F, q)
+        q, residual = _rr_newton(true_rows, F, q)
+        if residual <= _RR_GOOD:
+            out.append(q)
+        elif fill_rows == true_rows:  # (a perturbed table has solutions the arm has not)
+            doubt = True
+    return out, doubt
+
+
+def _rr_between(fill_rows, true_rows, t):
+    """The rows a share t of the way from true_rows to fill_rows (twists renormalised)."""
+    out = []
+    for f, r in zip(fill_rows, true_rows):
+        d, a = r[0] + t * (f[0] - r[0]), r[1] + t * (f[1] - r[1])
+        ca, sa = r[2] + t * (f[2] - r[2]), r[3] + t * (f[3] - r[3])
+        h = math.hypot(ca, sa)
+        out.append((d, a, ca / h, sa / h))
+    return out
+
+
+def _rr_candidates(P0, Ps, Pc, Q, F, rows):
+    """The unpolished joint angles of one split from its matrices (ALGORITHMS.md 4.4-4.7),
+    and whether the eigenvalues came in clusters (an answer in doubt)."""
+    found = _rr_eigenvalues(P0, Ps, Pc, Q)
+    if found is None:
+        return [], True
+    values, (A, B, C), moebius = found
+    real = np.sort(values[np.abs(values.imag) <= _RR_IMAG_TOL * (1.0 + np.abs(values))].real)
+    doubt = False
+    ys: list[list[float]] = []
+    for y in real:
+        if ys and abs(y - ys[-1][-1]) <= _RR_CLUSTER_TOL * (1.0 + abs(y)):
+            ys[-1].append(y)
+            doubt = True
+        else:
+            ys.append([y])
+    out = []
+    ma, mb, mc, md = moebius
+    for cluster in ys:
+        y = sum(cluster) / len(cluster)
+        theta3 = 2.0 * math.atan2(ma * y + mb, mc * y + md)
+        _, sv, vt = np.linalg.svd(A * y * y + B * y + C)
+        vectors = [vt[-1]]
+        if len(cluster) > 1 or sv[-2] <= _RR_NULL2_TOL * sv[0]:
+            # two solutions may share theta3: both from the null space's plane
+            vectors += _rr_unmix(vt[-1], vt[-2])
+            doubt = True
+        for v in vectors:
+            t4 = _rr_ratio_angle(v, _RR_X4_PAIRS)
+            t5 = _rr_ratio_angle(v, _RR_X5_PAIRS)
+            for t1, t2 in _rr_joints12(rows, F, theta3, t4, t5):
+                t6 = _rr_theta6(rows, F, (t1, t2, theta3, t4, t5))
+                out.append(np.array([t1, t2, theta3, t4, t5, t6]))
+    return out, doubt
+
+
+def _rr_joints12(rows, F, t3, t4, t5):
+    """The (theta1, theta2) pairs once theta3..theta5 are known. The third and fourth columns
+    of A3 A4 A5 (a direction l and a point p in frame 2), moved by X2 and Tz(d2) to g, meet
+    those of the target f: Rz(theta1) X1 Rz(theta2) g = f. Four equations linear in (cos,
+    sin) of theta2 (the z components, |p|^2 and l.p, which theta1 leaves alone) give theta2
+    by least squares (two values where the equations fix only one direction); the rotation
+    about z0 taking X1 Rz(theta2) g onto f gives theta1. (Least squares on Q m12 = P m45
+    would need Q of full rank, which arms with a1 = 0 lack.)"""
+    M = _rr_link(t3, rows[2]) @ _rr_link(t4, rows[3]) @ _rr_link(t5, rows[4])
+    d2, a2, ca2, sa2 = rows[1]
+    _, a1, ca1, sa1 = rows[0]
+    gl = np.array([M[0, 2], ca2 * M[1, 2] - sa2 * M[2, 2], sa2 * M[1, 2] + ca2 * M[2, 2]])
+    gp = np.array([M[0, 3] + a2, ca2 * M[1, 3] - sa2 * M[2, 3], sa2 * M[1, 3] + ca2 * M[2, 3] + d2])
+    fl, fp = F[:3, 2], F[:3, 3]
+    # rows (coefficient of cos theta2, of sin theta2, right side)
+    system = np.array(
+        [
+            [sa1 * gl[1], sa1 * gl[0], fl[2] - ca1 * gl[2]],
+            [sa1 * gp[1], sa1 * gp[0], fp[2] - ca1 * gp[2]],
+            [2.0 * a1 * gp[0], -2.0 * a1 * gp[1], fp @ fp - gp @ gp - a1 * a1],
+            [a1 * gl[0], -a1 * gl[1], fl @ fp - gl @ gp],
+        ]
+    )
+    out = []
+    for c2, s2 in _rr_unit_solutions(system):
+        # w = X1 Rz(theta2) g, then Rz(theta1) w = f
+        wl = np.array([c2 * gl[0] - s2 * gl[1], s2 * gl[0] + c2 * gl[1], gl[2]])
+        wp = np.array([c2 * gp[0] - s2 * gp[1] + a1, s2 * gp[0] + c2 * gp[1], gp[2]])
+        wl = np.array([wl[0], ca1 * wl[1] - sa1 * wl[2], sa1 * wl[1] + ca1 * wl[2]])
+        wp = np.array([wp[0], ca1 * wp[1] - sa1 * wp[2], sa1 * wp[1] + ca1 * wp[2]])
+        across = wl[0] * fl[1] - wl[1] * fl[0] + wp[0] * fp[1] - wp[1] * fp[0]
+        along = wl[0] * fl[0] + wl[1] * fl[1] + wp[0] * fp[0] + wp[1] * fp[1]
+        out.append((math.atan2(across, along), math.atan2(s2, c2)))
+    return out
+
+
+def _rr_unit_solutions(system):
+    """Unit vectors (c, s) solving the rows [a, b, e] (a c + b s = e) by least squares: one
+    where the rows span the plane, the two points of the unit circle on the line they give
+    where they span one direction only."""
+    U, S, Vt = np.linalg.svd(system[:, :2], full_matrices=False)
+    if S[1] > 1e-8 * S[0]:
+        cs = Vt.T @ ((U.T @ system[:, 2]) / S)
+        h = math.hypot(cs[0], cs[1])
+        return [(cs[0] / h, cs[1] / h)] if h > 0.0 else [(1.0, 0.0)]
+    if S[0] == 0.0:
+        return [(1.0, 0.0)]
+    n = Vt[0]
+    along = float(U[:, 0] @ system[:, 2]) / S[0]
+    along = max(-1.0, min(1.0, along))
+    side = math.sqrt(1.0 - along * along)
+    return [
+        (along * n[0] - side * n[1], along * n[1] + side * n[0]),
+        (along * n[0] + side * n[1], along * n[1] - side * n[0]),
+    ]
+
+
+def _rr_eigenvalues(P0, Ps, Pc, Q):
+    """The eigenvalues y of the pencil (24, complex), the pencil (A, B, C) and the Moebius
+    map used; None where no map gives a usable leading matrix (a singular pencil)."""
+    U, S, _ = np.linalg.svd(Q)
+    floor = _RR_RANK_TOL * max(S[0], 1.0)
+    rank = int((floor < S).sum())
+    N = U[:, rank:].T
+    if N.shape[0] > 6:
+        N = _RR_MIX[:, : N.shape[0]] @ N
+    A6 = N @ (P0 - Pc) @ _RR_H45
+    B6 = N @ (2.0 * Ps) @ _RR_H45
+    C6 = N @ (P0 + Pc) @ _RR_H45
+    pencil = (np.eye(12), np.eye(12), np.eye(12))
+    moebius = _RR_MOEBIUS[0]
+    best = math.inf
+    for m in _RR_MOEBIUS:
+        abc = _rr_pencil(A6, B6, C6, m)
+        cond = np.linalg.cond(abc[0])
+        if cond < best:
+            pencil, moebius, best = abc, m, cond
+        if cond < _RR_COND_LIMIT:
+            break
+    if not best < 1e16:
+        return None
+    A, B, C = pencil
+    Ainv = np.linalg.inv(A)
+    companion = np.zeros((24, 24))
+    companion[:12, 12:] = np.eye(12)
+    companion[12:, :12] = -Ainv @ C
+    companion[12:, 12:] = -Ainv @ B
+    return np.linalg.eigvals(companion), pencil, moebius
+
+
+def _rr_pencil(A6, B6, C6, moebius):
+    """The 12 x 12 lifted pencil (A, B, C) in y for the map x3 = (a y + b) / (c y + d)."""
+    a, b, c, d = moebius
+    out = []
+    for M6 in (
+        a * a * A6 + a * c * B6 + c * c * C6,
+        2.0 * a * b * A6 + (a * d + b * c) * B6 + 2.0 * c * d * C6,
+        b * b * A6 + b * d * B6 + d * d * C6,
+    ):
+        M = np.zeros((12, 12))
+        M[:6, :9] = M6
+        M[6:, 3:] = M6  # times x4: x4^i x5^j -> x4^(i+1) x5^j
+        out.append(M)
+    return out
+
+
+def _rr_unmix(v1, v2):
+    """The (up to two) vectors of monomials x4^a x5^b in the plane of v1 and v2: the mixture
+    u v1 + w v2 with (u, w) a root of the largest of the quadratic rules v_i v_j = v_k v_l."""
+    best = (0.0, 0.0, 0.0)
+    size = -1.0
+    for i, j, k, l in _RR_MONOMIAL_RULES:
+        # (u v1 + w v2)_i (u v1 + w v2)_j - (...)_k (...)_l = p u^2 + q u w + r w^2
+        p = v1[i] * v1[j] - v1[k] * v1[l]
+        q = v1[i] * v2[j] + v2[i] * v1[j] - v1[k] * v2[l] - v2[k] * v1[l]
+        r = v2[i] * v2[j] - v2[k] * v2[l]
+        if abs(p) + abs(q) + abs(r) > size:
+            best, size = (p, q, r), abs(p) + abs(q) + abs(r)
+    p, q, r = best
+    out = []
+    disc = q * q - 4.0 * p * r
+    if disc < 0.0:
+        disc = 0.0
+    root = math.sqrt(disc)
+    # roots (u : w) of p u^2 + q u w + r w^2, as directions (2 p, -q -+ root) or (-q -+ root, 2 r)
+    for sign in (1.0, -1.0):
+        h = -q - sign * root if q >= 0.0 else -q + sign * root
+        if abs(p) >= abs(r):
+            u, w = h, 2.0 * p
+        else:
+            u, w = 2.0 * r, h
+        if abs(u) + abs(w) > 0.0:
+            out.append(u * v1 + w * v2)
+    return out or [v1]
+
+
+def _rr_ratio_angle(v, pairs):
+    """The angle t with x = tan(t / 2) the common ratio v[hi] / v[lo] of the pairs, by least
+    squares in the direction (lo, hi): x = inf (t = pi) is fine."""
+    lo, hi = v[pairs[0]], v[pairs[1]]
+    across, low, high = float(hi @ lo), float(lo @ lo), float(hi @ hi)
+    if low >= high:
+        return 2.0 * math.atan2(across, low)
+    return 2.0 * math.atan2(high, across)
+
+
+def _rr_link(theta, row):
+    """A_i = Rz(theta) Tz(d) Tx(a) Rx(alpha) of standard DH; row = (d, a, cos alpha, sin alpha)."""
+    d, a, ca, sa = row
+    ct, st = math.cos(theta), math.sin(theta)
+    return np.array(
+        [
+            [ct, -st * ca, st * sa, a * ct],
+            [st, ct * ca, -ct * sa, a * st],
+            [0.0, sa, ca, d],
+            [0.0, 0.0, 0.0, 1.0],
+        ]
+    )
+
+
+def _rr_theta6(rows, F, thetas):
+    """theta6 from the pose: (A1 ... A5)^-1 F = Rz(theta6) in the split's frame."""
+    M = np.eye(4)
+    for t, row in zip(thetas, rows):
+        M = M @ _rr_link(t, row)
+    R = M[:3, :3].T @ F[:3, :3]
+    return math.atan2(R[1, 0], R[0, 0])
+
+
+def _rr_newton(rows, F, q):
+    """Newton steps on the split's forward kinematics (geometric Jacobian) from q towards F:
+    the polished angles and the final error (largest entry of the top three rows of the pose
+    difference, lengths in units of _RR_LENGTH)."""
+    q = np.array(q, dtype=float)
+    best_q, best = q, math.inf
+    frames = np.empty((7, 4, 4))
+    for _ in range(_RR_NEWTON_STEPS + 1):
+        frames[0] = np.eye(4)
+        for i in range(6):
+            frames[i + 1] = frames[i] @ _rr_link(q[i], rows[i])
+        E = frames[6]
+        size = float(np.abs(F[:3] - E[:3]).max())
+        if size < best:
+            best_q, best = q, size
+        if size <= 1e-15 or size > _RR_NEWTON_REACH:
+            break
+        # position error, and half the sum of E's columns crossed with F's (the rotation)
+        e, f = E[:3, :3], F[:3, :3]
+        turn = np.array(
+            [
+                e[1] @ f[2] - e[2] @ f[1],
+                e[2] @ f[0] - e[0] @ f[2],
+                e[0] @ f[1] - e[1] @ f[0],
+            ]
+        )
+        error = np.concatenate((F[:3, 3] - E[:3, 3], 0.5 * turn))
+        z = frames[:6, :3, 2]
+        r = E[:3, 3] - frames[:6, :3, 3]
+        J = np.empty((6, 6))
+        J[0] = z[:, 1] * r[:, 2] - z[:, 2] * r[:, 1]
+        J[1] = z[:, 2] * r[:, 0] - z[:, 0] * r[:, 2]
+        J[2] = z[:, 0] * r[:, 1] - z[:, 1] * r[:, 0]
+        J[3:] = z.T
+        try:
+            step = np.linalg.solve(J, error)
+        except np.linalg.LinAlgError:
+            break
+        longest = float(np.abs(step).max())
+        q = q + (step if longest <= 0.5 else step * (0.5 / longest))
+    return best_q, best

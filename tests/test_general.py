@@ -1,0 +1,108 @@
+"""The general 6R method (issue 17): the published cases with their full solution sets, random
+arms of any geometry, and the closed-form arms solved again by the general method."""
+
+from __future__ import annotations
+
+import math
+import tempfile
+import zlib
+from pathlib import Path
+
+import numpy as np
+import pytest
+from hypothesis import HealthCheck, given, settings
+
+from derive.cli import resolve_spec
+from derive.emit import render_module
+from derive.pipeline import build_plan
+from derive.spec import parse_spec
+from derive.verify import roundtrip, sample_joints
+
+from cases import GENERAL_CASES
+from conftest import build_module, import_path, spec_text
+from strategies import general_arms
+
+
+def case_module(name: str, folder: Path):
+    """The generated module of a case's arm (standard DH rows a, alpha, d)."""
+    rows = [(alpha, a, d, 0.0) for a, alpha, d in GENERAL_CASES[name]["rows"]]
+    return build_module(spec_text(name, "standard", rows), folder)
+
+
+def same_set(found: np.ndarray, expected: np.ndarray, tol_deg: float) -> bool:
+    """Every expected row is in found and every found row in expected (angles mod 360)."""
+
+    def near(a: np.ndarray, b: np.ndarray) -> bool:
+        return bool(np.all(np.abs((a - b + 180.0) % 360.0 - 180.0) <= tol_deg))
+
+    return len(found) == len(expected) and all(any(near(e, f) for f in found) for e in expected)
+
+
+@pytest.mark.parametrize("name", sorted(GENERAL_CASES))
+def test_published_cases_every_solution(name, tmp_path):
+    case = GENERAL_CASES[name]
+    m = case_module(name, tmp_path)
+    assert m.METHOD == "general"
+    T = np.vstack([np.array(case["T"]), [0.0, 0.0, 0.0, 1.0]])
+    found = np.degrees(m.ik(T, backend="python"))
+    # the published exact solutions have 9 to 12 digits
+    assert same_set(found, np.array(case["solutions"]), 1e-6), found.round(4)
+    for q in np.radians(found):
+        assert np.abs(m.fk(q) - T).max() <= 1e-9
+
+
+def test_the_bundled_general_arm_is_the_published_one(generated):
+    m = generated("manocha_canny")
+    assert m.METHOD == "general" and m.MAX_SOLUTIONS == 16
+    case = GENERAL_CASES["manocha_canny_16"]
+    T = np.vstack([np.array(case["T"]), [0.0, 0.0, 0.0, 1.0]])
+    assert same_set(np.degrees(m.ik(T)), np.array(case["solutions"]), 1e-6)
+
+
+@settings(max_examples=12, deadline=None, suppress_health_check=list(HealthCheck))
+@given(general_arms())
+def test_random_arms_of_any_geometry(text):
+    """Sound always; the generating q found at every regular sample but, at most, one in 12:
+    the long run in the issue's note measures completeness (99.7% on 500 arms x 200 samples
+    before the last fixes); a unit test of 12 samples cannot assert 99.9%."""
+    plan = build_plan(parse_spec(text, "<hypothesis>"))
+    if plan.ik is None or plan.ik.method != "general":
+        return  # a closed form applies, or the arm is degenerate (tests elsewhere)
+    with tempfile.TemporaryDirectory() as tmp:
+        m = build_module(text, Path(tmp))
+    rng = np.random.default_rng(zlib.crc32(text.encode()))
+    result = roundtrip(m, sample_joints(m, 12, rng), "python")
+    assert result.unsound == [], (result.summary(), text)
+    if result.singular < result.samples:  # not an arm that is singular everywhere
+        assert len(result.misses) <= 1, (result.summary(), text)
+
+
+@pytest.mark.parametrize("arm", ["puma560", "parallel_6r", "lecture_6r"])
+def test_closed_form_arms_solved_again_by_the_general_method(arm, tmp_path):
+    """The general method on arms a closed form solves: every solution it returns is one of the
+    closed form's (sound, always), and on random poses it returns all of them on most. These
+    arms give singular pencils, solved through a perturbed table whose solutions lie up to
+    ~10 deg from the arm's; Newton from there sometimes lands on a neighbour. Measured on
+    these 60 poses: PUMA 53, parallel_6r and lecture_6r 57-60; the bound is 85% (not 100%:
+    that is the closed forms' job, and the figure is reported in issue 17's note)."""
+    spec = resolve_spec(arm)
+    modules = []
+    for method in ("general", None):
+        path = tmp_path / f"{arm}_{method or 'closed'}.py"
+        path.write_text(render_module(build_plan(spec, method)))
+        modules.append(import_path(path))
+    general, closed = modules
+    rng = np.random.default_rng(17)
+    same = 0
+    poses = 60
+    for _ in range(poses):
+        q = rng.uniform(-math.pi, math.pi, 6)
+        T = closed.fk(q)
+        a, b = closed.ik(T, backend="python"), general.ik(T, backend="python")
+        for row in b:
+            assert np.abs(closed.fk(row) - T).max() <= 1e-9
+            assert any(
+                np.abs((row - x + math.pi) % (2 * math.pi) - math.pi).max() < 1e-6 for x in a
+            )
+        same += len(a) == len(b)
+    assert same >= 0.85 * poses, f"{same} of {poses} poses with the same solution set"
