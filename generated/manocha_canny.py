@@ -167,6 +167,11 @@ _RR_NULL2_TOL = 1e-5
 _RR_GOOD = 1e-10
 
 
+# where no candidate polishes to _RR_GOOD (a singular pose: Newton converges slowly there),
+# those within _RR_NEAR are returned for certification
+_RR_NEAR = 1e-7
+
+
 _RR_NEWTON_STEPS = 10
 
 
@@ -714,19 +719,26 @@ def _general(flanges, tol):
     flanges: per split, the 12 top entries of the target in the split's frame (row-major).
     """
     found: list[np.ndarray] = []
+    near: list[np.ndarray] = []
     targets = [_rr_target(f) for f in flanges]
     doubt = True
     for k, F in enumerate(targets):
-        candidates, doubt = _rr_split(k, F, F)
+        candidates, close, doubt = _rr_split(k, F, F)
         _rr_merge(found, [_rr_to_arm(k, q) for q in candidates])
+        _rr_merge(near, [_rr_to_arm(k, q) for q in close])
         if not doubt and len(found) % 2 == 0:
             break
     if doubt or not found or len(found) % 2:
         # the rescue: solve slightly moved poses, polish back onto the true one
         for move in _RR_RESCUE:
             for k, F in enumerate(targets):
-                candidates, _ = _rr_split(k, F, F @ _rr_motion(*move))
+                candidates, close, _ = _rr_split(k, F, F @ _rr_motion(*move))
                 _rr_merge(found, [_rr_to_arm(k, q) for q in candidates])
+                _rr_merge(near, [_rr_to_arm(k, q) for q in close])
+    if not found:
+        # a singular pose, where Newton converges slowly: what came within _RR_NEAR (the
+        # caller's certification decides)
+        found = near
     # a self-motion (a singular pose) has a curve of solutions: at most MAX_SOLUTIONS of them
     return [tuple(float(t) for t in q) for q in found[:MAX_SOLUTIONS]]
 
@@ -768,7 +780,8 @@ def _rr_merge(found, candidates):
 
 def _rr_split(k, F, moved):
     """The polished candidates of split k for the target F, found from the pose `moved` (F
-    itself, or F slightly moved in a rescue), and whether the answer is in doubt."""
+    itself, or F slightly moved in a rescue); those that came within _RR_NEAR only; and
+    whether the answer is in doubt."""
     _, fill_rows, true_rows = _RR_SPLITS[k]
     values = np.zeros(490)
     _rr_fill(k, *moved[:3, 2], *moved[:3, 3], values)
@@ -783,15 +796,19 @@ def _rr_split(k, F, moved):
         [_rr_between(fill_rows, true_rows, t) for t in _RR_PATH] if fill_rows != true_rows else []
     )
     out = []
+    close = []
     for q in candidates:
         for rows in path:
             q, _ = _rr_newton(rows, F, q)
         q, residual = _rr_newton(true_rows, F, q)
         if residual <= _RR_GOOD:
             out.append(q)
-        elif fill_rows == true_rows:  # (a perturbed table has solutions the arm has not)
+            continue
+        if residual <= _RR_NEAR:
+            close.append(q)
+        if fill_rows == true_rows:  # (a perturbed table has solutions the arm has not)
             doubt = True
-    return out, doubt
+    return out, close, doubt
 
 
 def _rr_between(fill_rows, true_rows, t):

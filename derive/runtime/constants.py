@@ -53,6 +53,9 @@ _RR_IMAG_TOL = 1e-6
 _RR_CLUSTER_TOL = 1e-6
 _RR_NULL2_TOL = 1e-5
 _RR_GOOD = 1e-10
+# where no candidate polishes to _RR_GOOD (a singular pose: Newton converges slowly there),
+# those within _RR_NEAR are returned for certification
+_RR_NEAR = 1e-7
 _RR_NEWTON_STEPS = 10
 _RR_NEWTON_REACH = 0.5
 # a perturbed table's candidates are polished on tables these shares of the way back first
