@@ -730,9 +730,9 @@ def _general(flanges, tol):
             break
     if doubt or not found or len(found) % 2:
         # the rescue: solve slightly moved poses, polish back onto the true one
-        for move in _RR_RESCUE:
+        for motion in _RR_MOTIONS:
             for k, F in enumerate(targets):
-                candidates, close, _ = _rr_split(k, F, F @ _rr_motion(*move))
+                candidates, close, _ = _rr_split(k, F, F @ motion)
                 _rr_merge(found, [_rr_to_arm(k, q) for q in candidates])
                 _rr_merge(near, [_rr_to_arm(k, q) for q in close])
     if not found:
@@ -760,6 +760,10 @@ def _rr_motion(angle, shift):
     M[:3, :3] = np.eye(3) + s * K + (1.0 - c) * (K @ K)
     M[:3, 3] = shift * np.array([0.36, 0.48, -0.8])
     return M
+
+
+# the rescue's moves, one per (angle, shift) of _RR_RESCUE
+_RR_MOTIONS = np.array([_rr_motion(angle, shift) for angle, shift in _RR_RESCUE])
 
 
 def _rr_to_arm(k, q):
@@ -1325,58 +1329,89 @@ _prange = range
 
 def _kgeneral(flanges, out):
     """The general method's solutions of one pose into out (6 angles per row, at most
-    out.size // 6): their count, or -1 where the Python solver must settle the pose (an
-    answer in doubt in every split: the Python solver's fallback and rescue take over). The
-    steps of derive/runtime/general.py with small routines of its own instead of LAPACK."""
+    out.size // 6, the first ones found where a self-motion gives more, as the Python solver
+    keeps its first MAX_SOLUTIONS): their count, or -1 where the Python solver must settle
+    the pose (no solution polished). The steps of derive/runtime/general.py, in the same
+    order (best split, fallback split, rescue), with small routines of its own instead of
+    LAPACK."""
     limit = out.size // 6
-    count = 0
-    values = np.zeros(490)
-    F = np.eye(4)
-    cands = np.zeros((4 * _KRR_MAX, 6))
-    for k in range(len(flanges)):
+    splits = len(flanges)
+    targets = np.zeros((splits, 4, 4))
+    for k in range(splits):
         flange = flanges[k]
+        targets[k, 3, 3] = 1.0
         for r in range(3):
             for c in range(4):
-                F[r, c] = flange[4 * r + c]
-            F[r, 3] /= _RR_LENGTH
-        fill = np.array(_RR_SPLITS[k][1])
-        true = np.array(_RR_SPLITS[k][2])
-        perturbed = False
-        for i in range(6):
-            for j in range(4):
-                if fill[i, j] != true[i, j]:
-                    perturbed = True
-        values[:] = 0.0
-        _rr_fill(k, F[0, 2], F[1, 2], F[2, 2], F[0, 3], F[1, 3], F[2, 3], values)
-        n, doubt = _krr_candidates(values, F, fill, cands)
-        for c in range(n):
-            q = cands[c].copy()
-            if perturbed:
-                for t in _RR_PATH:
-                    q, _ = _krr_newton(_krr_between(fill, true, t), F, q)
-            q, error = _krr_newton(true, F, q)
-            if error > _RR_GOOD:
-                if not perturbed:
-                    doubt = True
-                continue
-            if _RR_SPLITS[k][0]:  # the reversed chain: joint j is -theta_{7-j}
-                q = -q[::-1]
-            seen = False
-            for r in range(count):
-                gap = 0.0
-                for j in range(6):
-                    gap = max(gap, abs((q[j] - out[6 * r + j] + math.pi) % _TWO_PI - math.pi))
-                if gap <= 1e-7:
-                    seen = True
-                    break
-            if not seen:
-                if count == limit:
-                    return -1
-                out[6 * count : 6 * count + 6] = q
-                count += 1
-        if not doubt and count % 2 == 0 and count > 0:
+                targets[k, r, c] = flange[4 * r + c]
+            targets[k, r, 3] /= _RR_LENGTH
+    count = 0
+    doubt = True
+    for k in range(splits):
+        count, doubt = _krr_split(k, targets[k], targets[k], out, count)
+        if count == limit:
             return count
-    return -1
+        if not doubt and count % 2 == 0:
+            break
+    if doubt or count == 0 or count % 2:
+        moved = np.zeros((4, 4))
+        for m in range(_RR_MOTIONS.shape[0]):
+            for k in range(splits):
+                for r in range(4):
+                    for c in range(4):
+                        total = 0.0
+                        for i in range(4):
+                            total += targets[k, r, i] * _RR_MOTIONS[m, i, c]
+                        moved[r, c] = total
+                count, _ = _krr_split(k, targets[k], moved, out, count)
+                if count == limit:
+                    return count
+    return count if count > 0 else -1
+
+
+def _krr_split(k, F, moved, out, count):
+    """_rr_split in the kernel: split k's polished candidates for the target F (found from
+    the pose `moved`) added to out[6 count:] where new, until out is full; (the new count,
+    doubt)."""
+    limit = out.size // 6
+    fill = np.array(_RR_SPLITS[k][1])
+    true = np.array(_RR_SPLITS[k][2])
+    perturbed = False
+    for i in range(6):
+        for j in range(4):
+            if fill[i, j] != true[i, j]:
+                perturbed = True
+    values = np.zeros(490)
+    _rr_fill(
+        k, moved[0, 2], moved[1, 2], moved[2, 2], moved[0, 3], moved[1, 3], moved[2, 3], values
+    )
+    cands = np.zeros((4 * _KRR_MAX, 6))
+    n, doubt = _krr_candidates(values, moved, fill, cands)
+    for c in range(n):
+        q = cands[c].copy()
+        if perturbed:
+            for t in _RR_PATH:
+                q, _ = _krr_newton(_krr_between(fill, true, t), F, q)
+        q, error = _krr_newton(true, F, q)
+        if error > _RR_GOOD:
+            if not perturbed:
+                doubt = True
+            continue
+        if _RR_SPLITS[k][0]:  # the reversed chain: joint j is -theta_{7-j}
+            q = -q[::-1]
+        seen = False
+        for r in range(count):
+            gap = 0.0
+            for j in range(6):
+                gap = max(gap, abs((q[j] - out[6 * r + j] + math.pi) % _TWO_PI - math.pi))
+            if gap <= 1e-7:
+                seen = True
+                break
+        if not seen:
+            out[6 * count : 6 * count + 6] = q
+            count += 1
+            if count == limit:
+                return count, doubt
+    return count, doubt
 
 
 # the most candidates of one split: 16 eigenvalues, each with up to 3 null vectors (one, and
@@ -2904,6 +2939,7 @@ _KBUF = 96
 _KERNEL_SPACE = "_derive_ik_kernels_manocha_canny_79027869596efc09"
 _KERNEL = (
     '_kwrap',
+    '_rr_motion',
     '_kpose_ok',
     '_kdistinct',
     '_kfinish',
@@ -2913,6 +2949,7 @@ _KERNEL = (
     '_kone',
     '_kbatch',
     '_kgeneral',
+    '_krr_split',
     '_krr_candidates',
     '_krr_pencil',
     '_kpivot_ratio',

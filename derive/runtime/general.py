@@ -83,9 +83,9 @@ def _general(flanges, tol):
             break
     if doubt or not found or len(found) % 2:
         # the rescue: solve slightly moved poses, polish back onto the true one
-        for move in _RR_RESCUE:
+        for motion in _RR_MOTIONS:
             for k, F in enumerate(targets):
-                candidates, close, _ = _rr_split(k, F, F @ _rr_motion(*move))
+                candidates, close, _ = _rr_split(k, F, F @ motion)
                 _rr_merge(found, [_rr_to_arm(k, q) for q in candidates])
                 _rr_merge(near, [_rr_to_arm(k, q) for q in close])
     if not found:
@@ -113,6 +113,10 @@ def _rr_motion(angle, shift):
     M[:3, :3] = np.eye(3) + s * K + (1.0 - c) * (K @ K)
     M[:3, 3] = shift * np.array([0.36, 0.48, -0.8])
     return M
+
+
+# the rescue's moves, one per (angle, shift) of _RR_RESCUE
+_RR_MOTIONS = np.array([_rr_motion(angle, shift) for angle, shift in _RR_RESCUE])
 
 
 def _rr_to_arm(k, q):
