@@ -2,11 +2,11 @@
 form), derived once in symbols for every arm: the first step of the general method (issue 17).
 
 Standard DH, A_i = Rz(theta_i) Tz(d_i) Tx(a_i) Rx(alpha_i) with c_i, s_i, a_i, d_i,
-lam_i = cos(alpha_i), mu_i = sin(alpha_i). The split A3 A4 A5 = A2^-1 A1^-1 T A6^-1 (M-C eq. 3):
+lambda_i = cos(alpha_i), mu_i = sin(alpha_i). The split A3 A4 A5 = A2^-1 A1^-1 T A6^-1 (M-C eq. 3):
 columns 3 and 4 of both sides (a direction l and a point p) do not involve theta6, and the
-pose enters through six numbers (lx, ly, lz) = column 3 and (px, py, pz) = column 4 of
+pose enters through six numbers (l_x, l_y, l_z) = column 3 and (p_x, p_y, p_z) = column 4 of
 T A6^-1. Per side: l (3), p (3), p.p, p.l, p x l (3), v = (p.p) l - 2 (p.l) p (3); equated,
-with s^2 = 1 - c^2 and mu^2 = 1 - lam^2 applied until no even power of s or mu is left, they
+with s^2 = 1 - c^2 and mu^2 = 1 - lambda^2 applied until no even power of s or mu is left, they
 read (M-C eq. 4)
 
     (P0 + Ps s3 + Pc c3) m45 = Q m12,

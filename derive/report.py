@@ -18,6 +18,7 @@ import sympy as sp
 from derive import raghavan_roth as rr
 from derive import symbols as sym
 from derive.emit import GENERATOR, environment
+from derive.methods import general
 from derive.plan import Assign, Eigen, Plan, Solve
 from derive.runtime import general as runtime_general
 
@@ -315,14 +316,7 @@ def eigen_blocks(step: Eigen, env: dict[sp.Symbol, float]) -> list[Block]:
     for k, target in enumerate(step.args[:12]):
         F[k // 4, k % 4] = env[target]
     F[:3, 3] /= step.unit
-    rows = split.fill_rows[:5]
-    args = [r[1] for r in rows] + [r[0] for r in rows] + [r[2] for r in rows]
-    args += [r[3] for r in rows] + [*F[:3, 2], *F[:3, 3]]
-    f = rr.fundamental()
-    P0, Ps, Pc, Q = (
-        np.array(m.xreplace(dict(zip(rr.GENS, args))).evalf(), dtype=float)
-        for m in (f.P0, f.Ps, f.Pc, f.Q)
-    )
+    P0, Ps, Pc, Q = general.matrices_at(split.fill_rows, F)
     found = runtime_general._rr_eigenvalues(P0, Ps, Pc, Q)
     if found is None:
         return [Block("p", f"The pencil of {split.name} is singular at this pose.")]

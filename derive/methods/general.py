@@ -145,7 +145,7 @@ def fill_expressions(rows: tuple[Row, ...], exact: dict[sp.Symbol, sp.Expr]) -> 
     return tuple(out)
 
 
-def exact_numbers(chain: Chain, length: float) -> dict[sp.Symbol, sp.Expr]:
+def exact_numbers(chain: Chain) -> dict[sp.Symbol, sp.Expr]:
     """The exact twists of the chain (cos, sin of 0, 90, 180 deg stay exact integers)."""
     subs: dict[sp.Symbol, sp.Expr] = {}
     for i in range(1, 6):
@@ -164,7 +164,7 @@ def measure(chain: Chain, reversed_: int, length: float, perturb: bool) -> Split
     """A split of the chain, measured on POSES random poses (fixed seed)."""
     true_rows = flange_rows(chain, length)
     fill_rows = perturbed(true_rows) if perturb else true_rows
-    fill = fill_expressions(fill_rows, {} if perturb else exact_numbers(chain, length))
+    fill = fill_expressions(fill_rows, {} if perturb else exact_numbers(chain))
     recovered, conds = score(fill_rows, true_rows)
     return Split(
         reversed=bool(reversed_),
@@ -183,9 +183,6 @@ def score(fill_rows: tuple[Row, ...], true_rows: tuple[Row, ...]) -> tuple[int, 
     generating joint values among the split's polished candidates; and the condition numbers
     of the pencil's leading matrix."""
     rng = np.random.default_rng(20261201)
-    functions = numeric_matrices()
-    numbers = [r[1] for r in fill_rows[:5]] + [r[0] for r in fill_rows[:5]]
-    numbers += [r[2] for r in fill_rows[:5]] + [r[3] for r in fill_rows[:5]]
     recovered = 0
     conds = []
     for _ in range(POSES):
@@ -195,8 +192,7 @@ def score(fill_rows: tuple[Row, ...], true_rows: tuple[Row, ...]) -> tuple[int, 
         F = np.eye(4)
         for t, row in zip(q, true_rows):
             F = F @ runtime._rr_link(t, row)
-        args = [*numbers, *F[:3, 2], *F[:3, 3]]
-        P0, Ps, Pc, Q = (np.array(fn(*args), dtype=float) for fn in functions)
+        P0, Ps, Pc, Q = matrices_at(fill_rows, F)
         candidates, _ = runtime._rr_candidates(P0, Ps, Pc, Q, F, fill_rows)
         conds.append(leading_condition(P0, Ps, Pc, Q))
         for c in candidates:
@@ -221,6 +217,15 @@ def leading_condition(P0, Ps, Pc, Q) -> float:
         N @ (P0 - Pc) @ H, N @ (2.0 * Ps) @ H, N @ (P0 + Pc) @ H, runtime._RR_MOEBIUS[0]
     )
     return float(min(np.linalg.cond(A), 1e20))
+
+
+def matrices_at(rows: tuple[Row, ...], F: np.ndarray) -> tuple[np.ndarray, ...]:
+    """P0, Ps, Pc, Q as numbers for the rows (d, a, cos alpha, sin alpha) and the flange
+    target F (position in the rows' units)."""
+    numbers = [r[1] for r in rows[:5]] + [r[0] for r in rows[:5]]
+    numbers += [r[2] for r in rows[:5]] + [r[3] for r in rows[:5]]
+    args = [*numbers, *F[:3, 2], *F[:3, 3]]
+    return tuple(np.array(fn(*args), dtype=float) for fn in numeric_matrices())
 
 
 @cache
