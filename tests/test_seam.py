@@ -11,6 +11,9 @@ from conftest import BUNDLED, needs_numba
 
 SEAM_SHARE = 0.2
 POSES = 10_000
+# The general method's Python solver takes about 2 ms a pose (the closed forms 50 us): its arm
+# gets fewer poses so that the suite stays inside CI's time.
+POSES_FOR = {"manocha_canny": 2_000}
 
 
 def seam_poses(m, n: int, seed: int) -> np.ndarray:
@@ -48,7 +51,7 @@ def compare(reference: np.ndarray, other: np.ndarray) -> str:
 
 def tally(m, backends: tuple[str, ...]) -> dict[str, dict[str, int]]:
     """Per backend's ik and ik_batch, how its rows compare with the Python ik's, pose by pose."""
-    T = seam_poses(m, POSES, 53)
+    T = seam_poses(m, POSES_FOR.get(m.NAME, POSES), 53)
     batches = {b: m.ik_batch(T, backend=b) for b in backends}
     counts: dict[str, dict[str, int]] = {}
     for i in range(len(T)):
@@ -79,14 +82,15 @@ def tally(m, backends: tuple[str, ...]) -> dict[str, dict[str, int]]:
 # (at most 1.6e-11) and 3-5 such seam values; parallel_6r has one pose whose elbow is 2e-7
 # from folded, where the compiled solver merges two solutions 2e-6 apart and the Python one
 # keeps both. No backend returns a value a full turn away from another's, and none -pi.
-# manocha_canny (general method): on these poses 21 differ by more than 1e-6 ("turn"), 1 at
-# the seam and 11 by rounding between the compiled and the Python ik: poses where axes 3 and 6
-# line up (a self-motion, theta3 + theta6 fixed) have a curve of solutions, and each backend
-# returns its own certified points of it (the general method has no reference value to give
-# a free joint); elsewhere the eigenvalue routines (LAPACK's and the kernel's) round apart.
+# manocha_canny (general method, 2,000 poses): 7 differ by more than 1e-6 ("turn") and 3 by
+# rounding between the compiled and the Python ik (on 10,000: 21, 11 and 1 at the seam):
+# poses where axes 3 and 6 line up (a self-motion, theta3 + theta6 fixed) have a curve of
+# solutions, and each backend returns its own certified points of it (the general method has
+# no reference value to give a free joint); elsewhere the eigenvalue routines (LAPACK's and
+# the kernel's) round apart.
 ALLOWED = {
     "lecture_6r": {"rounding": 500, "seam": 50},
-    "manocha_canny": {"rounding": 30, "seam": 10, "turn": 30, "count": 15},
+    "manocha_canny": {"rounding": 10, "seam": 5, "turn": 12, "count": 5},
     "parallel_6r": {"rounding": 20, "count": 1},
     "puma560": {"rounding": 30, "seam": 10},
 }
@@ -105,7 +109,8 @@ def check(name: str, counts: dict[str, dict[str, int]]) -> None:
 @pytest.mark.parametrize("name", BUNDLED)
 def test_python_ik_and_ik_batch_agree_at_the_seam(generated, name):
     counts = tally(generated(name), ("python",))
-    assert counts["python ik at pi"]["values"] > 0.05 * POSES  # the poses reach the seam
+    poses = POSES_FOR.get(name, POSES)
+    assert counts["python ik at pi"]["values"] > 0.05 * poses  # the poses reach the seam
     check(name, counts)
 
 
