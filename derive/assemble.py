@@ -39,6 +39,8 @@ IMPORTS = (
 # the public names of a module with forward kinematics only, and with inverse kinematics
 FK_ROOTS = ("fk", "fk_batch")
 IK_ROOTS = (*FK_ROOTS, "ik", "ik_batch", "nearest", "warmup", "CERTIFY_TOL", "BACKEND")
+# the public names a module with free joints adds
+FREE_ROOTS = ("ik_sweep",)
 # the compiled kernel's entry points (_compile builds them and what they call)
 KERNEL_ROOTS = ("_kbatch", "_kone", "_kpick")
 
@@ -148,12 +150,20 @@ class Assembly:
     kernel: tuple[str, ...]
 
 
-def assemble(arm_source: str, has_ik: bool) -> Assembly:
-    """The runtime pieces for a module whose arm-specific code is arm_source."""
+def assemble(arm_source: str, has_ik: bool, free: bool = False) -> Assembly:
+    """The runtime pieces for a module whose arm-specific code is arm_source (free: the arm
+    has free joints, and ik_sweep)."""
     runtime = runtime_pieces()
+    if free:  # redundant's public functions replace api's of the same names
+        replaced = {n for p in runtime if p.module == "redundant" for n in p.defines}
+        runtime = tuple(p for p in runtime if p.module != "api" or not p.defines & replaced)
+    else:
+        runtime = tuple(p for p in runtime if p.module != "redundant")
     arm = split("arm", arm_source)
     everything = runtime + arm
     roots = set(IK_ROOTS if has_ik else FK_ROOTS)
+    if has_ik and free:
+        roots |= set(FREE_ROOTS)
     for piece in arm:
         roots |= piece.uses
     kernel: tuple[str, ...] = ()

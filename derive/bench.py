@@ -158,6 +158,11 @@ def measure(
         )
         # nearest (within the limits, every 2 pi variant considered) against the same poses
         figures["nearest_us"] = median_us(module.nearest, list(zip(poses, Q)))
+        if getattr(module, "FREE", ()):
+            # the free joints sampled 64 times over their limits (default backend)
+            figures["ik_sweep_us"] = median_us(
+                partial(module.ik_sweep, n=64), [(T,) for T in poses[:200]]
+            )
         result = roundtrip(module, Q)
         figures.update(batch_figures(module, batch_n, seed, memory_n, figures.get("threads", 0)))
         figures["batch_agrees"] = batch_agreement(module, module.fk_batch(Q))

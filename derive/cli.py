@@ -86,7 +86,17 @@ def worked_example(plan: Plan, module: ModuleType) -> Example:
         )
         how = f"the pose of q = ({shown}) (degrees for R joints)"
     # one pose: the Python solver (compiling the numba one would cost seconds)
-    solutions = module.ik(pose, backend="python") if hasattr(module, "ik") else ()
+    free = getattr(module, "FREE", ())
+    values = {}
+    if free:
+        given = arm.example_q if arm.example_q is not None else (0.0,) * arm.dof
+        values["free"] = [given[j - 1] for j in free]
+        given_values = [
+            math.degrees(given[j - 1]) if arm.joint_types[j - 1] == "R" else given[j - 1]
+            for j in free
+        ]
+        how += "; free joints " + ", ".join(f"q{j} = {v:g}" for j, v in zip(free, given_values))
+    solutions = module.ik(pose, backend="python", **values) if hasattr(module, "ik") else ()
     return Example(
         tuple(float(v) for v in pose.ravel()),
         tuple(tuple(float(v) for v in row) for row in solutions),
@@ -309,19 +319,29 @@ def cmd_solve(args: argparse.Namespace) -> int:
     module = load_module(spec)
     if not hasattr(module, "ik"):
         raise UsageError(f"{spec.name}: no IK method applies to this arm")
+    q = None
     if args.q is not None:
-        pose = module.fk(joint_vector(spec, parse_numbers(args.q, "--q"), args.rad))
+        q = joint_vector(spec, parse_numbers(args.q, "--q"), args.rad)
+        pose = module.fk(q)
     else:
         numbers = parse_numbers([args.pose], "--pose")
         if len(numbers) not in (12, 16):
             raise UsageError("--pose: give 12 numbers (3 rows of 4) or 16 (4 rows of 4)")
         pose = np.array([*numbers[:12], 0.0, 0.0, 0.0, 1.0]).reshape(4, 4)
+    free = free_values(spec, module, args, q)
     try:
-        sols = module.ik(pose, backend="python")  # one pose: not worth compiling
+        # one pose: not worth compiling
+        sols = module.ik(pose, backend="python", **({"free": free} if free else {}))
     except ValueError as exc:
         raise UsageError(f"--pose: {exc}") from None
     print("pose:")
     print(format_pose(pose))
+    if free:
+        given = [
+            f"q{j} = {math.degrees(v) if spec.joint_types[j - 1] == 'R' else v:g}"
+            for j, v in zip(module.FREE, free)
+        ]
+        print(f"free joints: {', '.join(given)} (degrees for R joints)")
     print(f"{len(sols)} solution(s) (degrees for R joints):")
     for k, q in enumerate(sols, start=1):
         shown = [math.degrees(v) if t == "R" else v for v, t in zip(q, spec.joint_types)]
@@ -336,6 +356,26 @@ def cmd_solve(args: argparse.Namespace) -> int:
             f"{k:2d}: " + " ".join(f"{v:10.4f}" for v in shown) + f"  residual {residual:.1e}{flag}"
         )
     return 0
+
+
+def free_values(
+    spec: ArmSpec, module: ModuleType, args: argparse.Namespace, q: list[float] | None
+) -> list[float]:
+    """The free joints' values for solve: --free's (degrees for R joints unless --rad), else
+    those of --q, else zeros; [] for an arm without free joints."""
+    free = getattr(module, "FREE", ())
+    if args.free is None:
+        return [q[j - 1] if q is not None else 0.0 for j in free]
+    if not free:
+        raise UsageError(f"--free: {spec.name} has no free joints")
+    numbers = parse_numbers(args.free, "--free")
+    if len(numbers) != len(free):
+        names = ", ".join(f"q{j}" for j in free)
+        raise UsageError(f"--free: give {len(free)} value(s), for {names}")
+    return [
+        math.radians(v) if spec.joint_types[j - 1] == "R" and not args.rad else v
+        for v, j in zip(numbers, free)
+    ]
 
 
 def cmd_bench(args: argparse.Namespace) -> int:
@@ -395,6 +435,8 @@ def bench_text(name: str, f: dict) -> str:
             f"{f['ik_batch_1thread_us']:.2f} on one thread"
         )
     line += f"\n  nearest (within limits) {f['nearest_us']:.1f} us/pose (median)"
+    if "ik_sweep_us" in f:
+        line += f"; ik_sweep (64 free values) {f['ik_sweep_us']:.1f} us/pose (median)"
     line += (
         f"\n  python: ik {f['ik_python_us']:.1f} us/pose (median); ik_batch "
         f"{f['ik_batch_python_us']:.2f} us/pose at N = {f['batch_n']}"
@@ -445,7 +487,10 @@ def parser() -> argparse.ArgumentParser:
     group = solve.add_mutually_exclusive_group(required=True)
     group.add_argument("--pose", help="'r11 r12 r13 px r21 ... pz' (12 or 16 numbers)")
     group.add_argument("--q", nargs="+", help="solve the pose of these joint values")
-    solve.add_argument("--rad", action="store_true", help="--q values are in radians")
+    solve.add_argument("--rad", action="store_true", help="--q and --free values are in radians")
+    solve.add_argument(
+        "--free", nargs="+", help="an arm with free joints: their values (default: --q's, or 0)"
+    )
     solve.set_defaults(run=cmd_solve)
     report = sub.add_parser("report", help="the derivation, lecture style (Markdown or LaTeX)")
     report.add_argument("arm", help="spec file or bundled arm name")

@@ -15,6 +15,7 @@ from importlib import resources
 import jinja2
 import sympy as sp
 
+from derive import free
 from derive import symbols as sym
 from derive.assemble import assemble, import_block
 from derive.layout import wrap_code
@@ -129,6 +130,9 @@ class PrintedModule:
     match: str
     components: str
     general: str
+    free: tuple[int, ...]
+    free_const: str
+    free_text: str
 
 
 def print_plan(plan: Plan) -> PrintedModule:
@@ -181,6 +185,9 @@ def print_plan(plan: Plan) -> PrintedModule:
         match=match_expression(ik.certify) if ik else "",
         components=ik.certify if ik else "",
         general=general_code(plan),
+        free=ik.free if ik else (),
+        free_const=repr(ik.free) if ik else "()",
+        free_text=free.describe(ik, arm.dof) if ik else "",
     )
 
 
@@ -244,7 +251,7 @@ def render_module(plan: Plan) -> str:
     # the kernel's function list is part of the arm's code and follows from it: print the
     # code once without it to find the routines it calls
     draft = arm.render(m=printed, kernel_names="()")
-    parts = assemble(draft, bool(printed.has_ik))
+    parts = assemble(draft, bool(printed.has_ik), bool(printed.free))
     layout = env.get_template("module.py.j2")
     arm_code = wrap_code(arm.render(m=printed, kernel_names=_names_tuple(parts.kernel)))
 

@@ -6,6 +6,7 @@ import math
 
 import sympy as sp
 
+from derive import free
 from derive import symbols as sym
 from derive.classify import Structure, classify
 from derive.methods import general, parallel, pieper, planar
@@ -30,7 +31,11 @@ def build_plan(spec: ArmSpec, method: str | None = None) -> Plan:
     structure = classify(chain)
     if method is not None and method not in METHODS:
         raise ValueError(f"no method {method!r}; methods: {', '.join(METHODS)}")
-    ik, refusal = choose_method(chain, structure, (method,) if method else tuple(METHODS))
+    names = (method,) if method else tuple(METHODS)
+    if chain.dof > free.REMAINDER_DOF:
+        ik, refusal = choose_free(chain, spec.free, names)
+    else:
+        ik, refusal = choose_method(chain, structure, names)
     return Plan(
         arm=arm_info(spec, chain),
         structure=structure.describe(chain.dof),
@@ -55,6 +60,39 @@ def choose_method(
         if isinstance(result, IkPlan):
             return result, ""
         reasons.append(result)
+    return None, "; ".join(reasons)
+
+
+def choose_free(
+    chain: Chain, named: tuple[int, ...] | None, names: tuple[str, ...]
+) -> tuple[IkPlan | None, str]:
+    """For an arm of more than 6 joints: the first method that solves the remainder of one
+    of the free-joint choices (the spec's, else end joints; every closed form on every choice
+    before the general method), lifted to the arm; or None and why none does."""
+    reasons: list[str] = []
+    usable = []
+    for choice in free.candidates(chain, named):
+        label = "free " + ", ".join(f"q{i}" for i in choice)
+        why = free.refusal(chain, choice)
+        if why:
+            reasons.append(f"{label}: {why}")
+            continue
+        rest = free.remainder(chain, choice)
+        structure = classify(rest)
+        if structure.coincident:
+            i = structure.coincident[0]
+            reasons.append(
+                f"{label}: the remainder loses a degree of freedom (its axes {i} and {i + 1} "
+                "coincide)"
+            )
+            continue
+        usable.append((choice, label, rest, structure))
+    for name in names:
+        for choice, label, rest, structure in usable:
+            result = METHODS[name](rest, structure)
+            if isinstance(result, IkPlan):
+                return free.lift(result, chain, choice), ""
+            reasons.append(f"{label}: {result}")
     return None, "; ".join(reasons)
 
 

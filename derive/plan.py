@@ -236,11 +236,18 @@ class Eigen(Solve):
 
     kind: ClassVar[str] = "eigen"
     splits: tuple[Split, ...] = ()
+    # the arm's number of the split's first joint (2 where joint 1 of a 7-joint arm is free)
+    first: int = 1
+
+    @property
+    def indices(self) -> range:
+        """The arm's numbers of the six joints the step gives."""
+        return range(self.first, self.first + 6)
 
     @property
     def variables(self) -> tuple[str, ...]:
         """The joint angles the step gives (the arm's)."""
-        return tuple(f"theta{i}" for i in range(1, 7))
+        return tuple(f"theta{i}" for i in self.indices)
 
 
 # every kind of Solve step: each backend's printer has a function for each (a test checks it)
@@ -264,6 +271,8 @@ class IkPlan:
         solves_for: the pose components the solver is defined on, in words.
         certify: "pose" (every solution reproduces the whole pose) or "position" (the tool
             point only: arms that do not control the orientation).
+        free: the joints (1-based) the caller gives values for (an arm of more than 6
+            joints); their values are the reference values qr_i.
     """
 
     method: str
@@ -274,6 +283,7 @@ class IkPlan:
     details: tuple[tuple[str, sp.Expr], ...] = ()
     solves_for: str = "the full pose (rotation and position)"
     certify: str = "pose"
+    free: tuple[int, ...] = ()
 
 
 @dataclass(frozen=True)

@@ -15,6 +15,7 @@ from dataclasses import dataclass
 import numpy as np
 import sympy as sp
 
+from derive import free
 from derive import raghavan_roth as rr
 from derive import symbols as sym
 from derive.emit import GENERATOR, environment
@@ -206,6 +207,16 @@ def method_blocks(plan: Plan) -> list[Block]:
             f"solutions; the solver is defined on {ik.solves_for}.",
         )
     )
+    if ik.free:
+        out.append(
+            Block(
+                "p",
+                f"Free joints: {free.describe(ik, plan.arm.dof)}. The solver takes their values "
+                "(`ik(T, free=...)`) and solves the other joints; in the steps below free joint "
+                "$i$'s value is $qr_{i}$ (`qr` for q_ref: the solver's reference values carry "
+                "it).",
+            )
+        )
     details = dict(ik.details)
     if "general_f1" in details:
         out.append(Block("h3", "Pieper's functions, general form (lecture, Pieper -2 to -4)"))
@@ -394,6 +405,7 @@ def walk(plan: Plan, pose: np.ndarray, q: tuple[float, ...]) -> list[tuple[str, 
         for j in range(4):
             env[world[i, j]] = float(pose[i, j])
     values = plan_values(plan, q)
+    env |= free_values(values)
     lines = []
     for step in plan.ik.steps:
         if isinstance(step, Assign):
@@ -402,7 +414,7 @@ def walk(plan: Plan, pose: np.ndarray, q: tuple[float, ...]) -> list[tuple[str, 
                 lines.append((tex(target), number(env[target])))
             continue
         if isinstance(step, Eigen):
-            for k in range(1, 7):  # the solution's joint values, from the eigen-solve
+            for k in step.indices:  # the solution's joint values, from the eigen-solve
                 t = sym.theta(k)
                 env[t] = values[t]
                 lines.append((f"{tex(t)} / ^\\circ", number(math.degrees(values[t]))))
@@ -425,16 +437,23 @@ def walk(plan: Plan, pose: np.ndarray, q: tuple[float, ...]) -> list[tuple[str, 
     return lines
 
 
-def assigned(plan: Plan, pose: np.ndarray) -> dict[sp.Symbol, float]:
-    """The values of the plan's assignments at the pose (world entries included)."""
+def assigned(plan: Plan, pose: np.ndarray, q: tuple[float, ...]) -> dict[sp.Symbol, float]:
+    """The values of the plan's assignments at the pose (world entries included), the free
+    joints (if any) at solution q's values."""
     assert plan.ik is not None
     world = sym.world_pose()
     env = {world[i, j]: float(pose[i, j]) for i in range(3) for j in range(4)}
+    env |= free_values(plan_values(plan, q))
     for step in plan.ik.steps:
         if isinstance(step, Assign):
             for target, expr in zip(step.targets, step.exprs):
                 env[target] = float(expr.xreplace(env))
     return env
+
+
+def free_values(values: dict[sp.Symbol, float]) -> dict[sp.Symbol, float]:
+    """Of plan_values, the free joints' values (qr_i: the solver's input)."""
+    return {k: v for k, v in values.items() if k.name.startswith("qr")}
 
 
 def plan_values(plan: Plan, q: tuple[float, ...]) -> dict[sp.Symbol, float]:
@@ -481,7 +500,7 @@ def example_blocks(plan: Plan, example: Example) -> list[Block]:
     out += [Block("math", lhs, rhs) for lhs, rhs in walk(plan, pose, first)]
     for step in plan.ik.steps:
         if isinstance(step, Eigen):
-            out += eigen_blocks(step, assigned(plan, pose))
+            out += eigen_blocks(step, assigned(plan, pose, first))
     if arm.dof == 6:
         out += wrist_matrices(plan, first, flange)
     rows = [

@@ -23,6 +23,9 @@ Spec format (all keys other than those listed are errors)::
     [tool]                      # optional: same keys
     [example]                   # optional: the report's worked example: q = [...] (joint
                                 # values in the spec's units), or a world pose given like base
+    [ik]                        # optional
+    free = [7]                  # the joints (1-based) an arm of more than 6 joints leaves
+                                # free: ik takes their values; default: derive chooses
 """
 
 from __future__ import annotations
@@ -72,7 +75,9 @@ SHADOWED_MODULES = frozenset(
 )
 TOP_KEYS = (
     "name", "convention", "angle_unit", "length_unit", "joint", "base", "tool", "example", "source",
+    "ik",
 )  # fmt: skip
+IK_KEYS = ("free",)
 SOURCE_KEYS = ("urdf", "sha256", "base", "tip", "joints", "snaps", "deviation")
 # the text a [source] table may hold (it reaches the report, never the generated code)
 SOURCE_TEXT = re.compile(r"[A-Za-z0-9_ .,:;()+\-<>'=/]{1,200}")
@@ -158,6 +163,8 @@ class ArmSpec:
         example_q: joint values of the report's worked example (spec units), or None.
         example_pose: world pose of the worked example, or None (then example_q or a default).
         source: the file the spec came from (for messages), or "<memory>".
+        origin: the URDF the spec was converted from, or None.
+        free: the joints (1-based, ascending) named free in [ik], or None (derive chooses).
     """
 
     name: str
@@ -171,6 +178,7 @@ class ArmSpec:
     example_pose: Frame | None = None
     source: str = "<memory>"
     origin: Source | None = None
+    free: tuple[int, ...] | None = None
 
     @property
     def dof(self) -> int:
@@ -212,6 +220,8 @@ class ArmSpec:
         }
         if self.origin is not None:  # (absent from the digests of specs without one)
             data["source"] = asdict(self.origin)
+        if self.free is not None:  # (likewise)
+            data["ik"] = {"free": list(self.free)}
         return data
 
     def digest(self) -> str:
@@ -312,7 +322,34 @@ def _validate(data: dict, where: str) -> ArmSpec:
         example_pose,
         where,
         _source(data.get("source"), where, len(joints)),
+        _free(data.get("ik"), where, joints),
     )
+
+
+def _free(table: object, where: str, joints: tuple[Joint, ...]) -> tuple[int, ...] | None:
+    """The optional [ik] table: `free`, the joints an arm of more than 6 joints leaves free."""
+    if table is None:
+        return None
+    if not isinstance(table, dict):
+        raise SpecError(f"{where}: ik: must be a table ({', '.join(IK_KEYS)})")
+    _no_unknown_keys(table, IK_KEYS, where, "ik.")
+    if "free" not in table:
+        return None
+    value = table["free"]
+    n = len(joints)
+    allowed = f"allowed: a list of {n - 6} distinct joint numbers 1 to {n}"
+    if n <= 6:
+        raise SpecError(
+            f"{where}: ik.free: the arm has {n} joints; only an arm of more than 6 has free joints"
+        )
+    if (
+        not isinstance(value, list)
+        or len(value) != n - 6
+        or not all(type(v) is int and 1 <= v <= n for v in value)
+        or len(set(value)) != len(value)
+    ):
+        raise SpecError(f"{where}: ik.free: {str(value)[:40]} is not allowed; {allowed}")
+    return tuple(sorted(value))
 
 
 def _source(table: object, where: str, dof: int) -> Source | None:

@@ -118,11 +118,15 @@ def jacobian_nullity(module: ModuleType, q: np.ndarray) -> tuple[float, np.ndarr
     """Smallest singular value of the normalised Jacobian at q and its right singular vector.
 
     Columns are central differences of fk (rotation entries, and position / REACH); only the
-    position rows for a solver of the position (IK_COMPONENTS == "position").
+    position rows for a solver of the position (IK_COMPONENTS == "position"). An arm's free
+    joints (FREE) are given, not solved: their columns are left out (their entries of the
+    vector are 0).
     """
     h = 1e-6
     cols = []
-    for j in range(module.DOF):
+    free = getattr(module, "FREE", ())
+    solved = [j for j in range(module.DOF) if j + 1 not in free]
+    for j in solved:
         step = np.zeros(module.DOF)
         step[j] = h if module.JOINT_TYPES[j] == "R" else h * module.REACH
         d = (module.fk(q + step) - module.fk(q - step)) / (2 * h)
@@ -130,9 +134,11 @@ def jacobian_nullity(module: ModuleType, q: np.ndarray) -> tuple[float, np.ndarr
         cols.append(d[:3, 3] if module.IK_COMPONENTS == "position" else d[:3, :].ravel())
     J = np.array(cols).T
     _, sigma, vt = np.linalg.svd(J)
-    if len(sigma) < module.DOF:
-        return 0.0, vt[-1]
-    return float(sigma[-1]), vt[-1]
+    null = np.zeros(module.DOF)
+    null[solved] = vt[-1]
+    if len(sigma) < len(solved):
+        return 0.0, null
+    return float(sigma[-1]), null
 
 
 def same_joints(a: np.ndarray, b: np.ndarray, revolute: np.ndarray, mask: np.ndarray) -> bool:
@@ -148,9 +154,11 @@ def roundtrip(module: ModuleType, Q: np.ndarray, backend: str | None = None) -> 
     out = RoundTrip()
     revolute = np.array([k == "R" for k in module.JOINT_TYPES])
     everything = np.ones(module.DOF, dtype=bool)
+    free = [j - 1 for j in getattr(module, "FREE", ())]
     for index, q in enumerate(Q):
         T = module.fk(q)
-        sols = module.ik(T, backend=backend)
+        # an arm with free joints: solved for q's values of them
+        sols = module.ik(T, backend=backend, **({"free": q[free]} if free else {}))
         out.samples += 1
         out.solutions += len(sols)
         out.counts[len(sols)] = out.counts.get(len(sols), 0) + 1

@@ -19,7 +19,16 @@ from derive.spec import parse_spec
 
 ROOT = Path(__file__).resolve().parent.parent
 GENERATED = ROOT / "generated"
-BUNDLED = ("lecture_6r", "lecture_rrr", "manocha_canny", "parallel_6r", "planar_2r", "puma560")
+BUNDLED = (
+    "iiwa14",
+    "lecture_6r",
+    "lecture_rrr",
+    "manocha_canny",
+    "panda",
+    "parallel_6r",
+    "planar_2r",
+    "puma560",
+)
 _counter = itertools.count()
 
 # Property-test profiles: "ci" (the default) keeps the suite to minutes, with a fixed seed

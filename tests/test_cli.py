@@ -56,7 +56,9 @@ def test_failure_part_way_keeps_earlier_files(tmp_path, capsys):
 
 def test_unknown_arm_name_exits_2(capsys):
     assert main(["fk", "no_such_arm", "0"]) == 2
-    assert "bundled arms: lecture_6r" in capsys.readouterr().err
+    assert "bundled arms: iiwa14, lecture_6r, lecture_rrr, manocha_canny, panda" in (
+        capsys.readouterr().err
+    )
 
 
 def test_require_ik_exits_3_for_fk_only_arm(tmp_path):

@@ -88,7 +88,14 @@ def tally(m, backends: tuple[str, ...]) -> dict[str, dict[str, int]]:
 # solutions, and each backend returns its own certified points of it (the general method has
 # no reference value to give a free joint); elsewhere the eigenvalue routines (LAPACK's and
 # the kernel's) round apart.
+# iiwa14 and panda (q7 free, at its default 0; Pieper on the reversed remainder): iiwa14 has 2
+# poses beyond 1e-12 between the Python ik and ik_batch, and against the compiled ik 15 such,
+# 4 at the seam and 1 whose theta6 is 1.3e-8 above -pi in one backend and 1.2e-8 above pi in
+# the other (its rows differ by 5e-8 throughout: a near-singular pose, q5 near -90 deg);
+# panda has one pose beyond 1e-12.
 ALLOWED = {
+    "iiwa14": {"rounding": 30, "seam": 10, "turn": 2},
+    "panda": {"rounding": 5},
     "lecture_6r": {"rounding": 500, "seam": 50},
     "manocha_canny": {"rounding": 10, "seam": 5, "turn": 12, "count": 5},
     "parallel_6r": {"rounding": 20, "count": 1},

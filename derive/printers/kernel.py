@@ -170,19 +170,20 @@ KGENERAL_ROWS = 16
 def _eigen(c: Context) -> Block:
     step = c.step
     assert isinstance(step, Eigen)
+    j = step.joint
     groups = [c.values[k : k + 12] for k in range(0, len(c.values), 12)]
     flanges = ", ".join(f"({', '.join(g)})" for g in groups)
     at, end = c.at, c.at + 6 * KGENERAL_ROWS
     lines = [
-        Line(0, f"_n3 = _kgeneral(({flanges},), buf[{at}:{end}])"),
-        Line(0, "if _n3 < 0:"),
+        Line(0, f"_n{j} = _kgeneral(({flanges},), buf[{at}:{end}])"),
+        Line(0, f"if _n{j} < 0:"),
         Line(1, "return -1"),
-        Line(0, "_f3 = False"),
-        Line(0, "_m3 = n"),
-        Line(0, "for _k3 in range(_n3):"),
+        Line(0, f"_f{j} = False"),
+        Line(0, f"_m{j} = n"),
+        Line(0, f"for _k{j} in range(_n{j}):"),
     ]
-    for k in range(1, 7):
-        lines.append(Line(1, f"theta{k} = buf[{at} + 6 * _k3 + {k - 1}]"))
+    for place, k in enumerate(step.indices):
+        lines.append(Line(1, f"theta{k} = buf[{at} + 6 * _k{j} + {place}]"))
         for kind, function in (("c", "cos"), ("s", "sin")):
             if f"{kind}{k}" in c.after:
                 lines.append(Line(1, f"{kind}{k} = {function}(theta{k})"))
@@ -224,6 +225,8 @@ def kernel_lines(plan: Plan) -> tuple[tuple[tuple[int, str], ...], int]:
         if isinstance(step, Assign):
             body.append(Line(depth, f"# {step.note}"))
             body += assign_lines(step.targets, step.exprs, names, printer, depth, live.after)
+            # (free joints' values: an arm with free joints reads them here)
+            refs |= {str(s) for e in step.exprs for s in e.free_symbols if s.name[:2] == "qr"}
             continue
         head, values = step_arguments(step, names, printer, depth)
         cos_ref, sin_ref = reference_cs(step.ref, printer)
@@ -239,6 +242,7 @@ def kernel_lines(plan: Plan) -> tuple[tuple[tuple[int, str], ...], int]:
         checks.append((depth, step.joint))
         depth += block.loop
     outputs = [printer.doprint(e) for e in plan.ik.outputs]
+    refs |= {str(s) for e in plan.ik.outputs for s in e.free_symbols if s.name[:2] == "qr"}
     if same_joints(plan):
         body.append(Line(depth, f"e = _fk_from_cs({cs_arguments(plan)})"))
     else:

@@ -106,7 +106,7 @@ def solve_lines(
         groups = [values[k : k + 12] for k in range(0, len(values), 12)]
         call = SOLVES[Eigen](step, ", ".join(f"({', '.join(g)})" for g in groups), "", "")
         lines.append(Line(depth, f"for {', '.join(step.variables)} in {call}:"))
-        for k in range(1, 7):
+        for k in step.indices:
             for name, function in ((f"c{k}", "cos"), (f"s{k}", "sin")):
                 if name in after:
                     lines.append(Line(depth + 1, f"{name} = {function}(theta{k})"))

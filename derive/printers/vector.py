@@ -76,6 +76,8 @@ def ik_batch_lines(plan: Plan) -> tuple[str, ...]:
     world = sym.world_pose()
     lines += [f"{world[i, j]} = T[:, {i}, {j}].reshape(shape)" for i in range(3) for j in range(4)]
     lines.append("valid = np.ones(shape, dtype=bool)")
+    # a free joint's value may differ per pose (ik_batch's free)
+    lines += [f"qr{j} = _vshape(qr{j}, shape)" for j in plan.ik.free]
     level = 0
     for live in steps:
         step = live.step

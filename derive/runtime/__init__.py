@@ -14,6 +14,8 @@ Modules, in copy order:
 ``api``        fk, fk_batch, ik, ik_batch, nearest, warmup: wrapping and dropping
                repeats, joint limits, the choice of backend and the kernels' build
 ``common``     argument checks and joint-value helpers the others share
+``redundant``  ik_sweep and the searching nearest of arms with free joints (copied only
+               into their modules, whose nearest it replaces)
 ``closed``     closed forms shared by the Python and compiled solvers (quadratic,
                quartic, atan2, Newton steps, the free-joint reach searches)
 ``general``    the general 6R method in the Python solver (numpy's eigensolver)
@@ -26,4 +28,6 @@ Modules, in copy order:
 arm (DOF, LIMITS, the forward kinematics, the solver bodies), so that this package imports.
 """
 
-MODULES = ("constants", "api", "common", "closed", "general", "scalar", "vector", "kernel")
+MODULES = (
+    "constants", "api", "common", "redundant", "closed", "general", "scalar", "vector", "kernel",
+)  # fmt: skip

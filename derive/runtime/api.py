@@ -17,6 +17,7 @@ from derive.runtime.arm import (
     _KERNEL_SPACE,
     _REVOLUTE,
     DOF,
+    FREE,
     LIMITS,
     MAX_SOLUTIONS,
     _cs_columns,
@@ -75,6 +76,7 @@ def fk_batch(Q: ArrayLike) -> np.ndarray:
 def ik(
     T: ArrayLike,
     *,
+    free: ArrayLike | None = None,
     within_limits: bool = False,
     q_ref: ArrayLike | None = None,
     tol: float = CERTIFY_TOL,
@@ -85,6 +87,9 @@ def ik(
 
     Args:
         T: 4x4 homogeneous transform of the tool frame in the world.
+        free: an arm with free joints (FREE, more than 6 joints): their values, one per joint
+            in FREE's order (a number where FREE has one); default: q_ref's values. Every
+            solution has these values.
         within_limits: keep only solutions inside LIMITS. Each solution comes once, each
             revolute joint at the value q + 2 pi k inside its limits nearest q_ref's (joints
             without limits too: by default the wrapped value). A solution with a joint that
@@ -107,9 +112,10 @@ def ik(
     Raises:
         ValueError: T is not 4x4, has non-finite or complex entries, or its rotation is not
             orthonormal within POSE_TOL; q_ref is not DOF finite numbers; tol is not a
-            positive finite number; all_turns would give more than MAX_TURN_ROWS rows.
+            positive finite number; all_turns would give more than MAX_TURN_ROWS rows; free
+            is given for an arm without free joints, or is not len(FREE) finite numbers.
     """
-    refs = _reference(q_ref)
+    refs = _with_free(_reference(q_ref), free)
     tol = _tolerance(tol)
     if within_limits:
 
@@ -143,6 +149,7 @@ def _array44(T):
 def ik_batch(
     T: ArrayLike,
     *,
+    free: ArrayLike | None = None,
     q_ref: ArrayLike | None = None,
     tol: float = CERTIFY_TOL,
     chunk: int = 4096,
@@ -152,6 +159,8 @@ def ik_batch(
 
     Args:
         T: (N, 4, 4) poses.
+        free: an arm with free joints: their values per pose, (N, len(FREE)) (or (N,) where
+            FREE has one); default: q_ref's values for every pose.
         q_ref: as for ik (one joint vector for all poses).
         tol: as for ik.
         chunk: poses the python backend solves together; memory grows with it, not with N.
@@ -171,42 +180,86 @@ def ik_batch(
     tol = _tolerance(tol)
     if type(chunk) is bool or not isinstance(chunk, (int, np.integer)) or chunk < 1:
         raise ValueError(f"chunk must be a positive integer, got {chunk!r}")
+    refs = _reference(q_ref)
     kernels = _kernels(backend)
     if kernels is None:
-        return _ik_batch_numpy(T, q_ref, tol, int(chunk))
+        return _ik_batch_numpy(T, refs, free, tol, int(chunk))
     T = np.ascontiguousarray(_real(T, "T"))
     if T.ndim != 3 or T.shape[1:] != (4, 4):
         raise ValueError(f"T must have shape (N, 4, 4), got {T.shape}")
-    refs = _reference(q_ref)
     n = T.shape[0]
+    per_pose = _free_rows(free, refs, n)
     # np.full writes its memory here: np.zeros would leave the page faults to the kernel's
     # threads, which contend for them (about a third of the kernel's time)
     Q = np.full((n, MAX_SOLUTIONS, DOF), 0.0)
     valid = np.full((n, MAX_SOLUTIONS), False)
     retry = np.zeros(n, dtype=bool)
+    qref = np.array([refs]) if per_pose is None else per_pose
     with _BATCH_LOCK:  # numba's default thread pool must not be entered twice at once
-        kernels[0](T, float(tol), refs, Q, valid, retry)
+        kernels[0](T, float(tol), qref, Q, valid, retry)
     for i in np.flatnonzero(retry):
-        _settle(Q, valid, i, ik(T[i], q_ref=q_ref, tol=tol, backend="python"))
+        ref_i = refs if per_pose is None else per_pose[i]
+        _settle(Q, valid, i, ik(T[i], q_ref=ref_i, tol=tol, backend="python"))
     return Q, valid
 
 
-def _ik_batch_numpy(T, q_ref, tol, chunk):
+def _ik_batch_numpy(T, refs, free, tol, chunk):
     """ik_batch's numpy backend: chunks of poses, every branch along its own array axis."""
     T, good = _vpose(T)
-    refs = _reference(q_ref)
     n = T.shape[0]
+    per_pose = _free_rows(free, refs, n)
     Q = np.zeros((n, MAX_SOLUTIONS, DOF))
     valid = np.zeros((n, MAX_SOLUTIONS), dtype=bool)
     for start in range(0, n, chunk):
         part = slice(start, min(n, start + chunk))
-        cand, ok, retry = _ik_candidates(T[part], *refs, tol)
+        args = list(refs)
+        for j in FREE if per_pose is not None else ():
+            args[j - 1] = per_pose[part, j - 1]
+        cand, ok, retry = _ik_candidates(T[part], *args, tol)
         Q[part], valid[part] = _vfinish(cand, ok & good[part, None])
         for i in start + np.flatnonzero(retry & good[part]):
             # a free joint whose first value left a branch without solution (rare): the
             # scalar solver tries its further values
-            _settle(Q, valid, i, ik(T[i], q_ref=q_ref, tol=tol, backend="python"))
+            ref_i = refs if per_pose is None else per_pose[i]
+            _settle(Q, valid, i, ik(T[i], q_ref=ref_i, tol=tol, backend="python"))
     return Q, valid
+
+
+def _with_free(refs, free):
+    """q_ref's values with the free joints' values from free (None: q_ref's own)."""
+    if free is None:
+        return refs
+    if not FREE:
+        raise ValueError("free: this arm has no free joints (FREE is empty)")
+    values = _real(free, "free").reshape(-1)
+    if values.shape != (len(FREE),) or not np.isfinite(values).all():
+        raise ValueError(
+            f"free must be {len(FREE)} finite number(s), one per joint in FREE = {FREE}"
+        )
+    out = list(refs)
+    for j, x in zip(FREE, values.tolist()):
+        out[j - 1] = x
+    return tuple(out)
+
+
+def _free_rows(free, refs, n):
+    """Per pose, q_ref's values with the free joints' values from free ((n, len(FREE)), or
+    (n,) where FREE has one), as an (n, DOF) array; None for free=None."""
+    if free is None:
+        return None
+    if not FREE:
+        raise ValueError("free: this arm has no free joints (FREE is empty)")
+    values = _real(free, "free")
+    if values.ndim == 1 and len(FREE) == 1:
+        values = values[:, None]
+    if values.shape != (n, len(FREE)) or not np.isfinite(values).all():
+        raise ValueError(
+            f"free must be finite numbers of shape ({n}, {len(FREE)}): one value per pose "
+            f"for each joint in FREE = {FREE}"
+        )
+    rows = np.tile(np.array(refs), (n, 1))
+    rows[:, [j - 1 for j in FREE]] = values
+    return rows
 
 
 def _settle(Q, valid, i, sols):
@@ -222,17 +275,33 @@ def nearest(
     *,
     within_limits: bool = True,
     weights: ArrayLike | None = None,
+    metric: str = "l2",
 ) -> np.ndarray | None:
-    """The solution closest to q_ref (weighted squared joint distance), or None.
+    """The solution closest to q_ref, or None.
 
     With within_limits=True each revolute joint takes its value q + 2 pi k inside LIMITS
-    nearest q_ref's (the distance is a sum over joints, so this is the nearest variant of
-    the whole vector); with within_limits=False revolute differences are wrapped to
-    (-pi, pi] and the solution is returned wrapped.
+    nearest q_ref's (the distance is a sum or maximum over joints, so this is the nearest
+    variant of the whole vector); with within_limits=False revolute differences are wrapped
+    to (-pi, pi] and the solution is returned wrapped.
 
     Args:
         weights: DOF finite non-negative numbers (default ones).
+        metric: "l2" (weighted squared distance, sum of w_i dq_i^2) or "max" (max of
+            w_i |dq_i|).
     """
+    refs, w = _nearest_arguments(q_ref, weights, metric)
+    sols = ik(T, within_limits=within_limits, q_ref=refs)
+    if len(sols) == 0:
+        return None
+    if metric == "max":
+        return sols[int(np.argmin(_distances(sols, refs, w, metric, not within_limits)))]
+    kernels = _kernels(None)
+    pick = _kpick if kernels is None else kernels[2]
+    return sols[pick(sols, refs, w, not within_limits)]
+
+
+def _nearest_arguments(q_ref, weights, metric):
+    """nearest's q_ref and weights, checked."""
     refs = _reference(q_ref, required=True)
     if weights is None:
         w = _ONES
@@ -240,12 +309,19 @@ def nearest(
         w = _real(weights, "weights")
         if w.shape != (DOF,) or not np.isfinite(w).all() or (w < 0.0).any():
             raise ValueError(f"weights must be {DOF} finite non-negative numbers")
-    sols = ik(T, within_limits=within_limits, q_ref=refs)
-    if len(sols) == 0:
-        return None
-    kernels = _kernels(None)
-    pick = _kpick if kernels is None else kernels[2]
-    return sols[pick(sols, refs, w, not within_limits)]
+    if metric not in ("l2", "max"):
+        raise ValueError(f"metric must be 'l2' or 'max', got {metric!r}")
+    return refs, w
+
+
+def _distances(rows, refs, w, metric, wrap):
+    """Per row, its distance from refs: sum of w dq^2 ("l2") or max of w |dq| ("max")."""
+    d = rows - np.array(refs)
+    if wrap:
+        d -= _TWO_PI * np.rint(d / _TWO_PI) * _REV
+    if metric == "max":
+        return (w * np.abs(d)).max(axis=1, initial=0.0)
+    return (w * d * d).sum(axis=1)
 
 
 def _pose(T):

@@ -21,6 +21,8 @@ LIMITS = ((-math.pi, math.pi), (-1.0, 1.0))
 REACH = 1.0
 # the most solutions a pose can have by the arm's derivation
 MAX_SOLUTIONS = 2
+# the joints (1-based) whose values the caller gives (an arm of more than 6 joints)
+FREE: tuple[int, ...] = ()
 # "pose" or "position": what certification compares
 IK_COMPONENTS = "pose"
 _REVOLUTE = (True, False)

@@ -36,6 +36,12 @@ _SEAM_SNAP = 1e-12
 _SEAM = math.pi - _SEAM_BAND
 # all_turns=True returns at most this many rows (every 2 pi variant of every joint)
 MAX_TURN_ROWS = 100_000
+# arms with free joints: nearest steps them by FREE_STEP (radians, or length) outward from
+# q_ref's values, solving NEAREST_BATCH values at a time; ik_sweep and nearest take at most
+# MAX_FREE_VALUES values
+FREE_STEP = 0.01
+NEAREST_BATCH = 16
+MAX_FREE_VALUES = 100_000
 # the general 6R method (derive/runtime/general.py): Q's rank counts singular values above
 # _RR_RANK_TOL of the largest; a Moebius map x3 = (a y + b) / (c y + d) is kept once the
 # leading matrix's condition number is below _RR_COND_LIMIT (else the best of the three);

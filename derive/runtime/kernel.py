@@ -379,11 +379,13 @@ def _kone(T, tol, qref, limited):
 
 def _kbatch(T, tol, qref, Q, valid, retry):
     """Every pose of T (n, 4, 4): solutions into Q, valid (rows in ik's order, repeats
-    dropped); retry[i] where the scalar solver must settle pose i. The poses are split into
-    _KPARTS ranges, solved in parallel when compiled; each pose's result depends on that pose
-    alone."""
+    dropped); retry[i] where the scalar solver must settle pose i. qref (1, DOF): one
+    reference for every pose, or (n, DOF): one per pose (a redundant arm's free values). The
+    poses are split into _KPARTS ranges, solved in parallel when compiled; each pose's result
+    depends on that pose alone."""
     n = T.shape[0]
-    ref = _kreference(qref)
+    shared = _kreference(qref[0])
+    each = qref.shape[0] > 1
     for part in _prange(_KPARTS):
         found = np.zeros((MAX_SOLUTIONS, DOF))
         buf = np.zeros(_KBUF)
@@ -391,6 +393,7 @@ def _kbatch(T, tol, qref, Q, valid, retry):
         for i in range(part * n // _KPARTS, (part + 1) * n // _KPARTS):
             if not _kpose_ok(T, i):
                 continue
+            ref = _kreference(qref[i]) if each else shared
             count = _ksolve_pose(T, i, tol, ref, found, buf)
             if count < 0:
                 retry[i] = True

@@ -365,3 +365,9 @@ def _vfinish(Q, valid):
 def _vdefer(n, dof):
     """_ik_candidates's result sending all n poses to the scalar solver (no branch values)."""
     return np.zeros((n, 1, dof)), np.zeros((n, 1), dtype=bool), np.ones(n, dtype=bool)
+
+
+def _vshape(value, shape):
+    """A free joint's reference value: one number for every pose as it is, an array of one
+    value per pose shaped like the poses' axis (shape)."""
+    return value if np.ndim(value) == 0 else np.reshape(value, shape)
