@@ -9,7 +9,7 @@ import math
 import numpy as np
 from numpy.typing import ArrayLike
 
-from derive.runtime.api import _distances, _in_limits, _nearest_arguments, _pose, ik_batch
+from derive.runtime.api import _distances, _in_limits, _nearest_arguments, _pose, ik, ik_batch
 from derive.runtime.arm import _REVOLUTE, FREE, LIMITS, REACH
 from derive.runtime.common import _real, _reference
 from derive.runtime.constants import CERTIFY_TOL, FREE_STEP, MAX_FREE_VALUES, NEAREST_BATCH
@@ -67,12 +67,19 @@ def nearest(
     bound = _distances(own, refs, w, metric, False)
     order = np.argsort(bound, kind="stable")
     best, least = None, math.inf
-    for first in range(0, len(order), NEAREST_BATCH):
-        chunk = order[first : first + NEAREST_BATCH]
+    # q_ref's own free values first (one ik: along a smooth path that usually settles it),
+    # then NEAREST_BATCH values per ik_batch
+    starts = [0, *range(1, len(order), NEAREST_BATCH)]
+    for first, end in zip(starts, [*starts[1:], len(order)]):
+        chunk = order[first:end]
         if bound[chunk[0]] >= least:
             break
-        Q, valid = ik_batch(np.repeat(A[None], len(chunk), axis=0), free=grid[chunk], q_ref=refs)
-        rows = Q[valid]
+        if len(chunk) == 1:
+            rows = ik(A, free=grid[chunk[0]], q_ref=refs)
+        else:
+            poses = np.repeat(A[None], len(chunk), axis=0)
+            Q, valid = ik_batch(poses, free=grid[chunk], q_ref=refs)
+            rows = Q[valid]
         if within_limits:
             rows = _in_limits(rows, refs, False)
         if len(rows) == 0:
