@@ -20,6 +20,7 @@ from __future__ import annotations
 
 from dataclasses import fields, replace
 
+import numpy as np
 import sympy as sp
 
 from derive import symbols as sym
@@ -45,15 +46,62 @@ def candidates(chain: Chain, named: tuple[int, ...] | None) -> tuple[tuple[int, 
 def refusal(chain: Chain, free: tuple[int, ...]) -> str:
     """Why this choice of free joints cannot be used, or "" if it can."""
     n = chain.dof
+    rank = remainder_rank(chain, free)
+    if rank < REMAINDER_DOF:
+        return (
+            f"with these joints fixed the other joints move the tool in {rank} directions "
+            f"only (their Jacobian has rank {rank} at random configurations): the remainder "
+            "loses a degree of freedom"
+        )
     k, m = split(free, n)
     if free[k:] == tuple(range(n - m + 1, n + 1)):
         return ""
     middle = next(i for i in free[k:] if not set(range(i, n + 1)) <= set(free))
     return (
         f"free joint {middle} is a middle joint: only end joints (the first or the last ones) "
-        f"can be free, so that the other {REMAINDER_DOF} joints form one chain whose base and "
-        "tool the free joints move"
+        f"can be free here, so that the other {REMAINDER_DOF} joints form one chain whose base "
+        "and tool the free joints move"
     )
+
+
+def remainder_rank(chain: Chain, free: tuple[int, ...]) -> int:
+    """The rank of the other joints' Jacobian (rotation and position, lengths in units of the
+    arm's size) at three random configurations, the largest: below 6 where fixing the free
+    joints takes a degree of freedom from the tool (q4 of an S-R-S arm fixes the distance
+    from shoulder to wrist)."""
+    rng = np.random.default_rng(18)
+    size = max(
+        [1.0] + [abs(float(t.a)) for t in chain.twists] + [abs(float(j.d)) for j in chain.joints]
+    )
+    moving = [i for i in range(chain.dof) if i + 1 not in free]
+    best = 0
+    for _ in range(3):
+        q = rng.uniform(-np.pi, np.pi, chain.dof)
+        columns = []
+        for i in moving:
+            step = np.zeros(chain.dof)
+            step[i] = 1e-6
+            d = (pose_numbers(chain, q + step, size) - pose_numbers(chain, q - step, size)) / 2e-6
+            columns.append(d[:3].ravel())
+        sigma = np.linalg.svd(np.array(columns).T, compute_uv=False)
+        best = max(best, int((sigma > 1e-6 * sigma[0]).sum()))
+    return best
+
+
+def pose_numbers(chain: Chain, q: np.ndarray, size: float) -> np.ndarray:
+    """X_0 Z_1 X_1 ... Z_n X_n at joint values q (a prismatic joint's q in units of size),
+    lengths divided by size."""
+    out = np.eye(4)
+    for k, twist in enumerate(chain.twists):
+        if k:
+            j = chain.joints[k - 1]
+            angle = q[k - 1] if j.kind == "R" else float(j.theta)
+            shift = float(j.d) / size if j.kind == "R" else q[k - 1]
+            c, s = np.cos(angle), np.sin(angle)
+            out = out @ np.array([[c, -s, 0, 0], [s, c, 0, 0], [0, 0, 1, shift], [0, 0, 0, 1]])
+        ca, sa, a = float(twist.ca), float(twist.sa), float(twist.a) / size
+        out = out @ np.array([[1, 0, 0, a], [0, ca, -sa, 0], [0, sa, ca, 0], [0, 0, 0, 1]])
+    return out
 
 
 def split(free: tuple[int, ...], n: int) -> tuple[int, int]:

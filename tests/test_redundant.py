@@ -247,7 +247,7 @@ def test_the_spec_names_the_free_joint(tmp_path):
 @pytest.mark.parametrize(
     ("free", "message"),
     [
-        ("[4]", "free joint 4 is a middle joint"),
+        ("[4]", "free q4: with these joints fixed the other joints move the tool in 5 directions"),
         ("[3]", "free joint 3 is a middle joint"),
     ],
 )
