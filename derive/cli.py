@@ -18,7 +18,7 @@ import time
 from importlib import resources
 from pathlib import Path
 from types import ModuleType
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 if TYPE_CHECKING:
     from collections.abc import Iterable
@@ -107,7 +107,7 @@ def worked_example(plan: Plan, module: ModuleType) -> Example:
 TMP_SUFFIX = ".derive-tmp"
 
 
-def write_atomic(path: Path, text: str) -> None:
+def write_atomic(path: Path, text: str | bytes) -> None:
     """Write through a temporary file and rename, so no partial file is ever visible.
 
     The file gets the mode an existing file at ``path`` has, else the mode a new file gets
@@ -123,8 +123,12 @@ def write_atomic(path: Path, text: str) -> None:
         mode = 0o666 & ~current_umask()
     fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=TMP_SUFFIX, dir=path.parent)
     try:
-        with os.fdopen(fd, "w", encoding="utf-8", newline="\n") as handle:
-            handle.write(text)
+        if isinstance(text, bytes):
+            with os.fdopen(fd, "wb") as binary:
+                binary.write(text)
+        else:
+            with os.fdopen(fd, "w", encoding="utf-8", newline="\n") as handle:
+                handle.write(text)
         os.chmod(tmp, mode)
         os.replace(tmp, path)
     except BaseException:
@@ -319,21 +323,7 @@ def cmd_solve(args: argparse.Namespace) -> int:
     module = load_module(spec)
     if not hasattr(module, "ik"):
         raise UsageError(f"{spec.name}: no IK method applies to this arm")
-    q = None
-    if args.q is not None:
-        q = joint_vector(spec, parse_numbers(args.q, "--q"), args.rad)
-        pose = module.fk(q)
-    else:
-        numbers = parse_numbers([args.pose], "--pose")
-        if len(numbers) not in (12, 16):
-            raise UsageError("--pose: give 12 numbers (3 rows of 4) or 16 (4 rows of 4)")
-        pose = np.array([*numbers[:12], 0.0, 0.0, 0.0, 1.0]).reshape(4, 4)
-    free = free_values(spec, module, args, q)
-    try:
-        # one pose: not worth compiling
-        sols = module.ik(pose, backend="python", **({"free": free} if free else {}))
-    except ValueError as exc:
-        raise UsageError(f"--pose: {exc}") from None
+    pose, free, sols = solve_arguments(spec, module, args)
     print("pose:")
     print(format_pose(pose))
     if free:
@@ -355,6 +345,55 @@ def cmd_solve(args: argparse.Namespace) -> int:
         print(
             f"{k:2d}: " + " ".join(f"{v:10.4f}" for v in shown) + f"  residual {residual:.1e}{flag}"
         )
+    return 0
+
+
+def solve_arguments(
+    spec: ArmSpec, module: ModuleType, args: argparse.Namespace
+) -> tuple[Any, list[float], Any]:
+    """The pose of --pose or --q, the free joints' values, and every solution (Python ik)."""
+    import numpy as np
+
+    q = None
+    if args.q is not None:
+        q = joint_vector(spec, parse_numbers(args.q, "--q"), args.rad)
+        pose = module.fk(q)
+    else:
+        numbers = parse_numbers([args.pose], "--pose")
+        if len(numbers) not in (12, 16):
+            raise UsageError("--pose: give 12 numbers (3 rows of 4) or 16 (4 rows of 4)")
+        pose = np.array([*numbers[:12], 0.0, 0.0, 0.0, 1.0]).reshape(4, 4)
+    free = free_values(spec, module, args, q)
+    try:
+        # one pose: not worth compiling
+        sols = module.ik(pose, backend="python", **({"free": free} if free else {}))
+    except ValueError as exc:
+        raise UsageError(f"--pose: {exc}") from None
+    return pose, free, sols
+
+
+def cmd_plot(args: argparse.Namespace) -> int:
+    """Draw every IK solution of a pose (one panel each) into an SVG or PNG file."""
+    from derive.plot import PlotUnavailable, figure_bytes, solutions_figure
+
+    spec = resolve_spec(args.arm, urdf_options(args))
+    module = load_module(spec)
+    if not hasattr(module, "ik"):
+        raise UsageError(f"{spec.name}: no IK method applies to this arm")
+    output = Path(args.output or f"{spec.name}_solutions.svg")
+    fmt = output.suffix.lstrip(".").lower()
+    if fmt not in ("svg", "png"):
+        raise UsageError(f"-o: {output}: the file must end in .svg or .png")
+    pose, _, sols = solve_arguments(spec, module, args)
+    try:
+        fig, _ = solutions_figure(
+            module, spec.convention, pose, sols, f"{spec.name}: {len(sols)} solution(s)"
+        )
+        data = figure_bytes(fig, fmt)
+    except PlotUnavailable as exc:
+        raise UsageError(str(exc)) from None
+    write_atomic(output, data)
+    print(f"{output}: {len(sols)} solution(s) drawn")
     return 0
 
 
@@ -483,15 +522,12 @@ def parser() -> argparse.ArgumentParser:
     fk.add_argument("--rad", action="store_true", help="R joint values are in radians")
     fk.set_defaults(run=cmd_fk)
     solve = sub.add_parser("solve", help="print every IK solution of a pose")
-    solve.add_argument("arm", help="spec file or bundled arm name")
-    group = solve.add_mutually_exclusive_group(required=True)
-    group.add_argument("--pose", help="'r11 r12 r13 px r21 ... pz' (12 or 16 numbers)")
-    group.add_argument("--q", nargs="+", help="solve the pose of these joint values")
-    solve.add_argument("--rad", action="store_true", help="--q and --free values are in radians")
-    solve.add_argument(
-        "--free", nargs="+", help="an arm with free joints: their values (default: --q's, or 0)"
-    )
+    add_pose_arguments(solve)
     solve.set_defaults(run=cmd_solve)
+    plot = sub.add_parser("plot", help="draw every IK solution of a pose (needs matplotlib)")
+    add_pose_arguments(plot)
+    plot.add_argument("-o", "--output", help="FILE.svg or FILE.png (default: NAME_solutions.svg)")
+    plot.set_defaults(run=cmd_plot)
     report = sub.add_parser("report", help="the derivation, lecture style (Markdown or LaTeX)")
     report.add_argument("arm", help="spec file or bundled arm name")
     report.add_argument("--format", choices=("md", "tex"), default="md", help="md (default) or tex")
@@ -519,9 +555,21 @@ def parser() -> argparse.ArgumentParser:
     )
     imp.add_argument("-o", "--output", help="write the spec here (default: standard output)")
     imp.set_defaults(run=cmd_import_urdf)
-    for command in (gen, chk, fk, solve, report, bench, imp):
+    for command in (gen, chk, fk, solve, plot, report, bench, imp):
         add_urdf_arguments(command, required=command is imp)
     return top
+
+
+def add_pose_arguments(command: argparse.ArgumentParser) -> None:
+    """The arm and the pose of solve and plot: --pose or --q, --rad, --free."""
+    command.add_argument("arm", help="spec file or bundled arm name")
+    group = command.add_mutually_exclusive_group(required=True)
+    group.add_argument("--pose", help="'r11 r12 r13 px r21 ... pz' (12 or 16 numbers)")
+    group.add_argument("--q", nargs="+", help="solve the pose of these joint values")
+    command.add_argument("--rad", action="store_true", help="--q and --free values are in radians")
+    command.add_argument(
+        "--free", nargs="+", help="an arm with free joints: their values (default: --q's, or 0)"
+    )
 
 
 def add_urdf_arguments(command: argparse.ArgumentParser, required: bool) -> None:

@@ -1,0 +1,97 @@
+"""Pictures of the solutions (issue 19): every solution drawn, end points at the target,
+deterministic SVG, a clear message without matplotlib."""
+
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+from derive.cli import main, resolve_spec
+from derive.pipeline import build_plan
+from derive.plot import arm_drawing, figure_bytes, solutions_figure
+
+pytest.importorskip("matplotlib", reason="pictures need matplotlib (the test extra has it)")
+
+
+def arm_lines(fig):
+    """Per panel, the arm's polyline (the line drawn with joint markers) as (k, 3) points."""
+    out = []
+    for ax in fig.axes:
+        for line in ax.get_lines():
+            if line.get_marker() == "o":
+                out.append(np.array(line.get_data_3d()).T)
+    return out
+
+
+def test_the_puma_pose_of_the_report_shows_eight_arms_at_the_target(generated):
+    m = generated("puma560")
+    q = np.radians([20.0] * 6)
+    T = m.fk(q)
+    sols = m.ik(T, backend="python")
+    fig, drawings = solutions_figure(m, "standard", T, sols, "puma560")
+    assert len(sols) == 8 and len(fig.axes) == 8
+    for points, d, row in zip(arm_lines(fig), drawings, sols):
+        assert np.abs(points[-1] - m.fk(row)[:3, 3]).max() <= 1e-12
+        assert np.abs(points[-1] - T[:3, 3]).max() <= 1e-9
+        assert np.abs(d.tool - m.fk(row)).max() <= 1e-12
+    assert "20.0, 20.0, 20.0, 20.0, 20.0, 20.0" in fig.axes[0].get_title()
+    figure_bytes(fig, "png")
+
+
+def test_the_lecture_cup_example_shows_its_eight_solutions(generated):
+    m = generated("lecture_6r")
+    plan = build_plan(resolve_spec("lecture_6r"))
+    assert plan.arm.example_pose is not None
+    T = np.array(plan.arm.example_pose).reshape(4, 4)
+    sols = m.ik(T, backend="python")
+    fig, drawings = solutions_figure(m, "modified", T, sols, "lecture_6r")
+    assert len(drawings) == 8 == len(arm_lines(fig))
+    for points in arm_lines(fig):
+        assert np.abs(points[-1] - T[:3, 3]).max() <= 1e-9 * m.REACH
+    figure_bytes(fig, "svg")
+
+
+@pytest.mark.parametrize("name", ["iiwa14", "panda", "parallel_6r", "planar_2r", "manocha_canny"])
+def test_drawings_end_at_fk_in_both_conventions(generated, name):
+    m = generated(name)
+    convention = build_plan(resolve_spec(name)).arm.convention
+    for q in np.random.default_rng(4).uniform(-3, 3, (5, m.DOF)):
+        d = arm_drawing(m, convention, q)
+        assert np.abs(d.tool - m.fk(q)).max() <= 1e-12
+        assert d.outside == tuple(
+            i + 1 for i, (v, (lo, hi)) in enumerate(zip(q, m.LIMITS)) if not lo <= v <= hi
+        )
+
+
+def test_svg_is_the_same_bytes_across_runs_and_hash_seeds(tmp_path):
+    outputs = []
+    for seed in ("0", "1", "0"):
+        path = tmp_path / f"puma_{len(outputs)}.svg"
+        env = dict(os.environ, PYTHONHASHSEED=seed)
+        command = ["plot", "puma560", "--q", *["20"] * 6, "-o", str(path)]
+        subprocess.run(
+            [sys.executable, "-m", "derive", *command],
+            check=True,
+            env=env,
+            capture_output=True,
+        )
+        outputs.append(path.read_bytes())
+    assert outputs[0] == outputs[1] == outputs[2]
+    assert b"<dc:date>" not in outputs[0]
+
+
+def test_without_matplotlib_plot_says_what_to_install(monkeypatch, tmp_path, capsys):
+    monkeypatch.setitem(sys.modules, "matplotlib", None)
+    out = tmp_path / "p.svg"
+    assert main(["plot", "puma560", "--q", *["20"] * 6, "-o", str(out)]) == 2
+    assert "pip install 'derive-ik[plot]'" in capsys.readouterr().err
+    assert not out.exists()
+
+
+def test_plot_refuses_other_file_types(tmp_path, capsys):
+    assert main(["plot", "puma560", "--q", *["20"] * 6, "-o", str(tmp_path / "p.jpg")]) == 2
+    assert "must end in .svg or .png" in capsys.readouterr().err
