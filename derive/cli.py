@@ -397,6 +397,39 @@ def cmd_plot(args: argparse.Namespace) -> int:
     return 0
 
 
+def cmd_workspace(args: argparse.Namespace) -> int:
+    """Map a section of the reachable and dexterous workspace and the solutions per position."""
+    from derive.classify import classify
+    from derive.plot import PlotUnavailable, figure_bytes, workspace_figure
+    from derive.transforms import chain_from_spec
+    from derive.workspace import workspace
+
+    spec = resolve_spec(args.arm, urdf_options(args))
+    module = load_module(spec)
+    if not hasattr(module, "ik"):
+        raise UsageError(f"{spec.name}: no IK method applies to this arm")
+    if not 3 <= args.resolution <= 2001 or args.resolution % 2 == 0:
+        raise UsageError("--resolution: an odd number from 3 to 2001 (the grid holds the centre)")
+    output = Path(args.output or f"{spec.name}_workspace.svg")
+    fmt = output.suffix.lstrip(".").lower()
+    if fmt not in ("svg", "png"):
+        raise UsageError(f"-o: {output}: the file must end in .svg or .png")
+    chain = chain_from_spec(spec)
+    planar = len(classify(chain).parallel) == chain.dof - 1
+    try:
+        from derive.plot import pyplot
+
+        pyplot()  # before the computation: say at once if matplotlib is missing
+        wmap = workspace(module, planar, spec.convention, args.resolution, args.limits)
+        data = figure_bytes(workspace_figure(wmap, f"{spec.name}: workspace section"), fmt)
+    except PlotUnavailable as exc:
+        raise UsageError(str(exc)) from None
+    write_atomic(output, data)
+    print(f"{spec.name}: {wmap.summary()}")
+    print(f"{output}: written")
+    return 0
+
+
 def free_values(
     spec: ArmSpec, module: ModuleType, args: argparse.Namespace, q: list[float] | None
 ) -> list[float]:
@@ -528,6 +561,16 @@ def parser() -> argparse.ArgumentParser:
     add_pose_arguments(plot)
     plot.add_argument("-o", "--output", help="FILE.svg or FILE.png (default: NAME_solutions.svg)")
     plot.set_defaults(run=cmd_plot)
+    space = sub.add_parser(
+        "workspace", help="reachable and dexterous workspace section (needs matplotlib)"
+    )
+    space.add_argument("arm", help="spec file or bundled arm name")
+    space.add_argument("-o", "--output", help="FILE.svg or FILE.png (default: NAME_workspace.svg)")
+    space.add_argument(
+        "--resolution", type=int, default=201, help="grid points per side, odd (default 201)"
+    )
+    space.add_argument("--limits", action="store_true", help="honour the joint limits")
+    space.set_defaults(run=cmd_workspace)
     report = sub.add_parser("report", help="the derivation, lecture style (Markdown or LaTeX)")
     report.add_argument("arm", help="spec file or bundled arm name")
     report.add_argument("--format", choices=("md", "tex"), default="md", help="md (default) or tex")
@@ -555,7 +598,7 @@ def parser() -> argparse.ArgumentParser:
     )
     imp.add_argument("-o", "--output", help="write the spec here (default: standard output)")
     imp.set_defaults(run=cmd_import_urdf)
-    for command in (gen, chk, fk, solve, plot, report, bench, imp):
+    for command in (gen, chk, fk, solve, plot, space, report, bench, imp):
         add_urdf_arguments(command, required=command is imp)
     return top
 

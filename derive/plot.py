@@ -180,3 +180,33 @@ def figure_bytes(fig: Any, fmt: str) -> bytes:
     fig.savefig(buffer, format=fmt, metadata=metadata, dpi=110)
     plt.close(fig)
     return buffer.getvalue()
+
+
+def workspace_figure(wmap: Any, title: str) -> Any:
+    """Three panels of a workspace section: reachable, dexterous, solutions per position."""
+    plt = pyplot()
+    fig, axes = plt.subplots(1, 3, figsize=(13.5, 4.6))
+    fig.suptitle(title, fontsize=10)
+    extent = (wmap.u[0], wmap.u[-1], wmap.v[0], wmap.v[-1])
+    section = "the arm's plane" if wmap.planar else "the plane through axis 1"
+    panels = (
+        (wmap.reachable, "reachable (some orientation)", "Greys"),
+        (wmap.dexterous, f"dexterous (all {wmap.orientations} orientations)", "Greys"),
+        (wmap.counts, "solutions (most over the orientations)", "viridis"),
+    )
+    for ax, (values, name, cmap) in zip(axes, panels):
+        image = ax.imshow(
+            values.astype(float), origin="lower", extent=extent, cmap=cmap, interpolation="nearest"
+        )
+        ax.set_title(name, fontsize=8)
+        ax.set_xlabel(f"u (in {section})", fontsize=7)
+        ax.set_ylabel("v" if wmap.planar else "along axis 1", fontsize=7)
+        ax.tick_params(labelsize=6)
+        ax.set_aspect("equal")
+        if cmap == "viridis":
+            fig.colorbar(image, ax=ax, shrink=0.8)
+    dots = np.argwhere(wmap.dexterous)
+    if 0 < len(dots) <= 20:  # a few dexterous cells: marked, or they would not show
+        axes[1].plot(wmap.u[dots[:, 1]], wmap.v[dots[:, 0]], "r.", markersize=6)
+    fig.tight_layout()
+    return fig
