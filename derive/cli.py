@@ -479,12 +479,64 @@ def cmd_report(args: argparse.Namespace) -> int:
     spec = resolve_spec(args.arm, urdf_options(args))
     plan = build_plan(spec)
     module = import_source(spec.name, render_module(plan))
-    text = render_report(plan, worked_example(plan, module), args.format)
+    example = worked_example(plan, module)
+    figures = report_figures(spec, plan, module, example, args) if args.figures else ()
+    text = render_report(plan, example, args.format, figures)
     if args.output:
         write_atomic(Path(args.output), text)
     else:
         sys.stdout.write(text)
     return 0
+
+
+def report_figures(
+    spec: ArmSpec, plan: Plan, module: ModuleType, example: Example, args: argparse.Namespace
+) -> tuple[tuple[str, str], ...]:
+    """The report's pictures, written beside its output (or into the working folder): the
+    worked example's solutions and a workspace section (SVG for Markdown, PNG for LaTeX,
+    which pdflatex includes). Returns (caption, file name) pairs."""
+    import numpy as np
+
+    from derive.classify import classify
+    from derive.plot import PlotUnavailable, figure_bytes, solutions_figure, workspace_figure
+    from derive.transforms import chain_from_spec
+    from derive.workspace import workspace
+
+    folder = Path(args.output).parent if args.output else Path(".")
+    ext = "png" if args.format == "tex" else "svg"
+    pose = np.array(example.pose).reshape(4, 4)
+    chain = chain_from_spec(spec)
+    planar = len(classify(chain).parallel) == chain.dof - 1
+    try:
+        drawing, _ = solutions_figure(
+            module,
+            spec.convention,
+            pose,
+            np.array(example.solutions),
+            f"{spec.name}: the worked example",
+        )
+        solutions = figure_bytes(drawing, ext)
+        wmap = workspace(module, planar, spec.convention, REPORT_RESOLUTION)
+        section = figure_bytes(workspace_figure(wmap, f"{spec.name}: workspace section"), ext)
+    except PlotUnavailable as exc:
+        raise UsageError(f"--figures: {exc}") from None
+    out = []
+    for stem, data, caption in (
+        ("solutions", solutions, f"The worked example's {len(example.solutions)} solutions."),
+        (
+            "workspace",
+            section,
+            f"Workspace section ({REPORT_RESOLUTION} x {REPORT_RESOLUTION}): {wmap.summary()}.",
+        ),
+    ):
+        name = f"{spec.name}_{stem}.{ext}"
+        write_atomic(folder / name, data)
+        out.append((caption, name))
+    return tuple(out)
+
+
+# the report's workspace section: grid points per side
+REPORT_RESOLUTION = 101
 
 
 def versus(ours: float, theirs: float) -> str:
@@ -575,6 +627,11 @@ def parser() -> argparse.ArgumentParser:
     report.add_argument("arm", help="spec file or bundled arm name")
     report.add_argument("--format", choices=("md", "tex"), default="md", help="md (default) or tex")
     report.add_argument("-o", "--output", help="write to this file (default: standard output)")
+    report.add_argument(
+        "--figures",
+        action="store_true",
+        help="draw the worked example's solutions and a workspace section beside the report",
+    )
     report.set_defaults(run=cmd_report)
     bench = sub.add_parser("bench", help="time generation and solvers; round-trip figures")
     bench.add_argument("specs", nargs="*", help="spec files or bundled arm names (default: all)")

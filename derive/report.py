@@ -32,9 +32,10 @@ class Block:
     """One piece of the report.
 
     Attributes:
-        kind: "h2", "h3", "p" (text), "math" (lhs = rhs, display) or "table".
-        text: the text, or the math block's left-hand side (LaTeX, may be empty).
-        math: the math block's right-hand side, printed by SymPy.
+        kind: "h2", "h3", "p" (text), "math" (lhs = rhs, display), "table" or "image".
+        text: the text, the math block's left-hand side (LaTeX, may be empty), or the
+            image's caption.
+        math: the math block's right-hand side, printed by SymPy, or the image's file.
         rows: the table's rows, the first one its header.
     """
 
@@ -582,14 +583,22 @@ def for_tex(block: Block) -> Block:
     """A block whose plain text is escaped for LaTeX."""
     if block.kind in ("h2", "h3", "p"):
         return Block(block.kind, latex_text(block.text))
+    if block.kind == "image":
+        return Block("image", latex_text(block.text), block.math)
     if block.kind == "table":
         return Block("table", rows=tuple(tuple(latex_text(c) for c in r) for r in block.rows))
     return block
 
 
-def render_report(plan: Plan, example: Example, fmt: str = "md") -> str:
-    """The report as Markdown ("md") or a standalone LaTeX document ("tex")."""
+def render_report(
+    plan: Plan, example: Example, fmt: str = "md", figures: tuple[tuple[str, str], ...] = ()
+) -> str:
+    """The report as Markdown ("md") or a standalone LaTeX document ("tex"); figures:
+    (caption, file name) pairs shown in a last section."""
     blocks = report_blocks(plan, example)
+    if figures:
+        blocks += (Block("h2", "6. Figures"),)
+        blocks += tuple(Block("image", caption, name) for caption, name in figures)
     if fmt == "tex":
         blocks = tuple(for_tex(b) for b in blocks)
     template = environment().get_template(f"report.{fmt}.j2")

@@ -95,3 +95,16 @@ def test_without_matplotlib_plot_says_what_to_install(monkeypatch, tmp_path, cap
 def test_plot_refuses_other_file_types(tmp_path, capsys):
     assert main(["plot", "puma560", "--q", *["20"] * 6, "-o", str(tmp_path / "p.jpg")]) == 2
     assert "must end in .svg or .png" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize(("fmt", "ext"), [("md", "svg"), ("tex", "png")])
+def test_the_report_embeds_its_figures(tmp_path, fmt, ext):
+    out = tmp_path / f"planar_2r.{fmt}"
+    assert main(["report", "planar_2r", "--figures", "--format", fmt, "-o", str(out)]) == 0
+    text = out.read_text()
+    for stem in ("solutions", "workspace"):
+        name = f"planar_2r_{stem}.{ext}"
+        assert (tmp_path / name).stat().st_size > 1000
+        link = f"]({name})" if fmt == "md" else f"\\includegraphics[width=\\linewidth]{{{name}}}"
+        assert link in text
+    assert "Workspace section (101 x 101): reachable 12.5" in text
