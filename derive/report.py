@@ -579,8 +579,64 @@ def latex_text(text: str) -> str:
     return "$".join(parts)
 
 
+# a table with a row longer than this (characters) is scaled to the text width
+TEX_TABLE = 120
+# a displayed equation's right-hand side longer than this (LaTeX source characters; about a
+# line of a page with 2 cm margins) is broken at its top-level + and - signs
+TEX_LINE = 110
+
+
+def break_sum(math: str, width: int = TEX_LINE) -> tuple[str, ...]:
+    """LaTeX math split at its top-level + and - signs and commas (outside braces and
+    \\left ... \\right) into pieces of about width characters; a sign starts the next piece,
+    a comma ends its own."""
+    cuts = []
+    depth = 0
+    k = 0
+    while k < len(math):
+        if math.startswith("\\left", k):
+            depth += 1
+            k += 5
+            continue
+        if math.startswith("\\right", k):
+            depth -= 1
+            k += 6
+            continue
+        ch = math[k]
+        if ch == "{":
+            depth += 1
+        elif ch == "}":
+            depth -= 1
+        elif depth == 0 and ch in "+-" and k > 0 and math[k - 1] == " ":
+            cuts.append(k)
+        elif depth == 0 and ch == "," and math.startswith(", ", k):
+            cuts.append(k + 2)
+        k += 1
+    pieces: list[str] = []
+    start = 0
+    for at in cuts:
+        if at - start >= width:
+            pieces.append(math[start:at].rstrip())
+            start = at
+    pieces.append(math[start:])
+    return tuple(p for p in pieces if p)
+
+
 def for_tex(block: Block) -> Block:
-    """A block whose plain text is escaped for LaTeX."""
+    """A block whose plain text is escaped for LaTeX; a long equation broken into lines
+    (kind "lines": rows of one piece each)."""
+    if block.kind == "math" and len(block.math) > TEX_LINE:
+        pieces = break_sum(block.math)
+        if len(pieces) > 1:
+            return Block("lines", block.text, rows=tuple((p,) for p in pieces))
+    if block.kind == "math" and len(block.text) > TEX_LINE:  # a long left-hand side
+        pieces = break_sum(block.text)
+        if len(pieces) > 1:
+            lines = (*pieces[:-1], f"{pieces[-1]} = {block.math}")
+            return Block("lines", "", rows=tuple((p,) for p in lines))
+    if block.kind == "table" and max(len(" & ".join(r)) for r in block.rows) > TEX_TABLE:
+        rows = tuple(tuple(latex_text(c) for c in r) for r in block.rows)
+        return Block("widetable", rows=rows)
     if block.kind in ("h2", "h3", "p"):
         return Block(block.kind, latex_text(block.text))
     if block.kind == "image":
