@@ -10,7 +10,10 @@ the generated solver's own solutions. Every formula is printed by SymPy's LaTeX 
 from __future__ import annotations
 
 import math
+import re
+from collections.abc import Callable
 from dataclasses import dataclass
+from functools import partial
 
 import numpy as np
 import sympy as sp
@@ -622,6 +625,44 @@ def break_sum(math: str, width: int = TEX_LINE) -> tuple[str, ...]:
     return tuple(p for p in pieces if p)
 
 
+NoteReplacement = str | Callable[[re.Match[str]], str]
+# the plan's notes write maths in plain text ("0_3R", "Rx(alpha4)", "theta3", "x^2 + y^2");
+# in LaTeX headings these pieces become inline math: (pattern, replacement) in order
+NOTE_MATH = (
+    (r"\b0P_4org\b", r"{}^{0}P_{4\,org}"),
+    (r"\b(\d|n)_(\d|n)([RT])\b", r"{}^{\1}_{\2}\3"),
+    (r"\bR([xyz])\(", lambda m: f"R_{m.group(1).upper()}("),
+    (r"\bT([xyz])\(", lambda m: f"T_{m.group(1)}("),
+    (r"\b(theta|alpha)(\d)\b", r"\\\1_{\2}"),
+    (r"\bt(\d)\b", r"\\theta_{\1}"),
+    (r"\b([csgkvdxq])(\d|n)\b", r"\1_{\2}"),
+    (r"\bW(\d)(\d)\b", r"W_{\1\2}"),
+    (r"\be3\b", r"e_3"),
+    (r"\b([XZ])(\d|n)\b", r"\1_{\2}"),
+    (r"\^-1\b", r"^{-1}"),
+)
+
+
+def note_tex(note: str) -> str:
+    """A plan note for a LaTeX heading: its maths pieces as inline math, the rest escaped."""
+    pieces: list[str] = []
+
+    def keep(match: re.Match[str], replacement: NoteReplacement) -> str:
+        """The match kept aside as inline math; a placeholder in its place."""
+        text = replacement(match) if callable(replacement) else match.expand(replacement)
+        pieces.append(f"${text}$")
+        return f"\x00{len(pieces) - 1}\x00"
+
+    out = note
+    for pattern, replacement in NOTE_MATH:
+        out = re.sub(pattern, partial(keep, replacement=replacement), out)
+    # x^2, ^T and the like
+    out = re.sub(r"\^(\w+)", lambda m: keep(m, r"^{\1}"), out)
+    text = latex_text(out)
+    text = re.sub("\x00(\\d+)\x00", lambda m: pieces[int(m.group(1))], text)
+    return text.replace("$$", "")  # adjacent pieces: one inline formula
+
+
 def for_tex(block: Block) -> Block:
     """A block whose plain text is escaped for LaTeX; a long equation broken into lines
     (kind "lines": rows of one piece each)."""
@@ -637,7 +678,9 @@ def for_tex(block: Block) -> Block:
     if block.kind == "table" and max(len(" & ".join(r)) for r in block.rows) > TEX_TABLE:
         rows = tuple(tuple(latex_text(c) for c in r) for r in block.rows)
         return Block("widetable", rows=rows)
-    if block.kind in ("h2", "h3", "p"):
+    if block.kind == "h3":
+        return Block("h3", note_tex(block.text))
+    if block.kind in ("h2", "p"):
         return Block(block.kind, latex_text(block.text))
     if block.kind == "image":
         return Block("image", latex_text(block.text), block.math)

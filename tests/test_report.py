@@ -187,3 +187,17 @@ def test_the_latex_report_compiles_and_fits_the_page(name, tmp_path):
     log = (tmp_path / f"{name}.log").read_text(errors="replace")
     widths = [float(w) for w in re.findall(r"Overfull \\hbox \(([0-9.]+)pt too wide\)", log)]
     assert max(widths, default=0.0) <= 20.0, widths
+
+
+def test_latex_headings_typeset_their_maths():
+    from derive.report import note_tex
+
+    tex = note_tex("wrist W = (0_3R Rx(alpha3))^T 0_6R = Rz(t4) Rx(alpha4)")
+    assert tex == (
+        r"wrist W = (${}^{0}_{3}R$ $R_X(\alpha_{3}$))$^{T}$ ${}^{0}_{6}R$ = "
+        r"$R_Z(\theta_{4}$) $R_X(\alpha_{4}$)"
+    )
+    assert note_tex("theta2: x^2 + y^2 = 2*c2 + 2 (elbow up / down)") == (
+        r"$\theta_{2}$: x$^{2}$ + y$^{2}$ = 2*$c_{2}$ + 2 (elbow up / down)"
+    )
+    assert note_tex("50% of a_b & c") == r"50\% of a\_b \& c"
