@@ -61,12 +61,21 @@ def resolve_spec(text: str, options: urdf.Options | None = None) -> ArmSpec:
     raise UsageError(f"{text}: no such spec file or bundled arm; bundled arms: {names}")
 
 
-def outputs_for(spec: ArmSpec) -> tuple[Plan, dict[str, str]]:
-    """The plan and file name -> content of everything generated for one arm."""
+def outputs_for(spec: ArmSpec, figures: bool = False) -> tuple[Plan, dict[str, str | bytes]]:
+    """The plan and file name -> content of everything generated for one arm (with figures:
+    the report's pictures too, embedded in it)."""
     plan = build_plan(spec)
     module_source = render_module(plan)
-    report = render_report(plan, worked_example(plan, import_source(spec.name, module_source)))
-    return plan, {f"{spec.name}.py": module_source, f"{spec.name}.md": report}
+    module = import_source(spec.name, module_source)
+    example = worked_example(plan, module)
+    files: dict[str, str | bytes] = {f"{spec.name}.py": module_source}
+    shown: tuple[tuple[str, str], ...] = ()
+    if figures and plan.ik is not None:
+        made = figure_files(spec, module, example, "svg")
+        files.update({name: data for _, name, data in made})
+        shown = tuple((caption, name) for caption, name, _ in made)
+    files[f"{spec.name}.md"] = render_report(plan, example, "md", shown)
+    return plan, files
 
 
 def worked_example(plan: Plan, module: ModuleType) -> Example:
@@ -182,7 +191,7 @@ def cmd_generate(args: argparse.Namespace) -> int:
         start = time.perf_counter()
         try:
             spec = resolve_spec(text, urdf_options(args))
-            plan, files = outputs_for(spec)
+            plan, files = outputs_for(spec, args.figures)
             for name, content in files.items():
                 write_atomic(out / name, content)
         except (SpecError, UsageError, GenerationError, OSError) as exc:
@@ -218,13 +227,13 @@ def cmd_check(args: argparse.Namespace) -> int:
     expected: dict[str, bytes] = {}
     with tempfile.TemporaryDirectory() as tmp:
         for spec in specs:
-            for name, content in outputs_for(spec)[1].items():
+            for name, content in outputs_for(spec, args.figures)[1].items():
                 write_atomic(Path(tmp) / name, content)
         for path in sorted(Path(tmp).iterdir()):
             expected[path.name] = path.read_bytes()
     names = set(expected)
     if not args.specs and out.is_dir():
-        names |= {p.name for p in out.iterdir() if p.suffix in (".py", ".md")}
+        names |= {p.name for p in out.iterdir() if p.suffix in (".py", ".md", ".svg")}
     problems = []
     for name in sorted(names):
         path = out / name
@@ -492,9 +501,20 @@ def cmd_report(args: argparse.Namespace) -> int:
 def report_figures(
     spec: ArmSpec, plan: Plan, module: ModuleType, example: Example, args: argparse.Namespace
 ) -> tuple[tuple[str, str], ...]:
-    """The report's pictures, written beside its output (or into the working folder): the
-    worked example's solutions and a workspace section (SVG for Markdown, PNG for LaTeX,
-    which pdflatex includes). Returns (caption, file name) pairs."""
+    """The report's pictures, written beside its output (or into the working folder), SVG
+    for Markdown, PNG for LaTeX (which pdflatex includes). Returns (caption, file name)
+    pairs."""
+    folder = Path(args.output).parent if args.output else Path(".")
+    made = figure_files(spec, module, example, "png" if args.format == "tex" else "svg")
+    for _, name, data in made:
+        write_atomic(folder / name, data)
+    return tuple((caption, name) for caption, name, _ in made)
+
+
+def figure_files(
+    spec: ArmSpec, module: ModuleType, example: Example, ext: str
+) -> tuple[tuple[str, str, bytes], ...]:
+    """The worked example's solutions and a workspace section, as (caption, file name, bytes)."""
     import numpy as np
 
     from derive.classify import classify
@@ -502,37 +522,31 @@ def report_figures(
     from derive.transforms import chain_from_spec
     from derive.workspace import workspace
 
-    folder = Path(args.output).parent if args.output else Path(".")
-    ext = "png" if args.format == "tex" else "svg"
     pose = np.array(example.pose).reshape(4, 4)
     chain = chain_from_spec(spec)
     planar = len(classify(chain).parallel) == chain.dof - 1
     try:
-        drawing, _ = solutions_figure(
-            module,
-            spec.convention,
-            pose,
-            np.array(example.solutions),
-            f"{spec.name}: the worked example",
-        )
+        rows = np.array(example.solutions).reshape(-1, spec.dof)
+        title = f"{spec.name}: the worked example"
+        drawing, _ = solutions_figure(module, spec.convention, pose, rows, title)
         solutions = figure_bytes(drawing, ext)
-        wmap = workspace(module, planar, spec.convention, REPORT_RESOLUTION)
+        wmap = workspace(module, planar, spec.convention, REPORT_RESOLUTION, progress=None)
         section = figure_bytes(workspace_figure(wmap, f"{spec.name}: workspace section"), ext)
     except PlotUnavailable as exc:
         raise UsageError(f"--figures: {exc}") from None
-    out = []
-    for stem, data, caption in (
-        ("solutions", solutions, f"The worked example's {len(example.solutions)} solutions."),
+    grid = f"{REPORT_RESOLUTION} x {REPORT_RESOLUTION}"
+    return (
         (
-            "workspace",
-            section,
-            f"Workspace section ({REPORT_RESOLUTION} x {REPORT_RESOLUTION}): {wmap.summary()}.",
+            f"The worked example's {len(example.solutions)} solutions.",
+            f"{spec.name}_solutions.{ext}",
+            solutions,
         ),
-    ):
-        name = f"{spec.name}_{stem}.{ext}"
-        write_atomic(folder / name, data)
-        out.append((caption, name))
-    return tuple(out)
+        (
+            f"Workspace section ({grid}): {wmap.summary()}.",
+            f"{spec.name}_workspace.{ext}",
+            section,
+        ),
+    )
 
 
 # the report's workspace section: grid points per side
@@ -596,10 +610,16 @@ def parser() -> argparse.ArgumentParser:
     )
     gen.add_argument("--out", default=DEFAULT_OUT, help="output folder (default ./generated)")
     gen.add_argument("--require-ik", action="store_true", help="exit 3 if an arm has no IK method")
+    gen.add_argument(
+        "--figures",
+        action="store_true",
+        help="also draw each report's worked example and workspace section (SVG, embedded)",
+    )
     gen.set_defaults(run=cmd_generate)
     chk = sub.add_parser("check", help="fail if DIR is not what generate would write")
     chk.add_argument("specs", nargs="*", help="spec files (default: all bundled arms)")
     chk.add_argument("--out", default=DEFAULT_OUT, help="folder to check (default ./generated)")
+    chk.add_argument("--figures", action="store_true", help="as generate --figures wrote DIR")
     chk.set_defaults(run=cmd_check)
     fk = sub.add_parser("fk", help="print the pose for joint values")
     fk.add_argument("arm", help="spec file or bundled arm name")

@@ -108,3 +108,18 @@ def test_the_report_embeds_its_figures(tmp_path, fmt, ext):
         link = f"]({name})" if fmt == "md" else f"\\includegraphics[width=\\linewidth]{{{name}}}"
         assert link in text
     assert "Workspace section (101 x 101): reachable 12.5" in text
+
+
+def test_generate_with_figures_embeds_them_and_check_reproduces_them(tmp_path, capsys):
+    out = tmp_path / "gen"
+    assert main(["generate", "planar_2r", "--figures", "--out", str(out)]) == 0
+    names = sorted(p.name for p in out.iterdir())
+    assert names == [
+        "planar_2r.md",
+        "planar_2r.py",
+        "planar_2r_solutions.svg",
+        "planar_2r_workspace.svg",
+    ]
+    assert "](planar_2r_workspace.svg)" in (out / "planar_2r.md").read_text()
+    assert main(["check", "planar_2r", "--figures", "--out", str(out)]) == 0
+    assert "up to date (4 files)" in capsys.readouterr().out
