@@ -67,14 +67,20 @@ def test_drawings_end_at_fk_in_both_conventions(generated, name):
         )
 
 
-def test_svg_is_the_same_bytes_across_runs_and_hash_seeds(tmp_path):
+@pytest.mark.parametrize(
+    "command",
+    [
+        ["plot", "puma560", "--q", *["20"] * 6],
+        ["workspace", "planar_2r", "--resolution", "21"],
+    ],
+)
+def test_svg_is_the_same_bytes_across_runs_and_hash_seeds(tmp_path, command):
     outputs = []
     for seed in ("0", "1", "0"):
-        path = tmp_path / f"puma_{len(outputs)}.svg"
+        path = tmp_path / f"figure_{len(outputs)}.svg"
         env = dict(os.environ, PYTHONHASHSEED=seed)
-        command = ["plot", "puma560", "--q", *["20"] * 6, "-o", str(path)]
         subprocess.run(
-            [sys.executable, "-m", "derive", *command],
+            [sys.executable, "-m", "derive", *command, "-o", str(path)],
             check=True,
             env=env,
             capture_output=True,
