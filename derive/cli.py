@@ -278,7 +278,10 @@ def load_module(spec: ArmSpec) -> ModuleType:
 
 
 def import_source(name: str, content: str) -> ModuleType:
-    """Import generated module source through a temporary file."""
+    """Import generated module source through a temporary file. DERIVE_BACKEND in the
+    environment ("auto", "numba" or "python") sets the module's BACKEND: a module imported
+    from a temporary file compiles its kernels on every run (numba cannot cache them there),
+    which "python" skips."""
     with tempfile.TemporaryDirectory() as tmp:
         path = Path(tmp) / f"{name}.py"
         path.write_text(content, encoding="utf-8")
@@ -286,6 +289,11 @@ def import_source(name: str, content: str) -> ModuleType:
         assert loader_spec is not None and loader_spec.loader is not None
         module = importlib.util.module_from_spec(loader_spec)
         loader_spec.loader.exec_module(module)
+    backend = os.environ.get("DERIVE_BACKEND")
+    if backend is not None and hasattr(module, "BACKEND"):
+        if backend not in ("auto", "numba", "python"):
+            raise UsageError(f"DERIVE_BACKEND={backend[:20]!r}; allowed: auto, numba, python")
+        setattr(module, "BACKEND", backend)  # noqa: B010 (a generated module's setting)
     return module
 
 

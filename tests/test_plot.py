@@ -71,14 +71,14 @@ def test_drawings_end_at_fk_in_both_conventions(generated, name):
     "command",
     [
         ["plot", "puma560", "--q", *["20"] * 6],
-        ["workspace", "planar_2r", "--resolution", "21"],
+        ["workspace", "planar_2r", "--resolution", "9"],
     ],
 )
 def test_svg_is_the_same_bytes_across_runs_and_hash_seeds(tmp_path, command):
     outputs = []
-    for seed in ("0", "1", "0"):
+    for seed in ("0", "1"):
         path = tmp_path / f"figure_{len(outputs)}.svg"
-        env = dict(os.environ, PYTHONHASHSEED=seed)
+        env = dict(os.environ, PYTHONHASHSEED=seed, DERIVE_BACKEND="python")
         subprocess.run(
             [sys.executable, "-m", "derive", *command, "-o", str(path)],
             check=True,
@@ -86,7 +86,7 @@ def test_svg_is_the_same_bytes_across_runs_and_hash_seeds(tmp_path, command):
             capture_output=True,
         )
         outputs.append(path.read_bytes())
-    assert outputs[0] == outputs[1] == outputs[2]
+    assert outputs[0] == outputs[1]
     assert b"<dc:date>" not in outputs[0]
 
 
@@ -104,7 +104,8 @@ def test_plot_refuses_other_file_types(tmp_path, capsys):
 
 
 @pytest.mark.parametrize(("fmt", "ext"), [("md", "svg"), ("tex", "png")])
-def test_the_report_embeds_its_figures(tmp_path, fmt, ext):
+def test_the_report_embeds_its_figures(tmp_path, monkeypatch, fmt, ext):
+    monkeypatch.setenv("DERIVE_BACKEND", "python")  # (no numba compile of a throwaway module)
     out = tmp_path / f"planar_2r.{fmt}"
     assert main(["report", "planar_2r", "--figures", "--format", fmt, "-o", str(out)]) == 0
     text = out.read_text()
@@ -116,7 +117,8 @@ def test_the_report_embeds_its_figures(tmp_path, fmt, ext):
     assert "Workspace section (101 x 101): reachable 12.5" in text
 
 
-def test_generate_with_figures_embeds_them_and_check_reproduces_them(tmp_path, capsys):
+def test_generate_with_figures_embeds_them_and_check_reproduces_them(tmp_path, capsys, monkeypatch):
+    monkeypatch.setenv("DERIVE_BACKEND", "python")
     out = tmp_path / "gen"
     assert main(["generate", "planar_2r", "--figures", "--out", str(out)]) == 0
     names = sorted(p.name for p in out.iterdir())

@@ -57,7 +57,8 @@ def test_a_tool_offset_makes_the_dexterous_section_smaller(generated):
     assert cup.volume(cup.dexterous) < cup.volume(cup.reachable)
 
 
-def test_the_workspace_command_writes_its_figure_and_figures(tmp_path, capsys):
+def test_the_workspace_command_writes_its_figure_and_figures(tmp_path, capsys, monkeypatch):
+    monkeypatch.setenv("DERIVE_BACKEND", "python")
     out = tmp_path / "ws.svg"
     assert main(["workspace", "planar_2r", "--resolution", "41", "-o", str(out)]) == 0
     printed = capsys.readouterr().out
