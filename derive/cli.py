@@ -336,10 +336,7 @@ def cmd_solve(args: argparse.Namespace) -> int:
     """Print every IK solution of a pose, its FK residual and the joints outside limits."""
     import numpy as np
 
-    spec = resolve_spec(args.arm, urdf_options(args))
-    module = load_module(spec)
-    if not hasattr(module, "ik"):
-        raise UsageError(f"{spec.name}: no IK method applies to this arm")
+    spec, module = ik_module(args)
     pose, free, sols = solve_arguments(spec, module, args)
     print("pose:")
     print(format_pose(pose))
@@ -363,6 +360,33 @@ def cmd_solve(args: argparse.Namespace) -> int:
             f"{k:2d}: " + " ".join(f"{v:10.4f}" for v in shown) + f"  residual {residual:.1e}{flag}"
         )
     return 0
+
+
+def ik_module(args: argparse.Namespace) -> tuple[ArmSpec, ModuleType]:
+    """The arm of args.arm and its generated module, which must have an IK solver."""
+    spec = resolve_spec(args.arm, urdf_options(args))
+    module = load_module(spec)
+    if not hasattr(module, "ik"):
+        raise UsageError(f"{spec.name}: no IK method applies to this arm")
+    return spec, module
+
+
+def figure_output(args: argparse.Namespace, default: str) -> tuple[Path, str]:
+    """The picture's file (-o, else default) and its format, svg or png."""
+    output = Path(args.output or default)
+    fmt = output.suffix.lstrip(".").lower()
+    if fmt not in ("svg", "png"):
+        raise UsageError(f"-o: {output}: the file must end in .svg or .png")
+    return output, fmt
+
+
+def is_planar(spec: ArmSpec) -> bool:
+    """Every axis parallel: the workspace section is the arm's own plane."""
+    from derive.classify import classify
+    from derive.transforms import chain_from_spec
+
+    chain = chain_from_spec(spec)
+    return len(classify(chain).parallel) == chain.dof - 1
 
 
 def solve_arguments(
@@ -393,14 +417,8 @@ def cmd_plot(args: argparse.Namespace) -> int:
     """Draw every IK solution of a pose (one panel each) into an SVG or PNG file."""
     from derive.plot import PlotUnavailable, figure_bytes, solutions_figure
 
-    spec = resolve_spec(args.arm, urdf_options(args))
-    module = load_module(spec)
-    if not hasattr(module, "ik"):
-        raise UsageError(f"{spec.name}: no IK method applies to this arm")
-    output = Path(args.output or f"{spec.name}_solutions.svg")
-    fmt = output.suffix.lstrip(".").lower()
-    if fmt not in ("svg", "png"):
-        raise UsageError(f"-o: {output}: the file must end in .svg or .png")
+    spec, module = ik_module(args)
+    output, fmt = figure_output(args, f"{spec.name}_solutions.svg")
     pose, _, sols = solve_arguments(spec, module, args)
     try:
         fig, _ = solutions_figure(
@@ -416,23 +434,14 @@ def cmd_plot(args: argparse.Namespace) -> int:
 
 def cmd_workspace(args: argparse.Namespace) -> int:
     """Map a section of the reachable and dexterous workspace and the solutions per position."""
-    from derive.classify import classify
     from derive.plot import PlotUnavailable, figure_bytes, workspace_figure
-    from derive.transforms import chain_from_spec
     from derive.workspace import workspace
 
-    spec = resolve_spec(args.arm, urdf_options(args))
-    module = load_module(spec)
-    if not hasattr(module, "ik"):
-        raise UsageError(f"{spec.name}: no IK method applies to this arm")
+    spec, module = ik_module(args)
     if not 3 <= args.resolution <= 2001 or args.resolution % 2 == 0:
         raise UsageError("--resolution: an odd number from 3 to 2001 (the grid holds the centre)")
-    output = Path(args.output or f"{spec.name}_workspace.svg")
-    fmt = output.suffix.lstrip(".").lower()
-    if fmt not in ("svg", "png"):
-        raise UsageError(f"-o: {output}: the file must end in .svg or .png")
-    chain = chain_from_spec(spec)
-    planar = len(classify(chain).parallel) == chain.dof - 1
+    output, fmt = figure_output(args, f"{spec.name}_workspace.svg")
+    planar = is_planar(spec)
     try:
         from derive.plot import pyplot
 
@@ -525,14 +534,11 @@ def figure_files(
     """The worked example's solutions and a workspace section, as (caption, file name, bytes)."""
     import numpy as np
 
-    from derive.classify import classify
     from derive.plot import PlotUnavailable, figure_bytes, solutions_figure, workspace_figure
-    from derive.transforms import chain_from_spec
     from derive.workspace import workspace
 
     pose = np.array(example.pose).reshape(4, 4)
-    chain = chain_from_spec(spec)
-    planar = len(classify(chain).parallel) == chain.dof - 1
+    planar = is_planar(spec)
     try:
         rows = np.array(example.solutions).reshape(-1, spec.dof)
         title = f"{spec.name}: the worked example"
