@@ -456,6 +456,75 @@ def cmd_workspace(args: argparse.Namespace) -> int:
     return 0
 
 
+def cmd_reach(args: argparse.Namespace) -> int:
+    """Map where the arm reaches: IK solution counts of every pose of a voxel grid x
+    orientations, stored in a zarr folder (resumable), locally or on a Dask cluster."""
+    from derive import reach
+
+    spec = resolve_spec(args.arm, urdf_options(args))
+    plan = build_plan(spec)
+    source = render_module(plan)
+    if plan.ik is None:
+        raise UsageError(f"{spec.name}: no IK method applies to this arm")
+    if plan.ik.certify == "position":
+        raise UsageError(
+            f"{spec.name}: its solver places the tool point only; reach maps sample "
+            "orientations (use derive workspace)"
+        )
+    if not (math.isfinite(args.resolution) and args.resolution > 0):
+        raise UsageError(f"--resolution: a positive length, got {args.resolution:g}")
+    if not 1 <= args.directions <= 100_000:
+        raise UsageError(f"--directions: from 1 to 100000, got {args.directions}")
+    if not 1 <= args.rolls <= 3600:
+        raise UsageError(f"--rolls: from 1 to 3600, got {args.rolls}")
+    params = reach.Parameters(
+        resolution=args.resolution,
+        directions=args.directions,
+        rolls=args.rolls,
+        within_limits=args.within_limits,
+        first=args.first,
+        symmetry=not args.no_symmetry,
+    )
+    output = Path(args.output)
+    try:
+        figure = None
+        if args.output_plot:
+            figure = Path(args.output_plot), Path(args.output_plot).suffix.lstrip(".").lower()
+            if figure[1] not in ("svg", "png"):
+                raise UsageError(f"--plot: {figure[0]}: the file must end in .svg or .png")
+            from derive.plot import pyplot
+
+            pyplot()  # say at once if matplotlib is missing
+        done = reach.run(
+            output, spec.name, spec.digest(), source, spec.convention, params, dask=args.dask
+        )
+        rmap = reach.load(output)
+        print(rmap.summary())
+        rate = f", {done.poses / done.seconds:,.0f} poses/s" if done.seconds > 0 else ""
+        print(
+            f"{output}: {done.computed} chunk(s) computed in {done.seconds:.1f} s{rate}"
+            + (f", {done.skipped} done before" if done.skipped else "")
+        )
+        if args.hdf5:
+            poses = reach.export_hdf5(rmap, Path(args.hdf5))
+            print(f"{args.hdf5}: written (Reuleaux layout, {poses:,} poses)")
+        if figure is not None:
+            from derive.plot import figure_bytes
+
+            data = figure_bytes(reach.reach_figure(rmap, f"{spec.name}: reachability"), figure[1])
+            write_atomic(figure[0], data)
+            print(f"{figure[0]}: written")
+    except reach.ReachError as exc:
+        raise UsageError(str(exc)) from None
+    except KeyboardInterrupt:
+        print(
+            f"\ninterrupted: the chunks written are kept; the same command continues {output}",
+            file=sys.stderr,
+        )
+        return 130
+    return 0
+
+
 def free_values(
     spec: ArmSpec, module: ModuleType, args: argparse.Namespace, q: list[float] | None
 ) -> list[float]:
@@ -657,6 +726,35 @@ def parser() -> argparse.ArgumentParser:
     )
     space.add_argument("--limits", action="store_true", help="honour the joint limits")
     space.set_defaults(run=cmd_workspace)
+    reach = sub.add_parser(
+        "reach", help="reachability map: IK on a voxel grid x orientations (zarr, needs [scale])"
+    )
+    reach.add_argument("arm", help="spec file or bundled arm name")
+    reach.add_argument("-o", "--output", required=True, help="the map's folder, MAP.zarr")
+    reach.add_argument(
+        "--resolution", type=float, default=0.05, help="voxel side, in the arm's lengths (0.05)"
+    )
+    reach.add_argument(
+        "--directions", type=int, default=200, help="approach directions per voxel (200)"
+    )
+    reach.add_argument("--rolls", type=int, default=8, help="rolls about each direction (8)")
+    reach.add_argument(
+        "--within-limits", action="store_true", help="count the solutions inside the limits"
+    )
+    reach.add_argument("--first", action="store_true", help="also store each pose's first solution")
+    reach.add_argument(
+        "--no-symmetry", action="store_true", help="solve every voxel and roll (no reduction)"
+    )
+    reach.add_argument(
+        "--dask",
+        metavar="ADDRESS",
+        help="run on Dask: local:N (N worker processes here) or tcp://HOST:PORT (a scheduler)",
+    )
+    reach.add_argument("--hdf5", metavar="FILE.h5", help="also export in Reuleaux's HDF5 layout")
+    reach.add_argument(
+        "--plot", metavar="FILE", dest="output_plot", help="draw two sections (.svg or .png)"
+    )
+    reach.set_defaults(run=cmd_reach)
     report = sub.add_parser("report", help="the derivation, lecture style (Markdown or LaTeX)")
     report.add_argument("arm", help="spec file or bundled arm name")
     report.add_argument("--format", choices=("md", "tex"), default="md", help="md (default) or tex")
@@ -689,7 +787,7 @@ def parser() -> argparse.ArgumentParser:
     )
     imp.add_argument("-o", "--output", help="write the spec here (default: standard output)")
     imp.set_defaults(run=cmd_import_urdf)
-    for command in (gen, chk, fk, solve, plot, space, report, bench, imp):
+    for command in (gen, chk, fk, solve, plot, space, reach, report, bench, imp):
         add_urdf_arguments(command, required=command is imp)
     return top
 

@@ -225,7 +225,7 @@ def workspace(
                 reached[rows] = flat.reshape(n_rows, resolution, width)
         now = time.perf_counter()
         if progress is not None and (now - shown > 0.5 or rows.stop == resolution):
-            _progress(progress, rows.stop, resolution, start)
+            progress_line(progress, "workspace", rows.stop, resolution, start, "rows")
             shown = now
     reachable = counts > 0
     dexterous = reached.all(axis=2) & reachable
@@ -234,10 +234,10 @@ def workspace(
     )
 
 
-def _progress(out: TextIO, done: int, total: int, start: float) -> None:
-    """One line of progress with an estimate of the time left."""
+def progress_line(out: TextIO, label: str, done: int, total: int, start: float, unit: str) -> None:
+    """One line of progress (rewritten in place) with an estimate of the time left."""
     elapsed = time.perf_counter() - start
-    left = elapsed / done * (total - done)
-    bar = "#" * (30 * done // total)
-    out.write(f"\rworkspace [{bar:<30}] {done}/{total} rows, {elapsed:.0f} s, ETA {left:.0f} s")
+    left = elapsed / max(done, 1) * (total - done)
+    bar = "#" * (30 * done // max(total, 1))
+    out.write(f"\r{label} [{bar:<30}] {done}/{total} {unit}, {elapsed:.0f} s, ETA {left:.0f} s")
     out.flush()

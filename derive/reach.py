@@ -1,0 +1,865 @@
+"""Reachability maps: how many IK solutions every pose of a voxel grid of tool poses has, and
+per voxel the share of orientations reached, computed with a generated solver's ``ik_batch``.
+
+The grid: voxels of side ``resolution`` in a cube around axis 1, in the *axis-1 frame* F: its
+origin on axis 1 (where the arm's drawing puts it at the zero pose), z along the axis, x the
+base's x direction made normal to the axis. There are n voxels per side (n odd, the middle
+column on axis 1) covering the arm's REACH. Voxel (i, j, k) is centred at F (c_i, c_j, c_k),
+c_i = (i - (n - 1) / 2) resolution.
+
+The orientations of a voxel: ``directions`` approach directions (the tool's z axis), spread
+evenly over the sphere (a Fibonacci lattice), times ``rolls`` turns of the tool about that
+axis (every 360 / rolls degrees). They are stated in the voxel's *cylindrical frame*: F
+turned about axis 1 by the voxel's azimuth atan2(c_j, c_i) (0 on the axis). So a pose's
+rotation is R_F Rz(azimuth) O(direction, roll), and the map is exactly invariant under turns
+of the arm about axis 1 (below).
+
+Symmetry, decided from the DH table (checked on the solver's FK) and the limits:
+
+* joint 1 revolute, not free, and turning a whole revolution (or limits not asked for): the
+  poses of a voxel are those of a voxel on the x axis of F at the same distance from axis 1,
+  turned about the axis, and their solutions differ by q1 only. One *column* of voxels is
+  solved per distinct distance (i - c)^2 + (j - c)^2 and shared by every voxel at it.
+* the last joint revolute, not free, a whole revolution (or no limits), and rolling the tool
+  about its z axis the same as turning the last joint (the tool frame's z on that axis): the
+  rolls of a pose have the same solutions but for q_n; one roll is solved.
+
+Without symmetry every (i, j) is its own column. The results are the same either way (a
+test compares them on a small grid).
+
+The store (zarr; ``derive-ik[scale]``), one group:
+
+* ``counts`` (columns, n, directions, rolls stored) uint8: the solutions of each pose (inside
+  the limits when asked); ``column_of`` (n, n) int32 names the column of voxel (i, j), and
+  rolls stored is 1 where the roll symmetry holds (every roll has that count).
+* ``first`` (columns, n, directions, rolls stored, DOF) float32, with ``--first``: each pose's
+  first solution (NaN where none).
+* ``column_index`` (columns, n) float32 and ``index`` (n, n, n) float32: the reachability
+  index, the share of a voxel's orientations with a solution.
+* ``centres`` (n,), ``directions`` (directions, 3), ``rolls`` (rolls,) radians, ``columns``
+  (columns, 2): the points of the solved columns in F.
+* ``done`` (chunks,) uint8: 1 when a chunk's arrays are written. A chunk is a block of
+  columns x heights with all their orientations; it is computed and written as one unit, and
+  a run that finds a store with the same parameters writes only the chunks not done.
+
+Attributes: the arm's name and spec digest, the solver source's SHA-256, the parameters, F
+(``frame``, 4x4 row-major, world), the symmetries used and the reduction factor,
+``complete``.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import importlib.util
+import math
+import os
+import sys
+import tempfile
+import time
+from collections.abc import Iterable
+from concurrent.futures import Future, ThreadPoolExecutor
+from dataclasses import asdict, dataclass
+from pathlib import Path
+from types import ModuleType
+from typing import Any, TextIO
+
+import numpy as np
+
+from derive.workspace import inside_limits, progress_line, section
+
+FORMAT = 1
+RESOLUTION = 0.05
+DIRECTIONS = 200
+ROLLS = 8
+# poses per chunk, at most: one ik_batch call each (memory: under 1 kB a pose for the poses,
+# Q and valid: 0.3 GB a chunk for 16 solutions of 6 joints)
+CHUNK_POSES = 131_072
+# the largest grid side accepted (voxels)
+MAX_SIDE = 1001
+# symmetry checks on the FK: random configurations, and the agreement asked (of REACH)
+SYMMETRY_SAMPLES = 8
+SYMMETRY_TOL = 1e-9
+
+
+class ReachError(Exception):
+    """A reach map cannot be made or read as asked; the message says why."""
+
+
+@dataclass(frozen=True)
+class Parameters:
+    """What a map is made of (stored as the store's attributes)."""
+
+    resolution: float = RESOLUTION
+    directions: int = DIRECTIONS
+    rolls: int = ROLLS
+    within_limits: bool = False
+    first: bool = False
+    symmetry: bool = True
+    # poses per chunk, at most (a chunk has at least one column's height)
+    chunk: int = CHUNK_POSES
+
+
+@dataclass(frozen=True)
+class Layout:
+    """The grid and the columns solved for an arm and parameters.
+
+    Attributes:
+        frame: (4, 4) F, the axis-1 frame in the world.
+        centres: (n,) voxel centres along each axis of F.
+        columns: (m, 2) the (x, y) in F of the solved columns.
+        column_of: (n, n) the column of voxel (i, j).
+        rotations: (directions, rolls stored, 3, 3) the orientations O in the cylindrical frame.
+        rolls: the roll angles (all of them, also where one is stored).
+        block: (columns, heights) per chunk.
+        joint1, roll: the symmetries used.
+    """
+
+    frame: np.ndarray
+    centres: np.ndarray
+    columns: np.ndarray
+    column_of: np.ndarray
+    rotations: np.ndarray
+    rolls: np.ndarray
+    block: tuple[int, int]
+    joint1: bool
+    roll: bool
+
+    @property
+    def side(self) -> int:
+        return len(self.centres)
+
+    @property
+    def chunks(self) -> tuple[int, int]:
+        """Chunks along the columns and along the heights."""
+        return (
+            -(-len(self.columns) // self.block[0]),
+            -(-self.side // self.block[1]),
+        )
+
+    @property
+    def n_chunks(self) -> int:
+        a, b = self.chunks
+        return a * b
+
+    @property
+    def poses(self) -> int:
+        """The poses of the whole map (what an unreduced computation solves)."""
+        return self.side**3 * len(self.rotations) * len(self.rolls)
+
+    @property
+    def solved(self) -> int:
+        """The poses solved."""
+        return len(self.columns) * self.side * self.rotations.shape[0] * self.rotations.shape[1]
+
+    @property
+    def reduction(self) -> float:
+        return self.poses / self.solved
+
+    def chunk_slices(self, chunk: int) -> tuple[slice, slice]:
+        """The columns and heights of a chunk."""
+        a, b = divmod(chunk, self.chunks[1])
+        bc, bz = self.block
+        return (
+            slice(a * bc, min(len(self.columns), (a + 1) * bc)),
+            slice(b * bz, min(self.side, (b + 1) * bz)),
+        )
+
+
+def fibonacci_directions(count: int) -> np.ndarray:
+    """count unit vectors spread evenly over the sphere (a Fibonacci lattice)."""
+    k = np.arange(count, dtype=float)
+    z = 1.0 - (2.0 * k + 1.0) / count
+    r = np.sqrt(np.maximum(0.0, 1.0 - z * z))
+    phi = k * math.pi * (3.0 - math.sqrt(5.0))
+    return np.stack([r * np.cos(phi), r * np.sin(phi), z], axis=1)
+
+
+def tool_rotations(directions: np.ndarray, rolls: np.ndarray) -> np.ndarray:
+    """(D, K, 3, 3): the rotation whose z axis is each direction, turned about it by each
+    roll (roll 0: x the unit vector nearest to x or, for directions near x, to y)."""
+    z = directions / np.linalg.norm(directions, axis=1)[:, None]
+    helper = np.where(np.abs(z[:, :1]) < 0.9, [[1.0, 0.0, 0.0]], [[0.0, 1.0, 0.0]])
+    x0 = helper - np.sum(helper * z, axis=1)[:, None] * z
+    x0 /= np.linalg.norm(x0, axis=1)[:, None]
+    y0 = np.cross(z, x0)
+    c, s = np.cos(rolls)[None, :, None], np.sin(rolls)[None, :, None]
+    x = c * x0[:, None] + s * y0[:, None]
+    y = np.cross(np.broadcast_to(z[:, None], x.shape), x)
+    return np.stack([x, y, np.broadcast_to(z[:, None], x.shape)], axis=-1)
+
+
+def axis_frame(module: ModuleType, convention: str) -> np.ndarray:
+    """F: origin on axis 1, z along it, x the base's x made normal to it."""
+    start, x, axis = section(module, False, convention)
+    frame = np.eye(4)
+    frame[:3, 0], frame[:3, 1], frame[:3, 2], frame[:3, 3] = x, np.cross(axis, x), axis, start
+    return frame
+
+
+def _full_turn(module: ModuleType, joint: int, within_limits: bool) -> bool:
+    """Joint (1-based) is revolute, not free, and turns a whole revolution where it counts."""
+    if module.JOINT_TYPES[joint - 1] != "R" or joint in getattr(module, "FREE", ()):
+        return False
+    lo, hi = module.LIMITS[joint - 1]
+    return not within_limits or hi - lo >= 2.0 * math.pi - 1e-12
+
+
+def _turn(axis: np.ndarray, angle: float) -> np.ndarray:
+    """Rotation by angle about a unit axis (3x3)."""
+    K = np.array([[0.0, -axis[2], axis[1]], [axis[2], 0.0, -axis[0]], [-axis[1], axis[0], 0.0]])
+    return np.eye(3) + math.sin(angle) * K + (1.0 - math.cos(angle)) * (K @ K)
+
+
+def symmetries(module: ModuleType, frame: np.ndarray, within_limits: bool) -> tuple[bool, bool]:
+    """(joint-1 symmetry, roll symmetry) of the module docstring, each also checked on the FK
+    at random configurations: turning joint 1 turns the tool about axis 1; turning the last
+    joint rolls the tool about its own z axis."""
+    rng = np.random.default_rng(0)
+    dof = module.DOF
+    joint1 = _full_turn(module, 1, within_limits)
+    roll = _full_turn(module, dof, within_limits)
+    tol = SYMMETRY_TOL * max(float(module.REACH), 1.0)
+    for _ in range(SYMMETRY_SAMPLES):
+        q = rng.uniform(-math.pi, math.pi, dof)
+        angle = float(rng.uniform(-math.pi, math.pi))
+        T = module.fk(q)
+        if joint1:
+            turn = np.eye(4)
+            turn[:3, :3] = _turn(frame[:3, 2], angle)
+            turn[:3, 3] = frame[:3, 3] - turn[:3, :3] @ frame[:3, 3]
+            joint1 = bool(np.abs(module.fk(q + angle * np.eye(dof)[0]) - turn @ T).max() < tol)
+        if roll:
+            spin = np.eye(4)
+            spin[:3, :3] = _turn(np.array([0.0, 0.0, 1.0]), angle)
+            roll = bool(np.abs(module.fk(q + angle * np.eye(dof)[-1]) - T @ spin).max() < tol)
+    return joint1, roll
+
+
+def make_layout(module: ModuleType, convention: str, params: Parameters) -> Layout:
+    """The grid, the columns and the chunks of a map (see the module docstring)."""
+    half = math.ceil(float(module.REACH) / params.resolution)
+    side = 2 * half + 1
+    if side > MAX_SIDE:
+        raise ReachError(
+            f"--resolution {params.resolution:g}: {side} voxels per side for a reach of "
+            f"{float(module.REACH):g}; at most {MAX_SIDE} (a coarser resolution)"
+        )
+    centres = (np.arange(side) - half) * params.resolution
+    frame = axis_frame(module, convention)
+    joint1, roll = (
+        symmetries(module, frame, params.within_limits) if params.symmetry else (False, False)
+    )
+    i, j = np.meshgrid(np.arange(side) - half, np.arange(side) - half, indexing="ij")
+    if joint1:
+        keys, column_of = np.unique(i * i + j * j, return_inverse=True)
+        columns = np.stack([np.sqrt(keys) * params.resolution, np.zeros(len(keys))], axis=1)
+    else:
+        column_of = np.arange(side * side)
+        columns = np.stack([i.ravel(), j.ravel()], axis=1) * params.resolution
+    rolls = 2.0 * math.pi * np.arange(params.rolls) / params.rolls
+    rotations = tool_rotations(
+        fibonacci_directions(params.directions), rolls[:1] if roll else rolls
+    )
+    per_cell = rotations.shape[0] * rotations.shape[1]
+    cells = max(1, params.chunk // per_cell)
+    bz = min(side, cells)
+    bc = max(1, min(len(columns), cells // bz))
+    return Layout(
+        frame,
+        centres,
+        columns,
+        column_of.reshape(side, side).astype(np.int32),
+        rotations,
+        rolls,
+        (bc, bz),
+        joint1,
+        roll,
+    )
+
+
+def chunk_poses(layout: Layout, chunk: int) -> np.ndarray:
+    """The world poses of a chunk, (columns, heights, directions, rolls stored, 4, 4), made
+    from the grid's indices."""
+    cols, heights = layout.chunk_slices(chunk)
+    xy = layout.columns[cols]
+    z = layout.centres[heights]
+    azimuth = np.arctan2(xy[:, 1], xy[:, 0])
+    c, s = np.cos(azimuth), np.sin(azimuth)
+    spin = np.zeros((len(xy), 3, 3))
+    spin[:, 0, 0], spin[:, 0, 1], spin[:, 1, 0], spin[:, 1, 1] = c, -s, s, c
+    spin[:, 2, 2] = 1.0
+    D, K = layout.rotations.shape[:2]
+    # one column's poses without their positions, then copied up the column (16 contiguous
+    # numbers a pose: about 11 ns a pose here, against about 33 for a broadcast 3x3 write)
+    column = np.zeros((len(xy), D, K, 4, 4))
+    column[..., :3, :3] = (layout.frame[:3, :3] @ spin)[:, None, None] @ layout.rotations[None]
+    column[..., 3, 3] = 1.0
+    points = np.empty((len(xy), len(z), 3))
+    points[:, :, 0] = xy[:, None, 0]
+    points[:, :, 1] = xy[:, None, 1]
+    points[:, :, 2] = z[None, :]
+    world = points @ layout.frame[:3, :3].T + layout.frame[:3, 3]
+    T = _scratch(len(xy) * len(z) * D * K * 16).reshape(len(xy), len(z), D, K, 4, 4)
+    T[:] = column[:, None]
+    T[..., :3, 3] = world[:, :, None, None, :]
+    return T
+
+
+_SCRATCH: list[np.ndarray] = []
+
+
+def _scratch(size: int) -> np.ndarray:
+    """A reused float64 buffer of size numbers for a chunk's poses (fresh memory for every
+    chunk costs its page faults: about a fifth of the time of making the poses). One per
+    process: chunks are made one at a time in a process (the local run's main thread, a Dask
+    worker with one task thread)."""
+    if not _SCRATCH or _SCRATCH[0].size < size:
+        _SCRATCH[:] = [np.empty(size)]
+    return _SCRATCH[0][:size]
+
+
+def solve_chunk(
+    module: ModuleType, layout: Layout, params: Parameters, chunk: int
+) -> dict[str, np.ndarray]:
+    """A chunk's arrays: counts, column_index and (with params.first) first."""
+    T = chunk_poses(layout, chunk)
+    shape = T.shape[:4]
+    Q, valid = module.ik_batch(T.reshape(-1, 4, 4))
+    if params.within_limits:
+        valid &= inside_limits(module, Q)
+    # (a uint8 product: 5 ns a pose, against 20 for sum or count_nonzero)
+    counts = (valid.view(np.uint8) @ np.ones(valid.shape[1], dtype=np.uint8)).reshape(shape)
+    out = {
+        "counts": counts,
+        "column_index": (counts > 0).mean(axis=(2, 3), dtype=np.float64).astype(np.float32),
+    }
+    if params.first:
+        first = np.full((len(Q), module.DOF), np.nan, dtype=np.float32)
+        has = valid.any(axis=1)
+        rows = np.argmax(valid, axis=1)
+        first[has] = Q[np.flatnonzero(has), rows[has]]
+        out["first"] = first.reshape(*shape, module.DOF)
+    return out
+
+
+# --- loading the solver in any process (the local run and Dask workers) -------------------
+
+_SOLVERS: dict[str, ModuleType] = {}
+
+
+def solver_cache() -> Path:
+    """Where solver sources are kept so that numba caches their compiled kernels:
+    DERIVE_CACHE, else $XDG_CACHE_HOME/derive-ik, else ~/.cache/derive-ik."""
+    if "DERIVE_CACHE" in os.environ:
+        return Path(os.environ["DERIVE_CACHE"])
+    root = os.environ.get("XDG_CACHE_HOME") or str(Path.home() / ".cache")
+    return Path(root) / "derive-ik"
+
+
+def load_solver(name: str, source: str) -> ModuleType:
+    """Import a generated module's source (once per process), from a file named by its hash
+    in the solver cache, so that numba's cache of its kernels is found on the next run."""
+    sha = hashlib.sha256(source.encode()).hexdigest()[:16]
+    key = f"{name}_{sha}"
+    if key in _SOLVERS:
+        return _SOLVERS[key]
+    folder = solver_cache() / "solvers"
+    folder.mkdir(parents=True, exist_ok=True)
+    path = folder / f"{key}.py"
+    if not path.exists() or path.read_text(encoding="utf-8") != source:
+        fd, tmp = tempfile.mkstemp(prefix=f".{key}.", suffix=".tmp", dir=folder)
+        with os.fdopen(fd, "w", encoding="utf-8", newline="\n") as handle:
+            handle.write(source)
+        os.replace(tmp, path)  # atomic: workers sharing the folder see all of it or none
+    loader_spec = importlib.util.spec_from_file_location(f"derive_ik_reach_{key}", path)
+    assert loader_spec is not None and loader_spec.loader is not None
+    module = importlib.util.module_from_spec(loader_spec)
+    loader_spec.loader.exec_module(module)
+    backend = os.environ.get("DERIVE_BACKEND")
+    if backend in ("auto", "numba", "python"):
+        setattr(module, "BACKEND", backend)  # noqa: B010 (a generated module's setting)
+    _SOLVERS[key] = module
+    return module
+
+
+# --- the store --------------------------------------------------------------------------
+
+
+def _zarr() -> Any:
+    try:
+        import zarr
+    except ImportError:
+        raise ReachError("reach maps need zarr: pip install 'derive-ik[scale]'") from None
+    return zarr
+
+
+def _attributes(
+    name: str, digest: str, source: str, params: Parameters, layout: Layout
+) -> dict[str, Any]:
+    return {
+        "format": FORMAT,
+        "arm": name,
+        "spec_digest": digest,
+        "solver_sha256": hashlib.sha256(source.encode()).hexdigest(),
+        "parameters": asdict(params),
+        "frame": [float(v) for v in layout.frame.ravel()],
+        "side": layout.side,
+        "joint1_symmetry": layout.joint1,
+        "roll_symmetry": layout.roll,
+        "poses": layout.poses,
+        "poses_solved": layout.solved,
+        "reduction": layout.reduction,
+        "block": list(layout.block),
+    }
+
+
+def open_store(
+    path: Path, name: str, digest: str, source: str, params: Parameters, layout: Layout
+) -> Any:
+    """The store at path: created for these parameters, or an existing one made with the
+    same (a resumed run, which also completes a store killed while it was being created);
+    another map there is an error."""
+    zarr = _zarr()
+    attrs = _attributes(name, digest, source, params, layout)
+    if path.exists():
+        try:
+            group = zarr.open_group(str(path), mode="r+")
+            old = dict(group.attrs)
+        except Exception as exc:  # zarr raises several kinds for a folder that is not a map
+            raise ReachError(f"{path}: exists and is not a reach map ({exc})") from None
+        differ = sorted(k for k in attrs if old.get(k) != attrs[k])
+        if differ:
+            raise ReachError(
+                f"{path}: holds another map (it differs in {', '.join(differ)}); "
+                "choose another -o or remove it"
+            )
+    else:
+        group = zarr.create_group(str(path), attributes=attrs)
+    side, m = layout.side, len(layout.columns)
+    D, K = layout.rotations.shape[:2]
+    bc, bz = layout.block
+    dof = _dof(source)
+    fixed = {
+        "centres": layout.centres,
+        "columns": layout.columns,
+        "column_of": layout.column_of,
+        "directions": layout.rotations[:, 0, :, 2],
+        "rolls": layout.rolls,
+    }
+    chunked = {
+        "counts": ((m, side, D, K), (bc, bz, D, K), "uint8", 0),
+        "column_index": ((m, side), (bc, bz), "float32", 0.0),
+        "done": ((layout.n_chunks,), (1,), "uint8", 0),
+    }
+    if params.first:
+        chunked["first"] = ((m, side, D, K, dof), (bc, bz, D, K, dof), "float32", math.nan)
+    present = set(group.array_keys())
+    for key, data in fixed.items():
+        if key not in present:
+            group.create_array(key, data=data, chunks=data.shape)
+    # the done marks last: a store whose done array exists has every array
+    for key, (shape, chunks, dtype, fill) in sorted(
+        chunked.items(), key=lambda kv: kv[0] == "done"
+    ):
+        if key not in present:
+            group.create_array(key, shape=shape, chunks=chunks, dtype=dtype, fill_value=fill)
+    return group
+
+
+def _dof(source: str) -> int:
+    """DOF of a generated module's source (its `DOF = n` line)."""
+    for line in source.splitlines():
+        if line.startswith("DOF = "):
+            return int(line.split("=")[1])
+    raise ReachError("the solver source has no DOF")  # pragma: no cover (generated always has)
+
+
+def pending(group: Any) -> list[int]:
+    """The chunks not yet written."""
+    done = group["done"][:]
+    return [int(c) for c in np.flatnonzero(done == 0)]
+
+
+def write_chunk(group: Any, layout: Layout, chunk: int, arrays: dict[str, np.ndarray]) -> None:
+    """A chunk's arrays, then its done mark (last: a chunk killed half way is redone)."""
+    cols, heights = layout.chunk_slices(chunk)
+    for key, data in arrays.items():
+        _array(group, key)[cols, heights] = data
+    _array(group, "done")[chunk] = 1
+
+
+_ARRAYS: dict[tuple[int, str], Any] = {}
+
+
+def _array(group: Any, key: str) -> Any:
+    """A group's array, opened once (opening reads its metadata from the store)."""
+    if (id(group), key) not in _ARRAYS:
+        _ARRAYS[id(group), key] = group[key]
+    return _ARRAYS[id(group), key]
+
+
+def finish(group: Any) -> None:
+    """The per-voxel index from the columns', and the store marked complete. (The per-voxel
+    arrays are small: a voxel has directions x rolls poses.)"""
+    column_of = group["column_of"][:]
+    column_index = group["column_index"][:]
+    side = column_of.shape[0]
+    slab = max(1, min(side, 4_000_000 // (side * side)))
+    if "index" not in group:
+        group.create_array(
+            "index", shape=(side, side, side), chunks=(side, side, slab), dtype="float32"
+        )
+    index = group["index"]
+    for k in range(0, side, slab):
+        index[:, :, k : k + slab] = column_index[:, k : k + slab][column_of]
+    group.attrs["complete"] = True
+
+
+# --- running the chunks -----------------------------------------------------------------
+
+
+def _chunk_task(
+    path: str, name: str, source: str, convention: str, params: Parameters, chunk: int, threads: int
+) -> int:
+    """One chunk in any process: load the solver, solve, write. Returns the chunk."""
+    if threads > 0:
+        _set_threads(threads)
+    module = load_solver(name, source)
+    layout = _layouts(module, convention, params)
+    group = _zarr().open_group(path, mode="r+")
+    write_chunk(group, layout, chunk, solve_chunk(module, layout, params, chunk))
+    return chunk
+
+
+_LAYOUTS: dict[tuple[int, str, Parameters], Layout] = {}
+
+
+def _layouts(module: ModuleType, convention: str, params: Parameters) -> Layout:
+    """The layout, made once per process per module and parameters."""
+    key = (id(module), convention, params)
+    if key not in _LAYOUTS:
+        _LAYOUTS[key] = make_layout(module, convention, params)
+    return _LAYOUTS[key]
+
+
+def _set_threads(threads: int) -> None:
+    """numba's threads in this process (the compiled batch solver runs on them)."""
+    try:
+        import numba
+    except ImportError:
+        return
+    limit = int(getattr(numba.config, "NUMBA_NUM_THREADS", threads))  # (the pool's size)
+    numba.set_num_threads(max(1, min(threads, limit)))
+
+
+@dataclass(frozen=True)
+class Run:
+    """What a run did: chunks computed now and before, the poses solved now, seconds."""
+
+    computed: int
+    skipped: int
+    poses: int
+    seconds: float
+
+
+def run(
+    path: Path,
+    name: str,
+    digest: str,
+    source: str,
+    convention: str,
+    params: Parameters,
+    dask: str | None = None,
+    progress: TextIO | None = sys.stderr,
+    stop_after: int | None = None,
+) -> Run:
+    """Make (or finish) the map at path. dask: None runs here on all cores; "local:N" on a
+    LocalCluster of N worker processes; an address ("tcp://host:port") on that cluster.
+    stop_after: stop (with KeyboardInterrupt) after this many chunks (for tests of resuming)."""
+    module = load_solver(name, source)
+    layout = _layouts(module, convention, params)
+    group = open_store(path, name, digest, source, params, layout)
+    todo = pending(group)
+    skipped = layout.n_chunks - len(todo)
+    per_chunk = layout.solved / layout.n_chunks
+    start = time.perf_counter()
+    shown = 0.0
+
+    def tick(done: int) -> None:
+        nonlocal shown
+        now = time.perf_counter()
+        if progress is not None and (now - shown > 0.5 or done == len(todo)):
+            progress_line(progress, "reach", done, len(todo), start, "chunks")
+            shown = now
+        if stop_after is not None and done >= stop_after:
+            raise KeyboardInterrupt
+
+    if dask is None:
+        # writes go to a thread (zarr's compression and I/O overlap the next chunk's solve);
+        # at most two chunks wait to be written
+        with ThreadPoolExecutor(max_workers=1) as writer:
+            waiting: list[Future[None]] = []
+            for done, chunk in enumerate(todo, 1):
+                arrays = solve_chunk(module, layout, params, chunk)
+                waiting.append(writer.submit(write_chunk, group, layout, chunk, arrays))
+                if len(waiting) > 2:
+                    waiting.pop(0).result()
+                tick(done)
+            for future in waiting:
+                future.result()
+    elif todo:
+        chunks = _dask_chunks(dask, str(path), name, source, convention, params, todo)
+        for done, _ in enumerate(chunks, 1):
+            tick(done)
+    if progress is not None and todo:
+        progress.write("\n")
+    finish(group)
+    return Run(len(todo), skipped, round(per_chunk * len(todo)), time.perf_counter() - start)
+
+
+def _dask_chunks(
+    address: str,
+    path: str,
+    name: str,
+    source: str,
+    convention: str,
+    params: Parameters,
+    todo: list[int],
+) -> Iterable[int]:
+    """Run the chunks as Dask tasks; yields each chunk as it is written."""
+    try:
+        from distributed import Client, LocalCluster, as_completed
+    except ImportError:
+        raise ReachError("--dask needs dask.distributed: pip install 'derive-ik[scale]'") from None
+    cluster = None
+    if address.startswith("local:"):
+        try:
+            workers = int(address.split(":", 1)[1])
+        except ValueError:
+            workers = 0
+        if workers < 1:
+            raise ReachError(f"--dask {address}: local:N with N >= 1 worker processes")
+        threads = max(1, (os.cpu_count() or 1) // workers)
+        cluster = LocalCluster(
+            n_workers=workers,
+            threads_per_worker=1,
+            processes=True,
+            dashboard_address=None,
+            silence_logs=40,
+        )
+        client = Client(cluster)
+    else:
+        threads = 0  # each worker: its cores / its threads (below)
+        try:
+            client = Client(address, timeout="20s")
+        except (OSError, TimeoutError, ValueError) as exc:
+            raise ReachError(f"--dask {address}: cannot reach the scheduler ({exc})") from None
+    try:
+        shared = client.scatter(source, broadcast=True)
+        if threads == 0:
+            client.run(_worker_threads)  # the setting stays with each worker process
+        futures = [
+            client.submit(
+                _chunk_task, path, name, shared, convention, params, chunk, threads, pure=False
+            )
+            for chunk in todo
+        ]
+        for future in as_completed(futures):
+            yield future.result()
+    finally:
+        client.close()
+        if cluster is not None:
+            cluster.close()
+
+
+def _worker_threads(dask_worker: Any = None) -> int:
+    """On a worker: numba's threads set to its cores divided by the worker's task threads."""
+    nthreads = getattr(getattr(dask_worker, "state", dask_worker), "nthreads", 1) or 1
+    threads = max(1, (os.cpu_count() or 1) // int(nthreads))
+    _set_threads(threads)
+    return threads
+
+
+# --- reading a map ----------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class ReachMap:
+    """A finished map, read back (arrays small enough to hold: not counts)."""
+
+    group: Any
+    frame: np.ndarray
+    centres: np.ndarray
+    index: np.ndarray
+    column_of: np.ndarray
+    attrs: dict[str, Any]
+
+    def counts(self) -> np.ndarray:
+        """Every pose's count, (n, n, n, directions, rolls): the columns' spread to the
+        voxels and rolls (for small maps: this holds the whole map)."""
+        stored = self.group["counts"][:]
+        full = stored[self.column_of]
+        rolls = len(self.group["rolls"][:])
+        return np.broadcast_to(full, (*full.shape[:-1], rolls)) if full.shape[-1] != rolls else full
+
+    def summary(self) -> str:
+        a = self.attrs
+        reached = self.index > 0
+        mean = float(self.index[reached].mean()) if reached.any() else 0.0
+        return (
+            f"{a['arm']}: {a['side']}^3 voxels of {a['parameters']['resolution']:g}, "
+            f"{a['parameters']['directions']} directions x {a['parameters']['rolls']} rolls = "
+            f"{a['poses']:,} poses ({a['poses_solved']:,} solved, reduction x{a['reduction']:.3g}"
+            f"{': joint-1 symmetry' if a['joint1_symmetry'] else ''}"
+            f"{', roll symmetry' if a['roll_symmetry'] else ''}); "
+            f"{int(reached.sum())} voxels reached, {int((self.index >= 1.0).sum())} in every "
+            f"orientation, mean index of those reached {mean:.3f}"
+        )
+
+
+def load(path: Path) -> ReachMap:
+    """A complete map from its store."""
+    zarr = _zarr()
+    try:
+        group = zarr.open_group(str(path), mode="r")
+        attrs = dict(group.attrs)
+    except Exception as exc:
+        raise ReachError(f"{path}: not a reach map ({exc})") from None
+    if not attrs.get("complete"):
+        raise ReachError(f"{path}: the map is not complete (run derive reach again to finish it)")
+    return ReachMap(
+        group,
+        np.array(attrs["frame"]).reshape(4, 4),
+        group["centres"][:],
+        group["index"][:],
+        group["column_of"][:],
+        attrs,
+    )
+
+
+def quaternions(R: np.ndarray) -> np.ndarray:
+    """Unit quaternions (x, y, z, w) of rotations R (..., 3, 3), w >= 0."""
+    m = R.reshape(-1, 3, 3)
+    trace = m[:, 0, 0] + m[:, 1, 1] + m[:, 2, 2]
+    q = np.empty((len(m), 4))
+    # each row from the largest of w, x, y, z (the well-conditioned one)
+    big = np.stack([trace, m[:, 0, 0], m[:, 1, 1], m[:, 2, 2]], axis=1).argmax(axis=1)
+    for case in range(4):
+        rows = big == case
+        a = m[rows]
+        if case == 0:
+            s = 2.0 * np.sqrt(1.0 + trace[rows])
+            q[rows] = np.stack(
+                [
+                    (a[:, 2, 1] - a[:, 1, 2]) / s,
+                    (a[:, 0, 2] - a[:, 2, 0]) / s,
+                    (a[:, 1, 0] - a[:, 0, 1]) / s,
+                    0.25 * s,
+                ],
+                axis=1,
+            )
+            continue
+        i = case - 1
+        j, k = (i + 1) % 3, (i + 2) % 3
+        s = 2.0 * np.sqrt(1.0 + a[:, i, i] - a[:, j, j] - a[:, k, k])
+        part = np.empty((len(a), 4))
+        part[:, i] = 0.25 * s
+        part[:, j] = (a[:, j, i] + a[:, i, j]) / s
+        part[:, k] = (a[:, k, i] + a[:, i, k]) / s
+        part[:, 3] = (a[:, k, j] - a[:, j, k]) / s
+        q[rows] = part
+    q *= np.where(q[:, 3:] < 0.0, -1.0, 1.0)
+    return q.reshape(*R.shape[:-2], 4)
+
+
+def export_hdf5(rmap: ReachMap, path: Path, progress: TextIO | None = sys.stderr) -> int:
+    """Write the map in Reuleaux's layout: /Spheres/sphere_dataset (x, y, z, index) of the
+    voxels reached, attribute Resolution, and /Poses/poses_dataset, float32 rows (voxel x, y,
+    z, pose x, y, z, quaternion x, y, z, w) of every pose with a solution; world coordinates.
+    Written height by height (memory: one horizontal slab of the map). Returns the poses."""
+    try:
+        import h5py
+    except ImportError:
+        raise ReachError("the HDF5 export needs h5py: pip install 'derive-ik[scale]'") from None
+    group = rmap.group
+    counts = group["counts"]
+    side = len(rmap.centres)
+    directions = group["directions"][:]
+    rolls = group["rolls"][:]
+    rotations = tool_rotations(directions, rolls)
+    stored_rolls = counts.shape[3]
+    c = rmap.centres
+    i, j = np.meshgrid(np.arange(side), np.arange(side), indexing="ij")
+    azimuth = np.arctan2(c[j], c[i])
+    frame = rmap.frame
+    tmp = path.with_name(f".{path.name}.derive-tmp")
+    written = 0
+    start = time.perf_counter()
+    with h5py.File(tmp, "w") as h5:
+        spheres = h5.create_group("Spheres").create_dataset(
+            "sphere_dataset", shape=(0, 4), maxshape=(None, 4), dtype="float64", chunks=True
+        )
+        spheres.attrs["Resolution"] = float(rmap.attrs["parameters"]["resolution"])
+        poses = h5.create_group("Poses").create_dataset(
+            "poses_dataset", shape=(0, 10), maxshape=(None, 10), dtype="float32", chunks=True
+        )
+        for k in range(side):
+            slab = counts[:, k][rmap.column_of]  # (side, side, D, rolls stored)
+            if stored_rolls != len(rolls):
+                slab = np.broadcast_to(slab, (*slab.shape[:3], len(rolls)))
+            points = np.stack([c[i], c[j], np.full(i.shape, c[k])], axis=-1)
+            world = points @ frame[:3, :3].T + frame[:3, 3]
+            reached = rmap.index[:, :, k] > 0
+            rows = np.concatenate([world[reached], rmap.index[:, :, k][reached][:, None]], axis=1)
+            spheres.resize(len(spheres) + len(rows), axis=0)
+            spheres[len(spheres) - len(rows) :] = rows
+            vi, vj, d, r = np.nonzero(slab > 0)
+            if len(vi):
+                spin = np.zeros((len(vi), 3, 3))
+                az = azimuth[vi, vj]
+                spin[:, 0, 0], spin[:, 0, 1] = np.cos(az), -np.sin(az)
+                spin[:, 1, 0], spin[:, 1, 1] = np.sin(az), np.cos(az)
+                spin[:, 2, 2] = 1.0
+                R = frame[:3, :3] @ spin @ rotations[d, r]
+                xyz = world[vi, vj]
+                block = np.concatenate([xyz, xyz, quaternions(R)], axis=1).astype(np.float32)
+                poses.resize(len(poses) + len(block), axis=0)
+                poses[len(poses) - len(block) :] = block
+                written += len(block)
+            if progress is not None:
+                progress_line(progress, "hdf5", k + 1, side, start, "heights")
+    if progress is not None:
+        progress.write("\n")
+    os.replace(tmp, path)
+    return written
+
+
+def reach_figure(rmap: ReachMap, title: str) -> Any:
+    """Two sections of the reachability index: the vertical plane through axis 1 (x-z of F)
+    and the horizontal plane where the most voxels are reached."""
+    from derive.plot import pyplot
+
+    plt = pyplot()
+    side = len(rmap.centres)
+    middle = side // 2
+    height = int(np.argmax((rmap.index > 0).sum(axis=(0, 1))))
+    c = rmap.centres
+    step = float(c[1] - c[0]) if side > 1 else 1.0
+    extent = (c[0] - step / 2, c[-1] + step / 2, c[0] - step / 2, c[-1] + step / 2)
+    fig, axes = plt.subplots(1, 2, figsize=(10.5, 4.6), layout="constrained")
+    panels = (
+        (rmap.index[:, middle, :].T, "x (axis-1 frame)", "z (along axis 1)", "through axis 1"),
+        (rmap.index[:, :, height].T, "x (axis-1 frame)", "y", f"at z = {c[height]:.3g}"),
+    )
+    image = None
+    for ax, (data, xlabel, ylabel, label) in zip(axes, panels):
+        shown = np.ma.masked_where(data <= 0, data)
+        image = ax.imshow(shown, origin="lower", extent=extent, vmin=0.0, vmax=1.0, cmap="viridis")
+        ax.set_xlabel(xlabel)
+        ax.set_ylabel(ylabel)
+        ax.set_title(label, fontsize=10)
+        ax.set_aspect("equal")
+        ax.set_facecolor("#eeeeee")
+    fig.colorbar(image, ax=list(axes), label="reachability index (share of orientations)")
+    fig.suptitle(title)
+    return fig

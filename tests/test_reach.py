@@ -1,0 +1,301 @@
+"""Reachability maps (issue 20): the map against a direct loop over poses calling ik, the
+symmetry reduction against the unreduced map, resuming after an interruption (also a real
+kill), Dask against the local run, the Reuleaux export and the command."""
+
+from __future__ import annotations
+
+import math
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from derive import reach
+from derive.cli import main, resolve_spec
+from derive.emit import render_module
+from derive.pipeline import build_plan
+
+pytest.importorskip("zarr", reason="reach maps need zarr (the scale and test extras have it)")
+
+# small maps: 9^3 voxels (resolution 0.3 for the PUMA's reach of 1.03) x 6 directions x 3 rolls
+SMALL = {"resolution": 0.3, "directions": 6, "rolls": 3}
+# the same grid for any arm: a resolution of its reach / 3.2
+
+
+@pytest.fixture(autouse=True)
+def _python_solver(monkeypatch, tmp_path_factory):
+    """The maps here are small: numpy's batch solver (no compile); solver files in a
+    temporary cache."""
+    monkeypatch.setenv("DERIVE_BACKEND", "python")
+    monkeypatch.setenv("DERIVE_CACHE", str(tmp_path_factory.getbasetemp() / "cache"))
+
+
+def arm(name: str) -> tuple[str, str, str, str]:
+    spec = resolve_spec(name)
+    return spec.name, spec.digest(), render_module(build_plan(spec)), spec.convention
+
+
+def make(path: Path, name: str, **params) -> reach.ReachMap:
+    reach.run(path, *arm_args(name), small(name, **params), progress=None)
+    return reach.load(path)
+
+
+def small(name: str, **params) -> reach.Parameters:
+    """SMALL's map for any arm (9 voxels a side), with params."""
+    reach_of = build_plan(resolve_spec(name)).arm.reach
+    return reach.Parameters(**{**SMALL, "resolution": reach_of / 3.2, **params})
+
+
+def arm_args(name: str) -> tuple[str, str, str, str]:
+    return _ARMS.setdefault(name, arm(name))
+
+
+_ARMS: dict[str, tuple[str, str, str, str]] = {}
+
+
+def direct_counts(rmap: reach.ReachMap, module, within_limits: bool) -> np.ndarray:
+    """The map's definition, pose by pose: position F c, rotation R_F Rz(azimuth) O(d, r),
+    each solved by ik."""
+    F, c = rmap.frame, rmap.centres
+    directions = rmap.group["directions"][:]
+    rolls = rmap.group["rolls"][:]
+    out = np.zeros((len(c), len(c), len(c), len(directions), len(rolls)), dtype=np.uint8)
+    for i, j, k in np.ndindex(len(c), len(c), len(c)):
+        az = math.atan2(c[j], c[i])
+        spin = np.array(
+            [[math.cos(az), -math.sin(az), 0], [math.sin(az), math.cos(az), 0], [0, 0, 1]]
+        )
+        for d, r in np.ndindex(len(directions), len(rolls)):
+            z = directions[d]
+            O = reach.tool_rotations(z[None], rolls[r : r + 1])[0, 0]
+            T = np.eye(4)
+            T[:3, :3] = F[:3, :3] @ spin @ O
+            T[:3, 3] = F[:3, :3] @ [c[i], c[j], c[k]] + F[:3, 3]
+            out[i, j, k, d, r] = len(module.ik(T, within_limits=within_limits))
+    return out
+
+
+@pytest.mark.parametrize(
+    ("name", "limits"), [("puma560", False), ("puma560", True), ("lecture_6r", True)]
+)
+def test_the_map_equals_a_direct_loop_over_poses_calling_ik(name, limits, tmp_path, generated):
+    rmap = make(tmp_path / "m.zarr", name, within_limits=limits)
+    counts = rmap.counts()
+    expected = direct_counts(rmap, generated(name), limits)
+    assert counts.shape == expected.shape
+    assert (counts > 0).any() and (counts == 0).any()
+    assert np.array_equal(counts, expected), int((counts != expected).sum())
+    index = (expected > 0).mean(axis=(3, 4))
+    assert np.allclose(rmap.index, index, atol=1e-6)
+
+
+def test_the_orientations_are_rotations_with_the_asked_approach_and_roll():
+    z = reach.fibonacci_directions(50)
+    assert np.allclose(np.linalg.norm(z, axis=1), 1.0)
+    assert abs(z.mean(axis=0)).max() < 0.05  # spread evenly: no side favoured
+    R = reach.tool_rotations(z, np.array([0.0, 0.7]))
+    assert np.allclose(R[..., 2], z[:, None])
+    assert np.allclose(np.einsum("dkij,dkil->dkjl", R, R), np.eye(3))
+    assert np.allclose(np.linalg.det(R), 1.0)
+    turned = np.einsum("dij,j->di", R[:, 0], [math.cos(0.7), math.sin(0.7), 0.0])
+    assert np.allclose(turned, R[:, 1, :, 0])
+
+
+@pytest.mark.parametrize(
+    ("name", "limits", "joint1", "roll"),
+    [
+        ("puma560", False, True, True),
+        ("puma560", True, False, True),  # q1 in +-160 deg: no joint-1 symmetry
+        ("lecture_6r", False, True, False),  # the tool frame is off axis 6
+        ("iiwa14", False, True, False),  # q7 is free: it does not roll the tool
+    ],
+)
+def test_the_symmetry_reduction_gives_the_unreduced_map(name, limits, joint1, roll, tmp_path):
+    reduced = make(tmp_path / "r.zarr", name, within_limits=limits)
+    full = make(tmp_path / "f.zarr", name, within_limits=limits, symmetry=False)
+    a = reduced.attrs
+    assert (a["joint1_symmetry"], a["roll_symmetry"]) == (joint1, roll)
+    assert a["reduction"] == full.attrs["poses"] / a["poses_solved"]
+    assert a["reduction"] > 1.0 if joint1 or roll else a["reduction"] == 1.0
+    assert np.array_equal(reduced.counts(), full.counts())
+    assert np.array_equal(reduced.index, full.index)
+
+
+def test_an_interrupted_run_continues_without_redoing_its_chunks(tmp_path, monkeypatch):
+    args = arm_args("puma560")
+    params = small("puma560", symmetry=False, chunk=500)  # 27 chunks
+    path = tmp_path / "m.zarr"
+    with pytest.raises(KeyboardInterrupt):
+        reach.run(path, *args, params, progress=None, stop_after=2)
+    solved: list[int] = []
+    original = reach.solve_chunk
+
+    def spy(module, layout, p, chunk):
+        solved.append(chunk)
+        return original(module, layout, p, chunk)
+
+    monkeypatch.setattr(reach, "solve_chunk", spy)
+    done = reach.run(path, *args, params, progress=None)
+    layout = reach.make_layout(reach.load_solver(args[0], args[2]), args[3], params)
+    assert done.skipped == 2 and done.computed == layout.n_chunks - 2 > 0
+    assert sorted(solved) == list(range(2, layout.n_chunks))
+    whole = make(tmp_path / "w.zarr", "puma560", symmetry=False)
+    assert whole.attrs["block"] != reach.load(path).attrs["block"]
+    assert np.array_equal(reach.load(path).counts(), whole.counts())
+
+
+def test_a_killed_command_finishes_with_the_same_map_when_run_again(tmp_path):
+    """derive reach killed (SIGKILL) after its first chunks, then run again."""
+    path = tmp_path / "k.zarr"
+    command = [sys.executable, "-m", "derive", "reach", "puma560", "-o", str(path)]
+    command += ["--resolution", "0.15", "--directions", "40", "--rolls", "4", "--no-symmetry"]
+    env = {**os.environ, "DERIVE_BACKEND": "python"}
+    run = subprocess.Popen(command, env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    marks = path / "done" / "c"
+    deadline = time.monotonic() + 120
+    while time.monotonic() < deadline and run.poll() is None:
+        if marks.exists() and len(list(marks.iterdir())) >= 3:
+            break
+        time.sleep(0.02)
+    assert run.poll() is None, "the run ended before it could be killed: make it longer"
+    run.send_signal(signal.SIGKILL)
+    run.wait()
+    group = reach._zarr().open_group(str(path), mode="r")
+    first = int(group["done"][:].sum())
+    assert 0 < first < group["done"].shape[0] and not group.attrs.get("complete")
+    again = subprocess.run(command, env=env, capture_output=True, text=True, check=True)
+    assert f"{first} done before" in again.stdout
+    whole = make(
+        tmp_path / "w.zarr", "puma560", resolution=0.15, directions=40, rolls=4, symmetry=False
+    )
+    assert np.array_equal(reach.load(path).counts(), whole.counts())
+
+
+def test_dask_local_workers_give_the_local_map(tmp_path):
+    pytest.importorskip("distributed")
+    local = make(tmp_path / "l.zarr", "lecture_6r")
+    args = arm_args("lecture_6r")
+    reach.run(tmp_path / "d.zarr", *args, small("lecture_6r"), dask="local:2", progress=None)
+    remote = reach.load(tmp_path / "d.zarr")
+    assert np.array_equal(remote.counts(), local.counts())
+    assert np.array_equal(remote.index, local.index)
+
+
+def test_first_solutions_reach_their_poses(tmp_path, generated):
+    rmap = make(tmp_path / "m.zarr", "puma560", first=True)
+    first = rmap.group["first"][:]
+    counts = rmap.group["counts"][:]
+    assert np.array_equal(np.isnan(first).all(axis=-1), counts == 0)
+    layout = reach.make_layout(generated("puma560"), "standard", small("puma560", first=True))
+    T = np.concatenate(
+        [reach.chunk_poses(layout, c).reshape(-1, 4, 4) for c in range(layout.n_chunks)]
+    )
+    Q = first.reshape(-1, 6)
+    has = ~np.isnan(Q).any(axis=1)
+    fk = generated("puma560").fk_batch(Q[has].astype(float))
+    assert np.abs(fk - T[has]).max() < 1e-5  # float32 storage
+
+
+def test_the_hdf5_export_has_reuleaux_layout(tmp_path, generated):
+    h5py = pytest.importorskip("h5py")
+    rmap = make(tmp_path / "m.zarr", "puma560")
+    poses = reach.export_hdf5(rmap, tmp_path / "m.h5", progress=None)
+    with h5py.File(tmp_path / "m.h5", "r") as h5:
+        spheres = h5["/Spheres/sphere_dataset"][:]
+        rows = h5["/Poses/poses_dataset"][:]
+        resolution = h5["/Spheres/sphere_dataset"].attrs["Resolution"]
+    assert resolution == rmap.attrs["parameters"]["resolution"]
+    assert spheres.shape == (int((rmap.index > 0).sum()), 4)
+    assert rows.dtype == np.float32 and rows.shape == (poses, 10)
+    assert poses == int((rmap.counts() > 0).sum())
+    module = generated("puma560")
+    for row in rows[:: max(1, len(rows) // 25)]:
+        x, y, z, w = (float(v) for v in row[6:])
+        R = np.array(
+            [
+                [1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
+                [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
+                [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)],
+            ]
+        )
+        T = np.eye(4)
+        T[:3, :3], T[:3, 3] = R, row[3:6]
+        assert len(module.ik(T, tol=1e-5)) > 0  # (float32 rows)
+
+
+def test_quaternions_round_trip():
+    rng = np.random.default_rng(3)
+    q = rng.normal(size=(200, 4))
+    q /= np.linalg.norm(q, axis=1)[:, None]
+    q[:4] = [[1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1]]  # 180-degree turns, identity
+    x, y, z, w = q.T
+    R = np.stack(
+        [
+            np.stack([1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)], -1),
+            np.stack([2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)], -1),
+            np.stack([2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)], -1),
+        ],
+        axis=1,
+    )
+    got = reach.quaternions(R)
+    assert np.allclose(got, q * np.where(q[:, 3:] < 0, -1, 1), atol=1e-12)
+
+
+def test_the_command_writes_the_map_its_sections_and_says_what_it_did(tmp_path, capsys):
+    pytest.importorskip("matplotlib")
+    out = tmp_path / "m.zarr"
+    code = main(
+        ["reach", "puma560", "-o", str(out), "--resolution", "0.3", "--directions", "6",
+         "--rolls", "3", "--plot", str(tmp_path / "m.png")]
+    )  # fmt: skip
+    assert code == 0
+    text = capsys.readouterr().out
+    assert "reduction x" in text and "joint-1 symmetry" in text and "voxels reached" in text
+    assert (tmp_path / "m.png").read_bytes()[:4] == b"\x89PNG"
+    # the same command again: nothing left to do
+    assert main(["reach", "puma560", "-o", str(out), "--resolution", "0.3", "--directions", "6",
+                 "--rolls", "3"]) == 0  # fmt: skip
+    assert "0 chunk(s) computed" in capsys.readouterr().out
+
+
+@pytest.mark.parametrize(
+    ("argv", "message"),
+    [
+        (["--resolution", "0"], "--resolution: a positive length"),
+        (["--directions", "0"], "--directions: from 1"),
+        (["--plot", "m.pdf"], "--plot: m.pdf: the file must end in .svg or .png"),
+        (["--dask", "local:0"], "--dask local:0: local:N with N >= 1"),
+    ],
+)
+def test_bad_options_are_named(argv, message, tmp_path, capsys, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    assert main(["reach", "puma560", "-o", "m.zarr", *argv]) == 2
+    assert message in capsys.readouterr().err
+
+
+def test_another_map_in_the_folder_is_refused_by_name(tmp_path, capsys):
+    make(tmp_path / "m.zarr", "puma560")
+    assert main(["reach", "puma560", "-o", str(tmp_path / "m.zarr"), "--resolution", "0.2"]) == 2
+    err = capsys.readouterr().err
+    assert "m.zarr: holds another map (it differs in" in err and "parameters" in err
+    (tmp_path / "x").mkdir()
+    (tmp_path / "x" / "junk").write_text("not zarr")
+    assert main(["reach", "puma560", "-o", str(tmp_path / "x"), "--resolution", "0.3"]) == 2
+    assert "x: " in capsys.readouterr().err
+
+
+def test_a_position_only_arm_is_sent_to_the_workspace_command(capsys):
+    assert main(["reach", "planar_2r", "-o", "never.zarr"]) == 2
+    assert "use derive workspace" in capsys.readouterr().err
+    assert not Path("never.zarr").exists()
+
+
+def test_without_zarr_the_message_says_what_to_install(tmp_path, monkeypatch, capsys):
+    monkeypatch.setitem(sys.modules, "zarr", None)
+    assert main(["reach", "puma560", "-o", str(tmp_path / "m.zarr")]) == 2
+    assert "pip install 'derive-ik[scale]'" in capsys.readouterr().err
