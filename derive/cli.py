@@ -11,6 +11,7 @@ import difflib
 import importlib.util
 import math
 import os
+import resource
 import stat
 import sys
 import tempfile
@@ -477,6 +478,10 @@ def cmd_reach(args: argparse.Namespace) -> int:
         raise UsageError(f"--directions: from 1 to 100000, got {args.directions}")
     if not 1 <= args.rolls <= 3600:
         raise UsageError(f"--rolls: from 1 to 3600, got {args.rolls}")
+    if args.directions * args.rolls > 65_536:
+        raise UsageError("--directions x --rolls: at most 65536 orientations per voxel")
+    if not 1 <= args.chunk <= 10_000_000:
+        raise UsageError(f"--chunk: from 1 to 10000000 poses, got {args.chunk}")
     params = reach.Parameters(
         resolution=args.resolution,
         directions=args.directions,
@@ -484,6 +489,7 @@ def cmd_reach(args: argparse.Namespace) -> int:
         within_limits=args.within_limits,
         first=args.first,
         symmetry=not args.no_symmetry,
+        chunk=args.chunk,
     )
     output = Path(args.output)
     try:
@@ -505,6 +511,15 @@ def cmd_reach(args: argparse.Namespace) -> int:
             f"{output}: {done.computed} chunk(s) computed in {done.seconds:.1f} s{rate}"
             + (f", {done.skipped} done before" if done.skipped else "")
         )
+        if args.bench:
+            alone = reach.batch_alone(spec.name, source, spec.convention, params)
+            rss = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
+            print(
+                f"bench: the run {done.poses / done.seconds:,.0f} poses/s; ik_batch alone on "
+                f"the same poses {alone.poses / alone.seconds:,.0f} poses/s; the run at "
+                f"{100 * (done.poses / done.seconds) / (alone.poses / alone.seconds):.1f}% of "
+                f"it; peak RSS of this process {rss:.0f} MB"
+            )
         if args.hdf5:
             poses = reach.export_hdf5(rmap, Path(args.hdf5))
             print(f"{args.hdf5}: written (Reuleaux layout, {poses:,} poses)")
@@ -746,9 +761,20 @@ def parser() -> argparse.ArgumentParser:
         "--no-symmetry", action="store_true", help="solve every voxel and roll (no reduction)"
     )
     reach.add_argument(
+        "--chunk",
+        type=int,
+        default=262_144,
+        help="poses per chunk, the unit of work, storage and resuming (262144: about 0.3 GB)",
+    )
+    reach.add_argument(
         "--dask",
         metavar="ADDRESS",
         help="run on Dask: local:N (N worker processes here) or tcp://HOST:PORT (a scheduler)",
+    )
+    reach.add_argument(
+        "--bench",
+        action="store_true",
+        help="then time ik_batch alone on the same poses and compare (needs a fresh -o)",
     )
     reach.add_argument("--hdf5", metavar="FILE.h5", help="also export in Reuleaux's HDF5 layout")
     reach.add_argument(

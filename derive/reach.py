@@ -73,7 +73,9 @@ DIRECTIONS = 200
 ROLLS = 8
 # poses per chunk, at most: one ik_batch call each (memory: under 1 kB a pose for the poses,
 # Q and valid: 0.3 GB a chunk for 16 solutions of 6 joints)
-CHUNK_POSES = 131_072
+CHUNK_POSES = 262_144
+# poses per ik_batch call inside a chunk (see solve_chunk)
+PIECE = 8192
 # the largest grid side accepted (voxels)
 MAX_SIDE = 1001
 # symmetry checks on the FK: random configurations, and the agreement asked (of REACH)
@@ -278,8 +280,18 @@ def make_layout(module: ModuleType, convention: str, params: Parameters) -> Layo
 
 
 def chunk_poses(layout: Layout, chunk: int) -> np.ndarray:
-    """The world poses of a chunk, (columns, heights, directions, rolls stored, 4, 4), made
-    from the grid's indices."""
+    """The world poses of a chunk, (columns, heights, directions, rolls stored, 4, 4)."""
+    cols, heights = layout.chunk_slices(chunk)
+    D, K = layout.rotations.shape[:2]
+    shape = (cols.stop - cols.start, heights.stop - heights.start, D, K, 4, 4)
+    return np.concatenate([T.copy() for _, T in pieces(layout, chunk, 1 << 62)]).reshape(shape)
+
+
+def pieces(layout: Layout, chunk: int, size: int) -> Iterable[tuple[slice, np.ndarray]]:
+    """A chunk's poses, made from the grid's indices about size at a time (whole voxels):
+    (rows of the chunk's flat pose list, (rows, 4, 4) poses). The poses are in a reused
+    buffer, valid until the next piece: a piece that fits the cache is made and solved
+    while it is there (a whole chunk's poses made first cost 38 ns a pose, against 11)."""
     cols, heights = layout.chunk_slices(chunk)
     xy = layout.columns[cols]
     z = layout.centres[heights]
@@ -289,8 +301,7 @@ def chunk_poses(layout: Layout, chunk: int) -> np.ndarray:
     spin[:, 0, 0], spin[:, 0, 1], spin[:, 1, 0], spin[:, 1, 1] = c, -s, s, c
     spin[:, 2, 2] = 1.0
     D, K = layout.rotations.shape[:2]
-    # one column's poses without their positions, then copied up the column (16 contiguous
-    # numbers a pose: about 11 ns a pose here, against about 33 for a broadcast 3x3 write)
+    # each column's poses without their positions, copied to each of its voxels
     column = np.zeros((len(xy), D, K, 4, 4))
     column[..., :3, :3] = (layout.frame[:3, :3] @ spin)[:, None, None] @ layout.rotations[None]
     column[..., 3, 3] = 1.0
@@ -298,11 +309,15 @@ def chunk_poses(layout: Layout, chunk: int) -> np.ndarray:
     points[:, :, 0] = xy[:, None, 0]
     points[:, :, 1] = xy[:, None, 1]
     points[:, :, 2] = z[None, :]
-    world = points @ layout.frame[:3, :3].T + layout.frame[:3, 3]
-    T = _scratch(len(xy) * len(z) * D * K * 16).reshape(len(xy), len(z), D, K, 4, 4)
-    T[:] = column[:, None]
-    T[..., :3, 3] = world[:, :, None, None, :]
-    return T
+    world = (points @ layout.frame[:3, :3].T + layout.frame[:3, 3]).reshape(-1, 3)
+    per_cell = D * K
+    step = max(1, size // per_cell)
+    for first in range(0, len(world), step):
+        cells = np.arange(first, min(len(world), first + step))
+        T = _scratch(len(cells) * per_cell * 16).reshape(len(cells), D, K, 4, 4)
+        np.take(column, cells // len(z), axis=0, out=T, mode="clip")  # (unbuffered)
+        T[..., :3, 3] = world[cells][:, None, None, :]
+        yield slice(first * per_cell, (first + len(cells)) * per_cell), T.reshape(-1, 4, 4)
 
 
 _SCRATCH: list[np.ndarray] = []
@@ -321,23 +336,26 @@ def _scratch(size: int) -> np.ndarray:
 def solve_chunk(
     module: ModuleType, layout: Layout, params: Parameters, chunk: int
 ) -> dict[str, np.ndarray]:
-    """A chunk's arrays: counts, column_index and (with params.first) first."""
-    T = chunk_poses(layout, chunk)
-    shape = T.shape[:4]
-    Q, valid = module.ik_batch(T.reshape(-1, 4, 4))
-    if params.within_limits:
-        valid &= inside_limits(module, Q)
-    # (a uint8 product: 5 ns a pose, against 20 for sum or count_nonzero)
-    counts = (valid.view(np.uint8) @ np.ones(valid.shape[1], dtype=np.uint8)).reshape(shape)
-    out = {
-        "counts": counts,
-        "column_index": (counts > 0).mean(axis=(2, 3), dtype=np.float64).astype(np.float32),
-    }
-    if params.first:
-        first = np.full((len(Q), module.DOF), np.nan, dtype=np.float32)
-        has = valid.any(axis=1)
-        rows = np.argmax(valid, axis=1)
-        first[has] = Q[np.flatnonzero(has), rows[has]]
+    """A chunk's arrays: counts and (with params.first) first. ik_batch gets about PIECE
+    poses at a time: its solutions array then stays under 32 MB, which the C allocator keeps
+    for reuse (larger ones are mapped afresh each call and cost their page faults again)."""
+    cols, heights = layout.chunk_slices(chunk)
+    shape = (cols.stop - cols.start, heights.stop - heights.start, *layout.rotations.shape[:2])
+    n = math.prod(shape)
+    counts = np.empty(n, dtype=np.uint8)
+    first = np.full((n, module.DOF), np.nan, dtype=np.float32) if params.first else None
+    ones = np.ones(module.MAX_SOLUTIONS, dtype=np.uint8)
+    for rows, T in pieces(layout, chunk, PIECE):
+        Q, valid = module.ik_batch(T)
+        if params.within_limits:
+            valid &= inside_limits(module, Q)
+        # (a uint8 product: 5 ns a pose, against 20 for sum or count_nonzero)
+        counts[rows] = valid.view(np.uint8) @ ones
+        if first is not None:
+            has = np.flatnonzero(valid.any(axis=1))
+            first[rows.start + has] = Q[has, np.argmax(valid[has], axis=1)]
+    out = {"counts": counts.reshape(shape)}
+    if first is not None:
         out["first"] = first.reshape(*shape, module.DOF)
     return out
 
@@ -446,9 +464,8 @@ def open_store(
         "directions": layout.rotations[:, 0, :, 2],
         "rolls": layout.rolls,
     }
-    chunked = {
+    chunked: dict[str, tuple[tuple[int, ...], tuple[int, ...], str, float]] = {
         "counts": ((m, side, D, K), (bc, bz, D, K), "uint8", 0),
-        "column_index": ((m, side), (bc, bz), "float32", 0.0),
         "done": ((layout.n_chunks,), (1,), "uint8", 0),
     }
     if params.first:
@@ -480,30 +497,37 @@ def pending(group: Any) -> list[int]:
     return [int(c) for c in np.flatnonzero(done == 0)]
 
 
-def write_chunk(group: Any, layout: Layout, chunk: int, arrays: dict[str, np.ndarray]) -> None:
-    """A chunk's arrays, then its done mark (last: a chunk killed half way is redone)."""
+def write_chunk(
+    store: dict[str, Any], layout: Layout, chunk: int, data: dict[str, np.ndarray]
+) -> None:
+    """A chunk's arrays, then its done mark (last: a chunk killed half way is redone).
+    store: the group's arrays by name (opening one reads its metadata: once per run)."""
     cols, heights = layout.chunk_slices(chunk)
-    for key, data in arrays.items():
-        _array(group, key)[cols, heights] = data
-    _array(group, "done")[chunk] = 1
+    for key, values in data.items():
+        store[key][cols, heights] = values
+    store["done"][chunk] = 1
 
 
-_ARRAYS: dict[tuple[int, str], Any] = {}
+def arrays(group: Any) -> dict[str, Any]:
+    """A store's arrays by name."""
+    return {key: group[key] for key in group.array_keys()}
 
 
-def _array(group: Any, key: str) -> Any:
-    """A group's array, opened once (opening reads its metadata from the store)."""
-    if (id(group), key) not in _ARRAYS:
-        _ARRAYS[id(group), key] = group[key]
-    return _ARRAYS[id(group), key]
-
-
-def finish(group: Any) -> None:
-    """The per-voxel index from the columns', and the store marked complete. (The per-voxel
-    arrays are small: a voxel has directions x rolls poses.)"""
-    column_of = group["column_of"][:]
-    column_index = group["column_index"][:]
-    side = column_of.shape[0]
+def finish(group: Any, layout: Layout) -> None:
+    """The reachability index (per column and height, then per voxel) from the counts, read
+    chunk by chunk, and the store marked complete. (The per-voxel arrays are small: a voxel
+    has directions x rolls poses.)"""
+    counts = group["counts"]
+    column_index = np.zeros(counts.shape[:2], dtype=np.float32)
+    for chunk in range(layout.n_chunks):
+        cols, heights = layout.chunk_slices(chunk)
+        column_index[cols, heights] = (counts[cols, heights] > 0).mean(axis=(2, 3))
+    if "column_index" not in group:
+        group.create_array("column_index", data=column_index, chunks=column_index.shape)
+    else:
+        group["column_index"][:] = column_index
+    column_of = layout.column_of
+    side = layout.side
     slab = max(1, min(side, 4_000_000 // (side * side)))
     if "index" not in group:
         group.create_array(
@@ -527,16 +551,16 @@ def _chunk_task(
     module = load_solver(name, source)
     layout = _layouts(module, convention, params)
     group = _zarr().open_group(path, mode="r+")
-    write_chunk(group, layout, chunk, solve_chunk(module, layout, params, chunk))
+    write_chunk(arrays(group), layout, chunk, solve_chunk(module, layout, params, chunk))
     return chunk
 
 
-_LAYOUTS: dict[tuple[int, str, Parameters], Layout] = {}
+_LAYOUTS: dict[tuple[str, str, Parameters], Layout] = {}
 
 
 def _layouts(module: ModuleType, convention: str, params: Parameters) -> Layout:
     """The layout, made once per process per module and parameters."""
-    key = (id(module), convention, params)
+    key = (module.__name__, convention, params)  # (a solver's name holds its source's hash)
     if key not in _LAYOUTS:
         _LAYOUTS[key] = make_layout(module, convention, params)
     return _LAYOUTS[key]
@@ -597,11 +621,12 @@ def run(
     if dask is None:
         # writes go to a thread (zarr's compression and I/O overlap the next chunk's solve);
         # at most two chunks wait to be written
+        store = arrays(group)
         with ThreadPoolExecutor(max_workers=1) as writer:
             waiting: list[Future[None]] = []
             for done, chunk in enumerate(todo, 1):
-                arrays = solve_chunk(module, layout, params, chunk)
-                waiting.append(writer.submit(write_chunk, group, layout, chunk, arrays))
+                data = solve_chunk(module, layout, params, chunk)
+                waiting.append(writer.submit(write_chunk, store, layout, chunk, data))
                 if len(waiting) > 2:
                     waiting.pop(0).result()
                 tick(done)
@@ -613,7 +638,7 @@ def run(
             tick(done)
     if progress is not None and todo:
         progress.write("\n")
-    finish(group)
+    finish(group, layout)
     return Run(len(todo), skipped, round(per_chunk * len(todo)), time.perf_counter() - start)
 
 
@@ -640,6 +665,12 @@ def _dask_chunks(
         if workers < 1:
             raise ReachError(f"--dask {address}: local:N with N >= 1 worker processes")
         threads = max(1, (os.cpu_count() or 1) // workers)
+        import dask
+
+        # dask starts workers with MALLOC_TRIM_THRESHOLD_=65536; any fixed threshold turns
+        # off glibc's adaptive mmap threshold, so every array of ik_batch is mapped afresh
+        # and page-faults (measured: half the throughput). Workers here start without it.
+        dask.config.set({"distributed.nanny.pre-spawn-environ.MALLOC_TRIM_THRESHOLD_": None})
         cluster = LocalCluster(
             n_workers=workers,
             threads_per_worker=1,
@@ -678,6 +709,20 @@ def _worker_threads(dask_worker: Any = None) -> int:
     threads = max(1, (os.cpu_count() or 1) // int(nthreads))
     _set_threads(threads)
     return threads
+
+
+def batch_alone(name: str, source: str, convention: str, params: Parameters) -> Run:
+    """ik_batch alone on a map's solved poses, chunk by chunk as the run makes them (the
+    poses made outside the timing): what the run's throughput is measured against."""
+    module = load_solver(name, source)
+    layout = _layouts(module, convention, params)
+    seconds = 0.0
+    for chunk in range(layout.n_chunks):
+        for _, T in pieces(layout, chunk, PIECE):  # as solve_chunk calls it
+            start = time.perf_counter()
+            module.ik_batch(T)
+            seconds += time.perf_counter() - start
+    return Run(layout.n_chunks, 0, layout.solved, seconds)
 
 
 # --- reading a map ----------------------------------------------------------------------
