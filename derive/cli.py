@@ -480,6 +480,8 @@ def cmd_reach(args: argparse.Namespace) -> int:
         raise UsageError(f"--rolls: from 1 to 3600, got {args.rolls}")
     if args.directions * args.rolls > 65_536:
         raise UsageError("--directions x --rolls: at most 65536 orientations per voxel")
+    if not 0 <= args.worker_threads <= 1024:
+        raise UsageError(f"--worker-threads: from 0 (automatic) to 1024, got {args.worker_threads}")
     if not 1 <= args.chunk <= 10_000_000:
         raise UsageError(f"--chunk: from 1 to 10000000 poses, got {args.chunk}")
     params = reach.Parameters(
@@ -502,7 +504,14 @@ def cmd_reach(args: argparse.Namespace) -> int:
 
             pyplot()  # say at once if matplotlib is missing
         done = reach.run(
-            output, spec.name, spec.digest(), source, spec.convention, params, dask=args.dask
+            output,
+            spec.name,
+            spec.digest(),
+            source,
+            spec.convention,
+            params,
+            dask=args.dask,
+            worker_threads=args.worker_threads,
         )
         rmap = reach.load(output)
         print(rmap.summary())
@@ -775,6 +784,13 @@ def parser() -> argparse.ArgumentParser:
         "--bench",
         action="store_true",
         help="then time ik_batch alone on the same poses and compare (needs a fresh -o)",
+    )
+    reach.add_argument(
+        "--worker-threads",
+        type=int,
+        default=0,
+        help="numba threads per Dask worker (default: cores / N for local:N, else a "
+        "worker's cores / its task threads)",
     )
     reach.add_argument("--hdf5", metavar="FILE.h5", help="also export in Reuleaux's HDF5 layout")
     reach.add_argument(

@@ -150,7 +150,7 @@ def inside_limits(module: ModuleType, Q: np.ndarray) -> np.ndarray:
     ok = np.ones(Q.shape[:-1], dtype=bool)
     for j, ((lo, hi), kind) in enumerate(zip(module.LIMITS, module.JOINT_TYPES)):
         x = Q[..., j]
-        if kind == "R" and math.isfinite(lo) and math.isfinite(hi):
+        if kind == "R" and math.isfinite(lo) and hi - lo < 2.0 * math.pi:  # (else every q)
             ok &= np.mod(x - lo, 2.0 * math.pi) <= hi - lo + 1e-12
         elif kind == "P":
             ok &= (lo - 1e-12 <= x) & (x <= hi + 1e-12)

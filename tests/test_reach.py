@@ -188,6 +188,22 @@ def test_dask_local_workers_give_the_local_map(tmp_path):
     assert np.array_equal(remote.index, local.index)
 
 
+def test_a_dask_scheduler_address_gives_the_local_map(tmp_path):
+    """--dask tcp://...: a cluster started apart (here a LocalCluster on the loopback)."""
+    distributed = pytest.importorskip("distributed")
+    local = make(tmp_path / "l.zarr", "puma560")
+    with distributed.LocalCluster(
+        n_workers=1, threads_per_worker=1, processes=True, dashboard_address=None
+    ) as cluster:
+        assert cluster.scheduler_address.startswith("tcp://127.0.0.1:")
+        path = tmp_path / "d.zarr"
+        reach.run(
+            path, *arm_args("puma560"), small("puma560"), dask=cluster.scheduler_address,
+            progress=None,
+        )  # fmt: skip
+    assert np.array_equal(reach.load(path).counts(), local.counts())
+
+
 def test_first_solutions_reach_their_poses(tmp_path, generated):
     rmap = make(tmp_path / "m.zarr", "puma560", first=True)
     first = rmap.group["first"][:]
