@@ -480,6 +480,8 @@ def cmd_reach(args: argparse.Namespace) -> int:
         raise UsageError(f"--rolls: from 1 to 3600, got {args.rolls}")
     if args.directions * args.rolls > 65_536:
         raise UsageError("--directions x --rolls: at most 65536 orientations per voxel")
+    if not 0 <= args.processes <= 1024:
+        raise UsageError(f"--processes: from 0 (one per core) to 1024, got {args.processes}")
     if not 0 <= args.worker_threads <= 1024:
         raise UsageError(f"--worker-threads: from 0 (automatic) to 1024, got {args.worker_threads}")
     if not 1 <= args.chunk <= 10_000_000:
@@ -512,6 +514,7 @@ def cmd_reach(args: argparse.Namespace) -> int:
             params,
             dask=args.dask,
             worker_threads=args.worker_threads,
+            processes=args.processes,
         )
         rmap = reach.load(output)
         print(rmap.summary())
@@ -784,6 +787,12 @@ def parser() -> argparse.ArgumentParser:
         "--bench",
         action="store_true",
         help="then time ik_batch alone on the same poses and compare (needs a fresh -o)",
+    )
+    reach.add_argument(
+        "--processes",
+        type=int,
+        default=0,
+        help="without --dask: worker processes here (default 0: one per core; 1: this one)",
     )
     reach.add_argument(
         "--worker-threads",

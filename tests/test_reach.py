@@ -40,8 +40,8 @@ def arm(name: str) -> tuple[str, str, str, str]:
     return spec.name, spec.digest(), render_module(build_plan(spec)), spec.convention
 
 
-def make(path: Path, name: str, **params) -> reach.ReachMap:
-    reach.run(path, *arm_args(name), small(name, **params), progress=None)
+def make(path: Path, name: str, processes: int = 1, **params) -> reach.ReachMap:
+    reach.run(path, *arm_args(name), small(name, **params), processes=processes, progress=None)
     return reach.load(path)
 
 
@@ -131,7 +131,7 @@ def test_an_interrupted_run_continues_without_redoing_its_chunks(tmp_path, monke
     params = small("puma560", symmetry=False, chunk=500)  # 27 chunks
     path = tmp_path / "m.zarr"
     with pytest.raises(KeyboardInterrupt):
-        reach.run(path, *args, params, progress=None, stop_after=2)
+        reach.run(path, *args, params, processes=1, progress=None, stop_after=2)
     solved: list[int] = []
     original = reach.solve_chunk
 
@@ -140,7 +140,7 @@ def test_an_interrupted_run_continues_without_redoing_its_chunks(tmp_path, monke
         return original(module, layout, p, chunk)
 
     monkeypatch.setattr(reach, "solve_chunk", spy)
-    done = reach.run(path, *args, params, progress=None)
+    done = reach.run(path, *args, params, processes=1, progress=None)
     layout = reach.make_layout(reach.load_solver(args[0], args[2]), args[3], params)
     assert done.skipped == 2 and done.computed == layout.n_chunks - 2 > 0
     assert sorted(solved) == list(range(2, layout.n_chunks))
@@ -167,7 +167,11 @@ def test_a_killed_command_finishes_with_the_same_map_when_run_again(tmp_path):
     run.send_signal(signal.SIGKILL)
     run.wait()
     group = reach._zarr().open_group(str(path), mode="r")
-    first = int(group["done"][:].sum())
+    # its worker processes finish the chunks they hold, then see their parent gone and end
+    first, settled = -1, int(group["done"][:].sum())
+    while settled != first:
+        time.sleep(1.0)
+        first, settled = settled, int(group["done"][:].sum())
     assert 0 < first < group["done"].shape[0] and not group.attrs.get("complete")
     again = subprocess.run(command, env=env, capture_output=True, text=True, check=True)
     assert f"{first} done before" in again.stdout
@@ -202,6 +206,14 @@ def test_a_dask_scheduler_address_gives_the_local_map(tmp_path):
             progress=None,
         )  # fmt: skip
     assert np.array_equal(reach.load(path).counts(), local.counts())
+
+
+def test_worker_processes_give_the_map_of_one_process(tmp_path):
+    one = make(tmp_path / "one.zarr", "lecture_6r", chunk=200)
+    two = make(tmp_path / "two.zarr", "lecture_6r", chunk=200, processes=2)
+    assert one.attrs["block"] == two.attrs["block"] and one.group["done"].shape[0] > 2
+    assert np.array_equal(one.counts(), two.counts())
+    assert np.array_equal(one.index, two.index)
 
 
 def test_first_solutions_reach_their_poses(tmp_path, generated):
