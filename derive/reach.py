@@ -75,6 +75,8 @@ ROLLS = 8
 # poses per chunk, at most: one ik_batch call each (memory: under 1 kB a pose for the poses,
 # Q and valid: 0.3 GB a chunk for 16 solutions of 6 joints)
 CHUNK_POSES = 262_144
+# chunks per Dask task, at most
+DASK_CHUNKS_PER_TASK = 8
 # poses per ik_batch call inside a chunk (see solve_chunk)
 PIECE = 8192
 # the largest grid side accepted (voxels)
@@ -546,16 +548,22 @@ def finish(group: Any, layout: Layout) -> None:
 
 
 def _chunk_task(
-    path: str, name: str, source: str, convention: str, params: Parameters, chunk: int, threads: int
-) -> int:
-    """One chunk in a Dask worker: the solver, layout and arrays set up on the worker's first
-    task of a map (opening a store's arrays reads their metadata: about 10 ms), then solve
-    and write. Returns the chunk."""
+    path: str,
+    name: str,
+    source: str,
+    convention: str,
+    params: Parameters,
+    chunks: list[int],
+    threads: int,
+) -> list[int]:
+    """Chunks in a Dask worker: the solver, layout and arrays set up on the worker's first
+    task of a map (opening a store's arrays reads their metadata: about 10 ms), then each
+    chunk solved and written. Returns the chunks."""
     key = (path, name, hashlib.sha256(source.encode()).hexdigest(), convention, params)
     if _WORKER.get("key") != key:
         _start_worker(path, name, source, convention, params, threads)
         _WORKER["key"] = key
-    return _worker_chunk(chunk)
+    return [_worker_chunk(chunk) for chunk in chunks]
 
 
 # a local worker process's solver, layout and arrays (set once by _start_worker)
@@ -731,14 +739,14 @@ def _dask_chunks(
         # dask starts workers with MALLOC_TRIM_THRESHOLD_=65536; any fixed threshold turns
         # off glibc's adaptive mmap threshold, so every array of ik_batch is mapped afresh
         # and page-faults (measured: half the throughput). Workers here start without it.
-        dask.config.set({"distributed.nanny.pre-spawn-environ.MALLOC_TRIM_THRESHOLD_": None})
-        cluster = LocalCluster(
-            n_workers=workers,
-            threads_per_worker=1,
-            processes=True,
-            dashboard_address=None,
-            silence_logs=40,
-        )
+        with dask.config.set({"distributed.nanny.pre-spawn-environ.MALLOC_TRIM_THRESHOLD_": None}):
+            cluster = LocalCluster(
+                n_workers=workers,
+                threads_per_worker=1,
+                processes=True,
+                dashboard_address=None,
+                silence_logs=40,
+            )
         client = Client(cluster)
     else:
         threads = worker_threads  # 0: each worker's cores / its task threads (below)
@@ -750,14 +758,25 @@ def _dask_chunks(
         shared = client.scatter(source, broadcast=True)
         if threads == 0:
             client.run(_worker_threads)  # the setting stays with each worker process
+        # tasks of a few chunks (each task costs the scheduler a few ms), about 8 a task thread
+        slots = max(1, sum(client.nthreads().values()))
+        size = max(1, min(DASK_CHUNKS_PER_TASK, len(todo) // (8 * slots)))
         futures = [
             client.submit(
-                _chunk_task, path, name, shared, convention, params, chunk, threads, pure=False
+                _chunk_task,
+                path,
+                name,
+                shared,
+                convention,
+                params,
+                todo[first : first + size],
+                threads,
+                pure=False,
             )
-            for chunk in todo
+            for first in range(0, len(todo), size)
         ]
         for future in completed(futures):
-            yield future.result()
+            yield from future.result()
     finally:
         client.close()
         if cluster is not None:
