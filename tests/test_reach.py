@@ -94,6 +94,22 @@ def test_the_map_equals_a_direct_loop_over_poses_calling_ik(name, limits, tmp_pa
     assert np.allclose(rmap.index, index, atol=1e-6)
 
 
+@pytest.mark.parametrize("name", ["puma560", "panda", "iiwa14"])
+def test_the_interval_limits_check_agrees_with_the_modulo(name, generated):
+    """reach.within (comparisons) against workspace.inside_limits (q - lo modulo 2 pi), on
+    values inside (-pi, pi] and far outside it."""
+    from derive.workspace import inside_limits
+
+    module = generated(name)
+    rng = np.random.default_rng(5)
+    Q = rng.uniform(-math.pi, math.pi, (20000, module.DOF))
+    Q[:500] *= 7.0
+    assert reach.allowed(module)
+    inside = reach.within(module, Q)
+    assert 0 < inside.mean() < 1
+    assert np.array_equal(inside, inside_limits(module, Q))
+
+
 def test_the_orientations_are_rotations_with_the_asked_approach_and_roll():
     z = reach.fibonacci_directions(50)
     assert np.allclose(np.linalg.norm(z, axis=1), 1.0)
