@@ -81,7 +81,8 @@ def direct_counts(rmap: reach.ReachMap, module, within_limits: bool) -> np.ndarr
 
 
 @pytest.mark.parametrize(
-    ("name", "limits"), [("puma560", False), ("puma560", True), ("lecture_6r", True)]
+    ("name", "limits"),
+    [("puma560", False), ("puma560", True), ("lecture_6r", False), ("panda", True)],
 )
 def test_the_map_equals_a_direct_loop_over_poses_calling_ik(name, limits, tmp_path, generated):
     rmap = make(tmp_path / "m.zarr", name, within_limits=limits)
