@@ -776,7 +776,7 @@ def parser() -> argparse.ArgumentParser:
         "--chunk",
         type=int,
         default=262_144,
-        help="poses per chunk, the unit of work, storage and resuming (262144: about 0.3 GB)",
+        help="poses per chunk, the unit of work, storage and resuming (262144)",
     )
     reach.add_argument(
         "--dask",

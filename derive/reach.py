@@ -72,8 +72,8 @@ FORMAT = 1
 RESOLUTION = 0.05
 DIRECTIONS = 200
 ROLLS = 8
-# poses per chunk, at most: one ik_batch call each (memory: under 1 kB a pose for the poses,
-# Q and valid: 0.3 GB a chunk for 16 solutions of 6 joints)
+# poses per chunk, at most: the unit of work, storage and resuming (memory: a chunk's counts,
+# 1 byte a pose, and first solutions, 4 bytes a joint; the poses and solutions of one PIECE)
 CHUNK_POSES = 262_144
 # chunks per Dask task, at most
 DASK_CHUNKS_PER_TASK = 8
