@@ -505,6 +505,8 @@ def cmd_reach(args: argparse.Namespace) -> int:
             from derive.plot import pyplot
 
             pyplot()  # say at once if matplotlib is missing
+        if args.hdf5:
+            reach.h5py_module()  # (likewise h5py)
         done = reach.run(
             output,
             spec.name,
@@ -523,14 +525,18 @@ def cmd_reach(args: argparse.Namespace) -> int:
             f"{output}: {done.computed} chunk(s) computed in {done.seconds:.1f} s{rate}"
             + (f", {done.skipped} done before" if done.skipped else "")
         )
-        if args.bench:
+        if args.bench and done.computed == 0:
+            print("bench: nothing was computed (the map was complete): give a new -o")
+        elif args.bench:
             alone = reach.batch_alone(spec.name, source, spec.convention, params)
             rss = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
+            workers = resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss / 1024
+            run_rate, alone_rate = done.poses / done.seconds, alone.poses / alone.seconds
             print(
-                f"bench: the run {done.poses / done.seconds:,.0f} poses/s; ik_batch alone on "
-                f"the same poses {alone.poses / alone.seconds:,.0f} poses/s; the run at "
-                f"{100 * (done.poses / done.seconds) / (alone.poses / alone.seconds):.1f}% of "
-                f"it; peak RSS of this process {rss:.0f} MB"
+                f"bench: the run {run_rate:,.0f} poses/s; ik_batch alone on the same poses "
+                f"{alone_rate:,.0f} poses/s; the run at {100 * run_rate / alone_rate:.1f}% of "
+                f"it; peak RSS {rss:.0f} MB (this process), {workers:.0f} MB (its largest "
+                "worker process)"
             )
         if args.hdf5:
             poses = reach.export_hdf5(rmap, Path(args.hdf5))

@@ -943,15 +943,21 @@ def quaternions(R: np.ndarray) -> np.ndarray:
     return q.reshape(*R.shape[:-2], 4)
 
 
+def h5py_module() -> Any:
+    """h5py, or a ReachError saying how to install it."""
+    try:
+        import h5py
+    except ImportError:
+        raise ReachError("the HDF5 export needs h5py: pip install 'derive-ik[scale]'") from None
+    return h5py
+
+
 def export_hdf5(rmap: ReachMap, path: Path, progress: TextIO | None = sys.stderr) -> int:
     """Write the map in Reuleaux's layout: /Spheres/sphere_dataset (x, y, z, index) of the
     voxels reached, attribute Resolution, and /Poses/poses_dataset, float32 rows (voxel x, y,
     z, pose x, y, z, quaternion x, y, z, w) of every pose with a solution; world coordinates.
     Written height by height (memory: one horizontal slab of the map). Returns the poses."""
-    try:
-        import h5py
-    except ImportError:
-        raise ReachError("the HDF5 export needs h5py: pip install 'derive-ik[scale]'") from None
+    h5py = h5py_module()
     group = rmap.group
     counts = group["counts"]
     side = len(rmap.centres)

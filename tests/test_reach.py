@@ -306,6 +306,10 @@ def test_the_command_writes_the_map_its_sections_and_says_what_it_did(tmp_path, 
     assert main(["reach", "puma560", "-o", str(out), "--resolution", "0.3", "--directions", "6",
                  "--rolls", "3"]) == 0  # fmt: skip
     assert "0 chunk(s) computed" in capsys.readouterr().out
+    # --bench on a finished map says there is nothing to time
+    argv = ["reach", "puma560", "-o", str(out), "--resolution", "0.3", "--directions", "6"]
+    assert main([*argv, "--rolls", "3", "--bench"]) == 0
+    assert "bench: nothing was computed" in capsys.readouterr().out
 
 
 @pytest.mark.parametrize(
@@ -340,7 +344,11 @@ def test_a_position_only_arm_is_sent_to_the_workspace_command(capsys):
     assert not Path("never.zarr").exists()
 
 
-def test_without_zarr_the_message_says_what_to_install(tmp_path, monkeypatch, capsys):
-    monkeypatch.setitem(sys.modules, "zarr", None)
-    assert main(["reach", "puma560", "-o", str(tmp_path / "m.zarr")]) == 2
+@pytest.mark.parametrize(("module", "option"), [("zarr", []), ("h5py", ["--hdf5", "m.h5"])])
+def test_without_the_scale_extra_the_message_says_what_to_install(
+    module, option, tmp_path, monkeypatch, capsys
+):
+    monkeypatch.setitem(sys.modules, module, None)
+    assert main(["reach", "puma560", "-o", str(tmp_path / "m.zarr"), *option]) == 2
     assert "pip install 'derive-ik[scale]'" in capsys.readouterr().err
+    assert not (tmp_path / "m.zarr").exists()  # said before any work
