@@ -56,6 +56,7 @@ import multiprocessing
 import os
 import sys
 import tempfile
+import threading
 import time
 from collections.abc import Iterable
 from concurrent.futures import Future, ProcessPoolExecutor, ThreadPoolExecutor, as_completed
@@ -79,6 +80,8 @@ CHUNK_POSES = 262_144
 DASK_CHUNKS_PER_TASK = 8
 # poses per ik_batch call inside a chunk (see solve_chunk)
 PIECE = 8192
+# how often (seconds) a local worker process checks that the command that started it lives
+PARENT_POLL = 0.5
 # the largest grid side accepted (voxels)
 MAX_SIDE = 1001
 # symmetry checks on the FK: random configurations, and the agreement asked (of REACH)
@@ -629,6 +632,23 @@ def _start_worker(
     _WORKER.update(module=module, layout=layout, params=params, store=store, key=None)
 
 
+def _start_local_worker(
+    path: str, name: str, source: str, convention: str, params: Parameters, threads: int
+) -> None:
+    """A local worker process: as _start_worker, and it ends itself when the command that
+    started it is gone (a command killed by SIGKILL leaves its workers waiting on a queue no
+    one writes to: they would wait for ever)."""
+    parent = os.getppid()
+
+    def watch() -> None:
+        while os.getppid() == parent:
+            time.sleep(PARENT_POLL)
+        os._exit(1)
+
+    threading.Thread(target=watch, daemon=True).start()
+    _start_worker(path, name, source, convention, params, threads)
+
+
 def _worker_chunk(chunk: int) -> int:
     """One chunk in a local worker process."""
     w = _WORKER
@@ -717,7 +737,7 @@ def run(
         pool = ProcessPoolExecutor(
             max_workers=processes,
             mp_context=multiprocessing.get_context("spawn"),
-            initializer=_start_worker,
+            initializer=_start_local_worker,
             initargs=(str(path), name, source, convention, params, threads),
         )
         try:

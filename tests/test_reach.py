@@ -197,6 +197,27 @@ def test_a_killed_command_finishes_with_the_same_map_when_run_again(tmp_path):
     assert np.array_equal(reach.load(path).counts(), whole.counts())
 
 
+def test_worker_processes_end_when_the_command_is_killed(tmp_path):
+    """SIGKILL reaches the command only: its worker processes see it gone and end."""
+    psutil = pytest.importorskip("psutil")  # (distributed's dependency)
+    path = tmp_path / "k.zarr"
+    command = [sys.executable, "-m", "derive", "reach", "puma560", "-o", str(path)]
+    command += ["--resolution", "0.1", "--no-symmetry", "--processes", "2"]
+    env = {**os.environ, "DERIVE_BACKEND": "python"}
+    run = subprocess.Popen(command, env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    parent = psutil.Process(run.pid)
+    deadline = time.monotonic() + 60
+    workers: list = []
+    while time.monotonic() < deadline and len(workers) < 2 and run.poll() is None:
+        workers = [p for p in parent.children() if "spawn_main" in " ".join(p.cmdline())]
+        time.sleep(0.05)
+    assert len(workers) == 2, "the command started no worker processes"
+    run.send_signal(signal.SIGKILL)
+    run.wait()
+    _, alive = psutil.wait_procs(workers, timeout=30)
+    assert not alive, f"{len(alive)} worker process(es) outlived the command"
+
+
 def test_dask_local_workers_give_the_local_map(tmp_path):
     pytest.importorskip("distributed")
     local = make(tmp_path / "l.zarr", "lecture_6r")
