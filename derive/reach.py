@@ -67,7 +67,7 @@ from typing import Any, TextIO
 
 import numpy as np
 
-from derive.workspace import progress_line, section
+from derive.workspace import inside_limits, progress_line, section
 
 FORMAT = 1
 RESOLUTION = 0.05
@@ -356,7 +356,7 @@ def solve_chunk(
         if params.within_limits:  # (the solutions only, as rows: most slots are empty)
             slots = np.flatnonzero(valid)
             solutions = np.take(Q.reshape(-1, module.DOF), slots, axis=0)
-            valid.reshape(-1)[slots[~within(module, solutions)]] = False
+            valid.reshape(-1)[slots[~inside_limits(module, solutions)]] = False
         # (a uint8 product: 5 ns a pose, against 20 for sum or count_nonzero)
         counts[rows] = valid.view(np.uint8) @ ones
         if first is not None:
@@ -366,52 +366,6 @@ def solve_chunk(
     if first is not None:
         out["first"] = first.reshape(*shape, module.DOF)
     return out
-
-
-_WINDOW = math.pi + 1e-9
-
-
-def allowed(module: ModuleType) -> tuple[tuple[int, tuple[tuple[float, float], ...]], ...]:
-    """The joints whose limits exclude some value, each with its allowed values as intervals:
-    a revolute joint's q + 2 pi k in [lo, hi] (1e-12 slack, as ik's within_limits) for the
-    values ik returns, (-pi, pi] (the turns of [lo, hi] that meet it); a prismatic joint's
-    [lo, hi]."""
-    out: list[tuple[int, tuple[tuple[float, float], ...]]] = []
-    for j, ((lo, hi), kind) in enumerate(zip(module.LIMITS, module.JOINT_TYPES)):
-        if kind == "R" and not (math.isfinite(lo) and hi - lo < 2.0 * math.pi):
-            continue
-        if kind == "P" and not (math.isfinite(lo) or math.isfinite(hi)):
-            continue
-        if kind == "P":
-            out.append((j, ((lo - 1e-12, hi + 1e-12),)))
-            continue
-        turns: list[tuple[float, float]] = []
-        for k in range(-3, 4):
-            a, b = lo - 1e-12 + 2.0 * math.pi * k, hi + 1e-12 + 2.0 * math.pi * k
-            if b >= -_WINDOW and a <= _WINDOW:
-                turns.append((a, b))
-        out.append((j, tuple(turns)))
-    return tuple(out)
-
-
-def within(module: ModuleType, Q: np.ndarray) -> np.ndarray:
-    """Per row of Q (..., DOF), whether every joint is inside LIMITS (a revolute one at some
-    q + 2 pi k), by comparisons with allowed's intervals (a quarter of the time of reducing
-    each value modulo 2 pi); values outside (-pi, pi] by the modulo."""
-    ok = np.ones(Q.shape[:-1], dtype=bool)
-    for j, intervals in allowed(module):
-        x = Q[..., j]
-        inside = np.zeros(x.shape, dtype=bool)
-        for a, b in intervals:
-            inside |= (x >= a) & (x <= b)
-        if module.JOINT_TYPES[j] == "R":
-            far = np.abs(x) > _WINDOW
-            if far.any():
-                lo, hi = module.LIMITS[j]
-                turns = np.ceil((lo - 1e-12 - x[far]) / (2.0 * math.pi))
-                inside[far] = x[far] + 2.0 * math.pi * turns <= hi + 1e-12
-        ok &= inside
-    return ok
 
 
 # --- loading the solver in any process (the local run and Dask workers) -------------------

@@ -144,16 +144,49 @@ def _rotation(axis: np.ndarray, angle: float) -> np.ndarray:
     return np.eye(3) + math.sin(angle) * K + (1.0 - math.cos(angle)) * (K @ K)
 
 
+_WINDOW = math.pi + 1e-9
+
+
+def allowed(module: ModuleType) -> tuple[tuple[int, tuple[tuple[float, float], ...]], ...]:
+    """The joints whose limits exclude some value, each with its allowed values as intervals:
+    a revolute joint's q + 2 pi k in [lo, hi] (1e-12 slack, as ik's within_limits) for the
+    values ik returns, (-pi, pi] (the turns of [lo, hi] that meet it); a prismatic joint's
+    [lo, hi]."""
+    out: list[tuple[int, tuple[tuple[float, float], ...]]] = []
+    for j, ((lo, hi), kind) in enumerate(zip(module.LIMITS, module.JOINT_TYPES)):
+        if kind == "R" and not (math.isfinite(lo) and hi - lo < 2.0 * math.pi):
+            continue
+        if kind == "P" and not (math.isfinite(lo) or math.isfinite(hi)):
+            continue
+        if kind == "P":
+            out.append((j, ((lo - 1e-12, hi + 1e-12),)))
+            continue
+        turns: list[tuple[float, float]] = []
+        for k in range(-3, 4):
+            a, b = lo - 1e-12 + 2.0 * math.pi * k, hi + 1e-12 + 2.0 * math.pi * k
+            if b >= -_WINDOW and a <= _WINDOW:
+                turns.append((a, b))
+        out.append((j, tuple(turns)))
+    return tuple(out)
+
+
 def inside_limits(module: ModuleType, Q: np.ndarray) -> np.ndarray:
     """Per row of Q (..., DOF), whether every joint is inside LIMITS (a revolute one at some
-    value q + 2 pi k)."""
+    q + 2 pi k), by comparisons with allowed's intervals (a quarter of the time of reducing
+    each value modulo 2 pi); values outside (-pi, pi] by the modulo."""
     ok = np.ones(Q.shape[:-1], dtype=bool)
-    for j, ((lo, hi), kind) in enumerate(zip(module.LIMITS, module.JOINT_TYPES)):
+    for j, intervals in allowed(module):
         x = Q[..., j]
-        if kind == "R" and math.isfinite(lo) and hi - lo < 2.0 * math.pi:  # (else every q)
-            ok &= np.mod(x - lo, 2.0 * math.pi) <= hi - lo + 1e-12
-        elif kind == "P":
-            ok &= (lo - 1e-12 <= x) & (x <= hi + 1e-12)
+        inside = np.zeros(x.shape, dtype=bool)
+        for a, b in intervals:
+            inside |= (x >= a) & (x <= b)
+        if module.JOINT_TYPES[j] == "R":
+            far = np.abs(x) > _WINDOW
+            if far.any():
+                lo, hi = module.LIMITS[j]
+                turns = np.ceil((lo - 1e-12 - x[far]) / (2.0 * math.pi))
+                inside[far] = x[far] + 2.0 * math.pi * turns <= hi + 1e-12
+        ok &= inside
     return ok
 
 
