@@ -16,6 +16,7 @@ import stat
 import sys
 import tempfile
 import time
+from functools import partial
 from importlib import resources
 from pathlib import Path
 from types import ModuleType
@@ -62,10 +63,18 @@ def resolve_spec(text: str, options: urdf.Options | None = None) -> ArmSpec:
     raise UsageError(f"{text}: no such spec file or bundled arm; bundled arms: {names}")
 
 
-def outputs_for(spec: ArmSpec, figures: bool = False) -> tuple[Plan, dict[str, str | bytes]]:
+LANGS = ("python", "c", "cpp-ikfast")
+
+
+def outputs_for(
+    spec: ArmSpec, figures: bool = False, lang: str = "python"
+) -> tuple[Plan, dict[str, str | bytes]]:
     """The plan and file name -> content of everything generated for one arm (with figures:
-    the report's pictures too, embedded in it)."""
+    the report's pictures too, embedded in it). lang "c": the C solver's files instead;
+    "cpp-ikfast": those and the MoveIt IKFast shim."""
     plan = build_plan(spec)
+    if lang != "python":
+        return plan, c_outputs(plan, lang)
     module_source = render_module(plan)
     module = import_source(spec.name, module_source)
     example = worked_example(plan, module)
@@ -77,6 +86,16 @@ def outputs_for(spec: ArmSpec, figures: bool = False) -> tuple[Plan, dict[str, s
         shown = tuple((caption, name) for caption, name, _ in made)
     files[f"{spec.name}.md"] = render_report(plan, example, "md", shown)
     return plan, files
+
+
+def c_outputs(plan: Plan, lang: str) -> dict[str, str | bytes]:
+    """The C solver's files (lang "c"), with the MoveIt IKFast shim (lang "cpp-ikfast")."""
+    from derive.emit_c import render_c, render_ikfast
+
+    files: dict[str, str | bytes] = dict(render_c(plan))
+    if lang == "cpp-ikfast":
+        files.update(render_ikfast(plan))
+    return files
 
 
 def worked_example(plan: Plan, module: ModuleType) -> Example:
@@ -192,10 +211,17 @@ def cmd_generate(args: argparse.Namespace) -> int:
         start = time.perf_counter()
         try:
             spec = resolve_spec(text, urdf_options(args))
-            plan, files = outputs_for(spec, args.figures)
+            plan, files = outputs_for(spec, args.figures, args.lang)
             for name, content in files.items():
                 write_atomic(out / name, content)
-        except (SpecError, UsageError, GenerationError, OSError) as exc:
+        except GenerationError as exc:
+            if args.lang != "python" and not args.specs:  # a bundled arm C does not serve
+                print(f"{Path(text).stem}: skipped: {exc}")
+                continue
+            print(f"error: {exc}", file=sys.stderr)
+            failed.append(text)
+            continue
+        except (SpecError, UsageError, OSError) as exc:
             print(f"error: {exc}", file=sys.stderr)
             failed.append(text)
             continue
@@ -221,6 +247,10 @@ def cmd_generate(args: argparse.Namespace) -> int:
     return 0
 
 
+# the file whose presence says an arm was generated with --lang c or cpp-ikfast (in order)
+C_MARKERS = {"c": "_ik.c", "cpp-ikfast": "_ikfast_solver.cpp"}
+
+
 def cmd_check(args: argparse.Namespace) -> int:
     """Compare DIR with a fresh generation; never writes into DIR."""
     out = Path(args.out)
@@ -228,13 +258,19 @@ def cmd_check(args: argparse.Namespace) -> int:
     expected: dict[str, bytes] = {}
     with tempfile.TemporaryDirectory() as tmp:
         for spec in specs:
-            for name, content in outputs_for(spec, args.figures)[1].items():
+            plan, files = outputs_for(spec, args.figures)
+            # the C files of an arm generated with --lang c (or cpp-ikfast) are checked too
+            langs = [lang for lang, f in C_MARKERS.items() if (out / f"{spec.name}{f}").exists()]
+            if langs:
+                files.update(c_outputs(plan, langs[-1]))
+            for name, content in files.items():
                 write_atomic(Path(tmp) / name, content)
         for path in sorted(Path(tmp).iterdir()):
             expected[path.name] = path.read_bytes()
     names = set(expected)
     if not args.specs and out.is_dir():
-        names |= {p.name for p in out.iterdir() if p.suffix in (".py", ".md", ".svg")}
+        suffixes = (".py", ".md", ".svg", ".c", ".h", ".cpp")
+        names |= {p.name for p in out.iterdir() if p.suffix in suffixes}
     problems = []
     for name in sorted(names):
         path = out / name
@@ -250,6 +286,8 @@ def cmd_check(args: argparse.Namespace) -> int:
     for problem in problems:
         print(problem)
     specs_text = " ".join(args.specs)
+    if any(p.split(":")[0].endswith((".c", ".h", ".cpp")) for p in problems):
+        print(f"to update the C files: derive generate ARM --lang c (or cpp-ikfast) --out {out}")
     print(
         f"to update: derive generate {specs_text + ' ' if specs_text else ''}--out {out}"
         + (" and delete the stale files" if any("stale" in p for p in problems) else "")
@@ -584,6 +622,8 @@ def cmd_bench(args: argparse.Namespace) -> int:
 
     from derive.bench import measure
 
+    if args.lang == "c":
+        return bench_c(args)
     results = []
     for spec in load_specs(args.specs, urdf_options(args)):
         start = time.perf_counter()
@@ -599,6 +639,61 @@ def cmd_bench(args: argparse.Namespace) -> int:
             print(bench_text(spec.name, figures), flush=True)
     if args.json:
         print(json.dumps(results, indent=2, sort_keys=True))
+    return 0
+
+
+def solve_with(module: ModuleType, T: Any, values: dict) -> Any:
+    """module.ik(T, **values) (a named function: the benchmark's callable)."""
+    return module.ik(T, **values)
+
+
+def bench_c(args: argparse.Namespace) -> int:
+    """`derive bench --lang c`: the C solver compiled (-O2) and timed by its harness on
+    --samples random poses (no joint at a special value), beside the compiled Python ik."""
+    import numpy as np
+
+    from derive.bench import median_us
+    from derive.cbuild import BuildError, Harness
+    from derive.verify import sample_joints
+
+    for spec in load_specs(args.specs, urdf_options(args)):
+        plan = build_plan(spec)
+        with tempfile.TemporaryDirectory() as tmp:
+            try:
+                harness = Harness(plan, Path(tmp))
+            except (BuildError, GenerationError) as exc:
+                print(f"{spec.name}: no C figures: {exc}")
+                continue
+            module = load_module(spec)
+            rng = np.random.default_rng(args.seed)
+            Q = sample_joints(module, args.samples, rng, degenerate_share=0.0)
+            T = module.fk_batch(Q)
+            refs = np.zeros_like(Q)
+            for j in module.FREE:
+                refs[:, j - 1] = Q[:, j - 1]
+            mean, single = harness.bench(T, refs)
+        kw = [{"free": [r[j - 1] for j in module.FREE]} if module.FREE else {} for r in refs]
+        module.ik(T[0], **kw[0])  # compile (or load numba's cache) before timing
+        python = median_us(partial(solve_with, module), list(zip(T, kw)))
+        print(
+            f"{spec.name}: C ik {mean / 1000:.3f} us/pose (median of 21 rounds over "
+            f"{len(T)} poses), {single / 1000:.3f} us median single call; Python ik "
+            f"({module.BACKEND} backend) {python:.1f} us (median)",
+            flush=True,
+        )
+    return 0
+
+
+def cmd_build(args: argparse.Namespace) -> int:
+    """`derive build ARM --lang c`: lib<name>_ik.so and its ctypes binding <name>_c.py."""
+    from derive.cbuild import BuildError, build
+
+    spec = resolve_spec(args.arm, urdf_options(args))
+    try:
+        binding = build(build_plan(spec), Path(args.out))
+    except BuildError as exc:
+        raise UsageError(str(exc).replace("\n", " ")) from None
+    print(f"{binding} (and {binding.with_name(f'lib{spec.name}_ik.so').name}): import it")
     return 0
 
 
@@ -727,6 +822,13 @@ def parser() -> argparse.ArgumentParser:
     gen.add_argument("--out", default=DEFAULT_OUT, help="output folder (default ./generated)")
     gen.add_argument("--require-ik", action="store_true", help="exit 3 if an arm has no IK method")
     gen.add_argument(
+        "--lang",
+        choices=LANGS,
+        default="python",
+        help="python (NAME.py, NAME.md; default), c (NAME_ik.h, NAME_ik.c: C99, math.h only) "
+        "or cpp-ikfast (the C files and NAME_ikfast_solver.cpp for MoveIt's IKFast plugin)",
+    )
+    gen.add_argument(
         "--figures",
         action="store_true",
         help="also draw each report's worked example and workspace section (SVG, embedded)",
@@ -833,7 +935,20 @@ def parser() -> argparse.ArgumentParser:
         "--memory", type=int, default=0, help="also measure ik_batch peak memory on this many poses"
     )
     bench.add_argument("--json", action="store_true", help="print figures as JSON")
+    bench.add_argument(
+        "--lang",
+        choices=("python", "c"),
+        default="python",
+        help="c: time the generated C solver (compiled -O2 here) instead",
+    )
     bench.set_defaults(run=cmd_bench)
+    build = sub.add_parser(
+        "build", help="compile an arm's C solver into a shared library with a Python binding"
+    )
+    build.add_argument("arm", help="spec file or bundled arm name")
+    build.add_argument("--lang", choices=("c",), default="c", help="c (the only one)")
+    build.add_argument("-o", "--out", default="build", help="output folder (default ./build)")
+    build.set_defaults(run=cmd_build)
     imp = sub.add_parser("import-urdf", help="write the spec of a URDF's chain from base to tip")
     imp.add_argument("urdf", help="the URDF file (xacro expanded)")
     imp.add_argument(
@@ -844,7 +959,7 @@ def parser() -> argparse.ArgumentParser:
     )
     imp.add_argument("-o", "--output", help="write the spec here (default: standard output)")
     imp.set_defaults(run=cmd_import_urdf)
-    for command in (gen, chk, fk, solve, plot, space, reach, report, bench, imp):
+    for command in (gen, chk, fk, solve, plot, space, reach, report, bench, build, imp):
         add_urdf_arguments(command, required=command is imp)
     return top
 

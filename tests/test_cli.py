@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import shutil
 import subprocess
 import sys
 from pathlib import Path
@@ -10,7 +11,7 @@ import pytest
 
 from derive.cli import main
 
-from conftest import ROOT, USER_ROWS, spec_text
+from conftest import GENERATED, ROOT, USER_ROWS, spec_text
 
 USER_ARM = spec_text("user_arm", "modified", USER_ROWS)
 
@@ -69,15 +70,17 @@ def test_require_ik_exits_3_for_fk_only_arm(tmp_path):
 
 
 def test_check_detects_edited_removed_and_extra_files(tmp_path, capsys):
+    # the committed output (test_regeneration checks it is today's), copied: one whole
+    # generation fewer, and the C files of the arms generated with --lang c come along
     out = tmp_path / "gen"
-    assert main(["generate", "--out", str(out)]) == 0
-    assert main(["check", "--out", str(out)]) == 0
+    shutil.copytree(GENERATED, out, ignore=shutil.ignore_patterns("__pycache__"))
+    assert main(["check", "puma560", "--out", str(out)]) == 0
     target = out / "puma560.py"
     original = target.read_text()
     target.write_text(original.replace("DOF = 6", "DOF = 7"))
     before = target.read_bytes()
     capsys.readouterr()
-    assert main(["check", "--out", str(out)]) == 1
+    assert main(["check", "puma560", "--out", str(out)]) == 1
     report = capsys.readouterr().out
     assert (
         f"{target}: differs" in report
@@ -86,12 +89,22 @@ def test_check_detects_edited_removed_and_extra_files(tmp_path, capsys):
     )
     assert target.read_bytes() == before
     target.unlink()
-    assert main(["check", "--out", str(out)]) == 1
+    assert main(["check", "puma560", "--out", str(out)]) == 1
     assert "puma560.py: missing" in capsys.readouterr().out
     target.write_text(original)
+    # an arm generated with --lang c has its C files checked too
+    c_file = out / "puma560_ik.c"
+    c_text = c_file.read_text()
+    c_file.write_text(c_text.replace("#define DK_MAX 8", "#define DK_MAX 9"))
+    assert main(["check", "puma560", "--out", str(out)]) == 1
+    report = capsys.readouterr().out
+    assert f"{c_file}: differs" in report and "derive generate ARM --lang c" in report
+    c_file.write_text(c_text)
     (out / "old_arm.py").write_text("")
+    (out / "old_arm_ik.c").write_text("")
     assert main(["check", "--out", str(out)]) == 1
-    assert "old_arm.py: not generated" in capsys.readouterr().out
+    report = capsys.readouterr().out
+    assert "old_arm.py: not generated" in report and "old_arm_ik.c: not generated" in report
 
 
 def test_fk_command_prints_report_pose():
@@ -122,7 +135,8 @@ def test_solve_rejects_non_rigid_pose():
 def test_bench_reports_round_trip_figures(capsys):
     import json
 
-    assert main(["bench", "puma560", "--n", "30", "--json"]) == 0  # --n: --samples
+    # --n: --samples; a small --batch (its timing is not what is tested)
+    assert main(["bench", "puma560", "--n", "30", "--batch", "2000", "--json"]) == 0
     figures = json.loads(capsys.readouterr().out)[0]
     assert figures["name"] == "puma560" and figures["samples"] == 30
     assert figures["unsound"] == 0 and figures["completeness"] == 1.0

@@ -108,14 +108,21 @@ def assign_lines(
     temps, reduced = sp.cse(list(exprs), symbols=names, order="canonical")
     pairs = [*temps, *zip(targets, reduced)]
     if live is not None:
-        needed = set(live)
-        kept = []
-        for target, expr in reversed(pairs):
-            if str(target) in needed:
-                kept.append((target, expr))
-                needed |= {str(s) for s in expr.free_symbols}
-        pairs = kept[::-1]
+        pairs = read_pairs(pairs, set(live))
     return [Line(depth, f"{t} = {printer.doprint(e)}") for t, e in pairs]
+
+
+def read_pairs(
+    pairs: list[tuple[sp.Symbol, sp.Expr]], needed: set[str]
+) -> list[tuple[sp.Symbol, sp.Expr]]:
+    """The (target, expression) pairs whose target is needed, directly or through later
+    pairs, in their order."""
+    kept = []
+    for target, expr in reversed(pairs):
+        if str(target) in needed:
+            kept.append((target, expr))
+            needed |= {str(s) for s in expr.free_symbols}
+    return kept[::-1]
 
 
 def cs_arguments(plan: Plan) -> str:

@@ -1,0 +1,199 @@
+"""plan -> the C99 solver: `<name>_ik.h` and `<name>_ik.c` (templates/arm.h.j2, arm.c.j2,
+runtime.c.j2), printed by derive/printers/c.py. Deterministic as the Python output: the
+same plan gives the same bytes."""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Iterable
+from dataclasses import dataclass
+
+from derive import free
+from derive.emit import GENERATOR, GenerationError, check_printable, environment
+from derive.plan import Plan
+from derive.printers import c
+from derive.runtime import closed, constants
+
+
+@dataclass(frozen=True)
+class PrintedC:
+    """Everything the C templates need, as strings, ints and tuples of them."""
+
+    name: str
+    upper: str
+    guard: str
+    digest: str
+    dof: int
+    method: str
+    max_solutions: int
+    free: tuple[int, ...]
+    free_list: str
+    free_zero: str
+    free_tuple: str
+    free_text: str
+    certify_tol: str
+    reach: str
+    revolute: str
+    limits: tuple[tuple[str, str], ...]
+    fk_pose: tuple[str, ...]
+    fk_joints: tuple[str, ...]
+    fk_params: str
+    solve: tuple[tuple[int, str], ...]
+
+
+@dataclass(frozen=True)
+class RuntimeConstants:
+    """The runtime's tolerances as C literals (from derive/runtime/constants.py)."""
+
+    FREE_TOL: str
+    CLAMP_TOL: str
+    FOLD_TOL: str
+    LEAD_TOL: str
+    ROOT_IMAG_TOL: str
+    CLUSTER_TOL: str
+    MERGE_TOL: str
+    RESIDUAL_TOL: str
+    DEDUP_TOL: str
+    POSE_TOL: str
+    SEAM: str
+    SEAM_SNAP: str
+    PI: str
+    TWO_PI: str
+    FREE_COUNT: int
+    FREE_STEPS: str
+    ANGLE_AT: str
+    TAN_AT: str
+
+
+def runtime_constants() -> RuntimeConstants:
+    steps = [repr(s) for s in constants._FREE_STEPS]
+    rows = [", ".join(steps[k : k + 4]) for k in range(0, len(steps), 4)]
+    return RuntimeConstants(
+        FREE_TOL=repr(constants._FREE_TOL),
+        CLAMP_TOL=repr(constants._CLAMP_TOL),
+        FOLD_TOL=repr(constants._FOLD_TOL),
+        LEAD_TOL=repr(constants._LEAD_TOL),
+        ROOT_IMAG_TOL=repr(constants._ROOT_IMAG_TOL),
+        CLUSTER_TOL=repr(constants._CLUSTER_TOL),
+        MERGE_TOL=repr(constants._MERGE_TOL),
+        RESIDUAL_TOL=repr(constants._RESIDUAL_TOL),
+        DEDUP_TOL=repr(constants.DEDUP_TOL),
+        POSE_TOL=repr(constants.POSE_TOL),
+        SEAM=repr(constants._SEAM),
+        SEAM_SNAP=repr(constants._SEAM_SNAP),
+        PI=repr(math.pi),
+        TWO_PI=repr(constants._TWO_PI),
+        FREE_COUNT=len(steps),
+        FREE_STEPS=",\n".join(f"    {row}" for row in rows),
+        ANGLE_AT=_c_array(closed._ANGLE_AT),
+        TAN_AT=_c_array(closed._TAN_AT),
+    )
+
+
+def _c_array(values: Iterable[float]) -> str:
+    """A C array initialiser of doubles."""
+    return "{" + ", ".join(repr(float(v)) for v in values) + "}"
+
+
+def print_c(plan: Plan) -> PrintedC:
+    """The printed IR of the C solver.
+
+    Raises:
+        GenerationError: the arm has no IK, or a step C has no code for.
+    """
+    check_printable(plan)
+    arm, ik = plan.arm, plan.ik
+    if ik is None:
+        raise GenerationError(f"{arm.name}: no IK method, so no C solver: {plan.refusal}")
+    try:
+        solve = c.solve_lines(plan)
+    except c.UnsupportedError as exc:
+        raise GenerationError(f"{arm.name}: --lang c: {exc}") from None
+    fk_pose, fk_joints, fk_params = c.fk_lines(plan)
+    upper = arm.name.upper()
+    text = free.describe(ik, arm.dof) if ik.free else ""
+    return PrintedC(
+        name=arm.name,
+        upper=upper,
+        guard=f"{upper}_IK_H",
+        digest=arm.digest,
+        dof=arm.dof,
+        method=ik.method,
+        max_solutions=ik.max_solutions,
+        free=ik.free,
+        free_list=", ".join(str(j) for j in ik.free) or "0",
+        free_zero=", ".join(str(j - 1) for j in ik.free),
+        free_tuple=repr(tuple(ik.free)),
+        free_text=f"Free joints: {text}." if text else "",
+        certify_tol=repr(constants.CERTIFY_TOL),
+        reach=repr(arm.reach),
+        revolute=", ".join("1" if k == "R" else "0" for k in arm.joint_types),
+        limits=tuple((c.c_double(lo), c.c_double(hi)) for lo, hi in arm.limits),
+        fk_pose=fk_pose,
+        fk_joints=fk_joints,
+        fk_params=fk_params,
+        solve=solve,
+    )
+
+
+# the runtime's routines dk_solve may call, and those each of them calls
+ROUTINES = {
+    "dk_poly": (),
+    "dk_cs1": (),
+    "dk_cs1r": ("dk_cs1",),
+    "dk_cs2": ("dk_one",),
+    "dk_cs2r": ("dk_one",),
+    "dk_atan2": ("dk_one",),
+}
+
+
+def routines(solve: tuple[tuple[int, str], ...]) -> frozenset[str]:
+    """The runtime routines dk_solve calls, with those they call (the C file holds only
+    these: an unused static function is an error under -Werror)."""
+    called = {name for name in ROUTINES for _, line in solve if f"{name}(" in line}
+    return frozenset(called.union(*(ROUTINES[name] for name in called)))
+
+
+def render_c(plan: Plan) -> dict[str, str]:
+    """The C solver's files of an arm: {file name: text}."""
+    printed = print_c(plan)
+    env = environment()
+    args = {
+        "m": printed,
+        "c": runtime_constants(),
+        "generator": GENERATOR,
+        "uses": routines(printed.solve),
+    }
+    return {
+        f"{printed.name}_ik.h": env.get_template("arm.h.j2").render(**args),
+        f"{printed.name}_ik.c": env.get_template("arm.c.j2").render(**args),
+    }
+
+
+def render_ikfast(plan: Plan) -> dict[str, str]:
+    """The MoveIt IKFast plugin shim of an arm: {file name: text}.
+
+    Raises:
+        GenerationError: the arm's solver is not a 6-DOF pose solver (IKP_Transform6D).
+    """
+    printed = print_c(plan)
+    assert plan.ik is not None
+    if plan.ik.certify != "pose" or printed.dof - len(printed.free) != 6:
+        raise GenerationError(
+            f"{printed.name}: the IKFast shim serves arms solved for the whole pose with 6 "
+            f"joints besides the free ones (IKP_Transform6D); this arm has {printed.dof} joints "
+            f"({len(printed.free)} free), solved for {plan.ik.solves_for}"
+        )
+    text = environment().get_template("ikfast.cpp.j2").render(m=printed, generator=GENERATOR)
+    return {f"{printed.name}_ikfast_solver.cpp": text}
+
+
+def render_binding(plan: Plan) -> str:
+    """The ctypes binding `derive build` writes beside the compiled library."""
+    printed = print_c(plan)
+    return environment().get_template("binding.py.j2").render(m=printed, generator=GENERATOR)
+
+
+def render_harness(plan: Plan) -> str:
+    """The command-line harness around the C solver (tests, `derive bench --lang c`)."""
+    return environment().get_template("harness.c.j2").render(m=print_c(plan))

@@ -1,0 +1,288 @@
+"""The C printer: the solver of one pose (dk_solve), forward kinematics and the arm's constants
+as C99, from the same plan the Python printers read (templates/arm.c.j2 lays them out).
+
+dk_solve follows the Python solver's steps (derive/printers/scalar.py) with the compiled
+kernel's closed forms (derive/printers/kernel.py, templates/runtime.c.j2): one loop per Solve
+step over the joint's values; a free joint steps through its values (5 degree steps out from
+its first one) until one gives a certified solution, as the Python solver does. A root the
+closed forms cannot settle (a polynomial of another degree, a root failing the residual test,
+a split multiple root) makes it return DK_UNSETTLED: the C solver then says so instead of
+answering (the Python solver settles such poses with numpy).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import sympy as sp
+
+from derive import symbols as sym
+from derive.plan import (
+    Assign,
+    Atan2,
+    Cs1,
+    Cs1Reach,
+    Cs2,
+    Cs2Reach,
+    Eigen,
+    Plan,
+    Poly,
+    PolyD,
+    Solve,
+)
+from derive.printers.common import (
+    CodePrinter,
+    Line,
+    cs_arguments,
+    live_steps,
+    read_pairs,
+    same_joints,
+    world_names,
+)
+
+
+class UnsupportedError(ValueError):
+    """The plan has a step the C printer has no code for (the message says which)."""
+
+
+class CPrinter(CodePrinter):
+    """C99 source for SymPy expressions: math.h's functions, powers as products."""
+
+    def _print_Pow(self, expr: sp.Pow, rational: bool = False) -> str:
+        base, exp = expr.as_base_exp()
+        if exp == sp.S.Half:
+            return f"sqrt({self._print(base)})"
+        if exp.is_Integer:
+            k = int(exp)
+            inner = self.parenthesize(base, 100)
+            if 0 < k <= 4:
+                return "(" + "*".join([inner] * k) + ")"
+            if -4 <= k < 0:
+                return "(1.0/(" + "*".join([inner] * -k) + "))"
+        return f"pow({self._print(base)}, {self._print(exp)})"
+
+
+@dataclass
+class Scope:
+    """The names declared so far, per open block (C needs each declared once per scope)."""
+
+    levels: list[set[str]]
+
+    def declare(self, name: str) -> bool:
+        """Whether name is new in every open block (then it is declared in the innermost)."""
+        if any(name in level for level in self.levels):
+            return False
+        self.levels[-1].add(name)
+        return True
+
+
+def _assign(target: str, text: str, depth: int, scope: Scope) -> Line:
+    if scope.declare(target):
+        return Line(depth, f"double {target} = {text};")
+    return Line(depth, f"{target} = {text};")
+
+
+def _cse_lines(
+    targets: tuple[sp.Symbol, ...],
+    exprs: tuple[sp.Expr, ...],
+    names: sp.utilities.iterables.numbered_symbols,
+    printer: CPrinter,
+    depth: int,
+    scope: Scope,
+    live: frozenset[str] | None,
+) -> tuple[list[Line], list[str]]:
+    """CSE'd declarations for targets = exprs (only those live reads, if given; no targets:
+    the temporaries only) and the printed reduced expressions."""
+    temps, reduced = sp.cse(list(exprs), symbols=names, order="canonical")
+    pairs = [*temps, *zip(targets, reduced)]
+    if live is not None:
+        needed = set(live) | {str(s) for e in reduced[len(targets) :] for s in e.free_symbols}
+        pairs = read_pairs(pairs, needed)
+    lines = [_assign(str(t), printer.doprint(e), depth, scope) for t, e in pairs]
+    return lines, [printer.doprint(e) for e in reduced[len(targets) :]]
+
+
+@dataclass(frozen=True)
+class Call:
+    """A Solve step's call filling its dk_values: the routine and its printed arguments."""
+
+    routine: str
+    args: tuple[str, ...]
+    # a declaration the call needs first (a polynomial's coefficients: C++ has no compound
+    # literals, and the C file is valid C++ too, for the IKFast shim that includes it)
+    before: str = ""
+
+
+def _poly(step: Solve, values: list[str], ref: str) -> Call:
+    degree = len(values) - 1
+    unit = 1.0 if step.angle else step.unit
+    free = 1e-10 * step.scale
+    angles = "1" if step.angle else "0"
+    coeffs = f"dk_p{step.joint}"
+    array = f"const double {coeffs}[] = {{{', '.join(values)}}};"
+    return Call("dk_poly", (coeffs, str(degree), angles, repr(free), repr(unit), ref), array)
+
+
+def _cs1(step: Solve, values: list[str], ref: str) -> Call:
+    routine = "dk_cs1r" if isinstance(step, Cs1Reach) else "dk_cs1"
+    return Call(routine, (*values, repr(step.scale), ref))
+
+
+def _cs2(step: Solve, values: list[str], ref: str) -> Call:
+    routine = "dk_cs2r" if isinstance(step, Cs2Reach) else "dk_cs2"
+    return Call(routine, (*values, ref))
+
+
+def _atan2(step: Solve, values: list[str], ref: str) -> Call:
+    return Call("dk_atan2", (*values, ref))
+
+
+CALLS: dict[type[Solve], Callable[[Solve, list[str], str], Call]] = {
+    Poly: _poly,
+    PolyD: _poly,
+    Cs1: _cs1,
+    Cs1Reach: _cs1,
+    Cs2: _cs2,
+    Cs2Reach: _cs2,
+    Atan2: _atan2,
+}
+
+
+def solve_lines(plan: Plan) -> tuple[tuple[int, str], ...]:
+    """Body of dk_solve(t, tol, ref, found): the certified solutions of the pose t (12 top
+    entries) into found, in the Python solver's branch order; their count, or DK_UNSETTLED.
+
+    Raises:
+        UnsupportedError: a step of a kind C has no code for (the general method's).
+    """
+    assert plan.ik is not None
+    printer = CPrinter()
+    names = sp.numbered_symbols("x")
+    scope = Scope([set()])
+    steps, inputs = live_steps(plan)
+    dof = plan.arm.dof
+    body: list[Line] = []
+    for k, name in enumerate(world_names()):
+        if name in inputs or any(name in live.after for live in steps):
+            body.append(_assign(name, f"t[{k}]", 0, scope))
+    refs = sorted(
+        {str(s) for e in _expressions(plan) for s in e.free_symbols if s.name[:2] == "qr"},
+        key=lambda s: int(s[2:]),
+    )
+    body = [_assign(r, f"ref[{int(r[2:]) - 1}]", 0, scope) for r in refs] + body
+    body += [Line(0, "const double ptol = tol * DK_REACH;"), Line(0, "int n = 0;")]
+    depth = 0
+    closing: list[Line] = []
+    for live in steps:
+        step = live.step
+        if isinstance(step, Assign):
+            body.append(Line(depth, f"/* {_comment(step.note)} */"))
+            lines, _ = _cse_lines(
+                step.targets, step.exprs, names, printer, depth, scope, live.after
+            )
+            body += lines
+            continue
+        if isinstance(step, Eigen):
+            raise UnsupportedError(
+                "the general method (eigenvalues of a 24 x 24 matrix) has no C code yet"
+            )
+        j = step.joint
+        body.append(Line(depth, f"/* {_comment(step.note)} */"))
+        lines, values = _cse_lines((), tuple(step.args), names, printer, depth, scope, None)
+        body += lines
+        call = CALLS[type(step)](step, values, printer.doprint(step.ref))
+        if call.before:
+            body.append(Line(depth, call.before))
+        body.append(Line(depth, f"dk_values dk_v{j};"))
+        body.append(Line(depth, f"if ({call.routine}(&dk_v{j}, {', '.join(call.args)}) < 0) {{"))
+        body.append(Line(depth + 1, "return DK_UNSETTLED;"))
+        body.append(Line(depth, "}"))
+        body.append(Line(depth, f"const int dk_m{j} = n;"))
+        body.append(Line(depth, f"for (int dk_k{j} = 0; dk_k{j} < dk_v{j}.n; dk_k{j}++) {{"))
+        scope.levels.append(set())
+        var = step.variable
+        c_name, s_name = f"c{j}", f"s{j}"
+        if not step.angle:
+            c_name, s_name = f"dk_c{j}", f"dk_s{j}"
+        scope.declare(str(var))
+        scope.declare(c_name)
+        scope.declare(s_name)
+        body.append(Line(depth + 1, f"double {var}, {c_name}, {s_name};"))
+        body.append(Line(depth + 1, f"dk_value(&dk_v{j}, dk_k{j}, &{var}, &{c_name}, &{s_name});"))
+        if not step.angle:
+            body.append(Line(depth + 1, f"(void){c_name};"))
+            body.append(Line(depth + 1, f"(void){s_name};"))
+        # a free joint's loop ends at its first value that gave a solution
+        closing.append(Line(depth + 1, f"if (dk_v{j}.free && n > dk_m{j}) {{"))
+        depth += 1
+    outputs = [printer.doprint(e) for e in plan.ik.outputs]
+    body.append(Line(depth, "double e[12];"))
+    if same_joints(plan):
+        body.append(Line(depth, f"dk_fk_cs({cs_arguments(plan)}, e);"))
+    else:
+        body.append(Line(depth, f"const double q[{dof}] = {{{', '.join(outputs)}}};"))
+        body.append(Line(depth, "dk_fk_q(q, e);"))
+    position = "1" if plan.ik.certify == "position" else "0"
+    body.append(Line(depth, f"if (n < DK_MAX && dk_match(e, t, tol, ptol, {position})) {{"))
+    body += [Line(depth + 1, f"found[n][{k}] = {v};") for k, v in enumerate(outputs)]
+    body.append(Line(depth + 1, "n++;"))
+    body.append(Line(depth, "}"))
+    for line in reversed(closing):
+        body.append(line)
+        body.append(Line(line.depth + 1, "break;"))
+        body.append(Line(line.depth, "}"))
+        body.append(Line(line.depth - 1, "}"))
+        scope.levels.pop()
+    body.append(Line(0, "return n;"))
+    return tuple((ln.depth, ln.text) for ln in body)
+
+
+def _expressions(plan: Plan) -> list[sp.Expr]:
+    """Every expression of the plan's IK (to find the q_ref values it reads)."""
+    assert plan.ik is not None
+    out: list[sp.Expr] = list(plan.ik.outputs)
+    for step in plan.ik.steps:
+        if isinstance(step, Assign):
+            out += step.exprs
+        else:
+            out += [*step.args, step.ref]
+    return out
+
+
+def _comment(note: str) -> str:
+    """A note as the text of a C comment (no comment end inside)."""
+    return note.replace("*/", "* /")
+
+
+def fk_lines(plan: Plan) -> tuple[tuple[str, ...], tuple[str, ...], str]:
+    """dk_fk_cs's body (the pose entries from c_i, s_i and d_i), dk_fk_q's body (c_i, s_i from
+    q) and dk_fk_cs's parameter list."""
+    printer = CPrinter()
+    names = sp.numbered_symbols("x")
+    pose = plan.fk_pose
+    entries = tuple(pose[i, j] for i in range(3) for j in range(4))
+    targets = tuple(sym.named(f"t{i}{j}") for i in range(3) for j in range(4))
+    scope = Scope([set()])
+    lines, _ = _cse_lines(targets, entries, names, printer, 0, scope, None)
+    pose_body = tuple(ln.text for ln in lines)
+    pose_body += tuple(f"e[{k}] = {t};" for k, t in enumerate(targets))
+    joints = []
+    for k, (target, expr) in enumerate(plan.joint_defs):
+        value = printer.doprint(expr.xreplace({sym.q(k + 1): sp.Symbol(f"q[{k}]")}))
+        joints.append(f"const double {target} = {value};")
+        if str(target).startswith("theta"):
+            joints.append(f"const double c{k + 1} = cos({target});")
+            joints.append(f"const double s{k + 1} = sin({target});")
+    joints.append(f"dk_fk_cs({cs_arguments(plan)}, e);")
+    params = ", ".join(f"double {a}" for a in cs_arguments(plan).split(", "))
+    return pose_body, tuple(joints), params
+
+
+def c_double(value: float) -> str:
+    """A double as a C literal (HUGE_VAL for infinities)."""
+    if math.isinf(value):
+        return "HUGE_VAL" if value > 0 else "-HUGE_VAL"
+    text = repr(float(value))
+    return text
