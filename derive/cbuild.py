@@ -57,13 +57,19 @@ def write_sources(plan: Plan, folder: Path, harness: bool = False) -> list[Path]
 class Harness:
     """The compiled harness of one arm (see templates/harness.c.j2)."""
 
-    def __init__(self, plan: Plan, folder: Path, sanitize: bool = False, opt: str = "-O2"):
+    def __init__(
+        self,
+        plan: Plan,
+        folder: Path,
+        sanitize: bool = False,
+        opt: tuple[str, ...] = ("-O2",),
+    ):
         self.dof = plan.arm.dof
         assert plan.ik is not None
         self.max = plan.ik.max_solutions
         self.path = folder / f"{plan.arm.name}_harness"
         sources = write_sources(plan, folder, harness=True)
-        flags = [*WARNINGS, opt, *(SANITIZE if sanitize else ())]
+        flags = [*WARNINGS, *opt, *(SANITIZE if sanitize else ())]
         _compile([*flags, *map(str, sources), "-o", str(self.path), "-lm"])
 
     def _run(self, args: list[str], data: bytes) -> bytes:

@@ -647,6 +647,10 @@ def solve_with(module: ModuleType, T: Any, values: dict) -> Any:
     return module.ik(T, **values)
 
 
+# the C benchmark's compiler flags: what a controller's release build would use on this CPU
+BENCH_CFLAGS = ("-O3", "-march=native")
+
+
 def bench_c(args: argparse.Namespace) -> int:
     """`derive bench --lang c`: the C solver compiled (-O2) and timed by its harness on
     --samples random poses (no joint at a special value), beside the compiled Python ik."""
@@ -660,7 +664,7 @@ def bench_c(args: argparse.Namespace) -> int:
         plan = build_plan(spec)
         with tempfile.TemporaryDirectory() as tmp:
             try:
-                harness = Harness(plan, Path(tmp))
+                harness = Harness(plan, Path(tmp), opt=BENCH_CFLAGS)
             except (BuildError, GenerationError) as exc:
                 print(f"{spec.name}: no C figures: {exc}")
                 continue
@@ -676,9 +680,9 @@ def bench_c(args: argparse.Namespace) -> int:
         module.ik(T[0], **kw[0])  # compile (or load numba's cache) before timing
         python = median_us(partial(solve_with, module), list(zip(T, kw)))
         print(
-            f"{spec.name}: C ik {mean / 1000:.3f} us/pose (median of 21 rounds over "
-            f"{len(T)} poses), {single / 1000:.3f} us median single call; Python ik "
-            f"({module.BACKEND} backend) {python:.1f} us (median)",
+            f"{spec.name}: C ({' '.join(BENCH_CFLAGS)}) ik {mean / 1000:.3f} us/pose (median "
+            f"of 21 rounds over {len(T)} poses), {single / 1000:.3f} us median single call; "
+            f"Python ik ({module.BACKEND} backend) {python:.1f} us (median)",
             flush=True,
         )
     return 0
