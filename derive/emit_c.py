@@ -7,10 +7,13 @@ from __future__ import annotations
 import math
 from collections.abc import Iterable
 from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
 
 from derive import free
 from derive.emit import GENERATOR, GenerationError, check_printable, environment
-from derive.plan import Plan
+from derive.plan import Eigen, Plan
 from derive.printers import c
 from derive.runtime import closed, constants
 
@@ -65,6 +68,46 @@ class RuntimeConstants:
     TAN_AT: str
 
 
+def general_constants(plan: Plan) -> dict[str, object]:
+    """The general method's constants and dk_rr_fill for templates/general.c.j2."""
+    from derive.runtime import general
+
+    step = next(s for s in plan.ik.steps if isinstance(s, Eigen)) if plan.ik else None
+    assert step is not None
+
+    def nested(values: Any) -> str:
+        if isinstance(values, (int, float, np.integer, np.floating)) and not isinstance(
+            values, bool
+        ):
+            return repr(float(values)) if isinstance(values, (float, np.floating)) else str(values)
+        return "{" + ", ".join(nested(v) for v in values) + "}"
+
+    return {
+        "RANK_TOL": repr(constants._RR_RANK_TOL),
+        "COND_LIMIT": repr(constants._RR_COND_LIMIT),
+        "IMAG_TOL": repr(constants._RR_IMAG_TOL),
+        "CLUSTER_TOL": repr(constants._RR_CLUSTER_TOL),
+        "NULL2_TOL": repr(constants._RR_NULL2_TOL),
+        "GOOD": repr(constants._RR_GOOD),
+        "NEWTON_STEPS": constants._RR_NEWTON_STEPS,
+        "NEWTON_REACH": repr(constants._RR_NEWTON_REACH),
+        "SPLIT_COUNT": len(step.splits),
+        "LENGTH": repr(float(step.unit)),
+        "MOEBIUS": nested(constants._RR_MOEBIUS),
+        "PATH_COUNT": len(constants._RR_PATH),
+        "PATH": nested(constants._RR_PATH),
+        "H45": nested(general._RR_H45.tolist()),
+        "MIX": nested(general._RR_MIX.tolist()),
+        "RULES": nested(general._RR_MONOMIAL_RULES),
+        "MOTION_COUNT": len(general._RR_MOTIONS),
+        "MOTIONS": nested(general._RR_MOTIONS.tolist()),
+        "REVERSED": "{" + ", ".join("1" if s.reversed else "0" for s in step.splits) + "}",
+        "FILL": nested([s.fill_rows for s in step.splits]),
+        "TRUE": nested([s.true_rows for s in step.splits]),
+        "fill": c.general_fill(plan),
+    }
+
+
 def runtime_constants() -> RuntimeConstants:
     steps = [repr(s) for s in constants._FREE_STEPS]
     rows = [", ".join(steps[k : k + 4]) for k in range(0, len(steps), 4)]
@@ -99,16 +142,13 @@ def print_c(plan: Plan) -> PrintedC:
     """The printed IR of the C solver.
 
     Raises:
-        GenerationError: the arm has no IK, or a step C has no code for.
+        GenerationError: the arm has no IK.
     """
     check_printable(plan)
     arm, ik = plan.arm, plan.ik
     if ik is None:
         raise GenerationError(f"{arm.name}: no IK method, so no C solver: {plan.refusal}")
-    try:
-        solve = c.solve_lines(plan)
-    except c.UnsupportedError as exc:
-        raise GenerationError(f"{arm.name}: --lang c: {exc}") from None
+    solve = c.solve_lines(plan)
     fk_pose, fk_joints, fk_params = c.fk_lines(plan)
     upper = arm.name.upper()
     text = free.describe(ik, arm.dof) if ik.free else ""
@@ -138,6 +178,7 @@ def print_c(plan: Plan) -> PrintedC:
 
 # the runtime's routines dk_solve may call, and those each of them calls
 ROUTINES = {
+    "dk_general": (),
     "dk_poly": (),
     "dk_cs1": (),
     "dk_cs1r": ("dk_cs1",),
@@ -163,6 +204,7 @@ def render_c(plan: Plan) -> dict[str, str]:
         "c": runtime_constants(),
         "generator": GENERATOR,
         "uses": routines(printed.solve),
+        "g": general_constants(plan) if "dk_general" in routines(printed.solve) else None,
     }
     return {
         f"{printed.name}_ik.h": env.get_template("arm.h.j2").render(**args),

@@ -24,20 +24,28 @@ pytestmark = pytest.mark.skipif(
     cbuild.c_compiler() is None, reason="no C compiler (set CC or install gcc); CI has one"
 )
 
-# every bundled arm with an IK method the C printer serves (manocha_canny's general method has
-# no C code yet: its generation is refused, tested below)
-C_ARMS = tuple(name for name in BUNDLED if name != "manocha_canny")
+# every bundled arm (manocha_canny through the general method's C port)
+C_ARMS = BUNDLED
 POSES = 10_000
+# the general method's Python solver takes about 2 ms a pose (the closed forms 50 us)
+POSES_FOR = {"manocha_canny": 2_000}
 # Rows that differ from the Python solver's by more than 1e-9 (but at most 1e-6), and poses
-# with another number of rows, measured on these 10,000 poses (seed 5, 20% of the joints at
-# 0, +-90, 180 deg). Everywhere else the rows agree to 1e-9 (most to 1e-12). These are poses
+# with another number of rows, measured on these poses (seed 5, 20% of the joints at 0,
+# +-90, 180 deg). Everywhere else the rows agree to 1e-9 (most to 1e-12). These are poses
 # near a double root (elbow or wrist nearly straight): the C solver takes atan2 and real
 # quartics where the Python one takes complex closed forms, and a rounding of the pose moves
 # such a root by its square root (the compiled Python kernel differs from the Python solver
 # there as much: tests/test_seam.py). The counts: parallel_6r's elbow 2e-7 from folded keeps
-# two solutions 2e-6 apart in one solver and merges them in the other.
+# two solutions 2e-6 apart in one solver and merges them in the other. manocha_canny (the
+# general method): at singular and near-singular samples (102 of 10,000 are singular; axes
+# 3 and 6 in line give a curve of solutions) the eigenvalue routines round apart, clusters
+# and the rescue decide otherwise, and the C and Python solvers return other certified points
+# of the curve or another number of them: 91 poses with another count and 17 with rows
+# farther apart than 1e-6 on 10,000 (1.1%; the Python solver and its compiled kernel differ
+# on 0.3%). Every regular sample's own q is among the C rows there too (checked below).
 BEYOND = {"lecture_6r": 10, "parallel_6r": 4, "iiwa14": 15, "panda": 15}
-COUNT = {"parallel_6r": 1}
+COUNT = {"parallel_6r": 1, "manocha_canny": 40}
+TURN = {"manocha_canny": 12}
 
 
 def plan_of(name: str):
@@ -80,26 +88,31 @@ def python_rows(m, T: np.ndarray, refs: np.ndarray) -> list[np.ndarray]:
 @pytest.mark.parametrize("name", C_ARMS)
 def test_c_solver_gives_the_python_solutions(generated, harnesses, name):
     m = generated(name)
-    Q, T, refs = poses(m, POSES, 5)
+    Q, T, refs = poses(m, POSES_FOR.get(name, POSES), 5)
     harness = harnesses(name)
     np.testing.assert_allclose(harness.fk(Q), T, atol=1e-12)
     counts, QC = harness.solve(T, refs)
     assert (counts >= 0).all(), "a pose the C solver did not settle"
     P = python_rows(m, T, refs)
-    beyond = other_count = 0
+    beyond = other_count = turn = 0
+    revolute = np.array([k == "R" for k in m.JOINT_TYPES])
     for i in range(len(T)):
         rows, c_rows = P[i], QC[i, : counts[i]]
+        for row in c_rows:  # sound: each C row reproduces the pose (what the solver solves for)
+            assert max(verify.pose_error(m, row, T[i])) <= 1e-6, (i, row)
+        if verify.jacobian_nullity(m, Q[i])[0] >= verify.SINGULAR_SIGMA:  # complete
+            every = np.ones(m.DOF, bool)
+            assert any(verify.same_joints(r, Q[i], revolute, every) for r in c_rows), i
         if len(rows) != len(c_rows):
             other_count += 1
             continue
         if len(rows):
             d = np.abs(rows - c_rows).max()
-            assert d <= 1e-6, (i, d)  # never another solution, nor a turn apart
-            beyond += d > 1e-9
+            turn += d > 1e-6  # another solution, or a value a turn apart
+            beyond += 1e-9 < d <= 1e-6
     assert other_count <= COUNT.get(name, 0), other_count
+    assert turn <= TURN.get(name, 0), turn
     assert beyond <= BEYOND.get(name, 0), beyond
-    # the pose was reached: the sample's own q is among the C rows at regular samples
-    assert counts.sum() >= len(T)
 
 
 def test_invalid_poses_give_the_error_code(harnesses):
@@ -120,7 +133,7 @@ def test_sanitized_round_trips(generated, harnesses):
     assert probe is not None
     for name in C_ARMS:
         m = generated(name)
-        _, T, refs = poses(m, 1000, 7)
+        _, T, refs = poses(m, 200 if name == "manocha_canny" else 1000, 7)
         try:
             harness = harnesses(name, sanitize=True)
         except cbuild.BuildError as exc:  # a compiler without the sanitizer runtimes
@@ -133,7 +146,8 @@ def test_sanitized_round_trips(generated, harnesses):
             counts[i] == len(P[i]) and np.allclose(QC[i, : counts[i]], P[i], atol=1e-6)
             for i in range(len(T))
         )
-        assert agree >= len(T) - 2, (name, agree)
+        # (the general method differs from the Python solver at 1.1% of such poses: above)
+        assert agree >= len(T) - (6 if name == "manocha_canny" else 2), (name, agree)
 
 
 @pytest.mark.parametrize("name", ["puma560", "iiwa14"])
@@ -176,11 +190,9 @@ def test_ikfast_shim_compiles_and_answers(generated, tmp_path, name):
     assert at == len(out)
 
 
-def test_general_arm_is_refused_by_name(tmp_path):
+def test_arms_the_shim_cannot_serve_are_refused_by_name(tmp_path):
     from derive.emit import GenerationError
 
-    with pytest.raises(GenerationError, match="manocha_canny: --lang c: the general method"):
-        render_c(plan_of("manocha_canny"))
     with pytest.raises(GenerationError, match="planar_2r: the IKFast shim serves"):
         render_ikfast(plan_of("planar_2r"))
 

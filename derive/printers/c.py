@@ -43,10 +43,6 @@ from derive.printers.common import (
 )
 
 
-class UnsupportedError(ValueError):
-    """The plan has a step the C printer has no code for (the message says which)."""
-
-
 class CPrinter(CodePrinter):
     """C99 source for SymPy expressions: math.h's functions, powers as products."""
 
@@ -153,9 +149,6 @@ CALLS: dict[type[Solve], Callable[[Solve, list[str], str], Call]] = {
 def solve_lines(plan: Plan) -> tuple[tuple[int, str], ...]:
     """Body of dk_solve(t, tol, ref, found): the certified solutions of the pose t (12 top
     entries) into found, in the Python solver's branch order; their count, or DK_UNSETTLED.
-
-    Raises:
-        UnsupportedError: a step of a kind C has no code for (the general method's).
     """
     assert plan.ik is not None
     printer = CPrinter()
@@ -185,9 +178,13 @@ def solve_lines(plan: Plan) -> tuple[tuple[int, str], ...]:
             body += lines
             continue
         if isinstance(step, Eigen):
-            raise UnsupportedError(
-                "the general method (eigenvalues of a 24 x 24 matrix) has no C code yet"
-            )
+            lines, values = _cse_lines((), tuple(step.args), names, printer, depth, scope, None)
+            body.append(Line(depth, f"/* {_comment(step.note)} */"))
+            body += lines
+            body += _eigen_lines(step, values, live.after, depth, scope)
+            closing.append(Line(depth + 1, ""))
+            depth += 1
+            continue
         j = step.joint
         body.append(Line(depth, f"/* {_comment(step.note)} */"))
         lines, values = _cse_lines((), tuple(step.args), names, printer, depth, scope, None)
@@ -230,13 +227,60 @@ def solve_lines(plan: Plan) -> tuple[tuple[int, str], ...]:
     body.append(Line(depth + 1, "n++;"))
     body.append(Line(depth, "}"))
     for line in reversed(closing):
-        body.append(line)
-        body.append(Line(line.depth + 1, "break;"))
-        body.append(Line(line.depth, "}"))
+        if line.text:  # a free joint's loop ends at its first value that gave a solution
+            body.append(line)
+            body.append(Line(line.depth + 1, "break;"))
+            body.append(Line(line.depth, "}"))
         body.append(Line(line.depth - 1, "}"))
         scope.levels.pop()
     body.append(Line(0, "return n;"))
     return tuple((ln.depth, ln.text) for ln in body)
+
+
+def _eigen_lines(
+    step: Eigen, values: list[str], after: frozenset[str], depth: int, scope: Scope
+) -> list[Line]:
+    """The general method's step: dk_general on the splits' flange targets, then a loop over
+    its rows opening the joints' values (and their cos and sin where later steps read them)."""
+    groups = [values[k : k + 12] for k in range(0, len(values), 12)]
+    flanges = ", ".join("{" + ", ".join(g) + "}" for g in groups)
+    j = step.joint
+    lines = [
+        Line(depth, f"const double dk_fl{j}[DK_RR_SPLIT_COUNT][12] = {{{flanges}}};"),
+        Line(depth, f"double dk_rows{j}[DK_RR_ROWS][6];"),
+        Line(depth, f"const int dk_n{j} = dk_general(dk_fl{j}, dk_rows{j});"),
+        Line(depth, f"if (dk_n{j} < 0) {{"),
+        Line(depth + 1, "return DK_UNSETTLED;"),
+        Line(depth, "}"),
+        Line(depth, f"for (int dk_k{j} = 0; dk_k{j} < dk_n{j}; dk_k{j}++) {{"),
+    ]
+    scope.levels.append(set())
+    for place, k in enumerate(step.indices):
+        scope.declare(f"theta{k}")
+        lines.append(Line(depth + 1, f"const double theta{k} = dk_rows{j}[dk_k{j}][{place}];"))
+        for kind, function in (("c", "cos"), ("s", "sin")):
+            if f"{kind}{k}" in after:
+                scope.declare(f"{kind}{k}")
+                lines.append(Line(depth + 1, f"const double {kind}{k} = {function}(theta{k});"))
+    return lines
+
+
+def general_fill(plan: Plan) -> tuple[str, ...]:
+    """dk_rr_fill's body: per split, the nonzero entries of its matrices from the flange
+    target's l and p (CSE'd), as derive/printers/general.py prints them for Python."""
+    step = next((s for s in plan.ik.steps if isinstance(s, Eigen)), None) if plan.ik else None
+    assert step is not None
+    printer = CPrinter()
+    lines = []
+    for k, split in enumerate(step.splits):
+        names = sp.numbered_symbols("x")
+        entries = [(i, e) for i, e in enumerate(split.fill) if e != 0]
+        temps, reduced = sp.cse([e for _, e in entries], symbols=names, order="canonical")
+        lines.append(f"if (k == {k}) {{")
+        lines += [f"    const double {t} = {printer.doprint(e)};" for t, e in temps]
+        lines += [f"    out[{i}] = {printer.doprint(e)};" for (i, _), e in zip(entries, reduced)]
+        lines += ["    return;", "}"]
+    return tuple(lines)
 
 
 def _expressions(plan: Plan) -> list[sp.Expr]:
