@@ -656,7 +656,7 @@ def bench_c(args: argparse.Namespace) -> int:
     --samples random poses (no joint at a special value), beside the compiled Python ik."""
     import numpy as np
 
-    from derive.bench import median_us
+    from derive.bench import eaik_figures, median_us
     from derive.cbuild import BuildError, Harness
     from derive.verify import sample_joints
 
@@ -679,12 +679,25 @@ def bench_c(args: argparse.Namespace) -> int:
         kw = [{"free": [r[j - 1] for j in module.FREE]} if module.FREE else {} for r in refs]
         module.ik(T[0], **kw[0])  # compile (or load numba's cache) before timing
         python = median_us(partial(solve_with, module), list(zip(T, kw)))
-        print(
+        batch = math.inf
+        free = {"free": refs[:, [j - 1 for j in module.FREE]]} if module.FREE else {}
+        for _ in range(3):
+            start = time.perf_counter()
+            module.ik_batch(T, **free)
+            batch = min(batch, (time.perf_counter() - start) / len(T) * 1e6)
+        line = (
             f"{spec.name}: C ({' '.join(BENCH_CFLAGS)}) ik {mean / 1000:.3f} us/pose (median "
             f"of 21 rounds over {len(T)} poses), {single / 1000:.3f} us median single call; "
-            f"Python ik ({module.BACKEND} backend) {python:.1f} us (median)",
-            flush=True,
+            f"Python module ({module.BACKEND} backend): ik {python:.1f} us (median), ik_batch "
+            f"{batch:.2f} us/pose (best of 3)"
         )
+        eaik = eaik_figures(module, T)
+        if "eaik_ik_us" in eaik:
+            line += (
+                f"; EAIK ik {eaik['eaik_ik_us']:.1f} us (median), batch "
+                f"{eaik['eaik_batch_us']:.2f} us/pose"
+            )
+        print(line, flush=True)
     return 0
 
 
