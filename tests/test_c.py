@@ -258,3 +258,36 @@ def test_within_limits_and_nearest_match_python(generated, tmp_path):
         assert best is not None
         np.testing.assert_allclose(best, m.nearest(T, ref), atol=1e-9)
         assert np.abs(best - q).max() <= 1e-6
+
+
+def test_the_readme_cmake_recipe_builds_a_program_that_solves(tmp_path):
+    """README's CMake lines, around a small controller program, configure, build and solve."""
+    cmake = shutil.which("cmake")
+    if cmake is None:
+        pytest.skip("no cmake")
+    readme = (ROOT / "README.md").read_text()
+    recipe = readme.split("```cmake\n", 1)[1].split("```", 1)[0]
+    for name in ("puma560_ik.c", "puma560_ik.h"):
+        shutil.copy(GENERATED / name, tmp_path / name)
+    (tmp_path / "main.c").write_text(
+        """#include <stdio.h>
+#include "puma560_ik.h"
+int main(void)
+{
+    const double q0[6] = {0.1, 0.2, 0.3, 0.4, 0.5, 0.6};
+    double T[16], q[PUMA560_MAX_SOLUTIONS][PUMA560_DOF];
+    puma560_fk(q0, T);
+    printf("%d\\n", puma560_ik(T, NULL, PUMA560_CERTIFY_TOL, q));
+    return 0;
+}
+"""
+    )
+    (tmp_path / "CMakeLists.txt").write_text(
+        "cmake_minimum_required(VERSION 3.10)\nproject(controller C)\n"
+        "add_executable(my_controller main.c)\n" + recipe
+    )
+    build = tmp_path / "build"
+    subprocess.run([cmake, "-S", str(tmp_path), "-B", str(build)], check=True, capture_output=True)
+    subprocess.run([cmake, "--build", str(build)], check=True, capture_output=True)
+    out = subprocess.run([build / "my_controller"], check=True, capture_output=True, text=True)
+    assert out.stdout.strip() == "8"
