@@ -1009,8 +1009,14 @@ static int dk_solve(const double t[12], double tol, const double ref[DK_DOF],
                             double theta6, c6, s6;
                             dk_value(&dk_v6, dk_k6, &theta6, &c6, &s6);
                             double e[12];
-                            const double q[7] = {-theta6, -theta5, -theta4, -theta3, -theta2, -theta1, qr7};
-                            dk_fk_q(q, e);
+                            const double dk_c1 = c6, dk_s1 = -s6;
+                            const double dk_c2 = c5, dk_s2 = -s5;
+                            const double dk_c3 = c4, dk_s3 = -s4;
+                            const double dk_c4 = c3, dk_s4 = -s3;
+                            const double dk_c5 = c2, dk_s5 = -s2;
+                            const double dk_c6 = c1, dk_s6 = -s1;
+                            const double dk_c7 = c7, dk_s7 = s7;
+                            dk_fk_cs(dk_c1, dk_s1, dk_c2, dk_s2, dk_c3, dk_s3, dk_c4, dk_s4, dk_c5, dk_s5, dk_c6, dk_s6, dk_c7, dk_s7, e);
                             if (n < DK_MAX && dk_match(e, t, tol, ptol, 0)) {
                                 found[n][0] = -theta6;
                                 found[n][1] = -theta5;

@@ -155,7 +155,6 @@ def solve_lines(plan: Plan) -> tuple[tuple[int, str], ...]:
     names = sp.numbered_symbols("x")
     scope = Scope([set()])
     steps, inputs = live_steps(plan)
-    dof = plan.arm.dof
     body: list[Line] = []
     for k, name in enumerate(world_names()):
         if name in inputs or any(name in live.after for live in steps):
@@ -219,8 +218,7 @@ def solve_lines(plan: Plan) -> tuple[tuple[int, str], ...]:
     if same_joints(plan):
         body.append(Line(depth, f"dk_fk_cs({cs_arguments(plan)}, e);"))
     else:
-        body.append(Line(depth, f"const double q[{dof}] = {{{', '.join(outputs)}}};"))
-        body.append(Line(depth, "dk_fk_q(q, e);"))
+        body += _arm_cs_lines(plan, printer, depth, scope)
     position = "1" if plan.ik.certify == "position" else "0"
     body.append(Line(depth, f"if (n < DK_MAX && dk_match(e, t, tol, ptol, {position})) {{"))
     body += [Line(depth + 1, f"found[n][{k}] = {v};") for k, v in enumerate(outputs)]
@@ -235,6 +233,78 @@ def solve_lines(plan: Plan) -> tuple[tuple[int, str], ...]:
         scope.levels.pop()
     body.append(Line(0, "return n;"))
     return tuple((ln.depth, ln.text) for ln in body)
+
+
+def _arm_cs_lines(plan: Plan, printer: CPrinter, depth: int, scope: Scope) -> list[Line]:
+    """The certification's forward kinematics where the plan's joints are not the arm's (a
+    reversed chain, free joints): the arm's cos and sin from the plan's where an output is
+    +-theta_j plus a constant (the sum formulas: no transcendental call), else from the
+    output's value; then dk_fk_cs."""
+    assert plan.ik is not None
+    known = _known_cs(plan, scope)
+    args = []
+    lines = []
+    for k, ((target, expr), output) in enumerate(zip(plan.joint_defs, plan.ik.outputs)):
+        value = sp.expand(expr.xreplace({sym.q(k + 1): output}))
+        if not str(target).startswith("theta"):
+            lines.append(Line(depth, f"const double dk_d{k + 1} = {printer.doprint(value)};"))
+            args.append(f"dk_d{k + 1}")
+            continue
+        c, s = f"dk_c{k + 1}", f"dk_s{k + 1}"
+        angle = _plus_minus_angle(value, known)
+        if angle is None:
+            text = printer.doprint(value)
+            lines.append(Line(depth, f"const double {c} = cos({text}), {s} = sin({text});"))
+        elif angle[3] == 0.0:
+            cj, sj, sign, _ = angle
+            minus = "" if sign > 0 else "-"
+            lines.append(Line(depth, f"const double {c} = {cj}, {s} = {minus}{sj};"))
+        else:
+            cj, sj, sign, delta = angle
+            cd, sd = math.cos(delta), math.sin(delta)
+            lines.append(Line(depth, f"const double {c} = {cd!r}*{cj} - {sign * sd!r}*{sj};"))
+            lines.append(Line(depth, f"const double {s} = {sd!r}*{cj} + {sign * cd!r}*{sj};"))
+        args += [c, s]
+    lines.append(Line(depth, f"dk_fk_cs({', '.join(args)}, e);"))
+    return lines
+
+
+def _known_cs(plan: Plan, scope: Scope) -> dict[sp.Symbol, tuple[str, str]]:
+    """The angles whose cos and sin are variables in scope at the leaf: theta_j (c_j, s_j)
+    and the arguments of cos and sin an assignment names (a free joint's q_ref value)."""
+    assert plan.ik is not None
+    declared = set().union(*scope.levels)
+    known: dict[sp.Symbol, tuple[str, str]] = {}
+    for target, _ in plan.joint_defs:
+        j = str(target)[5:]
+        if str(target).startswith("theta") and {f"c{j}", f"s{j}"} <= declared:
+            known[target] = (f"c{j}", f"s{j}")
+    halves: dict[sp.Expr, dict[str, str]] = {}
+    for step in plan.ik.steps:
+        if isinstance(step, Assign):
+            for name, expr in zip(step.targets, step.exprs):
+                if isinstance(expr, (sp.cos, sp.sin)) and str(name) in declared:
+                    kind = "c" if isinstance(expr, sp.cos) else "s"
+                    halves.setdefault(expr.args[0], {})[kind] = str(name)
+    for arg, names in halves.items():
+        if isinstance(arg, sp.Symbol) and len(names) == 2 and arg not in known:
+            known[arg] = (names["c"], names["s"])
+    return known
+
+
+def _plus_minus_angle(
+    value: sp.Expr, known: dict[sp.Symbol, tuple[str, str]]
+) -> tuple[str, str, float, float] | None:
+    """(c, s, sign, delta) where value is sign * x + delta for an x whose cos and sin are
+    the variables c and s."""
+    if len(value.free_symbols) != 1:
+        return None
+    (x,) = value.free_symbols
+    coeff = value.coeff(x)
+    rest = value - coeff * x
+    if x not in known or coeff not in (1, -1) or not rest.is_number:
+        return None
+    return known[x][0], known[x][1], float(coeff), float(rest)
 
 
 def _eigen_lines(
