@@ -134,12 +134,13 @@ def test_invalid_poses_give_the_error_code(harnesses):
 
 def test_sanitized_round_trips(generated, harnesses):
     """Every C arm under AddressSanitizer and UndefinedBehaviorSanitizer (a report aborts the
-    harness, which fails the test), 1,000 poses each, checked against the Python solver."""
+    harness, which fails the test), 300 poses each (100 of the general arm), checked
+    against the Python solver."""
     probe = cbuild.c_compiler()
     assert probe is not None
     for name in C_ARMS:
         m = generated(name)
-        _, T, refs = poses(m, 200 if name == "manocha_canny" else 1000, 7)
+        _, T, refs = poses(m, 100 if name == "manocha_canny" else 300, 7)
         try:
             harness = harnesses(name, sanitize=True)
         except cbuild.BuildError as exc:  # a compiler without the sanitizer runtimes
@@ -153,7 +154,7 @@ def test_sanitized_round_trips(generated, harnesses):
             for i in range(len(T))
         )
         # (the general method differs from the Python solver at 1.1% of such poses: above)
-        assert agree >= len(T) - (6 if name == "manocha_canny" else 2), (name, agree)
+        assert agree >= len(T) - (3 if name == "manocha_canny" else 2), (name, agree)
 
 
 @pytest.mark.parametrize("name", ["puma560", "iiwa14"])
