@@ -100,15 +100,21 @@ def test_c_solver_gives_the_python_solutions(generated, harnesses, name):
     counts, QC = harness.solve(T, refs)
     assert (counts >= 0).all(), "a pose the C solver did not settle"
     P = python_rows(m, T, refs)
+    # sound: every C row reproduces its pose (what the solver solves for)
+    found = np.arange(QC.shape[1])[None, :] < counts[:, None]
+    E = m.fk_batch(QC[found])
+    owner = T[np.nonzero(found)[0]]
+    assert np.abs(E[:, :3, 3] - owner[:, :3, 3]).max(initial=0.0) <= 1e-6 * m.REACH
+    if m.IK_COMPONENTS == "pose":
+        assert np.abs(E[:, :3, :3] - owner[:, :3, :3]).max(initial=0.0) <= 1e-6
     beyond = other_count = turn = 0
     revolute = np.array([k == "R" for k in m.JOINT_TYPES])
+    every = np.ones(m.DOF, bool)
     for i in range(len(T)):
         rows, c_rows = P[i], QC[i, : counts[i]]
-        for row in c_rows:  # sound: each C row reproduces the pose (what the solver solves for)
-            assert max(verify.pose_error(m, row, T[i])) <= 1e-6, (i, row)
-        if verify.jacobian_nullity(m, Q[i])[0] >= verify.SINGULAR_SIGMA:  # complete
-            every = np.ones(m.DOF, bool)
-            assert any(verify.same_joints(r, Q[i], revolute, every) for r in c_rows), i
+        # complete: the sample's own q is among the rows, unless the sample is singular
+        if not any(verify.same_joints(r, Q[i], revolute, every) for r in c_rows):
+            assert verify.jacobian_nullity(m, Q[i])[0] < verify.SINGULAR_SIGMA, i
         if len(rows) != len(c_rows):
             other_count += 1
             continue
@@ -132,13 +138,19 @@ def test_invalid_poses_give_the_error_code(harnesses):
     assert counts.tolist() == [-1] * len(bad)
 
 
+# the arms whose C goes through every routine of the C runtime: polynomial, half-angle and
+# two-equation steps, free joints stepping through their values (a reversed chain with q7
+# given), and the general method (compiling a sanitized build takes seconds per arm)
+SANITIZED = ("puma560", "iiwa14", "manocha_canny", "lecture_6r")
+
+
 def test_sanitized_round_trips(generated, harnesses):
-    """Every C arm under AddressSanitizer and UndefinedBehaviorSanitizer (a report aborts the
+    """C arms under AddressSanitizer and UndefinedBehaviorSanitizer (a report aborts the
     harness, which fails the test), 300 poses each (100 of the general arm), checked
     against the Python solver."""
     probe = cbuild.c_compiler()
     assert probe is not None
-    for name in C_ARMS:
+    for name in SANITIZED:
         m = generated(name)
         _, T, refs = poses(m, 100 if name == "manocha_canny" else 300, 7)
         try:
