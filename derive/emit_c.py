@@ -76,10 +76,11 @@ def general_constants(plan: Plan) -> dict[str, object]:
     assert step is not None
 
     def nested(values: Any) -> str:
-        if isinstance(values, (int, float, np.integer, np.floating)) and not isinstance(
-            values, bool
-        ):
-            return repr(float(values)) if isinstance(values, (float, np.floating)) else str(values)
+        """Nested sequences of numbers as a C initialiser (floats as doubles)."""
+        if isinstance(values, (float, np.floating)):
+            return repr(float(values))
+        if isinstance(values, (int, np.integer)):
+            return str(int(values))
         return "{" + ", ".join(nested(v) for v in values) + "}"
 
     return {

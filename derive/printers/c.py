@@ -398,5 +398,4 @@ def c_double(value: float) -> str:
     """A double as a C literal (HUGE_VAL for infinities)."""
     if math.isinf(value):
         return "HUGE_VAL" if value > 0 else "-HUGE_VAL"
-    text = repr(float(value))
-    return text
+    return repr(float(value))
