@@ -168,6 +168,24 @@ def wrapped_close(a: np.ndarray, b: np.ndarray, tol: float) -> bool:
 sys.path.insert(0, str(ROOT / "tests"))
 
 
+def pytest_sessionfinish(session) -> None:
+    """In a pytest-xdist worker: hand the worst degenerate-pose error to the controller."""
+    from degenerate import WORST
+
+    output = getattr(session.config, "workeroutput", None)
+    if output is not None:
+        output["degenerate_worst"] = WORST["error"]
+
+
+@pytest.hookimpl(optionalhook=True)
+def pytest_testnodedown(node, error) -> None:
+    """In the controller: the worst degenerate-pose error over the workers."""
+    from degenerate import WORST
+
+    worst = getattr(node, "workeroutput", {}).get("degenerate_worst", 0.0)
+    WORST["error"] = max(WORST["error"], worst)
+
+
 def pytest_terminal_summary(terminalreporter) -> None:
     """The worst pose error the degenerate-pose suites met in this run (for the notes)."""
     from degenerate import WORST
