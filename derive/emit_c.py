@@ -13,8 +13,9 @@ import numpy as np
 
 from derive import free
 from derive.emit import GENERATOR, GenerationError, check_printable, environment
-from derive.plan import Eigen, Plan
+from derive.plan import Plan
 from derive.printers import c
+from derive.printers.general import eigen_step
 from derive.runtime import closed, constants
 
 
@@ -72,7 +73,7 @@ def general_constants(plan: Plan) -> dict[str, object]:
     """The general method's constants and dk_rr_fill for templates/general.c.j2."""
     from derive.runtime import general
 
-    step = next(s for s in plan.ik.steps if isinstance(s, Eigen)) if plan.ik else None
+    step = eigen_step(plan)
     assert step is not None
 
     def nested(values: Any) -> str:

@@ -4,10 +4,11 @@ as C99, from the same plan the Python printers read (templates/arm.c.j2 lays the
 dk_solve follows the Python solver's steps (derive/printers/scalar.py) with the compiled
 kernel's closed forms (derive/printers/kernel.py, templates/runtime.c.j2): one loop per Solve
 step over the joint's values; a free joint steps through its values (5 degree steps out from
-its first one) until one gives a certified solution, as the Python solver does. A root the
-closed forms cannot settle (a polynomial of another degree, a root failing the residual test,
-a split multiple root) makes it return DK_UNSETTLED: the C solver then says so instead of
-answering (the Python solver settles such poses with numpy).
+its first one) until one gives a certified solution, as the Python solver does. Roots failing
+the residual test are refined by Aberth iterations and split multiple roots merged (numpy's
+role in the Python solver); a polynomial of degree 3 or above 4 (once vanishing leading
+coefficients are dropped), or a general-method pose where no candidate polishes, makes it
+return DK_UNSETTLED: the C solver then says so instead of answering.
 """
 
 from __future__ import annotations
@@ -41,6 +42,7 @@ from derive.printers.common import (
     same_joints,
     world_names,
 )
+from derive.printers.general import eigen_step, fill_entries
 
 
 class CPrinter(CodePrinter):
@@ -337,18 +339,16 @@ def _eigen_lines(
 
 def general_fill(plan: Plan) -> tuple[str, ...]:
     """dk_rr_fill's body: per split, the nonzero entries of its matrices from the flange
-    target's l and p (CSE'd), as derive/printers/general.py prints them for Python."""
-    step = next((s for s in plan.ik.steps if isinstance(s, Eigen)), None) if plan.ik else None
+    target's l and p (CSE'd as for Python: derive/printers/general.py)."""
+    step = eigen_step(plan)
     assert step is not None
     printer = CPrinter()
     lines = []
     for k, split in enumerate(step.splits):
-        names = sp.numbered_symbols("x")
-        entries = [(i, e) for i, e in enumerate(split.fill) if e != 0]
-        temps, reduced = sp.cse([e for _, e in entries], symbols=names, order="canonical")
+        temps, entries = fill_entries(split)
         lines.append(f"if (k == {k}) {{")
         lines += [f"    const double {t} = {printer.doprint(e)};" for t, e in temps]
-        lines += [f"    out[{i}] = {printer.doprint(e)};" for (i, _), e in zip(entries, reduced)]
+        lines += [f"    out[{i}] = {printer.doprint(e)};" for i, e in entries]
         lines += ["    return;", "}"]
     return tuple(lines)
 

@@ -7,7 +7,7 @@ from __future__ import annotations
 import sympy as sp
 
 from derive import raghavan_roth as rr
-from derive.plan import Eigen, Plan
+from derive.plan import Eigen, Plan, Split
 from derive.printers.common import CodePrinter, float_literal
 
 
@@ -19,6 +19,17 @@ def eigen_step(plan: Plan) -> Eigen | None:
         if isinstance(step, Eigen):
             return step
     return None
+
+
+def fill_entries(
+    split: Split,
+) -> tuple[list[tuple[sp.Symbol, sp.Expr]], list[tuple[int, sp.Expr]]]:
+    """A split's fill as CSE'd straight-line code: the temporaries, and (index, expression)
+    of each nonzero entry of out (every backend's _rr_fill prints these)."""
+    entries = [(i, e) for i, e in enumerate(split.fill) if e != 0]
+    names = sp.numbered_symbols("x")
+    temps, reduced = sp.cse([e for _, e in entries], symbols=names, order="canonical")
+    return temps, [(i, e) for (i, _), e in zip(entries, reduced)]
 
 
 def general_code(plan: Plan) -> str:
@@ -50,15 +61,13 @@ def general_code(plan: Plan) -> str:
         '    _RR_LENGTH), into out (490 zeros on entry)."""',
     ]
     for k, split in enumerate(step.splits):
-        names = sp.numbered_symbols("x")
-        entries = [(i, e) for i, e in enumerate(split.fill) if e != 0]
-        temps, reduced = sp.cse([e for _, e in entries], symbols=names, order="canonical")
+        temps, entries = fill_entries(split)
         last = k == len(step.splits) - 1
         indent = "    " if last else "        "
         if not last:
             lines.append(f"    if k == {k}:")
         lines += [f"{indent}{t} = {printer.doprint(e)}" for t, e in temps]
-        lines += [f"{indent}out[{i}] = {printer.doprint(e)}" for (i, _), e in zip(entries, reduced)]
+        lines += [f"{indent}out[{i}] = {printer.doprint(e)}" for i, e in entries]
         if not last:
             lines.append(f"{indent}return")
     return "\n".join(lines) + "\n"
