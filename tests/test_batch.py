@@ -32,7 +32,18 @@ def test_ik_batch_equals_ik_pose_by_pose(generated, name):
     for i in range(len(T)):
         # same set, same order; values agree to 1e-6 (at singular poses the scalar and the
         # vectorised arithmetic differ by ~1e-8)
-        assert same_rows(m.ik(T[i]), batch[i][valid[i]], revolute, 1e-6), i
+        single, rows = m.ik(T[i]), batch[i][valid[i]]
+        if same_rows(single, rows, revolute, 1e-6):
+            continue
+        # Except where the general method meets a curve of solutions (a singular sample,
+        # axes in line): there ik and ik_batch return certified points of the curve that
+        # can differ (1.2e-5 at sample 157, q4 = q5 = -90 deg, in one CI run with the tests
+        # spread over worker processes; tests/test_seam.py allows the same): the same
+        # number of rows, each reproducing the pose.
+        assert m.METHOD == "general" and jacobian_nullity(m, Q[i])[0] < SINGULAR_SIGMA, i
+        assert len(single) == len(rows), i
+        for row in rows:
+            np.testing.assert_allclose(m.fk(row), T[i], atol=1e-6 * max(1.0, m.REACH))
 
 
 @needs_numba
