@@ -145,9 +145,10 @@ MAX_TURN_ROWS = 100_000
 # _RR_CLUSTER_TOL (1 + |y|) are one cluster (the answer is then in doubt); a second singular
 # value below _RR_NULL2_TOL of the largest makes the null space two-dimensional; a candidate
 # is kept when _RR_NEWTON_STEPS Newton steps (each at most 0.5 rad per joint, started where
-# the pose error is below _RR_NEWTON_REACH) bring its pose error below _RR_GOOD (lengths in
-# units of the arm's size); the rescue solves the pose moved by each (angle, shift) of
-# _RR_RESCUE and polishes back
+# the pose error is below _RR_NEWTON_REACH), or as many Levenberg-Marquardt steps after them
+# (damping |error|^2), bring its pose error below _RR_GOOD (lengths in units of the arm's
+# size); the rescue solves the pose moved by each (angle, shift) of _RR_RESCUE and polishes
+# back
 _RR_RANK_TOL = 1e-10
 
 
@@ -169,8 +170,8 @@ _RR_NULL2_TOL = 1e-5
 _RR_GOOD = 1e-10
 
 
-# where no candidate polishes to _RR_GOOD (a singular pose: Newton converges slowly there),
-# those within _RR_NEAR are returned for certification
+# where no candidate polishes to _RR_GOOD (a singular pose: the steps converge slowly at an
+# isolated multiple solution), those within _RR_NEAR are returned for certification
 _RR_NEAR = 1e-7
 
 
@@ -1109,9 +1110,24 @@ def _rr_theta6(rows, F, thetas):
 
 
 def _rr_newton(rows, F, q):
-    """Newton steps on the split's forward kinematics (geometric Jacobian) from q towards F:
+    """Newton steps on the split's forward kinematics (geometric Jacobian) from q towards F,
+    then, if they do not reach _RR_GOOD, Levenberg-Marquardt steps from the best point met:
     the polished angles and the final error (largest entry of the top three rows of the pose
     difference, lengths in units of _RR_LENGTH)."""
+    q, error = _rr_steps(rows, F, q, False)
+    if error > _RR_GOOD:
+        damped, damped_error = _rr_steps(rows, F, q, True)
+        if damped_error < error:
+            return damped, damped_error
+    return q, error
+
+
+def _rr_steps(rows, F, q, damped):
+    """_RR_NEWTON_STEPS steps from q: Newton's (J step = error), or damped ones (J^T J + mu)
+    step = J^T error with mu = |error|^2 (Levenberg-Marquardt as Yamashita and Fukushima: still
+    quadratic onto a curve of solutions, where J is singular and Newton's steps jump; slow in
+    a direction J nearly loses, which is why Newton goes first). The best point met and its
+    error."""
     q = np.array(q, dtype=float)
     best_q, best = q, math.inf
     frames = np.empty((7, 4, 4))
@@ -1143,7 +1159,11 @@ def _rr_newton(rows, F, q):
         J[2] = z[:, 0] * r[:, 1] - z[:, 1] * r[:, 0]
         J[3:] = z.T
         try:
-            step = np.linalg.solve(J, error)
+            if damped:
+                mu = float(error @ error)
+                step = np.linalg.solve(J.T @ J + mu * np.eye(6), J.T @ error)
+            else:
+                step = np.linalg.solve(J, error)
         except np.linalg.LinAlgError:
             break
         longest = float(np.abs(step).max())
@@ -1941,6 +1961,16 @@ def _krr_between(fill, true, t):
 
 def _krr_newton(rows, F, q0):
     """_rr_newton in the kernel."""
+    q, error = _krr_steps(rows, F, q0, False)
+    if error > _RR_GOOD:
+        damped, damped_error = _krr_steps(rows, F, q, True)
+        if damped_error < error:
+            return damped, damped_error
+    return q, error
+
+
+def _krr_steps(rows, F, q0, damped):
+    """_rr_steps in the kernel."""
     q = q0.copy()
     best_q = q.copy()
     best = math.inf
@@ -1979,9 +2009,24 @@ def _krr_newton(rows, F, q0):
             J[1, i] = z[2] * dx - z[0] * dz
             J[2, i] = z[0] * dy - z[1] * dx
             J[3, i], J[4, i], J[5, i] = z[0], z[1], z[2]
-        step = error.copy()
-        if not _ksolve_into(J, step):
-            break
+        if damped:  # Levenberg-Marquardt, mu = |error|^2
+            mu = 0.0
+            for r in range(6):
+                mu += error[r, 0] * error[r, 0]
+            normal = np.zeros((6, 6))
+            step = np.zeros((6, 1))
+            for r in range(6):
+                for k in range(6):
+                    step[r, 0] += J[k, r] * error[k, 0]
+                    for c in range(6):
+                        normal[r, c] += J[k, r] * J[k, c]
+                normal[r, r] += mu
+            if not _ksolve_into(normal, step):
+                break
+        else:
+            step = error.copy()
+            if not _ksolve_into(J, step):
+                break
         longest = np.abs(step).max()
         scale = 1.0 if longest <= 0.5 else 0.5 / longest
         for i in range(6):
@@ -3044,6 +3089,7 @@ _KERNEL = (
     '_krr_theta6',
     '_krr_between',
     '_krr_newton',
+    '_krr_steps',
     '_keigenvalues',
     '_fk_from_cs',
     '_kreference',

@@ -79,8 +79,8 @@ static int dk_pose_ok(const double T[16])
    C, step for step: per split, the 14 x 9 / 14 x 8 matrices of the pose, the left null space
    of Q, the 12 x 12 quadratic matrix polynomial in a Moebius-mapped half-angle of theta3, its
    24 x 24 companion matrix's eigenvalues (Hessenberg reduction and Francis double-shift QR),
-   the null vector of each real root, theta1 and theta2 by back-substitution, theta6, and Newton
-   steps on the forward kinematics; where the answer is in doubt, the fallback split and the
+   the null vector of each real root, theta1 and theta2 by back-substitution, theta6, and
+   Levenberg-Marquardt steps on the forward kinematics; where the answer is in doubt, the fallback split and the
    rescue (the pose moved a little and polished back). No LAPACK. */
 
 #define DK_RR_RANK_TOL (1e-10)
@@ -1120,17 +1120,19 @@ static void dk_rr_between(const double fill[6][4], const double truth[6][4], dou
     }
 }
 
-/* Newton steps on the forward kinematics of rows towards F from q (in place: the best
-   point met); the pose error there */
-static double dk_rr_newton(const double rows[6][4], const double F[4][4], double q[6])
+/* DK_RR_NEWTON_STEPS steps on the forward kinematics of rows towards F from q (in place: the
+   best point met): Newton's, or Levenberg-Marquardt's (damping |error|^2) where damped is
+   set; the pose error there */
+static double dk_rr_steps(const double rows[6][4], const double F[4][4], double q[6],
+                          int damped)
 {
-    double cur[6], frames[7][4][4], J[6][6], step[6], best = HUGE_VAL;
+    double cur[6], frames[7][4][4], J[6][6], normal[6][6], rhs[6], step[6], best = HUGE_VAL;
     int it, i, r, c, k;
     for (i = 0; i < 6; i++) {
         cur[i] = q[i];
     }
     for (it = 0; it < DK_RR_NEWTON_STEPS + 1; it++) {
-        double size = 0.0, longest = 0.0, scale;
+        double size = 0.0, longest = 0.0, mu = 0.0, scale;
         dk_eye4(frames[0]);
         for (i = 0; i < 6; i++) {
             for (r = 0; r < 4; r++) {
@@ -1175,7 +1177,28 @@ static double dk_rr_newton(const double rows[6][4], const double F[4][4], double
             J[4][i] = z1;
             J[5][i] = z2;
         }
-        if (!dk_solve_into(&J[0][0], 6, step, 1)) {
+        if (damped) { /* (J^T J + mu) step = J^T error, mu = |error|^2 */
+            for (r = 0; r < 6; r++) {
+                mu += step[r] * step[r];
+            }
+            for (r = 0; r < 6; r++) {
+                rhs[r] = 0.0;
+                for (k = 0; k < 6; k++) {
+                    rhs[r] += J[k][r] * step[k];
+                }
+                for (c = 0; c < 6; c++) {
+                    normal[r][c] = 0.0;
+                    for (k = 0; k < 6; k++) {
+                        normal[r][c] += J[k][r] * J[k][c];
+                    }
+                }
+                normal[r][r] += mu;
+            }
+            for (r = 0; r < 6; r++) {
+                step[r] = rhs[r];
+            }
+        }
+        if (!dk_solve_into(damped ? &normal[0][0] : &J[0][0], 6, step, 1)) {
             break;
         }
         for (i = 0; i < 6; i++) {
@@ -1187,6 +1210,28 @@ static double dk_rr_newton(const double rows[6][4], const double F[4][4], double
         }
     }
     return best;
+}
+
+/* Newton steps, then, where they do not reach DK_RR_GOOD, Levenberg-Marquardt steps from the
+   best point met (the Python solver's _rr_newton): q in place, the pose error there */
+static double dk_rr_newton(const double rows[6][4], const double F[4][4], double q[6])
+{
+    double damped[6], error = dk_rr_steps(rows, F, q, 0), damped_error;
+    int i;
+    if (error <= DK_RR_GOOD) {
+        return error;
+    }
+    for (i = 0; i < 6; i++) {
+        damped[i] = q[i];
+    }
+    damped_error = dk_rr_steps(rows, F, damped, 1);
+    if (damped_error < error) {
+        for (i = 0; i < 6; i++) {
+            q[i] = damped[i];
+        }
+        return damped_error;
+    }
+    return error;
 }
 
 /* the eigenvalues (wr, wi) of a real 24 x 24 matrix: Householder reduction to upper

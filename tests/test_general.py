@@ -106,3 +106,14 @@ def test_closed_form_arms_solved_again_by_the_general_method(arm, tmp_path):
             )
         same += len(a) == len(b)
     assert same >= 0.85 * poses, f"{same} of {poses} poses with the same solution set"
+
+
+def test_an_arm_singular_everywhere_is_refused_with_the_reason():
+    """Axes 3-6 parallel: the Jacobian has rank 5 at every configuration, every reachable pose
+    has a curve of solutions; the general method says so instead of generating a solver that
+    finds nothing (standard DH; the closed forms refuse it too)."""
+    rows = [(90, 0.3, 0.2, 0), (40, 0.5, 0.1, 0), (0, 0.4, 0, 0), (0, 0.3, 0.1, 0)]
+    rows += [(0, 0.2, 0, 0), (70, 0.1, 0.15, 0)]
+    plan = build_plan(parse_spec(spec_text("flat", "standard", rows), "<test>"))
+    assert plan.ik is None
+    assert "rank below 6 at every configuration (axes 3-6 are parallel)" in plan.refusal

@@ -42,6 +42,9 @@ NAME = "general"
 # a table whose pencil is singular
 POSES = 40
 PERTURBATION = 1e-4
+# below this ratio of the Jacobian's smallest to largest singular value, a configuration is
+# singular (for refusing an arm singular everywhere)
+SINGULAR_EVERYWHERE = 1e-10
 Row = tuple[float, float, float, float]
 
 
@@ -56,6 +59,12 @@ def derive(chain: Chain, structure: Structure) -> IkPlan | str:
     )
     if length == 0.0:
         return "general: every link length and offset is zero (the arm is a point)"
+    if everywhere_singular(flange_rows(chain, length)):
+        return (
+            "general: the arm's Jacobian has rank below 6 at every configuration"
+            f"{parallel_run(structure)}: it reaches a set of poses of dimension below 6, each "
+            "along a curve of solutions; no solver is generated"
+        )
     chains = (chain, reverse_chain(chain))
     splits = [measure(c, reversed_, length, False) for reversed_, c in enumerate(chains)]
     if max(s.recovered for s in splits) < POSES:
@@ -88,6 +97,37 @@ def derive(chain: Chain, structure: Structure) -> IkPlan | str:
         steps=tuple(steps),
         outputs=joint_outputs(chain),
     )
+
+
+def everywhere_singular(rows: tuple[Row, ...]) -> bool:
+    """Whether the Jacobian of the chain (flange rows) is singular at 8 random configurations:
+    smallest singular value below SINGULAR_EVERYWHERE of the largest at each (a regular arm's
+    is ~1e-2 at random configurations; a degenerate one's is rounding)."""
+    rng = np.random.default_rng(5)
+    for _ in range(8):
+        frames = [np.eye(4)]
+        for t, row in zip(rng.uniform(-math.pi, math.pi, 6), rows):
+            frames.append(frames[-1] @ runtime._rr_link(t, row))
+        end = frames[6][:3, 3]
+        z = [f[:3, 2] for f in frames[:6]]
+        J = np.array(
+            [np.concatenate((np.cross(z[i], end - frames[i][:3, 3]), z[i])) for i in range(6)]
+        )
+        S = np.linalg.svd(J, compute_uv=False)
+        if S[-1] > SINGULAR_EVERYWHERE * S[0]:
+            return False
+    return True
+
+
+def parallel_run(structure: Structure) -> str:
+    """ " (axes i-j are parallel)" for the first run of four or more parallel axes, else ""."""
+    for i in structure.parallel_triples:
+        if i + 1 in structure.parallel_triples:
+            j = i + 3
+            while j in structure.parallel:
+                j += 1
+            return f" (axes {i}-{j} are parallel)"
+    return ""
 
 
 def split_target(chain: Chain, target: sp.Matrix, k: int) -> Assign:

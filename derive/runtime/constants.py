@@ -49,9 +49,10 @@ MAX_FREE_VALUES = 100_000
 # _RR_CLUSTER_TOL (1 + |y|) are one cluster (the answer is then in doubt); a second singular
 # value below _RR_NULL2_TOL of the largest makes the null space two-dimensional; a candidate
 # is kept when _RR_NEWTON_STEPS Newton steps (each at most 0.5 rad per joint, started where
-# the pose error is below _RR_NEWTON_REACH) bring its pose error below _RR_GOOD (lengths in
-# units of the arm's size); the rescue solves the pose moved by each (angle, shift) of
-# _RR_RESCUE and polishes back
+# the pose error is below _RR_NEWTON_REACH), or as many Levenberg-Marquardt steps after them
+# (damping |error|^2), bring its pose error below _RR_GOOD (lengths in units of the arm's
+# size); the rescue solves the pose moved by each (angle, shift) of _RR_RESCUE and polishes
+# back
 _RR_RANK_TOL = 1e-10
 _RR_COND_LIMIT = 1e8
 _RR_MOEBIUS = ((1.0, 0.3, -0.4, 1.0), (1.0, -0.7, 0.5, 1.0), (0.6, 1.0, -1.0, 0.8))
@@ -59,8 +60,8 @@ _RR_IMAG_TOL = 1e-6
 _RR_CLUSTER_TOL = 1e-6
 _RR_NULL2_TOL = 1e-5
 _RR_GOOD = 1e-10
-# where no candidate polishes to _RR_GOOD (a singular pose: Newton converges slowly there),
-# those within _RR_NEAR are returned for certification
+# where no candidate polishes to _RR_GOOD (a singular pose: the steps converge slowly at an
+# isolated multiple solution), those within _RR_NEAR are returned for certification
 _RR_NEAR = 1e-7
 _RR_NEWTON_STEPS = 10
 _RR_NEWTON_REACH = 0.5

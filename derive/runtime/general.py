@@ -11,7 +11,8 @@ and Q (``_rr_fill``). From there the steps are the same for every arm (ALGORITHM
 3. the null space of the matrix at each eigenvalue (SVD) gives theta4 and theta5; a
    two-dimensional one (two solutions sharing theta3) is split by the monomial structure;
 4. theta1, theta2 by least squares from Q m12 = P m45, theta6 from the pose;
-5. Newton steps on the arm's forward kinematics polish every candidate.
+5. Newton steps on the arm's forward kinematics polish every candidate, then, where they do
+   not converge (a pose with a curve of solutions), Levenberg-Marquardt steps.
 
 A pose whose answer is in doubt (a candidate that does not polish, eigenvalues in a cluster,
 an odd number of solutions, none at all) is solved again with the runner-up split and then
@@ -385,9 +386,24 @@ def _rr_theta6(rows, F, thetas):
 
 
 def _rr_newton(rows, F, q):
-    """Newton steps on the split's forward kinematics (geometric Jacobian) from q towards F:
+    """Newton steps on the split's forward kinematics (geometric Jacobian) from q towards F,
+    then, if they do not reach _RR_GOOD, Levenberg-Marquardt steps from the best point met:
     the polished angles and the final error (largest entry of the top three rows of the pose
     difference, lengths in units of _RR_LENGTH)."""
+    q, error = _rr_steps(rows, F, q, False)
+    if error > _RR_GOOD:
+        damped, damped_error = _rr_steps(rows, F, q, True)
+        if damped_error < error:
+            return damped, damped_error
+    return q, error
+
+
+def _rr_steps(rows, F, q, damped):
+    """_RR_NEWTON_STEPS steps from q: Newton's (J step = error), or damped ones (J^T J + mu)
+    step = J^T error with mu = |error|^2 (Levenberg-Marquardt as Yamashita and Fukushima: still
+    quadratic onto a curve of solutions, where J is singular and Newton's steps jump; slow in
+    a direction J nearly loses, which is why Newton goes first). The best point met and its
+    error."""
     q = np.array(q, dtype=float)
     best_q, best = q, math.inf
     frames = np.empty((7, 4, 4))
@@ -419,7 +435,11 @@ def _rr_newton(rows, F, q):
         J[2] = z[:, 0] * r[:, 1] - z[:, 1] * r[:, 0]
         J[3:] = z.T
         try:
-            step = np.linalg.solve(J, error)
+            if damped:
+                mu = float(error @ error)
+                step = np.linalg.solve(J.T @ J + mu * np.eye(6), J.T @ error)
+            else:
+                step = np.linalg.solve(J, error)
         except np.linalg.LinAlgError:
             break
         longest = float(np.abs(step).max())

@@ -963,6 +963,16 @@ def _krr_between(fill, true, t):
 
 def _krr_newton(rows, F, q0):
     """_rr_newton in the kernel."""
+    q, error = _krr_steps(rows, F, q0, False)
+    if error > _RR_GOOD:
+        damped, damped_error = _krr_steps(rows, F, q, True)
+        if damped_error < error:
+            return damped, damped_error
+    return q, error
+
+
+def _krr_steps(rows, F, q0, damped):
+    """_rr_steps in the kernel."""
     q = q0.copy()
     best_q = q.copy()
     best = math.inf
@@ -1001,9 +1011,24 @@ def _krr_newton(rows, F, q0):
             J[1, i] = z[2] * dx - z[0] * dz
             J[2, i] = z[0] * dy - z[1] * dx
             J[3, i], J[4, i], J[5, i] = z[0], z[1], z[2]
-        step = error.copy()
-        if not _ksolve_into(J, step):
-            break
+        if damped:  # Levenberg-Marquardt, mu = |error|^2
+            mu = 0.0
+            for r in range(6):
+                mu += error[r, 0] * error[r, 0]
+            normal = np.zeros((6, 6))
+            step = np.zeros((6, 1))
+            for r in range(6):
+                for k in range(6):
+                    step[r, 0] += J[k, r] * error[k, 0]
+                    for c in range(6):
+                        normal[r, c] += J[k, r] * J[k, c]
+                normal[r, r] += mu
+            if not _ksolve_into(normal, step):
+                break
+        else:
+            step = error.copy()
+            if not _ksolve_into(J, step):
+                break
         longest = np.abs(step).max()
         scale = 1.0 if longest <= 0.5 else 0.5 / longest
         for i in range(6):
