@@ -104,8 +104,8 @@ def general_constants(plan: Plan) -> dict[str, object]:
         "MOTION_COUNT": len(general._RR_MOTIONS),
         "MOTIONS": nested(general._RR_MOTIONS.tolist()),
         "REVERSED": "{" + ", ".join("1" if s.reversed else "0" for s in step.splits) + "}",
-        "FILL": nested([s.fill_rows for s in step.splits]),
-        "TRUE": nested([s.true_rows for s in step.splits]),
+        "FILL": nested([(*s.fill_rows, (*s.slide, 0.0, 0.0)) for s in step.splits]),
+        "TRUE": nested([(*s.true_rows, (*s.slide, 0.0, 0.0)) for s in step.splits]),
         "fill": c.general_fill(plan),
     }
 

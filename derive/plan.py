@@ -209,6 +209,8 @@ class Split:
         poses: the number of poses measured.
         cond: the median condition number of the pencil's leading matrix on them.
         singular: the arm's own table gives a singular pencil (fill_rows are perturbed).
+        slide: (1.0, theta3) where the split's joint 3 is prismatic (its fixed angle; its d3 is
+            then the eigen-variable), else (0.0, 0.0).
     """
 
     reversed: bool
@@ -219,6 +221,7 @@ class Split:
     poses: int
     cond: float
     singular: bool
+    slide: tuple[float, float] = (0.0, 0.0)
 
     @property
     def name(self) -> str:
@@ -238,6 +241,8 @@ class Eigen(Solve):
     splits: tuple[Split, ...] = ()
     # the arm's number of the split's first joint (2 where joint 1 of a 7-joint arm is free)
     first: int = 1
+    # the six joints' kinds, R or P, in the arm's order
+    kinds: str = "RRRRRR"
 
     @property
     def indices(self) -> range:
@@ -246,8 +251,10 @@ class Eigen(Solve):
 
     @property
     def variables(self) -> tuple[str, ...]:
-        """The joint angles the step gives (the arm's)."""
-        return tuple(f"theta{i}" for i in self.indices)
+        """The joint values the step gives (the arm's): theta_i, or d_i of a prismatic joint."""
+        return tuple(
+            f"{'theta' if kind == 'R' else 'd'}{i}" for i, kind in zip(self.indices, self.kinds)
+        )
 
 
 # every kind of Solve step: each backend's printer has a function for each (a test checks it)

@@ -321,6 +321,19 @@ def general_blocks(step: Eigen) -> list[Block]:
             "steps polish every candidate and forward kinematics certifies it.",
         ),
     ]
+    if step.splits[0].slide[0]:
+        out.append(
+            Block(
+                "p",
+                "Joint 3 of the split is prismatic here ($\\theta_3$ fixed at "
+                f"{number(math.degrees(step.splits[0].slide[1]))} deg, $d_3$ its variable): "
+                "$P_0 + P_s s_3 + P_c c_3$ at that angle is a polynomial "
+                "$B_0 + B_1 d_3 + B_2 d_3^2$ ($d_3$ enters $p$ linearly), so no half-angle is "
+                "taken for it: the matrices are filled as $P_0' = (B_0 + B_2)/2$, "
+                "$P_s' = B_1/2$, $P_c' = (B_0 - B_2)/2$ and the eigen-variable $x_3$ is $d_3$ "
+                "itself.",
+            )
+        )
     return out
 
 
@@ -331,12 +344,24 @@ def eigen_blocks(step: Eigen, env: dict[sp.Symbol, float]) -> list[Block]:
     for k, target in enumerate(step.args[:12]):
         F[k // 4, k % 4] = env[target]
     F[:3, 3] /= step.unit
-    P0, Ps, Pc, Q = general.matrices_at(split.fill_rows, F)
+    P0, Ps, Pc, Q = general.matrices_at(split.fill_rows, F, split.slide)
     found = runtime_general._rr_eigenvalues(P0, Ps, Pc, Q)
     if found is None:
         return [Block("p", f"The pencil of {split.name} is singular at this pose.")]
     values, _, (a, b, c, d) = found
     real = sorted(v.real for v in values if abs(v.imag) <= 1e-6 * (1 + abs(v)))
+    if split.slide[0]:
+        lengths = [(a * y + b) / (c * y + d) * step.unit for y in real if c * y + d != 0.0]
+        return [
+            Block(
+                "p",
+                f"The companion matrix of {split.name} at this pose has {len(values)} "
+                f"eigenvalues, {len(real)} of them real (y, with d3 = ({a:g} y + {b:g}) / "
+                f"({c:g} y + {d:g}) times {number(step.unit)}); d3 from each:",
+            ),
+            Block("math", "y", ", ".join(number(y) for y in real)),
+            Block("math", "d_3", ", ".join(number(t) for t in lengths)),
+        ]
     thetas = [math.degrees(2 * math.atan2(a * y + b, c * y + d)) for y in real]
     return [
         Block(
@@ -418,7 +443,12 @@ def walk(plan: Plan, pose: np.ndarray, q: tuple[float, ...]) -> list[tuple[str, 
                 lines.append((tex(target), number(env[target])))
             continue
         if isinstance(step, Eigen):
-            for k in step.indices:  # the solution's joint values, from the eigen-solve
+            for k, kind in zip(step.indices, step.kinds):  # the solution's, from the eigen-solve
+                if kind == "P":
+                    t = sym.d(k)
+                    env[t] = values[t]
+                    lines.append((tex(t), number(values[t])))
+                    continue
                 t = sym.theta(k)
                 env[t] = values[t]
                 lines.append((f"{tex(t)} / ^\\circ", number(math.degrees(values[t]))))

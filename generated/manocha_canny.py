@@ -778,6 +778,10 @@ _RR_H45 = np.array(
 _RR_MIX = np.sin(np.outer(np.arange(1, 7), np.arange(1, 15)) * 0.731 + 0.25)
 
 
+# (slides, theta3) of a split whose joint 3 turns; one whose joint 3 slides has (1.0, theta3)
+_RR_TURNS = (0.0, 0.0)
+
+
 # the pairs (k, k') of null-vector entries whose ratio is x5 (k' = k + 1) and x4 (k' = k + 3)
 _RR_X5_PAIRS = (np.array([0, 1, 3, 4, 6, 7, 9, 10]), np.array([1, 2, 4, 5, 7, 8, 10, 11]))
 
@@ -845,7 +849,11 @@ _RR_MOTIONS = np.array([_rr_motion(angle, shift) for angle, shift in _RR_RESCUE]
 
 
 def _rr_to_arm(k, q):
-    """A split's joint angles as the arm's: the reversed chain's joint j is -theta_{7-j}."""
+    """A split's joint values as the arm's: a sliding joint 3 in the arm's lengths, and the
+    reversed chain's joint j is -q_{7-j}."""
+    if _RR_SPLITS[k][3][0]:
+        q = q.copy()
+        q[2] *= _RR_LENGTH
     return -q[::-1] if _RR_SPLITS[k][0] else q
 
 
@@ -864,14 +872,14 @@ def _rr_split(k, F, moved):
     """The polished candidates of split k for the target F, found from the pose `moved` (F
     itself, or F slightly moved in a rescue); those that came within _RR_NEAR only; and
     whether the answer is in doubt."""
-    _, fill_rows, true_rows = _RR_SPLITS[k]
+    _, fill_rows, true_rows, slide = _RR_SPLITS[k]
     values = np.zeros(490)
     _rr_fill(k, *moved[:3, 2], *moved[:3, 3], values)
     P0 = values[:126].reshape(14, 9)
     Ps = values[126:252].reshape(14, 9)
     Pc = values[252:378].reshape(14, 9)
     Q = values[378:].reshape(14, 8)
-    candidates, doubt = _rr_candidates(P0, Ps, Pc, Q, moved, fill_rows)
+    candidates, doubt = _rr_candidates(P0, Ps, Pc, Q, moved, fill_rows, slide)
     # a perturbed table's solutions are walked back to the arm's in steps (a continuation),
     # so that Newton does not jump to another branch
     path = (
@@ -880,9 +888,11 @@ def _rr_split(k, F, moved):
     out = []
     close = []
     for q in candidates:
-        for rows in path:
-            q, _ = _rr_newton(rows, F, q)
-        q, residual = _rr_newton(true_rows, F, q)
+        for rows in path:  # (Newton's steps only: damped ones may change branch on the way)
+            q, _ = _rr_steps(rows, F, q, slide, False)
+        q, residual, damped = _rr_newton(true_rows, F, q, slide)
+        if damped and fill_rows == true_rows:  # Newton alone did not settle it
+            doubt = True
         if residual <= _RR_GOOD:
             out.append(q)
             continue
@@ -904,14 +914,23 @@ def _rr_between(fill_rows, true_rows, t):
     return out
 
 
-def _rr_candidates(P0, Ps, Pc, Q, F, rows):
-    """The unpolished joint angles of one split from its matrices (ALGORITHMS.md 4.4-4.7),
-    and whether the eigenvalues came in clusters (an answer in doubt)."""
+def _rr_candidates(P0, Ps, Pc, Q, F, rows, slide=_RR_TURNS):
+    """The unpolished joint values of one split from its matrices (ALGORITHMS.md 4.4-4.7),
+    and whether the eigenvalues came in clusters (an answer in doubt). Where joint 3 slides
+    (slide[0] set) the eigen-variable x3 is d3 itself, not tan(theta3 / 2)."""
     found = _rr_eigenvalues(P0, Ps, Pc, Q)
     if found is None:
         return [], True
     values, (A, B, C), moebius = found
     real = np.sort(values[np.abs(values.imag) <= _RR_IMAG_TOL * (1.0 + np.abs(values))].real)
+    ma, mb, mc, md = moebius
+    if slide[0]:
+        # a sliding joint 3 moves the flange by d3 along its axis, the other links by at most
+        # the sum of their lengths: |d3| <= |p| + that sum. The pencil's roots beyond (the
+        # degree it loses without a half-angle, near x3 = infinity) are left out before
+        # clustering.
+        reach = float(np.abs(F[:3, 3]).sum()) + sum(abs(r[0]) + abs(r[1]) for r in rows)
+        real = real[np.abs(ma * real + mb) <= reach * np.abs(mc * real + md)]
     doubt = False
     ys: list[list[float]] = []
     for y in real:
@@ -921,10 +940,12 @@ def _rr_candidates(P0, Ps, Pc, Q, F, rows):
         else:
             ys.append([y])
     out = []
-    ma, mb, mc, md = moebius
     for cluster in ys:
         y = sum(cluster) / len(cluster)
-        theta3 = 2.0 * math.atan2(ma * y + mb, mc * y + md)
+        if slide[0]:
+            theta3 = (ma * y + mb) / (mc * y + md)
+        else:
+            theta3 = 2.0 * math.atan2(ma * y + mb, mc * y + md)
         _, sv, vt = np.linalg.svd(A * y * y + B * y + C)
         vectors = [vt[-1]]
         if len(cluster) > 1 or sv[-2] <= _RR_NULL2_TOL * sv[0]:
@@ -934,13 +955,13 @@ def _rr_candidates(P0, Ps, Pc, Q, F, rows):
         for v in vectors:
             t4 = _rr_ratio_angle(v, _RR_X4_PAIRS)
             t5 = _rr_ratio_angle(v, _RR_X5_PAIRS)
-            for t1, t2 in _rr_joints12(rows, F, theta3, t4, t5):
-                t6 = _rr_theta6(rows, F, (t1, t2, theta3, t4, t5))
+            for t1, t2 in _rr_joints12(rows, F, theta3, t4, t5, slide):
+                t6 = _rr_theta6(rows, F, (t1, t2, theta3, t4, t5), slide)
                 out.append(np.array([t1, t2, theta3, t4, t5, t6]))
     return out, doubt
 
 
-def _rr_joints12(rows, F, t3, t4, t5):
+def _rr_joints12(rows, F, t3, t4, t5, slide):
     """The (theta1, theta2) pairs once theta3..theta5 are known. The third and fourth columns
     of A3 A4 A5 (a direction l and a point p in frame 2), moved by X2 and Tz(d2) to g, meet
     those of the target f: Rz(theta1) X1 Rz(theta2) g = f. Four equations linear in (cos,
@@ -948,7 +969,7 @@ def _rr_joints12(rows, F, t3, t4, t5):
     by least squares (two values where the equations fix only one direction); the rotation
     about z0 taking X1 Rz(theta2) g onto f gives theta1. (Least squares on Q m12 = P m45
     would need Q of full rank, which arms with a1 = 0 lack.)"""
-    M = _rr_link(t3, rows[2]) @ _rr_link(t4, rows[3]) @ _rr_link(t5, rows[4])
+    M = _rr_joint(2, t3, rows, slide) @ _rr_link(t4, rows[3]) @ _rr_link(t5, rows[4])
     d2, a2, ca2, sa2 = rows[1]
     _, a1, ca1, sa1 = rows[0]
     gl = np.array([M[0, 2], ca2 * M[1, 2] - sa2 * M[2, 2], sa2 * M[1, 2] + ca2 * M[2, 2]])
@@ -1100,29 +1121,44 @@ def _rr_link(theta, row):
     )
 
 
-def _rr_theta6(rows, F, thetas):
+def _rr_joint(i, value, rows, slide):
+    """A_i of a split's joint i (0-based) at its value: _rr_link, or, for joint 3 where it
+    slides, Rz(theta3) Tz(value) Tx(a) Rx(alpha) with theta3 = slide[1] fixed."""
+    if i == 2 and slide[0]:
+        return _rr_link(slide[1], (value, *rows[2][1:]))
+    return _rr_link(value, rows[i])
+
+
+def _rr_theta6(rows, F, thetas, slide):
     """theta6 from the pose: (A1 ... A5)^-1 F = Rz(theta6) in the split's frame."""
     M = np.eye(4)
-    for t, row in zip(thetas, rows):
-        M = M @ _rr_link(t, row)
+    for i, t in enumerate(thetas):
+        M = M @ _rr_joint(i, t, rows, slide)
     R = M[:3, :3].T @ F[:3, :3]
     return math.atan2(R[1, 0], R[0, 0])
 
 
-def _rr_newton(rows, F, q):
+def _rr_newton(rows, F, q, slide=_RR_TURNS):
     """Newton steps on the split's forward kinematics (geometric Jacobian) from q towards F,
     then, if they do not reach _RR_GOOD, Levenberg-Marquardt steps from the best point met:
-    the polished angles and the final error (largest entry of the top three rows of the pose
-    difference, lengths in units of _RR_LENGTH)."""
-    q, error = _rr_steps(rows, F, q, False)
-    if error > _RR_GOOD:
-        damped, damped_error = _rr_steps(rows, F, q, True)
-        if damped_error < error:
-            return damped, damped_error
-    return q, error
+    the polished values, the final error (largest entry of the top three rows of the pose
+    difference, lengths in units of _RR_LENGTH) and whether the damped steps were taken (a
+    candidate Newton does not settle puts the answer in doubt, as before they existed). Newton's
+    steps again after the damped ones: a regular solution the damped steps reach slowly is
+    settled exactly, not left a rounding's width from the same solution found otherwise."""
+    q, error = _rr_steps(rows, F, q, slide, False)
+    if error <= _RR_GOOD:
+        return q, error, False
+    damped, damped_error = _rr_steps(rows, F, q, slide, True)
+    if damped_error < error:
+        q, error = damped, damped_error
+        again, again_error = _rr_steps(rows, F, q, slide, False)
+        if again_error < error:
+            q, error = again, again_error
+    return q, error, True
 
 
-def _rr_steps(rows, F, q, damped):
+def _rr_steps(rows, F, q, slide, damped):
     """_RR_NEWTON_STEPS steps from q: Newton's (J step = error), or damped ones (J^T J + mu)
     step = J^T error with mu = |error|^2 (Levenberg-Marquardt as Yamashita and Fukushima: still
     quadratic onto a curve of solutions, where J is singular and Newton's steps jump; slow in
@@ -1134,7 +1170,7 @@ def _rr_steps(rows, F, q, damped):
     for _ in range(_RR_NEWTON_STEPS + 1):
         frames[0] = np.eye(4)
         for i in range(6):
-            frames[i + 1] = frames[i] @ _rr_link(q[i], rows[i])
+            frames[i + 1] = frames[i] @ _rr_joint(i, q[i], rows, slide)
         E = frames[6]
         size = float(np.abs(F[:3] - E[:3]).max())
         if size < best:
@@ -1158,6 +1194,9 @@ def _rr_steps(rows, F, q, damped):
         J[1] = z[:, 2] * r[:, 0] - z[:, 0] * r[:, 2]
         J[2] = z[:, 0] * r[:, 1] - z[:, 1] * r[:, 0]
         J[3:] = z.T
+        if slide[0]:  # a sliding joint 3 moves the flange along its axis
+            J[:3, 2] = z[2]
+            J[3:, 2] = 0.0
         try:
             if damped:
                 mu = float(error @ error)
@@ -1473,8 +1512,13 @@ def _krr_split(k, F, moved, out, count):
     the pose `moved`) added to out[6 count:] where new, until out is full; (the new count,
     doubt)."""
     limit = out.size // 6
-    fill = np.array(_RR_SPLITS[k][1])
-    true = np.array(_RR_SPLITS[k][2])
+    # rows 0-5: the split's rows; row 6: its slide (1.0, theta3 where joint 3 slides)
+    fill = np.zeros((7, 4))
+    true = np.zeros((7, 4))
+    fill[:6] = np.array(_RR_SPLITS[k][1])
+    true[:6] = np.array(_RR_SPLITS[k][2])
+    fill[6, 0], fill[6, 1] = _RR_SPLITS[k][3]
+    true[6, 0], true[6, 1] = _RR_SPLITS[k][3]
     perturbed = False
     for i in range(6):
         for j in range(4):
@@ -1490,13 +1534,17 @@ def _krr_split(k, F, moved, out, count):
         q = cands[c].copy()
         if perturbed:
             for t in _RR_PATH:
-                q, _ = _krr_newton(_krr_between(fill, true, t), F, q)
-        q, error = _krr_newton(true, F, q)
+                q, _ = _krr_steps(_krr_between(fill, true, t), F, q, False)
+        q, error, damped = _krr_newton(true, F, q)
+        if damped and not perturbed:
+            doubt = True
         if error > _RR_GOOD:
             if not perturbed:
                 doubt = True
             continue
-        if _RR_SPLITS[k][0]:  # the reversed chain: joint j is -theta_{7-j}
+        if true[6, 0] != 0.0:  # a sliding joint 3, in the arm's lengths
+            q[2] *= _RR_LENGTH
+        if _RR_SPLITS[k][0]:  # the reversed chain: joint j is -q_{7-j}
             q = -q[::-1]
         seen = False
         for r in range(count):
@@ -1574,16 +1622,21 @@ def _krr_candidates(values, F, rows, out):
     wr, wi, ok = _keigenvalues(K)
     if not ok:
         return 0, True
+    ma, mb, mc, md = moebius
+    reach = abs(F[0, 3]) + abs(F[1, 3]) + abs(F[2, 3])  # (|d3| beyond: spurious, as in Python)
+    for i in range(6):
+        reach += abs(rows[i, 0]) + abs(rows[i, 1])
     reals = np.zeros(24)
     n_real = 0
     for i in range(24):
         if abs(wi[i]) <= _RR_IMAG_TOL * (1.0 + math.hypot(wr[i], wi[i])):
-            reals[n_real] = wr[i]
-            n_real += 1
+            y = wr[i]
+            if rows[6, 0] == 0.0 or abs(ma * y + mb) <= reach * abs(mc * y + md):
+                reals[n_real] = y
+                n_real += 1
     reals = np.sort(reals[:n_real])
     doubt = False
     count = 0
-    ma, mb, mc, md = moebius
     start = 0
     V = np.zeros((3, 12))
     while start < n_real:
@@ -1595,7 +1648,10 @@ def _krr_candidates(values, F, rows, out):
         y = reals[start:stop].mean()
         clustered = stop - start > 1
         start = stop
-        theta3 = 2.0 * math.atan2(ma * y + mb, mc * y + md)
+        if rows[6, 0] != 0.0:  # joint 3 slides: x3 is d3
+            theta3 = (ma * y + mb) / (mc * y + md)
+        else:
+            theta3 = 2.0 * math.atan2(ma * y + mb, mc * y + md)
         S = A * (y * y) + B * y + C
         nv, plane = _knull_right(S, V)
         if clustered or plane:
@@ -1847,8 +1903,12 @@ def _krr_ratio_angle(v, step):
 
 
 def _krr_link(t, rows, i, M):
-    """M := M A_i(t) (standard DH row i: d, a, cos alpha, sin alpha)."""
+    """M := M A_i(t) (standard DH row i: d, a, cos alpha, sin alpha; row 6: the slide, where
+    joint 3 (i = 2) is Rz(theta3) Tz(t) X3 with theta3 = rows[6, 1])."""
     d, a, ca, sa = rows[i, 0], rows[i, 1], rows[i, 2], rows[i, 3]
+    if i == 2 and rows[6, 0] != 0.0:
+        d = t
+        t = rows[6, 1]
     ct, st = cos(t), sin(t)
     for r in range(4):
         m0, m1, m2 = M[r, 0], M[r, 1], M[r, 2]
@@ -1947,7 +2007,8 @@ def _krr_theta6(rows, F, t1, t2, t3, t4, t5):
 
 def _krr_between(fill, true, t):
     """_rr_between in the kernel."""
-    out = np.zeros((6, 4))
+    out = np.zeros((7, 4))
+    out[6] = true[6]
     for i in range(6):
         out[i, 0] = true[i, 0] + t * (fill[i, 0] - true[i, 0])
         out[i, 1] = true[i, 1] + t * (fill[i, 1] - true[i, 1])
@@ -1962,11 +2023,15 @@ def _krr_between(fill, true, t):
 def _krr_newton(rows, F, q0):
     """_rr_newton in the kernel."""
     q, error = _krr_steps(rows, F, q0, False)
-    if error > _RR_GOOD:
-        damped, damped_error = _krr_steps(rows, F, q, True)
-        if damped_error < error:
-            return damped, damped_error
-    return q, error
+    if error <= _RR_GOOD:
+        return q, error, False
+    damped, damped_error = _krr_steps(rows, F, q, True)
+    if damped_error < error:
+        q, error = damped, damped_error
+        again, again_error = _krr_steps(rows, F, q, False)
+        if again_error < error:
+            q, error = again, again_error
+    return q, error, True
 
 
 def _krr_steps(rows, F, q0, damped):
@@ -2009,6 +2074,9 @@ def _krr_steps(rows, F, q0, damped):
             J[1, i] = z[2] * dx - z[0] * dz
             J[2, i] = z[0] * dy - z[1] * dx
             J[3, i], J[4, i], J[5, i] = z[0], z[1], z[2]
+            if i == 2 and rows[6, 0] != 0.0:  # a sliding joint 3
+                J[0, i], J[1, i], J[2, i] = z[0], z[1], z[2]
+                J[3, i], J[4, i], J[5, i] = 0.0, 0.0, 0.0
         if damped:  # Levenberg-Marquardt, mu = |error|^2
             mu = 0.0
             for r in range(6):
@@ -2333,8 +2401,8 @@ def _ik_scalar(target, qr1, qr2, qr3, qr4, qr5, qr6, tol):
     F1_32 = 0.9998476951563913*w32 - 0.01745240643728351*w33
     F1_33 = 0.01745240643728351*w32 + 0.9998476951563913*w33
     F1_34 = wz
-    # general 6R: Raghavan-Roth equations of the arm's chain, theta3 from a 24 x 24 eigenproblem,
-    # the rest by back-substitution
+    # general 6-joint: Raghavan-Roth equations of the arm's chain, its joint 3 from a 24 x 24
+    # eigenproblem, the rest by back-substitution
     for theta1, theta2, theta3, theta4, theta5, theta6 in _general(((F0_11, F0_12, F0_13, F0_14,
         F0_21, F0_22, F0_23, F0_24, F0_31, F0_32, F0_33, F0_34), (F1_11, F1_12, F1_13, F1_14, F1_21,
         F1_22, F1_23, F1_24, F1_31, F1_32, F1_33, F1_34),), tol):
@@ -2359,8 +2427,8 @@ def _ik_candidates(T, qr1, qr2, qr3, qr4, qr5, qr6, tol):
     """Every branch of the solution for poses T (n, 4, 4): (n, M, DOF) values, (n, M)
     validity, certified by forward kinematics (tol as for ik), and (n,) the poses to retry
     with the scalar solver (a free joint's value left its branch without solution)."""
-    # general 6R: Raghavan-Roth equations of the arm's chain, theta3 from a 24 x 24 eigenproblem,
-    # the rest by back-substitution: one eigenproblem per pose, in the scalar solver
+    # general 6-joint: Raghavan-Roth equations of the arm's chain, its joint 3 from a 24 x 24
+    # eigenproblem, the rest by back-substitution: one eigenproblem per pose, in the scalar solver
     return _vdefer(T.shape[0], DOF)
 
 
@@ -2405,8 +2473,8 @@ def _ksolve(w11, w12, w13, wx, w21, w22, w23, wy, w31, w32, w33, wz, tol, ref, f
     F1_32 = 0.9998476951563913*w32 - 0.01745240643728351*w33
     F1_33 = 0.01745240643728351*w32 + 0.9998476951563913*w33
     F1_34 = wz
-    # general 6R: Raghavan-Roth equations of the arm's chain, theta3 from a 24 x 24 eigenproblem,
-    # the rest by back-substitution
+    # general 6-joint: Raghavan-Roth equations of the arm's chain, its joint 3 from a 24 x 24
+    # eigenproblem, the rest by back-substitution
     _n3 = (_kgeneral(((F0_11, F0_12, F0_13, F0_14, F0_21, F0_22, F0_23, F0_24, F0_31, F0_32, F0_33,
         F0_34), (F1_11, F1_12, F1_13, F1_14, F1_21, F1_22, F1_23, F1_24, F1_31, F1_32, F1_33,
         F1_34),), buf[0:96]))
@@ -2451,8 +2519,9 @@ def _ksolve(w11, w12, w13, wx, w21, w22, w23, wy, w31, w32, w33, wz, tol, ref, f
 
 
 # the general method's splits, best first: (reversed, the rows the matrices are filled
-# from, the arm's rows); rows (d, a, cos alpha, sin alpha) of standard DH from the
-# flange frame, lengths in units of _RR_LENGTH
+# from, the arm's rows, (1.0, theta3) where joint 3 slides else (0.0, 0.0)); rows (d, a,
+# cos alpha, sin alpha) of standard DH from the flange frame, lengths in units of
+# _RR_LENGTH
 _RR_SPLITS = (
     (
         False,
@@ -2472,6 +2541,7 @@ _RR_SPLITS = (
             (0.0, 0.0, 0.0, 1.0),
             (0.0, 0.0, 1.0, 0.0),
         ),
+        (0.0, 0.0),
     ),
     (
         False,
@@ -2491,6 +2561,7 @@ _RR_SPLITS = (
             (0.0, 0.0, 0.0, 1.0),
             (0.0, 0.0, 1.0, 0.0),
         ),
+        (0.0, 0.0),
     ),
 )
 _RR_LENGTH = 1.5

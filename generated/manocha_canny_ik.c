@@ -103,10 +103,11 @@ static const double DK_RR_MIX[6][14] = {{0.831053977697249, 0.9900473146183112, 
 static const int DK_RR_MONOMIAL_RULES[5][4] = {{0, 4, 1, 3}, {1, 5, 2, 4}, {3, 7, 4, 6}, {4, 8, 5, 7}, {6, 10, 7, 9}};
 static const double DK_RR_MOTIONS[2][4][4] = {{{0.999999996152, -6.400143989332459e-05, -5.999846390000934e-05, 3.6e-05}, {6.399855989334209e-05, 0.9999999968000001, -4.800191991998833e-05, 4.8e-05}, {6.000153589999067e-05, 4.799807992001167e-05, 0.999999997048, -8e-05}, {0.0, 0.0, 0.0, 1.0}}, {{0.9999999846080001, 0.0001279942391467017, 0.00012000614319996266, 5.399999999999999e-05}, {-0.0001280057591466317, 0.9999999872, 9.59923193600467e-05, 7.199999999999999e-05}, {-0.00011999385520003735, -9.600767935995333e-05, 0.9999999881920001, -0.00011999999999999999}, {0.0, 0.0, 0.0, 1.0}}};
 /* per split: whether it is the reversed chain, the rows its matrices are filled from and the
-   arm's rows: (d, a, cos alpha, sin alpha) of standard DH from the flange frame */
+   arm's rows: (d, a, cos alpha, sin alpha) of standard DH from the flange frame, then the
+   split's slide (1, theta3, 0, 0) where its joint 3 is prismatic, else zeros */
 static const int DK_RR_REVERSED[DK_RR_SPLIT_COUNT] = {0, 0};
-static const double DK_RR_FILL[DK_RR_SPLIT_COUNT][6][4] = {{{0.0, 0.19999999999999998, 0.0, 1.0}, {0.0, 0.6666666666666666, 0.9998476951563913, 0.01745240643728351}, {0.13333333333333333, 0.0, 0.0, 1.0}, {0.0, 1.0, 0.9998476951563913, 0.01745240643728351}, {0.0, 0.0, 0.0, 1.0}, {0.0, 0.0, 1.0, 0.0}}, {{0.0, 0.20006442176872374, -8.91207358880526e-05, 0.9999999960287472}, {9.092974268256818e-05, 0.6667342129847218, 0.9998471099604567, 0.017485900140468767}, {0.1332803497192425, -8.182771110644103e-05, 9.775301161088936e-05, 0.9999999952221743}, {-7.727644875559877e-05, 0.9999535397820586, 0.9998478401328801, 0.017444098761891264}, {7.28969040125876e-05, 9.37999976774739e-05, -9.989413401767637e-05, 0.999999995010581}, {0.0, 0.0, 1.0, 0.0}}};
-static const double DK_RR_TRUE[DK_RR_SPLIT_COUNT][6][4] = {{{0.0, 0.19999999999999998, 0.0, 1.0}, {0.0, 0.6666666666666666, 0.9998476951563913, 0.01745240643728351}, {0.13333333333333333, 0.0, 0.0, 1.0}, {0.0, 1.0, 0.9998476951563913, 0.01745240643728351}, {0.0, 0.0, 0.0, 1.0}, {0.0, 0.0, 1.0, 0.0}}, {{0.0, 0.19999999999999998, 0.0, 1.0}, {0.0, 0.6666666666666666, 0.9998476951563913, 0.01745240643728351}, {0.13333333333333333, 0.0, 0.0, 1.0}, {0.0, 1.0, 0.9998476951563913, 0.01745240643728351}, {0.0, 0.0, 0.0, 1.0}, {0.0, 0.0, 1.0, 0.0}}};
+static const double DK_RR_FILL[DK_RR_SPLIT_COUNT][7][4] = {{{0.0, 0.19999999999999998, 0.0, 1.0}, {0.0, 0.6666666666666666, 0.9998476951563913, 0.01745240643728351}, {0.13333333333333333, 0.0, 0.0, 1.0}, {0.0, 1.0, 0.9998476951563913, 0.01745240643728351}, {0.0, 0.0, 0.0, 1.0}, {0.0, 0.0, 1.0, 0.0}, {0.0, 0.0, 0.0, 0.0}}, {{0.0, 0.20006442176872374, -8.91207358880526e-05, 0.9999999960287472}, {9.092974268256818e-05, 0.6667342129847218, 0.9998471099604567, 0.017485900140468767}, {0.1332803497192425, -8.182771110644103e-05, 9.775301161088936e-05, 0.9999999952221743}, {-7.727644875559877e-05, 0.9999535397820586, 0.9998478401328801, 0.017444098761891264}, {7.28969040125876e-05, 9.37999976774739e-05, -9.989413401767637e-05, 0.999999995010581}, {0.0, 0.0, 1.0, 0.0}, {0.0, 0.0, 0.0, 0.0}}};
+static const double DK_RR_TRUE[DK_RR_SPLIT_COUNT][7][4] = {{{0.0, 0.19999999999999998, 0.0, 1.0}, {0.0, 0.6666666666666666, 0.9998476951563913, 0.01745240643728351}, {0.13333333333333333, 0.0, 0.0, 1.0}, {0.0, 1.0, 0.9998476951563913, 0.01745240643728351}, {0.0, 0.0, 0.0, 1.0}, {0.0, 0.0, 1.0, 0.0}, {0.0, 0.0, 0.0, 0.0}}, {{0.0, 0.19999999999999998, 0.0, 1.0}, {0.0, 0.6666666666666666, 0.9998476951563913, 0.01745240643728351}, {0.13333333333333333, 0.0, 0.0, 1.0}, {0.0, 1.0, 0.9998476951563913, 0.01745240643728351}, {0.0, 0.0, 0.0, 1.0}, {0.0, 0.0, 1.0, 0.0}, {0.0, 0.0, 0.0, 0.0}}};
 
 /* the entries of P0, Ps, Pc (14 x 9 each) and Q (14 x 8), row-major, of split k at the flange
    target whose third and fourth columns are l and p (p in units of DK_RR_LENGTH), into out
@@ -970,10 +971,15 @@ static double dk_rr_ratio_angle(const double v[12], int step)
 }
 
 /* M := M A_i(t) (standard DH row i: d, a, cos alpha, sin alpha) */
-static void dk_rr_link(double t, const double rows[6][4], int i, double M[4][4])
+static void dk_rr_link(double t, const double rows[7][4], int i, double M[4][4])
 {
-    double d = rows[i][0], a = rows[i][1], ca = rows[i][2], sa = rows[i][3];
-    double ct = cos(t), st = sin(t);
+    double d = rows[i][0], a = rows[i][1], ca = rows[i][2], sa = rows[i][3], ct, st;
+    if (i == 2 && rows[6][0] != 0.0) { /* a sliding joint 3: Rz(theta3) Tz(t) X3 */
+        d = t;
+        t = rows[6][1];
+    }
+    ct = cos(t);
+    st = sin(t);
     int r;
     for (r = 0; r < 4; r++) {
         double m0 = M[r][0], m1 = M[r][1], m2 = M[r][2];
@@ -1042,7 +1048,7 @@ static int dk_unit_solutions(const double system[4][3], double cs[2][2])
 }
 
 /* theta1 and theta2 from theta3..theta5: their number of pairs, into t12 */
-static int dk_rr_joints12(const double rows[6][4], const double F[4][4], double t3, double t4,
+static int dk_rr_joints12(const double rows[7][4], const double F[4][4], double t3, double t4,
                           double t5, double t12[2][2])
 {
     double M[4][4], gl[3], gp[3], fl[3], fp[3], system[4][3], cs[2][2];
@@ -1091,7 +1097,7 @@ static int dk_rr_joints12(const double rows[6][4], const double F[4][4], double 
     return n;
 }
 
-static double dk_rr_theta6(const double rows[6][4], const double F[4][4], const double q[5])
+static double dk_rr_theta6(const double rows[7][4], const double F[4][4], const double q[5])
 {
     double M[4][4], r10, r00;
     int i;
@@ -1105,10 +1111,13 @@ static double dk_rr_theta6(const double rows[6][4], const double F[4][4], const 
 }
 
 /* the rows a share t of the way from the arm's (true) to the filled ones */
-static void dk_rr_between(const double fill[6][4], const double truth[6][4], double t,
-                          double out[6][4])
+static void dk_rr_between(const double fill[7][4], const double truth[7][4], double t,
+                          double out[7][4])
 {
     int i;
+    for (i = 0; i < 4; i++) {
+        out[6][i] = truth[6][i];
+    }
     for (i = 0; i < 6; i++) {
         double ca = truth[i][2] + t * (fill[i][2] - truth[i][2]);
         double sa = truth[i][3] + t * (fill[i][3] - truth[i][3]);
@@ -1123,7 +1132,7 @@ static void dk_rr_between(const double fill[6][4], const double truth[6][4], dou
 /* DK_RR_NEWTON_STEPS steps on the forward kinematics of rows towards F from q (in place: the
    best point met): Newton's, or Levenberg-Marquardt's (damping |error|^2) where damped is
    set; the pose error there */
-static double dk_rr_steps(const double rows[6][4], const double F[4][4], double q[6],
+static double dk_rr_steps(const double rows[7][4], const double F[4][4], double q[6],
                           int damped)
 {
     double cur[6], frames[7][4][4], J[6][6], normal[6][6], rhs[6], step[6], best = HUGE_VAL;
@@ -1176,6 +1185,12 @@ static double dk_rr_steps(const double rows[6][4], const double F[4][4], double 
             J[3][i] = z0;
             J[4][i] = z1;
             J[5][i] = z2;
+            if (i == 2 && rows[6][0] != 0.0) { /* a sliding joint 3 */
+                J[0][i] = z0;
+                J[1][i] = z1;
+                J[2][i] = z2;
+                J[3][i] = J[4][i] = J[5][i] = 0.0;
+            }
         }
         if (damped) { /* (J^T J + mu) step = J^T error, mu = |error|^2 */
             for (r = 0; r < 6; r++) {
@@ -1213,23 +1228,33 @@ static double dk_rr_steps(const double rows[6][4], const double F[4][4], double 
 }
 
 /* Newton steps, then, where they do not reach DK_RR_GOOD, Levenberg-Marquardt steps from the
-   best point met (the Python solver's _rr_newton): q in place, the pose error there */
-static double dk_rr_newton(const double rows[6][4], const double F[4][4], double q[6])
+   best point met (the Python solver's _rr_newton): q in place, the pose error there; *used
+   set where the damped steps were taken */
+static double dk_rr_newton(const double rows[7][4], const double F[4][4], double q[6],
+                           int *used)
 {
     double damped[6], error = dk_rr_steps(rows, F, q, 0), damped_error;
     int i;
-    if (error <= DK_RR_GOOD) {
+    *used = error > DK_RR_GOOD;
+    if (!*used) {
         return error;
     }
     for (i = 0; i < 6; i++) {
         damped[i] = q[i];
     }
     damped_error = dk_rr_steps(rows, F, damped, 1);
-    if (damped_error < error) {
+    if (damped_error < error) { /* then Newton again: a regular solution settled exactly */
         for (i = 0; i < 6; i++) {
             q[i] = damped[i];
         }
-        return damped_error;
+        error = damped_error;
+        damped_error = dk_rr_steps(rows, F, damped, 0);
+        if (damped_error < error) {
+            for (i = 0; i < 6; i++) {
+                q[i] = damped[i];
+            }
+            error = damped_error;
+        }
     }
     return error;
 }
@@ -1459,10 +1484,12 @@ static void dk_sort_doubles(double *x, int n)
 /* the candidate joint vectors of one split: their count written to out; *doubt: whether
    the answer is in doubt (clusters, or no usable pencil) */
 static int dk_rr_candidates(const double values[490], const double F[4][4],
-                            const double rows[6][4], double out[4 * DK_RR_MAX][6], int *doubt)
+                            const double rows[7][4], double out[4 * DK_RR_MAX][6], int *doubt)
 {
     double N[14][14], A6[6][9], B6[6][9], C6[6][9], pencil[3][12][12], best_pencil[3][12][12];
     double K[24][24], rhs[12][24], wr[24], wi[24], reals[24], V[3][12], best = HUGE_VAL;
+    /* a sliding joint 3: |d3| <= |p| + the other links' lengths (roots beyond are spurious) */
+    double reach = fabs(F[0][3]) + fabs(F[1][3]) + fabs(F[2][3]);
     const double *moebius = DK_RR_MOEBIUS[0];
     int rank_rows, i, m, r, col, c, n_real = 0, count = 0, start = 0;
     const double(*P0)[9] = (const double(*)[9])values;
@@ -1470,6 +1497,9 @@ static int dk_rr_candidates(const double values[490], const double F[4][4],
     const double(*Pc)[9] = (const double(*)[9])(values + 252);
     const double(*Q)[8] = (const double(*)[8])(values + 378);
     *doubt = 1;
+    for (i = 0; i < 6; i++) {
+        reach += fabs(rows[i][0]) + fabs(rows[i][1]);
+    }
     rank_rows = dk_null_left(Q, N);
     if (rank_rows == 0) {
         return 0;
@@ -1543,8 +1573,11 @@ static int dk_rr_candidates(const double values[490], const double F[4][4],
         return 0;
     }
     for (i = 0; i < 24; i++) {
-        if (fabs(wi[i]) <= DK_RR_IMAG_TOL * (1.0 + hypot(wr[i], wi[i]))) {
-            reals[n_real++] = wr[i];
+        const double y = wr[i];
+        if (fabs(wi[i]) <= DK_RR_IMAG_TOL * (1.0 + hypot(wr[i], wi[i])) &&
+            (rows[6][0] == 0.0 ||
+             fabs(moebius[0] * y + moebius[1]) <= reach * fabs(moebius[2] * y + moebius[3]))) {
+            reals[n_real++] = y; /* (a sliding joint 3's roots beyond reach left out) */
         }
     }
     dk_sort_doubles(reals, n_real);
@@ -1562,7 +1595,11 @@ static int dk_rr_candidates(const double values[490], const double F[4][4],
         y /= (double)(stop - start);
         clustered = stop - start > 1;
         start = stop;
-        theta3 = 2.0 * atan2(moebius[0] * y + moebius[1], moebius[2] * y + moebius[3]);
+        if (rows[6][0] != 0.0) { /* joint 3 slides: x3 is d3 */
+            theta3 = (moebius[0] * y + moebius[1]) / (moebius[2] * y + moebius[3]);
+        } else {
+            theta3 = 2.0 * atan2(moebius[0] * y + moebius[1], moebius[2] * y + moebius[3]);
+        }
         for (i = 0; i < 12; i++) {
             for (col = 0; col < 12; col++) {
                 S[i][col] = best_pencil[0][i][col] * (y * y) + best_pencil[1][i][col] * y +
@@ -1604,8 +1641,8 @@ static int dk_rr_candidates(const double values[490], const double F[4][4],
 static int dk_rr_split(int k, const double F[4][4], const double moved[4][4],
                        double out[DK_RR_ROWS][6], int count, int *doubt)
 {
-    double values[490], cands[4 * DK_RR_MAX][6], between[6][4];
-    int perturbed = 0, n, c, i, j, r;
+    double values[490], cands[4 * DK_RR_MAX][6], between[7][4];
+    int perturbed = 0, damped = 0, n, c, i, j, r;
     for (i = 0; i < 6; i++) {
         for (j = 0; j < 4; j++) {
             if (DK_RR_FILL[k][i][j] != DK_RR_TRUE[k][i][j]) {
@@ -1628,17 +1665,23 @@ static int dk_rr_split(int k, const double F[4][4], const double moved[4][4],
         if (perturbed) {
             for (i = 0; i < (int)(sizeof DK_RR_PATH / sizeof DK_RR_PATH[0]); i++) {
                 dk_rr_between(DK_RR_FILL[k], DK_RR_TRUE[k], DK_RR_PATH[i], between);
-                dk_rr_newton(between, F, q);
+                dk_rr_steps(between, F, q, 0); /* Newton only on the way */
             }
         }
-        error = dk_rr_newton(DK_RR_TRUE[k], F, q);
+        error = dk_rr_newton(DK_RR_TRUE[k], F, q, &damped);
+        if (damped && !perturbed) { /* Newton alone did not settle it */
+            *doubt = 1;
+        }
         if (error > DK_RR_GOOD) {
             if (!perturbed) {
                 *doubt = 1;
             }
             continue;
         }
-        for (j = 0; j < 6; j++) { /* the reversed chain: joint j is -theta_{7-j} */
+        if (DK_RR_TRUE[k][6][0] != 0.0) { /* a sliding joint 3, in the arm's lengths */
+            q[2] *= DK_RR_LENGTH;
+        }
+        for (j = 0; j < 6; j++) { /* the reversed chain: joint j is -q_{7-j} */
             arm[j] = DK_RR_REVERSED[k] ? -q[5 - j] : q[j];
         }
         for (r = 0; r < count && !seen; r++) {
@@ -1870,7 +1913,7 @@ static int dk_solve(const double t[12], double tol, const double ref[DK_DOF],
     double F1_32 = 0.9998476951563913*w32 - 0.01745240643728351*w33;
     double F1_33 = 0.01745240643728351*w32 + 0.9998476951563913*w33;
     double F1_34 = wz;
-    /* general 6R: Raghavan-Roth equations of the arm's chain, theta3 from a 24 x 24 eigenproblem, the rest by back-substitution */
+    /* general 6-joint: Raghavan-Roth equations of the arm's chain, its joint 3 from a 24 x 24 eigenproblem, the rest by back-substitution */
     const double dk_fl3[DK_RR_SPLIT_COUNT][12] = {{F0_11, F0_12, F0_13, F0_14, F0_21, F0_22, F0_23, F0_24, F0_31, F0_32, F0_33, F0_34}, {F1_11, F1_12, F1_13, F1_14, F1_21, F1_22, F1_23, F1_24, F1_31, F1_32, F1_33, F1_34}};
     double dk_rows3[DK_RR_ROWS][6];
     const int dk_n3 = dk_general(dk_fl3, dk_rows3);

@@ -123,6 +123,18 @@ def spec_text(
     return out + extra
 
 
+# an arm with no closed form and one prismatic joint (rows alpha, a, d, theta; the prismatic
+# joint's theta is its fixed angle, its d its offset): the general method's joint 3 or 4
+SLIDER_ROWS = [(90, 0.2, 0.3, 0), (40, 0.5, 0.1, 10), (-70, 0.3, 0.2, 30)]
+SLIDER_ROWS += [(60, 0.25, 0.15, 0), (-50, 0.1, 0.2, 0), (35, 0.05, 0.1, 0)]
+
+
+def slider_text(kinds: str, convention: str) -> str:
+    """The slider arm with joints of these kinds (one P), its prismatic joint within +-1 m."""
+    text = spec_text("slider", convention, SLIDER_ROWS, kinds=kinds)
+    return text.replace('type = "P"\n', 'type = "P"\nlimits = [-1.0, 1.0]\n')
+
+
 def rx(a: float) -> np.ndarray:
     c, s = math.cos(a), math.sin(a)
     return np.array([[1, 0, 0, 0], [0, c, -s, 0], [0, s, c, 0], [0, 0, 0, 1.0]])

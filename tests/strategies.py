@@ -159,9 +159,11 @@ def planar_arms(draw) -> str:
 
 @st.composite
 def general_arms(draw) -> str:
-    """6R arms of any geometry (most have no closed form): twists mix 0, +-90, 180 and
-    generic values, lengths and offsets are zero or not; the arm is solved by whichever
-    method applies (the general one where none of the others does)."""
+    """6-joint arms of any geometry (most have no closed form): twists mix 0, +-90, 180 and
+    generic values, lengths and offsets are zero or not, a fifth have joint 3 or 4 prismatic
+    (the places the general method takes one); the arm is solved by whichever method applies
+    (the general one where none of the others does)."""
+    slider = draw(st.sampled_from([0, 0, 0, 0, 0, 0, 0, 0, 3, 4]))
     convention = draw(st.sampled_from(["standard", "modified"]))
     twist = st.one_of(TWISTS, st.sampled_from([0.0, 180.0]))
     alpha = [draw(twist) for _ in range(7)]
@@ -171,4 +173,8 @@ def general_arms(draw) -> str:
     a[draw(st.integers(1, 5))] = draw(LENGTH)  # at least one link with length
     scale = draw(SCALE)
     rows = rows_for(convention, alpha, scaled(a, scale), scaled(d, scale), theta)
-    return spec_text("general_arm", convention, rows)
+    if not slider:
+        return spec_text("general_arm", convention, rows)
+    kinds = "RRRRRR"[: slider - 1] + "P" + "RRRRRR"[slider:]
+    text = spec_text("general_arm", convention, rows, kinds=kinds)
+    return text.replace('type = "P"\n', f'type = "P"\nlimits = [{-scale}, {scale}]\n')

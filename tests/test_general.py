@@ -19,7 +19,7 @@ from derive.spec import parse_spec
 from derive.verify import roundtrip, sample_joints
 
 from cases import GENERAL_CASES
-from conftest import build_module, import_path, spec_text
+from conftest import build_module, import_path, slider_text, spec_text
 from strategies import general_arms
 
 
@@ -117,3 +117,34 @@ def test_an_arm_singular_everywhere_is_refused_with_the_reason():
     plan = build_plan(parse_spec(spec_text("flat", "standard", rows), "<test>"))
     assert plan.ik is None
     assert "rank below 6 at every configuration (axes 3-6 are parallel)" in plan.refusal
+
+
+@pytest.mark.parametrize(
+    ("kinds", "convention", "backend"),
+    [
+        ("RRPRRR", "standard", "python"),
+        ("RRRPRR", "modified", "python"),
+        ("RRPRRR", "modified", "numba"),
+    ],
+)
+def test_a_prismatic_joint_3_or_4_is_the_eigen_joint(kinds, convention, backend, tmp_path):
+    """Joint 3 prismatic (or joint 4: the reversed chain's joint 3): d3 is the eigen-variable
+    (no half-angle); every solution sound, every sample's q found (Python and compiled)."""
+    text = slider_text(kinds, convention)
+    plan = build_plan(parse_spec(text, "<test>"))
+    assert plan.ik is not None and plan.ik.method == "general", plan.refusal
+    step = plan.ik.steps[-1]
+    assert all(split.slide[0] == 1.0 for split in step.splits)
+    assert "d" + str(kinds.index("P") + 1) in step.variables
+    m = build_module(text, tmp_path)
+    Q = sample_joints(m, 60 if backend == "python" else 30, np.random.default_rng(3))
+    result = roundtrip(m, Q, backend)
+    assert result.unsound == [] and result.misses == [], result.summary()
+    assert result.singular < result.samples
+
+
+def test_a_prismatic_joint_elsewhere_is_refused_with_the_reason():
+    plan = build_plan(parse_spec(slider_text("RPRRRR", "standard"), "<test>"))
+    assert plan.ik is None
+    assert "one prismatic joint at most, as joint 3 or 4" in plan.refusal
+    assert "prismatic joints: 2" in plan.refusal

@@ -49,26 +49,35 @@ Row = tuple[float, float, float, float]
 
 
 def derive(chain: Chain, structure: Structure) -> IkPlan | str:
-    """The general method's plan, or why it does not apply (not 6 revolute joints)."""
+    """The general method's plan, or why it does not apply (not 6 joints; a prismatic joint
+    other than one joint 3 or 4, which a split's eigen-joint (its joint 3) must be)."""
     if chain.dof != 6:
         return f"general: needs 6 joints, the arm has {chain.dof}"
-    if any(j.kind != "R" for j in chain.joints):
-        return "general: revolute joints only (prismatic joints are not supported by it yet)"
+    sliding = [j.index for j in chain.joints if j.kind == "P"]
+    if len(sliding) > 1 or (sliding and sliding[0] not in (3, 4)):
+        where = ", ".join(map(str, sliding))
+        return (
+            "general: takes one prismatic joint at most, as joint 3 or 4 (the eigen-joint of the "
+            f"arm's chain or of its reversal); the arm's prismatic joints: {where}"
+        )
     length = max(
-        [abs(float(t.a)) for t in chain.twists[1:6]] + [abs(float(j.d)) for j in chain.joints[1:5]]
+        [abs(float(t.a)) for t in chain.twists[1:6]]
+        + [abs(float(j.d if j.kind == "R" else j.offset)) for j in chain.joints[1:5]]
     )
     if length == 0.0:
         return "general: every link length and offset is zero (the arm is a point)"
-    if everywhere_singular(flange_rows(chain, length)):
+    if everywhere_singular(flange_rows(chain, length), slide_of(chain)):
         return (
             "general: the arm's Jacobian has rank below 6 at every configuration"
             f"{parallel_run(structure)}: it reaches a set of poses of dimension below 6, each "
             "along a curve of solutions; no solver is generated"
         )
     chains = (chain, reverse_chain(chain))
-    splits = [measure(c, reversed_, length, False) for reversed_, c in enumerate(chains)]
-    if max(s.recovered for s in splits) < POSES:
-        splits += [measure(c, reversed_, length, True) for reversed_, c in enumerate(chains)]
+    # the chains whose joint 3 is the sliding joint, if there is one
+    usable = [k for k in (0, 1) if not sliding or chains[k].joints[2].kind == "P"]
+    splits = [measure(chains[k], k, length, False) for k in usable]
+    if max(s.recovered for s in splits) < POSES or len(splits) < 2:
+        splits += [measure(chains[k], k, length, True) for k in usable]
     splits.sort(key=lambda s: (-s.recovered, s.singular, round(math.log10(s.cond), 1)))
     chosen = tuple(splits[:2])
     steps: list[Assign | Eigen] = []
@@ -83,11 +92,12 @@ def derive(chain: Chain, structure: Structure) -> IkPlan | str:
         Eigen(
             joint=3,
             args=tuple(args),
-            note=f"general 6R: Raghavan-Roth equations of {first.name}, theta3 from a 24 x 24 "
-            "eigenproblem, the rest by back-substitution",
+            note=f"general 6-joint: Raghavan-Roth equations of {first.name}, its joint 3 from a "
+            "24 x 24 eigenproblem, the rest by back-substitution",
             fanout=16,
             unit=length,
             splits=chosen,
+            kinds="".join(j.kind for j in chain.joints),
         )
     )
     return IkPlan(
@@ -99,19 +109,31 @@ def derive(chain: Chain, structure: Structure) -> IkPlan | str:
     )
 
 
-def everywhere_singular(rows: tuple[Row, ...]) -> bool:
+def slide_of(chain: Chain) -> tuple[float, float]:
+    """(1.0, theta3) where the chain's joint 3 slides (theta3 its fixed angle), else
+    runtime._RR_TURNS."""
+    joint = chain.joints[2]
+    return (1.0, float(joint.theta)) if joint.kind == "P" else runtime._RR_TURNS
+
+
+def everywhere_singular(rows: tuple[Row, ...], slide: tuple[float, float]) -> bool:
     """Whether the Jacobian of the chain (flange rows) is singular at 8 random configurations:
     smallest singular value below SINGULAR_EVERYWHERE of the largest at each (a regular arm's
     is ~1e-2 at random configurations; a degenerate one's is rounding)."""
     rng = np.random.default_rng(5)
     for _ in range(8):
         frames = [np.eye(4)]
-        for t, row in zip(rng.uniform(-math.pi, math.pi, 6), rows):
-            frames.append(frames[-1] @ runtime._rr_link(t, row))
+        for i, t in enumerate(rng.uniform(-math.pi, math.pi, 6)):
+            frames.append(frames[-1] @ runtime._rr_joint(i, t, rows, slide))
         end = frames[6][:3, 3]
         z = [f[:3, 2] for f in frames[:6]]
         J = np.array(
-            [np.concatenate((np.cross(z[i], end - frames[i][:3, 3]), z[i])) for i in range(6)]
+            [
+                np.concatenate((z[i], np.zeros(3)))
+                if i == 2 and slide[0]
+                else np.concatenate((np.cross(z[i], end - frames[i][:3, 3]), z[i]))
+                for i in range(6)
+            ]
         )
         S = np.linalg.svd(J, compute_uv=False)
         if S[-1] > SINGULAR_EVERYWHERE * S[0]:
@@ -144,7 +166,9 @@ def flange_rows(chain: Chain, length: float) -> tuple[Row, ...]:
     rows: list[Row] = []
     for i in range(1, 7):
         twist = chain.twists[i]
-        d = 0.0 if i in (1, 6) else float(chain.joints[i - 1].d) / length
+        joint = chain.joints[i - 1]
+        # (a sliding joint's d is its variable: the row's is not read)
+        d = 0.0 if i in (1, 6) or joint.kind == "P" else float(joint.d) / length
         if i == 6:
             rows.append((0.0, 0.0, 1.0, 0.0))
         else:
@@ -169,8 +193,14 @@ def perturbed(rows: tuple[Row, ...]) -> tuple[Row, ...]:
     return (*out, rows[5])
 
 
-def fill_expressions(rows: tuple[Row, ...], exact: dict[sp.Symbol, sp.Expr]) -> tuple[sp.Expr, ...]:
-    """The 490 entries of P0, Ps, Pc, Q for these rows (exact numbers where given)."""
+def fill_expressions(
+    rows: tuple[Row, ...], exact: dict[sp.Symbol, sp.Expr], slide: tuple[float, float]
+) -> tuple[sp.Expr, ...]:
+    """The 490 entries of P0, Ps, Pc, Q for these rows (exact numbers where given). Where joint
+    3 slides, P(d3) = P0 + Ps s3 + Pc c3 at its fixed theta3 is B0 + B1 d3 + B2 d3^2 (degree 2:
+    d3 enters p linearly), and the entries are those of P0' = (B0 + B2) / 2, Ps' = B1 / 2,
+    Pc' = (B0 - B2) / 2: the run time's pencil in x3, (P0' - Pc') x3^2 + 2 Ps' x3 + P0' + Pc',
+    is then B(x3) with x3 = d3."""
     f = rr.fundamental()
     subs: dict[sp.Symbol, sp.Expr] = {}
     for i, (d, a, ca, sa) in enumerate(rows[:5]):
@@ -179,10 +209,31 @@ def fill_expressions(rows: tuple[Row, ...], exact: dict[sp.Symbol, sp.Expr]) -> 
         subs[rr.lam[i]] = sp.Float(ca, 17)
         subs[rr.mu[i]] = sp.Float(sa, 17)
     subs.update(exact)
-    out = []
-    for m in (f.P0, f.Ps, f.Pc, f.Q):
-        out += [sp.expand(e.xreplace(subs)) for e in m]
-    return tuple(out)
+    if not slide[0]:
+        out = []
+        for m in (f.P0, f.Ps, f.Pc, f.Q):
+            out += [sp.expand(e.xreplace(subs)) for e in m]
+        return tuple(out)
+    d3 = rr.d[2]
+    del subs[d3]
+    c3, s3 = exact_cos_sin(slide[1])
+    B = [sp.expand((p0 + ps * s3 + pc * c3).xreplace(subs)) for p0, ps, pc in zip(f.P0, f.Ps, f.Pc)]
+    terms = [[b.coeff(d3, k) for b in B] for k in range(3)]
+    half = sp.Rational(1, 2)
+    P0 = [sp.expand(half * (b0 + b2)) for b0, b2 in zip(terms[0], terms[2])]
+    Ps = [sp.expand(half * b1) for b1 in terms[1]]
+    Pc = [sp.expand(half * (b0 - b2)) for b0, b2 in zip(terms[0], terms[2])]
+    Q = [sp.expand(e.xreplace(subs)) for e in f.Q]
+    return (*P0, *Ps, *Pc, *Q)
+
+
+def exact_cos_sin(angle: float) -> tuple[sp.Expr, sp.Expr]:
+    """cos and sin of a fixed angle: exact integers at multiples of 90 deg, else floats."""
+    quarter = angle / (math.pi / 2)
+    if abs(quarter - round(quarter)) < 1e-12:
+        k = round(quarter) % 4
+        return sp.Integer((1, 0, -1, 0)[k]), sp.Integer((0, 1, 0, -1)[k])
+    return sp.Float(math.cos(angle), 17), sp.Float(math.sin(angle), 17)
 
 
 def exact_numbers(chain: Chain) -> dict[sp.Symbol, sp.Expr]:
@@ -195,7 +246,7 @@ def exact_numbers(chain: Chain) -> dict[sp.Symbol, sp.Expr]:
             subs[rr.mu[i - 1]] = t.sa
         if t.a == 0:
             subs[rr.a[i - 1]] = sp.Integer(0)
-        if i > 1 and chain.joints[i - 1].d == 0:
+        if i > 1 and chain.joints[i - 1].kind == "R" and chain.joints[i - 1].d == 0:
             subs[rr.d[i - 1]] = sp.Integer(0)
     return subs
 
@@ -204,8 +255,9 @@ def measure(chain: Chain, reversed_: int, length: float, perturb: bool) -> Split
     """A split of the chain, measured on POSES random poses (fixed seed)."""
     true_rows = flange_rows(chain, length)
     fill_rows = perturbed(true_rows) if perturb else true_rows
-    fill = fill_expressions(fill_rows, {} if perturb else exact_numbers(chain))
-    recovered, conds = score(fill_rows, true_rows)
+    slide = slide_of(chain)
+    fill = fill_expressions(fill_rows, {} if perturb else exact_numbers(chain), slide)
+    recovered, conds = score(fill_rows, true_rows, slide)
     return Split(
         reversed=bool(reversed_),
         fill=fill,
@@ -215,13 +267,16 @@ def measure(chain: Chain, reversed_: int, length: float, perturb: bool) -> Split
         poses=POSES,
         cond=float(np.median(conds)),
         singular=perturb,
+        slide=slide,
     )
 
 
-def score(fill_rows: tuple[Row, ...], true_rows: tuple[Row, ...]) -> tuple[int, list[float]]:
-    """Of POSES random poses (a fifth of the joints at 0, +-90 or 180 deg), how many have their
-    generating joint values among the split's polished candidates; and the condition numbers
-    of the pencil's leading matrix."""
+def score(
+    fill_rows: tuple[Row, ...], true_rows: tuple[Row, ...], slide: tuple[float, float]
+) -> tuple[int, list[float]]:
+    """Of POSES random poses (a fifth of the joints at 0, +-90 or 180 deg; a sliding joint 3
+    within +-1 arm size), how many have their generating joint values among the split's
+    polished candidates; and the condition numbers of the pencil's leading matrix."""
     rng = np.random.default_rng(20261201)
     recovered = 0
     conds = []
@@ -229,14 +284,17 @@ def score(fill_rows: tuple[Row, ...], true_rows: tuple[Row, ...]) -> tuple[int, 
         q = rng.uniform(-math.pi, math.pi, 6)
         special = rng.random(6) < 0.2
         q[special] = rng.choice([0.0, math.pi / 2, -math.pi / 2, math.pi], special.sum())
+        if slide[0]:
+            q[2] /= math.pi
         F = np.eye(4)
-        for t, row in zip(q, true_rows):
-            F = F @ runtime._rr_link(t, row)
-        P0, Ps, Pc, Q = matrices_at(fill_rows, F)
-        candidates, _ = runtime._rr_candidates(P0, Ps, Pc, Q, F, fill_rows)
+        for i, t in enumerate(q):
+            F = F @ runtime._rr_joint(i, t, true_rows, slide)
+        P0, Ps, Pc, Q = matrices_at(fill_rows, F, slide)
+        candidates, _ = runtime._rr_candidates(P0, Ps, Pc, Q, F, fill_rows, slide)
         conds.append(leading_condition(P0, Ps, Pc, Q))
         for c in candidates:
-            p, error = runtime._rr_newton(true_rows, F, c)
+            # (Newton's steps only, as the splits were always measured)
+            p, error = runtime._rr_steps(true_rows, F, c, slide, False)
             gap = np.abs((p - q + math.pi) % (2 * math.pi) - math.pi)
             if error <= runtime._RR_GOOD and gap.max() <= 1e-6:
                 recovered += 1
@@ -259,13 +317,30 @@ def leading_condition(P0, Ps, Pc, Q) -> float:
     return float(min(np.linalg.cond(A), 1e20))
 
 
-def matrices_at(rows: tuple[Row, ...], F: np.ndarray) -> tuple[np.ndarray, ...]:
+def matrices_at(
+    rows: tuple[Row, ...], F: np.ndarray, slide: tuple[float, float] = runtime._RR_TURNS
+) -> tuple[np.ndarray, ...]:
     """P0, Ps, Pc, Q as numbers for the rows (d, a, cos alpha, sin alpha) and the flange
-    target F (position in the rows' units)."""
-    numbers = [r[1] for r in rows[:5]] + [r[0] for r in rows[:5]]
-    numbers += [r[2] for r in rows[:5]] + [r[3] for r in rows[:5]]
-    args = [*numbers, *F[:3, 2], *F[:3, 3]]
-    return tuple(np.array(fn(*args), dtype=float) for fn in numeric_matrices())
+    target F (position in the rows' units); where joint 3 slides, those of fill_expressions
+    (P at d3 = 0, 1, -1 gives B's three coefficients)."""
+
+    def at(d3: float | None) -> tuple[np.ndarray, ...]:
+        ds = [r[0] if i != 2 or d3 is None else d3 for i, r in enumerate(rows[:5])]
+        numbers = [r[1] for r in rows[:5]] + ds
+        numbers += [r[2] for r in rows[:5]] + [r[3] for r in rows[:5]]
+        args = [*numbers, *F[:3, 2], *F[:3, 3]]
+        return tuple(np.array(fn(*args), dtype=float) for fn in numeric_matrices())
+
+    if not slide[0]:
+        return at(None)
+    c3, s3 = math.cos(slide[1]), math.sin(slide[1])
+    B = []
+    for d3 in (0.0, 1.0, -1.0):
+        P0, Ps, Pc, Q = at(d3)
+        B.append(P0 + Ps * s3 + Pc * c3)
+    B1 = 0.5 * (B[1] - B[2])
+    B2 = 0.5 * (B[1] + B[2]) - B[0]
+    return 0.5 * (B[0] + B2), 0.5 * B1, 0.5 * (B[0] - B2), Q
 
 
 @cache

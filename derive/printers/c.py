@@ -327,13 +327,13 @@ def _eigen_lines(
         Line(depth, f"for (int dk_k{j} = 0; dk_k{j} < dk_n{j}; dk_k{j}++) {{"),
     ]
     scope.levels.append(set())
-    for place, k in enumerate(step.indices):
-        scope.declare(f"theta{k}")
-        lines.append(Line(depth + 1, f"const double theta{k} = dk_rows{j}[dk_k{j}][{place}];"))
+    for place, (k, variable) in enumerate(zip(step.indices, step.variables)):
+        scope.declare(variable)
+        lines.append(Line(depth + 1, f"const double {variable} = dk_rows{j}[dk_k{j}][{place}];"))
         for kind, function in (("c", "cos"), ("s", "sin")):
-            if f"{kind}{k}" in after:
+            if f"{kind}{k}" in after and variable.startswith("theta"):
                 scope.declare(f"{kind}{k}")
-                lines.append(Line(depth + 1, f"const double {kind}{k} = {function}(theta{k});"))
+                lines.append(Line(depth + 1, f"const double {kind}{k} = {function}({variable});"))
     return lines
 
 

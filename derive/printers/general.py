@@ -45,13 +45,15 @@ def general_code(plan: Plan) -> str:
 
     lines = [
         "# the general method's splits, best first: (reversed, the rows the matrices are filled",
-        "# from, the arm's rows); rows (d, a, cos alpha, sin alpha) of standard DH from the",
-        "# flange frame, lengths in units of _RR_LENGTH",
+        "# from, the arm's rows, (1.0, theta3) where joint 3 slides else (0.0, 0.0)); rows (d, a,",
+        "# cos alpha, sin alpha) of standard DH from the flange frame, lengths in units of",
+        "# _RR_LENGTH",
         "_RR_SPLITS = (",
     ]
     for split in step.splits:
         lines += ["    (", f"        {split.reversed},", *rows(split.fill_rows)]
-        lines += [*rows(split.true_rows), "    ),"]
+        slide = ", ".join(float_literal(v) for v in split.slide)
+        lines += [*rows(split.true_rows), f"        ({slide}),", "    ),"]
     lines += [")", f"_RR_LENGTH = {float_literal(step.unit)}", "", ""]
     args = ", ".join(str(s) for s in (*rr.L, *rr.P))
     lines += [

@@ -182,11 +182,11 @@ def _eigen(c: Context) -> Block:
         Line(0, f"_m{j} = n"),
         Line(0, f"for _k{j} in range(_n{j}):"),
     ]
-    for place, k in enumerate(step.indices):
-        lines.append(Line(1, f"theta{k} = buf[{at} + 6 * _k{j} + {place}]"))
+    for place, (k, variable) in enumerate(zip(step.indices, step.variables)):
+        lines.append(Line(1, f"{variable} = buf[{at} + 6 * _k{j} + {place}]"))
         for kind, function in (("c", "cos"), ("s", "sin")):
-            if f"{kind}{k}" in c.after:
-                lines.append(Line(1, f"{kind}{k} = {function}(theta{k})"))
+            if f"{kind}{k}" in c.after and variable.startswith("theta"):
+                lines.append(Line(1, f"{kind}{k} = {function}({variable})"))
     return Block(tuple(lines), loop=True, reads_cs=False, slots=6 * KGENERAL_ROWS)
 
 

@@ -106,10 +106,10 @@ def solve_lines(
         groups = [values[k : k + 12] for k in range(0, len(values), 12)]
         call = SOLVES[Eigen](step, ", ".join(f"({', '.join(g)})" for g in groups), "", "")
         lines.append(Line(depth, f"for {', '.join(step.variables)} in {call}:"))
-        for k in step.indices:
+        for k, variable in zip(step.indices, step.variables):
             for name, function in ((f"c{k}", "cos"), (f"s{k}", "sin")):
-                if name in after:
-                    lines.append(Line(depth + 1, f"{name} = {function}(theta{k})"))
+                if name in after and variable.startswith("theta"):
+                    lines.append(Line(depth + 1, f"{name} = {function}({variable})"))
         return lines
     call = SOLVES[type(step)](
         step, ", ".join(values), printer.doprint(step.ref), repr(1e-10 * step.scale)

@@ -41,8 +41,12 @@ def _missing(*args: Any) -> Any:
 _fk_from_cs = _fk_q = _cs_columns = _keep = _ik_scalar = _ik_candidates = _missing
 _ksolve = _kreference = _kfk_q = _rr_fill = _missing
 BASE = TOOL = np.eye(4)
-# the general method's splits: (reversed, rows the matrices were filled from, the arm's rows),
-# rows (d, a, cos alpha, sin alpha) of standard DH in units of _RR_LENGTH
-_RR_SPLITS: tuple[tuple[bool, tuple[tuple[float, ...], ...], tuple[tuple[float, ...], ...]], ...]
+# the general method's splits: (reversed, rows the matrices were filled from, the arm's rows,
+# (1.0, theta3) where joint 3 slides else (0.0, 0.0)), rows (d, a, cos alpha, sin alpha) of
+# standard DH in units of _RR_LENGTH
+_RR_SPLITS: tuple[
+    tuple[bool, tuple[tuple[float, ...], ...], tuple[tuple[float, ...], ...], tuple[float, float]],
+    ...,
+]
 _RR_SPLITS = ()
 _RR_LENGTH = 1.0

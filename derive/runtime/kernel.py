@@ -475,8 +475,13 @@ def _krr_split(k, F, moved, out, count):
     the pose `moved`) added to out[6 count:] where new, until out is full; (the new count,
     doubt)."""
     limit = out.size // 6
-    fill = np.array(_RR_SPLITS[k][1])
-    true = np.array(_RR_SPLITS[k][2])
+    # rows 0-5: the split's rows; row 6: its slide (1.0, theta3 where joint 3 slides)
+    fill = np.zeros((7, 4))
+    true = np.zeros((7, 4))
+    fill[:6] = np.array(_RR_SPLITS[k][1])
+    true[:6] = np.array(_RR_SPLITS[k][2])
+    fill[6, 0], fill[6, 1] = _RR_SPLITS[k][3]
+    true[6, 0], true[6, 1] = _RR_SPLITS[k][3]
     perturbed = False
     for i in range(6):
         for j in range(4):
@@ -492,13 +497,17 @@ def _krr_split(k, F, moved, out, count):
         q = cands[c].copy()
         if perturbed:
             for t in _RR_PATH:
-                q, _ = _krr_newton(_krr_between(fill, true, t), F, q)
-        q, error = _krr_newton(true, F, q)
+                q, _ = _krr_steps(_krr_between(fill, true, t), F, q, False)
+        q, error, damped = _krr_newton(true, F, q)
+        if damped and not perturbed:
+            doubt = True
         if error > _RR_GOOD:
             if not perturbed:
                 doubt = True
             continue
-        if _RR_SPLITS[k][0]:  # the reversed chain: joint j is -theta_{7-j}
+        if true[6, 0] != 0.0:  # a sliding joint 3, in the arm's lengths
+            q[2] *= _RR_LENGTH
+        if _RR_SPLITS[k][0]:  # the reversed chain: joint j is -q_{7-j}
             q = -q[::-1]
         seen = False
         for r in range(count):
@@ -576,16 +585,21 @@ def _krr_candidates(values, F, rows, out):
     wr, wi, ok = _keigenvalues(K)
     if not ok:
         return 0, True
+    ma, mb, mc, md = moebius
+    reach = abs(F[0, 3]) + abs(F[1, 3]) + abs(F[2, 3])  # (|d3| beyond: spurious, as in Python)
+    for i in range(6):
+        reach += abs(rows[i, 0]) + abs(rows[i, 1])
     reals = np.zeros(24)
     n_real = 0
     for i in range(24):
         if abs(wi[i]) <= _RR_IMAG_TOL * (1.0 + math.hypot(wr[i], wi[i])):
-            reals[n_real] = wr[i]
-            n_real += 1
+            y = wr[i]
+            if rows[6, 0] == 0.0 or abs(ma * y + mb) <= reach * abs(mc * y + md):
+                reals[n_real] = y
+                n_real += 1
     reals = np.sort(reals[:n_real])
     doubt = False
     count = 0
-    ma, mb, mc, md = moebius
     start = 0
     V = np.zeros((3, 12))
     while start < n_real:
@@ -597,7 +611,10 @@ def _krr_candidates(values, F, rows, out):
         y = reals[start:stop].mean()
         clustered = stop - start > 1
         start = stop
-        theta3 = 2.0 * math.atan2(ma * y + mb, mc * y + md)
+        if rows[6, 0] != 0.0:  # joint 3 slides: x3 is d3
+            theta3 = (ma * y + mb) / (mc * y + md)
+        else:
+            theta3 = 2.0 * math.atan2(ma * y + mb, mc * y + md)
         S = A * (y * y) + B * y + C
         nv, plane = _knull_right(S, V)
         if clustered or plane:
@@ -849,8 +866,12 @@ def _krr_ratio_angle(v, step):
 
 
 def _krr_link(t, rows, i, M):
-    """M := M A_i(t) (standard DH row i: d, a, cos alpha, sin alpha)."""
+    """M := M A_i(t) (standard DH row i: d, a, cos alpha, sin alpha; row 6: the slide, where
+    joint 3 (i = 2) is Rz(theta3) Tz(t) X3 with theta3 = rows[6, 1])."""
     d, a, ca, sa = rows[i, 0], rows[i, 1], rows[i, 2], rows[i, 3]
+    if i == 2 and rows[6, 0] != 0.0:
+        d = t
+        t = rows[6, 1]
     ct, st = cos(t), sin(t)
     for r in range(4):
         m0, m1, m2 = M[r, 0], M[r, 1], M[r, 2]
@@ -949,7 +970,8 @@ def _krr_theta6(rows, F, t1, t2, t3, t4, t5):
 
 def _krr_between(fill, true, t):
     """_rr_between in the kernel."""
-    out = np.zeros((6, 4))
+    out = np.zeros((7, 4))
+    out[6] = true[6]
     for i in range(6):
         out[i, 0] = true[i, 0] + t * (fill[i, 0] - true[i, 0])
         out[i, 1] = true[i, 1] + t * (fill[i, 1] - true[i, 1])
@@ -964,11 +986,15 @@ def _krr_between(fill, true, t):
 def _krr_newton(rows, F, q0):
     """_rr_newton in the kernel."""
     q, error = _krr_steps(rows, F, q0, False)
-    if error > _RR_GOOD:
-        damped, damped_error = _krr_steps(rows, F, q, True)
-        if damped_error < error:
-            return damped, damped_error
-    return q, error
+    if error <= _RR_GOOD:
+        return q, error, False
+    damped, damped_error = _krr_steps(rows, F, q, True)
+    if damped_error < error:
+        q, error = damped, damped_error
+        again, again_error = _krr_steps(rows, F, q, False)
+        if again_error < error:
+            q, error = again, again_error
+    return q, error, True
 
 
 def _krr_steps(rows, F, q0, damped):
@@ -1011,6 +1037,9 @@ def _krr_steps(rows, F, q0, damped):
             J[1, i] = z[2] * dx - z[0] * dz
             J[2, i] = z[0] * dy - z[1] * dx
             J[3, i], J[4, i], J[5, i] = z[0], z[1], z[2]
+            if i == 2 and rows[6, 0] != 0.0:  # a sliding joint 3
+                J[0, i], J[1, i], J[2, i] = z[0], z[1], z[2]
+                J[3, i], J[4, i], J[5, i] = 0.0, 0.0, 0.0
         if damped:  # Levenberg-Marquardt, mu = |error|^2
             mu = 0.0
             for r in range(6):
