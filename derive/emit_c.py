@@ -88,6 +88,7 @@ def general_constants(plan: Plan) -> dict[str, object]:
         "RANK_TOL": repr(constants._RR_RANK_TOL),
         "COND_LIMIT": repr(constants._RR_COND_LIMIT),
         "IMAG_TOL": repr(constants._RR_IMAG_TOL),
+        "IMAG_LOOSE": repr(constants._RR_IMAG_LOOSE),
         "CLUSTER_TOL": repr(constants._RR_CLUSTER_TOL),
         "NULL2_TOL": repr(constants._RR_NULL2_TOL),
         "GOOD": repr(constants._RR_GOOD),

@@ -161,6 +161,11 @@ _RR_MOEBIUS = ((1.0, 0.3, -0.4, 1.0), (1.0, -0.7, 0.5, 1.0), (0.6, 1.0, -1.0, 0.
 _RR_IMAG_TOL = 1e-6
 
 
+# where nothing certifies otherwise (the pose's pencil is singular: a curve of solutions), the
+# eigenvalues with |Im| <= _RR_IMAG_LOOSE (1 + |y|) are tried too
+_RR_IMAG_LOOSE = 1e-3
+
+
 _RR_CLUSTER_TOL = 1e-6
 
 
@@ -817,6 +822,15 @@ def _general(flanges, tol):
                 candidates, close, _ = _rr_split(k, F, F @ motion)
                 _rr_merge(found, [_rr_to_arm(k, q) for q in candidates])
                 _rr_merge(near, [_rr_to_arm(k, q) for q in close])
+    for motion in (np.eye(4), *_RR_MOTIONS):
+        if found:
+            break
+        # the last resort: a pose whose pencil is singular (a curve of solutions) scatters
+        # the eigenvalues off the real line; those within _RR_IMAG_LOOSE of it, polished
+        for k, F in enumerate(targets):
+            candidates, close, _ = _rr_split(k, F, F @ motion, _RR_IMAG_LOOSE)
+            _rr_merge(found, [_rr_to_arm(k, q) for q in candidates])
+            _rr_merge(near, [_rr_to_arm(k, q) for q in close])
     if not found:
         # a singular pose, where Newton converges slowly: what came within _RR_NEAR (the
         # caller's certification decides)
@@ -868,10 +882,10 @@ def _rr_merge(found, candidates):
             found.append(q)
 
 
-def _rr_split(k, F, moved):
+def _rr_split(k, F, moved, imag_tol=_RR_IMAG_TOL):
     """The polished candidates of split k for the target F, found from the pose `moved` (F
-    itself, or F slightly moved in a rescue); those that came within _RR_NEAR only; and
-    whether the answer is in doubt."""
+    itself, or F slightly moved in a rescue; eigenvalues real within imag_tol); those that came
+    within _RR_NEAR only; and whether the answer is in doubt."""
     _, fill_rows, true_rows, slide = _RR_SPLITS[k]
     values = np.zeros(490)
     _rr_fill(k, *moved[:3, 2], *moved[:3, 3], values)
@@ -879,7 +893,7 @@ def _rr_split(k, F, moved):
     Ps = values[126:252].reshape(14, 9)
     Pc = values[252:378].reshape(14, 9)
     Q = values[378:].reshape(14, 8)
-    candidates, doubt = _rr_candidates(P0, Ps, Pc, Q, moved, fill_rows, slide)
+    candidates, doubt = _rr_candidates(P0, Ps, Pc, Q, moved, fill_rows, slide, imag_tol)
     # a perturbed table's solutions are walked back to the arm's in steps (a continuation),
     # so that Newton does not jump to another branch
     path = (
@@ -914,7 +928,7 @@ def _rr_between(fill_rows, true_rows, t):
     return out
 
 
-def _rr_candidates(P0, Ps, Pc, Q, F, rows, slide=_RR_TURNS):
+def _rr_candidates(P0, Ps, Pc, Q, F, rows, slide=_RR_TURNS, imag_tol=_RR_IMAG_TOL):
     """The unpolished joint values of one split from its matrices (ALGORITHMS.md 4.4-4.7),
     and whether the eigenvalues came in clusters (an answer in doubt). Where joint 3 slides
     (slide[0] set) the eigen-variable x3 is d3 itself, not tan(theta3 / 2)."""
@@ -922,7 +936,7 @@ def _rr_candidates(P0, Ps, Pc, Q, F, rows, slide=_RR_TURNS):
     if found is None:
         return [], True
     values, (A, B, C), moebius = found
-    real = np.sort(values[np.abs(values.imag) <= _RR_IMAG_TOL * (1.0 + np.abs(values))].real)
+    real = np.sort(values[np.abs(values.imag) <= imag_tol * (1.0 + np.abs(values))].real)
     ma, mb, mc, md = moebius
     if slide[0]:
         # a sliding joint 3 moves the flange by d3 along its axis, the other links by at most

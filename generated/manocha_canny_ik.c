@@ -86,6 +86,7 @@ static int dk_pose_ok(const double T[16])
 #define DK_RR_RANK_TOL (1e-10)
 #define DK_RR_COND_LIMIT (100000000.0)
 #define DK_RR_IMAG_TOL (1e-06)
+#define DK_RR_IMAG_LOOSE (0.001)
 #define DK_RR_CLUSTER_TOL (1e-06)
 #define DK_RR_NULL2_TOL (1e-05)
 #define DK_RR_GOOD (1e-10)
@@ -1484,7 +1485,8 @@ static void dk_sort_doubles(double *x, int n)
 /* the candidate joint vectors of one split: their count written to out; *doubt: whether
    the answer is in doubt (clusters, or no usable pencil) */
 static int dk_rr_candidates(const double values[490], const double F[4][4],
-                            const double rows[7][4], double out[4 * DK_RR_MAX][6], int *doubt)
+                            const double rows[7][4], double out[4 * DK_RR_MAX][6], int *doubt,
+                            double imag_tol)
 {
     double N[14][14], A6[6][9], B6[6][9], C6[6][9], pencil[3][12][12], best_pencil[3][12][12];
     double K[24][24], rhs[12][24], wr[24], wi[24], reals[24], V[3][12], best = HUGE_VAL;
@@ -1574,7 +1576,7 @@ static int dk_rr_candidates(const double values[490], const double F[4][4],
     }
     for (i = 0; i < 24; i++) {
         const double y = wr[i];
-        if (fabs(wi[i]) <= DK_RR_IMAG_TOL * (1.0 + hypot(wr[i], wi[i])) &&
+        if (fabs(wi[i]) <= imag_tol * (1.0 + hypot(wr[i], wi[i])) &&
             (rows[6][0] == 0.0 ||
              fabs(moebius[0] * y + moebius[1]) <= reach * fabs(moebius[2] * y + moebius[3]))) {
             reals[n_real++] = y; /* (a sliding joint 3's roots beyond reach left out) */
@@ -1639,7 +1641,7 @@ static int dk_rr_candidates(const double values[490], const double F[4][4],
 /* split k's polished candidates for the target F (found from the pose `moved`) added to
    out[count..] where new, until DK_RR_ROWS; the new count; *doubt as dk_rr_candidates' */
 static int dk_rr_split(int k, const double F[4][4], const double moved[4][4],
-                       double out[DK_RR_ROWS][6], int count, int *doubt)
+                       double out[DK_RR_ROWS][6], int count, int *doubt, double imag_tol)
 {
     double values[490], cands[4 * DK_RR_MAX][6], between[7][4];
     int perturbed = 0, damped = 0, n, c, i, j, r;
@@ -1655,7 +1657,7 @@ static int dk_rr_split(int k, const double F[4][4], const double moved[4][4],
     }
     dk_rr_fill(k, moved[0][2], moved[1][2], moved[2][2], moved[0][3], moved[1][3], moved[2][3],
                values);
-    n = dk_rr_candidates(values, moved, DK_RR_FILL[k], cands, doubt);
+    n = dk_rr_candidates(values, moved, DK_RR_FILL[k], cands, doubt, imag_tol);
     for (c = 0; c < n; c++) {
         double q[6], error, arm[6];
         int seen = 0;
@@ -1722,7 +1724,7 @@ static int dk_general(const double flanges[DK_RR_SPLIT_COUNT][12], double out[DK
         }
     }
     for (k = 0; k < DK_RR_SPLIT_COUNT; k++) {
-        count = dk_rr_split(k, targets[k], targets[k], out, count, &doubt);
+        count = dk_rr_split(k, targets[k], targets[k], out, count, &doubt, DK_RR_IMAG_TOL);
         if (count == DK_RR_ROWS) {
             return count;
         }
@@ -1743,10 +1745,31 @@ static int dk_general(const double flanges[DK_RR_SPLIT_COUNT][12], double out[DK
                         moved[r][c] = total;
                     }
                 }
-                count = dk_rr_split(k, targets[k], moved, out, count, &ignored);
+                count = dk_rr_split(k, targets[k], moved, out, count, &ignored, DK_RR_IMAG_TOL);
                 if (count == DK_RR_ROWS) {
                     return count;
                 }
+            }
+        }
+    }
+    /* the last resort: a pose whose pencil is singular (a curve of solutions) scatters the
+       eigenvalues off the real line; those within DK_RR_IMAG_LOOSE of it, polished */
+    for (m = -1; m < 2 && count == 0; m++) {
+        for (k = 0; k < DK_RR_SPLIT_COUNT; k++) {
+            int ignored;
+            for (r = 0; r < 4; r++) {
+                for (c = 0; c < 4; c++) {
+                    double total = 0.0;
+                    for (i = 0; i < 4; i++) { /* m = -1: the pose itself */
+                        const double w = m < 0 ? (i == c ? 1.0 : 0.0) : DK_RR_MOTIONS[m][i][c];
+                        total += targets[k][r][i] * w;
+                    }
+                    moved[r][c] = total;
+                }
+            }
+            count = dk_rr_split(k, targets[k], moved, out, count, &ignored, DK_RR_IMAG_LOOSE);
+            if (count == DK_RR_ROWS) {
+                return count;
             }
         }
     }

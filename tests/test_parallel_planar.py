@@ -186,8 +186,8 @@ def test_scara_rrpr_round_trips(tmp_path):
 
 
 def test_arm_no_method_covers_gets_a_one_line_reason():
-    """A 6-joint arm with a prismatic joint and no special structure: no method covers it
-    (the general method takes revolute joints only)."""
+    """A 6-joint arm with a prismatic joint 2 and no special structure: no method covers it
+    (the general method takes one prismatic joint, as joint 3 or 4)."""
     rows = [
         (90.0, 0.3, 0.1, 0.0),
         (1.0, 1.0, 0.0, 0.0),
@@ -196,10 +196,10 @@ def test_arm_no_method_covers_gets_a_one_line_reason():
         (90.0, 0.0, 0.0, 0.0),
         (1.0, 0.0, 0.0, 0.0),
     ]
-    plan = build_plan(parse_spec(spec_text("general6r", "standard", rows, kinds="RRRPRR")))
+    plan = build_plan(parse_spec(spec_text("general6r", "standard", rows, kinds="RPRRRR")))
     assert plan.ik is None
     assert "Pieper: neither axes 4, 5, 6 nor axes 1, 2, 3 meet in a point" in plan.refusal
-    assert "general: revolute joints only" in plan.refusal
+    assert "general: takes one prismatic joint at most, as joint 3 or 4" in plan.refusal
     assert "\n" not in plan.refusal
 
 

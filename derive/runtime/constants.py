@@ -57,6 +57,9 @@ _RR_RANK_TOL = 1e-10
 _RR_COND_LIMIT = 1e8
 _RR_MOEBIUS = ((1.0, 0.3, -0.4, 1.0), (1.0, -0.7, 0.5, 1.0), (0.6, 1.0, -1.0, 0.8))
 _RR_IMAG_TOL = 1e-6
+# where nothing certifies otherwise (the pose's pencil is singular: a curve of solutions), the
+# eigenvalues with |Im| <= _RR_IMAG_LOOSE (1 + |y|) are tried too
+_RR_IMAG_LOOSE = 1e-3
 _RR_CLUSTER_TOL = 1e-6
 _RR_NULL2_TOL = 1e-5
 _RR_GOOD = 1e-10
