@@ -4,6 +4,7 @@ same plan gives the same bytes."""
 
 from __future__ import annotations
 
+import functools
 import math
 from collections.abc import Iterable
 from dataclasses import dataclass
@@ -67,6 +68,11 @@ class RuntimeConstants:
     FREE_STEPS: str
     ANGLE_AT: str
     TAN_AT: str
+    UNIT_ANGLE: str
+    UNIT_ANGLE_COUNT: int
+    UNIT_ANGLE_TERMS: int
+    UNIT_ANGLE_SEGMENTS: int
+    UNIT_ANGLE_TOP: str
 
 
 def general_constants(plan: Plan) -> dict[str, object]:
@@ -111,6 +117,36 @@ def general_constants(plan: Plan) -> dict[str, object]:
     }
 
 
+# dk_uangle's table (templates/runtime.c.j2): the Taylor coefficients of asin at
+# UNIT_ANGLE_SEGMENTS + 1 points evenly spaced over [0, UNIT_ANGLE_TOP], to degree
+# UNIT_ANGLE_DEGREE. An offset of at most half a spacing (0.0056) from a point at most 0.72,
+# 0.28 from asin's singularity at 1, leaves terms beyond the degree below 0.02^11 < 3e-19
+UNIT_ANGLE_SEGMENTS = 64
+UNIT_ANGLE_TOP = 0.72
+UNIT_ANGLE_DEGREE = 10  # dk_uangle's Estrin scheme is written out for degree 10
+
+
+@functools.cache
+def unit_angle_table() -> list[list[float]]:
+    """asin's Taylor coefficients at the points k * top / segments, from its derivative
+    g = (1 - x^2)^(-1/2) and the recurrence (1 - x^2) g^(n+1) = (2n + 1) x g^(n) + n^2 g^(n-1)
+    (differentiating (1 - x^2) g' = x g n times), in 50-digit arithmetic, then rounded once."""
+    import mpmath
+
+    with mpmath.workdps(50):
+        rows = []
+        for k in range(UNIT_ANGLE_SEGMENTS + 1):
+            x = mpmath.mpf(k * (UNIT_ANGLE_TOP / UNIT_ANGLE_SEGMENTS))  # the C code's point
+            g = [1 / mpmath.sqrt(1 - x * x)]
+            for n in range(UNIT_ANGLE_DEGREE - 1):
+                before = g[n - 1] if n else mpmath.mpf(0)
+                g.append(((2 * n + 1) * x * g[n] + n * n * before) / (1 - x * x))
+            degrees = range(1, UNIT_ANGLE_DEGREE + 1)
+            terms = [mpmath.asin(x)] + [g[i - 1] / mpmath.factorial(i) for i in degrees]
+            rows.append([float(t) for t in terms])
+    return rows
+
+
 def runtime_constants() -> RuntimeConstants:
     steps = [repr(s) for s in constants._FREE_STEPS]
     rows = [", ".join(steps[k : k + 4]) for k in range(0, len(steps), 4)]
@@ -133,6 +169,11 @@ def runtime_constants() -> RuntimeConstants:
         FREE_STEPS=",\n".join(f"    {row}" for row in rows),
         ANGLE_AT=_c_array(closed._ANGLE_AT),
         TAN_AT=_c_array(closed._TAN_AT),
+        UNIT_ANGLE=",\n".join(f"    {_c_array(row)}" for row in unit_angle_table()),
+        UNIT_ANGLE_COUNT=UNIT_ANGLE_SEGMENTS + 1,
+        UNIT_ANGLE_TERMS=UNIT_ANGLE_DEGREE + 1,
+        UNIT_ANGLE_SEGMENTS=UNIT_ANGLE_SEGMENTS,
+        UNIT_ANGLE_TOP=repr(UNIT_ANGLE_TOP),
     )
 
 

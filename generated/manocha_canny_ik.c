@@ -53,24 +53,23 @@ static int dk_match(const double e[12], const double t[12], double tol, double p
 /* whether T (16 entries, row-major) is a finite rigid transform within DK_POSE_TOL */
 static int dk_pose_ok(const double T[16])
 {
-    double worst, det;
-    int r, s;
+    double det;
+    int ok = 1, r, s;
     for (r = 0; r < 16; r++) {
-        if (!isfinite(T[r])) {
-            return 0;
-        }
+        ok &= isfinite(T[r]) != 0;
     }
-    worst = fmax(fmax(fabs(T[12]), fabs(T[13])), fmax(fabs(T[14]), fabs(T[15] - 1.0)));
+    ok &= (fabs(T[12]) <= DK_POSE_TOL) & (fabs(T[13]) <= DK_POSE_TOL) &
+          (fabs(T[14]) <= DK_POSE_TOL) & (fabs(T[15] - 1.0) <= DK_POSE_TOL);
     for (r = 0; r < 3; r++) {
         for (s = r; s < 3; s++) {
             double dot = T[4 * r] * T[4 * s] + T[4 * r + 1] * T[4 * s + 1] +
                          T[4 * r + 2] * T[4 * s + 2];
-            worst = fmax(worst, r == s ? fabs(dot - 1.0) : fabs(dot));
+            ok &= fabs(r == s ? dot - 1.0 : dot) <= DK_POSE_TOL;
         }
     }
     det = T[0] * (T[5] * T[10] - T[6] * T[9]) - T[1] * (T[4] * T[10] - T[6] * T[8]) +
           T[2] * (T[4] * T[9] - T[5] * T[8]);
-    return worst <= DK_POSE_TOL && det > 0.0;
+    return ok && det > 0.0;
 }
 
 /* --- the general 6R method (Raghavan-Roth, Manocha-Canny): templates/general.c.j2 ---------
@@ -1998,20 +1997,13 @@ static int dk_finish(double found[DK_MAX][DK_DOF], int count, double rows[DK_MAX
             }
         }
         for (p = 0; p < m && distinct; p++) {
-            int same = 1;
+            double worst = 0.0; /* the largest difference, without a branch per joint */
             for (j = 0; j < DK_DOF; j++) {
-                double d = fabs(q[j] - rows[p][j]);
-                if (DK_REVOLUTE[j] && d > DK_PI) {
-                    d = DK_TWO_PI - d;
-                }
-                if (d > DK_DEDUP_TOL) {
-                    same = 0;
-                    break;
-                }
+                double d = fabs(q[j] - rows[p][j]), around = DK_TWO_PI - d;
+                d = DK_REVOLUTE[j] && around < d ? around : d;
+                worst = d > worst ? d : worst;
             }
-            if (same) {
-                distinct = 0;
-            }
+            distinct = worst > DK_DEDUP_TOL;
         }
         if (distinct) {
             for (j = 0; j < DK_DOF; j++) {

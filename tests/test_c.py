@@ -309,6 +309,55 @@ def test_within_limits_and_nearest_match_python(generated, tmp_path):
         assert np.abs(best - q).max() <= 1e-6
 
 
+UANGLE_PROBE = r"""
+#include "puma560_ik.c"
+#include <stdio.h>
+/* the largest |dk_uangle(sin t, cos t) - atan2(sin t, cos t)| (wrapped) over the angles on
+   stdin, and the values at the ends of the range */
+int main(void)
+{
+    double t, worst = 0.0;
+    while (scanf("%lf", &t) == 1) {
+        double c = cos(t), s = sin(t), e = fabs(dk_uangle(s, c) - atan2(s, c));
+        e = e > DK_PI ? fabs(e - DK_TWO_PI) : e;
+        worst = e > worst ? e : worst;
+    }
+    printf("%.17g %.17g %.17g %.17g\n", worst, dk_uangle(0.0, -1.0), dk_uangle(-0.0, -1.0),
+           dk_uangle(-0.0, 1.0));
+    return 0;
+}
+"""
+
+
+def test_unit_angle_is_atan2_to_the_last_places(tmp_path):
+    """dk_uangle (the division-free angle of a unit vector, from asin's Taylor table) is within
+    two units in the last place of pi of the library's atan2: at random angles, at the octant
+    and segment boundaries and their neighbours, and at +-pi, +-0."""
+    shutil.copy(GENERATED / "puma560_ik.c", tmp_path)
+    shutil.copy(GENERATED / "puma560_ik.h", tmp_path)
+    (tmp_path / "probe.c").write_text(UANGLE_PROBE)
+    exe = tmp_path / "probe"
+    flags = ["-std=c99", "-O2", "-Wno-unused-function"]
+    subprocess.run(
+        [cbuild.c_compiler(), *flags, str(tmp_path / "probe.c"), "-o", str(exe), "-lm"],
+        check=True,
+        cwd=tmp_path,
+    )
+    rng = np.random.default_rng(11)
+    ends = np.arcsin(np.arange(65) * (0.72 / 64)) + 0.0  # the table's points
+    edges = np.concatenate(
+        [k * np.pi / 4 + ends for k in range(-4, 4)] + [np.arange(-8, 9) * np.pi / 4]
+    )
+    edges = np.concatenate([edges + d for d in (-1e-9, -1e-15, 0.0, 1e-15, 1e-9)])
+    angles = np.concatenate([rng.uniform(-np.pi, np.pi, 200_000), edges, [np.pi, -np.pi, 0.0]])
+    text = "\n".join(repr(float(a)) for a in angles)
+    out = subprocess.run([str(exe)], input=text, capture_output=True, text=True, check=True)
+    worst, back, back_below, zero = (float(v) for v in out.stdout.split())
+    assert worst <= 2 * np.spacing(np.pi), worst
+    assert (back, back_below, zero) == (np.pi, -np.pi, 0.0)
+    assert np.copysign(1.0, zero) < 0  # -0.0 keeps its sign, as atan2's
+
+
 def test_the_readme_cmake_recipe_builds_a_program_that_solves(tmp_path):
     """README's CMake lines, around a small controller program, configure, build and solve."""
     cmake = shutil.which("cmake")
