@@ -292,13 +292,11 @@ def score(
         P0, Ps, Pc, Q = matrices_at(fill_rows, F, slide)
         candidates, _ = runtime._rr_candidates(P0, Ps, Pc, Q, F, fill_rows, slide)
         conds.append(leading_condition(P0, Ps, Pc, Q))
-        for c in candidates:
+        if candidates:
             # (Newton's steps only, as the splits were always measured)
-            p, error = runtime._rr_steps(true_rows, F, c, slide, False)
-            gap = np.abs((p - q + math.pi) % (2 * math.pi) - math.pi)
-            if error <= runtime._RR_GOOD and gap.max() <= 1e-6:
-                recovered += 1
-                break
+            P, errors = runtime._rr_steps_many(true_rows, F, np.array(candidates), slide, False)
+            gaps = np.abs((P - q + math.pi) % (2 * math.pi) - math.pi).max(axis=1)
+            recovered += bool(((errors <= runtime._RR_GOOD) & (gaps <= 1e-6)).any())
     return recovered, conds
 
 

@@ -144,12 +144,11 @@ def _rr_to_arm(k, q):
 def _rr_merge(found, candidates):
     """Add the candidates not already in found (angles compared modulo 2 pi)."""
     for q in candidates:
-        for p in found:
-            gap = np.abs((q - p + math.pi) % _TWO_PI - math.pi)
-            if gap.max() <= 1e-7:
-                break
-        else:
-            found.append(q)
+        if found:
+            gaps = np.abs((q - np.array(found) + math.pi) % _TWO_PI - math.pi).max(axis=1)
+            if gaps.min() <= 1e-7:
+                continue
+        found.append(q)
 
 
 def _rr_split(k, F, moved, imag_tol=_RR_IMAG_TOL):
@@ -169,13 +168,18 @@ def _rr_split(k, F, moved, imag_tol=_RR_IMAG_TOL):
     path = (
         [_rr_between(fill_rows, true_rows, t) for t in _RR_PATH] if fill_rows != true_rows else []
     )
-    out = []
-    close = []
-    for q in candidates:
-        for rows in path:  # (Newton's steps only: damped ones may change branch on the way)
-            q, _ = _rr_steps(rows, F, q, slide, False)
-        q, residual, damped = _rr_newton(true_rows, F, q, slide)
-        if damped and fill_rows == true_rows:  # Newton alone did not settle it
+    out: list[np.ndarray] = []
+    close: list[np.ndarray] = []
+    if not candidates:
+        return out, close, doubt
+    # every candidate at once (numpy's stacked products and solves: the Python solver's time
+    # went to calling numpy on 4 x 4 matrices one candidate at a time)
+    Q = np.array(candidates)
+    for rows in path:  # (Newton's steps only: damped ones may change branch on the way)
+        Q, _ = _rr_steps_many(rows, F, Q, slide, False)
+    Q, residuals, damped = _rr_newton_many(true_rows, F, Q, slide)
+    for q, residual, was_damped in zip(Q, residuals, damped):
+        if was_damped and fill_rows == true_rows:  # Newton alone did not settle it
             doubt = True
         if residual <= _RR_GOOD:
             out.append(q)
@@ -223,77 +227,107 @@ def _rr_candidates(P0, Ps, Pc, Q, F, rows, slide=_RR_TURNS, imag_tol=_RR_IMAG_TO
             doubt = True
         else:
             ys.append([y])
-    out = []
-    for cluster in ys:
-        y = sum(cluster) / len(cluster)
+    if not ys:
+        return [], doubt
+    # every cluster's null space at once (one stacked SVD), then every candidate's theta1,
+    # theta2 and theta6 at once
+    centres = np.array([sum(cluster) / len(cluster) for cluster in ys])
+    Y = centres[:, None, None]
+    _, svs, vts = np.linalg.svd(A * Y * Y + B * Y + C)
+    partial = []
+    for cluster, y, sv, vt in zip(ys, centres, svs, vts):
         if slide[0]:
             theta3 = (ma * y + mb) / (mc * y + md)
         else:
             theta3 = 2.0 * math.atan2(ma * y + mb, mc * y + md)
-        _, sv, vt = np.linalg.svd(A * y * y + B * y + C)
         vectors = [vt[-1]]
         if len(cluster) > 1 or sv[-2] <= _RR_NULL2_TOL * sv[0]:
             # two solutions may share theta3: both from the null space's plane
             vectors += _rr_unmix(vt[-1], vt[-2])
             doubt = True
         for v in vectors:
-            t4 = _rr_ratio_angle(v, _RR_X4_PAIRS)
-            t5 = _rr_ratio_angle(v, _RR_X5_PAIRS)
-            for t1, t2 in _rr_joints12(rows, F, theta3, t4, t5, slide):
-                t6 = _rr_theta6(rows, F, (t1, t2, theta3, t4, t5), slide)
-                out.append(np.array([t1, t2, theta3, t4, t5, t6]))
-    return out, doubt
+            partial.append(
+                (float(theta3), _rr_ratio_angle(v, _RR_X4_PAIRS), _rr_ratio_angle(v, _RR_X5_PAIRS))
+            )
+    T345 = np.array(partial)
+    joints = [
+        (t1, t2, *t345)
+        for t345, pairs in zip(partial, _rr_joints12_many(rows, F, T345, slide))
+        for t1, t2 in pairs
+    ]
+    if not joints:
+        return [], doubt
+    X = np.array(joints)
+    return list(np.column_stack((X, _rr_theta6_many(rows, F, X, slide)))), doubt
 
 
-def _rr_joints12(rows, F, t3, t4, t5, slide):
-    """The (theta1, theta2) pairs once theta3..theta5 are known. The third and fourth columns
-    of A3 A4 A5 (a direction l and a point p in frame 2), moved by X2 and Tz(d2) to g, meet
-    those of the target f: Rz(theta1) X1 Rz(theta2) g = f. Four equations linear in (cos,
-    sin) of theta2 (the z components, |p|^2 and l.p, which theta1 leaves alone) give theta2
-    by least squares (two values where the equations fix only one direction); the rotation
-    about z0 taking X1 Rz(theta2) g onto f gives theta1. (Least squares on Q m12 = P m45
-    would need Q of full rank, which arms with a1 = 0 lack.)"""
-    M = _rr_joint(2, t3, rows, slide) @ _rr_link(t4, rows[3]) @ _rr_link(t5, rows[4])
+def _rr_joints12_many(rows, F, T345, slide):
+    """The (theta1, theta2) pairs once theta3..theta5 are known (the rows of T345). The third
+    and fourth columns of A3 A4 A5 (a direction l and a point p in frame 2), moved by X2 and
+    Tz(d2) to g, meet those of the target f: Rz(theta1) X1 Rz(theta2) g = f. Four equations
+    linear in (cos, sin) of theta2 (the z components, |p|^2 and l.p, which theta1 leaves alone)
+    give theta2 by least squares (two values where the equations fix only one direction); the
+    rotation about z0 taking X1 Rz(theta2) g onto f gives theta1. (Least squares on
+    Q m12 = P m45 would need Q of full rank, which arms with a1 = 0 lack.)"""
+    links = _rr_chain(T345, rows, slide, first=2)
+    M = links[:, 0] @ links[:, 1] @ links[:, 2]
     d2, a2, ca2, sa2 = rows[1]
     _, a1, ca1, sa1 = rows[0]
-    gl = np.array([M[0, 2], ca2 * M[1, 2] - sa2 * M[2, 2], sa2 * M[1, 2] + ca2 * M[2, 2]])
-    gp = np.array([M[0, 3] + a2, ca2 * M[1, 3] - sa2 * M[2, 3], sa2 * M[1, 3] + ca2 * M[2, 3] + d2])
+    gl = np.stack(
+        [M[:, 0, 2], ca2 * M[:, 1, 2] - sa2 * M[:, 2, 2], sa2 * M[:, 1, 2] + ca2 * M[:, 2, 2]],
+        axis=1,
+    )
+    gp = np.stack(
+        [
+            M[:, 0, 3] + a2,
+            ca2 * M[:, 1, 3] - sa2 * M[:, 2, 3],
+            sa2 * M[:, 1, 3] + ca2 * M[:, 2, 3] + d2,
+        ],
+        axis=1,
+    )
     fl, fp = F[:3, 2], F[:3, 3]
     # rows (coefficient of cos theta2, of sin theta2, right side)
-    system = np.array(
-        [
-            [sa1 * gl[1], sa1 * gl[0], fl[2] - ca1 * gl[2]],
-            [sa1 * gp[1], sa1 * gp[0], fp[2] - ca1 * gp[2]],
-            [2.0 * a1 * gp[0], -2.0 * a1 * gp[1], fp @ fp - gp @ gp - a1 * a1],
-            [a1 * gl[0], -a1 * gl[1], fl @ fp - gl @ gp],
-        ]
+    systems = np.empty((len(M), 4, 3))
+    systems[:, 0] = np.stack([sa1 * gl[:, 1], sa1 * gl[:, 0], fl[2] - ca1 * gl[:, 2]], axis=1)
+    systems[:, 1] = np.stack([sa1 * gp[:, 1], sa1 * gp[:, 0], fp[2] - ca1 * gp[:, 2]], axis=1)
+    systems[:, 2] = np.stack(
+        [2.0 * a1 * gp[:, 0], -2.0 * a1 * gp[:, 1], fp @ fp - (gp * gp).sum(axis=1) - a1 * a1],
+        axis=1,
     )
+    systems[:, 3] = np.stack(
+        [a1 * gl[:, 0], -a1 * gl[:, 1], fl @ fp - (gl * gp).sum(axis=1)], axis=1
+    )
+    Us, Ss, Vts = np.linalg.svd(systems[:, :, :2], full_matrices=False)
     out = []
-    for c2, s2 in _rr_unit_solutions(system):
-        # w = X1 Rz(theta2) g, then Rz(theta1) w = f
-        wl = np.array([c2 * gl[0] - s2 * gl[1], s2 * gl[0] + c2 * gl[1], gl[2]])
-        wp = np.array([c2 * gp[0] - s2 * gp[1] + a1, s2 * gp[0] + c2 * gp[1], gp[2]])
-        wl = np.array([wl[0], ca1 * wl[1] - sa1 * wl[2], sa1 * wl[1] + ca1 * wl[2]])
-        wp = np.array([wp[0], ca1 * wp[1] - sa1 * wp[2], sa1 * wp[1] + ca1 * wp[2]])
-        across = wl[0] * fl[1] - wl[1] * fl[0] + wp[0] * fp[1] - wp[1] * fp[0]
-        along = wl[0] * fl[0] + wl[1] * fl[1] + wp[0] * fp[0] + wp[1] * fp[1]
-        out.append((math.atan2(across, along), math.atan2(s2, c2)))
+    for U, S, Vt, e, (gl0, gl1, gl2), (gp0, gp1, gp2) in zip(
+        Us, Ss, Vts, systems[:, :, 2], gl.tolist(), gp.tolist()
+    ):
+        pairs = []
+        for c2, s2 in _rr_unit_solutions(U, S, Vt, e):
+            # w = X1 Rz(theta2) g, then Rz(theta1) w = f
+            wl0, wl1 = c2 * gl0 - s2 * gl1, s2 * gl0 + c2 * gl1
+            wp0, wp1 = c2 * gp0 - s2 * gp1 + a1, s2 * gp0 + c2 * gp1
+            # (X1's rotation by alpha1; only the x and y components are needed)
+            wl1, wp1 = ca1 * wl1 - sa1 * gl2, ca1 * wp1 - sa1 * gp2
+            across = wl0 * fl[1] - wl1 * fl[0] + wp0 * fp[1] - wp1 * fp[0]
+            along = wl0 * fl[0] + wl1 * fl[1] + wp0 * fp[0] + wp1 * fp[1]
+            pairs.append((math.atan2(across, along), math.atan2(s2, c2)))
+        out.append(pairs)
     return out
 
 
-def _rr_unit_solutions(system):
-    """Unit vectors (c, s) solving the rows [a, b, e] (a c + b s = e) by least squares: one
-    where the rows span the plane, the two points of the unit circle on the line they give
-    where they span one direction only."""
-    U, S, Vt = np.linalg.svd(system[:, :2], full_matrices=False)
+def _rr_unit_solutions(U, S, Vt, e):
+    """Unit vectors (c, s) solving the rows a c + b s = e by least squares, from the SVD
+    U S Vt of the rows' (a, b): one where the rows span the plane, the two points of the unit
+    circle on the line they give where they span one direction only."""
     if S[1] > 1e-8 * S[0]:
-        cs = Vt.T @ ((U.T @ system[:, 2]) / S)
+        cs = Vt.T @ ((U.T @ e) / S)
         h = math.hypot(cs[0], cs[1])
         return [(cs[0] / h, cs[1] / h)] if h > 0.0 else [(1.0, 0.0)]
     if S[0] == 0.0:
         return [(1.0, 0.0)]
     n = Vt[0]
-    along = float(U[:, 0] @ system[:, 2]) / S[0]
+    along = float(U[:, 0] @ e) / S[0]
     along = max(-1.0, min(1.0, along))
     side = math.sqrt(1.0 - along * along)
     return [
@@ -413,82 +447,136 @@ def _rr_joint(i, value, rows, slide):
     return _rr_link(value, rows[i])
 
 
-def _rr_theta6(rows, F, thetas, slide):
-    """theta6 from the pose: (A1 ... A5)^-1 F = Rz(theta6) in the split's frame."""
-    M = np.eye(4)
-    for i, t in enumerate(thetas):
-        M = M @ _rr_joint(i, t, rows, slide)
-    R = M[:3, :3].T @ F[:3, :3]
-    return math.atan2(R[1, 0], R[0, 0])
+def _rr_theta6_many(rows, F, X, slide):
+    """theta6 of each row of X (theta1..theta5) from the pose: (A1 ... A5)^-1 F = Rz(theta6)
+    in the split's frame."""
+    links = _rr_chain(X[:, :5], rows, slide)
+    M = links[:, 0]
+    for i in range(1, 5):
+        M = M @ links[:, i]
+    R = M[:, :3, :3].transpose(0, 2, 1) @ F[:3, :3]
+    return np.arctan2(R[:, 1, 0], R[:, 0, 0])
 
 
-def _rr_newton(rows, F, q, slide=_RR_TURNS):
-    """Newton steps on the split's forward kinematics (geometric Jacobian) from q towards F,
-    then, if they do not reach _RR_GOOD, Levenberg-Marquardt steps from the best point met:
-    the polished values, the final error (largest entry of the top three rows of the pose
-    difference, lengths in units of _RR_LENGTH) and whether the damped steps were taken (a
-    candidate Newton does not settle puts the answer in doubt, as before they existed). Newton's
-    steps again after the damped ones: a regular solution the damped steps reach slowly is
-    settled exactly, not left a rounding's width from the same solution found otherwise."""
-    q, error = _rr_steps(rows, F, q, slide, False)
-    if error <= _RR_GOOD:
-        return q, error, False
-    damped, damped_error = _rr_steps(rows, F, q, slide, True)
-    if damped_error < error:
-        q, error = damped, damped_error
-        again, again_error = _rr_steps(rows, F, q, slide, False)
-        if again_error < error:
-            q, error = again, again_error
-    return q, error, True
+def _rr_newton_many(rows, F, Q, slide=_RR_TURNS):
+    """Newton steps on the split's forward kinematics (geometric Jacobian) from each row of Q
+    towards F, then, for those they do not bring within _RR_GOOD, Levenberg-Marquardt steps
+    from the best point met: the polished rows, their final errors (largest entry of the top
+    three rows of the pose difference, lengths in units of _RR_LENGTH) and which took the
+    damped steps (a candidate Newton does not settle puts the answer in doubt, as before they
+    existed). Newton's steps again after the damped ones: a regular solution the damped steps
+    reach slowly is settled exactly, not left a rounding's width from the same solution found
+    otherwise."""
+    Q, errors = _rr_steps_many(rows, F, Q, slide, False)
+    damped = errors > _RR_GOOD
+    if damped.any():
+        tried = np.flatnonzero(damped)
+        D, damped_errors = _rr_steps_many(rows, F, Q[tried], slide, True)
+        better = damped_errors < errors[tried]
+        kept = tried[better]
+        Q[kept], errors[kept] = D[better], damped_errors[better]
+        if kept.size:
+            A, again_errors = _rr_steps_many(rows, F, Q[kept], slide, False)
+            better = again_errors < errors[kept]
+            Q[kept[better]], errors[kept[better]] = A[better], again_errors[better]
+    return Q, errors, damped
 
 
-def _rr_steps(rows, F, q, slide, damped):
-    """_RR_NEWTON_STEPS steps from q: Newton's (J step = error), or damped ones (J^T J + mu)
-    step = J^T error with mu = |error|^2 (Levenberg-Marquardt as Yamashita and Fukushima: still
-    quadratic onto a curve of solutions, where J is singular and Newton's steps jump; slow in
-    a direction J nearly loses, which is why Newton goes first). The best point met and its
-    error."""
-    q = np.array(q, dtype=float)
-    best_q, best = q, math.inf
-    frames = np.empty((7, 4, 4))
+def _rr_chain(X, rows, slide, first=0):
+    """The split's link transforms A_i of joints first + 1, first + 2, ... at the values in the
+    columns of X (one row per candidate): shape (n, columns, 4, 4). Each entry of
+    Rz(theta) Tz(d) Tx(a) Rx(alpha) is cos theta, sin theta or 1 times a constant (the sums
+    below add exact zeros); a sliding joint 3 has theta = slide[1] and d its value."""
+    joints = range(first, first + X.shape[1])
+    d, a, ca, sa = (np.array([rows[i][k] for i in joints]) for k in range(4))
+    if slide[0] and 2 in joints:
+        d[2 - first] = 0.0
+    o = np.zeros(len(joints))
+    with_cos = np.stack([o + 1.0, o, o, a, o, ca, -sa, o, *[o] * 8], axis=1)
+    with_sin = np.stack([o, -ca, sa, o, o + 1.0, o, o, a, *[o] * 8], axis=1)
+    fixed = np.stack([*[o] * 9, sa, ca, d, o, o, o, o + 1.0], axis=1)
+    angles = X
+    if slide[0] and 2 in joints:
+        angles = X.copy()
+        angles[:, 2 - first] = slide[1]
+    c, s = np.cos(angles)[:, :, None], np.sin(angles)[:, :, None]
+    L = (c * with_cos + s * with_sin + fixed).reshape(len(X), len(joints), 4, 4)
+    if slide[0] and 2 in joints:
+        L[:, 2 - first, 2, 3] = X[:, 2 - first]
+    return L
+
+
+def _rr_steps_many(rows, F, Q, slide, damped):
+    """_RR_NEWTON_STEPS steps from each row of Q (all at once; each stops on its own, where
+    it is exact, beyond _RR_NEWTON_REACH or its system is singular): Newton's (J step = error),
+    or damped ones (J^T J + mu) step = J^T error with mu = |error|^2 (Levenberg-Marquardt as
+    Yamashita and Fukushima: still quadratic onto a curve of solutions, where J is singular
+    and Newton's steps jump; slow in a direction J nearly loses, which is why Newton goes
+    first). The best point met by each, and its error."""
+    q = np.array(Q, dtype=float)
+    best_q, best = q.copy(), np.full(len(q), math.inf)
+    live = np.arange(len(q))
     for _ in range(_RR_NEWTON_STEPS + 1):
-        frames[0] = np.eye(4)
+        x = q[live]
+        links = _rr_chain(x, rows, slide)
+        frames = np.empty((len(live), 7, 4, 4))
+        frames[:, 0] = np.eye(4)
         for i in range(6):
-            frames[i + 1] = frames[i] @ _rr_joint(i, q[i], rows, slide)
-        E = frames[6]
-        size = float(np.abs(F[:3] - E[:3]).max())
-        if size < best:
-            best_q, best = q, size
-        if size <= 1e-15 or size > _RR_NEWTON_REACH:
+            frames[:, i + 1] = frames[:, i] @ links[:, i]
+        size = np.abs(F[:3] - frames[:, 6, :3]).max(axis=(1, 2))
+        better = size < best[live]
+        best_q[live[better]], best[live[better]] = x[better], size[better]
+        going = (size > 1e-15) & (size <= _RR_NEWTON_REACH)
+        live, x, frames = live[going], x[going], frames[going]
+        if not live.size:
             break
+        E = frames[:, 6]
         # position error, and half the sum of E's columns crossed with F's (the rotation)
-        e, f = E[:3, :3], F[:3, :3]
-        turn = np.array(
+        e, f = E[:, :3, :3], F[:3, :3]
+        turn = np.stack(
             [
-                e[1] @ f[2] - e[2] @ f[1],
-                e[2] @ f[0] - e[0] @ f[2],
-                e[0] @ f[1] - e[1] @ f[0],
-            ]
+                e[:, 1] @ f[2] - e[:, 2] @ f[1],
+                e[:, 2] @ f[0] - e[:, 0] @ f[2],
+                e[:, 0] @ f[1] - e[:, 1] @ f[0],
+            ],
+            axis=1,
         )
-        error = np.concatenate((F[:3, 3] - E[:3, 3], 0.5 * turn))
-        z = frames[:6, :3, 2]
-        r = E[:3, 3] - frames[:6, :3, 3]
-        J = np.empty((6, 6))
-        J[0] = z[:, 1] * r[:, 2] - z[:, 2] * r[:, 1]
-        J[1] = z[:, 2] * r[:, 0] - z[:, 0] * r[:, 2]
-        J[2] = z[:, 0] * r[:, 1] - z[:, 1] * r[:, 0]
-        J[3:] = z.T
+        error = np.concatenate((F[:3, 3] - E[:, :3, 3], 0.5 * turn), axis=1)
+        z = frames[:, :6, :3, 2]
+        r = E[:, None, :3, 3] - frames[:, :6, :3, 3]
+        J = np.empty((len(live), 6, 6))
+        J[:, 0] = z[..., 1] * r[..., 2] - z[..., 2] * r[..., 1]
+        J[:, 1] = z[..., 2] * r[..., 0] - z[..., 0] * r[..., 2]
+        J[:, 2] = z[..., 0] * r[..., 1] - z[..., 1] * r[..., 0]
+        J[:, 3:] = z.transpose(0, 2, 1)
         if slide[0]:  # a sliding joint 3 moves the flange along its axis
-            J[:3, 2] = z[2]
-            J[3:, 2] = 0.0
-        try:
-            if damped:
-                mu = float(error @ error)
-                step = np.linalg.solve(J.T @ J + mu * np.eye(6), J.T @ error)
-            else:
-                step = np.linalg.solve(J, error)
-        except np.linalg.LinAlgError:
-            break
-        longest = float(np.abs(step).max())
-        q = q + (step if longest <= 0.5 else step * (0.5 / longest))
+            J[:, :3, 2] = z[:, 2]
+            J[:, 3:, 2] = 0.0
+        steps, solved = _rr_solve_many(J, error, damped)
+        live, x, steps = live[solved], x[solved], steps[solved]  # (a singular J: it stops)
+        longest = np.abs(steps).max(axis=1, initial=0.0)
+        shrink = np.where(longest <= 0.5, 1.0, 0.5 / np.maximum(longest, 0.5))
+        q[live] = x + steps * shrink[:, None]
     return best_q, best
+
+
+def _rr_solve_many(J, error, damped):
+    """The steps J step = error (or the damped ones, as _rr_steps_many) of a stack, and
+    which could be taken (a singular system's cannot)."""
+    if damped:
+        Jt = J.transpose(0, 2, 1)
+        mu = np.einsum("ij,ij->i", error, error)
+        A = Jt @ J + mu[:, None, None] * np.eye(6)
+        b = (Jt @ error[:, :, None])[:, :, 0]
+    else:
+        A, b = J, error
+    try:
+        return np.linalg.solve(A, b[:, :, None])[:, :, 0], np.ones(len(A), dtype=bool)
+    except np.linalg.LinAlgError:  # one of them is singular: each on its own
+        steps, solved = np.zeros_like(b), np.ones(len(A), dtype=bool)
+        for k in range(len(A)):
+            try:
+                steps[k] = np.linalg.solve(A[k], b[k])
+            except np.linalg.LinAlgError:
+                solved[k] = False
+        return steps, solved

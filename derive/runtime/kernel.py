@@ -984,7 +984,7 @@ def _krr_between(fill, true, t):
 
 
 def _krr_newton(rows, F, q0):
-    """_rr_newton in the kernel."""
+    """_rr_newton_many (derive/runtime/general.py) for one candidate, in the kernel."""
     q, error = _krr_steps(rows, F, q0, False)
     if error <= _RR_GOOD:
         return q, error, False
@@ -998,7 +998,7 @@ def _krr_newton(rows, F, q0):
 
 
 def _krr_steps(rows, F, q0, damped):
-    """_rr_steps in the kernel."""
+    """_rr_steps_many for one candidate, in the kernel."""
     q = q0.copy()
     best_q = q.copy()
     best = math.inf
