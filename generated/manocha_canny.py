@@ -1091,12 +1091,15 @@ def _rr_eigenvalues(P0, Ps, Pc, Q):
     if not best < 1e16:
         return None
     A, B, C = pencil
-    Ainv = np.linalg.inv(A)
-    companion = np.zeros((24, 24))
-    companion[:12, 12:] = np.eye(12)
-    companion[12:, :12] = -Ainv @ C
-    companion[12:, 12:] = -Ainv @ B
-    return np.linalg.eigvals(companion), pencil, moebius
+    try:  # (an estimate of cond below 1e16 does not rule out an exactly singular A)
+        Ainv = np.linalg.inv(A)
+        companion = np.zeros((24, 24))
+        companion[:12, 12:] = np.eye(12)
+        companion[12:, :12] = -Ainv @ C
+        companion[12:, 12:] = -Ainv @ B
+        return np.linalg.eigvals(companion), pencil, moebius
+    except np.linalg.LinAlgError:
+        return None
 
 
 def _rr_pencil(A6, B6, C6, moebius):

@@ -167,6 +167,38 @@ def test_a_prismatic_joint_3_or_4_is_the_eigen_joint(kinds, convention, backend,
     assert result.singular < result.samples
 
 
+# A long-run arm (numpy seed 1107 of the long run's draw) and a pose at which the pencil's
+# leading matrix passed the condition estimate but was exactly singular: the Python solver
+# raised LinAlgError from numpy.linalg.inv instead of answering.
+SINGULAR_LEAD_ROWS = [
+    (61.0, 0.0, 0.0, 21.25),
+    (0.0, 1.699802, -9.884458, -135.745),
+    (0.0, -1.025138, 0.0, 53.915),
+    (-134.0, 4.372269, -6.8712, 0.0),
+    (-78.0, 0.0, -7.472616, 180.0),
+    (180.0, -8.620569, 8.552602, -76.735),
+]
+SINGULAR_LEAD_Q = [
+    2.304114526254379,
+    0.0,
+    -5.70142673289314,
+    -2.158846183835519,
+    1.5364194608250328,
+    1.6263602665960164,
+]
+
+
+def test_an_exactly_singular_leading_matrix_is_not_an_exception(tmp_path):
+    """The split's pencil whose leading matrix is exactly singular is set aside like one
+    that fails the condition estimate (the other split or the rescue answers): every solution
+    is sound and the sample's own q is among them."""
+    text = spec_text("singular_lead", "standard", SINGULAR_LEAD_ROWS, kinds="RRPRRR")
+    text = text.replace('type = "P"\n', 'type = "P"\nlimits = [-10.0, 10.0]\n')
+    m = build_module(text, tmp_path)
+    result = roundtrip(m, np.array([SINGULAR_LEAD_Q]), "python")
+    assert result.unsound == [] and result.misses == [], result.summary()
+
+
 def test_a_prismatic_joint_elsewhere_is_refused_with_the_reason():
     plan = build_plan(parse_spec(slider_text("RPRRRR", "standard"), "<test>"))
     assert plan.ik is None
