@@ -234,25 +234,26 @@ def _rr_candidates(P0, Ps, Pc, Q, F, rows, slide=_RR_TURNS, imag_tol=_RR_IMAG_TO
     centres = np.array([sum(cluster) / len(cluster) for cluster in ys])
     Y = centres[:, None, None]
     _, svs, vts = np.linalg.svd(A * Y * Y + B * Y + C)
-    partial = []
+    thetas3, vectors = [], []
     for cluster, y, sv, vt in zip(ys, centres, svs, vts):
         if slide[0]:
             theta3 = (ma * y + mb) / (mc * y + md)
         else:
             theta3 = 2.0 * math.atan2(ma * y + mb, mc * y + md)
-        vectors = [vt[-1]]
+        found = [vt[-1]]
         if len(cluster) > 1 or sv[-2] <= _RR_NULL2_TOL * sv[0]:
             # two solutions may share theta3: both from the null space's plane
-            vectors += _rr_unmix(vt[-1], vt[-2])
+            found += _rr_unmix(vt[-1], vt[-2])
             doubt = True
-        for v in vectors:
-            partial.append(
-                (float(theta3), _rr_ratio_angle(v, _RR_X4_PAIRS), _rr_ratio_angle(v, _RR_X5_PAIRS))
-            )
-    T345 = np.array(partial)
+        thetas3 += [float(theta3)] * len(found)
+        vectors += found
+    V = np.array(vectors)
+    T345 = np.column_stack(
+        (thetas3, _rr_ratio_angles(V, _RR_X4_PAIRS), _rr_ratio_angles(V, _RR_X5_PAIRS))
+    )
     joints = [
         (t1, t2, *t345)
-        for t345, pairs in zip(partial, _rr_joints12_many(rows, F, T345, slide))
+        for t345, pairs in zip(T345.tolist(), _rr_joints12_many(rows, F, T345, slide))
         for t1, t2 in pairs
     ]
     if not joints:
@@ -273,30 +274,25 @@ def _rr_joints12_many(rows, F, T345, slide):
     M = links[:, 0] @ links[:, 1] @ links[:, 2]
     d2, a2, ca2, sa2 = rows[1]
     _, a1, ca1, sa1 = rows[0]
-    gl = np.stack(
-        [M[:, 0, 2], ca2 * M[:, 1, 2] - sa2 * M[:, 2, 2], sa2 * M[:, 1, 2] + ca2 * M[:, 2, 2]],
-        axis=1,
-    )
-    gp = np.stack(
-        [
-            M[:, 0, 3] + a2,
-            ca2 * M[:, 1, 3] - sa2 * M[:, 2, 3],
-            sa2 * M[:, 1, 3] + ca2 * M[:, 2, 3] + d2,
-        ],
-        axis=1,
-    )
+    gl = np.empty((len(M), 3))
+    gl[:, 0] = M[:, 0, 2]
+    gl[:, 1] = ca2 * M[:, 1, 2] - sa2 * M[:, 2, 2]
+    gl[:, 2] = sa2 * M[:, 1, 2] + ca2 * M[:, 2, 2]
+    gp = np.empty((len(M), 3))
+    gp[:, 0] = M[:, 0, 3] + a2
+    gp[:, 1] = ca2 * M[:, 1, 3] - sa2 * M[:, 2, 3]
+    gp[:, 2] = sa2 * M[:, 1, 3] + ca2 * M[:, 2, 3] + d2
     fl, fp = F[:3, 2], F[:3, 3]
     # rows (coefficient of cos theta2, of sin theta2, right side)
     systems = np.empty((len(M), 4, 3))
-    systems[:, 0] = np.stack([sa1 * gl[:, 1], sa1 * gl[:, 0], fl[2] - ca1 * gl[:, 2]], axis=1)
-    systems[:, 1] = np.stack([sa1 * gp[:, 1], sa1 * gp[:, 0], fp[2] - ca1 * gp[:, 2]], axis=1)
-    systems[:, 2] = np.stack(
-        [2.0 * a1 * gp[:, 0], -2.0 * a1 * gp[:, 1], fp @ fp - (gp * gp).sum(axis=1) - a1 * a1],
-        axis=1,
-    )
-    systems[:, 3] = np.stack(
-        [a1 * gl[:, 0], -a1 * gl[:, 1], fl @ fp - (gl * gp).sum(axis=1)], axis=1
-    )
+    systems[:, 0, 0], systems[:, 0, 1] = sa1 * gl[:, 1], sa1 * gl[:, 0]
+    systems[:, 0, 2] = fl[2] - ca1 * gl[:, 2]
+    systems[:, 1, 0], systems[:, 1, 1] = sa1 * gp[:, 1], sa1 * gp[:, 0]
+    systems[:, 1, 2] = fp[2] - ca1 * gp[:, 2]
+    systems[:, 2, 0], systems[:, 2, 1] = 2.0 * a1 * gp[:, 0], -2.0 * a1 * gp[:, 1]
+    systems[:, 2, 2] = fp @ fp - (gp * gp).sum(axis=1) - a1 * a1
+    systems[:, 3, 0], systems[:, 3, 1] = a1 * gl[:, 0], -a1 * gl[:, 1]
+    systems[:, 3, 2] = fl @ fp - (gl * gp).sum(axis=1)
     Us, Ss, Vts = np.linalg.svd(systems[:, :, :2], full_matrices=False)
     out = []
     for U, S, Vt, e, (gl0, gl1, gl2), (gp0, gp1, gp2) in zip(
@@ -418,14 +414,12 @@ def _rr_unmix(v1, v2):
     return out or [v1]
 
 
-def _rr_ratio_angle(v, pairs):
-    """The angle t with x = tan(t / 2) the common ratio v[hi] / v[lo] of the pairs, by least
-    squares in the direction (lo, hi): x = inf (t = pi) is fine."""
-    lo, hi = v[pairs[0]], v[pairs[1]]
-    across, low, high = float(hi @ lo), float(lo @ lo), float(hi @ hi)
-    if low >= high:
-        return 2.0 * math.atan2(across, low)
-    return 2.0 * math.atan2(high, across)
+def _rr_ratio_angles(V, pairs):
+    """Per row v of V, the angle t with x = tan(t / 2) the common ratio v[hi] / v[lo] of the
+    pairs, by least squares in the direction (lo, hi): x = inf (t = pi) is fine."""
+    lo, hi = V[:, pairs[0]], V[:, pairs[1]]
+    across, low, high = (hi * lo).sum(axis=1), (lo * lo).sum(axis=1), (hi * hi).sum(axis=1)
+    return 2.0 * np.where(low >= high, np.arctan2(across, low), np.arctan2(high, across))
 
 
 def _rr_link(theta, row):
@@ -490,23 +484,45 @@ def _rr_chain(X, rows, slide, first=0):
     columns of X (one row per candidate): shape (n, columns, 4, 4). Each entry of
     Rz(theta) Tz(d) Tx(a) Rx(alpha) is cos theta, sin theta or 1 times a constant (the sums
     below add exact zeros); a sliding joint 3 has theta = slide[1] and d its value."""
-    joints = range(first, first + X.shape[1])
-    d, a, ca, sa = (np.array([rows[i][k] for i in joints]) for k in range(4))
-    if slide[0] and 2 in joints:
-        d[2 - first] = 0.0
-    o = np.zeros(len(joints))
-    with_cos = np.stack([o + 1.0, o, o, a, o, ca, -sa, o, *[o] * 8], axis=1)
-    with_sin = np.stack([o, -ca, sa, o, o + 1.0, o, o, a, *[o] * 8], axis=1)
-    fixed = np.stack([*[o] * 9, sa, ca, d, o, o, o, o + 1.0], axis=1)
+    count = X.shape[1]
+    key = (tuple(map(tuple, rows)), slide[0], first, count)
+    weights = _RR_CHAIN_WEIGHTS.get(key)
+    if weights is None:  # (a split's rows are the same pose after pose: computed once)
+        weights = _RR_CHAIN_WEIGHTS[key] = _rr_chain_weights(*key)
+    sliding = 2 - first if slide[0] and first <= 2 < first + count else -1
     angles = X
-    if slide[0] and 2 in joints:
+    if sliding >= 0:
         angles = X.copy()
-        angles[:, 2 - first] = slide[1]
+        angles[:, sliding] = slide[1]
     c, s = np.cos(angles)[:, :, None], np.sin(angles)[:, :, None]
-    L = (c * with_cos + s * with_sin + fixed).reshape(len(X), len(joints), 4, 4)
-    if slide[0] and 2 in joints:
-        L[:, 2 - first, 2, 3] = X[:, 2 - first]
+    L = (c * weights[0] + s * weights[1] + weights[2]).reshape(len(X), count, 4, 4)
+    if sliding >= 0:
+        L[:, sliding, 2, 3] = X[:, sliding]
     return L
+
+
+# _rr_chain_weights by (rows, slides, first, count): a few per split (its rows and the
+# continuation path's)
+_RR_CHAIN_WEIGHTS: dict = {}
+
+
+def _rr_chain_weights(rows, slides, first, count):
+    """_rr_chain's constants: per joint, the 16 entries' factors of cos theta, of sin theta and
+    of 1."""
+    W = np.zeros((3, count, 16))
+    for k in range(count):
+        d, a, ca, sa = rows[first + k]
+        if slides and first + k == 2:
+            d = 0.0
+        W[0, k, [0, 3, 5, 6]] = 1.0, a, ca, -sa
+        W[1, k, [1, 2, 4, 7]] = -ca, sa, 1.0, a
+        W[2, k, [9, 10, 11, 15]] = sa, ca, d, 1.0
+    W.flags.writeable = False
+    return W
+
+
+_RR_EYE4 = np.eye(4)
+_RR_EYE6 = np.eye(6)
 
 
 def _rr_steps_many(rows, F, Q, slide, damped):
@@ -523,7 +539,7 @@ def _rr_steps_many(rows, F, Q, slide, damped):
         x = q[live]
         links = _rr_chain(x, rows, slide)
         frames = np.empty((len(live), 7, 4, 4))
-        frames[:, 0] = np.eye(4)
+        frames[:, 0] = _RR_EYE4
         for i in range(6):
             frames[:, i + 1] = frames[:, i] @ links[:, i]
         size = np.abs(F[:3] - frames[:, 6, :3]).max(axis=(1, 2))
@@ -536,15 +552,11 @@ def _rr_steps_many(rows, F, Q, slide, damped):
         E = frames[:, 6]
         # position error, and half the sum of E's columns crossed with F's (the rotation)
         e, f = E[:, :3, :3], F[:3, :3]
-        turn = np.stack(
-            [
-                e[:, 1] @ f[2] - e[:, 2] @ f[1],
-                e[:, 2] @ f[0] - e[:, 0] @ f[2],
-                e[:, 0] @ f[1] - e[:, 1] @ f[0],
-            ],
-            axis=1,
-        )
-        error = np.concatenate((F[:3, 3] - E[:, :3, 3], 0.5 * turn), axis=1)
+        error = np.empty((len(live), 6))
+        error[:, :3] = F[:3, 3] - E[:, :3, 3]
+        error[:, 3] = 0.5 * (e[:, 1] @ f[2] - e[:, 2] @ f[1])
+        error[:, 4] = 0.5 * (e[:, 2] @ f[0] - e[:, 0] @ f[2])
+        error[:, 5] = 0.5 * (e[:, 0] @ f[1] - e[:, 1] @ f[0])
         z = frames[:, :6, :3, 2]
         r = E[:, None, :3, 3] - frames[:, :6, :3, 3]
         J = np.empty((len(live), 6, 6))
@@ -569,7 +581,7 @@ def _rr_solve_many(J, error, damped):
     if damped:
         Jt = J.transpose(0, 2, 1)
         mu = np.einsum("ij,ij->i", error, error)
-        A = Jt @ J + mu[:, None, None] * np.eye(6)
+        A = Jt @ J + mu[:, None, None] * _RR_EYE6
         b = (Jt @ error[:, :, None])[:, :, 0]
     else:
         A, b = J, error
