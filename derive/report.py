@@ -296,6 +296,7 @@ def general_blocks(step: Eigen) -> list[Block]:
         Block("math", "Q[3, :]", tex(f.Q.row(2))),
     ]
     ops = [sum(sp.count_ops(e) for e in split.fill) for split in step.splits]
+    shift4, shift5 = runtime_general._RR_SHIFT45
     out += [
         Block(
             "p",
@@ -308,14 +309,19 @@ def general_blocks(step: Eigen) -> list[Block]:
             "p",
             "$N$, six rows spanning the left null space of $Q$ (from its SVD), removes "
             "$\\theta_1, \\theta_2$: $N (P_0 + P_s s_3 + P_c c_3) m_{45} = 0$. With "
-            "$x_i = \\tan(\\theta_i / 2)$, times $(1 + x_3^2)(1 + x_4^2)(1 + x_5^2)$, "
+            "$x_3 = \\tan(\\theta_3 / 2)$ and $x_i = \\tan((\\theta_i - \\phi_i) / 2)$ for "
+            f"$i = 4, 5$ (generic shifts $\\phi_4 = {shift4}$, $\\phi_5 = {shift5}$ rad, "
+            "so that $\\theta_4, \\theta_5 = \\pi$ are "
+            "not at $x = \\infty$), times $(1 + x_3^2)(1 + x_4^2)(1 + x_5^2)$, "
             "$m_{45}$ becomes the monomials $x_4^i x_5^j$ ($i, j \\le 2$) and the six "
             "equations $\\Sigma_6(x_3) = A_6 x_3^2 + B_6 x_3 + C_6$ (6 x 9); stacked with "
             "$x_4 \\Sigma_6$ they give the 12 x 12 quadratic matrix polynomial "
             "$\\Sigma(x_3) v = 0$, $v = [x_4^i x_5^j]$, $i \\le 3$, $j \\le 2$. "
             "$\\det \\Sigma$ has degree 24: 16 genuine roots and 8 at $x_3 = \\pm i$. "
             "A Moebius map $x_3 = (a y + b)/(c y + d)$ keeps $\\theta_3 = \\pi$ finite; "
-            "the real eigenvalues $y$ of the 24 x 24 companion matrix give $\\theta_3$, "
+            "the real eigenvalues $y$ of the 24 x 24 companion matrix give $\\theta_3$ "
+            "(a nearly real pair $y \\pm i \\eta$ is tried at $y \\mp \\eta$: two near-equal "
+            "roots its rounding split), "
             "the null space of $\\Sigma$ at each gives $\\theta_4, \\theta_5$, and "
             "$\\theta_1, \\theta_2, \\theta_6$ follow by back-substitution; Newton "
             "steps polish every candidate and forward kinematics certifies it.",

@@ -158,6 +158,18 @@ _RR_COND_LIMIT = 1e8
 _RR_MOEBIUS = ((1.0, 0.3, -0.4, 1.0), (1.0, -0.7, 0.5, 1.0), (0.6, 1.0, -1.0, 0.8))
 
 
+# the null vector's variables are x4 = tan((theta4 - _RR_SHIFT45[0]) / 2) and x5 likewise:
+# half-angles of generic shifts, so that the angles where x is infinite (shift + pi) are not
+# the special values joints and offsets take (with no shift, theta4 or theta5 = pi at 0 or 180
+# degree samples put the solution at x = infinity and the first split lost it)
+_RR_SHIFT45 = (0.37, -0.61)
+
+
+# a complex pair with 0 < Im <= _RR_PAIR_TOL (1 + |y|) is also tried, at Re -+ Im (two near
+# real roots its rounding split apart)
+_RR_PAIR_TOL = 0.05
+
+
 _RR_IMAG_TOL = 1e-6
 
 
@@ -762,17 +774,28 @@ def _kwrap(t: float) -> float:
     return w + _TWO_PI if w <= -math.pi else w
 
 
-# m45 (1 + x4^2)(1 + x5^2) = _RR_H45 [x4^i x5^j], column 3 i + j (ALGORITHMS.md 4.5): rows
-# are outer products of the coefficients over (1, x, x^2) of 2x, 1 - x^2 and 1 + x^2
-_RR_S, _RR_C, _RR_O = (0.0, 2.0, 0.0), (1.0, 0.0, -1.0), (1.0, 0.0, 1.0)
+def _rr_half_angle(shift):
+    """The coefficients over (1, x, x^2) of (1 + x^2) sin t, (1 + x^2) cos t and 1 + x^2 for
+    x = tan((t - shift) / 2): sin t = sin shift c' + cos shift s' and cos t = cos shift c' -
+    sin shift s' with s' (1 + x^2) = 2x and c' (1 + x^2) = 1 - x^2."""
+    cs, ss = math.cos(shift), math.sin(shift)
+    return (ss, 2.0 * cs, -ss), (cs, -2.0 * ss, -cs), (1.0, 0.0, 1.0)
+
+
+# m45 (1 + x4^2)(1 + x5^2) = _RR_H45 [x4^i x5^j], column 3 i + j (ALGORITHMS.md 4.5, with the
+# half-angles of _RR_SHIFT45): rows are outer products of _rr_half_angle's coefficients
+_RR_S4, _RR_C4, _RR_O4 = _rr_half_angle(_RR_SHIFT45[0])
+
+
+_RR_S5, _RR_C5, _RR_O5 = _rr_half_angle(_RR_SHIFT45[1])
 
 
 _RR_H45 = np.array(
     [
         [u[i] * w[j] for i in range(3) for j in range(3)]
         for u, w in zip(
-            (_RR_S, _RR_S, _RR_C, _RR_C, _RR_S, _RR_C, _RR_O, _RR_O, _RR_O),
-            (_RR_S, _RR_C, _RR_S, _RR_C, _RR_O, _RR_O, _RR_S, _RR_C, _RR_O),
+            (_RR_S4, _RR_S4, _RR_C4, _RR_C4, _RR_S4, _RR_C4, _RR_O4, _RR_O4, _RR_O4),
+            (_RR_S5, _RR_C5, _RR_S5, _RR_C5, _RR_O5, _RR_O5, _RR_S5, _RR_C5, _RR_O5),
         )
     ]
 )
@@ -892,7 +915,7 @@ def _rr_split(k, F, moved, imag_tol=_RR_IMAG_TOL):
     Ps = values[126:252].reshape(14, 9)
     Pc = values[252:378].reshape(14, 9)
     Q = values[378:].reshape(14, 8)
-    candidates, doubt = _rr_candidates(P0, Ps, Pc, Q, moved, fill_rows, slide, imag_tol)
+    candidates, doubt, extras = _rr_candidates(P0, Ps, Pc, Q, moved, fill_rows, slide, imag_tol)
     # a perturbed table's solutions are walked back to the arm's in steps (a continuation),
     # so that Newton does not jump to another branch
     path = (
@@ -907,12 +930,14 @@ def _rr_split(k, F, moved, imag_tol=_RR_IMAG_TOL):
     Q = np.array(candidates)
     for rows in path:  # (Newton's steps only: damped ones may change branch on the way)
         Q, _ = _rr_steps_many(rows, F, Q, slide, False)
-    Q, residuals, damped = _rr_newton_many(true_rows, F, Q, slide)
-    for q, residual, was_damped in zip(Q, residuals, damped):
-        if was_damped and fill_rows == true_rows:  # Newton alone did not settle it
+    Q, residuals, damped = _rr_newton_many(true_rows, F, Q, slide, np.array(extras))
+    for q, residual, was_damped, extra in zip(Q, residuals, damped, extras):
+        if was_damped and fill_rows == true_rows and not extra:  # Newton did not settle it
             doubt = True
         if residual <= _RR_GOOD:
             out.append(q)
+            continue
+        if extra:
             continue
         if residual <= _RR_NEAR:
             close.append(q)
@@ -934,13 +959,21 @@ def _rr_between(fill_rows, true_rows, t):
 
 def _rr_candidates(P0, Ps, Pc, Q, F, rows, slide=_RR_TURNS, imag_tol=_RR_IMAG_TOL):
     """The unpolished joint values of one split from its matrices (ALGORITHMS.md 4.4-4.7),
-    and whether the eigenvalues came in clusters (an answer in doubt). Where joint 3 slides
-    (slide[0] set) the eigen-variable x3 is d3 itself, not tan(theta3 / 2)."""
+    whether the eigenvalues came in clusters (an answer in doubt), and which candidates are
+    extras (from nearly real pairs: one that does not polish puts nothing in doubt). Where
+    joint 3 slides (slide[0] set) the eigen-variable x3 is d3 itself, not tan(theta3 / 2)."""
     found = _rr_eigenvalues(P0, Ps, Pc, Q)
     if found is None:
-        return [], True
+        return [], True, []
     values, (A, B, C), moebius = found
-    real = np.sort(values[np.abs(values.imag) <= imag_tol * (1.0 + np.abs(values))].real)
+    size = 1.0 + np.abs(values)
+    real = values[np.abs(values.imag) <= imag_tol * size].real
+    # a pair y +- i eta nearly real (two near-equal real roots of a near-singular pose the
+    # pencil's rounding split apart: the twins of a nearly folded elbow or wrist) is tried at
+    # y - eta and y + eta (Newton and the certification decide)
+    pair = values[(values.imag > imag_tol * size) & (values.imag <= _RR_PAIR_TOL * size)]
+    extra = np.sort(np.concatenate((pair.real - pair.imag, pair.real + pair.imag)))
+    real = np.sort(real)
     ma, mb, mc, md = moebius
     if slide[0]:
         # a sliding joint 3 moves the flange by d3 along its axis, the other links by at most
@@ -949,6 +982,7 @@ def _rr_candidates(P0, Ps, Pc, Q, F, rows, slide=_RR_TURNS, imag_tol=_RR_IMAG_TO
         # clustering.
         reach = float(np.abs(F[:3, 3]).sum()) + sum(abs(r[0]) + abs(r[1]) for r in rows)
         real = real[np.abs(ma * real + mb) <= reach * np.abs(mc * real + md)]
+        extra = extra[np.abs(ma * extra + mb) <= reach * np.abs(mc * extra + md)]
     doubt = False
     ys: list[list[float]] = []
     for y in real:
@@ -957,15 +991,17 @@ def _rr_candidates(P0, Ps, Pc, Q, F, rows, slide=_RR_TURNS, imag_tol=_RR_IMAG_TO
             doubt = True
         else:
             ys.append([y])
+    primary = len(ys)
+    ys += [[y] for y in extra]  # (on their own: they put nothing in doubt)
     if not ys:
-        return [], doubt
+        return [], doubt, []
     # every cluster's null space at once (one stacked SVD), then every candidate's theta1,
     # theta2 and theta6 at once
     centres = np.array([sum(cluster) / len(cluster) for cluster in ys])
     Y = centres[:, None, None]
     _, svs, vts = np.linalg.svd(A * Y * Y + B * Y + C)
-    thetas3, vectors = [], []
-    for cluster, y, sv, vt in zip(ys, centres, svs, vts):
+    thetas3, vectors, optional = [], [], []
+    for k, (cluster, y, sv, vt) in enumerate(zip(ys, centres, svs, vts)):
         if slide[0]:
             theta3 = (ma * y + mb) / (mc * y + md)
         else:
@@ -974,22 +1010,28 @@ def _rr_candidates(P0, Ps, Pc, Q, F, rows, slide=_RR_TURNS, imag_tol=_RR_IMAG_TO
         if len(cluster) > 1 or sv[-2] <= _RR_NULL2_TOL * sv[0]:
             # two solutions may share theta3: both from the null space's plane
             found += _rr_unmix(vt[-1], vt[-2])
-            doubt = True
+            doubt = doubt or k < primary
         thetas3 += [float(theta3)] * len(found)
         vectors += found
+        optional += [k >= primary] * len(found)
     V = np.array(vectors)
     T345 = np.column_stack(
-        (thetas3, _rr_ratio_angles(V, _RR_X4_PAIRS), _rr_ratio_angles(V, _RR_X5_PAIRS))
+        (
+            thetas3,
+            _rr_ratio_angles(V, _RR_X4_PAIRS) + _RR_SHIFT45[0],
+            _rr_ratio_angles(V, _RR_X5_PAIRS) + _RR_SHIFT45[1],
+        )
     )
-    joints = [
-        (t1, t2, *t345)
-        for t345, pairs in zip(T345.tolist(), _rr_joints12_many(rows, F, T345, slide))
-        for t1, t2 in pairs
-    ]
+    joints, extras = [], []
+    for t345, pairs, extra_one in zip(
+        T345.tolist(), _rr_joints12_many(rows, F, T345, slide), optional
+    ):
+        joints += [(t1, t2, *t345) for t1, t2 in pairs]
+        extras += [extra_one] * len(pairs)
     if not joints:
-        return [], doubt
+        return [], doubt, []
     X = np.array(joints)
-    return list(np.column_stack((X, _rr_theta6_many(rows, F, X, slide)))), doubt
+    return list(np.column_stack((X, _rr_theta6_many(rows, F, X, slide)))), doubt, extras
 
 
 def _rr_joints12_many(rows, F, T345, slide):
@@ -1146,7 +1188,8 @@ def _rr_unmix(v1, v2):
 
 def _rr_ratio_angles(V, pairs):
     """Per row v of V, the angle t with x = tan(t / 2) the common ratio v[hi] / v[lo] of the
-    pairs, by least squares in the direction (lo, hi): x = inf (t = pi) is fine."""
+    pairs, by least squares in the direction (lo, hi): x = inf (t = pi) is fine. (theta4 and
+    theta5 are t plus their _RR_SHIFT45.)"""
     lo, hi = V[:, pairs[0]], V[:, pairs[1]]
     across, low, high = (hi * lo).sum(axis=1), (lo * lo).sum(axis=1), (hi * hi).sum(axis=1)
     return 2.0 * np.where(low >= high, np.arctan2(across, low), np.arctan2(high, across))
@@ -1163,7 +1206,7 @@ def _rr_theta6_many(rows, F, X, slide):
     return np.arctan2(R[:, 1, 0], R[:, 0, 0])
 
 
-def _rr_newton_many(rows, F, Q, slide=_RR_TURNS):
+def _rr_newton_many(rows, F, Q, slide, extras):
     """Newton steps on the split's forward kinematics (geometric Jacobian) from each row of Q
     towards F, then, for those they do not bring within _RR_GOOD, Levenberg-Marquardt steps
     from the best point met: the polished rows, their final errors (largest entry of the top
@@ -1171,9 +1214,9 @@ def _rr_newton_many(rows, F, Q, slide=_RR_TURNS):
     damped steps (a candidate Newton does not settle puts the answer in doubt, as before they
     existed). Newton's steps again after the damped ones: a regular solution the damped steps
     reach slowly is settled exactly, not left a rounding's width from the same solution found
-    otherwise."""
+    otherwise. Rows marked in extras get Newton's steps only."""
     Q, errors = _rr_steps_many(rows, F, Q, slide, False)
-    damped = errors > _RR_GOOD
+    damped = (errors > _RR_GOOD) & ~extras  # (an extra Newton does not settle is dropped)
     if damped.any():
         tried = np.flatnonzero(damped)
         D, damped_errors = _rr_steps_many(rows, F, Q[tried], slide, True)
@@ -1625,18 +1668,19 @@ def _krr_split(k, F, moved, out, count):
     _rr_fill(
         k, moved[0, 2], moved[1, 2], moved[2, 2], moved[0, 3], moved[1, 3], moved[2, 3], values
     )
-    cands = np.zeros((4 * _KRR_MAX, 6))
-    n, doubt = _krr_candidates(values, moved, fill, cands)
+    cands = np.zeros((8 * _KRR_MAX, 6))
+    extra = np.zeros(8 * _KRR_MAX, dtype=np.bool_)
+    n, doubt = _krr_candidates(values, moved, fill, cands, extra)
     for c in range(n):
         q = cands[c].copy()
         if perturbed:
             for t in _RR_PATH:
                 q, _ = _krr_steps(_krr_between(fill, true, t), F, q, False)
-        q, error, damped = _krr_newton(true, F, q)
-        if damped and not perturbed:
+        q, error, damped = _krr_newton(true, F, q, extra[c])
+        if damped and not perturbed and not extra[c]:
             doubt = True
         if error > _RR_GOOD:
-            if not perturbed:
+            if not perturbed and not extra[c]:
                 doubt = True
             continue
         if true[6, 0] != 0.0:  # a sliding joint 3, in the arm's lengths
@@ -1660,13 +1704,14 @@ def _krr_split(k, F, moved, out, count):
 
 
 # the most candidates of one split: 16 eigenvalues, each with up to 3 null vectors (one, and
-# two from a plane) and 2 values of theta2
+# two from a plane) and 2 values of theta2 (room for 8 times as many: the extras too)
 _KRR_MAX = 16
 
 
-def _krr_candidates(values, F, rows, out):
-    """_rr_candidates in the kernel: the count of candidate joint vectors written to out and
-    whether the answer is in doubt (clusters, or no usable pencil)."""
+def _krr_candidates(values, F, rows, out, extra):
+    """_rr_candidates in the kernel: the count of candidate joint vectors written to out,
+    whether the answer is in doubt (clusters, or no usable pencil), and in extra which
+    candidates come from nearly real pairs."""
     P0 = values[:126].reshape(14, 9)
     Ps = values[126:252].reshape(14, 9)
     Pc = values[252:378].reshape(14, 9)
@@ -1725,13 +1770,22 @@ def _krr_candidates(values, F, rows, out):
         reach += abs(rows[i, 0]) + abs(rows[i, 1])
     reals = np.zeros(24)
     n_real = 0
+    extras = np.zeros(48)  # (nearly real pairs, at Re -+ Im: as in Python)
+    n_extra = 0
     for i in range(24):
-        if abs(wi[i]) <= _RR_IMAG_TOL * (1.0 + math.hypot(wr[i], wi[i])):
+        size = 1.0 + math.hypot(wr[i], wi[i])
+        if abs(wi[i]) <= _RR_IMAG_TOL * size:
             y = wr[i]
             if rows[6, 0] == 0.0 or abs(ma * y + mb) <= reach * abs(mc * y + md):
                 reals[n_real] = y
                 n_real += 1
+        elif _RR_IMAG_TOL * size < wi[i] <= _RR_PAIR_TOL * size:
+            for y in (wr[i] - wi[i], wr[i] + wi[i]):
+                if rows[6, 0] == 0.0 or abs(ma * y + mb) <= reach * abs(mc * y + md):
+                    extras[n_extra] = y
+                    n_extra += 1
     reals = np.sort(reals[:n_real])
+    extras = np.sort(extras[:n_extra])
     doubt = False
     count = 0
     start = 0
@@ -1745,32 +1799,53 @@ def _krr_candidates(values, F, rows, out):
         y = reals[start:stop].mean()
         clustered = stop - start > 1
         start = stop
-        if rows[6, 0] != 0.0:  # joint 3 slides: x3 is d3
-            theta3 = (ma * y + mb) / (mc * y + md)
-        else:
-            theta3 = 2.0 * math.atan2(ma * y + mb, mc * y + md)
-        S = A * (y * y) + B * y + C
-        nv, plane = _knull_right(S, V)
-        if clustered or plane:
-            doubt = True
-            if nv == 2:
-                nv = 1 + _krr_unmix(V)
-        for v in range(nv):
-            t4 = _krr_ratio_angle(V[v], 3)
-            t5 = _krr_ratio_angle(V[v], 1)
-            pairs, t1a, t2a, t1b, t2b = _krr_joints12(rows, F, theta3, t4, t5)
-            for p in range(pairs):
-                if count == out.shape[0]:
-                    return count, True
-                t1 = t1a if p == 0 else t1b
-                t2 = t2a if p == 0 else t2b
-                out[count, 0] = t1
-                out[count, 1] = t2
-                out[count, 2] = theta3
-                out[count, 3] = t4
-                out[count, 4] = t5
-                out[count, 5] = _krr_theta6(rows, F, t1, t2, theta3, t4, t5)
-                count += 1
+        count, more = _krr_value(A, B, C, moebius, rows, F, y, clustered, V, out, count)
+        doubt = doubt or more
+        if count < 0:
+            return -count, True
+    primary = count
+    for e in range(n_extra):
+        count, _ = _krr_value(A, B, C, moebius, rows, F, extras[e], False, V, out, count)
+        if count < 0:
+            count = -count
+            break
+    for c in range(out.shape[0]):
+        extra[c] = c >= primary
+    return count, doubt
+
+
+def _krr_value(A, B, C, moebius, rows, F, y, clustered, V, out, count):
+    """The candidates of one value y of the eigen-variable (a cluster's mean where clustered)
+    appended to out from row count: the new count (its negative where out filled up) and
+    whether they put the answer in doubt (a cluster, a plane of null vectors)."""
+    ma, mb, mc, md = moebius
+    if rows[6, 0] != 0.0:  # joint 3 slides: x3 is d3
+        theta3 = (ma * y + mb) / (mc * y + md)
+    else:
+        theta3 = 2.0 * math.atan2(ma * y + mb, mc * y + md)
+    S = A * (y * y) + B * y + C
+    nv, plane = _knull_right(S, V)
+    doubt = False
+    if clustered or plane:
+        doubt = True
+        if nv == 2:
+            nv = 1 + _krr_unmix(V)
+    for v in range(nv):
+        t4 = _krr_ratio_angle(V[v], 3)
+        t5 = _krr_ratio_angle(V[v], 1)
+        pairs, t1a, t2a, t1b, t2b = _krr_joints12(rows, F, theta3, t4, t5)
+        for p in range(pairs):
+            if count == out.shape[0]:
+                return -count, True
+            t1 = t1a if p == 0 else t1b
+            t2 = t2a if p == 0 else t2b
+            out[count, 0] = t1
+            out[count, 1] = t2
+            out[count, 2] = theta3
+            out[count, 3] = t4
+            out[count, 4] = t5
+            out[count, 5] = _krr_theta6(rows, F, t1, t2, theta3, t4, t5)
+            count += 1
     return count, doubt
 
 
@@ -1982,7 +2057,8 @@ def _krr_unmix(V):
 
 
 def _krr_ratio_angle(v, step):
-    """_rr_ratio_angle in the kernel: step 3 gives theta4, step 1 theta5."""
+    """_rr_ratio_angles in the kernel: step 3 gives theta4, step 1 theta5 (with their
+    _RR_SHIFT45)."""
     across = 0.0
     low = 0.0
     high = 0.0
@@ -1994,9 +2070,10 @@ def _krr_ratio_angle(v, step):
                 across += lo * hi
                 low += lo * lo
                 high += hi * hi
+    shift = _RR_SHIFT45[0] if step == 3 else _RR_SHIFT45[1]
     if low >= high:
-        return 2.0 * math.atan2(across, low)
-    return 2.0 * math.atan2(high, across)
+        return 2.0 * math.atan2(across, low) + shift
+    return 2.0 * math.atan2(high, across) + shift
 
 
 def _krr_link(t, rows, i, M):
@@ -2117,10 +2194,10 @@ def _krr_between(fill, true, t):
     return out
 
 
-def _krr_newton(rows, F, q0):
+def _krr_newton(rows, F, q0, extra):
     """_rr_newton_many (derive/runtime/general.py) for one candidate, in the kernel."""
     q, error = _krr_steps(rows, F, q0, False)
-    if error <= _RR_GOOD:
+    if error <= _RR_GOOD or extra:
         return q, error, False
     damped, damped_error = _krr_steps(rows, F, q, True)
     if damped_error < error:
@@ -3232,6 +3309,7 @@ _KBUF = 96
 _KERNEL_SPACE = "_derive_ik_kernels_manocha_canny_79027869596efc09"
 _KERNEL = (
     '_kwrap',
+    '_rr_half_angle',
     '_rr_motion',
     '_kpose_ok',
     '_kdistinct',
@@ -3244,6 +3322,7 @@ _KERNEL = (
     '_kgeneral',
     '_krr_split',
     '_krr_candidates',
+    '_krr_value',
     '_krr_pencil',
     '_kpivot_ratio',
     '_ksolve_into',

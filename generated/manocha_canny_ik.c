@@ -95,10 +95,15 @@ static int dk_pose_ok(const double T[16])
 #define DK_RR_LENGTH (1.5)
 #define DK_RR_ROWS 16 /* the most rows one pose gives */
 #define DK_RR_MAX 16  /* eigenvalues of one split */
+#define DK_RR_CANDS (8 * DK_RR_MAX) /* candidates of one split, the extras' too */
+#define DK_RR_PAIR_TOL (0.05)
 
 static const double DK_RR_MOEBIUS[3][4] = {{1.0, 0.3, -0.4, 1.0}, {1.0, -0.7, 0.5, 1.0}, {0.6, 1.0, -1.0, 0.8}};
 static const double DK_RR_PATH[3] = {0.3, 0.1, 0.03};
-static const double DK_RR_H45[9][9] = {{0.0, 0.0, 0.0, 0.0, 4.0, 0.0, 0.0, 0.0, 0.0}, {0.0, 0.0, -0.0, 2.0, 0.0, -2.0, 0.0, 0.0, -0.0}, {0.0, 2.0, 0.0, 0.0, 0.0, 0.0, -0.0, -2.0, -0.0}, {1.0, 0.0, -1.0, 0.0, 0.0, -0.0, -1.0, -0.0, 1.0}, {0.0, 0.0, 0.0, 2.0, 0.0, 2.0, 0.0, 0.0, 0.0}, {1.0, 0.0, 1.0, 0.0, 0.0, 0.0, -1.0, -0.0, -1.0}, {0.0, 2.0, 0.0, 0.0, 0.0, 0.0, 0.0, 2.0, 0.0}, {1.0, 0.0, -1.0, 0.0, 0.0, -0.0, 1.0, 0.0, -1.0}, {1.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 1.0}};
+static const double DK_RR_H45[9][9] = {{-0.20715771404290617, 0.5927947440648359, 0.20715771404290617, -1.0681999969191052, 3.056721043236494, 1.0681999969191052, 0.20715771404290617, -0.5927947440648359, -0.20715771404290617}, {0.29639737203241795, 0.41431542808581234, -0.29639737203241795, 1.528360521618247, 2.1363999938382103, -1.528360521618247, -0.29639737203241795, -0.41431542808581234, 0.29639737203241795}, {-0.5340999984595526, 1.528360521618247, 0.5340999984595526, 0.41431542808581234, -1.1855894881296718, -0.41431542808581234, 0.5340999984595526, -1.528360521618247, -0.5340999984595526}, {0.7641802608091235, 1.0681999969191052, -0.7641802608091235, -0.5927947440648359, -0.8286308561716247, 0.5927947440648359, -0.7641802608091235, -1.0681999969191052, 0.7641802608091235}, {0.361615431964962, 0.0, 0.361615431964962, 1.864654691212069, 0.0, 1.864654691212069, -0.361615431964962, -0.0, -0.361615431964962}, {0.9323273456060345, 0.0, 0.9323273456060345, -0.723230863929924, -0.0, -0.723230863929924, -0.9323273456060345, -0.0, -0.9323273456060345}, {-0.5728674601004813, 1.639296035690959, 0.5728674601004813, -0.0, 0.0, 0.0, -0.5728674601004813, 1.639296035690959, 0.5728674601004813}, {0.8196480178454795, 1.1457349202009626, -0.8196480178454795, 0.0, 0.0, -0.0, 0.8196480178454795, 1.1457349202009626, -0.8196480178454795}, {1.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 1.0}};
+/* x4 = tan((theta4 - DK_RR_SHIFT4) / 2), x5 likewise (the Python solver's _RR_SHIFT45) */
+#define DK_RR_SHIFT4 (0.37)
+#define DK_RR_SHIFT5 (-0.61)
 static const double DK_RR_MIX[6][14] = {{0.831053977697249, 0.9900473146183112, 0.64314065170999, -0.032401674147217494, -0.6913872085223244, -0.9970837803306998, -0.7932848190961409, -0.1841286755130694, 0.5191145844484333, 0.957097725720417, 0.9060176352363181, 0.39197550774272616, -0.3223604909348076, -0.8719748950976475}, {0.9900473146183112, -0.032401674147217494, -0.9970837803306998, -0.1841286755130694, 0.957097725720417, 0.39197550774272616, -0.8719748950976475, -0.5813367556690181, 0.7457296853584616, 0.7432821334878895, -0.5843158268289446, -0.870174289183519, 0.39534560504897837, 0.9560289824265693}, {0.64314065170999, -0.9970837803306998, 0.5191145844484333, 0.39197550774272616, -0.9760226149538952, 0.7457296853584616, 0.1067594209631354, -0.870174289183519, 0.9075631905615887, -0.187730865010247, -0.6887338553031781, 0.9905566108870916, -0.46591295615435313, -0.44746305790115903}, {-0.032401674147217494, -0.1841286755130694, 0.39197550774272616, -0.5813367556690181, 0.7432821334878895, -0.870174289183519, 0.9560289824265693, -0.9967973016436514, 0.9905566108870916, -0.9376012214411736, 0.8404285120874396, -0.7036211525980088, 0.5336309848028128, -0.3384747534102578}, {-0.6913872085223244, 0.957097725720417, -0.9760226149538952, 0.7432821334878895, -0.31888792310970165, -0.187730865010247, 0.6459436459222883, -0.9376012214411736, 0.987500301463081, -0.7827745135506544, 0.37621196990266487, 0.12735603593086048, -0.5980855567720366, 0.9145999794700689}, {-0.9970837803306998, 0.39197550774272616, 0.7457296853584616, -0.870174289183519, -0.187730865010247, 0.9905566108870916, -0.44746305790115903, -0.7036211525980088, 0.8986597641266819, 0.12735603593086048, -0.9803267573911277, 0.5012779986293977, 0.6588824957315815, -0.9237860638944368}};
 static const int DK_RR_MONOMIAL_RULES[5][4] = {{0, 4, 1, 3}, {1, 5, 2, 4}, {3, 7, 4, 6}, {4, 8, 5, 7}, {6, 10, 7, 9}};
 static const double DK_RR_MOTIONS[2][4][4] = {{{0.999999996152, -6.400143989332459e-05, -5.999846390000934e-05, 3.6e-05}, {6.399855989334209e-05, 0.9999999968000001, -4.800191991998833e-05, 4.8e-05}, {6.000153589999067e-05, 4.799807992001167e-05, 0.999999997048, -8e-05}, {0.0, 0.0, 0.0, 1.0}}, {{0.9999999846080001, 0.0001279942391467017, 0.00012000614319996266, 5.399999999999999e-05}, {-0.0001280057591466317, 0.9999999872, 9.59923193600467e-05, 7.199999999999999e-05}, {-0.00011999385520003735, -9.600767935995333e-05, 0.9999999881920001, -0.00011999999999999999}, {0.0, 0.0, 0.0, 1.0}}};
@@ -948,10 +953,10 @@ static int dk_rr_unmix(double V[3][12])
     return n;
 }
 
-/* theta4 (step 3) or theta5 (step 1) from a null vector's entry ratios */
+/* theta4 (step 3) or theta5 (step 1) from a null vector's entry ratios and the shifts */
 static double dk_rr_ratio_angle(const double v[12], int step)
 {
-    double across = 0.0, low = 0.0, high = 0.0;
+    double across = 0.0, low = 0.0, high = 0.0, shift;
     int i, j;
     for (i = 0; i < 4; i++) {
         for (j = 0; j < 3; j++) {
@@ -964,10 +969,11 @@ static double dk_rr_ratio_angle(const double v[12], int step)
             }
         }
     }
+    shift = step == 3 ? DK_RR_SHIFT4 : DK_RR_SHIFT5;
     if (low >= high) {
-        return 2.0 * atan2(across, low);
+        return 2.0 * atan2(across, low) + shift;
     }
-    return 2.0 * atan2(high, across);
+    return 2.0 * atan2(high, across) + shift;
 }
 
 /* M := M A_i(t) (standard DH row i: d, a, cos alpha, sin alpha) */
@@ -1231,11 +1237,11 @@ static double dk_rr_steps(const double rows[7][4], const double F[4][4], double 
    best point met (the Python solver's _rr_newton): q in place, the pose error there; *used
    set where the damped steps were taken */
 static double dk_rr_newton(const double rows[7][4], const double F[4][4], double q[6],
-                           int *used)
+                           int *used, int extra)
 {
     double damped[6], error = dk_rr_steps(rows, F, q, 0), damped_error;
     int i;
-    *used = error > DK_RR_GOOD;
+    *used = error > DK_RR_GOOD && !extra; /* (an extra gets Newton's steps only) */
     if (!*used) {
         return error;
     }
@@ -1481,18 +1487,28 @@ static void dk_sort_doubles(double *x, int n)
     }
 }
 
-/* the candidate joint vectors of one split: their count written to out; *doubt: whether
-   the answer is in doubt (clusters, or no usable pencil) */
+/* whether a root y is kept: any where joint 3 turns; where it slides, |d3| within reach */
+static int dk_rr_within_reach(const double rows[7][4], const double *moebius, double y,
+                              double reach)
+{
+    return rows[6][0] == 0.0 ||
+           fabs(moebius[0] * y + moebius[1]) <= reach * fabs(moebius[2] * y + moebius[3]);
+}
+
+/* the candidate joint vectors of one split: their count written to out, extra[c] set for
+   those from nearly real pairs; *doubt: whether the answer is in doubt (clusters, or no
+   usable pencil) */
 static int dk_rr_candidates(const double values[490], const double F[4][4],
-                            const double rows[7][4], double out[4 * DK_RR_MAX][6], int *doubt,
-                            double imag_tol)
+                            const double rows[7][4], double out[DK_RR_CANDS][6], int extra[],
+                            int *doubt, double imag_tol)
 {
     double N[14][14], A6[6][9], B6[6][9], C6[6][9], pencil[3][12][12], best_pencil[3][12][12];
-    double K[24][24], rhs[12][24], wr[24], wi[24], reals[24], V[3][12], best = HUGE_VAL;
+    double K[24][24], rhs[12][24], wr[24], wi[24], reals[24], extras[48], V[3][12];
+    double best = HUGE_VAL;
     /* a sliding joint 3: |d3| <= |p| + the other links' lengths (roots beyond are spurious) */
     double reach = fabs(F[0][3]) + fabs(F[1][3]) + fabs(F[2][3]);
     const double *moebius = DK_RR_MOEBIUS[0];
-    int rank_rows, i, m, r, col, c, n_real = 0, count = 0, start = 0;
+    int rank_rows, i, m, r, col, c, n_real = 0, n_extra = 0, count = 0, start = 0;
     const double(*P0)[9] = (const double(*)[9])values;
     const double(*Ps)[9] = (const double(*)[9])(values + 126);
     const double(*Pc)[9] = (const double(*)[9])(values + 252);
@@ -1574,26 +1590,39 @@ static int dk_rr_candidates(const double values[490], const double F[4][4],
         return 0;
     }
     for (i = 0; i < 24; i++) {
-        const double y = wr[i];
-        if (fabs(wi[i]) <= imag_tol * (1.0 + hypot(wr[i], wi[i])) &&
-            (rows[6][0] == 0.0 ||
-             fabs(moebius[0] * y + moebius[1]) <= reach * fabs(moebius[2] * y + moebius[3]))) {
-            reals[n_real++] = y; /* (a sliding joint 3's roots beyond reach left out) */
+        const double size = 1.0 + hypot(wr[i], wi[i]);
+        int side;
+        if (fabs(wi[i]) <= imag_tol * size) {
+            if (dk_rr_within_reach(rows, moebius, wr[i], reach)) {
+                reals[n_real++] = wr[i];
+            }
+        } else if (imag_tol * size < wi[i] && wi[i] <= DK_RR_PAIR_TOL * size) {
+            for (side = -1; side <= 1; side += 2) { /* a nearly real pair: Re -+ Im */
+                const double y = wr[i] + side * wi[i];
+                if (dk_rr_within_reach(rows, moebius, y, reach)) {
+                    extras[n_extra++] = y;
+                }
+            }
         }
     }
     dk_sort_doubles(reals, n_real);
+    dk_sort_doubles(extras, n_extra);
     *doubt = 0;
-    while (start < n_real) {
+    while (start < n_real + n_extra) {
         double y = 0.0, theta3, S[12][12];
-        int stop = start + 1, clustered, nv, plane, v;
-        while (stop < n_real &&
-               reals[stop] - reals[stop - 1] <= DK_RR_CLUSTER_TOL * (1.0 + fabs(reals[stop]))) {
-            stop++;
+        int stop = start + 1, clustered, nv, plane, v, is_extra = start >= n_real;
+        if (is_extra) { /* (on their own: they put nothing in doubt) */
+            y = extras[start - n_real];
+        } else {
+            while (stop < n_real && reals[stop] - reals[stop - 1] <=
+                                        DK_RR_CLUSTER_TOL * (1.0 + fabs(reals[stop]))) {
+                stop++;
+            }
+            for (i = start; i < stop; i++) {
+                y += reals[i];
+            }
+            y /= (double)(stop - start);
         }
-        for (i = start; i < stop; i++) {
-            y += reals[i];
-        }
-        y /= (double)(stop - start);
         clustered = stop - start > 1;
         start = stop;
         if (rows[6][0] != 0.0) { /* joint 3 slides: x3 is d3 */
@@ -1609,7 +1638,7 @@ static int dk_rr_candidates(const double values[490], const double F[4][4],
         }
         nv = dk_null_right(S, V, &plane);
         if (clustered || plane) {
-            *doubt = 1;
+            *doubt |= !is_extra;
             if (nv == 2) {
                 nv = 1 + dk_rr_unmix(V);
             }
@@ -1620,10 +1649,11 @@ static int dk_rr_candidates(const double values[490], const double F[4][4],
             int pairs = dk_rr_joints12(rows, F, theta3, t4, t5, t12), p;
             for (p = 0; p < pairs; p++) {
                 double q5[5];
-                if (count == 4 * DK_RR_MAX) {
-                    *doubt = 1;
+                if (count == DK_RR_CANDS) {
+                    *doubt |= !is_extra;
                     return count;
                 }
+                extra[count] = is_extra;
                 q5[0] = out[count][0] = t12[p][0];
                 q5[1] = out[count][1] = t12[p][1];
                 q5[2] = out[count][2] = theta3;
@@ -1642,8 +1672,8 @@ static int dk_rr_candidates(const double values[490], const double F[4][4],
 static int dk_rr_split(int k, const double F[4][4], const double moved[4][4],
                        double out[DK_RR_ROWS][6], int count, int *doubt, double imag_tol)
 {
-    double values[490], cands[4 * DK_RR_MAX][6], between[7][4];
-    int perturbed = 0, damped = 0, n, c, i, j, r;
+    double values[490], cands[DK_RR_CANDS][6], between[7][4];
+    int extra[DK_RR_CANDS], perturbed = 0, damped = 0, n, c, i, j, r;
     for (i = 0; i < 6; i++) {
         for (j = 0; j < 4; j++) {
             if (DK_RR_FILL[k][i][j] != DK_RR_TRUE[k][i][j]) {
@@ -1656,7 +1686,7 @@ static int dk_rr_split(int k, const double F[4][4], const double moved[4][4],
     }
     dk_rr_fill(k, moved[0][2], moved[1][2], moved[2][2], moved[0][3], moved[1][3], moved[2][3],
                values);
-    n = dk_rr_candidates(values, moved, DK_RR_FILL[k], cands, doubt, imag_tol);
+    n = dk_rr_candidates(values, moved, DK_RR_FILL[k], cands, extra, doubt, imag_tol);
     for (c = 0; c < n; c++) {
         double q[6], error, arm[6];
         int seen = 0;
@@ -1669,12 +1699,12 @@ static int dk_rr_split(int k, const double F[4][4], const double moved[4][4],
                 dk_rr_steps(between, F, q, 0); /* Newton only on the way */
             }
         }
-        error = dk_rr_newton(DK_RR_TRUE[k], F, q, &damped);
-        if (damped && !perturbed) { /* Newton alone did not settle it */
+        error = dk_rr_newton(DK_RR_TRUE[k], F, q, &damped, extra[c]);
+        if (damped && !perturbed && !extra[c]) { /* Newton alone did not settle it */
             *doubt = 1;
         }
         if (error > DK_RR_GOOD) {
-            if (!perturbed) {
+            if (!perturbed && !extra[c]) {
                 *doubt = 1;
             }
             continue;

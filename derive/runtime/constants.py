@@ -56,6 +56,14 @@ MAX_FREE_VALUES = 100_000
 _RR_RANK_TOL = 1e-10
 _RR_COND_LIMIT = 1e8
 _RR_MOEBIUS = ((1.0, 0.3, -0.4, 1.0), (1.0, -0.7, 0.5, 1.0), (0.6, 1.0, -1.0, 0.8))
+# the null vector's variables are x4 = tan((theta4 - _RR_SHIFT45[0]) / 2) and x5 likewise:
+# half-angles of generic shifts, so that the angles where x is infinite (shift + pi) are not
+# the special values joints and offsets take (with no shift, theta4 or theta5 = pi at 0 or 180
+# degree samples put the solution at x = infinity and the first split lost it)
+_RR_SHIFT45 = (0.37, -0.61)
+# a complex pair with 0 < Im <= _RR_PAIR_TOL (1 + |y|) is also tried, at Re -+ Im (two near
+# real roots its rounding split apart)
+_RR_PAIR_TOL = 0.05
 _RR_IMAG_TOL = 1e-6
 # where nothing certifies otherwise (the pose's pencil is singular: a curve of solutions), the
 # eigenvalues with |Im| <= _RR_IMAG_LOOSE (1 + |y|) are tried too

@@ -38,21 +38,33 @@ from derive.runtime.constants import (
     _RR_NEWTON_REACH,
     _RR_NEWTON_STEPS,
     _RR_NULL2_TOL,
+    _RR_PAIR_TOL,
     _RR_PATH,
     _RR_RANK_TOL,
     _RR_RESCUE,
+    _RR_SHIFT45,
     _TWO_PI,
 )
 
-# m45 (1 + x4^2)(1 + x5^2) = _RR_H45 [x4^i x5^j], column 3 i + j (ALGORITHMS.md 4.5): rows
-# are outer products of the coefficients over (1, x, x^2) of 2x, 1 - x^2 and 1 + x^2
-_RR_S, _RR_C, _RR_O = (0.0, 2.0, 0.0), (1.0, 0.0, -1.0), (1.0, 0.0, 1.0)
+
+def _rr_half_angle(shift):
+    """The coefficients over (1, x, x^2) of (1 + x^2) sin t, (1 + x^2) cos t and 1 + x^2 for
+    x = tan((t - shift) / 2): sin t = sin shift c' + cos shift s' and cos t = cos shift c' -
+    sin shift s' with s' (1 + x^2) = 2x and c' (1 + x^2) = 1 - x^2."""
+    cs, ss = math.cos(shift), math.sin(shift)
+    return (ss, 2.0 * cs, -ss), (cs, -2.0 * ss, -cs), (1.0, 0.0, 1.0)
+
+
+# m45 (1 + x4^2)(1 + x5^2) = _RR_H45 [x4^i x5^j], column 3 i + j (ALGORITHMS.md 4.5, with the
+# half-angles of _RR_SHIFT45): rows are outer products of _rr_half_angle's coefficients
+_RR_S4, _RR_C4, _RR_O4 = _rr_half_angle(_RR_SHIFT45[0])
+_RR_S5, _RR_C5, _RR_O5 = _rr_half_angle(_RR_SHIFT45[1])
 _RR_H45 = np.array(
     [
         [u[i] * w[j] for i in range(3) for j in range(3)]
         for u, w in zip(
-            (_RR_S, _RR_S, _RR_C, _RR_C, _RR_S, _RR_C, _RR_O, _RR_O, _RR_O),
-            (_RR_S, _RR_C, _RR_S, _RR_C, _RR_O, _RR_O, _RR_S, _RR_C, _RR_O),
+            (_RR_S4, _RR_S4, _RR_C4, _RR_C4, _RR_S4, _RR_C4, _RR_O4, _RR_O4, _RR_O4),
+            (_RR_S5, _RR_C5, _RR_S5, _RR_C5, _RR_O5, _RR_O5, _RR_S5, _RR_C5, _RR_O5),
         )
     ]
 )
@@ -162,7 +174,7 @@ def _rr_split(k, F, moved, imag_tol=_RR_IMAG_TOL):
     Ps = values[126:252].reshape(14, 9)
     Pc = values[252:378].reshape(14, 9)
     Q = values[378:].reshape(14, 8)
-    candidates, doubt = _rr_candidates(P0, Ps, Pc, Q, moved, fill_rows, slide, imag_tol)
+    candidates, doubt, extras = _rr_candidates(P0, Ps, Pc, Q, moved, fill_rows, slide, imag_tol)
     # a perturbed table's solutions are walked back to the arm's in steps (a continuation),
     # so that Newton does not jump to another branch
     path = (
@@ -177,12 +189,14 @@ def _rr_split(k, F, moved, imag_tol=_RR_IMAG_TOL):
     Q = np.array(candidates)
     for rows in path:  # (Newton's steps only: damped ones may change branch on the way)
         Q, _ = _rr_steps_many(rows, F, Q, slide, False)
-    Q, residuals, damped = _rr_newton_many(true_rows, F, Q, slide)
-    for q, residual, was_damped in zip(Q, residuals, damped):
-        if was_damped and fill_rows == true_rows:  # Newton alone did not settle it
+    Q, residuals, damped = _rr_newton_many(true_rows, F, Q, slide, np.array(extras))
+    for q, residual, was_damped, extra in zip(Q, residuals, damped, extras):
+        if was_damped and fill_rows == true_rows and not extra:  # Newton did not settle it
             doubt = True
         if residual <= _RR_GOOD:
             out.append(q)
+            continue
+        if extra:
             continue
         if residual <= _RR_NEAR:
             close.append(q)
@@ -204,13 +218,21 @@ def _rr_between(fill_rows, true_rows, t):
 
 def _rr_candidates(P0, Ps, Pc, Q, F, rows, slide=_RR_TURNS, imag_tol=_RR_IMAG_TOL):
     """The unpolished joint values of one split from its matrices (ALGORITHMS.md 4.4-4.7),
-    and whether the eigenvalues came in clusters (an answer in doubt). Where joint 3 slides
-    (slide[0] set) the eigen-variable x3 is d3 itself, not tan(theta3 / 2)."""
+    whether the eigenvalues came in clusters (an answer in doubt), and which candidates are
+    extras (from nearly real pairs: one that does not polish puts nothing in doubt). Where
+    joint 3 slides (slide[0] set) the eigen-variable x3 is d3 itself, not tan(theta3 / 2)."""
     found = _rr_eigenvalues(P0, Ps, Pc, Q)
     if found is None:
-        return [], True
+        return [], True, []
     values, (A, B, C), moebius = found
-    real = np.sort(values[np.abs(values.imag) <= imag_tol * (1.0 + np.abs(values))].real)
+    size = 1.0 + np.abs(values)
+    real = values[np.abs(values.imag) <= imag_tol * size].real
+    # a pair y +- i eta nearly real (two near-equal real roots of a near-singular pose the
+    # pencil's rounding split apart: the twins of a nearly folded elbow or wrist) is tried at
+    # y - eta and y + eta (Newton and the certification decide)
+    pair = values[(values.imag > imag_tol * size) & (values.imag <= _RR_PAIR_TOL * size)]
+    extra = np.sort(np.concatenate((pair.real - pair.imag, pair.real + pair.imag)))
+    real = np.sort(real)
     ma, mb, mc, md = moebius
     if slide[0]:
         # a sliding joint 3 moves the flange by d3 along its axis, the other links by at most
@@ -219,6 +241,7 @@ def _rr_candidates(P0, Ps, Pc, Q, F, rows, slide=_RR_TURNS, imag_tol=_RR_IMAG_TO
         # clustering.
         reach = float(np.abs(F[:3, 3]).sum()) + sum(abs(r[0]) + abs(r[1]) for r in rows)
         real = real[np.abs(ma * real + mb) <= reach * np.abs(mc * real + md)]
+        extra = extra[np.abs(ma * extra + mb) <= reach * np.abs(mc * extra + md)]
     doubt = False
     ys: list[list[float]] = []
     for y in real:
@@ -227,15 +250,17 @@ def _rr_candidates(P0, Ps, Pc, Q, F, rows, slide=_RR_TURNS, imag_tol=_RR_IMAG_TO
             doubt = True
         else:
             ys.append([y])
+    primary = len(ys)
+    ys += [[y] for y in extra]  # (on their own: they put nothing in doubt)
     if not ys:
-        return [], doubt
+        return [], doubt, []
     # every cluster's null space at once (one stacked SVD), then every candidate's theta1,
     # theta2 and theta6 at once
     centres = np.array([sum(cluster) / len(cluster) for cluster in ys])
     Y = centres[:, None, None]
     _, svs, vts = np.linalg.svd(A * Y * Y + B * Y + C)
-    thetas3, vectors = [], []
-    for cluster, y, sv, vt in zip(ys, centres, svs, vts):
+    thetas3, vectors, optional = [], [], []
+    for k, (cluster, y, sv, vt) in enumerate(zip(ys, centres, svs, vts)):
         if slide[0]:
             theta3 = (ma * y + mb) / (mc * y + md)
         else:
@@ -244,22 +269,28 @@ def _rr_candidates(P0, Ps, Pc, Q, F, rows, slide=_RR_TURNS, imag_tol=_RR_IMAG_TO
         if len(cluster) > 1 or sv[-2] <= _RR_NULL2_TOL * sv[0]:
             # two solutions may share theta3: both from the null space's plane
             found += _rr_unmix(vt[-1], vt[-2])
-            doubt = True
+            doubt = doubt or k < primary
         thetas3 += [float(theta3)] * len(found)
         vectors += found
+        optional += [k >= primary] * len(found)
     V = np.array(vectors)
     T345 = np.column_stack(
-        (thetas3, _rr_ratio_angles(V, _RR_X4_PAIRS), _rr_ratio_angles(V, _RR_X5_PAIRS))
+        (
+            thetas3,
+            _rr_ratio_angles(V, _RR_X4_PAIRS) + _RR_SHIFT45[0],
+            _rr_ratio_angles(V, _RR_X5_PAIRS) + _RR_SHIFT45[1],
+        )
     )
-    joints = [
-        (t1, t2, *t345)
-        for t345, pairs in zip(T345.tolist(), _rr_joints12_many(rows, F, T345, slide))
-        for t1, t2 in pairs
-    ]
+    joints, extras = [], []
+    for t345, pairs, extra_one in zip(
+        T345.tolist(), _rr_joints12_many(rows, F, T345, slide), optional
+    ):
+        joints += [(t1, t2, *t345) for t1, t2 in pairs]
+        extras += [extra_one] * len(pairs)
     if not joints:
-        return [], doubt
+        return [], doubt, []
     X = np.array(joints)
-    return list(np.column_stack((X, _rr_theta6_many(rows, F, X, slide)))), doubt
+    return list(np.column_stack((X, _rr_theta6_many(rows, F, X, slide)))), doubt, extras
 
 
 def _rr_joints12_many(rows, F, T345, slide):
@@ -416,7 +447,8 @@ def _rr_unmix(v1, v2):
 
 def _rr_ratio_angles(V, pairs):
     """Per row v of V, the angle t with x = tan(t / 2) the common ratio v[hi] / v[lo] of the
-    pairs, by least squares in the direction (lo, hi): x = inf (t = pi) is fine."""
+    pairs, by least squares in the direction (lo, hi): x = inf (t = pi) is fine. (theta4 and
+    theta5 are t plus their _RR_SHIFT45.)"""
     lo, hi = V[:, pairs[0]], V[:, pairs[1]]
     across, low, high = (hi * lo).sum(axis=1), (lo * lo).sum(axis=1), (hi * hi).sum(axis=1)
     return 2.0 * np.where(low >= high, np.arctan2(across, low), np.arctan2(high, across))
@@ -455,7 +487,7 @@ def _rr_theta6_many(rows, F, X, slide):
     return np.arctan2(R[:, 1, 0], R[:, 0, 0])
 
 
-def _rr_newton_many(rows, F, Q, slide=_RR_TURNS):
+def _rr_newton_many(rows, F, Q, slide, extras):
     """Newton steps on the split's forward kinematics (geometric Jacobian) from each row of Q
     towards F, then, for those they do not bring within _RR_GOOD, Levenberg-Marquardt steps
     from the best point met: the polished rows, their final errors (largest entry of the top
@@ -463,9 +495,9 @@ def _rr_newton_many(rows, F, Q, slide=_RR_TURNS):
     damped steps (a candidate Newton does not settle puts the answer in doubt, as before they
     existed). Newton's steps again after the damped ones: a regular solution the damped steps
     reach slowly is settled exactly, not left a rounding's width from the same solution found
-    otherwise."""
+    otherwise. Rows marked in extras get Newton's steps only."""
     Q, errors = _rr_steps_many(rows, F, Q, slide, False)
-    damped = errors > _RR_GOOD
+    damped = (errors > _RR_GOOD) & ~extras  # (an extra Newton does not settle is dropped)
     if damped.any():
         tried = np.flatnonzero(damped)
         D, damped_errors = _rr_steps_many(rows, F, Q[tried], slide, True)

@@ -55,8 +55,10 @@ from derive.runtime.constants import (
     _RR_NEWTON_REACH,
     _RR_NEWTON_STEPS,
     _RR_NULL2_TOL,
+    _RR_PAIR_TOL,
     _RR_PATH,
     _RR_RANK_TOL,
+    _RR_SHIFT45,
     _SEAM,
     _SEAM_SNAP,
     _TWO_PI,
@@ -491,18 +493,19 @@ def _krr_split(k, F, moved, out, count):
     _rr_fill(
         k, moved[0, 2], moved[1, 2], moved[2, 2], moved[0, 3], moved[1, 3], moved[2, 3], values
     )
-    cands = np.zeros((4 * _KRR_MAX, 6))
-    n, doubt = _krr_candidates(values, moved, fill, cands)
+    cands = np.zeros((8 * _KRR_MAX, 6))
+    extra = np.zeros(8 * _KRR_MAX, dtype=np.bool_)
+    n, doubt = _krr_candidates(values, moved, fill, cands, extra)
     for c in range(n):
         q = cands[c].copy()
         if perturbed:
             for t in _RR_PATH:
                 q, _ = _krr_steps(_krr_between(fill, true, t), F, q, False)
-        q, error, damped = _krr_newton(true, F, q)
-        if damped and not perturbed:
+        q, error, damped = _krr_newton(true, F, q, extra[c])
+        if damped and not perturbed and not extra[c]:
             doubt = True
         if error > _RR_GOOD:
-            if not perturbed:
+            if not perturbed and not extra[c]:
                 doubt = True
             continue
         if true[6, 0] != 0.0:  # a sliding joint 3, in the arm's lengths
@@ -526,13 +529,14 @@ def _krr_split(k, F, moved, out, count):
 
 
 # the most candidates of one split: 16 eigenvalues, each with up to 3 null vectors (one, and
-# two from a plane) and 2 values of theta2
+# two from a plane) and 2 values of theta2 (room for 8 times as many: the extras too)
 _KRR_MAX = 16
 
 
-def _krr_candidates(values, F, rows, out):
-    """_rr_candidates in the kernel: the count of candidate joint vectors written to out and
-    whether the answer is in doubt (clusters, or no usable pencil)."""
+def _krr_candidates(values, F, rows, out, extra):
+    """_rr_candidates in the kernel: the count of candidate joint vectors written to out,
+    whether the answer is in doubt (clusters, or no usable pencil), and in extra which
+    candidates come from nearly real pairs."""
     P0 = values[:126].reshape(14, 9)
     Ps = values[126:252].reshape(14, 9)
     Pc = values[252:378].reshape(14, 9)
@@ -591,13 +595,22 @@ def _krr_candidates(values, F, rows, out):
         reach += abs(rows[i, 0]) + abs(rows[i, 1])
     reals = np.zeros(24)
     n_real = 0
+    extras = np.zeros(48)  # (nearly real pairs, at Re -+ Im: as in Python)
+    n_extra = 0
     for i in range(24):
-        if abs(wi[i]) <= _RR_IMAG_TOL * (1.0 + math.hypot(wr[i], wi[i])):
+        size = 1.0 + math.hypot(wr[i], wi[i])
+        if abs(wi[i]) <= _RR_IMAG_TOL * size:
             y = wr[i]
             if rows[6, 0] == 0.0 or abs(ma * y + mb) <= reach * abs(mc * y + md):
                 reals[n_real] = y
                 n_real += 1
+        elif _RR_IMAG_TOL * size < wi[i] <= _RR_PAIR_TOL * size:
+            for y in (wr[i] - wi[i], wr[i] + wi[i]):
+                if rows[6, 0] == 0.0 or abs(ma * y + mb) <= reach * abs(mc * y + md):
+                    extras[n_extra] = y
+                    n_extra += 1
     reals = np.sort(reals[:n_real])
+    extras = np.sort(extras[:n_extra])
     doubt = False
     count = 0
     start = 0
@@ -611,32 +624,53 @@ def _krr_candidates(values, F, rows, out):
         y = reals[start:stop].mean()
         clustered = stop - start > 1
         start = stop
-        if rows[6, 0] != 0.0:  # joint 3 slides: x3 is d3
-            theta3 = (ma * y + mb) / (mc * y + md)
-        else:
-            theta3 = 2.0 * math.atan2(ma * y + mb, mc * y + md)
-        S = A * (y * y) + B * y + C
-        nv, plane = _knull_right(S, V)
-        if clustered or plane:
-            doubt = True
-            if nv == 2:
-                nv = 1 + _krr_unmix(V)
-        for v in range(nv):
-            t4 = _krr_ratio_angle(V[v], 3)
-            t5 = _krr_ratio_angle(V[v], 1)
-            pairs, t1a, t2a, t1b, t2b = _krr_joints12(rows, F, theta3, t4, t5)
-            for p in range(pairs):
-                if count == out.shape[0]:
-                    return count, True
-                t1 = t1a if p == 0 else t1b
-                t2 = t2a if p == 0 else t2b
-                out[count, 0] = t1
-                out[count, 1] = t2
-                out[count, 2] = theta3
-                out[count, 3] = t4
-                out[count, 4] = t5
-                out[count, 5] = _krr_theta6(rows, F, t1, t2, theta3, t4, t5)
-                count += 1
+        count, more = _krr_value(A, B, C, moebius, rows, F, y, clustered, V, out, count)
+        doubt = doubt or more
+        if count < 0:
+            return -count, True
+    primary = count
+    for e in range(n_extra):
+        count, _ = _krr_value(A, B, C, moebius, rows, F, extras[e], False, V, out, count)
+        if count < 0:
+            count = -count
+            break
+    for c in range(out.shape[0]):
+        extra[c] = c >= primary
+    return count, doubt
+
+
+def _krr_value(A, B, C, moebius, rows, F, y, clustered, V, out, count):
+    """The candidates of one value y of the eigen-variable (a cluster's mean where clustered)
+    appended to out from row count: the new count (its negative where out filled up) and
+    whether they put the answer in doubt (a cluster, a plane of null vectors)."""
+    ma, mb, mc, md = moebius
+    if rows[6, 0] != 0.0:  # joint 3 slides: x3 is d3
+        theta3 = (ma * y + mb) / (mc * y + md)
+    else:
+        theta3 = 2.0 * math.atan2(ma * y + mb, mc * y + md)
+    S = A * (y * y) + B * y + C
+    nv, plane = _knull_right(S, V)
+    doubt = False
+    if clustered or plane:
+        doubt = True
+        if nv == 2:
+            nv = 1 + _krr_unmix(V)
+    for v in range(nv):
+        t4 = _krr_ratio_angle(V[v], 3)
+        t5 = _krr_ratio_angle(V[v], 1)
+        pairs, t1a, t2a, t1b, t2b = _krr_joints12(rows, F, theta3, t4, t5)
+        for p in range(pairs):
+            if count == out.shape[0]:
+                return -count, True
+            t1 = t1a if p == 0 else t1b
+            t2 = t2a if p == 0 else t2b
+            out[count, 0] = t1
+            out[count, 1] = t2
+            out[count, 2] = theta3
+            out[count, 3] = t4
+            out[count, 4] = t5
+            out[count, 5] = _krr_theta6(rows, F, t1, t2, theta3, t4, t5)
+            count += 1
     return count, doubt
 
 
@@ -848,7 +882,8 @@ def _krr_unmix(V):
 
 
 def _krr_ratio_angle(v, step):
-    """_rr_ratio_angle in the kernel: step 3 gives theta4, step 1 theta5."""
+    """_rr_ratio_angles in the kernel: step 3 gives theta4, step 1 theta5 (with their
+    _RR_SHIFT45)."""
     across = 0.0
     low = 0.0
     high = 0.0
@@ -860,9 +895,10 @@ def _krr_ratio_angle(v, step):
                 across += lo * hi
                 low += lo * lo
                 high += hi * hi
+    shift = _RR_SHIFT45[0] if step == 3 else _RR_SHIFT45[1]
     if low >= high:
-        return 2.0 * math.atan2(across, low)
-    return 2.0 * math.atan2(high, across)
+        return 2.0 * math.atan2(across, low) + shift
+    return 2.0 * math.atan2(high, across) + shift
 
 
 def _krr_link(t, rows, i, M):
@@ -983,10 +1019,10 @@ def _krr_between(fill, true, t):
     return out
 
 
-def _krr_newton(rows, F, q0):
+def _krr_newton(rows, F, q0, extra):
     """_rr_newton_many (derive/runtime/general.py) for one candidate, in the kernel."""
     q, error = _krr_steps(rows, F, q0, False)
-    if error <= _RR_GOOD:
+    if error <= _RR_GOOD or extra:
         return q, error, False
     damped, damped_error = _krr_steps(rows, F, q, True)
     if damped_error < error:
