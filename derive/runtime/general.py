@@ -8,8 +8,11 @@ and Q (``_rr_fill``). From there the steps are the same for every arm (ALGORITHM
 2. the half-angle substitution and the dialytic lift give a 12 x 12 quadratic matrix
    polynomial in y, x3 = tan(theta3 / 2) = (a y + b) / (c y + d) (a Moebius map, so that
    theta3 = pi is a finite y); its real eigenvalues (24 x 24 companion matrix) give theta3;
-3. the null space of the matrix at each eigenvalue (SVD) gives theta4 and theta5; a
-   two-dimensional one (two solutions sharing theta3) is split by the monomial structure;
+3. the null space of the matrix at each eigenvalue (SVD) gives theta4 and theta5 (its
+   variables are x = tan((theta - shift) / 2), shifts _RR_SHIFT45, so that theta4, theta5 =
+   pi are finite too); a two-dimensional one (two solutions sharing theta3) is split by the
+   monomial structure; a nearly real pair of eigenvalues (imaginary part within
+   _RR_PAIR_TOL (1 + |y|)) is also tried at Re -+ Im, as optional candidates;
 4. theta1, theta2 by least squares from Q m12 = P m45, theta6 from the pose;
 5. Newton steps on the arm's forward kinematics polish every candidate, then, where they do
    not converge (a pose with a curve of solutions), Levenberg-Marquardt steps.
@@ -17,7 +20,8 @@ and Q (``_rr_fill``). From there the steps are the same for every arm (ALGORITHM
 A pose whose answer is in doubt (a candidate that does not polish, eigenvalues in a cluster,
 an odd number of solutions, none at all) is solved again with the runner-up split and then
 from slightly moved poses (a rescue), every candidate polished back onto the true pose; the
-union of what certifies is returned.
+union of what certifies is returned. The tolerances are stated beside their values in
+derive/runtime/constants.py.
 """
 
 from __future__ import annotations
