@@ -133,6 +133,22 @@ def test_an_arm_singular_everywhere_is_refused_with_the_reason():
     assert "rank below 6 at every configuration (axes 3-6 are parallel)" in plan.refusal
 
 
+def test_an_arm_with_joint_4_prismatic_singular_everywhere_is_refused():
+    """An arm the long run drew (modified DH, joint 4 sliding): its Jacobian has rank 5 at
+    every configuration (smallest singular value 1e-17 of the largest), and the verification
+    found every sample singular. The check ran on the arm's chain with its sliding joint 4
+    taken as a revolute one (and passed: 1e-2); it runs on the chain whose joint 3 slides
+    (the reversal) now, and the arm is refused with the reason."""
+    rows = [(180.0, 0.0, 0.0, -90.0), (180.0, 110.614623, 651.285644, 150.18)]
+    rows += [(0.0, 500.568675, 0.0, 180.0), (90.0, 0.0, 0.0, 5.082)]
+    rows += [(180.0, -598.147617, 0.0, 90.0), (135.0, -813.395727, 0.0, 0.0)]
+    text = spec_text("slider_flat", "modified", rows, kinds="RRRPRR")
+    text = text.replace('type = "P"\n', 'type = "P"\nlimits = [-1000.0, 1000.0]\n')
+    plan = build_plan(parse_spec(text, "<test>"))
+    assert plan.ik is None
+    assert "general: the arm's Jacobian has rank below 6 at every configuration" in plan.refusal
+
+
 # numba compiles a general arm's kernel in 70-150 s: the compiled case runs where asked
 LONG = os.environ.get("DERIVE_LONG_TESTS") == "1"
 

@@ -66,15 +66,16 @@ def derive(chain: Chain, structure: Structure) -> IkPlan | str:
     )
     if length == 0.0:
         return "general: every link length and offset is zero (the arm is a point)"
-    if everywhere_singular(flange_rows(chain, length), slide_of(chain)):
+    chains = (chain, reverse_chain(chain))
+    # the chains whose joint 3 is the sliding joint, if there is one
+    usable = [k for k in (0, 1) if not sliding or chains[k].joints[2].kind == "P"]
+    # (on a chain whose sliding joint is its joint 3: the rows hold no other kind of joint)
+    if everywhere_singular(flange_rows(chains[usable[0]], length), slide_of(chains[usable[0]])):
         return (
             "general: the arm's Jacobian has rank below 6 at every configuration"
             f"{parallel_run(structure)}: it reaches a set of poses of dimension below 6, each "
             "along a curve of solutions; no solver is generated"
         )
-    chains = (chain, reverse_chain(chain))
-    # the chains whose joint 3 is the sliding joint, if there is one
-    usable = [k for k in (0, 1) if not sliding or chains[k].joints[2].kind == "P"]
     splits = [measure(chains[k], k, length, False) for k in usable]
     if max(s.recovered for s in splits) < POSES or len(splits) < 2:
         splits += [measure(chains[k], k, length, True) for k in usable]
