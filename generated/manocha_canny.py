@@ -1239,7 +1239,8 @@ def _rr_chain(X, rows, slide, first=0):
     key = (tuple(map(tuple, rows)), slide[0], first, count)
     weights = _RR_CHAIN_WEIGHTS.get(key)
     if weights is None:  # (a split's rows are the same pose after pose: computed once)
-        weights = _RR_CHAIN_WEIGHTS[key] = _rr_chain_weights(*key)
+        weights = _rr_chain_weights(*key)
+        _RR_CHAIN_WEIGHTS[key] = weights
     sliding = 2 - first if slide[0] and first <= 2 < first + count else -1
     angles = X
     if sliding >= 0:
