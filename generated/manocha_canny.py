@@ -1791,62 +1791,46 @@ def _krr_candidates(values, F, rows, out, extra):
     count = 0
     start = 0
     V = np.zeros((3, 12))
-    while start < n_real:
+    while start < n_real + n_extra:  # the clusters of real values, then each extra value
         stop = start + 1
-        while stop < n_real and reals[stop] - reals[stop - 1] <= _RR_CLUSTER_TOL * (
-            1.0 + abs(reals[stop])
-        ):
-            stop += 1
-        y = reals[start:stop].mean()
+        is_extra = start >= n_real
+        if is_extra:  # (on their own: they put nothing in doubt)
+            y = extras[start - n_real]
+        else:
+            while stop < n_real and reals[stop] - reals[stop - 1] <= _RR_CLUSTER_TOL * (
+                1.0 + abs(reals[stop])
+            ):
+                stop += 1
+            y = reals[start:stop].mean()
         clustered = stop - start > 1
         start = stop
-        count, more = _krr_value(A, B, C, moebius, rows, F, y, clustered, V, out, count)
-        doubt = doubt or more
-        if count < 0:
-            return -count, True
-    primary = count
-    for e in range(n_extra):
-        count, _ = _krr_value(A, B, C, moebius, rows, F, extras[e], False, V, out, count)
-        if count < 0:
-            count = -count
-            break
-    for c in range(out.shape[0]):
-        extra[c] = c >= primary
-    return count, doubt
-
-
-def _krr_value(A, B, C, moebius, rows, F, y, clustered, V, out, count):
-    """The candidates of one value y of the eigen-variable (a cluster's mean where clustered)
-    appended to out from row count: the new count (its negative where out filled up) and
-    whether they put the answer in doubt (a cluster, a plane of null vectors)."""
-    ma, mb, mc, md = moebius
-    if rows[6, 0] != 0.0:  # joint 3 slides: x3 is d3
-        theta3 = (ma * y + mb) / (mc * y + md)
-    else:
-        theta3 = 2.0 * math.atan2(ma * y + mb, mc * y + md)
-    S = A * (y * y) + B * y + C
-    nv, plane = _knull_right(S, V)
-    doubt = False
-    if clustered or plane:
-        doubt = True
-        if nv == 2:
-            nv = 1 + _krr_unmix(V)
-    for v in range(nv):
-        t4 = _krr_ratio_angle(V[v], 3)
-        t5 = _krr_ratio_angle(V[v], 1)
-        pairs, t1a, t2a, t1b, t2b = _krr_joints12(rows, F, theta3, t4, t5)
-        for p in range(pairs):
-            if count == out.shape[0]:
-                return -count, True
-            t1 = t1a if p == 0 else t1b
-            t2 = t2a if p == 0 else t2b
-            out[count, 0] = t1
-            out[count, 1] = t2
-            out[count, 2] = theta3
-            out[count, 3] = t4
-            out[count, 4] = t5
-            out[count, 5] = _krr_theta6(rows, F, t1, t2, theta3, t4, t5)
-            count += 1
+        if rows[6, 0] != 0.0:  # joint 3 slides: x3 is d3
+            theta3 = (ma * y + mb) / (mc * y + md)
+        else:
+            theta3 = 2.0 * math.atan2(ma * y + mb, mc * y + md)
+        S = A * (y * y) + B * y + C
+        nv, plane = _knull_right(S, V)
+        if clustered or plane:
+            doubt = doubt or not is_extra
+            if nv == 2:
+                nv = 1 + _krr_unmix(V)
+        for v in range(nv):
+            t4 = _krr_ratio_angle(V[v], 3)
+            t5 = _krr_ratio_angle(V[v], 1)
+            pairs, t1a, t2a, t1b, t2b = _krr_joints12(rows, F, theta3, t4, t5)
+            for p in range(pairs):
+                if count == out.shape[0]:
+                    return count, doubt or not is_extra
+                t1 = t1a if p == 0 else t1b
+                t2 = t2a if p == 0 else t2b
+                out[count, 0] = t1
+                out[count, 1] = t2
+                out[count, 2] = theta3
+                out[count, 3] = t4
+                out[count, 4] = t5
+                out[count, 5] = _krr_theta6(rows, F, t1, t2, theta3, t4, t5)
+                extra[count] = is_extra
+                count += 1
     return count, doubt
 
 
@@ -3323,7 +3307,6 @@ _KERNEL = (
     '_kgeneral',
     '_krr_split',
     '_krr_candidates',
-    '_krr_value',
     '_krr_pencil',
     '_kpivot_ratio',
     '_ksolve_into',
