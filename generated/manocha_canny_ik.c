@@ -1922,7 +1922,7 @@ static void dk_fk_q(const double q[DK_DOF], double e[12])
 /* The certified solutions of the pose t (its 12 top entries) into found, before wrapping and
    dropping repeats: their count, or DK_UNSETTLED. ref: q_ref's values (free joints': theirs). */
 static int dk_solve(const double t[12], double tol, const double ref[DK_DOF],
-                    double found[DK_MAX][DK_DOF])
+                    double found[DK_MAX][DK_DOF], int *repeats)
 {
     (void)ref;
     double w11 = t[0];
@@ -1939,6 +1939,7 @@ static int dk_solve(const double t[12], double tol, const double ref[DK_DOF],
     double wz = t[11];
     const double ptol = tol * DK_REACH;
     int n = 0;
+    int dk_close = 1;
     /* split 0: flange target 0_nT = (B X0 Tz(d1))^-1 T (Tz(dn) Xn E)^-1 */
     double F0_11 = w11;
     double F0_12 = 0.9998476951563913*w12 - 0.01745240643728351*w13;
@@ -2003,12 +2004,15 @@ static int dk_solve(const double t[12], double tol, const double ref[DK_DOF],
             n++;
         }
     }
+    *repeats = dk_close;
     return n;
 }
 
 /* found[0..count) wrapped (a value just above -pi as its equivalent above pi, one within
-   DK_SEAM_SNAP of pi as pi), without repeats, into rows: their number */
-static int dk_finish(double found[DK_MAX][DK_DOF], int count, double rows[DK_MAX][DK_DOF])
+   DK_SEAM_SNAP of pi as pi), without repeats (looked for only where dk_solve says rows can
+   repeat), into rows: their number */
+static int dk_finish(double found[DK_MAX][DK_DOF], int count, int repeats,
+                     double rows[DK_MAX][DK_DOF])
 {
     int m = 0, r, p, j;
     for (r = 0; r < count; r++) {
@@ -2026,7 +2030,7 @@ static int dk_finish(double found[DK_MAX][DK_DOF], int count, double rows[DK_MAX
                 }
             }
         }
-        for (p = 0; p < m && distinct; p++) {
+        for (p = 0; p < m && distinct && repeats; p++) {
             double worst = 0.0; /* the largest difference, without a branch per joint */
             for (j = 0; j < DK_DOF; j++) {
                 double d = fabs(q[j] - rows[p][j]), around = DK_TWO_PI - d;
@@ -2063,7 +2067,7 @@ int manocha_canny_ik_ref(const double T[16], const double *free, const double *q
                           double q[DK_MAX][DK_DOF])
 {
     double ref[DK_DOF], found[DK_MAX][DK_DOF];
-    int j, count;
+    int j, count, repeats = 1;
     if (!dk_pose_ok(T) || !(tol > 0.0)) {
         return MANOCHA_CANNY_INVALID_POSE;
     }
@@ -2078,12 +2082,12 @@ int manocha_canny_ik_ref(const double T[16], const double *free, const double *q
     {
         const double t[12] = {T[0], T[1], T[2],  T[3],  T[4],  T[5],
                               T[6], T[7], T[8],  T[9],  T[10], T[11]};
-        count = dk_solve(t, tol, ref, found);
+        count = dk_solve(t, tol, ref, found, &repeats);
     }
     if (count < 0) {
         return MANOCHA_CANNY_UNSETTLED;
     }
-    return dk_finish(found, count, q);
+    return dk_finish(found, count, repeats, q);
 }
 
 int manocha_canny_ik(const double T[16], const double *free, double tol,

@@ -81,6 +81,21 @@ static void dk_set_free(dk_values *v, double ref, int angle)
     v->s[0] = 0.0;
 }
 
+/* whether two of the values lie within 8 DK_DEDUP_TOL of each other around the circle (by
+   their cos and sin: a length's are 1 and 0, so its values always count as near): then the
+   rows under them can repeat. A free joint's loop keeps one value. */
+static int dk_near(const dk_values *v)
+{
+    int near = 0, a, b;
+    for (a = 0; a < v->n && !v->free; a++) {
+        for (b = a + 1; b < v->n; b++) {
+            const double dc = v->c[a] - v->c[b], ds = v->s[a] - v->s[b];
+            near |= dc * dc + ds * ds <= 64.0 * DK_DEDUP_TOL * DK_DEDUP_TOL;
+        }
+    }
+    return near;
+}
+
 /* The angle of a unit vector (c, s) (a joint's cos and sin; within a few units in the last
    place of atan2(s, c) where c^2 + s^2 = 1 to rounding), without a division or a branch (their
    latency and a coin-toss branch were half the solver's time): asin of the smaller of |c| and
@@ -907,7 +922,7 @@ static void dk_fk_q(const double q[DK_DOF], double e[12])
 /* The certified solutions of the pose t (its 12 top entries) into found, before wrapping and
    dropping repeats: their count, or DK_UNSETTLED. ref: q_ref's values (free joints': theirs). */
 static int dk_solve(const double t[12], double tol, const double ref[DK_DOF],
-                    double found[DK_MAX][DK_DOF])
+                    double found[DK_MAX][DK_DOF], int *repeats)
 {
     (void)ref;
     double qr1 = ref[0];
@@ -926,6 +941,7 @@ static int dk_solve(const double t[12], double tol, const double ref[DK_DOF],
     double wz = t[11];
     const double ptol = tol * DK_REACH;
     int n = 0;
+    int dk_close = 0;
     /* flange target 0_nT = (B X0 Tz(d1))^-1 T (Tz(dn) Xn E)^-1 */
     double r11 = w11;
     double r13 = w13;
@@ -948,6 +964,7 @@ static int dk_solve(const double t[12], double tol, const double ref[DK_DOF],
         return DK_UNSETTLED;
     }
     const int dk_m3 = n;
+    dk_close |= dk_near(&dk_v3);
     for (int dk_k3 = 0; dk_k3 < dk_v3.n; dk_k3++) {
         double theta3, c3, s3;
         dk_value(&dk_v3, dk_k3, &theta3, &c3, &s3);
@@ -957,6 +974,7 @@ static int dk_solve(const double t[12], double tol, const double ref[DK_DOF],
             return DK_UNSETTLED;
         }
         const int dk_m2 = n;
+        dk_close |= dk_near(&dk_v2);
         for (int dk_k2 = 0; dk_k2 < dk_v2.n; dk_k2++) {
             double theta2, c2, s2;
             dk_value(&dk_v2, dk_k2, &theta2, &c2, &s2);
@@ -969,6 +987,7 @@ static int dk_solve(const double t[12], double tol, const double ref[DK_DOF],
                 return DK_UNSETTLED;
             }
             const int dk_m1 = n;
+            dk_close |= dk_near(&dk_v1);
             for (int dk_k1 = 0; dk_k1 < dk_v1.n; dk_k1++) {
                 double theta1, c1, s1;
                 dk_value(&dk_v1, dk_k1, &theta1, &c1, &s1);
@@ -995,6 +1014,7 @@ static int dk_solve(const double t[12], double tol, const double ref[DK_DOF],
                     return DK_UNSETTLED;
                 }
                 const int dk_m5 = n;
+                dk_close |= dk_near(&dk_v5);
                 for (int dk_k5 = 0; dk_k5 < dk_v5.n; dk_k5++) {
                     double theta5, c5, s5;
                     dk_value(&dk_v5, dk_k5, &theta5, &c5, &s5);
@@ -1007,6 +1027,7 @@ static int dk_solve(const double t[12], double tol, const double ref[DK_DOF],
                         return DK_UNSETTLED;
                     }
                     const int dk_m4 = n;
+                    dk_close |= dk_near(&dk_v4);
                     for (int dk_k4 = 0; dk_k4 < dk_v4.n; dk_k4++) {
                         double theta4, c4, s4;
                         dk_value(&dk_v4, dk_k4, &theta4, &c4, &s4);
@@ -1016,6 +1037,7 @@ static int dk_solve(const double t[12], double tol, const double ref[DK_DOF],
                             return DK_UNSETTLED;
                         }
                         const int dk_m6 = n;
+                        dk_close |= dk_near(&dk_v6);
                         for (int dk_k6 = 0; dk_k6 < dk_v6.n; dk_k6++) {
                             double theta6, c6, s6;
                             dk_value(&dk_v6, dk_k6, &theta6, &c6, &s6);
@@ -1054,12 +1076,15 @@ static int dk_solve(const double t[12], double tol, const double ref[DK_DOF],
             break;
         }
     }
+    *repeats = dk_close;
     return n;
 }
 
 /* found[0..count) wrapped (a value just above -pi as its equivalent above pi, one within
-   DK_SEAM_SNAP of pi as pi), without repeats, into rows: their number */
-static int dk_finish(double found[DK_MAX][DK_DOF], int count, double rows[DK_MAX][DK_DOF])
+   DK_SEAM_SNAP of pi as pi), without repeats (looked for only where dk_solve says rows can
+   repeat), into rows: their number */
+static int dk_finish(double found[DK_MAX][DK_DOF], int count, int repeats,
+                     double rows[DK_MAX][DK_DOF])
 {
     int m = 0, r, p, j;
     for (r = 0; r < count; r++) {
@@ -1077,7 +1102,7 @@ static int dk_finish(double found[DK_MAX][DK_DOF], int count, double rows[DK_MAX
                 }
             }
         }
-        for (p = 0; p < m && distinct; p++) {
+        for (p = 0; p < m && distinct && repeats; p++) {
             double worst = 0.0; /* the largest difference, without a branch per joint */
             for (j = 0; j < DK_DOF; j++) {
                 double d = fabs(q[j] - rows[p][j]), around = DK_TWO_PI - d;
@@ -1114,7 +1139,7 @@ int puma560_ik_ref(const double T[16], const double *free, const double *q_ref, 
                     double q[DK_MAX][DK_DOF])
 {
     double ref[DK_DOF], found[DK_MAX][DK_DOF];
-    int j, count;
+    int j, count, repeats = 1;
     if (!dk_pose_ok(T) || !(tol > 0.0)) {
         return PUMA560_INVALID_POSE;
     }
@@ -1129,12 +1154,12 @@ int puma560_ik_ref(const double T[16], const double *free, const double *q_ref, 
     {
         const double t[12] = {T[0], T[1], T[2],  T[3],  T[4],  T[5],
                               T[6], T[7], T[8],  T[9],  T[10], T[11]};
-        count = dk_solve(t, tol, ref, found);
+        count = dk_solve(t, tol, ref, found, &repeats);
     }
     if (count < 0) {
         return PUMA560_UNSETTLED;
     }
-    return dk_finish(found, count, q);
+    return dk_finish(found, count, repeats, q);
 }
 
 int puma560_ik(const double T[16], const double *free, double tol,

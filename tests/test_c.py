@@ -115,6 +115,11 @@ def test_c_solver_gives_the_python_solutions(generated, harnesses, name):
         # complete: the sample's own q is among the rows, unless the sample is singular
         if not any(verify.same_joints(r, Q[i], revolute, every) for r in c_rows):
             assert verify.jacobian_nullity(m, Q[i])[0] < verify.SINGULAR_SIGMA, i
+        # no repeats (the C solver looks for them only where two branch values nearly meet)
+        gaps = np.abs(c_rows[:, None, :] - c_rows[None, :, :])
+        gaps[..., revolute] = np.minimum(gaps[..., revolute], 2 * np.pi - gaps[..., revolute])
+        apart = gaps.max(axis=2, initial=0.0) + np.eye(len(c_rows))
+        assert apart.min(initial=1.0) > 1e-6, (i, c_rows)
         if len(rows) != len(c_rows):
             other_count += 1
             continue

@@ -167,6 +167,9 @@ def solve_lines(plan: Plan) -> tuple[tuple[int, str], ...]:
     )
     body = [_assign(r, f"ref[{int(r[2:]) - 1}]", 0, scope) for r in refs] + body
     body += [Line(0, "const double ptol = tol * DK_REACH;"), Line(0, "int n = 0;")]
+    # whether two rows can repeat: where two values of one step lie within DK_DEDUP_TOL (or
+    # always, where a row's joints are not the steps' values themselves)
+    body.append(Line(0, f"int dk_close = {0 if branches_are_outputs(plan) else 1};"))
     depth = 0
     closing: list[Line] = []
     for live in steps:
@@ -198,6 +201,7 @@ def solve_lines(plan: Plan) -> tuple[tuple[int, str], ...]:
         body.append(Line(depth + 1, "return DK_UNSETTLED;"))
         body.append(Line(depth, "}"))
         body.append(Line(depth, f"const int dk_m{j} = n;"))
+        body.append(Line(depth, f"dk_close |= dk_near(&dk_v{j});"))
         body.append(Line(depth, f"for (int dk_k{j} = 0; dk_k{j} < dk_v{j}.n; dk_k{j}++) {{"))
         scope.levels.append(set())
         var = step.variable
@@ -233,8 +237,30 @@ def solve_lines(plan: Plan) -> tuple[tuple[int, str], ...]:
             body.append(Line(line.depth, "}"))
         body.append(Line(line.depth - 1, "}"))
         scope.levels.pop()
+    body.append(Line(0, "*repeats = dk_close;"))
     body.append(Line(0, "return n;"))
     return tuple((ln.depth, ln.text) for ln in body)
+
+
+def branches_are_outputs(plan: Plan) -> bool:
+    """Whether every joint value the solve branches on is some output joint up to sign and a
+    constant: then rows from branches whose values differ by more than DK_DEDUP_TOL (around
+    the circle) differ by as much in that output, and cannot repeat one another. False for
+    the general method (its rows are polished candidates, which can meet)."""
+    assert plan.ik is not None
+    outputs = [sp.expand(o) for o in plan.ik.outputs]
+    for step in plan.ik.steps:
+        if isinstance(step, Eigen):
+            return False
+        if not isinstance(step, Solve):
+            continue
+        x = sym.named(step.variable)
+        if not any(
+            o.free_symbols == {x} and o.coeff(x) in (1, -1) and (o - o.coeff(x) * x).is_number
+            for o in outputs
+        ):
+            return False
+    return True
 
 
 def _arm_cs_lines(plan: Plan, printer: CPrinter, depth: int, scope: Scope) -> list[Line]:
