@@ -895,13 +895,19 @@ def _rr_to_arm(k, q):
 
 
 def _rr_merge(found, candidates):
-    """Add the candidates not already in found (angles compared modulo 2 pi)."""
-    for q in candidates:
-        if found:
-            gaps = np.abs((q - np.array(found) + math.pi) % _TWO_PI - math.pi).max(axis=1)
-            if gaps.min() <= 1e-7:
-                continue
-        found.append(q)
+    """Add the candidates not already in found, nor equal to an earlier candidate added
+    (angles compared modulo 2 pi, within 1e-7): one table of the differences of all of them."""
+    if not candidates:
+        return
+    start = len(found)
+    rows = np.array(found + candidates)
+    gaps = np.abs((rows[:, None, :] - rows[None, :, :] + math.pi) % _TWO_PI - math.pi)
+    near = (gaps.max(axis=2) <= 1e-7).tolist()
+    kept = list(range(start))
+    for i in range(start, len(rows)):
+        if not any(near[i][j] for j in kept):
+            kept.append(i)
+            found.append(candidates[i - start])
 
 
 def _rr_split(k, F, moved, imag_tol=_RR_IMAG_TOL):
@@ -1022,20 +1028,17 @@ def _rr_candidates(P0, Ps, Pc, Q, F, rows, slide=_RR_TURNS, imag_tol=_RR_IMAG_TO
             _rr_ratio_angles(V, _RR_X5_PAIRS) + _RR_SHIFT45[1],
         )
     )
-    joints, extras = [], []
-    for t345, pairs, extra_one in zip(
-        T345.tolist(), _rr_joints12_many(rows, F, T345, slide), optional
-    ):
-        joints += [(t1, t2, *t345) for t1, t2 in pairs]
-        extras += [extra_one] * len(pairs)
-    if not joints:
+    owner, theta1, theta2 = _rr_joints12_many(rows, F, T345, slide)
+    if not owner.size:
         return [], doubt, []
-    X = np.array(joints)
+    X = np.column_stack((theta1, theta2, T345[owner]))
+    extras = np.array(optional)[owner].tolist()
     return list(np.column_stack((X, _rr_theta6_many(rows, F, X, slide)))), doubt, extras
 
 
 def _rr_joints12_many(rows, F, T345, slide):
-    """The (theta1, theta2) pairs once theta3..theta5 are known (the rows of T345). The third
+    """The (theta1, theta2) pairs once theta3..theta5 are known (the rows of T345), as the row
+    of T345 each pair belongs to (in order), theta1 and theta2. The third
     and fourth columns of A3 A4 A5 (a direction l and a point p in frame 2), moved by X2 and
     Tz(d2) to g, meet those of the target f: Rz(theta1) X1 Rz(theta2) g = f. Four equations
     linear in (cos, sin) of theta2 (the z components, |p|^2 and l.p, which theta1 leaves alone)
@@ -1066,22 +1069,34 @@ def _rr_joints12_many(rows, F, T345, slide):
     systems[:, 3, 0], systems[:, 3, 1] = a1 * gl[:, 0], -a1 * gl[:, 1]
     systems[:, 3, 2] = fl @ fp - (gl * gp).sum(axis=1)
     Us, Ss, Vts = np.linalg.svd(systems[:, :, :2], full_matrices=False)
-    out = []
-    for U, S, Vt, e, (gl0, gl1, gl2), (gp0, gp1, gp2) in zip(
-        Us, Ss, Vts, systems[:, :, 2], gl.tolist(), gp.tolist()
-    ):
-        pairs = []
-        for c2, s2 in _rr_unit_solutions(U, S, Vt, e):
-            # w = X1 Rz(theta2) g, then Rz(theta1) w = f
-            wl0, wl1 = c2 * gl0 - s2 * gl1, s2 * gl0 + c2 * gl1
-            wp0, wp1 = c2 * gp0 - s2 * gp1 + a1, s2 * gp0 + c2 * gp1
-            # (X1's rotation by alpha1; only the x and y components are needed)
-            wl1, wp1 = ca1 * wl1 - sa1 * gl2, ca1 * wp1 - sa1 * gp2
-            across = wl0 * fl[1] - wl1 * fl[0] + wp0 * fp[1] - wp1 * fp[0]
-            along = wl0 * fl[0] + wl1 * fl[1] + wp0 * fp[0] + wp1 * fp[1]
-            pairs.append((math.atan2(across, along), math.atan2(s2, c2)))
-        out.append(pairs)
-    return out
+    E = systems[:, :, 2]
+    # (cos, sin) of theta2 per row: rows whose equations span the plane all at once, the
+    # others (one direction: two points) on their own
+    regular = np.flatnonzero(Ss[:, 1] > 1e-8 * Ss[:, 0])
+    owner, C2, S2 = [regular], [], []
+    x = np.einsum("nij,ni->nj", Us[regular], E[regular]) / Ss[regular]
+    cs = np.einsum("nji,nj->ni", Vts[regular], x)
+    h = np.hypot(cs[:, 0], cs[:, 1])
+    h[h == 0.0] = math.inf  # (then (0, 0) / inf: (1, 0) below)
+    C2.append(np.where(h < math.inf, cs[:, 0] / h, 1.0))
+    S2.append(cs[:, 1] / h)
+    for i in np.flatnonzero(Ss[:, 1] <= 1e-8 * Ss[:, 0]):
+        units = np.array(_rr_unit_solutions(Us[i], Ss[i], Vts[i], E[i]))
+        owner.append(np.full(len(units), i))
+        C2.append(units[:, 0])
+        S2.append(units[:, 1])
+    order = np.argsort(np.concatenate(owner), kind="stable")
+    rows_of = np.concatenate(owner)[order]
+    c2, s2 = np.concatenate(C2)[order], np.concatenate(S2)[order]
+    gl, gp = gl[rows_of], gp[rows_of]
+    # w = X1 Rz(theta2) g, then Rz(theta1) w = f
+    wl0, wl1 = c2 * gl[:, 0] - s2 * gl[:, 1], s2 * gl[:, 0] + c2 * gl[:, 1]
+    wp0, wp1 = c2 * gp[:, 0] - s2 * gp[:, 1] + a1, s2 * gp[:, 0] + c2 * gp[:, 1]
+    # (X1's rotation by alpha1; only the x and y components are needed)
+    wl1, wp1 = ca1 * wl1 - sa1 * gl[:, 2], ca1 * wp1 - sa1 * gp[:, 2]
+    across = wl0 * fl[1] - wl1 * fl[0] + wp0 * fp[1] - wp1 * fp[0]
+    along = wl0 * fl[0] + wl1 * fl[1] + wp0 * fp[0] + wp1 * fp[1]
+    return rows_of, np.arctan2(across, along), np.arctan2(s2, c2)
 
 
 def _rr_unit_solutions(U, S, Vt, e):
