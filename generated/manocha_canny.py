@@ -1077,9 +1077,10 @@ def _rr_joints12_many(rows, F, T345, slide):
     x = np.einsum("nij,ni->nj", Us[regular], E[regular]) / Ss[regular]
     cs = np.einsum("nji,nj->ni", Vts[regular], x)
     h = np.hypot(cs[:, 0], cs[:, 1])
-    h[h == 0.0] = math.inf  # (then (0, 0) / inf: (1, 0) below)
-    C2.append(np.where(h < math.inf, cs[:, 0] / h, 1.0))
-    S2.append(cs[:, 1] / h)
+    unit = h > 0.0  # (else (1, 0), as _rr_unit_solutions)
+    h = np.where(unit, h, 1.0)
+    C2.append(np.where(unit, cs[:, 0] / h, 1.0))
+    S2.append(np.where(unit, cs[:, 1] / h, 0.0))
     for i in np.flatnonzero(Ss[:, 1] <= 1e-8 * Ss[:, 0]):
         units = np.array(_rr_unit_solutions(Us[i], Ss[i], Vts[i], E[i]))
         owner.append(np.full(len(units), i))
