@@ -208,6 +208,7 @@ static int dk_cs1(dk_values *v, double a, double b, double e, double scale, doub
     double rho = sqrt(a * a + b * b), inverse, ratio, sd, cb, sb;
     v->n = 0;
     v->free = 0;
+    v->ref = 0.0; /* (unread unless free; set so that no compiler sees it unset) */
     if (rho * rho <= DK_FREE_TOL * scale) {
         if (e * e <= DK_FREE_TOL * scale) {
             dk_set_free(v, ref, 1);
@@ -242,6 +243,7 @@ static int dk_one(dk_values *v, double y, double x)
 {
     double h = sqrt(x * x + y * y);
     v->free = 0;
+    v->ref = 0.0; /* (unread unless free; set so that no compiler sees it unset) */
     v->n = 1;
     if (h == 0.0) {
         v->t[0] = 0.0;
