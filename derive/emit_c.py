@@ -14,7 +14,7 @@ import numpy as np
 
 from derive import free
 from derive.emit import GENERATOR, GenerationError, check_printable, environment
-from derive.plan import Plan
+from derive.plan import Eigen, Plan
 from derive.printers import c
 from derive.printers.general import eigen_step
 from derive.runtime import closed, constants
@@ -117,6 +117,35 @@ def general_constants(plan: Plan) -> dict[str, object]:
         "FILL": nested([(*s.fill_rows, (*s.slide, 0.0, 0.0)) for s in step.splits]),
         "TRUE": nested([(*s.true_rows, (*s.slide, 0.0, 0.0)) for s in step.splits]),
         "fill": c.general_fill(plan),
+        **spurious_constants(step),
+    }
+
+
+def spurious_constants(step: Eigen) -> dict[str, object]:
+    """DK_RR_SPURIOUS (splits x 12 x width, zeros beyond each split's count; width at least
+    2, one vector's columns: C has no empty arrays, and GCC's bounds checks see the columns
+    dk_rr_deflate names), its counts and width."""
+    counts = [len(s.spurious[0]) if s.spurious else 0 for s in step.splits]
+    width = max(2, *counts)
+    tables = []
+    for split, n in zip(step.splits, counts):
+        rows = split.spurious if n else ((),) * 12
+        tables.append(
+            "{"
+            + ", ".join(
+                "{" + ", ".join(repr(float(v)) for v in (*row, *[0.0] * (width - n))) + "}"
+                for row in rows
+            )
+            + "}"
+        )
+    from derive.printers.general import pad
+
+    pivots = [pad(s.spurious_pivots, width // 2) for s in step.splits]
+    return {
+        "PIVOTS": "{" + ", ".join("{" + ", ".join(map(str, p)) + "}" for p in pivots) + "}",
+        "SPURIOUS_WIDTH": width,
+        "SPURIOUS_COUNT": "{" + ", ".join(map(str, counts)) + "}",
+        "SPURIOUS": "{" + ", ".join(tables) + "}",
     }
 
 

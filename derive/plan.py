@@ -211,6 +211,13 @@ class Split:
         singular: the arm's own table gives a singular pencil (fill_rows are perturbed).
         slide: (1.0, theta3) where the split's joint 3 is prismatic (its fixed angle; its d3 is
             then the eigen-variable), else (0.0, 0.0).
+        spurious: 12 rows of 2r numbers, the real and imaginary parts of r vectors v (columns
+            Re v_1, Im v_1, ...) that the lifted 12 x 12 matrix has in its null space at
+            x3 = i whatever the pose (the half-angle substitution's factor 1 + x3^2): the
+            companion matrix's eigenvalues there are known before the pose is, and the run
+            time deflates them. Empty where joint 3 slides.
+        spurious_pivots: the r rows where those vectors are the identity (v_j's entry 1 in
+            row spurious_pivots[j], the others' 0).
     """
 
     reversed: bool
@@ -222,6 +229,8 @@ class Split:
     cond: float
     singular: bool
     slide: tuple[float, float] = (0.0, 0.0)
+    spurious: tuple[tuple[float, ...], ...] = ()
+    spurious_pivots: tuple[int, ...] = ()
 
     @property
     def name(self) -> str:

@@ -369,6 +369,24 @@ def eigen_blocks(step: Eigen, env: dict[sp.Symbol, float]) -> list[Block]:
             Block("math", "d_3", ", ".join(number(t) for t in lengths)),
         ]
     thetas = [math.degrees(2 * math.atan2(a * y + b, c * y + d)) for y in real]
+    known = len(split.spurious[0]) if split.spurious else 0
+    deflated = (
+        [
+            Block(
+                "p",
+                f"{known} of the {len(values)} are known before the pose is: at "
+                "$x_3 = \\pm i$, where the half-angle substitution's factor $1 + x_3^2$ "
+                "vanishes, $P_0 (1 + x_3^2) + 2 P_s x_3 + P_c (1 - x_3^2)$ is "
+                "$2 (P_c \\pm i P_s)$, which does not depend on the pose, and the lifted "
+                f"12 x 12 matrix has {known // 2} null vectors $v$ there for every pose. The "
+                "solver takes the invariant subspace spanned by $[v; y_+ v]$ out of the "
+                "companion matrix (Householder reflections on both sides) "
+                f"and computes the other {len(values) - known} eigenvalues only.",
+            )
+        ]
+        if known
+        else []
+    )
     return [
         Block(
             "p",
@@ -378,6 +396,7 @@ def eigen_blocks(step: Eigen, env: dict[sp.Symbol, float]) -> list[Block]:
         ),
         Block("math", "y", ", ".join(number(y) for y in real)),
         Block("math", "\\theta_3 / ^\\circ", ", ".join(number(t) for t in thetas)),
+        *deflated,
     ]
 
 

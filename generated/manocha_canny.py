@@ -921,7 +921,11 @@ def _rr_split(k, F, moved, imag_tol=_RR_IMAG_TOL):
     Ps = values[126:252].reshape(14, 9)
     Pc = values[252:378].reshape(14, 9)
     Q = values[378:].reshape(14, 8)
-    candidates, doubt, extras = _rr_candidates(P0, Ps, Pc, Q, moved, fill_rows, slide, imag_tol)
+    count = _RR_SPURIOUS_COUNT[k]
+    spurious = (_RR_SPURIOUS[k, :, :count], _RR_PIVOTS[k, : count // 2]) if count else None
+    candidates, doubt, extras = _rr_candidates(
+        P0, Ps, Pc, Q, moved, fill_rows, slide, imag_tol, spurious
+    )
     # a perturbed table's solutions are walked back to the arm's in steps (a continuation),
     # so that Newton does not jump to another branch
     path = (
@@ -963,12 +967,12 @@ def _rr_between(fill_rows, true_rows, t):
     return out
 
 
-def _rr_candidates(P0, Ps, Pc, Q, F, rows, slide=_RR_TURNS, imag_tol=_RR_IMAG_TOL):
+def _rr_candidates(P0, Ps, Pc, Q, F, rows, slide=_RR_TURNS, imag_tol=_RR_IMAG_TOL, spurious=None):
     """The unpolished joint values of one split from its matrices (ALGORITHMS.md 4.4-4.7),
     whether the eigenvalues came in clusters (an answer in doubt), and which candidates are
     extras (from nearly real pairs: one that does not polish puts nothing in doubt). Where
     joint 3 slides (slide[0] set) the eigen-variable x3 is d3 itself, not tan(theta3 / 2)."""
-    found = _rr_eigenvalues(P0, Ps, Pc, Q)
+    found = _rr_eigenvalues(P0, Ps, Pc, Q, spurious)
     if found is None:
         return [], True, []
     values, (A, B, C), moebius = found
@@ -1120,9 +1124,11 @@ def _rr_unit_solutions(U, S, Vt, e):
     ]
 
 
-def _rr_eigenvalues(P0, Ps, Pc, Q):
-    """The eigenvalues y of the pencil (24, complex), the pencil (A, B, C) and the Moebius
-    map used; None where no map gives a usable leading matrix (a singular pencil)."""
+def _rr_eigenvalues(P0, Ps, Pc, Q, spurious=None):
+    """The eigenvalues y of the pencil (24, complex; without the 2r known ones where
+    spurious is (vectors, pivots) of Split.spurious: _rr_deflated), the pencil (A, B, C) and
+    the Moebius map used; None where no map gives a usable leading matrix (a singular
+    pencil)."""
     U, S, _ = np.linalg.svd(Q)
     floor = _RR_RANK_TOL * max(S[0], 1.0)
     rank = int((floor < S).sum())
@@ -1151,9 +1157,43 @@ def _rr_eigenvalues(P0, Ps, Pc, Q):
         companion[:12, 12:] = np.eye(12)
         companion[12:, :12] = -Ainv @ C
         companion[12:, 12:] = -Ainv @ B
+        if spurious is not None:
+            vectors, pivots = spurious
+            companion = _rr_deflated(companion, vectors, pivots, moebius)
         return np.linalg.eigvals(companion), pencil, moebius
     except np.linalg.LinAlgError:
         return None
+
+
+# _rr_deflated's rows and matrices by (vectors, pivots, Moebius map): a few per arm
+_RR_DEFLATIONS: dict = {}
+
+
+def _rr_deflated(K, vectors, pivots, moebius):
+    """The companion matrix K without its 2r known eigenvalues, as a (24 - 2r) square matrix
+    with the others. y+ = (d i - b) / (a - c i), the image of x3 = i under the map (a, b, c,
+    d), and its conjugate are eigenvalues with the eigenvectors [v; y+ v] for the split's
+    pose-independent null vectors v (Split.spurious: the identity at rows p = pivots). The
+    real and imaginary parts of those, W = [Re, Im] (24 x 2r), span an invariant subspace;
+    with S = [W, E] (E the unit vectors of the rows o outside p and 12 + p), S^-1 K S is
+    block upper triangular and its last block K[o, o] - G K[p', o] (p' = p, 12 + p;
+    G = W[o] W[p']^-1) has the other eigenvalues. W[p'] = [[I, 0], [yr I, yi I]], so
+    G = [Re[o] - (yr / yi) Im[o], Im[o] / yi] (yi is near 1 for every map)."""
+    key = (vectors.tobytes(), tuple(pivots), moebius)
+    found = _RR_DEFLATIONS.get(key)
+    if found is None:
+        a, b, c, d = moebius
+        scale = 1.0 / (a * a + c * c)
+        yr, yi = (-b * a - d * c) * scale, (d * a - b * c) * scale
+        v = vectors[:, 0::2] + 1j * vectors[:, 1::2]
+        W = np.concatenate((v, complex(yr, yi) * v))
+        p = np.concatenate((pivots, np.asarray(pivots) + 12))
+        o = np.setdiff1d(np.arange(24), p)
+        G = np.hstack((W[o].real - (yr / yi) * W[o].imag, W[o].imag / yi))
+        found = (np.ix_(o, o), np.ix_(p, o), G)
+        _RR_DEFLATIONS[key] = found
+    oo, po, G = found
+    return K[oo] - G @ K[po]
 
 
 def _rr_pencil(A6, B6, C6, moebius):
@@ -1687,7 +1727,7 @@ def _krr_split(k, F, moved, out, count):
     )
     cands = np.zeros((8 * _KRR_MAX, 6))
     extra = np.zeros(8 * _KRR_MAX, dtype=np.bool_)
-    n, doubt = _krr_candidates(values, moved, fill, cands, extra)
+    n, doubt = _krr_candidates(values, moved, fill, cands, extra, k)
     for c in range(n):
         q = cands[c].copy()
         if perturbed:
@@ -1725,9 +1765,9 @@ def _krr_split(k, F, moved, out, count):
 _KRR_MAX = 16
 
 
-def _krr_candidates(values, F, rows, out, extra):
-    """_rr_candidates in the kernel: the count of candidate joint vectors written to out,
-    whether the answer is in doubt (clusters, or no usable pencil), and in extra which
+def _krr_candidates(values, F, rows, out, extra, k):
+    """_rr_candidates in the kernel (split k): the count of candidate joint vectors written
+    to out, whether the answer is in doubt (clusters, or no usable pencil), and in extra which
     candidates come from nearly real pairs."""
     P0 = values[:126].reshape(14, 9)
     Ps = values[126:252].reshape(14, 9)
@@ -1778,7 +1818,7 @@ def _krr_candidates(values, F, rows, out, extra):
     if not _ksolve_into(A, rhs):
         return 0, True
     K[12:, :] = rhs
-    wr, wi, ok = _keigenvalues(K)
+    wr, wi, ok = _keigenvalues(_kdeflated(K, k, moebius))
     if not ok:
         return 0, True
     ma, mb, mc, md = moebius
@@ -1789,7 +1829,7 @@ def _krr_candidates(values, F, rows, out, extra):
     n_real = 0
     extras = np.zeros(48)  # (nearly real pairs, at Re -+ Im: as in Python)
     n_extra = 0
-    for i in range(24):
+    for i in range(wr.size):
         size = 1.0 + math.hypot(wr[i], wi[i])
         if abs(wi[i]) <= _RR_IMAG_TOL * size:
             y = wr[i]
@@ -2277,6 +2317,49 @@ def _krr_steps(rows, F, q0, damped):
     return best_q, best
 
 
+def _kdeflated(K, k, moebius):
+    """_rr_deflated in the kernel: split k's companion matrix K without its known
+    eigenvalues, K[o, o] - G K[p', o] (K itself where the split has none)."""
+    count = _RR_SPURIOUS_COUNT[k]
+    if count == 0:
+        return K
+    r = count // 2
+    a, b, c, d = moebius
+    scale = 1.0 / (a * a + c * c)
+    yr, yi = (-b * a - d * c) * scale, (d * a - b * c) * scale
+    p = np.zeros(count, dtype=np.int64)
+    taken = np.zeros(24, dtype=np.bool_)
+    for j in range(r):
+        p[j] = _RR_PIVOTS[k, j]
+        p[r + j] = _RR_PIVOTS[k, j] + 12
+        taken[p[j]] = True
+        taken[p[r + j]] = True
+    o = np.zeros(24 - count, dtype=np.int64)
+    n = 0
+    for i in range(24):
+        if not taken[i]:
+            o[n] = i
+            n += 1
+    # G = [Re W[o] - (yr / yi) Im W[o], Im W[o] / yi], W = [v; y+ v]
+    G = np.zeros((n, count))
+    for i in range(n):
+        row = o[i] % 12
+        for j in range(r):
+            vr, vi = _RR_SPURIOUS[k, row, 2 * j], _RR_SPURIOUS[k, row, 2 * j + 1]
+            if o[i] >= 12:
+                vr, vi = yr * vr - yi * vi, yr * vi + yi * vr
+            G[i, j] = vr - (yr / yi) * vi
+            G[i, r + j] = vi / yi
+    out = np.zeros((n, n))
+    for i in range(n):
+        for j in range(n):
+            total = K[o[i], o[j]]
+            for m in range(count):
+                total -= G[i, m] * K[p[m], o[j]]
+            out[i, j] = total
+    return out
+
+
 def _keigenvalues(M):
     """The eigenvalues (real parts, imaginary parts) of a real square matrix, and whether the
     iteration converged: reduction to upper Hessenberg form by Householder reflections, then
@@ -2740,6 +2823,52 @@ _RR_SPLITS = (
     ),
 )
 _RR_LENGTH = 1.5
+# per split, the null vectors its lifted 12 x 12 matrix has at x3 = i whatever the pose
+# (real and imaginary parts in turn, _RR_SPURIOUS_COUNT columns, then zeros): the
+# companion matrix's eigenvalues there are deflated (_rr_deflated)
+_RR_SPURIOUS_COUNT = (8, 8)
+# the rows where those vectors are the identity (v_j's entry 1 in row _RR_PIVOTS[k][j])
+_RR_PIVOTS = np.array(
+    [[11, 2, 0, 9], [11, 2, 0, 9]],
+    dtype=np.int64,
+)
+_RR_SPURIOUS = np.array(
+    [
+        0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 2.3315397943591634e-17, 0.0, 0.7153906225549211,
+        0.0, -0.7153906225549211, 0.0, -2.3315397943591634e-17, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0,
+        0.0, 0.0, 0.0, 9.535145291480543e-18, 0.0, 1.990221933835306e-17, 0.0,
+        0.48429884803130413, 0.0, 0.6243166352325856, 0.0, 0.446630266350433, 0.0,
+        0.3464628543957458, 0.0, -0.3464628543957458, 0.0, -0.446630266350433, 0.0,
+        0.6243166352325856, 0.0, 0.48429884803130413, 0.0, 1.990221933835306e-17, 0.0,
+        9.535145291480543e-18, 0.0, -1.990221933835306e-17, 0.0, 9.535145291480543e-18, 0.0,
+        0.6243166352325856, 0.0, -0.48429884803130413, 0.0, -0.3464628543957458, 0.0,
+        0.446630266350433, 0.0, -0.446630266350433, 0.0, 0.3464628543957458, 0.0,
+        -0.48429884803130413, 0.0, 0.6243166352325856, 0.0, 9.535145291480543e-18, 0.0,
+        -1.990221933835306e-17, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.7153906225549211,
+        0.0, -2.3315397943591634e-17, 0.0, 2.3315397943591634e-17, 0.0, -0.7153906225549211,
+        0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0,
+        -7.255068576340249e-05, 4.688531363128213e-05, 0.715209447006554, 6.33039381720525e-05,
+        -0.7153732088515714, 7.846797577500902e-05, 7.260696022940551e-05,
+        5.464246458337766e-05, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 0.0, -7.65304820827347e-05,
+        -1.2631076006511708e-06, 1.9641861163755297e-05, 4.6722445331075805e-07,
+        0.48421706031752626, 3.169128384697357e-05, 0.6245793147654155, -0.00012761649164709843,
+        0.44663477963601367, -0.00011355174976592901, 0.34631283934830703,
+        8.359183061978929e-05, -0.3463646411827924, 4.9082177054999265e-05, -0.4468439930094515,
+        7.239688385675835e-05, 0.6242767000399874, -0.0001326802320568436, 0.48429472105049637,
+        3.3565567735276754e-05, -1.9650690644375406e-05, -4.813687794645633e-07,
+        7.656487494714252e-05, 1.2996117796535055e-06, -1.9634010177554222e-05,
+        5.158817293894832e-07, -7.647374272426508e-05, 1.2734518354112767e-06,
+        0.6243600619580629, -0.0001444230064552185, -0.4843020707730552, -3.823260689170649e-05,
+        -0.34656239802866295, 3.580222277950288e-05, 0.44642171007041276,
+        -8.375106028191034e-05, -0.44663087598126405, 0.0001249264466365932, 0.3466142838650703,
+        9.69944221616676e-05, -0.48437973936284434, -3.6165892614425845e-05, 0.6240575712968248,
+        -0.00013931839983746415, 7.650810474107618e-05, -1.309937412265476e-06,
+        1.9642830241773232e-05, -5.300476360441113e-07, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0,
+        0.7154121904548304, -6.767063333116641e-05, -7.251206464961905e-05,
+        4.686224100638057e-05, 7.257124198573545e-05, 5.4611208050055614e-05, -0.71557591767809,
+        -7.414143929817516e-05, 1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0,
+    ]
+).reshape(2, 12, 8)
 
 
 def _rr_fill(k, l_x, l_y, l_z, p_x, p_y, p_z, out):
@@ -3337,6 +3466,7 @@ _KERNEL = (
     '_krr_between',
     '_krr_newton',
     '_krr_steps',
+    '_kdeflated',
     '_keigenvalues',
     '_fk_from_cs',
     '_kreference',

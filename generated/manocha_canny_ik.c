@@ -77,7 +77,8 @@ static int dk_pose_ok(const double T[16])
    The compiled kernel's routines (derive/runtime/kernel.py, _kgeneral and what it calls) in
    C, step for step: per split, the 14 x 9 / 14 x 8 matrices of the pose, the left null space
    of Q, the 12 x 12 quadratic matrix polynomial in a Moebius-mapped half-angle of theta3, its
-   24 x 24 companion matrix's eigenvalues (Hessenberg reduction and Francis double-shift QR),
+   24 x 24 companion matrix's eigenvalues but the 2r known ones (deflated), by Hessenberg
+   reduction and Francis double-shift QR,
    the null vector of each real root, theta1 and theta2 by back-substitution, theta6, and
    Levenberg-Marquardt steps on the forward kinematics; where the answer is in doubt, the fallback split and the
    rescue (the pose moved a little and polished back). No LAPACK. */
@@ -113,6 +114,13 @@ static const double DK_RR_MOTIONS[2][4][4] = {{{0.999999996152, -6.4001439893324
 static const int DK_RR_REVERSED[DK_RR_SPLIT_COUNT] = {0, 0};
 static const double DK_RR_FILL[DK_RR_SPLIT_COUNT][7][4] = {{{0.0, 0.19999999999999998, 0.0, 1.0}, {0.0, 0.6666666666666666, 0.9998476951563913, 0.01745240643728351}, {0.13333333333333333, 0.0, 0.0, 1.0}, {0.0, 1.0, 0.9998476951563913, 0.01745240643728351}, {0.0, 0.0, 0.0, 1.0}, {0.0, 0.0, 1.0, 0.0}, {0.0, 0.0, 0.0, 0.0}}, {{0.0, 0.20006442176872374, -8.91207358880526e-05, 0.9999999960287472}, {9.092974268256818e-05, 0.6667342129847218, 0.9998471099604567, 0.017485900140468767}, {0.1332803497192425, -8.182771110644103e-05, 9.775301161088936e-05, 0.9999999952221743}, {-7.727644875559877e-05, 0.9999535397820586, 0.9998478401328801, 0.017444098761891264}, {7.28969040125876e-05, 9.37999976774739e-05, -9.989413401767637e-05, 0.999999995010581}, {0.0, 0.0, 1.0, 0.0}, {0.0, 0.0, 0.0, 0.0}}};
 static const double DK_RR_TRUE[DK_RR_SPLIT_COUNT][7][4] = {{{0.0, 0.19999999999999998, 0.0, 1.0}, {0.0, 0.6666666666666666, 0.9998476951563913, 0.01745240643728351}, {0.13333333333333333, 0.0, 0.0, 1.0}, {0.0, 1.0, 0.9998476951563913, 0.01745240643728351}, {0.0, 0.0, 0.0, 1.0}, {0.0, 0.0, 1.0, 0.0}, {0.0, 0.0, 0.0, 0.0}}, {{0.0, 0.19999999999999998, 0.0, 1.0}, {0.0, 0.6666666666666666, 0.9998476951563913, 0.01745240643728351}, {0.13333333333333333, 0.0, 0.0, 1.0}, {0.0, 1.0, 0.9998476951563913, 0.01745240643728351}, {0.0, 0.0, 0.0, 1.0}, {0.0, 0.0, 1.0, 0.0}, {0.0, 0.0, 0.0, 0.0}}};
+/* per split, the null vectors its lifted 12 x 12 matrix has at x3 = i whatever the pose (real
+   and imaginary parts in turn, DK_RR_SPURIOUS_COUNT columns, then zeros), and the rows where
+   they are the identity: dk_rr_deflate */
+#define DK_RR_SPURIOUS_WIDTH 8
+static const int DK_RR_PIVOTS[DK_RR_SPLIT_COUNT][DK_RR_SPURIOUS_WIDTH / 2] = {{11, 2, 0, 9}, {11, 2, 0, 9}};
+static const int DK_RR_SPURIOUS_COUNT[DK_RR_SPLIT_COUNT] = {8, 8};
+static const double DK_RR_SPURIOUS[DK_RR_SPLIT_COUNT][12][DK_RR_SPURIOUS_WIDTH] = {{{0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0}, {2.3315397943591634e-17, 0.0, 0.7153906225549211, 0.0, -0.7153906225549211, 0.0, -2.3315397943591634e-17, 0.0}, {0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 0.0}, {9.535145291480543e-18, 0.0, 1.990221933835306e-17, 0.0, 0.48429884803130413, 0.0, 0.6243166352325856, 0.0}, {0.446630266350433, 0.0, 0.3464628543957458, 0.0, -0.3464628543957458, 0.0, -0.446630266350433, 0.0}, {0.6243166352325856, 0.0, 0.48429884803130413, 0.0, 1.990221933835306e-17, 0.0, 9.535145291480543e-18, 0.0}, {-1.990221933835306e-17, 0.0, 9.535145291480543e-18, 0.0, 0.6243166352325856, 0.0, -0.48429884803130413, 0.0}, {-0.3464628543957458, 0.0, 0.446630266350433, 0.0, -0.446630266350433, 0.0, 0.3464628543957458, 0.0}, {-0.48429884803130413, 0.0, 0.6243166352325856, 0.0, 9.535145291480543e-18, 0.0, -1.990221933835306e-17, 0.0}, {0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0}, {0.7153906225549211, 0.0, -2.3315397943591634e-17, 0.0, 2.3315397943591634e-17, 0.0, -0.7153906225549211, 0.0}, {1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0}}, {{0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0}, {-7.255068576340249e-05, 4.688531363128213e-05, 0.715209447006554, 6.33039381720525e-05, -0.7153732088515714, 7.846797577500902e-05, 7.260696022940551e-05, 5.464246458337766e-05}, {0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 0.0}, {-7.65304820827347e-05, -1.2631076006511708e-06, 1.9641861163755297e-05, 4.6722445331075805e-07, 0.48421706031752626, 3.169128384697357e-05, 0.6245793147654155, -0.00012761649164709843}, {0.44663477963601367, -0.00011355174976592901, 0.34631283934830703, 8.359183061978929e-05, -0.3463646411827924, 4.9082177054999265e-05, -0.4468439930094515, 7.239688385675835e-05}, {0.6242767000399874, -0.0001326802320568436, 0.48429472105049637, 3.3565567735276754e-05, -1.9650690644375406e-05, -4.813687794645633e-07, 7.656487494714252e-05, 1.2996117796535055e-06}, {-1.9634010177554222e-05, 5.158817293894832e-07, -7.647374272426508e-05, 1.2734518354112767e-06, 0.6243600619580629, -0.0001444230064552185, -0.4843020707730552, -3.823260689170649e-05}, {-0.34656239802866295, 3.580222277950288e-05, 0.44642171007041276, -8.375106028191034e-05, -0.44663087598126405, 0.0001249264466365932, 0.3466142838650703, 9.69944221616676e-05}, {-0.48437973936284434, -3.6165892614425845e-05, 0.6240575712968248, -0.00013931839983746415, 7.650810474107618e-05, -1.309937412265476e-06, 1.9642830241773232e-05, -5.300476360441113e-07}, {0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0}, {0.7154121904548304, -6.767063333116641e-05, -7.251206464961905e-05, 4.686224100638057e-05, 7.257124198573545e-05, 5.4611208050055614e-05, -0.71557591767809, -7.414143929817516e-05}, {1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0}}};
 
 /* the entries of P0, Ps, Pc (14 x 9 each) and Q (14 x 8), row-major, of split k at the flange
    target whose third and fourth columns are l and p (p in units of DK_RR_LENGTH), into out
@@ -1265,12 +1273,11 @@ static double dk_rr_newton(const double rows[7][4], const double F[4][4], double
     return error;
 }
 
-/* the eigenvalues (wr, wi) of a real 24 x 24 matrix: Householder reduction to upper
+/* the eigenvalues (wr, wi) of M's leading n x n block (n <= 24): Householder reduction to upper
    Hessenberg form, then the Francis double-shift QR iteration with deflation (Golub and Van
    Loan, algorithms 7.4.2 and 7.5.2), eigenvalues only; 0 where it did not converge */
-static int dk_eigenvalues(const double M[24][24], double wr[24], double wi[24])
+static int dk_eigenvalues(const double M[24][24], int n, double wr[24], double wi[24])
 {
-    static const int n = 24;
     double H[24][24], v[24];
     const double eps = 2.220446049250313e-16;
     int k, i, j, hi, lo, iterations = 0;
@@ -1498,9 +1505,65 @@ static int dk_rr_within_reach(const double rows[7][4], const double *moebius, do
 /* the candidate joint vectors of one split: their count written to out, extra[c] set for
    those from nearly real pairs; *doubt: whether the answer is in doubt (clusters, or no
    usable pencil) */
+/* split k's companion matrix K without its known eigenvalues (_rr_deflated in
+   derive/runtime/general.py): K[o, o] - G K[p', o], p' the rows DK_RR_PIVOTS[k] and 12 more,
+   o the others, G = [Re W[o] - (yr / yi) Im W[o], Im W[o] / yi] for W = [v; y+ v] (v the
+   split's DK_RR_SPURIOUS vectors, y+ = (d i - b) / (a - c i) the image of x3 = i), moved to
+   K's top left corner; its size */
+static int dk_rr_deflate(double K[24][24], int k, const double *moebius)
+{
+    const int count = DK_RR_SPURIOUS_COUNT[k], r = count / 2;
+    const double a = moebius[0], b = moebius[1], c = moebius[2], d = moebius[3];
+    const double scale = 1.0 / (a * a + c * c);
+    const double yr = (-b * a - d * c) * scale, yi = (d * a - b * c) * scale;
+    double G[24][DK_RR_SPURIOUS_WIDTH], out[24][24];
+    int p[DK_RR_SPURIOUS_WIDTH], o[24], taken[24] = {0}, n = 0, i, j, m;
+    if (count == 0) {
+        return 24;
+    }
+    for (j = 0; j < r; j++) {
+        p[j] = DK_RR_PIVOTS[k][j];
+        p[r + j] = DK_RR_PIVOTS[k][j] + 12;
+        taken[p[j]] = taken[p[r + j]] = 1;
+    }
+    for (i = 0; i < 24; i++) {
+        if (!taken[i]) {
+            o[n++] = i;
+        }
+    }
+    for (i = 0; i < n; i++) {
+        const int row = o[i] % 12;
+        for (j = 0; j < r; j++) {
+            double vr = DK_RR_SPURIOUS[k][row][2 * j], vi = DK_RR_SPURIOUS[k][row][2 * j + 1];
+            if (o[i] >= 12) {
+                const double wr = yr * vr - yi * vi;
+                vi = yr * vi + yi * vr;
+                vr = wr;
+            }
+            G[i][j] = vr - (yr / yi) * vi;
+            G[i][r + j] = vi / yi;
+        }
+    }
+    for (i = 0; i < n; i++) {
+        for (j = 0; j < n; j++) {
+            double total = K[o[i]][o[j]];
+            for (m = 0; m < count; m++) {
+                total -= G[i][m] * K[p[m]][o[j]];
+            }
+            out[i][j] = total;
+        }
+    }
+    for (i = 0; i < n; i++) {
+        for (j = 0; j < n; j++) {
+            K[i][j] = out[i][j];
+        }
+    }
+    return n;
+}
+
 static int dk_rr_candidates(const double values[490], const double F[4][4],
                             const double rows[7][4], double out[DK_RR_CANDS][6], int extra[],
-                            int *doubt, double imag_tol)
+                            int *doubt, double imag_tol, int split)
 {
     double N[14][14], A6[6][9], B6[6][9], C6[6][9], pencil[3][12][12], best_pencil[3][12][12];
     double K[24][24], rhs[12][24], wr[24], wi[24], reals[24], extras[48], V[3][12];
@@ -1508,7 +1571,7 @@ static int dk_rr_candidates(const double values[490], const double F[4][4],
     /* a sliding joint 3: |d3| <= |p| + the other links' lengths (roots beyond are spurious) */
     double reach = fabs(F[0][3]) + fabs(F[1][3]) + fabs(F[2][3]);
     const double *moebius = DK_RR_MOEBIUS[0];
-    int rank_rows, i, m, r, col, c, n_real = 0, n_extra = 0, count = 0, start = 0;
+    int rank_rows, i, m, r, col, c, n_eig, n_real = 0, n_extra = 0, count = 0, start = 0;
     const double(*P0)[9] = (const double(*)[9])values;
     const double(*Ps)[9] = (const double(*)[9])(values + 126);
     const double(*Pc)[9] = (const double(*)[9])(values + 252);
@@ -1586,10 +1649,11 @@ static int dk_rr_candidates(const double values[490], const double F[4][4],
             K[12 + i][col] = rhs[i][col];
         }
     }
-    if (!dk_eigenvalues(K, wr, wi)) {
+    n_eig = dk_rr_deflate(K, split, moebius);
+    if (!dk_eigenvalues(K, n_eig, wr, wi)) {
         return 0;
     }
-    for (i = 0; i < 24; i++) {
+    for (i = 0; i < n_eig; i++) {
         const double size = 1.0 + hypot(wr[i], wi[i]);
         int side;
         if (fabs(wi[i]) <= imag_tol * size) {
@@ -1686,7 +1750,7 @@ static int dk_rr_split(int k, const double F[4][4], const double moved[4][4],
     }
     dk_rr_fill(k, moved[0][2], moved[1][2], moved[2][2], moved[0][3], moved[1][3], moved[2][3],
                values);
-    n = dk_rr_candidates(values, moved, DK_RR_FILL[k], cands, extra, doubt, imag_tol);
+    n = dk_rr_candidates(values, moved, DK_RR_FILL[k], cands, extra, doubt, imag_tol, k);
     for (c = 0; c < n; c++) {
         double q[6], error, arm[6];
         int seen = 0;

@@ -90,3 +90,62 @@ def test_the_stored_derivation_is_the_one_derived_today():
     """derive/data/fundamental.json (read at generation) equals a fresh derivation; rewrite
     it with `python -m derive.raghavan_roth` when the derivation changes."""
     assert rr.to_terms(rr.derive_fundamental()) == rr.to_terms(rr.fundamental())
+
+
+@pytest.mark.parametrize("seed", range(12))
+def test_the_deflated_eigenvalues_are_the_full_problems_less_the_known_ones(seed):
+    """Split.spurious (derive.methods.general.spurious_vectors) of random arms (every other
+    one with two right-angle twists and a zero length): at random poses the pencil at y+ (the
+    image of x3 = i) annihilates them, the full companion matrix has 2r eigenvalues at y+ and
+    its conjugate, and the deflated one (_rr_deflated) has exactly the others. (Arms whose own
+    pencil is singular, solved on a perturbed table, have a nearly singular one, whose
+    eigenvalues move with rounding in either computation: their test is their solutions',
+    tests/test_general.py.)"""
+    from derive.methods.general import spurious_vectors
+
+    f = rr.fundamental()
+    functions = [sp.lambdify(rr.GENS, m) for m in (f.P0, f.Ps, f.Pc, f.Q)]
+    rng = np.random.default_rng(300 + seed)
+    d, a, alpha = rng.uniform(-1, 1, 6), rng.uniform(-1, 1, 6), rng.uniform(-3, 3, 6)
+    if seed % 2:  # two right-angle twists and a zero length, as real arms have them
+        alpha[[1, 3]] = np.round(alpha[[1, 3]] / (np.pi / 2)) * (np.pi / 2)
+        a[2] = 0.0
+    d[0] = d[5] = a[5] = alpha[5] = 0.0
+    rows = [(d[i], a[i], np.cos(alpha[i]), np.sin(alpha[i])) for i in range(6)]
+    numbers = tuple(r[k] for k in (1, 0, 2, 3) for r in rows[:5])
+    # (Ps and Pc do not depend on the pose: any pose gives the arm's)
+    fill = [functions[k](*numbers, 0.0, 0.0, 1.0, 0.1, 0.2, 0.3) for k in range(4)]
+    vectors, pivots = spurious_vectors(tuple(float(x) for m in fill for x in np.ravel(m)))
+    assert vectors, "every arm has them"
+    V = np.array(vectors)
+    assert V.shape == (12, 2 * len(pivots))
+    known = V.shape[1]
+    v = V[:, 0::2] + 1j * V[:, 1::2]
+    checked = 0
+    for _ in range(5):
+        theta = rng.uniform(-np.pi, np.pi, 6)
+        F = np.linalg.multi_dot([general._rr_link(t, r) for t, r in zip(theta, rows)])
+        P0, Ps, Pc, Q = (
+            np.array(fn(*numbers, *F[:3, 2], *F[:3, 3]), dtype=float) for fn in functions
+        )
+        full = general._rr_eigenvalues(P0, Ps, Pc, Q)
+        deflated = general._rr_eigenvalues(P0, Ps, Pc, Q, (V, np.array(pivots)))
+        if full is None:
+            assert deflated is None
+            continue
+        values, (A, B, C), (ma, mb, mc, md) = full
+        y = complex(-mb, md) / complex(ma, -mc)
+        scale = max(np.abs(A).max(), np.abs(B).max(), np.abs(C).max())
+        assert np.abs((A * y * y + B * y + C) @ v).max() <= 1e-10 * scale
+        near = np.minimum(abs(values - y), abs(values - y.conjugate())) <= 1e-6
+        assert near.sum() == known
+        rest = list(values[~near])
+        got = deflated[0]
+        assert len(got) == len(rest) == 24 - known
+        # each deflated eigenvalue is one of the others (nearest first; a multiple root's
+        # copies split by the square root of rounding in either computation)
+        for z in sorted(got, key=lambda z: min(abs(z - w) for w in rest)):
+            k = int(np.argmin([abs(z - w) for w in rest]))
+            assert abs(z - rest.pop(k)) <= 1e-6 * (1 + abs(z)), (z, values)
+        checked += 1
+    assert checked, "some pose had a usable pencil"

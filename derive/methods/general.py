@@ -45,6 +45,9 @@ PERTURBATION = 1e-4
 # below this ratio of the Jacobian's smallest to largest singular value, a configuration is
 # singular (for refusing an arm singular everywhere)
 SINGULAR_EVERYWHERE = 1e-10
+# a singular value of the lifted matrix at x3 = i below this share of the largest is zero
+# (the spurious null space's are rounding: 1e-17 in double precision)
+SPURIOUS_RANK_TOL = 1e-12
 Row = tuple[float, float, float, float]
 
 
@@ -259,6 +262,7 @@ def measure(chain: Chain, reversed_: int, length: float, perturb: bool) -> Split
     slide = slide_of(chain)
     fill = fill_expressions(fill_rows, {} if perturb else exact_numbers(chain), slide)
     recovered, conds = score(fill_rows, true_rows, slide)
+    spurious, pivots = spurious_vectors(fill) if not slide[0] else ((), ())
     return Split(
         reversed=bool(reversed_),
         fill=fill,
@@ -269,7 +273,72 @@ def measure(chain: Chain, reversed_: int, length: float, perturb: bool) -> Split
         cond=float(np.median(conds)),
         singular=perturb,
         slide=slide,
+        spurious=spurious,
+        spurious_pivots=pivots,
     )
+
+
+def spurious_vectors(
+    fill: tuple[sp.Expr, ...],
+) -> tuple[tuple[tuple[float, ...], ...], tuple[int, ...]]:
+    """Split.spurious and Split.spurious_pivots: the null space, at x3 = i, of the lifted
+    12 x 12 matrix a split's fill gives, as 12 rows (Re v_1, Im v_1, Re v_2, ...), and the
+    rows where the basis is the identity; ((), ()) where it has none.
+
+    (1 + x3^2) P(x3) = (P0 - Pc) x3^2 + 2 Ps x3 + P0 + Pc is 2 (Pc + i Ps) at x3 = i, and Ps,
+    Pc do not depend on the pose (only P0 and Q do): so neither does G = (Pc + i Ps) H45 nor
+    the null space of its lift [[G, 0], [0, G]] (the second copy shifted by 3 columns, times
+    x4), which the pose's pencil N G has too. Computed in 40-digit arithmetic from the fill's
+    numbers (deterministic); a singular value below SPURIOUS_RANK_TOL of the largest counts
+    as zero. The result is canonical: the basis whose rows at the r pivot rows (chosen by
+    size) are the identity."""
+    import mpmath
+
+    Ps, Pc = fill[126:252], fill[252:378]
+    if any(sp.sympify(e).free_symbols for e in (*Ps, *Pc)):
+        return (), ()  # (never for the 14 equations: the condition the argument needs)
+    H = runtime._RR_H45
+    with mpmath.workdps(40):
+        G = mpmath.matrix(14, 9)
+        for r in range(14):
+            for c in range(9):
+                G[r, c] = mpmath.mpc(mpmath.mpf(Pc[9 * r + c]), mpmath.mpf(Ps[9 * r + c]))
+        G = G * mpmath.matrix(H.tolist())
+        lifted = mpmath.matrix(28, 12)
+        for r in range(14):
+            for c in range(9):
+                lifted[r, c] = G[r, c]
+                lifted[14 + r, 3 + c] = G[r, c]
+        _, S, V = mpmath.svd_c(lifted)
+        rank = sum(1 for k in range(12) if S[k] > SPURIOUS_RANK_TOL * S[0])
+        if rank == 12:
+            return (), ()
+        # the null vectors (columns), then the canonical basis: pivot rows by size
+        null = mpmath.matrix(12, 12 - rank)
+        for j in range(12 - rank):
+            for i in range(12):
+                null[i, j] = mpmath.conj(V[rank + j, i])
+        pivots: list[int] = []
+        work = null.copy()
+        for j in range(12 - rank):
+            row = max((i for i in range(12) if i not in pivots), key=lambda i: abs(work[i, j]))
+            pivots.append(row)
+            work[:, j] = work[:, j] / work[row, j]
+            for other in range(12 - rank):
+                if other != j:
+                    work[:, other] = work[:, other] - work[row, other] * work[:, j]
+        # (parts below 1e-30 are the 40-digit arithmetic's rounding: zeros)
+        vectors = tuple(
+            tuple(
+                float(part) if abs(part) > 1e-30 else 0.0
+                for j in range(12 - rank)
+                for part in (work[i, j].real, work[i, j].imag)
+            )
+            for i in range(12)
+        )
+        for j, row in enumerate(pivots):  # (exactly the identity there)
+            assert vectors[row] == tuple(float(k == 2 * j) for k in range(2 * (12 - rank)))
+        return vectors, tuple(pivots)
 
 
 def score(

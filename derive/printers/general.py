@@ -4,6 +4,8 @@ the compiled one (numba compiles it as it is)."""
 
 from __future__ import annotations
 
+import textwrap
+
 import sympy as sp
 
 from derive import raghavan_roth as rr
@@ -32,6 +34,11 @@ def fill_entries(
     return temps, [(i, e) for (i, _), e in zip(entries, reduced)]
 
 
+def pad(values: tuple[int, ...], width: int) -> tuple[int, ...]:
+    """values followed by zeros up to width (one array shape for every split)."""
+    return (*values, *[0] * (width - len(values)))
+
+
 def general_code(plan: Plan) -> str:
     """_RR_SPLITS, _RR_LENGTH and _rr_fill for a plan of the general method ("" otherwise)."""
     step = eigen_step(plan)
@@ -54,7 +61,32 @@ def general_code(plan: Plan) -> str:
         lines += ["    (", f"        {split.reversed},", *rows(split.fill_rows)]
         slide = ", ".join(float_literal(v) for v in split.slide)
         lines += [*rows(split.true_rows), f"        ({slide}),", "    ),"]
-    lines += [")", f"_RR_LENGTH = {float_literal(step.unit)}", "", ""]
+    lines += [")", f"_RR_LENGTH = {float_literal(step.unit)}"]
+    counts = [len(split.spurious[0]) if split.spurious else 0 for split in step.splits]
+    width = max(2, *counts)  # (a vector's columns at least: no empty arrays in numba or C)
+    lines += [
+        "# per split, the null vectors its lifted 12 x 12 matrix has at x3 = i whatever the pose",
+        "# (real and imaginary parts in turn, _RR_SPURIOUS_COUNT columns, then zeros): the",
+        "# companion matrix's eigenvalues there are deflated (_rr_deflated)",
+        f"_RR_SPURIOUS_COUNT = {tuple(counts)}",
+        "# the rows where those vectors are the identity (v_j's entry 1 in row _RR_PIVOTS[k][j])",
+        "_RR_PIVOTS = np.array(",
+        f"    {[list(pad(split.spurious_pivots, width // 2)) for split in step.splits]},",
+        "    dtype=np.int64,",
+        ")",
+        "_RR_SPURIOUS = np.array(",
+        "    [",
+    ]
+    numbers = [
+        float_literal(v)
+        for split, n in zip(step.splits, counts)
+        for i in range(12)
+        for v in ((*split.spurious[i], *[0.0] * (width - n)) if n else (0.0,) * width)
+    ]
+    lines += textwrap.wrap(
+        ", ".join(numbers) + ",", width=96, initial_indent="        ", subsequent_indent="        "
+    )
+    lines += ["    ]", f").reshape({len(step.splits)}, 12, {width})", "", ""]
     args = ", ".join(str(s) for s in (*rr.L, *rr.P))
     lines += [
         f"def _rr_fill(k, {args}, out):",

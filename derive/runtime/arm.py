@@ -50,3 +50,8 @@ _RR_SPLITS: tuple[
 ]
 _RR_SPLITS = ()
 _RR_LENGTH = 1.0
+# per split, the vectors of Split.spurious (12 x _RR_SPURIOUS_COUNT[k] of the columns; the
+# rest zeros)
+_RR_SPURIOUS = np.zeros((0, 12, 0))
+_RR_SPURIOUS_COUNT: tuple[int, ...] = ()
+_RR_PIVOTS = np.zeros((0, 1), dtype=np.int64)

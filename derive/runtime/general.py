@@ -30,7 +30,15 @@ import math
 
 import numpy as np
 
-from derive.runtime.arm import _RR_LENGTH, _RR_SPLITS, MAX_SOLUTIONS, _rr_fill
+from derive.runtime.arm import (
+    _RR_LENGTH,
+    _RR_PIVOTS,
+    _RR_SPLITS,
+    _RR_SPURIOUS,
+    _RR_SPURIOUS_COUNT,
+    MAX_SOLUTIONS,
+    _rr_fill,
+)
 from derive.runtime.constants import (
     _RR_CLUSTER_TOL,
     _RR_COND_LIMIT,
@@ -184,7 +192,11 @@ def _rr_split(k, F, moved, imag_tol=_RR_IMAG_TOL):
     Ps = values[126:252].reshape(14, 9)
     Pc = values[252:378].reshape(14, 9)
     Q = values[378:].reshape(14, 8)
-    candidates, doubt, extras = _rr_candidates(P0, Ps, Pc, Q, moved, fill_rows, slide, imag_tol)
+    count = _RR_SPURIOUS_COUNT[k]
+    spurious = (_RR_SPURIOUS[k, :, :count], _RR_PIVOTS[k, : count // 2]) if count else None
+    candidates, doubt, extras = _rr_candidates(
+        P0, Ps, Pc, Q, moved, fill_rows, slide, imag_tol, spurious
+    )
     # a perturbed table's solutions are walked back to the arm's in steps (a continuation),
     # so that Newton does not jump to another branch
     path = (
@@ -226,12 +238,12 @@ def _rr_between(fill_rows, true_rows, t):
     return out
 
 
-def _rr_candidates(P0, Ps, Pc, Q, F, rows, slide=_RR_TURNS, imag_tol=_RR_IMAG_TOL):
+def _rr_candidates(P0, Ps, Pc, Q, F, rows, slide=_RR_TURNS, imag_tol=_RR_IMAG_TOL, spurious=None):
     """The unpolished joint values of one split from its matrices (ALGORITHMS.md 4.4-4.7),
     whether the eigenvalues came in clusters (an answer in doubt), and which candidates are
     extras (from nearly real pairs: one that does not polish puts nothing in doubt). Where
     joint 3 slides (slide[0] set) the eigen-variable x3 is d3 itself, not tan(theta3 / 2)."""
-    found = _rr_eigenvalues(P0, Ps, Pc, Q)
+    found = _rr_eigenvalues(P0, Ps, Pc, Q, spurious)
     if found is None:
         return [], True, []
     values, (A, B, C), moebius = found
@@ -383,9 +395,11 @@ def _rr_unit_solutions(U, S, Vt, e):
     ]
 
 
-def _rr_eigenvalues(P0, Ps, Pc, Q):
-    """The eigenvalues y of the pencil (24, complex), the pencil (A, B, C) and the Moebius
-    map used; None where no map gives a usable leading matrix (a singular pencil)."""
+def _rr_eigenvalues(P0, Ps, Pc, Q, spurious=None):
+    """The eigenvalues y of the pencil (24, complex; without the 2r known ones where
+    spurious is (vectors, pivots) of Split.spurious: _rr_deflated), the pencil (A, B, C) and
+    the Moebius map used; None where no map gives a usable leading matrix (a singular
+    pencil)."""
     U, S, _ = np.linalg.svd(Q)
     floor = _RR_RANK_TOL * max(S[0], 1.0)
     rank = int((floor < S).sum())
@@ -414,9 +428,43 @@ def _rr_eigenvalues(P0, Ps, Pc, Q):
         companion[:12, 12:] = np.eye(12)
         companion[12:, :12] = -Ainv @ C
         companion[12:, 12:] = -Ainv @ B
+        if spurious is not None:
+            vectors, pivots = spurious
+            companion = _rr_deflated(companion, vectors, pivots, moebius)
         return np.linalg.eigvals(companion), pencil, moebius
     except np.linalg.LinAlgError:
         return None
+
+
+# _rr_deflated's rows and matrices by (vectors, pivots, Moebius map): a few per arm
+_RR_DEFLATIONS: dict = {}
+
+
+def _rr_deflated(K, vectors, pivots, moebius):
+    """The companion matrix K without its 2r known eigenvalues, as a (24 - 2r) square matrix
+    with the others. y+ = (d i - b) / (a - c i), the image of x3 = i under the map (a, b, c,
+    d), and its conjugate are eigenvalues with the eigenvectors [v; y+ v] for the split's
+    pose-independent null vectors v (Split.spurious: the identity at rows p = pivots). The
+    real and imaginary parts of those, W = [Re, Im] (24 x 2r), span an invariant subspace;
+    with S = [W, E] (E the unit vectors of the rows o outside p and 12 + p), S^-1 K S is
+    block upper triangular and its last block K[o, o] - G K[p', o] (p' = p, 12 + p;
+    G = W[o] W[p']^-1) has the other eigenvalues. W[p'] = [[I, 0], [yr I, yi I]], so
+    G = [Re[o] - (yr / yi) Im[o], Im[o] / yi] (yi is near 1 for every map)."""
+    key = (vectors.tobytes(), tuple(pivots), moebius)
+    found = _RR_DEFLATIONS.get(key)
+    if found is None:
+        a, b, c, d = moebius
+        scale = 1.0 / (a * a + c * c)
+        yr, yi = (-b * a - d * c) * scale, (d * a - b * c) * scale
+        v = vectors[:, 0::2] + 1j * vectors[:, 1::2]
+        W = np.concatenate((v, complex(yr, yi) * v))
+        p = np.concatenate((pivots, np.asarray(pivots) + 12))
+        o = np.setdiff1d(np.arange(24), p)
+        G = np.hstack((W[o].real - (yr / yi) * W[o].imag, W[o].imag / yi))
+        found = (np.ix_(o, o), np.ix_(p, o), G)
+        _RR_DEFLATIONS[key] = found
+    oo, po, G = found
+    return K[oo] - G @ K[po]
 
 
 def _rr_pencil(A6, B6, C6, moebius):

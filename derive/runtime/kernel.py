@@ -21,7 +21,10 @@ from derive.runtime.arm import (
     _KBUF,
     _REVOLUTE,
     _RR_LENGTH,
+    _RR_PIVOTS,
     _RR_SPLITS,
+    _RR_SPURIOUS,
+    _RR_SPURIOUS_COUNT,
     DOF,
     MAX_SOLUTIONS,
     _kreference,
@@ -495,7 +498,7 @@ def _krr_split(k, F, moved, out, count):
     )
     cands = np.zeros((8 * _KRR_MAX, 6))
     extra = np.zeros(8 * _KRR_MAX, dtype=np.bool_)
-    n, doubt = _krr_candidates(values, moved, fill, cands, extra)
+    n, doubt = _krr_candidates(values, moved, fill, cands, extra, k)
     for c in range(n):
         q = cands[c].copy()
         if perturbed:
@@ -533,9 +536,9 @@ def _krr_split(k, F, moved, out, count):
 _KRR_MAX = 16
 
 
-def _krr_candidates(values, F, rows, out, extra):
-    """_rr_candidates in the kernel: the count of candidate joint vectors written to out,
-    whether the answer is in doubt (clusters, or no usable pencil), and in extra which
+def _krr_candidates(values, F, rows, out, extra, k):
+    """_rr_candidates in the kernel (split k): the count of candidate joint vectors written
+    to out, whether the answer is in doubt (clusters, or no usable pencil), and in extra which
     candidates come from nearly real pairs."""
     P0 = values[:126].reshape(14, 9)
     Ps = values[126:252].reshape(14, 9)
@@ -586,7 +589,7 @@ def _krr_candidates(values, F, rows, out, extra):
     if not _ksolve_into(A, rhs):
         return 0, True
     K[12:, :] = rhs
-    wr, wi, ok = _keigenvalues(K)
+    wr, wi, ok = _keigenvalues(_kdeflated(K, k, moebius))
     if not ok:
         return 0, True
     ma, mb, mc, md = moebius
@@ -597,7 +600,7 @@ def _krr_candidates(values, F, rows, out, extra):
     n_real = 0
     extras = np.zeros(48)  # (nearly real pairs, at Re -+ Im: as in Python)
     n_extra = 0
-    for i in range(24):
+    for i in range(wr.size):
         size = 1.0 + math.hypot(wr[i], wi[i])
         if abs(wi[i]) <= _RR_IMAG_TOL * size:
             y = wr[i]
@@ -1083,6 +1086,49 @@ def _krr_steps(rows, F, q0, damped):
         for i in range(6):
             q[i] += scale * step[i, 0]
     return best_q, best
+
+
+def _kdeflated(K, k, moebius):
+    """_rr_deflated in the kernel: split k's companion matrix K without its known
+    eigenvalues, K[o, o] - G K[p', o] (K itself where the split has none)."""
+    count = _RR_SPURIOUS_COUNT[k]
+    if count == 0:
+        return K
+    r = count // 2
+    a, b, c, d = moebius
+    scale = 1.0 / (a * a + c * c)
+    yr, yi = (-b * a - d * c) * scale, (d * a - b * c) * scale
+    p = np.zeros(count, dtype=np.int64)
+    taken = np.zeros(24, dtype=np.bool_)
+    for j in range(r):
+        p[j] = _RR_PIVOTS[k, j]
+        p[r + j] = _RR_PIVOTS[k, j] + 12
+        taken[p[j]] = True
+        taken[p[r + j]] = True
+    o = np.zeros(24 - count, dtype=np.int64)
+    n = 0
+    for i in range(24):
+        if not taken[i]:
+            o[n] = i
+            n += 1
+    # G = [Re W[o] - (yr / yi) Im W[o], Im W[o] / yi], W = [v; y+ v]
+    G = np.zeros((n, count))
+    for i in range(n):
+        row = o[i] % 12
+        for j in range(r):
+            vr, vi = _RR_SPURIOUS[k, row, 2 * j], _RR_SPURIOUS[k, row, 2 * j + 1]
+            if o[i] >= 12:
+                vr, vi = yr * vr - yi * vi, yr * vi + yi * vr
+            G[i, j] = vr - (yr / yi) * vi
+            G[i, r + j] = vi / yi
+    out = np.zeros((n, n))
+    for i in range(n):
+        for j in range(n):
+            total = K[o[i], o[j]]
+            for m in range(count):
+                total -= G[i, m] * K[p[m], o[j]]
+            out[i, j] = total
+    return out
 
 
 def _keigenvalues(M):
