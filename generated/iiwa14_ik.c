@@ -727,7 +727,8 @@ static int dk_cs1(dk_values *v, double a, double b, double e, double scale, doub
     v->t[0] = dk_uangle(v->s[0], v->c[0]);
     v->c[1] = cb * ratio + sb * sd;
     v->s[1] = sb * ratio - cb * sd;
-    v->t[1] = dk_uangle(v->s[1], v->c[1]);
+    /* (b = 0: (c, s) and (c, -s) exactly, and dk_uangle is odd in s: no second call) */
+    v->t[1] = sb == 0.0 && sd > 0.0 ? -v->t[0] : dk_uangle(v->s[1], v->c[1]);
     return 0;
 }
 
