@@ -261,6 +261,7 @@ ROUTINES = {
     "dk_cs2": ("dk_one",),
     "dk_cs2r": ("dk_one",),
     "dk_atan2": ("dk_one",),
+    "dk_flipped": (),
 }
 
 

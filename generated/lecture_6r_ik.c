@@ -96,6 +96,22 @@ static int dk_near(const dk_values *v)
     return near;
 }
 
+/* the wrist flip: a joint's one value (t, c, s), kept from the first branch, turned by pi
+   (t + pi around the circle, cos and sin negated) */
+static void dk_flipped(dk_values *v, double t, double c, double s)
+{
+    int k;
+    v->n = 1;
+    v->free = 0;
+    v->ref = 0.0;
+    v->t[0] = t + (t <= 0.0 ? DK_PI : -DK_PI);
+    v->c[0] = -c;
+    v->s[0] = -s;
+    for (k = 1; k < 4; k++) { /* (unread: v->n is 1) */
+        v->t[k] = v->c[k] = v->s[k] = 0.0;
+    }
+}
+
 /* The angle of a unit vector (c, s) (a joint's cos and sin; within a few units in the last
    place of atan2(s, c) where c^2 + s^2 = 1 to rounding), without a division or a branch (their
    latency and a coin-toss branch were half the solver's time): asin of the smaller of |c| and
@@ -1021,6 +1037,9 @@ static int dk_solve(const double t[12], double tol, const double ref[DK_DOF],
                 if (dk_cs1(&dk_v5, 1.0, 0.0, W33, 0.0, 0.0) < 0) {
                     return DK_UNSETTLED;
                 }
+                /* the wrist flip: theta4, theta6 of the second value */
+                double dk_f4[4] = {0.0}, dk_f6[4] = {0.0}; /* t, c, s, kept */
+                int dk_flip = 0;
                 const int dk_m5 = n;
                 dk_close |= dk_near(&dk_v5);
                 for (int dk_k5 = 0; dk_k5 < dk_v5.n; dk_k5++) {
@@ -1031,8 +1050,16 @@ static int dk_solve(const double t[12], double tol, const double ref[DK_DOF],
                     double v2 = 0.0;
                     /* theta4: (W13, W23) = Rz(theta4) (v1, v2); free at a singular wrist */
                     dk_values dk_v4;
-                    if (dk_cs2(&dk_v4, v1, -v2, W13, v2, v1, W23, 1.0, 1.0, qr4) < 0) {
+                    if (dk_flip) {
+                        dk_flipped(&dk_v4, dk_f4[0], dk_f4[1], dk_f4[2]);
+                    } else if (dk_cs2(&dk_v4, v1, -v2, W13, v2, v1, W23, 1.0, 1.0, qr4) < 0) {
                         return DK_UNSETTLED;
+                    }
+                    if (dk_k5 == 0 && dk_v4.n == 1 && !dk_v4.free) {
+                        dk_f4[0] = dk_v4.t[0];
+                        dk_f4[1] = dk_v4.c[0];
+                        dk_f4[2] = dk_v4.s[0];
+                        dk_f4[3] = 1.0; /* (kept) */
                     }
                     const int dk_m4 = n;
                     dk_close |= dk_near(&dk_v4);
@@ -1041,8 +1068,16 @@ static int dk_solve(const double t[12], double tol, const double ref[DK_DOF],
                         dk_value(&dk_v4, dk_k4, &theta4, &c4, &s4);
                         /* theta6: Rz(theta6) = (Rx(alpha4) Rz(theta5) Rx(alpha5))^T Rz(theta4)^T W */
                         dk_values dk_v6;
-                        if (dk_atan2(&dk_v6, -W11*s4 + W21*c4, W11*c4*c5 + W21*c5*s4 + W31*s5, qr6) < 0) {
+                        if (dk_flip) {
+                            dk_flipped(&dk_v6, dk_f6[0], dk_f6[1], dk_f6[2]);
+                        } else if (dk_atan2(&dk_v6, -W11*s4 + W21*c4, W11*c4*c5 + W21*c5*s4 + W31*s5, qr6) < 0) {
                             return DK_UNSETTLED;
+                        }
+                        if (dk_k5 == 0 && dk_v6.n == 1 && !dk_v6.free) {
+                            dk_f6[0] = dk_v6.t[0];
+                            dk_f6[1] = dk_v6.c[0];
+                            dk_f6[2] = dk_v6.s[0];
+                            dk_f6[3] = 1.0; /* (kept) */
                         }
                         const int dk_m6 = n;
                         dk_close |= dk_near(&dk_v6);
@@ -1068,6 +1103,9 @@ static int dk_solve(const double t[12], double tol, const double ref[DK_DOF],
                             break;
                         }
                     }
+                    dk_flip = dk_k5 == 0 && dk_v5.n == 2 && !dk_v5.free &&
+                            dk_v5.s[0] != 0.0 && dk_v5.t[1] == -dk_v5.t[0] &&
+                            dk_f4[3] == 1.0 && dk_f6[3] == 1.0;
                     if (dk_v5.free && n > dk_m5) {
                         break;
                     }
@@ -1099,16 +1137,13 @@ static int dk_finish(double found[DK_MAX][DK_DOF], int count, int repeats,
         double q[DK_DOF];
         int distinct = 1;
         for (j = 0; j < DK_DOF; j++) {
-            q[j] = found[r][j];
-            if (DK_REVOLUTE[j]) {
-                q[j] = dk_wrap(q[j]);
-                if (q[j] < -DK_SEAM) {
-                    q[j] += DK_TWO_PI;
-                }
-                if (fabs(q[j] - DK_PI) <= DK_SEAM_SNAP) {
-                    q[j] = DK_PI;
-                }
+            double x = found[r][j];
+            if (DK_REVOLUTE[j]) { /* (selects, not branches: a row's joints go either way) */
+                x = dk_wrap(x);
+                x = x < -DK_SEAM ? x + DK_TWO_PI : x;
+                x = fabs(x - DK_PI) <= DK_SEAM_SNAP ? DK_PI : x;
             }
+            q[j] = x;
         }
         for (p = 0; p < m && distinct && repeats; p++) {
             double worst = 0.0; /* the largest difference, without a branch per joint */

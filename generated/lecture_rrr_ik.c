@@ -491,16 +491,13 @@ static int dk_finish(double found[DK_MAX][DK_DOF], int count, int repeats,
         double q[DK_DOF];
         int distinct = 1;
         for (j = 0; j < DK_DOF; j++) {
-            q[j] = found[r][j];
-            if (DK_REVOLUTE[j]) {
-                q[j] = dk_wrap(q[j]);
-                if (q[j] < -DK_SEAM) {
-                    q[j] += DK_TWO_PI;
-                }
-                if (fabs(q[j] - DK_PI) <= DK_SEAM_SNAP) {
-                    q[j] = DK_PI;
-                }
+            double x = found[r][j];
+            if (DK_REVOLUTE[j]) { /* (selects, not branches: a row's joints go either way) */
+                x = dk_wrap(x);
+                x = x < -DK_SEAM ? x + DK_TWO_PI : x;
+                x = fabs(x - DK_PI) <= DK_SEAM_SNAP ? DK_PI : x;
             }
+            q[j] = x;
         }
         for (p = 0; p < m && distinct && repeats; p++) {
             double worst = 0.0; /* the largest difference, without a branch per joint */

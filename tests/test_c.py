@@ -289,6 +289,37 @@ def test_c_files_are_byte_deterministic_across_hash_seeds(tmp_path):
         assert (GENERATED / file).read_bytes() == data, file
 
 
+def test_the_wrist_flip_is_taken_where_both_wrist_twists_are_right_angles(tmp_path):
+    """PUMA's wrist (twists -90, 90 deg) gets the flip (theta4 + pi, -theta5, theta6 + pi from
+    the first theta5 branch); with its fifth twist at 60 deg it does not (the identity needs
+    both at +-90), and the C solver still gives the Python solver's rows there."""
+    from derive.printers.c import wrist_flip
+
+    assert wrist_flip(plan_of("puma560")) == (5, 4, 6)
+    assert "dk_flipped(" in (GENERATED / "puma560_ik.c").read_text()
+    text = (ROOT / "derive" / "arms" / "puma560.toml").read_text()
+    fifth = text.index("[[joint]]", text.index("d = 0.433"))
+    text = text[:fifth] + text[fifth:].replace("alpha = 90.0", "alpha = 60.0", 1)
+    plan = build_plan(parse_spec(text, "<test>"))
+    assert plan.ik is not None and plan.ik.method == "pieper"
+    assert wrist_flip(plan) is None
+    assert "dk_flipped(" not in render_c(plan)["puma560_ik.c"]
+    m = build_module(text, tmp_path)
+    harness = cbuild.Harness(plan, tmp_path)
+    _, T, refs = poses(m, 300, 3)
+    counts, QC = harness.solve(T, refs)
+    beyond = 0
+    for i, rows_py in enumerate(python_rows(m, T, refs)):
+        rows_c = QC[i, : counts[i]]
+        assert len(rows_c) == len(rows_py), i
+        gap = np.abs(rows_c - rows_py).max(initial=0.0)
+        # (near a singular wrist, theta5 ~ 3e-7 here, rounding moves theta4 and theta6 by
+        # ~1e-16 / theta5 in either solver: as BEYOND in the test above)
+        assert gap <= 1e-6, i
+        beyond += gap > 1e-9
+    assert beyond <= 3, beyond
+
+
 def test_c_header_states_the_interface():
     text = (GENERATED / "puma560_ik.h").read_text()
     for needle in (

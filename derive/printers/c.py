@@ -148,6 +148,40 @@ CALLS: dict[type[Solve], Callable[[Solve, list[str], str], Call]] = {
 }
 
 
+def wrist_flip(plan: Plan) -> tuple[int, int, int] | None:
+    """(j5, j4, j6), the joints of a Pieper wrist whose second theta5 value gives the first's
+    theta4 + pi and theta6 + pi, else None.
+
+    The wrist's steps (derive.methods.pieper.wrist_equations): theta5 from a c5 + b s5 = e
+    with b = 0 (so its values are +-t, exactly so in dk_cs1), v = Rx(alpha4) Rz(theta5)
+    Rx(alpha5) e3 with v2 = 0 identically (which is alpha4, alpha5 = +-90 deg: v2 =
+    -sin alpha5 c5 cos alpha4 - cos alpha5 sin alpha4), theta4 from (v1, v2) and theta6 by
+    atan2. There Rz(pi) Rx(alpha4) Rz(-t5) Rx(alpha5) Rz(pi) = Rx(alpha4) Rz(t5) Rx(alpha5),
+    so (theta4 + pi, -theta5, theta6 + pi) gives the wrist rotation of (theta4, theta5,
+    theta6): the C solver takes it instead of solving the second branch's theta4 and theta6
+    again (where the first branch's are single and not free)."""
+    assert plan.ik is not None
+    steps = [
+        s for s in plan.ik.steps if not isinstance(s, Assign) or s.targets[:1] == (sym.named("v1"),)
+    ]
+    for k in range(len(steps) - 3):
+        five, v, four, six = steps[k : k + 4]
+        if (
+            type(five) is Cs1
+            and isinstance(v, Assign)
+            and type(four) is Cs2
+            and type(six) is Atan2
+            and five.args[1] == 0
+            and five.args[0].is_number
+            and five.args[0] != 0
+            and v.targets == (sym.named("v1"), sym.named("v2"))
+            and v.exprs[1] == 0
+            and v.exprs[0] != 0
+        ):
+            return five.joint, four.joint, six.joint
+    return None
+
+
 def solve_lines(plan: Plan) -> tuple[tuple[int, str], ...]:
     """Body of dk_solve(t, tol, ref, found): the certified solutions of the pose t (12 top
     entries) into found, in the Python solver's branch order; their count, or DK_UNSETTLED.
@@ -172,6 +206,9 @@ def solve_lines(plan: Plan) -> tuple[tuple[int, str], ...]:
     body.append(Line(0, f"int dk_close = {0 if branches_are_outputs(plan) else 1};"))
     depth = 0
     closing: list[Line] = []
+    # lines ending a loop's body, before its free-joint check (by the loop's closing line)
+    endings: dict[int, list[Line]] = {}
+    flip = wrist_flip(plan)
     for live in steps:
         step = live.step
         if isinstance(step, Assign):
@@ -197,9 +234,39 @@ def solve_lines(plan: Plan) -> tuple[tuple[int, str], ...]:
         if call.before:
             body.append(Line(depth, call.before))
         body.append(Line(depth, f"dk_values dk_v{j};"))
-        body.append(Line(depth, f"if ({call.routine}(&dk_v{j}, {', '.join(call.args)}) < 0) {{"))
-        body.append(Line(depth + 1, "return DK_UNSETTLED;"))
-        body.append(Line(depth, "}"))
+        solve = f"{call.routine}(&dk_v{j}, {', '.join(call.args)}) < 0"
+        if flip and j in flip[1:]:  # the second theta5 branch: the first's turned by pi
+            body.append(Line(depth, "if (dk_flip) {"))
+            body.append(
+                Line(depth + 1, f"dk_flipped(&dk_v{j}, dk_f{j}[0], dk_f{j}[1], dk_f{j}[2]);")
+            )
+            body.append(Line(depth, f"}} else if ({solve}) {{"))
+            body.append(Line(depth + 1, "return DK_UNSETTLED;"))
+            body.append(Line(depth, "}"))
+            body.append(
+                Line(depth, f"if (dk_k{flip[0]} == 0 && dk_v{j}.n == 1 && !dk_v{j}.free) {{")
+            )
+            body.append(Line(depth + 1, f"dk_f{j}[0] = dk_v{j}.t[0];"))
+            body.append(Line(depth + 1, f"dk_f{j}[1] = dk_v{j}.c[0];"))
+            body.append(Line(depth + 1, f"dk_f{j}[2] = dk_v{j}.s[0];"))
+            body.append(Line(depth + 1, f"dk_f{j}[3] = 1.0; /* (kept) */"))
+            body.append(Line(depth, "}"))
+        else:
+            body.append(Line(depth, f"if ({solve}) {{"))
+            body.append(Line(depth + 1, "return DK_UNSETTLED;"))
+            body.append(Line(depth, "}"))
+        if flip and j == flip[0]:
+            j4, j6 = flip[1:]
+            body.append(
+                Line(depth, f"/* the wrist flip: theta{j4}, theta{j6} of the second value */")
+            )
+            body.append(
+                Line(
+                    depth,
+                    f"double dk_f{j4}[4] = {{0.0}}, dk_f{j6}[4] = {{0.0}}; /* t, c, s, kept */",
+                )
+            )
+            body.append(Line(depth, "int dk_flip = 0;"))
         body.append(Line(depth, f"const int dk_m{j} = n;"))
         body.append(Line(depth, f"dk_close |= dk_near(&dk_v{j});"))
         body.append(Line(depth, f"for (int dk_k{j} = 0; dk_k{j} < dk_v{j}.n; dk_k{j}++) {{"))
@@ -218,6 +285,13 @@ def solve_lines(plan: Plan) -> tuple[tuple[int, str], ...]:
             body.append(Line(depth + 1, f"(void){s_name};"))
         # a free joint's loop ends at its first value that gave a solution
         closing.append(Line(depth + 1, f"if (dk_v{j}.free && n > dk_m{j}) {{"))
+        if flip and j == flip[0]:
+            j4, j6 = flip[1:]
+            endings[id(closing[-1])] = [
+                Line(depth + 1, f"dk_flip = dk_k{j} == 0 && dk_v{j}.n == 2 && !dk_v{j}.free &&"),
+                Line(depth + 3, f"dk_v{j}.s[0] != 0.0 && dk_v{j}.t[1] == -dk_v{j}.t[0] &&"),
+                Line(depth + 3, f"dk_f{j4}[3] == 1.0 && dk_f{j6}[3] == 1.0;"),
+            ]
         depth += 1
     outputs = [printer.doprint(e) for e in plan.ik.outputs]
     body.append(Line(depth, "double e[12];"))
@@ -231,6 +305,7 @@ def solve_lines(plan: Plan) -> tuple[tuple[int, str], ...]:
     body.append(Line(depth + 1, "n++;"))
     body.append(Line(depth, "}"))
     for line in reversed(closing):
+        body += endings.get(id(line), [])
         if line.text:  # a free joint's loop ends at its first value that gave a solution
             body.append(line)
             body.append(Line(line.depth + 1, "break;"))
