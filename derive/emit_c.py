@@ -44,6 +44,8 @@ class PrintedC:
     fk_joints: tuple[str, ...]
     fk_params: str
     solve: tuple[tuple[int, str], ...]
+    # dk_solve brings every revolute output to ik's range (c.seamed_outputs): dk_finish copies
+    seamed: bool
 
 
 @dataclass(frozen=True)
@@ -249,6 +251,7 @@ def print_c(plan: Plan) -> PrintedC:
         fk_joints=fk_joints,
         fk_params=fk_params,
         solve=solve,
+        seamed=bool(c.seamed_outputs(plan)),
     )
 
 
@@ -262,6 +265,7 @@ ROUTINES = {
     "dk_cs2r": ("dk_one",),
     "dk_atan2": ("dk_one",),
     "dk_flipped": (),
+    "dk_seam": (),
 }
 
 

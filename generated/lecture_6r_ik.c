@@ -217,6 +217,15 @@ static double dk_wrap(double t)
     return w <= -DK_PI ? w + DK_TWO_PI : w;
 }
 
+/* an angle in ik's range: wrapped, a value just above -pi as its equivalent above pi, one
+   within DK_SEAM_SNAP of pi as pi (dk_finish's rules, once per value of a step) */
+static double dk_seam(double t)
+{
+    t = dk_wrap(t);
+    t = t < -DK_SEAM ? t + DK_TWO_PI : t;
+    return fabs(t - DK_PI) <= DK_SEAM_SNAP ? DK_PI : t;
+}
+
 /* complex numbers, for the quartic's fallback (no complex.h: math.h only) */
 typedef struct {
     double re, im;
@@ -992,6 +1001,7 @@ static int dk_solve(const double t[12], double tol, const double ref[DK_DOF],
     for (int dk_k3 = 0; dk_k3 < dk_v3.n; dk_k3++) {
         double theta3, c3, s3;
         dk_value(&dk_v3, dk_k3, &theta3, &c3, &s3);
+        theta3 = dk_seam(theta3);
         /* theta2: r and z equations, linear in (c2, s2) */
         dk_values dk_v2;
         if (dk_cs2(&dk_v2, 2400.0*c3 + 20280.0*s3 - 20400.0, 20280.0*c3 - 2400.0*s3, 27200.0*c3 + r + 229840.0*s3 - 232344.0, -338.0*c3 + 40.0*s3, 40.0*c3 + 338.0*s3 - 340.0, z, 33570240.0, 0.0, qr2) < 0) {
@@ -1002,6 +1012,7 @@ static int dk_solve(const double t[12], double tol, const double ref[DK_DOF],
         for (int dk_k2 = 0; dk_k2 < dk_v2.n; dk_k2++) {
             double theta2, c2, s2;
             dk_value(&dk_v2, dk_k2, &theta2, &c2, &s2);
+            theta2 = dk_seam(theta2);
             /* g1(theta2, theta3), g2(theta2, theta3) */
             double g1 = -40.0*c2*c3 - 338.0*c2*s3 + 340.0*c2 - 338.0*c3*s2 + 40.0*s2*s3 - 30.0;
             double g2 = 0.0;
@@ -1015,6 +1026,7 @@ static int dk_solve(const double t[12], double tol, const double ref[DK_DOF],
             for (int dk_k1 = 0; dk_k1 < dk_v1.n; dk_k1++) {
                 double theta1, c1, s1;
                 dk_value(&dk_v1, dk_k1, &theta1, &c1, &s1);
+                theta1 = dk_seam(theta1);
                 /* wrist W = (0_3R Rx(alpha3))^T 0_6R = Rz(t4) Rx(alpha4) Rz(t5) Rx(alpha5) Rz(t6) */
                 double x4 = c2*s3;
                 double x5 = c3*s2;
@@ -1045,6 +1057,7 @@ static int dk_solve(const double t[12], double tol, const double ref[DK_DOF],
                 for (int dk_k5 = 0; dk_k5 < dk_v5.n; dk_k5++) {
                     double theta5, c5, s5;
                     dk_value(&dk_v5, dk_k5, &theta5, &c5, &s5);
+                    theta5 = dk_seam(theta5);
                     /* v = Rx(alpha4) Rz(theta5) Rx(alpha5) e3 */
                     double v1 = -s5;
                     double v2 = 0.0;
@@ -1066,6 +1079,7 @@ static int dk_solve(const double t[12], double tol, const double ref[DK_DOF],
                     for (int dk_k4 = 0; dk_k4 < dk_v4.n; dk_k4++) {
                         double theta4, c4, s4;
                         dk_value(&dk_v4, dk_k4, &theta4, &c4, &s4);
+                        theta4 = dk_seam(theta4);
                         /* theta6: Rz(theta6) = (Rx(alpha4) Rz(theta5) Rx(alpha5))^T Rz(theta4)^T W */
                         dk_values dk_v6;
                         if (dk_flip) {
@@ -1084,6 +1098,7 @@ static int dk_solve(const double t[12], double tol, const double ref[DK_DOF],
                         for (int dk_k6 = 0; dk_k6 < dk_v6.n; dk_k6++) {
                             double theta6, c6, s6;
                             dk_value(&dk_v6, dk_k6, &theta6, &c6, &s6);
+                            theta6 = dk_seam(theta6);
                             double e[12];
                             dk_fk_cs(c1, s1, c2, s2, c3, s3, c4, s4, c5, s5, c6, s6, e);
                             if (n < DK_MAX && dk_match(e, t, tol, ptol, 0)) {
@@ -1137,13 +1152,7 @@ static int dk_finish(double found[DK_MAX][DK_DOF], int count, int repeats,
         double q[DK_DOF];
         int distinct = 1;
         for (j = 0; j < DK_DOF; j++) {
-            double x = found[r][j];
-            if (DK_REVOLUTE[j]) { /* (selects, not branches: a row's joints go either way) */
-                x = dk_wrap(x);
-                x = x < -DK_SEAM ? x + DK_TWO_PI : x;
-                x = fabs(x - DK_PI) <= DK_SEAM_SNAP ? DK_PI : x;
-            }
-            q[j] = x;
+            q[j] = found[r][j]; /* (dk_solve brought the angles to range: dk_seam) */
         }
         for (p = 0; p < m && distinct && repeats; p++) {
             double worst = 0.0; /* the largest difference, without a branch per joint */

@@ -201,6 +201,15 @@ static double dk_wrap(double t)
     return w <= -DK_PI ? w + DK_TWO_PI : w;
 }
 
+/* an angle in ik's range: wrapped, a value just above -pi as its equivalent above pi, one
+   within DK_SEAM_SNAP of pi as pi (dk_finish's rules, once per value of a step) */
+static double dk_seam(double t)
+{
+    t = dk_wrap(t);
+    t = t < -DK_SEAM ? t + DK_TWO_PI : t;
+    return fabs(t - DK_PI) <= DK_SEAM_SNAP ? DK_PI : t;
+}
+
 /* angles t with a cos t + b sin t = e (the half-angle method's two values); free when the
    equation vanishes identically */
 static int dk_cs1(dk_values *v, double a, double b, double e, double scale, double ref)
@@ -430,6 +439,7 @@ static int dk_solve(const double t[12], double tol, const double ref[DK_DOF],
     for (int dk_k2 = 0; dk_k2 < dk_v2.n; dk_k2++) {
         double theta2, c2, s2;
         dk_value(&dk_v2, dk_k2, &theta2, &c2, &s2);
+        theta2 = dk_seam(theta2);
         /* k1, k2 with x = k1 c1 - k2 s1 (+ const) */
         double k1 = 0.4*c2 + 1.0;
         double k2 = 0.4*s2;
@@ -443,6 +453,7 @@ static int dk_solve(const double t[12], double tol, const double ref[DK_DOF],
         for (int dk_k1 = 0; dk_k1 < dk_v1.n; dk_k1++) {
             double theta1, c1, s1;
             dk_value(&dk_v1, dk_k1, &theta1, &c1, &s1);
+            theta1 = dk_seam(theta1);
             /* theta3: heading, Rz(theta3) = A^T R B^T */
             double x0 = c1*s2;
             double x1 = c2*s1;
@@ -456,6 +467,7 @@ static int dk_solve(const double t[12], double tol, const double ref[DK_DOF],
             for (int dk_k3 = 0; dk_k3 < dk_v3.n; dk_k3++) {
                 double theta3, c3, s3;
                 dk_value(&dk_v3, dk_k3, &theta3, &c3, &s3);
+                theta3 = dk_seam(theta3);
                 double e[12];
                 dk_fk_cs(c1, s1, c2, s2, c3, s3, e);
                 if (n < DK_MAX && dk_match(e, t, tol, ptol, 0)) {
@@ -491,13 +503,7 @@ static int dk_finish(double found[DK_MAX][DK_DOF], int count, int repeats,
         double q[DK_DOF];
         int distinct = 1;
         for (j = 0; j < DK_DOF; j++) {
-            double x = found[r][j];
-            if (DK_REVOLUTE[j]) { /* (selects, not branches: a row's joints go either way) */
-                x = dk_wrap(x);
-                x = x < -DK_SEAM ? x + DK_TWO_PI : x;
-                x = fabs(x - DK_PI) <= DK_SEAM_SNAP ? DK_PI : x;
-            }
-            q[j] = x;
+            q[j] = found[r][j]; /* (dk_solve brought the angles to range: dk_seam) */
         }
         for (p = 0; p < m && distinct && repeats; p++) {
             double worst = 0.0; /* the largest difference, without a branch per joint */

@@ -320,6 +320,19 @@ def test_the_wrist_flip_is_taken_where_both_wrist_twists_are_right_angles(tmp_pa
     assert beyond <= 3, beyond
 
 
+def test_angles_are_brought_to_range_once_per_value_where_the_outputs_are_the_steps():
+    """PUMA's outputs are its steps' angles: dk_solve applies the seam rules once per value
+    (dk_seam) and dk_finish copies; iiwa14's (a reversed chain: -theta) keep dk_finish's
+    rules. (test_c_solver_gives_the_python_solutions checks the values, theta = pi samples
+    included.)"""
+    from derive.printers.c import seamed_outputs
+
+    assert seamed_outputs(plan_of("puma560")) == {f"theta{k}" for k in range(1, 7)}
+    assert seamed_outputs(plan_of("iiwa14")) == frozenset()
+    assert "dk_seam(" in (GENERATED / "puma560_ik.c").read_text()
+    assert "dk_seam(" not in (GENERATED / "iiwa14_ik.c").read_text()
+
+
 def test_c_header_states_the_interface():
     text = (GENERATED / "puma560_ik.h").read_text()
     for needle in (

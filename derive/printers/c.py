@@ -182,6 +182,26 @@ def wrist_flip(plan: Plan) -> tuple[int, int, int] | None:
     return None
 
 
+def seamed_outputs(plan: Plan) -> frozenset[str]:
+    """The angle steps' variables that dk_solve brings to ik's range itself (dk_seam, once
+    per value), where every revolute output joint is one of them: then dk_finish need not (a
+    row has 6 joints, a step's value serves several rows). Empty otherwise."""
+    assert plan.ik is not None
+    angles = {
+        step.variable
+        for step in plan.ik.steps
+        if isinstance(step, Solve) and not isinstance(step, Eigen) and step.angle
+    }
+    names = set()
+    for kind, output in zip(plan.arm.joint_types, plan.ik.outputs):
+        if kind != "R":
+            continue
+        if not (isinstance(output, sp.Symbol) and output.name in angles):
+            return frozenset()
+        names.add(output.name)
+    return frozenset(names)
+
+
 def solve_lines(plan: Plan) -> tuple[tuple[int, str], ...]:
     """Body of dk_solve(t, tol, ref, found): the certified solutions of the pose t (12 top
     entries) into found, in the Python solver's branch order; their count, or DK_UNSETTLED.
@@ -209,6 +229,7 @@ def solve_lines(plan: Plan) -> tuple[tuple[int, str], ...]:
     # lines ending a loop's body, before its free-joint check (by the loop's closing line)
     endings: dict[int, list[Line]] = {}
     flip = wrist_flip(plan)
+    seamed = seamed_outputs(plan)
     for live in steps:
         step = live.step
         if isinstance(step, Assign):
@@ -280,6 +301,8 @@ def solve_lines(plan: Plan) -> tuple[tuple[int, str], ...]:
         scope.declare(s_name)
         body.append(Line(depth + 1, f"double {var}, {c_name}, {s_name};"))
         body.append(Line(depth + 1, f"dk_value(&dk_v{j}, dk_k{j}, &{var}, &{c_name}, &{s_name});"))
+        if str(var) in seamed:
+            body.append(Line(depth + 1, f"{var} = dk_seam({var});"))
         if not step.angle:
             body.append(Line(depth + 1, f"(void){c_name};"))
             body.append(Line(depth + 1, f"(void){s_name};"))
