@@ -16,7 +16,7 @@ from derive import free
 from derive.emit import GENERATOR, GenerationError, check_printable, environment
 from derive.plan import Eigen, Plan
 from derive.printers import c
-from derive.printers.general import eigen_step
+from derive.printers.general import eigen_step, pad, spurious_counts
 from derive.runtime import closed, constants
 
 
@@ -124,11 +124,9 @@ def general_constants(plan: Plan) -> dict[str, object]:
 
 
 def spurious_constants(step: Eigen) -> dict[str, object]:
-    """DK_RR_SPURIOUS (splits x 12 x width, zeros beyond each split's count; width at least
-    2, one vector's columns: C has no empty arrays, and GCC's bounds checks see the columns
-    dk_rr_deflate names), its counts and width."""
-    counts = [len(s.spurious[0]) if s.spurious else 0 for s in step.splits]
-    width = max(2, *counts)
+    """DK_RR_SPURIOUS (splits x 12 x width, zeros beyond each split's count: spurious_counts),
+    its counts and width, and DK_RR_PIVOTS."""
+    counts, width = spurious_counts(step)
     tables = []
     for split, n in zip(step.splits, counts):
         rows = split.spurious if n else ((),) * 12
@@ -140,8 +138,6 @@ def spurious_constants(step: Eigen) -> dict[str, object]:
             )
             + "}"
         )
-    from derive.printers.general import pad
-
     pivots = [pad(s.spurious_pivots, width // 2) for s in step.splits]
     return {
         "PIVOTS": "{" + ", ".join("{" + ", ".join(map(str, p)) + "}" for p in pivots) + "}",

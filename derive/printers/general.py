@@ -39,6 +39,14 @@ def pad(values: tuple[int, ...], width: int) -> tuple[int, ...]:
     return (*values, *[0] * (width - len(values)))
 
 
+def spurious_counts(step: Eigen) -> tuple[list[int], int]:
+    """Per split, the columns of Split.spurious (2 per vector), and the width every split's
+    table is padded to: a vector's columns at least (no empty arrays in numba or C, and GCC's
+    bounds checks see the columns the C routine names)."""
+    counts = [len(split.spurious[0]) if split.spurious else 0 for split in step.splits]
+    return counts, max(2, *counts)
+
+
 def general_code(plan: Plan) -> str:
     """_RR_SPLITS, _RR_LENGTH and _rr_fill for a plan of the general method ("" otherwise)."""
     step = eigen_step(plan)
@@ -62,8 +70,7 @@ def general_code(plan: Plan) -> str:
         slide = ", ".join(float_literal(v) for v in split.slide)
         lines += [*rows(split.true_rows), f"        ({slide}),", "    ),"]
     lines += [")", f"_RR_LENGTH = {float_literal(step.unit)}"]
-    counts = [len(split.spurious[0]) if split.spurious else 0 for split in step.splits]
-    width = max(2, *counts)  # (a vector's columns at least: no empty arrays in numba or C)
+    counts, width = spurious_counts(step)
     lines += [
         "# per split, the null vectors its lifted 12 x 12 matrix has at x3 = i whatever the pose",
         "# (real and imaginary parts in turn, _RR_SPURIOUS_COUNT columns, then zeros): the",
