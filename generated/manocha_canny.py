@@ -205,6 +205,19 @@ _RR_PATH = (0.3, 0.1, 0.03)
 _RR_RESCUE = ((1e-4, 1e-4), (-2e-4, 1.5e-4))
 
 
+# where nothing polishes and a pencil on the arm's own table is singular at the pose, or a
+# candidate's polishing stopped within _RR_SEARCH_FROM of it (a curve of solutions the
+# eigenvalues missed), _RR_SEARCH_STEPS damped steps from those candidates and from fixed
+# starting points (a sliding joint's within +-_RR_SEARCH_SLIDE of the arm's size) look for it
+_RR_SEARCH_FROM = 1e-3
+
+
+_RR_SEARCH_STEPS = 40
+
+
+_RR_SEARCH_SLIDE = 1.5
+
+
 def fk(q: ArrayLike) -> np.ndarray:
     """World pose of the tool frame (base and tool included) for joint vector q."""
     values = _real(q, "q")
@@ -801,6 +814,11 @@ _RR_H45 = np.array(
 )
 
 
+# _rr_search's starting points (split values; a sliding joint 3's scaled to _RR_SEARCH_SLIDE):
+# deterministic numbers spread over the joints' turns, any such do
+_RR_SEARCH_STARTS = math.pi * np.sin(np.outer(np.arange(1, 25), np.arange(1, 7)) * 2.113 + 0.5)
+
+
 # fixed combinations of the rows of a null space of Q with more than six rows (a Q of rank
 # below 8): deterministic numbers, any generic ones do
 _RR_MIX = np.sin(np.outer(np.arange(1, 7), np.arange(1, 15)) * 0.731 + 0.25)
@@ -830,10 +848,11 @@ def _general(flanges, tol):
     """
     found: list[np.ndarray] = []
     near: list[np.ndarray] = []
+    leads = _RRLeads()
     targets = [_rr_target(f) for f in flanges]
     doubt = True
     for k, F in enumerate(targets):
-        candidates, close, doubt = _rr_split(k, F, F)
+        candidates, close, doubt = _rr_split(k, F, F, leads)
         _rr_merge(found, [_rr_to_arm(k, q) for q in candidates])
         _rr_merge(near, [_rr_to_arm(k, q) for q in close])
         if not doubt and len(found) % 2 == 0:
@@ -842,7 +861,7 @@ def _general(flanges, tol):
         # the rescue: solve slightly moved poses, polish back onto the true one
         for motion in _RR_MOTIONS:
             for k, F in enumerate(targets):
-                candidates, close, _ = _rr_split(k, F, F @ motion)
+                candidates, close, _ = _rr_split(k, F, F @ motion, leads)
                 _rr_merge(found, [_rr_to_arm(k, q) for q in candidates])
                 _rr_merge(near, [_rr_to_arm(k, q) for q in close])
     for motion in (np.eye(4), *_RR_MOTIONS):
@@ -851,15 +870,49 @@ def _general(flanges, tol):
         # the last resort: a pose whose pencil is singular (a curve of solutions) scatters
         # the eigenvalues off the real line; those within _RR_IMAG_LOOSE of it, polished
         for k, F in enumerate(targets):
-            candidates, close, _ = _rr_split(k, F, F @ motion, _RR_IMAG_LOOSE)
+            candidates, close, _ = _rr_split(k, F, F @ motion, leads, _RR_IMAG_LOOSE)
             _rr_merge(found, [_rr_to_arm(k, q) for q in candidates])
             _rr_merge(near, [_rr_to_arm(k, q) for q in close])
+    if not found and not near and (leads.singular or leads.rows):
+        # a curve of solutions that none of the above reached: a search (_rr_search)
+        _rr_merge(found, _rr_search(targets, leads.rows))
     if not found:
         # a singular pose, where Newton converges slowly: what came within _RR_NEAR (the
         # caller's certification decides)
         found = near
     # a self-motion (a singular pose) has a curve of solutions: at most MAX_SOLUTIONS of them
     return [tuple(float(t) for t in q) for q in found[:MAX_SOLUTIONS]]
+
+
+class _RRLeads:
+    """What the splits saw of a pose that may lie on a curve of solutions: whether a pencil
+    on the arm's own table was singular at it or at a pose moved by the rescue, and the
+    candidates (the arm's joint values) whose polishing stopped within _RR_SEARCH_FROM of the
+    pose without settling."""
+
+    def __init__(self):
+        self.singular = False
+        self.rows: list[np.ndarray] = []
+
+
+def _rr_search(targets, rows):
+    """The last resort of a pose whose solutions form a curve (its pencils singular, or
+    polishing slow everywhere) that the eigenvalues did not reach: damped steps
+    (_RR_SEARCH_STEPS of them, without _RR_NEWTON_REACH) from the leads' rows and from the
+    fixed starting points _RR_SEARCH_STARTS, on split 0's frame and the arm's own table, then
+    Newton's; the arm's values of those that reach _RR_GOOD."""
+    _, _, true_rows, slide = _RR_SPLITS[0]
+    starts = _RR_SEARCH_STARTS.copy()
+    if slide[0]:  # (a sliding joint 3: the starts' values over the arm's size)
+        starts[:, 2] *= _RR_SEARCH_SLIDE / math.pi
+    starts = np.vstack([_rr_from_arm(0, q) for q in rows] + [starts])
+    F = targets[0]
+    Q, errors = _rr_steps_many(true_rows, F, starts, slide, True, math.inf, _RR_SEARCH_STEPS)
+    Q = Q[errors <= _RR_SEARCH_FROM]
+    if not len(Q):
+        return []
+    Q, errors = _rr_steps_many(true_rows, F, Q, slide, False)
+    return [_rr_to_arm(0, q) for q in Q[errors <= _RR_GOOD]]
 
 
 def _rr_target(flange):
@@ -894,6 +947,14 @@ def _rr_to_arm(k, q):
     return -q[::-1] if _RR_SPLITS[k][0] else q
 
 
+def _rr_from_arm(k, q):
+    """The arm's joint values as split k's (_rr_to_arm's inverse)."""
+    q = -np.asarray(q, dtype=float)[::-1] if _RR_SPLITS[k][0] else np.array(q, dtype=float)
+    if _RR_SPLITS[k][3][0]:
+        q[2] /= _RR_LENGTH
+    return q
+
+
 def _rr_merge(found, candidates):
     """Add the candidates not already in found, nor equal to an earlier candidate added
     (angles compared modulo 2 pi, within 1e-7): one table of the differences of all of them."""
@@ -910,10 +971,12 @@ def _rr_merge(found, candidates):
             found.append(candidates[i - start])
 
 
-def _rr_split(k, F, moved, imag_tol=_RR_IMAG_TOL):
+def _rr_split(k, F, moved, leads, imag_tol=_RR_IMAG_TOL):
     """The polished candidates of split k for the target F, found from the pose `moved` (F
     itself, or F slightly moved in a rescue; eigenvalues real within imag_tol); those that came
-    within _RR_NEAR only; and whether the answer is in doubt."""
+    within _RR_NEAR only; and whether the answer is in doubt. Noted in leads (_RRLeads): a
+    singular pencil on the arm's own table, and the candidates that stopped within
+    _RR_SEARCH_FROM of F."""
     _, fill_rows, true_rows, slide = _RR_SPLITS[k]
     values = np.zeros(490)
     _rr_fill(k, *moved[:3, 2], *moved[:3, 3], values)
@@ -933,6 +996,9 @@ def _rr_split(k, F, moved, imag_tol=_RR_IMAG_TOL):
     )
     out: list[np.ndarray] = []
     close: list[np.ndarray] = []
+    if candidates is None:  # (a singular pencil)
+        leads.singular = leads.singular or fill_rows == true_rows
+        return out, close, doubt
     if not candidates:
         return out, close, doubt
     # every candidate at once (numpy's stacked products and solves: the Python solver's time
@@ -947,6 +1013,8 @@ def _rr_split(k, F, moved, imag_tol=_RR_IMAG_TOL):
         if residual <= _RR_GOOD:
             out.append(q)
             continue
+        if residual <= _RR_SEARCH_FROM:
+            leads.rows.append(_rr_to_arm(k, q))
         if extra:
             continue
         if residual <= _RR_NEAR:
@@ -973,8 +1041,8 @@ def _rr_candidates(P0, Ps, Pc, Q, F, rows, slide=_RR_TURNS, imag_tol=_RR_IMAG_TO
     extras (from nearly real pairs: one that does not polish puts nothing in doubt). Where
     joint 3 slides (slide[0] set) the eigen-variable x3 is d3 itself, not tan(theta3 / 2)."""
     found = _rr_eigenvalues(P0, Ps, Pc, Q, spurious)
-    if found is None:
-        return [], True, []
+    if found is None:  # (a singular pencil: None, where no eigenvalue is real gives [])
+        return None, True, []
     values, (A, B, C), moebius = found
     size = 1.0 + np.abs(values)
     real = values[np.abs(values.imag) <= imag_tol * size].real
@@ -1335,9 +1403,9 @@ _RR_EYE4 = np.eye(4)
 _RR_EYE6 = np.eye(6)
 
 
-def _rr_steps_many(rows, F, Q, slide, damped):
-    """_RR_NEWTON_STEPS steps from each row of Q (all at once; each stops on its own, where
-    it is exact, beyond _RR_NEWTON_REACH or its system is singular): Newton's (J step = error),
+def _rr_steps_many(rows, F, Q, slide, damped, reach=_RR_NEWTON_REACH, steps=_RR_NEWTON_STEPS):
+    """`steps` steps from each row of Q (all at once; each stops on its own, where it is
+    exact, its pose error beyond `reach` or its system is singular): Newton's (J step = error),
     or damped ones (J^T J + mu) step = J^T error with mu = |error|^2 (Levenberg-Marquardt as
     Yamashita and Fukushima: still quadratic onto a curve of solutions, where J is singular
     and Newton's steps jump; slow in a direction J nearly loses, which is why Newton goes
@@ -1345,7 +1413,7 @@ def _rr_steps_many(rows, F, Q, slide, damped):
     q = np.array(Q, dtype=float)
     best_q, best = q.copy(), np.full(len(q), math.inf)
     live = np.arange(len(q))
-    for _ in range(_RR_NEWTON_STEPS + 1):
+    for _ in range(steps + 1):
         x = q[live]
         links = _rr_chain(x, rows, slide)
         frames = np.empty((len(live), 7, 4, 4))
@@ -1355,7 +1423,7 @@ def _rr_steps_many(rows, F, Q, slide, damped):
         size = np.abs(F[:3] - frames[:, 6, :3]).max(axis=(1, 2))
         better = size < best[live]
         best_q[live[better]], best[live[better]] = x[better], size[better]
-        going = (size > 1e-15) & (size <= _RR_NEWTON_REACH)
+        going = (size > 1e-15) & (size <= reach)
         live, x, frames = live[going], x[going], frames[going]
         if not live.size:
             break
