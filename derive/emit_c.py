@@ -262,6 +262,7 @@ ROUTINES = {
     "dk_atan2": ("dk_one",),
     "dk_flipped": (),
     "dk_seam": (),
+    "dk_unit_seam": (),
 }
 
 

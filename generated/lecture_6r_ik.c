@@ -100,16 +100,12 @@ static int dk_near(const dk_values *v)
    (t + pi around the circle, cos and sin negated) */
 static void dk_flipped(dk_values *v, double t, double c, double s)
 {
-    int k;
     v->n = 1;
     v->free = 0;
     v->ref = 0.0;
     v->t[0] = t + (t <= 0.0 ? DK_PI : -DK_PI);
     v->c[0] = -c;
     v->s[0] = -s;
-    for (k = 1; k < 4; k++) { /* (unread: v->n is 1) */
-        v->t[k] = v->c[k] = v->s[k] = 0.0;
-    }
 }
 
 /* The angle of a unit vector (c, s) (a joint's cos and sin; within a few units in the last
@@ -189,12 +185,11 @@ static const double DK_UA[DK_UA_COUNT][11] = {
     {0.7877247342931528, 1.4175153458010392, 1.0093606827634702, 1.9121714558899199, 4.080020766878145, 9.86365232941592, 25.443002387240416, 68.73657092346092, 191.93592859499074, 549.5639313975494, 1604.7543491568185},
     {0.80380231893303, 1.4409760442605875, 1.0771415613243591, 2.10902117565816, 4.68680698754249, 11.78023457742733, 31.607732011996486, 88.8163111872012, 257.9616702293432, 768.2691824701259, 2333.473607317899}
 };
-static const double DK_UA_BASE[2][2] = {{0.0, DK_PI}, {0.5 * DK_PI, 0.5 * DK_PI}};
-
 static double dk_uangle(double s, double c)
 {
-    double ac = fabs(c), as = fabs(s), m = ac < as ? ac : as, d, d2, d4, p;
-    int steep = as > ac, back = c < 0.0, k;
+    double ac = fabs(c), as = fabs(s), m = ac < as ? ac : as, d, d2, d4, p, base;
+    const int steep = as > ac, back = c < 0.0;
+    int k;
     const double *w;
     m = m < DK_UA_TOP ? m : DK_UA_TOP; /* and a nan */
     k = (int)(m * DK_UA_SCALE + 0.5);
@@ -204,7 +199,9 @@ static double dk_uangle(double s, double c)
     d4 = d2 * d2;
     p = (w[0] + d * w[1]) + d2 * (w[2] + d * w[3]) +
         d4 * ((w[4] + d * w[5]) + d2 * (w[6] + d * w[7]) + d4 * ((w[8] + d * w[9]) + d2 * w[10]));
-    return copysign(DK_UA_BASE[steep][back] + (double)(1 - 2 * (steep ^ back)) * p, s);
+    /* the octant: p, pi - p, pi/2 - p or pi/2 + p (selects, not a table and a product) */
+    base = steep ? 0.5 * DK_PI : (back ? DK_PI : 0.0);
+    return copysign(base + (steep == back ? p : -p), s);
 }
 
 static double dk_wrap(double t)
@@ -222,6 +219,15 @@ static double dk_wrap(double t)
 static double dk_seam(double t)
 {
     t = dk_wrap(t);
+    t = t < -DK_SEAM ? t + DK_TWO_PI : t;
+    return fabs(t - DK_PI) <= DK_SEAM_SNAP ? DK_PI : t;
+}
+
+/* dk_seam of a value in [-pi, pi] (dk_uangle's, pi or 0, or one of those turned by pi:
+   dk_flipped; every value but a free joint's ref + step): there dk_wrap is the identity but
+   at -pi, which the seam rules take to pi themselves */
+static double dk_unit_seam(double t)
+{
     t = t < -DK_SEAM ? t + DK_TWO_PI : t;
     return fabs(t - DK_PI) <= DK_SEAM_SNAP ? DK_PI : t;
 }
@@ -474,7 +480,13 @@ static int dk_accept(const double *p, int d, const dk_cx *zs, int m, int check, 
     double xs[4];
     int simple[4], n = 0, count = 0, split = 0, used[4] = {0, 0, 0, 0}, k, j;
     for (k = 0; k < m; k++) {
-        double size = 1.0 + dk_cx_abs(zs[k]);
+        double size;
+        if (zs[k].im == 0.0 && !isnan(zs[k].re)) { /* (real: no size needed, no hypot) */
+            xs[n] = zs[k].re;
+            simple[n++] = 1;
+            continue;
+        }
+        size = 1.0 + dk_cx_abs(zs[k]);
         if (fabs(zs[k].im) <= DK_ROOT_IMAG_TOL * size) {
             xs[n] = zs[k].re;
             simple[n++] = 1;
@@ -606,7 +618,25 @@ static int dk_roots(const double *p, int d, double *out)
         return 1;
     }
     if (d == 2) {
-        dk_quadratic_real(p[1] / p[0], p[2] / p[0], &z[0], &z[1]);
+        const double b = p[1] / p[0], c = p[2] / p[0], disc = b * b - 4.0 * c;
+        if (disc > 0.0) { /* two real roots apart: dk_accept's steps without its loops */
+            const double q = -0.5 * (b + copysign(sqrt(disc), b));
+            double lo = q, hi = c / q;
+            if (hi < lo) {
+                lo = hi;
+                hi = q;
+            }
+            if (hi - lo > DK_MERGE_TOL * (1.0 + fabs(lo))) {
+                lo = dk_newton(p, d, lo);
+                hi = dk_newton(p, d, hi);
+                if (dk_small_residual(p, d, lo) && dk_small_residual(p, d, hi)) {
+                    out[0] = lo;
+                    out[1] = hi;
+                    return 2;
+                }
+            }
+        }
+        dk_quadratic_real(b, c, &z[0], &z[1]);
     } else if (d == 4) {
         dk_quartic_real(p[1] / p[0], p[2] / p[0], p[3] / p[0], p[4] / p[0], z);
     } else {
@@ -1001,18 +1031,23 @@ static int dk_solve(const double t[12], double tol, const double ref[DK_DOF],
     for (int dk_k3 = 0; dk_k3 < dk_v3.n; dk_k3++) {
         double theta3, c3, s3;
         dk_value(&dk_v3, dk_k3, &theta3, &c3, &s3);
-        theta3 = dk_seam(theta3);
+        theta3 = dk_v3.free ? dk_seam(theta3) : dk_unit_seam(theta3);
         /* theta2: r and z equations, linear in (c2, s2) */
         dk_values dk_v2;
         if (dk_cs2(&dk_v2, 2400.0*c3 + 20280.0*s3 - 20400.0, 20280.0*c3 - 2400.0*s3, 27200.0*c3 + r + 229840.0*s3 - 232344.0, -338.0*c3 + 40.0*s3, 40.0*c3 + 338.0*s3 - 340.0, z, 33570240.0, 0.0, qr2) < 0) {
             return DK_UNSETTLED;
         }
         const int dk_m2 = n;
-        dk_close |= dk_near(&dk_v2);
         for (int dk_k2 = 0; dk_k2 < dk_v2.n; dk_k2++) {
             double theta2, c2, s2;
             dk_value(&dk_v2, dk_k2, &theta2, &c2, &s2);
-            theta2 = dk_seam(theta2);
+            theta2 = dk_v2.free ? dk_seam(theta2) : dk_unit_seam(theta2);
+            double dk_h0 = c2*s3;
+            double dk_h2 = c3*s2;
+            double dk_h5 = c2*c3;
+            double dk_h7 = s2*s3;
+            double dk_h22 = -dk_h5 + s2*s3;
+            double dk_h23 = -dk_h0 - dk_h2;
             /* g1(theta2, theta3), g2(theta2, theta3) */
             double g1 = -40.0*c2*c3 - 338.0*c2*s3 + 340.0*c2 - 338.0*c3*s2 + 40.0*s2*s3 - 30.0;
             double g2 = 0.0;
@@ -1022,11 +1057,20 @@ static int dk_solve(const double t[12], double tol, const double ref[DK_DOF],
                 return DK_UNSETTLED;
             }
             const int dk_m1 = n;
-            dk_close |= dk_near(&dk_v1);
             for (int dk_k1 = 0; dk_k1 < dk_v1.n; dk_k1++) {
                 double theta1, c1, s1;
                 dk_value(&dk_v1, dk_k1, &theta1, &c1, &s1);
-                theta1 = dk_seam(theta1);
+                theta1 = dk_v1.free ? dk_seam(theta1) : dk_unit_seam(theta1);
+                double dk_h1 = c1*dk_h0;
+                double dk_h3 = c1*dk_h2;
+                double dk_h4 = -dk_h1 - dk_h3;
+                double dk_h6 = c1*dk_h5;
+                double dk_h8 = -c1*dk_h7 + dk_h6;
+                double dk_h13 = dk_h0*s1;
+                double dk_h14 = dk_h2*s1;
+                double dk_h15 = -dk_h13 - dk_h14;
+                double dk_h16 = dk_h5*s1;
+                double dk_h17 = dk_h16 - dk_h7*s1;
                 /* wrist W = (0_3R Rx(alpha3))^T 0_6R = Rz(t4) Rx(alpha4) Rz(t5) Rx(alpha5) Rz(t6) */
                 double x4 = c2*s3;
                 double x5 = c3*s2;
@@ -1057,7 +1101,7 @@ static int dk_solve(const double t[12], double tol, const double ref[DK_DOF],
                 for (int dk_k5 = 0; dk_k5 < dk_v5.n; dk_k5++) {
                     double theta5, c5, s5;
                     dk_value(&dk_v5, dk_k5, &theta5, &c5, &s5);
-                    theta5 = dk_seam(theta5);
+                    theta5 = dk_v5.free ? dk_seam(theta5) : dk_unit_seam(theta5);
                     /* v = Rx(alpha4) Rz(theta5) Rx(alpha5) e3 */
                     double v1 = -s5;
                     double v2 = 0.0;
@@ -1075,11 +1119,28 @@ static int dk_solve(const double t[12], double tol, const double ref[DK_DOF],
                         dk_f4[3] = 1.0; /* (kept) */
                     }
                     const int dk_m4 = n;
-                    dk_close |= dk_near(&dk_v4);
                     for (int dk_k4 = 0; dk_k4 < dk_v4.n; dk_k4++) {
                         double theta4, c4, s4;
                         dk_value(&dk_v4, dk_k4, &theta4, &c4, &s4);
-                        theta4 = dk_seam(theta4);
+                        theta4 = dk_v4.free ? dk_seam(theta4) : dk_unit_seam(theta4);
+                        double dk_h9 = c4*dk_h8 + s1*s4;
+                        double dk_h10 = dk_h9*s5;
+                        double dk_h11 = c4*s1 - dk_h8*s4;
+                        double dk_h12 = c5*dk_h9 + dk_h4*s5;
+                        double dk_h18 = -c1*s4 + c4*dk_h17;
+                        double dk_h19 = dk_h18*s5;
+                        double dk_h20 = -c1*c4 - dk_h17*s4;
+                        double dk_h21 = c5*dk_h18 + dk_h15*s5;
+                        double dk_h24 = c4*dk_h23;
+                        double dk_h25 = dk_h24*s5;
+                        double dk_h26 = dk_h23*s4;
+                        double dk_h27 = c5*dk_h24 + dk_h22*s5;
+                        double dk_e0 = c5*dk_h4 - dk_h10;
+                        double dk_e3 = 340.0*c1*c2 + 40.0*c1*s2*s3 - 30.0*c1 + 206.0*c5*dk_h4 - 338.0*dk_h1 - 206.0*dk_h10 - 338.0*dk_h3 - 40.0*dk_h6;
+                        double dk_e4 = c5*dk_h15 - dk_h19;
+                        double dk_e7 = 340.0*c2*s1 + 206.0*c5*dk_h15 - 338.0*dk_h13 - 338.0*dk_h14 - 40.0*dk_h16 - 206.0*dk_h19 + 40.0*s1*s2*s3 - 30.0*s1;
+                        double dk_e8 = c5*dk_h22 - dk_h25;
+                        double dk_e11 = 206.0*c5*dk_h22 + 40.0*dk_h0 + 40.0*dk_h2 - 206.0*dk_h25 - 338.0*dk_h5 + 338.0*dk_h7 - 340.0*s2 + 373.0;
                         /* theta6: Rz(theta6) = (Rx(alpha4) Rz(theta5) Rx(alpha5))^T Rz(theta4)^T W */
                         dk_values dk_v6;
                         if (dk_flip) {
@@ -1094,13 +1155,17 @@ static int dk_solve(const double t[12], double tol, const double ref[DK_DOF],
                             dk_f6[3] = 1.0; /* (kept) */
                         }
                         const int dk_m6 = n;
-                        dk_close |= dk_near(&dk_v6);
                         for (int dk_k6 = 0; dk_k6 < dk_v6.n; dk_k6++) {
                             double theta6, c6, s6;
                             dk_value(&dk_v6, dk_k6, &theta6, &c6, &s6);
-                            theta6 = dk_seam(theta6);
-                            double e[12];
-                            dk_fk_cs(c1, s1, c2, s2, c3, s3, c4, s4, c5, s5, c6, s6, e);
+                            theta6 = dk_v6.free ? dk_seam(theta6) : dk_unit_seam(theta6);
+                            double dk_e1 = -c6*dk_h11 + dk_h12*s6;
+                            double dk_e2 = c6*dk_h12 + dk_h11*s6;
+                            double dk_e5 = -c6*dk_h20 + dk_h21*s6;
+                            double dk_e6 = c6*dk_h21 + dk_h20*s6;
+                            double dk_e9 = c6*dk_h26 + dk_h27*s6;
+                            double dk_e10 = c6*dk_h27 - dk_h26*s6;
+                            const double e[12] = {dk_e0, dk_e1, dk_e2, dk_e3, dk_e4, dk_e5, dk_e6, dk_e7, dk_e8, dk_e9, dk_e10, dk_e11};
                             if (n < DK_MAX && dk_match(e, t, tol, ptol, 0)) {
                                 found[n][0] = theta1;
                                 found[n][1] = theta2;

@@ -173,12 +173,11 @@ static const double DK_UA[DK_UA_COUNT][11] = {
     {0.7877247342931528, 1.4175153458010392, 1.0093606827634702, 1.9121714558899199, 4.080020766878145, 9.86365232941592, 25.443002387240416, 68.73657092346092, 191.93592859499074, 549.5639313975494, 1604.7543491568185},
     {0.80380231893303, 1.4409760442605875, 1.0771415613243591, 2.10902117565816, 4.68680698754249, 11.78023457742733, 31.607732011996486, 88.8163111872012, 257.9616702293432, 768.2691824701259, 2333.473607317899}
 };
-static const double DK_UA_BASE[2][2] = {{0.0, DK_PI}, {0.5 * DK_PI, 0.5 * DK_PI}};
-
 static double dk_uangle(double s, double c)
 {
-    double ac = fabs(c), as = fabs(s), m = ac < as ? ac : as, d, d2, d4, p;
-    int steep = as > ac, back = c < 0.0, k;
+    double ac = fabs(c), as = fabs(s), m = ac < as ? ac : as, d, d2, d4, p, base;
+    const int steep = as > ac, back = c < 0.0;
+    int k;
     const double *w;
     m = m < DK_UA_TOP ? m : DK_UA_TOP; /* and a nan */
     k = (int)(m * DK_UA_SCALE + 0.5);
@@ -188,7 +187,9 @@ static double dk_uangle(double s, double c)
     d4 = d2 * d2;
     p = (w[0] + d * w[1]) + d2 * (w[2] + d * w[3]) +
         d4 * ((w[4] + d * w[5]) + d2 * (w[6] + d * w[7]) + d4 * ((w[8] + d * w[9]) + d2 * w[10]));
-    return copysign(DK_UA_BASE[steep][back] + (double)(1 - 2 * (steep ^ back)) * p, s);
+    /* the octant: p, pi - p, pi/2 - p or pi/2 + p (selects, not a table and a product) */
+    base = steep ? 0.5 * DK_PI : (back ? DK_PI : 0.0);
+    return copysign(base + (steep == back ? p : -p), s);
 }
 
 static double dk_wrap(double t)
@@ -206,6 +207,15 @@ static double dk_wrap(double t)
 static double dk_seam(double t)
 {
     t = dk_wrap(t);
+    t = t < -DK_SEAM ? t + DK_TWO_PI : t;
+    return fabs(t - DK_PI) <= DK_SEAM_SNAP ? DK_PI : t;
+}
+
+/* dk_seam of a value in [-pi, pi] (dk_uangle's, pi or 0, or one of those turned by pi:
+   dk_flipped; every value but a free joint's ref + step): there dk_wrap is the identity but
+   at -pi, which the seam rules take to pi themselves */
+static double dk_unit_seam(double t)
+{
     t = t < -DK_SEAM ? t + DK_TWO_PI : t;
     return fabs(t - DK_PI) <= DK_SEAM_SNAP ? DK_PI : t;
 }
@@ -439,7 +449,13 @@ static int dk_solve(const double t[12], double tol, const double ref[DK_DOF],
     for (int dk_k2 = 0; dk_k2 < dk_v2.n; dk_k2++) {
         double theta2, c2, s2;
         dk_value(&dk_v2, dk_k2, &theta2, &c2, &s2);
-        theta2 = dk_seam(theta2);
+        theta2 = dk_v2.free ? dk_seam(theta2) : dk_unit_seam(theta2);
+        double dk_e2 = 0.0;
+        double dk_e6 = 0.0;
+        double dk_e8 = 0.0;
+        double dk_e9 = 0.0;
+        double dk_e10 = 1.0;
+        double dk_e11 = 0.0;
         /* k1, k2 with x = k1 c1 - k2 s1 (+ const) */
         double k1 = 0.4*c2 + 1.0;
         double k2 = 0.4*s2;
@@ -449,11 +465,19 @@ static int dk_solve(const double t[12], double tol, const double ref[DK_DOF],
             return DK_UNSETTLED;
         }
         const int dk_m1 = n;
-        dk_close |= dk_near(&dk_v1);
         for (int dk_k1 = 0; dk_k1 < dk_v1.n; dk_k1++) {
             double theta1, c1, s1;
             dk_value(&dk_v1, dk_k1, &theta1, &c1, &s1);
-            theta1 = dk_seam(theta1);
+            theta1 = dk_v1.free ? dk_seam(theta1) : dk_unit_seam(theta1);
+            double dk_h0 = c1*c2;
+            double dk_h1 = s1*s2;
+            double dk_h2 = dk_h0 - dk_h1;
+            double dk_h4 = c1*s2;
+            double dk_h5 = c2*s1;
+            double dk_h6 = dk_h4 + dk_h5;
+            double dk_h7 = -dk_h6;
+            double dk_e3 = c1 + 0.4*dk_h0 - 0.4*dk_h1;
+            double dk_e7 = 0.4*dk_h4 + 0.4*dk_h5 + s1;
             /* theta3: heading, Rz(theta3) = A^T R B^T */
             double x0 = c1*s2;
             double x1 = c2*s1;
@@ -463,13 +487,17 @@ static int dk_solve(const double t[12], double tol, const double ref[DK_DOF],
                 return DK_UNSETTLED;
             }
             const int dk_m3 = n;
-            dk_close |= dk_near(&dk_v3);
             for (int dk_k3 = 0; dk_k3 < dk_v3.n; dk_k3++) {
                 double theta3, c3, s3;
                 dk_value(&dk_v3, dk_k3, &theta3, &c3, &s3);
-                theta3 = dk_seam(theta3);
-                double e[12];
-                dk_fk_cs(c1, s1, c2, s2, c3, s3, e);
+                theta3 = dk_v3.free ? dk_seam(theta3) : dk_unit_seam(theta3);
+                double dk_h3 = c3*dk_h2;
+                double dk_h8 = dk_h2*s3;
+                double dk_e0 = dk_h3 + dk_h7*s3;
+                double dk_e1 = c3*dk_h7 - dk_h8;
+                double dk_e4 = c3*dk_h6 + dk_h8;
+                double dk_e5 = dk_h3 - dk_h6*s3;
+                const double e[12] = {dk_e0, dk_e1, dk_e2, dk_e3, dk_e4, dk_e5, dk_e6, dk_e7, dk_e8, dk_e9, dk_e10, dk_e11};
                 if (n < DK_MAX && dk_match(e, t, tol, ptol, 0)) {
                     found[n][0] = theta1;
                     found[n][1] = theta2;

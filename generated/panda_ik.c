@@ -100,16 +100,12 @@ static int dk_near(const dk_values *v)
    (t + pi around the circle, cos and sin negated) */
 static void dk_flipped(dk_values *v, double t, double c, double s)
 {
-    int k;
     v->n = 1;
     v->free = 0;
     v->ref = 0.0;
     v->t[0] = t + (t <= 0.0 ? DK_PI : -DK_PI);
     v->c[0] = -c;
     v->s[0] = -s;
-    for (k = 1; k < 4; k++) { /* (unread: v->n is 1) */
-        v->t[k] = v->c[k] = v->s[k] = 0.0;
-    }
 }
 
 /* The angle of a unit vector (c, s) (a joint's cos and sin; within a few units in the last
@@ -189,12 +185,11 @@ static const double DK_UA[DK_UA_COUNT][11] = {
     {0.7877247342931528, 1.4175153458010392, 1.0093606827634702, 1.9121714558899199, 4.080020766878145, 9.86365232941592, 25.443002387240416, 68.73657092346092, 191.93592859499074, 549.5639313975494, 1604.7543491568185},
     {0.80380231893303, 1.4409760442605875, 1.0771415613243591, 2.10902117565816, 4.68680698754249, 11.78023457742733, 31.607732011996486, 88.8163111872012, 257.9616702293432, 768.2691824701259, 2333.473607317899}
 };
-static const double DK_UA_BASE[2][2] = {{0.0, DK_PI}, {0.5 * DK_PI, 0.5 * DK_PI}};
-
 static double dk_uangle(double s, double c)
 {
-    double ac = fabs(c), as = fabs(s), m = ac < as ? ac : as, d, d2, d4, p;
-    int steep = as > ac, back = c < 0.0, k;
+    double ac = fabs(c), as = fabs(s), m = ac < as ? ac : as, d, d2, d4, p, base;
+    const int steep = as > ac, back = c < 0.0;
+    int k;
     const double *w;
     m = m < DK_UA_TOP ? m : DK_UA_TOP; /* and a nan */
     k = (int)(m * DK_UA_SCALE + 0.5);
@@ -204,7 +199,9 @@ static double dk_uangle(double s, double c)
     d4 = d2 * d2;
     p = (w[0] + d * w[1]) + d2 * (w[2] + d * w[3]) +
         d4 * ((w[4] + d * w[5]) + d2 * (w[6] + d * w[7]) + d4 * ((w[8] + d * w[9]) + d2 * w[10]));
-    return copysign(DK_UA_BASE[steep][back] + (double)(1 - 2 * (steep ^ back)) * p, s);
+    /* the octant: p, pi - p, pi/2 - p or pi/2 + p (selects, not a table and a product) */
+    base = steep ? 0.5 * DK_PI : (back ? DK_PI : 0.0);
+    return copysign(base + (steep == back ? p : -p), s);
 }
 
 static double dk_wrap(double t)
@@ -465,7 +462,13 @@ static int dk_accept(const double *p, int d, const dk_cx *zs, int m, int check, 
     double xs[4];
     int simple[4], n = 0, count = 0, split = 0, used[4] = {0, 0, 0, 0}, k, j;
     for (k = 0; k < m; k++) {
-        double size = 1.0 + dk_cx_abs(zs[k]);
+        double size;
+        if (zs[k].im == 0.0 && !isnan(zs[k].re)) { /* (real: no size needed, no hypot) */
+            xs[n] = zs[k].re;
+            simple[n++] = 1;
+            continue;
+        }
+        size = 1.0 + dk_cx_abs(zs[k]);
         if (fabs(zs[k].im) <= DK_ROOT_IMAG_TOL * size) {
             xs[n] = zs[k].re;
             simple[n++] = 1;
@@ -597,7 +600,25 @@ static int dk_roots(const double *p, int d, double *out)
         return 1;
     }
     if (d == 2) {
-        dk_quadratic_real(p[1] / p[0], p[2] / p[0], &z[0], &z[1]);
+        const double b = p[1] / p[0], c = p[2] / p[0], disc = b * b - 4.0 * c;
+        if (disc > 0.0) { /* two real roots apart: dk_accept's steps without its loops */
+            const double q = -0.5 * (b + copysign(sqrt(disc), b));
+            double lo = q, hi = c / q;
+            if (hi < lo) {
+                lo = hi;
+                hi = q;
+            }
+            if (hi - lo > DK_MERGE_TOL * (1.0 + fabs(lo))) {
+                lo = dk_newton(p, d, lo);
+                hi = dk_newton(p, d, hi);
+                if (dk_small_residual(p, d, lo) && dk_small_residual(p, d, hi)) {
+                    out[0] = lo;
+                    out[1] = hi;
+                    return 2;
+                }
+            }
+        }
+        dk_quadratic_real(b, c, &z[0], &z[1]);
     } else if (d == 4) {
         dk_quartic_real(p[1] / p[0], p[2] / p[0], p[3] / p[0], p[4] / p[0], z);
     } else {
@@ -1053,7 +1074,6 @@ static int dk_solve(const double t[12], double tol, const double ref[DK_DOF],
                 return DK_UNSETTLED;
             }
             const int dk_m1 = n;
-            dk_close |= dk_near(&dk_v1);
             for (int dk_k1 = 0; dk_k1 < dk_v1.n; dk_k1++) {
                 double theta1, c1, s1;
                 dk_value(&dk_v1, dk_k1, &theta1, &c1, &s1);
@@ -1106,7 +1126,6 @@ static int dk_solve(const double t[12], double tol, const double ref[DK_DOF],
                         dk_f4[3] = 1.0; /* (kept) */
                     }
                     const int dk_m4 = n;
-                    dk_close |= dk_near(&dk_v4);
                     for (int dk_k4 = 0; dk_k4 < dk_v4.n; dk_k4++) {
                         double theta4, c4, s4;
                         dk_value(&dk_v4, dk_k4, &theta4, &c4, &s4);
@@ -1124,7 +1143,6 @@ static int dk_solve(const double t[12], double tol, const double ref[DK_DOF],
                             dk_f6[3] = 1.0; /* (kept) */
                         }
                         const int dk_m6 = n;
-                        dk_close |= dk_near(&dk_v6);
                         for (int dk_k6 = 0; dk_k6 < dk_v6.n; dk_k6++) {
                             double theta6, c6, s6;
                             dk_value(&dk_v6, dk_k6, &theta6, &c6, &s6);

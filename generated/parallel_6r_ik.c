@@ -173,12 +173,11 @@ static const double DK_UA[DK_UA_COUNT][11] = {
     {0.7877247342931528, 1.4175153458010392, 1.0093606827634702, 1.9121714558899199, 4.080020766878145, 9.86365232941592, 25.443002387240416, 68.73657092346092, 191.93592859499074, 549.5639313975494, 1604.7543491568185},
     {0.80380231893303, 1.4409760442605875, 1.0771415613243591, 2.10902117565816, 4.68680698754249, 11.78023457742733, 31.607732011996486, 88.8163111872012, 257.9616702293432, 768.2691824701259, 2333.473607317899}
 };
-static const double DK_UA_BASE[2][2] = {{0.0, DK_PI}, {0.5 * DK_PI, 0.5 * DK_PI}};
-
 static double dk_uangle(double s, double c)
 {
-    double ac = fabs(c), as = fabs(s), m = ac < as ? ac : as, d, d2, d4, p;
-    int steep = as > ac, back = c < 0.0, k;
+    double ac = fabs(c), as = fabs(s), m = ac < as ? ac : as, d, d2, d4, p, base;
+    const int steep = as > ac, back = c < 0.0;
+    int k;
     const double *w;
     m = m < DK_UA_TOP ? m : DK_UA_TOP; /* and a nan */
     k = (int)(m * DK_UA_SCALE + 0.5);
@@ -188,7 +187,9 @@ static double dk_uangle(double s, double c)
     d4 = d2 * d2;
     p = (w[0] + d * w[1]) + d2 * (w[2] + d * w[3]) +
         d4 * ((w[4] + d * w[5]) + d2 * (w[6] + d * w[7]) + d4 * ((w[8] + d * w[9]) + d2 * w[10]));
-    return copysign(DK_UA_BASE[steep][back] + (double)(1 - 2 * (steep ^ back)) * p, s);
+    /* the octant: p, pi - p, pi/2 - p or pi/2 + p (selects, not a table and a product) */
+    base = steep ? 0.5 * DK_PI : (back ? DK_PI : 0.0);
+    return copysign(base + (steep == back ? p : -p), s);
 }
 
 /* atan2(y, x) to within a few units in the last place, about twice as fast as the
@@ -557,6 +558,8 @@ static int dk_solve(const double t[12], double tol, const double ref[DK_DOF],
         for (int dk_k5 = 0; dk_k5 < dk_v5.n; dk_k5++) {
             double theta5, c5, s5;
             dk_value(&dk_v5, dk_k5, &theta5, &c5, &s5);
+            double dk_h11 = c5*s1;
+            double dk_h22 = c1*c5;
             /* squared radius of the planar target at theta6 = 0, 90, 180 deg */
             double x0 = 79.2*r32;
             double x1 = 79.2*c1;
@@ -576,7 +579,6 @@ static int dk_solve(const double t[12], double tol, const double ref[DK_DOF],
                 return DK_UNSETTLED;
             }
             const int dk_m6 = n;
-            dk_close |= dk_near(&dk_v6);
             for (int dk_k6 = 0; dk_k6 < dk_v6.n; dk_k6++) {
                 double theta6, c6, s6;
                 dk_value(&dk_v6, dk_k6, &theta6, &c6, &s6);
@@ -619,10 +621,22 @@ static int dk_solve(const double t[12], double tol, const double ref[DK_DOF],
                         return DK_UNSETTLED;
                     }
                     const int dk_m2 = n;
-                    dk_close |= dk_near(&dk_v2);
                     for (int dk_k2 = 0; dk_k2 < dk_v2.n; dk_k2++) {
                         double theta2, c2, s2;
                         dk_value(&dk_v2, dk_k2, &theta2, &c2, &s2);
+                        double dk_h0 = c2*s3;
+                        double dk_h1 = c3*s2;
+                        double dk_h2 = -c1*dk_h0 - c1*dk_h1;
+                        double dk_h4 = c2*c3;
+                        double dk_h5 = s2*s3;
+                        double dk_h6 = c1*dk_h5;
+                        double dk_h7 = c1*dk_h4 - dk_h6;
+                        double dk_h13 = -dk_h0*s1 - dk_h1*s1;
+                        double dk_h15 = dk_h4*s1;
+                        double dk_h16 = dk_h5*s1;
+                        double dk_h17 = dk_h15 - dk_h16;
+                        double dk_h24 = -dk_h4 + s2*s3;
+                        double dk_h26 = -dk_h0 - dk_h1;
                         /* theta4: heading, Rz(theta4) = A^T R B^T */
                         double x34 = c2*s3;
                         double x35 = c3*s2;
@@ -632,12 +646,38 @@ static int dk_solve(const double t[12], double tol, const double ref[DK_DOF],
                             return DK_UNSETTLED;
                         }
                         const int dk_m4 = n;
-                        dk_close |= dk_near(&dk_v4);
                         for (int dk_k4 = 0; dk_k4 < dk_v4.n; dk_k4++) {
                             double theta4, c4, s4;
                             dk_value(&dk_v4, dk_k4, &theta4, &c4, &s4);
-                            double e[12];
-                            dk_fk_cs(c1, s1, c2, s2, c3, s3, c4, s4, c5, s5, c6, s6, e);
+                            double dk_h3 = c4*dk_h2;
+                            double dk_h8 = dk_h3 - dk_h7*s4;
+                            double dk_h9 = c4*dk_h7 + dk_h2*s4;
+                            double dk_h10 = c5*dk_h9 - s1*s5;
+                            double dk_h12 = dk_h9*s5;
+                            double dk_h14 = c4*dk_h13;
+                            double dk_h18 = dk_h17*s4;
+                            double dk_h19 = dk_h14 - dk_h18;
+                            double dk_h20 = c4*dk_h17 + dk_h13*s4;
+                            double dk_h21 = c1*s5 + c5*dk_h20;
+                            double dk_h23 = dk_h20*s5;
+                            double dk_h25 = c4*dk_h24;
+                            double dk_h27 = dk_h25 - dk_h26*s4;
+                            double dk_h28 = c4*dk_h26 + dk_h24*s4;
+                            double dk_h29 = c5*dk_h28;
+                            double dk_h30 = dk_h28*s5;
+                            double dk_e0 = c6*dk_h10 + dk_h8*s6;
+                            double dk_e1 = c6*dk_h8 - dk_h10*s6;
+                            double dk_e2 = -dk_h11 - dk_h12;
+                            double dk_e3 = 173.0*c1*c2*c3 + 203.5*c1*c2 - 42.0*dk_h11 - 42.0*dk_h12 - 79.2*dk_h3 - 173.0*dk_h6 + 79.2*dk_h7*s4 - 116.5*s1;
+                            double dk_e4 = c6*dk_h21 + dk_h19*s6;
+                            double dk_e5 = c6*dk_h19 - dk_h21*s6;
+                            double dk_e6 = dk_h22 - dk_h23;
+                            double dk_e7 = 116.5*c1 + 203.5*c2*s1 - 79.2*dk_h14 + 173.0*dk_h15 - 173.0*dk_h16 + 79.2*dk_h18 + 42.0*dk_h22 - 42.0*dk_h23;
+                            double dk_e8 = c6*dk_h29 + dk_h27*s6;
+                            double dk_e9 = c6*dk_h27 - dk_h29*s6;
+                            double dk_e10 = -dk_h30;
+                            double dk_e11 = -173.0*dk_h0 - 173.0*dk_h1 - 79.2*dk_h25 + 79.2*dk_h26*s4 - 42.0*dk_h30 - 203.5*s2;
+                            const double e[12] = {dk_e0, dk_e1, dk_e2, dk_e3, dk_e4, dk_e5, dk_e6, dk_e7, dk_e8, dk_e9, dk_e10, dk_e11};
                             if (n < DK_MAX && dk_match(e, t, tol, ptol, 0)) {
                                 found[n][0] = theta1;
                                 found[n][1] = theta2 + 1.5707963267948966;

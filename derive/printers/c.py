@@ -148,6 +148,10 @@ CALLS: dict[type[Solve], Callable[[Solve, list[str], str], Call]] = {
 }
 
 
+# the steps whose routines give one value (dk_one) or a free joint's values (dk_set_free)
+SINGLE = (Cs2, Cs2Reach, Atan2)
+
+
 def wrist_flip(plan: Plan) -> tuple[int, int, int] | None:
     """(j5, j4, j6), the joints of a Pieper wrist whose second theta5 value gives the first's
     theta4 + pi and theta6 + pi, else None.
@@ -202,6 +206,40 @@ def seamed_outputs(plan: Plan) -> frozenset[str]:
     return frozenset(names)
 
 
+@dataclass
+class HoistedFK:
+    """The arm's forward kinematics in dk_solve, spread over its loops (loop-invariant code
+    motion done here, where GCC did not: the loops' breaks and calls stop it): the CSE'd
+    temporaries (dk_h0, ...) and the 12 pose entries (dk_e0, ...), each printed in the first
+    loop body where the joints' cos and sin (or lengths) it reads are known, not once per
+    row. A PUMA's entries of theta1..theta3 alone (its position) are computed 4 times a pose
+    instead of 8."""
+
+    pairs: list[tuple[str, sp.Expr]]
+    emitted: set[str]
+    known: set[str]
+
+    @classmethod
+    def of(cls, plan: Plan) -> HoistedFK:
+        pose = plan.fk_pose
+        entries = [pose[i, j] for i in range(3) for j in range(4)]
+        temps, reduced = sp.cse(entries, symbols=sp.numbered_symbols("dk_h"), order="canonical")
+        pairs = [(str(t), e) for t, e in temps]
+        pairs += [(f"dk_e{k}", e) for k, e in enumerate(reduced)]
+        return cls(pairs, set(), set())
+
+    def ready(self, names: set[str], depth: int, printer: CPrinter) -> list[Line]:
+        """The lines whose inputs are known once names are (declared at depth)."""
+        self.known |= names
+        out = []
+        for target, expr in self.pairs:
+            reads = {str(x) for x in expr.free_symbols}
+            if target not in self.emitted and reads <= self.known | self.emitted:
+                self.emitted.add(target)
+                out.append(Line(depth, f"double {target} = {printer.doprint(expr)};"))
+        return out
+
+
 def solve_lines(plan: Plan) -> tuple[tuple[int, str], ...]:
     """Body of dk_solve(t, tol, ref, found): the certified solutions of the pose t (12 top
     entries) into found, in the Python solver's branch order; their count, or DK_UNSETTLED.
@@ -230,6 +268,7 @@ def solve_lines(plan: Plan) -> tuple[tuple[int, str], ...]:
     endings: dict[int, list[Line]] = {}
     flip = wrist_flip(plan)
     seamed = seamed_outputs(plan)
+    hoisted = HoistedFK.of(plan) if same_joints(plan) else None
     for live in steps:
         step = live.step
         if isinstance(step, Assign):
@@ -289,7 +328,8 @@ def solve_lines(plan: Plan) -> tuple[tuple[int, str], ...]:
             )
             body.append(Line(depth, "int dk_flip = 0;"))
         body.append(Line(depth, f"const int dk_m{j} = n;"))
-        body.append(Line(depth, f"dk_close |= dk_near(&dk_v{j});"))
+        if type(step) not in SINGLE:  # (one value, or a free joint's loop: never near)
+            body.append(Line(depth, f"dk_close |= dk_near(&dk_v{j});"))
         body.append(Line(depth, f"for (int dk_k{j} = 0; dk_k{j} < dk_v{j}.n; dk_k{j}++) {{"))
         scope.levels.append(set())
         var = step.variable
@@ -301,8 +341,12 @@ def solve_lines(plan: Plan) -> tuple[tuple[int, str], ...]:
         scope.declare(s_name)
         body.append(Line(depth + 1, f"double {var}, {c_name}, {s_name};"))
         body.append(Line(depth + 1, f"dk_value(&dk_v{j}, dk_k{j}, &{var}, &{c_name}, &{s_name});"))
-        if str(var) in seamed:
-            body.append(Line(depth + 1, f"{var} = dk_seam({var});"))
+        if str(var) in seamed:  # (a free joint's ref + step may lie anywhere: dk_seam)
+            body.append(
+                Line(depth + 1, f"{var} = dk_v{j}.free ? dk_seam({var}) : dk_unit_seam({var});")
+            )
+        if hoisted is not None:
+            body += hoisted.ready({str(var), c_name, s_name}, depth + 1, printer)
         if not step.angle:
             body.append(Line(depth + 1, f"(void){c_name};"))
             body.append(Line(depth + 1, f"(void){s_name};"))
@@ -317,10 +361,12 @@ def solve_lines(plan: Plan) -> tuple[tuple[int, str], ...]:
             ]
         depth += 1
     outputs = [printer.doprint(e) for e in plan.ik.outputs]
-    body.append(Line(depth, "double e[12];"))
-    if same_joints(plan):
-        body.append(Line(depth, f"dk_fk_cs({cs_arguments(plan)}, e);"))
+    if hoisted is not None:
+        body += hoisted.ready(set(cs_arguments(plan).split(", ")), depth, printer)
+        entries = ", ".join(f"dk_e{k}" for k in range(12))
+        body.append(Line(depth, f"const double e[12] = {{{entries}}};"))
     else:
+        body.append(Line(depth, "double e[12];"))
         body += _arm_cs_lines(plan, printer, depth, scope)
     position = "1" if plan.ik.certify == "position" else "0"
     body.append(Line(depth, f"if (n < DK_MAX && dk_match(e, t, tol, ptol, {position})) {{"))
