@@ -280,3 +280,17 @@ def test_a_curve_of_solutions_the_eigenvalues_miss_is_found_by_the_search(name, 
     result = roundtrip(m, np.array(samples), "python")
     assert result.singular == len(samples), result.summary()
     assert result.singular_posed == len(samples) and result.unsound == [], result.summary()
+
+
+def test_the_search_stays_out_of_regular_poses_and_unreachable_ones(generated, monkeypatch):
+    """_rr_search is the last resort of poses on a curve of solutions: on the bundled arm
+    (whose own pencil is regular) no sample and no pose out of reach starts it."""
+    m = generated("manocha_canny")
+    calls = []
+    search = m._rr_search
+    monkeypatch.setattr(m, "_rr_search", lambda *args: calls.append(1) or search(*args))
+    T = m.fk_batch(sample_joints(m, 60, np.random.default_rng(5)))
+    far = T.copy()  # (its links' lengths add up to 3.0 m: 4 m away is out of reach)
+    far[:, :3, 3] *= 4.0 / np.linalg.norm(T[:, :3, 3], axis=1)[:, None]
+    rows = [len(m.ik(t, backend="python")) for t in np.concatenate((T, far))]
+    assert calls == [] and min(rows[:60]) > 0 and max(rows[60:]) == 0
