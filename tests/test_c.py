@@ -18,7 +18,7 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from derive import cbuild, verify
+from derive import cbuild, emit_c, verify
 from derive.emit_c import render_c, render_ikfast
 from derive.pipeline import build_plan
 from derive.spec import load_spec, parse_spec
@@ -411,7 +411,8 @@ def test_unit_angle_is_atan2_to_the_last_places(tmp_path):
         cwd=tmp_path,
     )
     rng = np.random.default_rng(11)
-    ends = np.arcsin(np.arange(65) * (0.72 / 64)) + 0.0  # the table's points
+    segments, top = emit_c.UNIT_ANGLE_SEGMENTS, emit_c.UNIT_ANGLE_TOP
+    ends = np.arcsin(np.arange(segments + 1) * (top / segments)) + 0.0  # the table's points
     edges = np.concatenate(
         [k * np.pi / 4 + ends for k in range(-4, 4)] + [np.arange(-8, 9) * np.pi / 4]
     )
