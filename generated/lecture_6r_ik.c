@@ -1272,7 +1272,8 @@ static int dk_solve(const double t[12], double tol, const double ref[DK_DOF],
 
 /* found[0..count) wrapped (a value just above -pi as its equivalent above pi, one within
    DK_SEAM_SNAP of pi as pi), without repeats (looked for only where dk_solve says rows can
-   repeat), into rows: their number */
+   repeat), into rows (which may be found itself: row m is written after row r >= m is
+   read): their number */
 static int dk_finish(double found[DK_MAX][DK_DOF], int count, int repeats,
                      double rows[DK_MAX][DK_DOF])
 {
@@ -1319,7 +1320,7 @@ void lecture_6r_fk(const double q[DK_DOF], double T[16])
 int lecture_6r_ik_ref(const double T[16], const double *free, const double *q_ref, double tol,
                        double q[DK_MAX][DK_DOF])
 {
-    double ref[DK_DOF], found[DK_MAX][DK_DOF];
+    double ref[DK_DOF];
     int j, count, repeats = 1;
     if (!dk_pose_ok(T) || !(tol > 0.0)) {
         return LECTURE_6R_INVALID_POSE;
@@ -1335,12 +1336,13 @@ int lecture_6r_ik_ref(const double T[16], const double *free, const double *q_re
     {
         const double t[12] = {T[0], T[1], T[2],  T[3],  T[4],  T[5],
                               T[6], T[7], T[8],  T[9],  T[10], T[11]};
-        count = dk_solve(t, tol, ref, found, &repeats);
+        /* (the rows straight into q, in range already: only repeats to drop, in place) */
+        count = dk_solve(t, tol, ref, q, &repeats);
     }
     if (count < 0) {
         return LECTURE_6R_UNSETTLED;
     }
-    return dk_finish(found, count, repeats, q);
+    return repeats ? dk_finish(q, count, repeats, q) : count;
 }
 
 int lecture_6r_ik(const double T[16], const double *free, double tol,

@@ -781,7 +781,8 @@ static int dk_solve(const double t[12], double tol, const double ref[DK_DOF],
 
 /* found[0..count) wrapped (a value just above -pi as its equivalent above pi, one within
    DK_SEAM_SNAP of pi as pi), without repeats (looked for only where dk_solve says rows can
-   repeat), into rows: their number */
+   repeat), into rows (which may be found itself: row m is written after row r >= m is
+   read): their number */
 static int dk_finish(double found[DK_MAX][DK_DOF], int count, int repeats,
                      double rows[DK_MAX][DK_DOF])
 {

@@ -38,7 +38,7 @@ void planar_2r_fk(const double q[2], double T[16]);
    q_ref (ik_ref; may be NULL: zeros): the value a joint the pose leaves free starts from.
    Returns the number of solutions written to q, PLANAR_2R_INVALID_POSE (T is no finite rigid
    transform) or PLANAR_2R_UNSETTLED (a root the closed forms cannot settle: ask the Python
-   solver). */
+   solver). The rows of q past the count (all of them on UNSETTLED) hold no solution. */
 int planar_2r_ik(const double T[16], const double *free, double tol,
                   double q[2][2]);
 int planar_2r_ik_ref(const double T[16], const double *free, const double *q_ref, double tol,
