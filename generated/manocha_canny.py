@@ -205,11 +205,15 @@ _RR_PATH = (0.3, 0.1, 0.03)
 _RR_RESCUE = ((1e-4, 1e-4), (-2e-4, 1.5e-4))
 
 
-# where nothing polishes and a pencil on the arm's own table is singular at the pose, or a
-# candidate's polishing stopped within _RR_SEARCH_FROM of it (a curve of solutions the
-# eigenvalues missed), _RR_SEARCH_STEPS damped steps from those candidates and from fixed
-# starting points (a sliding joint's within +-_RR_SEARCH_SLIDE of the arm's size) look for it
-_RR_SEARCH_FROM = 1e-3
+# where nothing polishes and a pencil on the arm's own table is singular at the pose (or at a
+# moved one), or a candidate's polishing stopped within _RR_SEARCH_FROM of it (a curve of
+# solutions the eigenvalues missed), _RR_SEARCH_STEPS damped steps from those candidates and
+# from 64 fixed starting points (a sliding joint's within +-_RR_SEARCH_SLIDE of the arm's
+# size) look for it; it ends after a quarter of them where no row came within _RR_SEARCH_BAIL
+_RR_SEARCH_FROM = 0.1
+
+
+_RR_SEARCH_BAIL = 0.3
 
 
 _RR_SEARCH_STEPS = 40
@@ -816,7 +820,7 @@ _RR_H45 = np.array(
 
 # _rr_search's starting points (split values; a sliding joint 3's scaled to _RR_SEARCH_SLIDE):
 # deterministic numbers spread over the joints' turns, any such do
-_RR_SEARCH_STARTS = math.pi * np.sin(np.outer(np.arange(1, 25), np.arange(1, 7)) * 2.113 + 0.5)
+_RR_SEARCH_STARTS = math.pi * np.sin(np.outer(np.arange(1, 65), np.arange(1, 7)) * 2.113 + 0.5)
 
 
 # fixed combinations of the rows of a null space of Q with more than six rows (a Q of rank
@@ -907,7 +911,13 @@ def _rr_search(targets, rows):
         starts[:, 2] *= _RR_SEARCH_SLIDE / math.pi
     starts = np.vstack([_rr_from_arm(0, q) for q in rows] + [starts])
     F = targets[0]
-    Q, errors = _rr_steps_many(true_rows, F, starts, slide, True, math.inf, _RR_SEARCH_STEPS)
+    # (a first quarter of the steps: where no row came within _RR_SEARCH_BAIL, a pose out of
+    # reach, most likely, the search ends there)
+    first = _RR_SEARCH_STEPS // 4
+    Q, errors = _rr_steps_many(true_rows, F, starts, slide, True, math.inf, first)
+    if not errors.min(initial=math.inf) <= _RR_SEARCH_BAIL:
+        return []
+    Q, errors = _rr_steps_many(true_rows, F, Q, slide, True, math.inf, _RR_SEARCH_STEPS - first)
     Q = Q[errors <= _RR_SEARCH_FROM]
     if not len(Q):
         return []

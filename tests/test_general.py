@@ -222,12 +222,36 @@ def test_a_prismatic_joint_elsewhere_is_refused_with_the_reason():
     assert "prismatic joints: 2" in plan.refusal
 
 
-# Two long-run arms (numpy seeds 471 and 1590 of the long run's draw; their own tables give
-# singular pencils, so they are solved on perturbed ones) and samples at which each has a
-# curve of solutions (a singular Jacobian; the first of each from the long run, the others
+# Three long-run arms (numpy seeds 26, 471 and 1590 of the long run's draw; their own tables
+# give singular pencils, so they are solved on perturbed ones) and samples at which each has
+# a curve of solutions (a singular Jacobian; the first of each from the long run, the others
 # from sample_joints(300, seed 1), generic values shortened): no eigenvalue led to a solution
-# there, and ik returned nothing until the search (_rr_search) was added.
+# there, and ik returned nothing until the search (_rr_search) was added. Seed 26's sample
+# needs the search's wider trigger (a candidate within 0.1) and its 64 starting points.
 CURVE_ARMS = {
+    "seed_26": (
+        "modified",
+        "RRRPRR",
+        0.001,
+        [
+            (122.0, 0.0, -0.000793, 123.895),
+            (-54.0, -0.000639, -0.000722, -89.369),
+            (-90.0, 0.0, 0.0, -179.314),
+            (180.0, 0.0, 0.000899, 90.0),
+            (90.0, 0.000578, -0.000857, 0.0),
+            (0.0, 0.000227, 0.0, -75.543),
+        ],
+        [
+            [
+                2.659894776369655,
+                0.0,
+                1.9224112611364053,
+                0.0007921105953685235,
+                math.pi,
+                -3.0674891039002934,
+            ]
+        ],
+    ),
     "seed_471": (
         "modified",
         "RRRPRR",

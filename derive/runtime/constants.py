@@ -79,10 +79,12 @@ _RR_NEWTON_REACH = 0.5
 # a perturbed table's candidates are polished on tables these shares of the way back first
 _RR_PATH = (0.3, 0.1, 0.03)
 _RR_RESCUE = ((1e-4, 1e-4), (-2e-4, 1.5e-4))
-# where nothing polishes and a pencil on the arm's own table is singular at the pose, or a
-# candidate's polishing stopped within _RR_SEARCH_FROM of it (a curve of solutions the
-# eigenvalues missed), _RR_SEARCH_STEPS damped steps from those candidates and from fixed
-# starting points (a sliding joint's within +-_RR_SEARCH_SLIDE of the arm's size) look for it
-_RR_SEARCH_FROM = 1e-3
+# where nothing polishes and a pencil on the arm's own table is singular at the pose (or at a
+# moved one), or a candidate's polishing stopped within _RR_SEARCH_FROM of it (a curve of
+# solutions the eigenvalues missed), _RR_SEARCH_STEPS damped steps from those candidates and
+# from 64 fixed starting points (a sliding joint's within +-_RR_SEARCH_SLIDE of the arm's
+# size) look for it; it ends after a quarter of them where no row came within _RR_SEARCH_BAIL
+_RR_SEARCH_FROM = 0.1
+_RR_SEARCH_BAIL = 0.3
 _RR_SEARCH_STEPS = 40
 _RR_SEARCH_SLIDE = 1.5

@@ -56,6 +56,7 @@ from derive.runtime.constants import (
     _RR_PATH,
     _RR_RANK_TOL,
     _RR_RESCUE,
+    _RR_SEARCH_BAIL,
     _RR_SEARCH_FROM,
     _RR_SEARCH_SLIDE,
     _RR_SEARCH_STEPS,
@@ -87,7 +88,7 @@ _RR_H45 = np.array(
 )
 # _rr_search's starting points (split values; a sliding joint 3's scaled to _RR_SEARCH_SLIDE):
 # deterministic numbers spread over the joints' turns, any such do
-_RR_SEARCH_STARTS = math.pi * np.sin(np.outer(np.arange(1, 25), np.arange(1, 7)) * 2.113 + 0.5)
+_RR_SEARCH_STARTS = math.pi * np.sin(np.outer(np.arange(1, 65), np.arange(1, 7)) * 2.113 + 0.5)
 # fixed combinations of the rows of a null space of Q with more than six rows (a Q of rank
 # below 8): deterministic numbers, any generic ones do
 _RR_MIX = np.sin(np.outer(np.arange(1, 7), np.arange(1, 15)) * 0.731 + 0.25)
@@ -168,7 +169,13 @@ def _rr_search(targets, rows):
         starts[:, 2] *= _RR_SEARCH_SLIDE / math.pi
     starts = np.vstack([_rr_from_arm(0, q) for q in rows] + [starts])
     F = targets[0]
-    Q, errors = _rr_steps_many(true_rows, F, starts, slide, True, math.inf, _RR_SEARCH_STEPS)
+    # (a first quarter of the steps: where no row came within _RR_SEARCH_BAIL, a pose out of
+    # reach, most likely, the search ends there)
+    first = _RR_SEARCH_STEPS // 4
+    Q, errors = _rr_steps_many(true_rows, F, starts, slide, True, math.inf, first)
+    if not errors.min(initial=math.inf) <= _RR_SEARCH_BAIL:
+        return []
+    Q, errors = _rr_steps_many(true_rows, F, Q, slide, True, math.inf, _RR_SEARCH_STEPS - first)
     Q = Q[errors <= _RR_SEARCH_FROM]
     if not len(Q):
         return []
