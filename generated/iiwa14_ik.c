@@ -249,11 +249,12 @@ static const double DK_UA[DK_UA_COUNT][9] = {
     {0.7957305393825658, 1.4290551152553423, 1.0424210880845572, 2.0071858810674508, 4.369953504845314, 10.770010548047312, 28.3281143891916, 78.035587822912, 222.18971739464203},
     {0.80380231893303, 1.4409760442605875, 1.0771415613243591, 2.10902117565816, 4.68680698754249, 11.78023457742733, 31.607732011996486, 88.8163111872012, 257.9616702293432}
 };
+static const double DK_UA_BASE[2][2] = {{0.0, DK_PI}, {0.5 * DK_PI, 0.5 * DK_PI}};
+
 static double dk_uangle(double s, double c)
 {
-    double ac = fabs(c), as = fabs(s), m = ac < as ? ac : as, d, d2, d4, p, base;
-    const int steep = as > ac, back = c < 0.0;
-    int k;
+    double ac = fabs(c), as = fabs(s), m = ac < as ? ac : as, d, d2, d4, p;
+    int steep = as > ac, back = c < 0.0, k;
     const double *w;
     m = m < DK_UA_TOP ? m : DK_UA_TOP; /* and a nan */
     k = (int)(m * DK_UA_SCALE + 0.5);
@@ -263,9 +264,9 @@ static double dk_uangle(double s, double c)
     d4 = d2 * d2;
     p = (w[0] + d * w[1]) + d2 * (w[2] + d * w[3]) +
         d4 * ((w[4] + d * w[5]) + d2 * (w[6] + d * w[7]) + d4 * w[8]);
-    /* the octant: p, pi - p, pi/2 - p or pi/2 + p (selects, not a table and a product) */
-    base = steep ? 0.5 * DK_PI : (back ? DK_PI : 0.0);
-    return copysign(base + (steep == back ? p : -p), s);
+    /* the octant: p, pi - p, pi/2 - p or pi/2 + p from a table and a product (selects became
+       branches on a coin toss: 20% more time for 3% fewer instructions) */
+    return copysign(DK_UA_BASE[steep][back] + (double)(1 - 2 * (steep ^ back)) * p, s);
 }
 
 static double dk_wrap(double t)
