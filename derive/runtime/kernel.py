@@ -1232,16 +1232,16 @@ def _keigenvalues(M):
                 if x > 0.0:
                     alpha = -alpha
                 u0, u1, u2 = x - alpha, y, z
-                uu = u0 * u0 + u1 * u1 + u2 * u2
+                uu = 2.0 / (u0 * u0 + u1 * u1 + u2 * u2)  # (one division a reflection)
                 first = max(lo, k - 1)
                 for j in range(first, hi + 1):  # eigenvalues only: the active block
-                    f = 2.0 * (u0 * H[k, j] + u1 * H[k + 1, j] + u2 * H[k + 2, j]) / uu
+                    f = (u0 * H[k, j] + u1 * H[k + 1, j] + u2 * H[k + 2, j]) * uu
                     H[k, j] -= f * u0
                     H[k + 1, j] -= f * u1
                     H[k + 2, j] -= f * u2
                 last = min(k + 3, hi)
                 for i in range(lo, last + 1):
-                    f = 2.0 * (u0 * H[i, k] + u1 * H[i, k + 1] + u2 * H[i, k + 2]) / uu
+                    f = (u0 * H[i, k] + u1 * H[i, k + 1] + u2 * H[i, k + 2]) * uu
                     H[i, k] -= f * u0
                     H[i, k + 1] -= f * u1
                     H[i, k + 2] -= f * u2
@@ -1259,13 +1259,13 @@ def _keigenvalues(M):
             if x > 0.0:
                 alpha = -alpha
             u0, u1 = x - alpha, y
-            uu = u0 * u0 + u1 * u1
+            uu = 2.0 / (u0 * u0 + u1 * u1)
             for j in range(max(lo, k - 1), hi + 1):
-                f = 2.0 * (u0 * H[k, j] + u1 * H[k + 1, j]) / uu
+                f = (u0 * H[k, j] + u1 * H[k + 1, j]) * uu
                 H[k, j] -= f * u0
                 H[k + 1, j] -= f * u1
             for i in range(lo, hi + 1):
-                f = 2.0 * (u0 * H[i, k] + u1 * H[i, k + 1]) / uu
+                f = (u0 * H[i, k] + u1 * H[i, k + 1]) * uu
                 H[i, k] -= f * u0
                 H[i, k + 1] -= f * u1
             if k > lo:
