@@ -140,10 +140,13 @@ MAX_TURN_ROWS = 100_000
 
 # the general 6R method (derive/runtime/general.py): Q's rank counts singular values above
 # _RR_RANK_TOL of the largest; a Moebius map x3 = (a y + b) / (c y + d) is kept once the
-# leading matrix's condition number is below _RR_COND_LIMIT (else the best of the three);
+# leading matrix's condition number is below _RR_COND_LIMIT (else the best of the three; the
+# Python solver takes the first map without an SVD where its 1-norm condition number, from
+# the inverse it needs anyway, is below _RR_COND_LIMIT / 12: then the 2-norm one is below);
 # an eigenvalue is real when |Im| <= _RR_IMAG_TOL (1 + |y|), and real ones closer than
 # _RR_CLUSTER_TOL (1 + |y|) are one cluster (the answer is then in doubt); a second singular
-# value below _RR_NULL2_TOL of the largest makes the null space two-dimensional; a candidate
+# value below _RR_NULL2_TOL of the largest makes the null space two-dimensional (the Python
+# solver's Rayleigh-Ritz estimates of both; the compiled one's pivots); a candidate
 # is kept when _RR_NEWTON_STEPS Newton steps (each at most 0.5 rad per joint, started where
 # the pose error is below _RR_NEWTON_REACH), or as many Levenberg-Marquardt steps after them
 # (damping |error|^2), bring its pose error below _RR_GOOD (lengths in units of the arm's
@@ -196,6 +199,12 @@ _RR_NEWTON_STEPS = 10
 
 
 _RR_NEWTON_REACH = 0.5
+
+
+# a Newton step from a pose error within _RR_NEWTON_DONE[0], no joint moving more than
+# _RR_NEWTON_DONE[1], is the last (its result is not measured: the error after it is at most
+# the step squared times the arm's curvature; near a singular Jacobian the step is long)
+_RR_NEWTON_DONE = (1e-11, 1e-8)
 
 
 # a perturbed table's candidates are polished on tables these shares of the way back first
@@ -1083,21 +1092,21 @@ def _rr_candidates(P0, Ps, Pc, Q, F, rows, slide=_RR_TURNS, imag_tol=_RR_IMAG_TO
     ys += [[y] for y in extra]  # (on their own: they put nothing in doubt)
     if not ys:
         return [], doubt, []
-    # every cluster's null space at once (one stacked SVD), then every candidate's theta1,
+    # every cluster's null space at once (_rr_null_vectors), then every candidate's theta1,
     # theta2 and theta6 at once
     centres = np.array([sum(cluster) / len(cluster) for cluster in ys])
     Y = centres[:, None, None]
-    _, svs, vts = np.linalg.svd(A * Y * Y + B * Y + C)
+    first, second, planes = _rr_null_vectors(A * Y * Y + B * Y + C)
     thetas3, vectors, optional = [], [], []
-    for k, (cluster, y, sv, vt) in enumerate(zip(ys, centres, svs, vts)):
+    for k, (cluster, y, v1, v2, plane) in enumerate(zip(ys, centres, first, second, planes)):
         if slide[0]:
             theta3 = (ma * y + mb) / (mc * y + md)
         else:
             theta3 = 2.0 * math.atan2(ma * y + mb, mc * y + md)
-        found = [vt[-1]]
-        if len(cluster) > 1 or sv[-2] <= _RR_NULL2_TOL * sv[0]:
+        found = [v1]
+        if len(cluster) > 1 or plane:
             # two solutions may share theta3: both from the null space's plane
-            found += _rr_unmix(vt[-1], vt[-2])
+            found += _rr_unmix(v1, v2)
             doubt = doubt or k < primary
         thetas3 += [float(theta3)] * len(found)
         vectors += found
@@ -1128,30 +1137,25 @@ def _rr_joints12_many(rows, F, T345, slide):
     rotation about z0 taking X1 Rz(theta2) g onto f gives theta1. (Least squares on
     Q m12 = P m45 would need Q of full rank, which arms with a1 = 0 lack.)"""
     links = _rr_chain(T345, rows, slide, first=2)
-    M = links[:, 0] @ links[:, 1] @ links[:, 2]
     d2, a2, ca2, sa2 = rows[1]
     _, a1, ca1, sa1 = rows[0]
-    gl = np.empty((len(M), 3))
-    gl[:, 0] = M[:, 0, 2]
-    gl[:, 1] = ca2 * M[:, 1, 2] - sa2 * M[:, 2, 2]
-    gl[:, 2] = sa2 * M[:, 1, 2] + ca2 * M[:, 2, 2]
-    gp = np.empty((len(M), 3))
-    gp[:, 0] = M[:, 0, 3] + a2
-    gp[:, 1] = ca2 * M[:, 1, 3] - sa2 * M[:, 2, 3]
-    gp[:, 2] = sa2 * M[:, 1, 3] + ca2 * M[:, 2, 3] + d2
+    # g[:, :, 0] = l, g[:, :, 1] = p
+    M = links[:, 0] @ (links[:, 1] @ links[:, 2, :, 2:])
+    g = np.array([[1.0, 0.0, 0.0], [0.0, ca2, -sa2], [0.0, sa2, ca2]]) @ M[:, :3]
+    g[:, 0, 1] += a2
+    g[:, 2, 1] += d2
     fl, fp = F[:3, 2], F[:3, 3]
-    # rows (coefficient of cos theta2, of sin theta2, right side)
-    systems = np.empty((len(M), 4, 3))
-    systems[:, 0, 0], systems[:, 0, 1] = sa1 * gl[:, 1], sa1 * gl[:, 0]
-    systems[:, 0, 2] = fl[2] - ca1 * gl[:, 2]
-    systems[:, 1, 0], systems[:, 1, 1] = sa1 * gp[:, 1], sa1 * gp[:, 0]
-    systems[:, 1, 2] = fp[2] - ca1 * gp[:, 2]
-    systems[:, 2, 0], systems[:, 2, 1] = 2.0 * a1 * gp[:, 0], -2.0 * a1 * gp[:, 1]
-    systems[:, 2, 2] = fp @ fp - (gp * gp).sum(axis=1) - a1 * a1
-    systems[:, 3, 0], systems[:, 3, 1] = a1 * gl[:, 0], -a1 * gl[:, 1]
-    systems[:, 3, 2] = fl @ fp - (gl * gp).sum(axis=1)
-    Us, Ss, Vts = np.linalg.svd(systems[:, :, :2], full_matrices=False)
-    E = systems[:, :, 2]
+    # rows: l_z, p_z, |p|^2, l.p; coefficients of (cos theta2, sin theta2) (linear in
+    # (l_x, p_x, l_y, p_y)), right sides
+    n = len(g)
+    weights = np.zeros((4, 8))
+    weights[2, 0] = weights[0, 1] = weights[3, 2] = weights[1, 3] = sa1
+    weights[1, 4], weights[3, 5], weights[0, 6], weights[2, 7] = 2.0 * a1, -2.0 * a1, a1, -a1
+    coefficients = (g[:, :2].reshape(n, 4) @ weights).reshape(n, 4, 2)
+    E = np.empty((n, 4))
+    E[:, :2] = F[2, 2:4] - ca1 * g[:, 2]
+    E[:, 2:] = (fp @ fp - a1 * a1, fl @ fp) - (g.transpose(0, 2, 1) @ g[:, :, 1:])[:, ::-1, 0]
+    Us, Ss, Vts = np.linalg.svd(coefficients, full_matrices=False)
     # (cos, sin) of theta2 per row: rows whose equations span the plane all at once, the
     # others (one direction: two points) on their own
     regular = np.flatnonzero(Ss[:, 1] > 1e-8 * Ss[:, 0])
@@ -1163,15 +1167,19 @@ def _rr_joints12_many(rows, F, T345, slide):
     h = np.where(unit, h, 1.0)
     C2.append(np.where(unit, cs[:, 0] / h, 1.0))
     S2.append(np.where(unit, cs[:, 1] / h, 0.0))
-    for i in np.flatnonzero(Ss[:, 1] <= 1e-8 * Ss[:, 0]):
-        units = np.array(_rr_unit_solutions(Us[i], Ss[i], Vts[i], E[i]))
-        owner.append(np.full(len(units), i))
-        C2.append(units[:, 0])
-        S2.append(units[:, 1])
-    order = np.argsort(np.concatenate(owner), kind="stable")
-    rows_of = np.concatenate(owner)[order]
-    c2, s2 = np.concatenate(C2)[order], np.concatenate(S2)[order]
-    gl, gp = gl[rows_of], gp[rows_of]
+    if len(regular) == n:
+        rows_of, c2, s2 = regular, C2[0], S2[0]
+    else:
+        for i in np.flatnonzero(Ss[:, 1] <= 1e-8 * Ss[:, 0]):
+            units = np.array(_rr_unit_solutions(Us[i], Ss[i], Vts[i], E[i]))
+            owner.append(np.full(len(units), i))
+            C2.append(units[:, 0])
+            S2.append(units[:, 1])
+        order = np.argsort(np.concatenate(owner), kind="stable")
+        rows_of = np.concatenate(owner)[order]
+        c2, s2 = np.concatenate(C2)[order], np.concatenate(S2)[order]
+        g = g[rows_of]
+    gl, gp = g[:, :, 0], g[:, :, 1]
     # w = X1 Rz(theta2) g, then Rz(theta1) w = f
     wl0, wl1 = c2 * gl[:, 0] - s2 * gl[:, 1], s2 * gl[:, 0] + c2 * gl[:, 1]
     wp0, wp1 = c2 * gp[:, 0] - s2 * gp[:, 1] + a1, s2 * gp[:, 0] + c2 * gp[:, 1]
@@ -1180,6 +1188,60 @@ def _rr_joints12_many(rows, F, T345, slide):
     across = wl0 * fl[1] - wl1 * fl[0] + wp0 * fp[1] - wp1 * fp[0]
     along = wl0 * fl[0] + wl1 * fl[1] + wp0 * fp[0] + wp1 * fp[1]
     return rows_of, np.arctan2(across, along), np.arctan2(s2, c2)
+
+
+# _rr_null_vectors' two fixed probe vectors (any generic pair) and its shift's share of |M|
+_RR_PROBES = np.cos(np.outer(np.arange(1, 13), (1.37, 2.91)) + 0.41)
+
+
+_RR_NULL_SHIFT = 1e-8
+
+
+def _rr_null_vectors(M):
+    """Per matrix of the stack M (n x 12 x 12, each singular or nearly): the vector v1 nearest
+    its null space, the second direction v2 of the plane nearest one, and whether that plane
+    is one (its second Ritz value at most _RR_NULL2_TOL of M's largest singular value).
+
+    One step of inverse iteration on M^T M + s^2 (s = _RR_NULL_SHIFT |M|, Frobenius: the
+    shift caps how much the nearly null directions are amplified, so that the second is not
+    lost to rounding beside the first) from _RR_PROBES, then Rayleigh-Ritz on M itself in the
+    plane of the two results: its values bound M's two smallest singular values from above
+    and, where the plane holds the near null space, equal them. The largest singular value is
+    estimated from below by a Rayleigh quotient (a few parts in a hundred). Fewer numpy calls
+    than a stacked SVD (what the solver's time goes to); the SVD where the plane degenerates.
+    """
+    size = np.sqrt((M * M).sum(axis=(1, 2)))
+    G = M.transpose(0, 2, 1) @ M
+    G.reshape(len(M), 144)[:, ::13] += ((_RR_NULL_SHIFT * size) ** 2)[:, None]
+    try:
+        X = np.linalg.solve(G, np.broadcast_to(_RR_PROBES, (len(M), 12, 2)))
+    except np.linalg.LinAlgError:  # (a zero matrix)
+        return _rr_null_vectors_svd(M)
+    a, b = X[:, :, 0], X[:, :, 1]
+    a = a / np.linalg.norm(a, axis=1)[:, None]
+    for _ in range(2):  # (twice: the plane is nearly a line where the null space is one)
+        b = b - (a * b).sum(axis=1)[:, None] * a
+    nb = np.linalg.norm(b, axis=1)
+    if not (nb > 0.0).all() or not np.isfinite(nb).all():
+        return _rr_null_vectors_svd(M)
+    b = b / nb[:, None]
+    Ma, Mb = np.einsum("nij,nj->ni", M, a), np.einsum("nij,nj->ni", M, b)
+    p, q, r = (Ma * Ma).sum(axis=1), (Mb * Mb).sum(axis=1), (Ma * Mb).sum(axis=1)
+    # the 2 x 2 problem [[p, r], [r, q]]: its larger eigenvalue's vector at angle phi
+    phi = 0.5 * np.arctan2(2.0 * r, p - q)
+    c, s = np.cos(phi)[:, None], np.sin(phi)[:, None]
+    v1, v2 = c * b - s * a, c * a + s * b
+    second = 0.5 * (p + q) + np.hypot(0.5 * (p - q), r)
+    # M's largest singular value squared: the Rayleigh quotient of G at G^2 times a probe
+    x = G @ (G @ _RR_PROBES[:, :1])
+    top = (x * (G @ x)).sum(axis=(1, 2)) / (x * x).sum(axis=(1, 2))
+    return v1, v2, second <= _RR_NULL2_TOL**2 * top
+
+
+def _rr_null_vectors_svd(M):
+    """_rr_null_vectors by the stacked SVD."""
+    _, svs, vts = np.linalg.svd(M)
+    return vts[:, -1], vts[:, -2], svs[:, -2] <= _RR_NULL2_TOL * svs[:, 0]
 
 
 def _rr_unit_solutions(U, S, Vt, e):
@@ -1213,31 +1275,40 @@ def _rr_eigenvalues(P0, Ps, Pc, Q, spurious=None):
     N = U[:, rank:].T
     if N.shape[0] > 6:
         N = _RR_MIX[:, : N.shape[0]] @ N
-    A6 = N @ (P0 - Pc) @ _RR_H45
-    B6 = N @ (2.0 * Ps) @ _RR_H45
-    C6 = N @ (P0 + Pc) @ _RR_H45
-    pencil = (np.eye(12), np.eye(12), np.eye(12))
+    # the pencil in x3 (6 x 9 each: x3^2, x3, 1), lifted and mapped per Moebius map
+    pencil6 = (N @ np.array((P0 - Pc, 2.0 * Ps, P0 + Pc)) @ _RR_H45).reshape(3, 54)
+    # a map whose leading matrix has a 1-norm condition number below _RR_COND_LIMIT / 12 has
+    # a (2-norm) one below _RR_COND_LIMIT: the first map is taken at the cost of the inverse
+    # the companion matrix needs anyway; otherwise as before, by the condition numbers
     moebius = _RR_MOEBIUS[0]
-    best = math.inf
-    for m in _RR_MOEBIUS:
-        abc = _rr_pencil(A6, B6, C6, m)
-        cond = np.linalg.cond(abc[0])
-        if cond < best:
-            pencil, moebius, best = abc, m, cond
-        if cond < _RR_COND_LIMIT:
-            break
-    if not best < 1e16:
-        return None
-    A, B, C = pencil
-    try:  # (an estimate of cond below 1e16 does not rule out an exactly singular A)
-        Ainv = np.linalg.inv(A)
-        companion = np.zeros((24, 24))
-        companion[:12, 12:] = np.eye(12)
-        companion[12:, :12] = -Ainv @ C
-        companion[12:, 12:] = -Ainv @ B
-        if spurious is not None:
-            vectors, pivots = spurious
-            companion = _rr_deflated(companion, vectors, pivots, moebius)
+    pencil = _rr_pencil(pencil6, moebius)
+    try:
+        Ainv = np.linalg.inv(pencil[0])
+        fast = np.abs(pencil[0]).sum(axis=0).max() * np.abs(Ainv).sum(axis=0).max()
+    except np.linalg.LinAlgError:
+        fast = math.inf
+    if not 12.0 * fast < _RR_COND_LIMIT:
+        best = math.inf
+        for m in _RR_MOEBIUS:
+            abc = pencil if m == _RR_MOEBIUS[0] else _rr_pencil(pencil6, m)
+            cond = np.linalg.cond(abc[0])
+            if cond < best:
+                pencil, moebius, best = abc, m, cond
+            if cond < _RR_COND_LIMIT:
+                break
+        if not best < 1e16:
+            return None
+        try:  # (an estimate of cond below 1e16 does not rule out an exactly singular A)
+            Ainv = np.linalg.inv(pencil[0])
+        except np.linalg.LinAlgError:
+            return None
+    companion = np.zeros((24, 24))
+    companion[:12, 12:] = _RR_EYE12
+    companion[12:] = -(Ainv @ np.concatenate((pencil[2], pencil[1]), axis=1))
+    if spurious is not None:
+        vectors, pivots = spurious
+        companion = _rr_deflated(companion, vectors, pivots, moebius)
+    try:
         return np.linalg.eigvals(companion), pencil, moebius
     except np.linalg.LinAlgError:
         return None
@@ -1274,19 +1345,21 @@ def _rr_deflated(K, vectors, pivots, moebius):
     return K[oo] - G @ K[po]
 
 
-def _rr_pencil(A6, B6, C6, moebius):
-    """The 12 x 12 lifted pencil (A, B, C) in y for the map x3 = (a y + b) / (c y + d)."""
+def _rr_pencil(pencil6, moebius):
+    """The 12 x 12 lifted pencil (A, B, C) in y for the map x3 = (a y + b) / (c y + d), from
+    the 6 x 9 one in x3 (pencil6: its three matrices flattened, a row each)."""
     a, b, c, d = moebius
-    out = []
-    for M6 in (
-        a * a * A6 + a * c * B6 + c * c * C6,
-        2.0 * a * b * A6 + (a * d + b * c) * B6 + 2.0 * c * d * C6,
-        b * b * A6 + b * d * B6 + d * d * C6,
-    ):
-        M = np.zeros((12, 12))
-        M[:6, :9] = M6
-        M[6:, 3:] = M6  # times x4: x4^i x5^j -> x4^(i+1) x5^j
-        out.append(M)
+    weights = np.array(
+        [
+            [a * a, a * c, c * c],
+            [2.0 * a * b, a * d + b * c, 2.0 * c * d],
+            [b * b, b * d, d * d],
+        ]
+    )
+    M6 = (weights @ pencil6).reshape(3, 6, 9)
+    out = np.zeros((3, 12, 12))
+    out[:, :6, :9] = M6
+    out[:, 6:, 3:] = M6  # times x4: x4^i x5^j -> x4^(i+1) x5^j
     return out
 
 
@@ -1413,6 +1486,17 @@ _RR_EYE4 = np.eye(4)
 _RR_EYE6 = np.eye(6)
 
 
+_RR_EYE12 = np.eye(12)
+
+
+# the components after and before each of x, y, z (cross products: a x b = a[NEXT] b[LAST] -
+# a[LAST] b[NEXT])
+_RR_NEXT = np.array([1, 2, 0])
+
+
+_RR_LAST = np.array([2, 0, 1])
+
+
 def _rr_steps_many(rows, F, Q, slide, damped, reach=_RR_NEWTON_REACH, steps=_RR_NEWTON_STEPS):
     """`steps` steps from each row of Q (all at once; each stops on its own, where it is
     exact, its pose error beyond `reach` or its system is singular): Newton's (J step = error),
@@ -1438,28 +1522,37 @@ def _rr_steps_many(rows, F, Q, slide, damped, reach=_RR_NEWTON_REACH, steps=_RR_
         if not live.size:
             break
         E = frames[:, 6]
-        # position error, and half the sum of E's columns crossed with F's (the rotation)
-        e, f = E[:, :3, :3], F[:3, :3]
+        # position error, and half the sum of E's columns crossed with F's (the rotation):
+        # the antisymmetric part of E's rotation times F's transposed
         error = np.empty((len(live), 6))
         error[:, :3] = F[:3, 3] - E[:, :3, 3]
-        error[:, 3] = 0.5 * (e[:, 1] @ f[2] - e[:, 2] @ f[1])
-        error[:, 4] = 0.5 * (e[:, 2] @ f[0] - e[:, 0] @ f[2])
-        error[:, 5] = 0.5 * (e[:, 0] @ f[1] - e[:, 1] @ f[0])
+        P = E[:, :3, :3] @ F[:3, :3].T
+        error[:, 3:] = 0.5 * (P[:, _RR_NEXT, _RR_LAST] - P[:, _RR_LAST, _RR_NEXT])
+        # J's columns: z_i x (p - o_i) over z_i (a sliding joint 3: z_3 over 0)
         z = frames[:, :6, :3, 2]
         r = E[:, None, :3, 3] - frames[:, :6, :3, 3]
-        J = np.empty((len(live), 6, 6))
-        J[:, 0] = z[..., 1] * r[..., 2] - z[..., 2] * r[..., 1]
-        J[:, 1] = z[..., 2] * r[..., 0] - z[..., 0] * r[..., 2]
-        J[:, 2] = z[..., 0] * r[..., 1] - z[..., 1] * r[..., 0]
-        J[:, 3:] = z.transpose(0, 2, 1)
+        columns = np.concatenate(
+            (z[..., _RR_NEXT] * r[..., _RR_LAST] - z[..., _RR_LAST] * r[..., _RR_NEXT], z), axis=2
+        )
         if slide[0]:  # a sliding joint 3 moves the flange along its axis
-            J[:, :3, 2] = z[:, 2]
-            J[:, 3:, 2] = 0.0
+            columns[:, 2, :3] = z[:, 2]
+            columns[:, 2, 3:] = 0.0
+        J = columns.transpose(0, 2, 1)
         steps, solved = _rr_solve_many(J, error, damped)
         live, x, steps = live[solved], x[solved], steps[solved]  # (a singular J: it stops)
         longest = np.abs(steps).max(axis=1, initial=0.0)
-        shrink = np.where(longest <= 0.5, 1.0, 0.5 / np.maximum(longest, 0.5))
-        q[live] = x + steps * shrink[:, None]
+        q[live] = x + steps * (0.5 / np.maximum(longest, 0.5))[:, None]  # (at most 0.5 a joint)
+        if not damped:
+            # Newton's step of at most _RR_NEWTON_DONE[1] from within _RR_NEWTON_DONE[0] lands
+            # a rounding's width from the solution (the error after it is at most the step
+            # squared times the arm's curvature): taken, and not measured again (its error is
+            # counted as the one before it; the caller certifies anyway)
+            before = size[going][solved]
+            done = (before <= _RR_NEWTON_DONE[0]) & (longest <= _RR_NEWTON_DONE[1])
+            best_q[live[done]], best[live[done]] = q[live[done]], before[done]
+            live = live[~done]
+            if not live.size:
+                break
     return best_q, best
 
 

@@ -44,10 +44,13 @@ NEAREST_BATCH = 16
 MAX_FREE_VALUES = 100_000
 # the general 6R method (derive/runtime/general.py): Q's rank counts singular values above
 # _RR_RANK_TOL of the largest; a Moebius map x3 = (a y + b) / (c y + d) is kept once the
-# leading matrix's condition number is below _RR_COND_LIMIT (else the best of the three);
+# leading matrix's condition number is below _RR_COND_LIMIT (else the best of the three; the
+# Python solver takes the first map without an SVD where its 1-norm condition number, from
+# the inverse it needs anyway, is below _RR_COND_LIMIT / 12: then the 2-norm one is below);
 # an eigenvalue is real when |Im| <= _RR_IMAG_TOL (1 + |y|), and real ones closer than
 # _RR_CLUSTER_TOL (1 + |y|) are one cluster (the answer is then in doubt); a second singular
-# value below _RR_NULL2_TOL of the largest makes the null space two-dimensional; a candidate
+# value below _RR_NULL2_TOL of the largest makes the null space two-dimensional (the Python
+# solver's Rayleigh-Ritz estimates of both; the compiled one's pivots); a candidate
 # is kept when _RR_NEWTON_STEPS Newton steps (each at most 0.5 rad per joint, started where
 # the pose error is below _RR_NEWTON_REACH), or as many Levenberg-Marquardt steps after them
 # (damping |error|^2), bring its pose error below _RR_GOOD (lengths in units of the arm's
@@ -76,6 +79,10 @@ _RR_GOOD = 1e-10
 _RR_NEAR = 1e-7
 _RR_NEWTON_STEPS = 10
 _RR_NEWTON_REACH = 0.5
+# a Newton step from a pose error within _RR_NEWTON_DONE[0], no joint moving more than
+# _RR_NEWTON_DONE[1], is the last (its result is not measured: the error after it is at most
+# the step squared times the arm's curvature; near a singular Jacobian the step is long)
+_RR_NEWTON_DONE = (1e-11, 1e-8)
 # a perturbed table's candidates are polished on tables these shares of the way back first
 _RR_PATH = (0.3, 0.1, 0.03)
 _RR_RESCUE = ((1e-4, 1e-4), (-2e-4, 1.5e-4))
