@@ -102,6 +102,8 @@ def general_constants(plan: Plan) -> dict[str, object]:
         "GOOD": repr(constants._RR_GOOD),
         "NEWTON_STEPS": constants._RR_NEWTON_STEPS,
         "NEWTON_REACH": repr(constants._RR_NEWTON_REACH),
+        "NEWTON_DONE": repr(constants._RR_NEWTON_DONE[0]),
+        "NEWTON_DONE_STEP": repr(constants._RR_NEWTON_DONE[1]),
         "SPLIT_COUNT": len(step.splits),
         "LENGTH": repr(float(step.unit)),
         "MOEBIUS": nested(constants._RR_MOEBIUS),

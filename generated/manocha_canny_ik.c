@@ -92,6 +92,8 @@ static int dk_pose_ok(const double T[16])
 #define DK_RR_GOOD (1e-10)
 #define DK_RR_NEWTON_STEPS 10
 #define DK_RR_NEWTON_REACH (0.5)
+#define DK_RR_NEWTON_DONE (1e-11)
+#define DK_RR_NEWTON_DONE_STEP (1e-08)
 #define DK_RR_SPLIT_COUNT 2
 #define DK_RR_LENGTH (1.5)
 #define DK_RR_ROWS 16 /* the most rows one pose gives */
@@ -1236,6 +1238,14 @@ static double dk_rr_steps(const double rows[7][4], const double F[4][4], double 
         scale = longest <= 0.5 ? 1.0 : 0.5 / longest;
         for (i = 0; i < 6; i++) {
             cur[i] += scale * step[i];
+        }
+        if (!damped && size <= DK_RR_NEWTON_DONE && longest <= DK_RR_NEWTON_DONE_STEP) {
+            /* the last step, not measured (the Python solver's _RR_NEWTON_DONE) */
+            for (i = 0; i < 6; i++) {
+                q[i] = cur[i];
+            }
+            best = size;
+            break;
         }
     }
     return best;

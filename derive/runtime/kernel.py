@@ -55,6 +55,7 @@ from derive.runtime.constants import (
     _RR_GOOD,
     _RR_IMAG_TOL,
     _RR_MOEBIUS,
+    _RR_NEWTON_DONE,
     _RR_NEWTON_REACH,
     _RR_NEWTON_STEPS,
     _RR_NULL2_TOL,
@@ -746,9 +747,15 @@ def _knull_left(Q):
     R = Q.copy()
     U = np.eye(m)
     norms = np.zeros(n)
+    top = 0.0
+    # (loops, not array expressions: each of those allocates a temporary, and their
+    # allocations took most of this routine's time)
     for j in range(n):
-        norms[j] = np.sqrt((R[:, j] ** 2).sum())
-    top = norms.max()
+        total = 0.0
+        for i in range(m):
+            total += R[i, j] * R[i, j]
+        norms[j] = math.sqrt(total)
+        top = max(top, norms[j])
     rank = 0
     v = np.zeros(m)
     for k in range(n):
@@ -763,24 +770,40 @@ def _knull_left(Q):
                 R[i, k], R[i, p] = R[i, p], R[i, k]
             norms[k], norms[p] = norms[p], norms[k]
         # the reflection taking R[k:, k] onto the axis
-        alpha = np.sqrt((R[k:, k] ** 2).sum())
+        alpha = 0.0
+        for i in range(k, m):
+            alpha += R[i, k] * R[i, k]
+        alpha = math.sqrt(alpha)
         if R[k, k] > 0.0:
             alpha = -alpha
-        v[:] = 0.0
-        v[k:] = R[k:, k]
+        vv = 0.0
+        for i in range(k, m):
+            v[i] = R[i, k]
         v[k] -= alpha
-        vv = (v[k:] ** 2).sum()
+        for i in range(k, m):
+            vv += v[i] * v[i]
         if vv == 0.0:
             rank += 1
             continue
         for j in range(k, n):
-            f = 2.0 * (v[k:] * R[k:, j]).sum() / vv
-            R[k:, j] -= f * v[k:]
+            f = 0.0
+            for i in range(k, m):
+                f += v[i] * R[i, j]
+            f = 2.0 * f / vv
+            for i in range(k, m):
+                R[i, j] -= f * v[i]
         for i in range(m):  # U := U H (columns of U: the orthogonal factor)
-            f = 2.0 * (U[i, k:] * v[k:]).sum() / vv
-            U[i, k:] -= f * v[k:]
+            f = 0.0
+            for c in range(k, m):
+                f += U[i, c] * v[c]
+            f = 2.0 * f / vv
+            for c in range(k, m):
+                U[i, c] -= f * v[c]
         for j in range(k + 1, n):
-            norms[j] = np.sqrt((R[k + 1 :, j] ** 2).sum())
+            total = 0.0
+            for i in range(k + 1, m):
+                total += R[i, j] * R[i, j]
+            norms[j] = math.sqrt(total)
         rank += 1
     free = m - rank
     N = np.zeros((free, m))
@@ -912,41 +935,49 @@ def _krr_joints12(rows, F, t3, t4, t5):
     _krr_link(t5, rows, 4, M)
     d2, a2, ca2, sa2 = rows[1, 0], rows[1, 1], rows[1, 2], rows[1, 3]
     a1, ca1, sa1 = rows[0, 1], rows[0, 2], rows[0, 3]
-    gl = np.array([M[0, 2], ca2 * M[1, 2] - sa2 * M[2, 2], sa2 * M[1, 2] + ca2 * M[2, 2]])
-    gp = np.array([M[0, 3] + a2, ca2 * M[1, 3] - sa2 * M[2, 3], sa2 * M[1, 3] + ca2 * M[2, 3] + d2])
-    fl = F[:3, 2].copy()
-    fp = F[:3, 3].copy()
+    # (scalars, not small arrays: each array is an allocation)
+    gl0, gl1, gl2 = M[0, 2], ca2 * M[1, 2] - sa2 * M[2, 2], sa2 * M[1, 2] + ca2 * M[2, 2]
+    gp0 = M[0, 3] + a2
+    gp1 = ca2 * M[1, 3] - sa2 * M[2, 3]
+    gp2 = sa2 * M[1, 3] + ca2 * M[2, 3] + d2
+    fl0, fl1, fl2 = F[0, 2], F[1, 2], F[2, 2]
+    fp0, fp1, fp2 = F[0, 3], F[1, 3], F[2, 3]
     system = np.empty((4, 3))
-    system[0, 0], system[0, 1], system[0, 2] = sa1 * gl[1], sa1 * gl[0], fl[2] - ca1 * gl[2]
-    system[1, 0], system[1, 1], system[1, 2] = sa1 * gp[1], sa1 * gp[0], fp[2] - ca1 * gp[2]
-    system[2, 0], system[2, 1] = 2.0 * a1 * gp[0], -2.0 * a1 * gp[1]
-    system[2, 2] = (fp * fp).sum() - (gp * gp).sum() - a1 * a1
-    system[3, 0], system[3, 1] = a1 * gl[0], -a1 * gl[1]
-    system[3, 2] = (fl * fp).sum() - (gl * gp).sum()
+    system[0, 0], system[0, 1], system[0, 2] = sa1 * gl1, sa1 * gl0, fl2 - ca1 * gl2
+    system[1, 0], system[1, 1], system[1, 2] = sa1 * gp1, sa1 * gp0, fp2 - ca1 * gp2
+    system[2, 0], system[2, 1] = 2.0 * a1 * gp0, -2.0 * a1 * gp1
+    system[2, 2] = (fp0 * fp0 + fp1 * fp1 + fp2 * fp2) - (gp0 * gp0 + gp1 * gp1 + gp2 * gp2)
+    system[2, 2] -= a1 * a1
+    system[3, 0], system[3, 1] = a1 * gl0, -a1 * gl1
+    system[3, 2] = (fl0 * fp0 + fl1 * fp1 + fl2 * fp2) - (gl0 * gp0 + gl1 * gp1 + gl2 * gp2)
     n, c2a, s2a, c2b, s2b = _kunit_solutions(system)
-    out = np.zeros(4)
+    t1a = t2a = t1b = t2b = 0.0
     for k in range(n):
         c2 = c2a if k == 0 else c2b
         s2 = s2a if k == 0 else s2b
-        wl0, wl1, wl2 = c2 * gl[0] - s2 * gl[1], s2 * gl[0] + c2 * gl[1], gl[2]
-        wp0, wp1, wp2 = c2 * gp[0] - s2 * gp[1] + a1, s2 * gp[0] + c2 * gp[1], gp[2]
-        wl1, wl2 = ca1 * wl1 - sa1 * wl2, sa1 * wl1 + ca1 * wl2
-        wp1, wp2 = ca1 * wp1 - sa1 * wp2, sa1 * wp1 + ca1 * wp2
-        across = wl0 * fl[1] - wl1 * fl[0] + wp0 * fp[1] - wp1 * fp[0]
-        along = wl0 * fl[0] + wl1 * fl[1] + wp0 * fp[0] + wp1 * fp[1]
-        out[2 * k] = math.atan2(across, along)
-        out[2 * k + 1] = math.atan2(s2, c2)
-    return n, out[0], out[1], out[2], out[3]
+        wl0, wl1 = c2 * gl0 - s2 * gl1, s2 * gl0 + c2 * gl1
+        wp0, wp1 = c2 * gp0 - s2 * gp1 + a1, s2 * gp0 + c2 * gp1
+        wl1 = ca1 * wl1 - sa1 * gl2
+        wp1 = ca1 * wp1 - sa1 * gp2
+        across = wl0 * fl1 - wl1 * fl0 + wp0 * fp1 - wp1 * fp0
+        along = wl0 * fl0 + wl1 * fl1 + wp0 * fp0 + wp1 * fp1
+        if k == 0:
+            t1a, t2a = math.atan2(across, along), math.atan2(s2, c2)
+        else:
+            t1b, t2b = math.atan2(across, along), math.atan2(s2, c2)
+    return n, t1a, t2a, t1b, t2b
 
 
 def _kunit_solutions(system):
     """_rr_unit_solutions in the kernel, from the normal equations' 2 x 2 eigenproblem:
     (count, c, s, c', s')."""
-    g00 = (system[:, 0] * system[:, 0]).sum()
-    g01 = (system[:, 0] * system[:, 1]).sum()
-    g11 = (system[:, 1] * system[:, 1]).sum()
-    b0 = (system[:, 0] * system[:, 2]).sum()
-    b1 = (system[:, 1] * system[:, 2]).sum()
+    g00 = g01 = g11 = b0 = b1 = 0.0
+    for r in range(4):
+        g00 += system[r, 0] * system[r, 0]
+        g01 += system[r, 0] * system[r, 1]
+        g11 += system[r, 1] * system[r, 1]
+        b0 += system[r, 0] * system[r, 2]
+        b1 += system[r, 1] * system[r, 2]
     mean = 0.5 * (g00 + g11)
     spread = math.hypot(0.5 * (g00 - g11), g01)
     big, small = mean + spread, mean - spread
@@ -1026,10 +1057,13 @@ def _krr_steps(rows, F, q0, damped):
     best_q = q.copy()
     best = math.inf
     frames = np.zeros((7, 4, 4))
+    for i in range(4):
+        frames[0, i, i] = 1.0
     J = np.zeros((6, 6))
     error = np.zeros((6, 1))
+    normal = np.zeros((6, 6))
+    step = np.zeros((6, 1))
     for _ in range(_RR_NEWTON_STEPS + 1):
-        frames[0] = np.eye(4)
         for i in range(6):
             frames[i + 1] = frames[i]
             _krr_link(q[i], rows, i, frames[i + 1])
@@ -1067,9 +1101,10 @@ def _krr_steps(rows, F, q0, damped):
             mu = 0.0
             for r in range(6):
                 mu += error[r, 0] * error[r, 0]
-            normal = np.zeros((6, 6))
-            step = np.zeros((6, 1))
             for r in range(6):
+                step[r, 0] = 0.0
+                for c in range(6):
+                    normal[r, c] = 0.0
                 for k in range(6):
                     step[r, 0] += J[k, r] * error[k, 0]
                     for c in range(6):
@@ -1078,13 +1113,20 @@ def _krr_steps(rows, F, q0, damped):
             if not _ksolve_into(normal, step):
                 break
         else:
-            step = error.copy()
+            for r in range(6):
+                step[r, 0] = error[r, 0]
             if not _ksolve_into(J, step):
                 break
-        longest = np.abs(step).max()
+        longest = 0.0
+        for r in range(6):
+            longest = max(longest, abs(step[r, 0]))
         scale = 1.0 if longest <= 0.5 else 0.5 / longest
         for i in range(6):
             q[i] += scale * step[i, 0]
+        if not damped and size <= _RR_NEWTON_DONE[0] and longest <= _RR_NEWTON_DONE[1]:
+            best_q[:] = q  # (as in Python: the last step, not measured)
+            best = size
+            break
     return best_q, best
 
 
