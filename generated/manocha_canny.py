@@ -145,8 +145,8 @@ MAX_TURN_ROWS = 100_000
 # the inverse it needs anyway, is below _RR_COND_LIMIT / 12: then the 2-norm one is below);
 # an eigenvalue is real when |Im| <= _RR_IMAG_TOL (1 + |y|), and real ones closer than
 # _RR_CLUSTER_TOL (1 + |y|) are one cluster (the answer is then in doubt); a second singular
-# value below _RR_NULL2_TOL of the largest makes the null space two-dimensional (the Python
-# solver's Rayleigh-Ritz estimates of both; the compiled one's pivots); a candidate
+# value below _RR_NULL2_TOL of the largest makes the null space two-dimensional (the compiled
+# and C solvers compare pivots of an elimination with complete pivoting instead); a candidate
 # is kept when _RR_NEWTON_STEPS Newton steps (each at most 0.5 rad per joint, started where
 # the pose error is below _RR_NEWTON_REACH), or as many Levenberg-Marquardt steps after them
 # (damping |error|^2), bring its pose error below _RR_GOOD (lengths in units of the arm's
@@ -1092,7 +1092,7 @@ def _rr_candidates(P0, Ps, Pc, Q, F, rows, slide=_RR_TURNS, imag_tol=_RR_IMAG_TO
     ys += [[y] for y in extra]  # (on their own: they put nothing in doubt)
     if not ys:
         return [], doubt, []
-    # every cluster's null space at once (_rr_null_vectors), then every candidate's theta1,
+    # every cluster's null space at once (one stacked SVD), then every candidate's theta1,
     # theta2 and theta6 at once
     centres = np.array([sum(cluster) / len(cluster) for cluster in ys])
     Y = centres[:, None, None]
@@ -1190,56 +1190,13 @@ def _rr_joints12_many(rows, F, T345, slide):
     return rows_of, np.arctan2(across, along), np.arctan2(s2, c2)
 
 
-# _rr_null_vectors' two fixed probe vectors (any generic pair) and its shift's share of |M|
-_RR_PROBES = np.cos(np.outer(np.arange(1, 13), (1.37, 2.91)) + 0.41)
-
-
-_RR_NULL_SHIFT = 1e-8
-
-
 def _rr_null_vectors(M):
-    """Per matrix of the stack M (n x 12 x 12, each singular or nearly): the vector v1 nearest
-    its null space, the second direction v2 of the plane nearest one, and whether that plane
-    is one (its second Ritz value at most _RR_NULL2_TOL of M's largest singular value).
-
-    One step of inverse iteration on M^T M + s^2 (s = _RR_NULL_SHIFT |M|, Frobenius: the
-    shift caps how much the nearly null directions are amplified, so that the second is not
-    lost to rounding beside the first) from _RR_PROBES, then Rayleigh-Ritz on M itself in the
-    plane of the two results: its values bound M's two smallest singular values from above
-    and, where the plane holds the near null space, equal them. The largest singular value is
-    estimated from below by a Rayleigh quotient (a few parts in a hundred). Fewer numpy calls
-    than a stacked SVD (what the solver's time goes to); the SVD where the plane degenerates.
-    """
-    size = np.sqrt((M * M).sum(axis=(1, 2)))
-    G = M.transpose(0, 2, 1) @ M
-    G.reshape(len(M), 144)[:, ::13] += ((_RR_NULL_SHIFT * size) ** 2)[:, None]
-    try:
-        X = np.linalg.solve(G, np.broadcast_to(_RR_PROBES, (len(M), 12, 2)))
-    except np.linalg.LinAlgError:  # (a zero matrix)
-        return _rr_null_vectors_svd(M)
-    a, b = X[:, :, 0], X[:, :, 1]
-    a = a / np.linalg.norm(a, axis=1)[:, None]
-    for _ in range(2):  # (twice: the plane is nearly a line where the null space is one)
-        b = b - (a * b).sum(axis=1)[:, None] * a
-    nb = np.linalg.norm(b, axis=1)
-    if not (nb > 0.0).all() or not np.isfinite(nb).all():
-        return _rr_null_vectors_svd(M)
-    b = b / nb[:, None]
-    Ma, Mb = np.einsum("nij,nj->ni", M, a), np.einsum("nij,nj->ni", M, b)
-    p, q, r = (Ma * Ma).sum(axis=1), (Mb * Mb).sum(axis=1), (Ma * Mb).sum(axis=1)
-    # the 2 x 2 problem [[p, r], [r, q]]: its larger eigenvalue's vector at angle phi
-    phi = 0.5 * np.arctan2(2.0 * r, p - q)
-    c, s = np.cos(phi)[:, None], np.sin(phi)[:, None]
-    v1, v2 = c * b - s * a, c * a + s * b
-    second = 0.5 * (p + q) + np.hypot(0.5 * (p - q), r)
-    # M's largest singular value squared: the Rayleigh quotient of G at G^2 times a probe
-    x = G @ (G @ _RR_PROBES[:, :1])
-    top = (x * (G @ x)).sum(axis=(1, 2)) / (x * x).sum(axis=(1, 2))
-    return v1, v2, second <= _RR_NULL2_TOL**2 * top
-
-
-def _rr_null_vectors_svd(M):
-    """_rr_null_vectors by the stacked SVD."""
+    """Per matrix of the stack M (n x 12 x 12, each singular or nearly): its last two right
+    singular vectors, and whether the second singular value is at most _RR_NULL2_TOL of the
+    largest (a two-dimensional null space). (Inverse iteration with a Rayleigh-Ritz step
+    took 2/3 of the stacked SVD's time, but where a third singular value lay near the second
+    its plane leaned 1e-4 off the null space's, and arms solved on a perturbed table lost
+    solutions: 2 of 200 samples on one long-run arm.)"""
     _, svs, vts = np.linalg.svd(M)
     return vts[:, -1], vts[:, -2], svs[:, -2] <= _RR_NULL2_TOL * svs[:, 0]
 
@@ -1276,7 +1233,9 @@ def _rr_eigenvalues(P0, Ps, Pc, Q, spurious=None):
     if N.shape[0] > 6:
         N = _RR_MIX[:, : N.shape[0]] @ N
     # the pencil in x3 (6 x 9 each: x3^2, x3, 1), lifted and mapped per Moebius map
-    pencil6 = (N @ np.array((P0 - Pc, 2.0 * Ps, P0 + Pc)) @ _RR_H45).reshape(3, 54)
+    pencil6 = np.array(
+        (N @ (P0 - Pc) @ _RR_H45, N @ (2.0 * Ps) @ _RR_H45, N @ (P0 + Pc) @ _RR_H45)
+    ).reshape(3, 54)
     # a map whose leading matrix has a 1-norm condition number below _RR_COND_LIMIT / 12 has
     # a (2-norm) one below _RR_COND_LIMIT: the first map is taken at the cost of the inverse
     # the companion matrix needs anyway; otherwise as before, by the condition numbers
@@ -1304,7 +1263,8 @@ def _rr_eigenvalues(P0, Ps, Pc, Q, spurious=None):
             return None
     companion = np.zeros((24, 24))
     companion[:12, 12:] = _RR_EYE12
-    companion[12:] = -(Ainv @ np.concatenate((pencil[2], pencil[1]), axis=1))
+    companion[12:, :12] = -Ainv @ pencil[2]
+    companion[12:, 12:] = -Ainv @ pencil[1]
     if spurious is not None:
         vectors, pivots = spurious
         companion = _rr_deflated(companion, vectors, pivots, moebius)
@@ -1347,19 +1307,18 @@ def _rr_deflated(K, vectors, pivots, moebius):
 
 def _rr_pencil(pencil6, moebius):
     """The 12 x 12 lifted pencil (A, B, C) in y for the map x3 = (a y + b) / (c y + d), from
-    the 6 x 9 one in x3 (pencil6: its three matrices flattened, a row each)."""
+    the 6 x 9 one in x3 (pencil6: its three matrices flattened, a row each). (Elementwise,
+    not as one matrix product: on arms solved on a perturbed table the product's different
+    rounding lost 7 of 200 samples' solutions more on one long-run arm.)"""
     a, b, c, d = moebius
-    weights = np.array(
-        [
-            [a * a, a * c, c * c],
-            [2.0 * a * b, a * d + b * c, 2.0 * c * d],
-            [b * b, b * d, d * d],
-        ]
-    )
-    M6 = (weights @ pencil6).reshape(3, 6, 9)
+    A6, B6, C6 = pencil6.reshape(3, 6, 9)
     out = np.zeros((3, 12, 12))
-    out[:, :6, :9] = M6
-    out[:, 6:, 3:] = M6  # times x4: x4^i x5^j -> x4^(i+1) x5^j
+    out[:, :6, :9] = (
+        a * a * A6 + a * c * B6 + c * c * C6,
+        2.0 * a * b * A6 + (a * d + b * c) * B6 + 2.0 * c * d * C6,
+        b * b * A6 + b * d * B6 + d * d * C6,
+    )
+    out[:, 6:, 3:] = out[:, :6, :9]  # times x4: x4^i x5^j -> x4^(i+1) x5^j
     return out
 
 

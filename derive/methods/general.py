@@ -378,7 +378,8 @@ def leading_condition(P0, Ps, Pc, Q) -> float:
     N = U[:, rank:].T
     if N.shape[0] > 6:
         N = runtime._RR_MIX[:, : N.shape[0]] @ N
-    pencil6 = (N @ np.array((P0 - Pc, 2.0 * Ps, P0 + Pc)) @ runtime._RR_H45).reshape(3, 54)
+    H = runtime._RR_H45
+    pencil6 = np.array((N @ (P0 - Pc) @ H, N @ (2.0 * Ps) @ H, N @ (P0 + Pc) @ H)).reshape(3, 54)
     A = runtime._rr_pencil(pencil6, runtime._RR_MOEBIUS[0])[0]
     return float(min(np.linalg.cond(A), 1e20))
 

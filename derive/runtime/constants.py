@@ -49,8 +49,8 @@ MAX_FREE_VALUES = 100_000
 # the inverse it needs anyway, is below _RR_COND_LIMIT / 12: then the 2-norm one is below);
 # an eigenvalue is real when |Im| <= _RR_IMAG_TOL (1 + |y|), and real ones closer than
 # _RR_CLUSTER_TOL (1 + |y|) are one cluster (the answer is then in doubt); a second singular
-# value below _RR_NULL2_TOL of the largest makes the null space two-dimensional (the Python
-# solver's Rayleigh-Ritz estimates of both; the compiled one's pivots); a candidate
+# value below _RR_NULL2_TOL of the largest makes the null space two-dimensional (the compiled
+# and C solvers compare pivots of an elimination with complete pivoting instead); a candidate
 # is kept when _RR_NEWTON_STEPS Newton steps (each at most 0.5 rad per joint, started where
 # the pose error is below _RR_NEWTON_REACH), or as many Levenberg-Marquardt steps after them
 # (damping |error|^2), bring its pose error below _RR_GOOD (lengths in units of the arm's
