@@ -1149,7 +1149,7 @@ def _rr_joints12_many(rows, F, T345, slide):
     # (l_x, p_x, l_y, p_y)), right sides
     n = len(g)
     weights = np.zeros((4, 8))
-    weights[2, 0] = weights[0, 1] = weights[3, 2] = weights[1, 3] = sa1
+    weights[[2, 0, 3, 1], [0, 1, 2, 3]] = sa1
     weights[1, 4], weights[3, 5], weights[0, 6], weights[2, 7] = 2.0 * a1, -2.0 * a1, a1, -a1
     coefficients = (g[:, :2].reshape(n, 4) @ weights).reshape(n, 4, 2)
     E = np.empty((n, 4))
@@ -2309,7 +2309,7 @@ def _krr_joints12(rows, F, t3, t4, t5):
     system[3, 0], system[3, 1] = a1 * gl0, -a1 * gl1
     system[3, 2] = (fl0 * fp0 + fl1 * fp1 + fl2 * fp2) - (gl0 * gp0 + gl1 * gp1 + gl2 * gp2)
     n, c2a, s2a, c2b, s2b = _kunit_solutions(system)
-    t1a = t2a = t1b = t2b = 0.0
+    t1a, t2a, t1b, t2b = 0.0, 0.0, 0.0, 0.0
     for k in range(n):
         c2 = c2a if k == 0 else c2b
         s2 = s2a if k == 0 else s2b
@@ -2329,7 +2329,7 @@ def _krr_joints12(rows, F, t3, t4, t5):
 def _kunit_solutions(system):
     """_rr_unit_solutions in the kernel, from the normal equations' 2 x 2 eigenproblem:
     (count, c, s, c', s')."""
-    g00 = g01 = g11 = b0 = b1 = 0.0
+    g00, g01, g11, b0, b1 = 0.0, 0.0, 0.0, 0.0, 0.0
     for r in range(4):
         g00 += system[r, 0] * system[r, 0]
         g01 += system[r, 0] * system[r, 1]

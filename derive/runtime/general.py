@@ -399,7 +399,7 @@ def _rr_joints12_many(rows, F, T345, slide):
     # (l_x, p_x, l_y, p_y)), right sides
     n = len(g)
     weights = np.zeros((4, 8))
-    weights[2, 0] = weights[0, 1] = weights[3, 2] = weights[1, 3] = sa1
+    weights[[2, 0, 3, 1], [0, 1, 2, 3]] = sa1
     weights[1, 4], weights[3, 5], weights[0, 6], weights[2, 7] = 2.0 * a1, -2.0 * a1, a1, -a1
     coefficients = (g[:, :2].reshape(n, 4) @ weights).reshape(n, 4, 2)
     E = np.empty((n, 4))

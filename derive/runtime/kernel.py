@@ -951,7 +951,7 @@ def _krr_joints12(rows, F, t3, t4, t5):
     system[3, 0], system[3, 1] = a1 * gl0, -a1 * gl1
     system[3, 2] = (fl0 * fp0 + fl1 * fp1 + fl2 * fp2) - (gl0 * gp0 + gl1 * gp1 + gl2 * gp2)
     n, c2a, s2a, c2b, s2b = _kunit_solutions(system)
-    t1a = t2a = t1b = t2b = 0.0
+    t1a, t2a, t1b, t2b = 0.0, 0.0, 0.0, 0.0
     for k in range(n):
         c2 = c2a if k == 0 else c2b
         s2 = s2a if k == 0 else s2b
@@ -971,7 +971,7 @@ def _krr_joints12(rows, F, t3, t4, t5):
 def _kunit_solutions(system):
     """_rr_unit_solutions in the kernel, from the normal equations' 2 x 2 eigenproblem:
     (count, c, s, c', s')."""
-    g00 = g01 = g11 = b0 = b1 = 0.0
+    g00, g01, g11, b0, b1 = 0.0, 0.0, 0.0, 0.0, 0.0
     for r in range(4):
         g00 += system[r, 0] * system[r, 0]
         g01 += system[r, 0] * system[r, 1]
