@@ -14,7 +14,7 @@ import numpy as np
 
 from derive import free
 from derive.emit import GENERATOR, GenerationError, check_printable, environment
-from derive.plan import Eigen, Plan
+from derive.plan import Eigen, Plan, Poly, PolyD
 from derive.printers import c
 from derive.printers.general import eigen_step, pad, spurious_counts
 from derive.runtime import closed, constants
@@ -277,6 +277,14 @@ def routines(solve: tuple[tuple[int, str], ...]) -> frozenset[str]:
     return frozenset(called.union(*(ROUTINES[name] for name in called)))
 
 
+def poly_max(plan: Plan) -> int:
+    """The most roots one of the plan's polynomials has (4 at least: the closed forms' size
+    of the C runtime's arrays; above it dk_roots has the Aberth iteration for other degrees)."""
+    steps = plan.ik.steps if plan.ik else ()
+    degrees = [len(s.args) - 1 for s in steps if isinstance(s, (Poly, PolyD))]
+    return max([4, *degrees])
+
+
 def render_c(plan: Plan) -> dict[str, str]:
     """The C solver's files of an arm: {file name: text}."""
     printed = print_c(plan)
@@ -286,6 +294,8 @@ def render_c(plan: Plan) -> dict[str, str]:
         "c": runtime_constants(),
         "generator": GENERATOR,
         "uses": routines(printed.solve),
+        "poly_max": (size := poly_max(plan)),
+        "poly_zeros": ", ".join(["0"] * size),
         "g": general_constants(plan) if "dk_general" in routines(printed.solve) else None,
     }
     return {

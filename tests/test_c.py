@@ -24,7 +24,7 @@ from derive.pipeline import build_plan
 from derive.spec import load_spec, parse_spec
 
 from conftest import BUNDLED, GENERATED, ROOT, build_module, import_path, slider_text
-from strategies import parallel_arms, pieper_arms, planar_arms
+from strategies import end_parallel_arms, parallel_arms, pieper_arms, planar_arms
 
 pytestmark = pytest.mark.skipif(
     cbuild.c_compiler() is None, reason="no C compiler (set CC or install gcc); CI has one"
@@ -470,7 +470,7 @@ C_RANDOM = settings(
 
 
 @C_RANDOM
-@given(st.one_of(pieper_arms(), parallel_arms(), planar_arms()))
+@given(st.one_of(pieper_arms(), parallel_arms(), end_parallel_arms(), planar_arms()))
 def test_random_arms_in_c_give_the_python_solutions(text):
     """Random arms of every closed-form family (both conventions, prismatic joints, lengths
     1e-3..1e3): their C compiled with -Werror gives the Python ik's solutions on 200 poses."""

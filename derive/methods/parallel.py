@@ -17,6 +17,7 @@ Axes 3, 4, 5 parallel are solved on the reversed chain, where they are axes 2, 3
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import replace
 
 import sympy as sp
@@ -34,7 +35,7 @@ from derive.methods.common import (
     unreverse_outputs,
 )
 from derive.methods.planar import flange_factors, heading_step, planar_steps
-from derive.plan import Assign, Cs1, Cs2, Cs2Reach, IkPlan, Poly, Solve, Step
+from derive.plan import Assign, Cs1, Cs2, Cs2Reach, IkPlan, Poly, PolyD, Solve, Step
 from derive.transforms import Chain, inverse, numbers_of, product, reverse_chain
 
 NAME = "three-parallel"
@@ -47,28 +48,197 @@ def derive(chain: Chain, structure: Structure) -> IkPlan | str:
     """Plan for axes 2-3-4 (or 3-4-5) parallel, or why the method does not apply."""
     if chain.dof != 6:
         return f"three-parallel: needs 6 joints, the arm has {chain.dof}"
-    if any(j.kind != "R" for j in chain.joints):
-        return "three-parallel: needs six revolute joints"
     triples = structure.parallel_triples
     if any(i + 1 in triples for i in triples):
         return "three-parallel: four consecutive parallel axes (a degree of freedom is lost)"
     refs = joint_refs(chain)
+    reasons = []
+    for first in (1, 4):
+        if first not in triples:
+            continue
+        try:
+            return derive_end(chain, refs, first)
+        except NotApplicable as exc:
+            reasons.append(str(exc))
+    if not {2, 3} & set(triples):
+        return "; ".join(reasons) or "three-parallel: no three consecutive axes are parallel"
+    if any(j.kind != "R" for j in chain.joints):
+        return "three-parallel: axes 2-4 or 3-5 parallel need six revolute joints"
     try:
         if 2 in triples:
             return derive_234(chain, sym.world_pose(), refs, "")
         if 3 in triples:
-            rev = reverse_chain(chain)
-            plan = derive_234(
-                rev,
-                inverse(sym.world_pose()),
-                reversed_refs(rev),
-                "axes 3-5 parallel: reversed chain (joint k is joint 7 - k, "
-                "q'_k = -q_{7-k}), solved for T^-1; ",
-            )
-            return replace(plan, outputs=unreverse_outputs(plan.outputs))
+            return on_reversed(chain, derive_234, "3-5")
     except NotApplicable as exc:
         return str(exc)
     return "three-parallel: axes 2, 3, 4 (or 3, 4, 5) are not parallel"
+
+
+def derive_end(chain: Chain, refs: tuple[sp.Expr, ...], first: int) -> IkPlan:
+    """The plan for axes 1, 2, 3 parallel (first = 1), or axes 4, 5, 6 (first = 4: the
+    reversed chain, where they are axes 1, 2, 3)."""
+    if first == 1:
+        return derive_123(chain, sym.world_pose(), refs, "")
+    return on_reversed(chain, derive_123, "4-6")
+
+
+def on_reversed(chain: Chain, derive_part: Callable[..., IkPlan], axes: str) -> IkPlan:
+    """derive_part's plan for the reversed chain (solved for T^-1), as the arm's joints."""
+    rev = reverse_chain(chain)
+    plan = derive_part(
+        rev,
+        inverse(sym.world_pose()),
+        reversed_refs(rev),
+        f"axes {axes} parallel: reversed chain (joint k is joint 7 - k, q'_k = -q_{{7-k}}), "
+        "solved for T^-1; ",
+    )
+    return replace(plan, outputs=unreverse_outputs(plan.outputs))
+
+
+def derive_123(chain: Chain, target: sp.Matrix, refs: tuple[sp.Expr, ...], prefix: str) -> IkPlan:
+    """The plan for axes 1, 2, 3 parallel (joints 1-3 and 6 revolute, joint 4 or 5 may
+    slide).
+
+    P = Z1 X1 Z2 X2 Z3 is planar, so the third row of the flange target 0_6T equals that of
+    P X3 Z4 X4 Z5 X5 Z6, (0, 0, +-1, d) X3 Z4 X4 Z5 X5 Z6, whose entries (3,3) and (3,4) hold
+    joints 4 and 5 only (Z6 turns about z and moves along it): two equations for them (a
+    polynomial in tan(theta4/2) where both turn, a cos + b sin = c and a linear equation where
+    one slides); theta6 from entries (3,1), (3,2); then the planar 3R (theta1, theta2 by the
+    law of cosines, theta3 from the heading) from G = 0_6T (X3 Z4 X4 Z5 X5 Z6)^-1 = P.
+    """
+    kinds = "".join(j.kind for j in chain.joints)
+    if kinds not in ("RRRRRR", "RRRPRR"):
+        # (a sliding joint 5 moves within the parallel axes' plane wherever theta4 turns it
+        # at right angles to them, and d5 is then free along a curve of solutions that the
+        # planar three must still reach: not solved here)
+        raise NotApplicable(
+            "three-parallel: axes 1-3 (or 4-6) parallel need revolute joints, or one "
+            "prismatic joint next to the parallel three (joint 4, or 3 of axes 4-6 "
+            f"parallel); the arm's joints, from the parallel end: {kinds}"
+        )
+    numbers = numbers_of(chain)
+    mats = [m.xreplace(numbers) for m in flange_factors(chain)]
+    planar_part = product(mats[0:5])  # Z1 X1 Z2 X2 Z3
+    rest = product(mats[5:])  # X3 Z4 X4 Z5 X5 Z6
+    row = planar_part[2, :]
+    if row.has(*(f(i) for i in (1, 2, 3) for f in (sym.c, sym.s))):
+        raise NotApplicable(
+            "three-parallel: the third row of Z1 X1 Z2 X2 Z3 depends on the parallel joints"
+        )
+    lhs = sym.flange_pose()[2, :]
+    rhs = (row * rest).applyfunc(sp.expand)
+    equations = [sp.expand(lhs[k] - rhs[k]) for k in range(4)]
+    length = sum(abs(float(t.a)) for t in chain.twists) + sum(
+        abs(float(j.d)) for j in chain.joints if j.kind == "R"
+    )
+    g = sp.Matrix(3, 4, lambda i, j: sym.named(f"G{i + 1}{j + 1}"))
+    g_value = (sym.flange_pose() * inverse(rest))[:3, :].applyfunc(sp.expand)
+    position = planar_part[:2, 3].applyfunc(sp.expand)
+    planar = planar_steps(position[0], position[1], 1, 2, g[0, 3], g[1, 3], refs, length)
+    steps: list[Step] = [flange_target(chain, target)]
+    middle, case = joints45_steps(equations[2], equations[3], kinds, refs, length)
+    steps += middle
+    note = "G = 0_6T (X3 Z4 X4 Z5 X5 Z6)^-1 = Z1 X1 Z2 X2 Z3 (planar)"
+    steps += planar_tail(equations, g, g_value, planar, refs, note)
+    steps.append(heading_step(product(mats[0:4])[:3, :3], sp.eye(3), 3, refs, g[:, :3]))
+    fanout = 2
+    for step in middle:
+        if isinstance(step, Solve):
+            fanout *= step.fanout
+    return IkPlan(
+        NAME, prefix + "axes 1-3 parallel: " + case, fanout, tuple(steps), joint_outputs(chain)
+    )
+
+
+def joints45_steps(
+    z_eq: sp.Expr, pos_eq: sp.Expr, kinds: str, refs: tuple[sp.Expr, ...], length: float
+) -> tuple[list[Step], str]:
+    """Joints 4 and 5 from entries (3,3) (z_eq) and (3,4) (pos_eq) of the invariant row, and
+    the case in words."""
+    c4, s4, c5, s5, u = sym.c(4), sym.s(4), sym.c(5), sym.s(5), sym.named("u")
+    if "P" in kinds:
+        k, turning = 4, 5
+        ct, st = sym.c(turning), sym.s(turning)
+        a, b, c = linear_coeffs(z_eq, ct, st)
+        if a == 0 and b == 0:
+            raise NotApplicable(f"three-parallel: entry (3,3) does not involve theta{turning}")
+        coeffs = tuple(sp.Poly(pos_eq, sym.d(k)).all_coeffs())
+        if len(coeffs) != 2:
+            raise NotApplicable(f"three-parallel: entry (3,4) is not linear in d{k}")
+        steps: list[Step] = [
+            Cs1(
+                turning,
+                (a, b, -c),
+                f"theta{turning}: entry (3,3), a c + b s = c",
+                2,
+                refs[turning - 1],
+                1.0,
+            ),
+            PolyD(k, coeffs, f"d{k}: entry (3,4), linear in d{k}", 1, unit=length),
+        ]
+        return steps, f"theta{turning} from entry (3,3), d{k} from entry (3,4)"
+    entries = ((z_eq, "(3,3)"), (pos_eq, "(3,4)"))
+    for k, (eq, name) in enumerate(entries):
+        for one, other in ((4, 5), (5, 4)):
+            if eq.has(sym.c(other), sym.s(other)) or not eq.has(sym.c(one), sym.s(one)):
+                continue
+            # this entry holds one joint only: it first, the other from the other entry
+            rest, rest_name = entries[1 - k]
+            if not rest.has(sym.c(other), sym.s(other)):
+                raise NotApplicable(f"three-parallel: neither entry involves theta{other}")
+            a, b, c = linear_coeffs(eq, sym.c(one), sym.s(one))
+            pa, pb, pc = linear_coeffs(rest, sym.c(other), sym.s(other))
+            # (free where an equation vanishes: a curve of solutions; rotation entries are
+            # of size 1, translation entries of the arm's length)
+            scales = (1.0, length**2) if k == 0 else (length**2, 1.0)
+            steps = [
+                Cs1(
+                    one,
+                    (a, b, -c),
+                    f"theta{one}: entry {name}, a c + b s = c",
+                    2,
+                    refs[one - 1],
+                    scales[0],
+                ),
+                Cs1(
+                    other,
+                    (pa, pb, -pc),
+                    f"theta{other}: entry {rest_name}, a c + b s = c",
+                    2,
+                    refs[other - 1],
+                    scales[1],
+                ),
+            ]
+            return steps, f"theta{one} from entry {name}, theta{other} from entry {rest_name}"
+    pa, pb, pc = linear_coeffs(pos_eq, c5, s5)
+    za, zb, zc = linear_coeffs(z_eq, c5, s5)
+    det = sp.expand(pa * zb - za * pb)
+    if det == 0:
+        raise NotApplicable("three-parallel: entries (3,3) and (3,4) are dependent in theta5")
+    cos5 = -(pc * zb - pb * zc)
+    sin5 = -(pa * zc - za * pc)
+    equation = reduce_pairs(sp.expand(cos5**2 + sin5**2 - det**2), [(s4, c4)])
+    if equation == 0:
+        raise NotApplicable("three-parallel: entries (3,3) and (3,4) are dependent")
+    coeffs = half_angle_poly(equation, c4, s4, u)
+    steps = [
+        Poly(
+            4,
+            coeffs,
+            "theta4: (c5, s5) eliminated from entries (3,3), (3,4): "
+            f"polynomial of degree {len(coeffs) - 1} in u = tan(theta4/2)",
+            len(coeffs) - 1,
+            refs[3],
+            typical_magnitude(coeffs, length),
+        ),
+        Cs2(
+            5,
+            (pa, pb, -pc, za, zb, -zc, sp.Integer(0), sp.Integer(0)),
+            "theta5: entries (3,3) and (3,4), linear in (c5, s5)",
+            1,
+        ),
+    ]
+    return steps, f"theta4 from a polynomial of degree {len(coeffs) - 1}, theta5 from both entries"
 
 
 def derive_234(chain: Chain, target: sp.Matrix, refs: tuple[sp.Expr, ...], prefix: str) -> IkPlan:
@@ -94,17 +264,8 @@ def derive_234(chain: Chain, target: sp.Matrix, refs: tuple[sp.Expr, ...], prefi
     planar = planar_steps(position[0], position[1], 2, 3, g[0, 3], g[1, 3], refs, length)
     steps: list[Step] = [flange_target(chain, target)]
     steps += theta1_theta5_steps(equations[3], equations[2], refs, length)
-    first_planar = planar[0]
-    assert isinstance(first_planar, Solve)
-    steps += theta6_steps(equations[0], equations[1], g_value, first_planar, refs)
-    steps.append(
-        Assign(
-            tuple(g),
-            tuple(g_value),
-            "G = (Z1 X1)^-1 0_6T (X4 Z5 X5 Z6)^-1 = Z2 X2 Z3 X3 Z4 (planar)",
-        )
-    )
-    steps += planar
+    note = "G = (Z1 X1)^-1 0_6T (X4 Z5 X5 Z6)^-1 = Z2 X2 Z3 X3 Z4 (planar)"
+    steps += planar_tail(equations, g, g_value, planar, refs, note)
     before = product(mats[2:6])[:3, :3]
     steps.append(heading_step(before, sp.eye(3), 4, refs, g[:, :3]))
     outputs = joint_outputs(chain)
@@ -114,6 +275,22 @@ def derive_234(chain: Chain, target: sp.Matrix, refs: tuple[sp.Expr, ...], prefi
         else "a5 != 0: quartic in tan(theta1/2)"
     )
     return IkPlan(NAME, case, 8, tuple(steps), outputs)
+
+
+def planar_tail(
+    equations: list[sp.Expr],
+    g: sp.Matrix,
+    g_value: sp.Matrix,
+    planar: list[Step],
+    refs: tuple[sp.Expr, ...],
+    note: str,
+) -> list[Step]:
+    """theta6 from entries (3,1), (3,2) of the invariant row, G (the planar part's target),
+    then the planar steps."""
+    elbow = planar[0]
+    assert isinstance(elbow, Solve)
+    steps = theta6_steps(equations[0], equations[1], g_value, elbow, refs)
+    return [*steps, Assign(tuple(g), tuple(g_value), note), *planar]
 
 
 def theta1_theta5_steps(
