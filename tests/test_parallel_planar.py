@@ -208,3 +208,28 @@ def test_planar_bundled_round_trips(generated, name):
     m = generated(name)
     result = check(m, np.random.default_rng(12), 400)
     assert result.singular_found == result.singular
+
+
+# Long-run arm 233 (tests/long_run.py): axes 1-3 parallel, and axis 5 parallel to them too
+# where theta4 is 0 or 180 deg; there both entries that give theta5 vanish (a curve of
+# solutions) and theta5 must be free: with no scale for that test, 8 of its 36 singular
+# samples got no solution.
+END_PARALLEL_ROWS = [
+    (0.0, -0.029004, 0.019387, 180.0),
+    (0.0, -0.088153, -0.095523, -90.0),
+    (90.0, 0.0, 0.020116, -76.403),
+    (-90.0, 0.08323, 0.0, 0.0),
+    (90.0, -0.02007, 0.041192, -63.826),
+    (-133.0, -0.097086, 0.065132, -90.0),
+]
+
+
+def test_axes_1_2_3_parallel_with_axis_5_joining_them_at_theta4_0(tmp_path):
+    m = build_module(spec_text("end_parallel", "standard", END_PARALLEL_ROWS), tmp_path)
+    assert "axes 1-3 parallel: theta4 from a polynomial of degree 8" in " ".join(m.__doc__.split())
+    Q = sample_joints(m, 120, np.random.default_rng(10_233))
+    Q[::2, 3] = np.where(Q[::2, 3] > 0, math.pi, 0.0)  # (half of them on the curves)
+    result = roundtrip(m, Q)
+    assert result.singular >= 30, result.summary()
+    assert result.unsound == [] and result.misses == [], result.summary()
+    assert result.singular_posed == result.singular, result.summary()

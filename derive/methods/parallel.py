@@ -231,11 +231,15 @@ def joints45_steps(
             refs[3],
             typical_magnitude(coeffs, length),
         ),
+        # (free where both entries vanish: theta4 puts axis 5 parallel to axes 1-3, a
+        # curve of solutions; the determinant is of the size of a length, the right side's
+        # square of a length's square)
         Cs2(
             5,
-            (pa, pb, -pc, za, zb, -zc, sp.Integer(0), sp.Integer(0)),
+            (pa, pb, -pc, za, zb, -zc, sp.Float(length), sp.Float(length**2)),
             "theta5: entries (3,3) and (3,4), linear in (c5, s5)",
             1,
+            refs[4],
         ),
     ]
     return steps, f"theta4 from a polynomial of degree {len(coeffs) - 1}, theta5 from both entries"
