@@ -12,7 +12,8 @@ steps follow, each read off derived expressions:
 3. theta6 from entries (3,1), (3,2): h^T Rz(theta6) = m^T; free when h vanishes (theta5 = 0);
 4. the planar 3R for theta2, theta3, theta4 from G = M (X4 Z5 X5 Z6)^-1 = P.
 
-Axes 3, 4, 5 parallel are solved on the reversed chain, where they are axes 2, 3, 4.
+Axes 3, 4, 5 parallel are solved on the reversed chain, where they are axes 2, 3, 4. Axes
+1, 2, 3 parallel (or 4, 5, 6, on the reversed chain) have their own steps: derive_123.
 """
 
 from __future__ import annotations
@@ -96,8 +97,7 @@ def on_reversed(chain: Chain, derive_part: Callable[..., IkPlan], axes: str) -> 
 
 
 def derive_123(chain: Chain, target: sp.Matrix, refs: tuple[sp.Expr, ...], prefix: str) -> IkPlan:
-    """The plan for axes 1, 2, 3 parallel (joints 1-3 and 6 revolute, joint 4 or 5 may
-    slide).
+    """The plan for axes 1, 2, 3 parallel (all joints revolute, or joint 4 sliding).
 
     P = Z1 X1 Z2 X2 Z3 is planar, so the third row of the flange target 0_6T equals that of
     P X3 Z4 X4 Z5 X5 Z6, (0, 0, +-1, d) X3 Z4 X4 Z5 X5 Z6, whose entries (3,3) and (3,4) hold
@@ -157,26 +157,17 @@ def joints45_steps(
     the case in words."""
     c4, s4, c5, s5, u = sym.c(4), sym.s(4), sym.c(5), sym.s(5), sym.named("u")
     if "P" in kinds:
-        k, turning = 4, 5
-        ct, st = sym.c(turning), sym.s(turning)
-        a, b, c = linear_coeffs(z_eq, ct, st)
+        a, b, c = linear_coeffs(z_eq, c5, s5)
         if a == 0 and b == 0:
-            raise NotApplicable(f"three-parallel: entry (3,3) does not involve theta{turning}")
-        coeffs = tuple(sp.Poly(pos_eq, sym.d(k)).all_coeffs())
+            raise NotApplicable("three-parallel: entry (3,3) does not involve theta5")
+        coeffs = tuple(sp.Poly(pos_eq, sym.d(4)).all_coeffs())
         if len(coeffs) != 2:
-            raise NotApplicable(f"three-parallel: entry (3,4) is not linear in d{k}")
+            raise NotApplicable("three-parallel: entry (3,4) is not linear in d4")
         steps: list[Step] = [
-            Cs1(
-                turning,
-                (a, b, -c),
-                f"theta{turning}: entry (3,3), a c + b s = c",
-                2,
-                refs[turning - 1],
-                1.0,
-            ),
-            PolyD(k, coeffs, f"d{k}: entry (3,4), linear in d{k}", 1, unit=length),
+            Cs1(5, (a, b, -c), "theta5: entry (3,3), a c + b s = c", 2, refs[4], 1.0),
+            PolyD(4, coeffs, "d4: entry (3,4), linear in d4", 1, unit=length),
         ]
-        return steps, f"theta{turning} from entry (3,3), d{k} from entry (3,4)"
+        return steps, "theta5 from entry (3,3), d4 from entry (3,4)"
     entries = ((z_eq, "(3,3)"), (pos_eq, "(3,4)"))
     for k, (eq, name) in enumerate(entries):
         for one, other in ((4, 5), (5, 4)):
