@@ -183,7 +183,8 @@ def general_arms(draw) -> str:
 @st.composite
 def end_parallel_arms(draw) -> str:
     """6-joint arms with axes 1, 2, 3 (or 4, 5, 6) parallel and the other three joints
-    generic, half of them with the joint next to the parallel three prismatic."""
+    generic, half of them with the joint next to the parallel three prismatic (its axis
+    sometimes parallel to the three: four parallel axes)."""
     convention = draw(st.sampled_from(["standard", "modified"]))
     alpha = [draw(TWISTS) for _ in range(7)]
     a = [draw(MAYBE_ZERO) for _ in range(7)]
@@ -191,7 +192,7 @@ def end_parallel_arms(draw) -> str:
     theta = [None] + [draw(OFFSETS) for _ in range(6)]
     # axes 1, 2, 3 parallel: the twists between them 0 or 180 deg, both links with length
     # (canonical alpha_i, a_i lie between axes i and i + 1 in both conventions; TWISTS has
-    # no 0 or 180, so axis 4 is not parallel too)
+    # no 0 or 180, so a turning axis 4 is not parallel too)
     for i in (1, 2):
         alpha[i] = draw(st.sampled_from([0.0, 180.0]))
         a[i] = draw(LENGTH)
@@ -199,8 +200,13 @@ def end_parallel_arms(draw) -> str:
     kinds = draw(st.sampled_from(["RRRRRR", "RRRPRR"]))
     if "P" in kinds:
         # a sliding joint 4 at right angles to the parallel axes would move in their plane
-        # (the method then does not apply): twist 3 generic
-        alpha[3] = draw(st.floats(15.0, 75.0).map(round) | st.floats(105.0, 165.0).map(round))
+        # (the method then does not apply): twist 3 generic, or 0 or 180 deg (axes 1-4
+        # parallel, joint 4 sliding at right angles to the plane of the three)
+        alpha[3] = draw(
+            st.sampled_from([0.0, 180.0])
+            | st.floats(15.0, 75.0).map(round)
+            | st.floats(105.0, 165.0).map(round)
+        )
     scale = draw(SCALE)
     rows = rows_for(convention, alpha, scaled(a, scale), scaled(d, scale), theta)
     text = spec_text("end_parallel_arm", convention, rows, kinds=kinds)

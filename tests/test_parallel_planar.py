@@ -233,3 +233,29 @@ def test_axes_1_2_3_parallel_with_axis_5_joining_them_at_theta4_0(tmp_path):
     assert result.singular >= 30, result.summary()
     assert result.unsound == [] and result.misses == [], result.summary()
     assert result.singular_posed == result.singular, result.summary()
+
+
+# Long-run arm 815 (tests/long_run.py, modified DH): axes 1-4 parallel, joint 4 sliding at
+# right angles to the plane of the three turning joints. It has all six degrees of freedom,
+# but four parallel axes were refused by the three-parallel method, and the general method
+# (on a perturbed table: its own is singular) lost 14 of its 189 regular samples.
+FOUR_PARALLEL_ROWS = [
+    (130.0, 52.678847, 0.0, 116.063),
+    (180.0, 80.349542, -85.470747, 95.553),
+    (0.0, 74.3039, 0.0, -90.0),
+    (0.0, 25.076194, 0.0, -117.608),
+    (-156.0, -47.240414, 61.890383, 180.0),
+    (-22.0, 0.0, 0.0, 0.0),
+]
+
+
+def test_axes_1_to_4_parallel_with_joint_4_sliding(tmp_path):
+    text = spec_text("four_parallel", "modified", FOUR_PARALLEL_ROWS, kinds="RRRPRR")
+    text = text.replace('type = "P"\n', 'type = "P"\nlimits = [-100.0, 100.0]\n')
+    m = build_module(text, tmp_path)
+    assert m.METHOD == "three-parallel"
+    assert "theta5 from entry (3,3), d4 from entry (3,4)" in " ".join(m.__doc__.split())
+    result = roundtrip(m, sample_joints(m, 200, np.random.default_rng(10_815)))
+    assert result.singular >= 5, result.summary()
+    assert result.unsound == [] and result.misses == [], result.summary()
+    assert result.singular_posed == result.singular, result.summary()

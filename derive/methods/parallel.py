@@ -50,8 +50,12 @@ def derive(chain: Chain, structure: Structure) -> IkPlan | str:
     if chain.dof != 6:
         return f"three-parallel: needs 6 joints, the arm has {chain.dof}"
     triples = structure.parallel_triples
-    if any(i + 1 in triples for i in triples):
-        return "three-parallel: four consecutive parallel axes (a degree of freedom is lost)"
+    kinds = "".join(j.kind for j in chain.joints)
+    if any(i + 1 in triples for i in triples) and not sliding_fourth(triples, kinds):
+        return (
+            "three-parallel: four consecutive parallel axes (a degree of freedom is lost unless "
+            "the fourth from an end slides, joint 4 of axes 1-4 or joint 3 of axes 3-6)"
+        )
     refs = joint_refs(chain)
     reasons = []
     for first in (1, 4):
@@ -73,6 +77,15 @@ def derive(chain: Chain, structure: Structure) -> IkPlan | str:
     except NotApplicable as exc:
         return str(exc)
     return "three-parallel: axes 2, 3, 4 (or 3, 4, 5) are not parallel"
+
+
+def sliding_fourth(triples: tuple[int, ...], kinds: str) -> bool:
+    """Axes 1-4 parallel with joint 4 sliding (or 3-6 with joint 3, the same on the reversed
+    chain): the three turning axes move in their plane, the slider at right angles to it, and
+    derive_123's case "joint 4 slides" solves them (theta5 from entry (3,3), d4 from (3,4))."""
+    return ({1, 2} <= set(triples) and kinds == "RRRPRR") or (
+        {3, 4} <= set(triples) and kinds == "RRPRRR"
+    )
 
 
 def derive_end(chain: Chain, refs: tuple[sp.Expr, ...], first: int) -> IkPlan:
