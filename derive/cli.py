@@ -675,7 +675,7 @@ def bench_c(args: argparse.Namespace) -> int:
             refs = np.zeros_like(Q)
             for j in module.FREE:
                 refs[:, j - 1] = Q[:, j - 1]
-            mean, single = harness.bench(T, refs)
+            least, median, single = harness.bench(T, refs)
         kw = [{"free": [r[j - 1] for j in module.FREE]} if module.FREE else {} for r in refs]
         module.ik(T[0], **kw[0])  # compile (or load numba's cache) before timing
         python = median_us(partial(solve_with, module), list(zip(T, kw)))
@@ -686,9 +686,10 @@ def bench_c(args: argparse.Namespace) -> int:
             module.ik_batch(T, **free)
             batch = min(batch, (time.perf_counter() - start) / len(T) * 1e6)
         line = (
-            f"{spec.name}: C ({' '.join(BENCH_CFLAGS)}) ik {mean / 1000:.3f} us/pose (median "
-            f"of 21 rounds over {len(T)} poses), {single / 1000:.3f} us median single call; "
-            f"Python module ({module.BACKEND} backend): ik {python:.1f} us (median), ik_batch "
+            f"{spec.name}: C ({' '.join(BENCH_CFLAGS)}) ik {least / 1000:.3f} us/pose (least "
+            f"of 21 rounds over {len(T)} poses; median round {median / 1000:.3f}), "
+            f"{single / 1000:.3f} us median single call (each pose's least of 21); Python "
+            f"module ({module.BACKEND} backend): ik {python:.1f} us (median), ik_batch "
             f"{batch:.2f} us/pose (best of 3)"
         )
         eaik = eaik_figures(module, T)
@@ -790,7 +791,10 @@ def versus(ours: float, theirs: float) -> str:
 
 def bench_text(name: str, f: dict) -> str:
     """The human-readable lines of one arm's benchmark figures."""
-    line = f"{name}: generate {f['generate_s']:.2f} s; fk {f['fk_us']:.1f} us"
+    line = (
+        f"{name}: generate {f['generate_s']:.2f} s; fk {f['fk_us']:.1f} us (single calls: "
+        "the median over the poses of each pose's least of 3 calls)"
+    )
     if "ik_us" not in f:
         return line
     if f["backend"] == "numba":

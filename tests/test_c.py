@@ -171,6 +171,31 @@ def test_invalid_poses_give_the_error_code(harnesses):
     assert counts.tolist() == [-1] * len(bad)
 
 
+def test_harness_bench_gives_the_least_and_median_round_and_single_calls(harnesses):
+    """`derive bench --lang c`'s figures: per call, the least and the median of the rounds'
+    means (least <= median) and the median of the poses' least single calls, all positive."""
+    harness = harnesses("planar_2r")
+    Q = np.random.default_rng(1).uniform(-3.0, 3.0, (50, 2))
+    m = import_path(GENERATED / "planar_2r.py")
+    T = m.fk_batch(Q)
+    least, median, single = harness.bench(T, np.zeros_like(Q), rounds=5)
+    assert 0.0 < least <= median < 1e6
+    assert 0.0 < single < 1e6
+
+
+def test_bench_lang_c_prints_the_figures(capsys):
+    from derive.cli import main
+
+    assert main(["bench", "planar_2r", "--lang", "c", "--samples", "40"]) == 0
+    out = capsys.readouterr().out
+    assert re.search(
+        r"planar_2r: C \(-O3 -march=native\) ik \d+\.\d+ us/pose \(least of 21 "
+        r"rounds over 40 poses; median round \d+\.\d+\)",
+        out,
+    ), out
+    assert "median single call (each pose's least of 21)" in out
+
+
 # the arms whose C goes through every routine of the C runtime: polynomial, half-angle and
 # two-equation steps, free joints stepping through their values (a reversed chain with q7
 # given), and the general method (compiling a sanitized build takes seconds per arm)
