@@ -877,6 +877,11 @@ def _general(flanges, tol):
                 candidates, close, _ = _rr_split(k, F, F @ motion, leads)
                 _rr_merge(found, [_rr_to_arm(k, q) for q in candidates])
                 _rr_merge(near, [_rr_to_arm(k, q) for q in close])
+    if len(found) % 2:
+        # an odd number (real solutions pair up where the pose is regular): one was missed,
+        # most likely the partner of a found one with the same eigen-joint value (the PUMA's
+        # wrist flip, on a perturbed table, continued onto the found one): the search
+        _rr_merge(found, _rr_search(targets, found))
     for motion in (np.eye(4), *_RR_MOTIONS):
         if found:
             break
@@ -1797,9 +1802,9 @@ def _kgeneral(flanges, out):
     """The general method's solutions of one pose into out (6 angles per row, at most
     out.size // 6, the first ones found where a self-motion gives more, as the Python solver
     keeps its first MAX_SOLUTIONS): their count, or -1 where the Python solver must settle
-    the pose (no solution polished). The steps of derive/runtime/general.py, in the same
-    order (best split, fallback split, rescue), with small routines of its own instead of
-    LAPACK."""
+    the pose (no solution polished, or an odd number: its search). The steps of
+    derive/runtime/general.py, in the same order (best split, fallback split, rescue), with
+    small routines of its own instead of LAPACK."""
     limit = out.size // 6
     splits = len(flanges)
     targets = np.zeros((splits, 4, 4))
@@ -1831,7 +1836,8 @@ def _kgeneral(flanges, out):
                 count, _ = _krr_split(k, targets[k], moved, out, count)
                 if count == limit:
                     return count
-    return count if count > 0 else -1
+    # (an odd count: the Python solver's search looks for the one missed)
+    return count if count > 0 and count % 2 == 0 else -1
 
 
 def _krr_split(k, F, moved, out, count):

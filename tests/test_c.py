@@ -54,6 +54,14 @@ COUNT = {"parallel_6r": 1, "manocha_canny": 40}
 TURN = {"manocha_canny": 12}
 
 
+def write_module(plan, path: Path) -> Path:
+    """The plan's Python module written to path."""
+    from derive.emit import render_module
+
+    path.write_text(render_module(plan), encoding="utf-8")
+    return path
+
+
 def plan_of(name: str):
     return build_plan(load_spec(ROOT / "derive" / "arms" / f"{name}.toml"))
 
@@ -158,6 +166,28 @@ def test_general_method_with_a_prismatic_joint_in_c(kinds, convention, tmp_path)
             order += 1
             assert all(np.abs(P[i] - r).max(axis=1).min() <= 1e-9 for r in rows), i
     assert order <= 2, order
+
+
+def test_general_method_in_c_finds_the_wrist_flip_partners_of_the_puma(tmp_path):
+    """The PUMA by the general method (a perturbed table) in C: the closed form's solution
+    sets on 400 random poses, the Python solver's rows to 1e-9 (as sets). Before the search
+    on odd counts (dk_rr_search) poses 46 and 346 had 7 of their 8 solutions."""
+    from test_general import resolve_spec
+
+    spec = resolve_spec("puma560")
+    plan = build_plan(spec, "general")
+    general = import_path(write_module(plan, tmp_path / "puma_general.py"))
+    closed = import_path(write_module(build_plan(spec), tmp_path / "puma_closed.py"))
+    rng = np.random.default_rng(17)
+    Q = np.array([rng.uniform(-np.pi, np.pi, 6) for _ in range(400)])
+    T = closed.fk_batch(Q)
+    counts, QC = cbuild.Harness(plan, tmp_path).solve(T, np.zeros_like(Q))
+    for i in range(len(T)):
+        rows, expected = QC[i, : counts[i]], closed.ik(T[i], backend="python")
+        assert len(rows) == len(expected), i
+        python = general.ik(T[i], backend="python")
+        gaps = np.abs((rows[:, None] - python[None] + np.pi) % (2 * np.pi) - np.pi)
+        assert gaps.max(axis=2).min(axis=1).max(initial=0.0) <= 1e-9, i
 
 
 def test_invalid_poses_give_the_error_code(harnesses):

@@ -127,6 +127,11 @@ def _general(flanges, tol):
                 candidates, close, _ = _rr_split(k, F, F @ motion, leads)
                 _rr_merge(found, [_rr_to_arm(k, q) for q in candidates])
                 _rr_merge(near, [_rr_to_arm(k, q) for q in close])
+    if len(found) % 2:
+        # an odd number (real solutions pair up where the pose is regular): one was missed,
+        # most likely the partner of a found one with the same eigen-joint value (the PUMA's
+        # wrist flip, on a perturbed table, continued onto the found one): the search
+        _rr_merge(found, _rr_search(targets, found))
     for motion in (np.eye(4), *_RR_MOTIONS):
         if found:
             break

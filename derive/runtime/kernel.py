@@ -439,9 +439,9 @@ def _kgeneral(flanges, out):
     """The general method's solutions of one pose into out (6 angles per row, at most
     out.size // 6, the first ones found where a self-motion gives more, as the Python solver
     keeps its first MAX_SOLUTIONS): their count, or -1 where the Python solver must settle
-    the pose (no solution polished). The steps of derive/runtime/general.py, in the same
-    order (best split, fallback split, rescue), with small routines of its own instead of
-    LAPACK."""
+    the pose (no solution polished, or an odd number: its search). The steps of
+    derive/runtime/general.py, in the same order (best split, fallback split, rescue), with
+    small routines of its own instead of LAPACK."""
     limit = out.size // 6
     splits = len(flanges)
     targets = np.zeros((splits, 4, 4))
@@ -473,7 +473,8 @@ def _kgeneral(flanges, out):
                 count, _ = _krr_split(k, targets[k], moved, out, count)
                 if count == limit:
                     return count
-    return count if count > 0 else -1
+    # (an odd count: the Python solver's search looks for the one missed)
+    return count if count > 0 and count % 2 == 0 else -1
 
 
 def _krr_split(k, F, moved, out, count):
