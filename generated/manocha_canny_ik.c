@@ -1755,8 +1755,6 @@ static int dk_rr_candidates(const double values[490], const double F[4][4],
     return count;
 }
 
-/* split k's polished candidates for the target F (found from the pose `moved`) added to
-   out[count..] where new, until DK_RR_ROWS; the new count; *doubt as dk_rr_candidates' */
 /* split k's joint values q as the arm's (a sliding joint 3 in the arm's lengths; the reversed
    chain's joint j is -q_{7-j}) added to out[0..count) unless there already (angles modulo
    2 pi, within 1e-7): the new count */
@@ -1784,6 +1782,8 @@ static int dk_rr_add(int k, const double q[6], double out[DK_RR_ROWS][6], int co
     return count + 1;
 }
 
+/* split k's polished candidates for the target F (found from the pose `moved`) added to
+   out[count..] where new, until DK_RR_ROWS; the new count; *doubt as dk_rr_candidates' */
 static int dk_rr_split(int k, const double F[4][4], const double moved[4][4],
                        double out[DK_RR_ROWS][6], int count, int *doubt, double imag_tol)
 {
@@ -1838,8 +1838,7 @@ static int dk_rr_split(int k, const double F[4][4], const double moved[4][4],
    steps; then Newton's steps from those within DK_RR_SEARCH_FROM. The new count. */
 static int dk_rr_search(const double F[4][4], double out[DK_RR_ROWS][6], int count)
 {
-    double Q[DK_RR_ROWS + DK_RR_SEARCH_COUNT][6], errors[DK_RR_ROWS + DK_RR_SEARCH_COUNT];
-    double least = HUGE_VAL;
+    double Q[DK_RR_ROWS + DK_RR_SEARCH_COUNT][6], least = HUGE_VAL;
     const int first = DK_RR_SEARCH_STEPS / 4, n = count + DK_RR_SEARCH_COUNT;
     const int slides = DK_RR_TRUE[0][6][0] != 0.0;
     int r, j;
@@ -1855,15 +1854,15 @@ static int dk_rr_search(const double F[4][4], double out[DK_RR_ROWS][6], int cou
             Q[r][2] = r < count ? Q[r][2] / DK_RR_LENGTH
                                 : Q[r][2] * (DK_RR_SEARCH_SLIDE / DK_PI);
         }
-        errors[r] = dk_rr_walk(DK_RR_TRUE[0], F, Q[r], 1, first, HUGE_VAL);
-        least = fmin(least, errors[r]);
+        least = fmin(least, dk_rr_walk(DK_RR_TRUE[0], F, Q[r], 1, first, HUGE_VAL));
     }
     if (!(least <= DK_RR_SEARCH_BAIL)) {
         return count;
     }
     for (r = 0; r < n && count < DK_RR_ROWS; r++) {
-        errors[r] = dk_rr_walk(DK_RR_TRUE[0], F, Q[r], 1, DK_RR_SEARCH_STEPS - first, HUGE_VAL);
-        if (errors[r] <= DK_RR_SEARCH_FROM && dk_rr_steps(DK_RR_TRUE[0], F, Q[r], 0) <= DK_RR_GOOD) {
+        const double error = dk_rr_walk(DK_RR_TRUE[0], F, Q[r], 1, DK_RR_SEARCH_STEPS - first,
+                                        HUGE_VAL);
+        if (error <= DK_RR_SEARCH_FROM && dk_rr_steps(DK_RR_TRUE[0], F, Q[r], 0) <= DK_RR_GOOD) {
             count = dk_rr_add(0, Q[r], out, count);
         }
     }
