@@ -172,7 +172,7 @@ def test_general_method_in_c_finds_the_wrist_flip_partners_of_the_puma(tmp_path)
     """The PUMA by the general method (a perturbed table) in C: the closed form's solution
     sets on 400 random poses, the Python solver's rows to 1e-9 (as sets). Before the search
     on odd counts (dk_rr_search) poses 46 and 346 had 7 of their 8 solutions."""
-    from test_general import resolve_spec
+    from derive.cli import resolve_spec
 
     spec = resolve_spec("puma560")
     plan = build_plan(spec, "general")
