@@ -71,7 +71,9 @@ def remainder_rank(chain: Chain, free: tuple[int, ...]) -> int:
     from shoulder to wrist)."""
     rng = np.random.default_rng(18)
     size = max(
-        [1.0] + [abs(float(t.a)) for t in chain.twists] + [abs(float(j.d)) for j in chain.joints]
+        [1.0]
+        + [abs(float(t.a)) for t in chain.twists]
+        + [abs(float(j.d if j.kind == "R" else j.offset)) for j in chain.joints]
     )
     moving = [i for i in range(chain.dof) if i + 1 not in free]
     best = 0

@@ -342,3 +342,36 @@ def test_panda_solutions_are_all_that_newton_finds(generated):
         for p in newton:
             assert any(wrapped_gap(p, r).max() < 1e-6 for r in rows), (p, rows)
         assert len(newton) == len(rows)
+
+
+# a PUMA 560 on a linear track (a 7-joint cell, joint 1 sliding along the floor): issue 37
+RAIL = spec_text(
+    "rail_puma",
+    "standard",
+    [(-90, 0, 0, 0), (-90, 0, 0, 0), (0, 0.432, 0, 0), (90, -0.02, 0.149, 0)]
+    + [(-90, 0, 0.433, 0), (90, 0, 0, 0), (0, 0, 0, 0)],
+    kinds="PRRRRRR",
+).replace('type = "P"\n', 'type = "P"\nlimits = [0.0, 3.0]\n', 1)
+
+
+@pytest.mark.parametrize("extra", ["", "[ik]\nfree = [1]\n"])
+def test_a_six_joint_arm_on_a_rail_is_solved_with_the_rail_free(extra, tmp_path):
+    m = build_module(RAIL + extra, tmp_path)
+    assert m.FREE == (1,) and m.METHOD == "pieper" and m.JOINT_TYPES[0] == "P"
+    result = roundtrip(m, sample_joints(m, 300, np.random.default_rng(37)), "python")
+    assert result.unsound == [] and result.misses == [], result.summary()
+    assert result.singular_posed == result.singular, result.summary()
+    q = np.array([1.7, 0.3, -0.4, 0.5, 0.6, -0.7, 0.8])
+    assert np.allclose(m.nearest(m.fk(q), q + 0.01), q, atol=1e-6)
+
+
+def test_telescoping_joints_on_one_axis_are_refused_in_one_line(tmp_path, capsys):
+    """Hello Robot Stretch from link_lift to link_wrist_roll: four sliding joints on one axis
+    and a wrist; no choice of free joints leaves six degrees of freedom."""
+    rows = [(0, 0, 0.1, 0)] * 4 + [(90, 0, 0.1, 0), (-90, 0, 0, 0), (0, 0, 0.1, 0)]
+    spec = tmp_path / "tele.toml"
+    spec.write_text(spec_text("tele", "standard", rows, kinds="PPPPRRR"))
+    assert main(["generate", str(spec), "--out", str(tmp_path / "out")]) == 0
+    out = capsys.readouterr().out
+    assert out.count("\n") == 1 and "FK only, no IK" in out
+    assert "the remainder loses a degree of freedom" in out
