@@ -25,7 +25,7 @@ from typing import TYPE_CHECKING, Any
 if TYPE_CHECKING:
     from collections.abc import Iterable
 
-from derive import urdf
+from derive import extras, urdf
 from derive.emit import GenerationError, render_module
 from derive.pipeline import build_plan
 from derive.plan import Plan
@@ -358,8 +358,8 @@ def joint_vector(spec: ArmSpec, values: list[float], radians: bool) -> list[floa
 
 
 def format_pose(pose: Iterable[Iterable[float]]) -> str:
-    """Four rows of a 4x4 matrix."""
-    return "\n".join("  ".join(f"{x: .10f}" for x in row) for row in pose)
+    """Four rows of a 4x4 matrix; a value that rounds to zero prints as 0 (not -0)."""
+    return "\n".join("  ".join(f"{round(x, 10) + 0.0: .10f}" for x in row) for row in pose)
 
 
 def cmd_fk(args: argparse.Namespace) -> int:
@@ -396,7 +396,9 @@ def cmd_solve(args: argparse.Namespace) -> int:
         ]
         flag = f"  out of limits: {', '.join(outside)}" if outside else ""
         print(
-            f"{k:2d}: " + " ".join(f"{v:10.4f}" for v in shown) + f"  residual {residual:.1e}{flag}"
+            f"{k:2d}: "
+            + " ".join(f"{round(v, 4) + 0.0:10.4f}" for v in shown)  # (+ 0.0: no -0.0000)
+            + f"  residual {residual:.1e}{flag}"
         )
     return 0
 
@@ -835,6 +837,7 @@ def parser() -> argparse.ArgumentParser:
     top = argparse.ArgumentParser(
         prog="derive", description="Closed-form IK solvers from DH tables."
     )
+    top.add_argument("--version", action="version", version=f"derive-ik {extras.version()}")
     sub = top.add_subparsers(dest="command", required=True)
     gen = sub.add_parser("generate", help="write generated/<name>.py and <name>.md for each arm")
     gen.add_argument(

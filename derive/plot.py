@@ -6,8 +6,9 @@ base and tool frames as small triads, and the target frame dashed. One panel per
 the same view and scale in every panel, the joint values in degrees in the panel's title
 and joints outside their limits marked in red.
 
-matplotlib is an optional dependency (``pip install 'derive-ik[plot]'``); SVG output is
-byte-deterministic (no date, fixed ids).
+matplotlib is an optional dependency (the ``plot`` extra; without it the message names the
+package to install, see derive/extras.py); SVG output is byte-deterministic (no date, fixed
+ids).
 """
 
 from __future__ import annotations
@@ -19,6 +20,8 @@ from types import ModuleType
 from typing import Any
 
 import numpy as np
+
+from derive.extras import install_hint
 
 # the panels per row, a panel's size in inches, and the view (degrees)
 COLUMNS = 4
@@ -105,7 +108,7 @@ def pyplot() -> Any:
     try:
         import matplotlib
     except ImportError:
-        raise PlotUnavailable("pictures need matplotlib: pip install 'derive-ik[plot]'") from None
+        raise PlotUnavailable(f"pictures need matplotlib: {install_hint('plot')}") from None
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
@@ -123,7 +126,8 @@ def solutions_figure(
     count = max(len(drawings), 1)
     cols = min(COLUMNS, count)
     rows = math.ceil(count / cols)
-    fig = plt.figure(figsize=(PANEL * cols, PANEL * rows + 0.5))
+    # constrained layout keeps each panel's title clear of the tick labels of the row above
+    fig = plt.figure(figsize=(PANEL * cols, PANEL * rows + 0.5), layout="constrained")
     fig.suptitle(title, fontsize=10)
     points = [pose[:3, 3][None]] + [d.origins for d in drawings]
     stacked = np.vstack(points)
@@ -136,7 +140,9 @@ def solutions_figure(
         for axis, (lo, hi) in zip("xyz", zip(centre - half, centre + half)):
             getattr(ax, f"set_{axis}lim")(lo, hi)
         ax.set_box_aspect((1, 1, 1))
-        ax.tick_params(labelsize=5)
+        ax.tick_params(labelsize=5, pad=0)
+        for axis in "xyz":
+            getattr(ax, f"set_{axis}label")(f"{axis} (world)", fontsize=6, labelpad=-4)
         _triad(ax, pose, TRIAD * size, "--")
         if not drawings:
             ax.set_title("no solution", fontsize=7)
@@ -149,7 +155,6 @@ def solutions_figure(
         )
         note = f"\noutside limits: {', '.join(f'q{i}' for i in d.outside)}" if d.outside else ""
         ax.set_title(f"{k + 1}: ({values}){note}", fontsize=6, color="red" if note else "black")
-    fig.tight_layout()
     return fig, drawings
 
 
@@ -185,7 +190,9 @@ def figure_bytes(fig: Any, fmt: str) -> bytes:
 def workspace_figure(wmap: Any, title: str) -> Any:
     """Three panels of a workspace section: reachable, dexterous, solutions per position."""
     plt = pyplot()
-    fig, axes = plt.subplots(1, 3, figsize=(13.5, 4.6))
+    from matplotlib.ticker import MaxNLocator
+
+    fig, axes = plt.subplots(1, 3, figsize=(13.5, 4.6), layout="constrained")
     fig.suptitle(title, fontsize=10)
     extent = (wmap.u[0], wmap.u[-1], wmap.v[0], wmap.v[-1])
     section = "the arm's plane" if wmap.planar else "the plane through axis 1"
@@ -203,10 +210,11 @@ def workspace_figure(wmap: Any, title: str) -> Any:
         ax.set_ylabel("v" if wmap.planar else "along axis 1", fontsize=7)
         ax.tick_params(labelsize=6)
         ax.set_aspect("equal")
-        if cmap == "viridis":
-            fig.colorbar(image, ax=ax, shrink=0.8)
+        if cmap == "viridis":  # solution counts are whole numbers: so are the ticks
+            bar = fig.colorbar(image, ax=ax, shrink=0.8)
+            bar.locator = MaxNLocator(integer=True)
+            bar.update_ticks()
     dots = np.argwhere(wmap.dexterous)
     if 0 < len(dots) <= 20:  # a few dexterous cells: marked, or they would not show
         axes[1].plot(wmap.u[dots[:, 1]], wmap.v[dots[:, 0]], "r.", markersize=6)
-    fig.tight_layout()
     return fig

@@ -415,7 +415,9 @@ def _zarr() -> Any:
     try:
         import zarr
     except ImportError:
-        raise ReachError("reach maps need zarr: pip install 'derive-ik[scale]'") from None
+        from derive.extras import install_hint
+
+        raise ReachError(f"reach maps need zarr: {install_hint('scale')}") from None
     return zarr
 
 
@@ -744,7 +746,9 @@ def _dask_chunks(
         from distributed import Client, LocalCluster
         from distributed import as_completed as completed
     except ImportError:
-        raise ReachError("--dask needs dask.distributed: pip install 'derive-ik[scale]'") from None
+        from derive.extras import install_hint
+
+        raise ReachError(f"--dask needs dask.distributed: {install_hint('scale')}") from None
     cluster = None
     if address.startswith("local:"):
         try:
@@ -922,7 +926,9 @@ def h5py_module() -> Any:
     try:
         import h5py
     except ImportError:
-        raise ReachError("the HDF5 export needs h5py: pip install 'derive-ik[scale]'") from None
+        from derive.extras import install_hint
+
+        raise ReachError(f"the HDF5 export needs h5py: {install_hint('scale')}") from None
     return h5py
 
 

@@ -260,6 +260,8 @@ def workspace(
         if progress is not None and (now - shown > 0.5 or rows.stop == resolution):
             progress_line(progress, "workspace", rows.stop, resolution, start, "rows")
             shown = now
+    if progress is not None:  # end the progress line: what is printed next starts a line
+        progress.write("\n")
     reachable = counts > 0
     dexterous = reached.all(axis=2) & reachable
     return WorkspaceMap(
@@ -268,7 +270,8 @@ def workspace(
 
 
 def progress_line(out: TextIO, label: str, done: int, total: int, start: float, unit: str) -> None:
-    """One line of progress (rewritten in place) with an estimate of the time left."""
+    """One line of progress (rewritten in place) with an estimate of the time left; the caller
+    ends the line once the work is done."""
     elapsed = time.perf_counter() - start
     left = elapsed / max(done, 1) * (total - done)
     bar = "#" * (30 * done // max(total, 1))

@@ -94,7 +94,7 @@ def test_without_matplotlib_plot_says_what_to_install(monkeypatch, tmp_path, cap
     monkeypatch.setitem(sys.modules, "matplotlib", None)
     out = tmp_path / "p.svg"
     assert main(["plot", "puma560", "--q", *["20"] * 6, "-o", str(out)]) == 2
-    assert "pip install 'derive-ik[plot]'" in capsys.readouterr().err
+    assert "pip install 'matplotlib==3.11.2' (the plot extra)" in capsys.readouterr().err
     assert not out.exists()
 
 
@@ -131,3 +131,35 @@ def test_generate_with_figures_embeds_them_and_check_reproduces_them(tmp_path, c
     assert "](planar_2r_workspace.svg)" in (out / "planar_2r.md").read_text()
     assert main(["check", "planar_2r", "--figures", "--out", str(out)]) == 0
     assert "up to date (4 files)" in capsys.readouterr().out
+
+
+def test_panel_titles_clear_the_row_above_and_the_axes_are_labelled(generated):
+    """Issue 37: the second row's titles sat on the first row's tick labels; no axis labels."""
+    m = generated("puma560")
+    T = m.fk(np.radians([20.0] * 6))
+    fig, _ = solutions_figure(m, "standard", T, m.ik(T, backend="python"), "puma560")
+    fig.canvas.draw()
+    renderer = fig.canvas.get_renderer()
+    top, bottom = fig.axes[:4], fig.axes[4:]
+    for ax in bottom:
+        title = ax.title.get_window_extent(renderer)
+        for above in top:
+            assert not title.overlaps(above.get_tightbbox(renderer)), ax.get_title()
+    for ax in fig.axes:
+        assert ax.get_xlabel() and ax.get_ylabel() and ax.get_zlabel()
+    figure_bytes(fig, "png")
+
+
+def test_the_workspace_colour_bar_ticks_whole_solution_counts(generated):
+    """Issue 37: a 2R's counts (0, 1, 2) got ticks at 0.25 steps."""
+    from derive.plot import workspace_figure
+    from derive.workspace import workspace
+
+    wmap = workspace(generated("planar_2r"), True, "standard", resolution=21, progress=None)
+    fig = workspace_figure(wmap, "planar_2r")
+    fig.canvas.draw()
+    bar = fig.axes[-1]
+    low, high = bar.get_ylim()
+    ticks = [t for t in bar.get_yticks() if low - 1e-9 <= t <= high + 1e-9]
+    assert ticks == [0.0, 1.0, 2.0]
+    figure_bytes(fig, "png")

@@ -66,3 +66,10 @@ def test_the_workspace_command_writes_its_figure_and_figures(tmp_path, capsys, m
     assert out.read_bytes().startswith(b"<?xml")
     assert main(["workspace", "planar_2r", "--resolution", "40"]) == 2
     assert "--resolution: an odd number" in capsys.readouterr().err
+
+
+def test_the_progress_line_is_ended_before_the_summary(generated):
+    """Issue 37: the summary was printed on the progress line, after "ETA 0 s"."""
+    out = io.StringIO()
+    workspace(generated("planar_2r"), True, "standard", resolution=21, progress=out)
+    assert "ETA" in out.getvalue() and out.getvalue().endswith("\n")
