@@ -1,4 +1,5 @@
-"""Which solvable structure an arm has, from its canonical DH chain (ALGORITHMS.md section 5.1).
+"""Which solvable structure an arm has, from its canonical DH chain (docs/algorithms.md,
+"Classifying an arm").
 
 Axis i and axis i+1 are related by the twist X_i = Rx(alpha_i) Tx(a_i) and by d_{i+1}, in both
 conventions. Exact numbers are tested exactly; float numbers within a relative tolerance.

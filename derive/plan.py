@@ -193,9 +193,10 @@ class PolyD(Solve):
 
 @dataclass(frozen=True)
 class Split:
-    """One way of writing a 6R arm's loop for the general method (ALGORITHMS.md 4.1): the
-    arm's chain or its reversal, in standard DH from the flange frame (d1 = d6 = 0, a6 =
-    alpha6 = 0), lengths in units of the Eigen step's unit.
+    """One way of writing a 6R arm's loop for the general method (docs/algorithms.md, "The
+    split and the 14 fundamental equations"): the arm's chain or its reversal, in standard DH
+    from the flange frame (d1 = d6 = 0, a6 = alpha6 = 0), lengths in units of the Eigen step's
+    unit.
 
     Attributes:
         reversed: the chain read from the tool (joint k is joint 7 - k, theta'_k = -theta_7-k).

@@ -14,7 +14,8 @@ read (M-C eq. 4)
     m12 = [s1 s2, s1 c2, c1 s2, c1 c2, s1, c1, s2, c2],
 
 P0, Ps, Pc 14 x 9 and Q 14 x 8 in the DH parameters and the six pose numbers; the right side's
-constant terms go into P0's last column with their sign changed (ALGORITHMS.md 4.1-4.3).
+constant terms go into P0's last column with their sign changed (docs/algorithms.md, "The
+split and the 14 fundamental equations").
 """
 
 from __future__ import annotations

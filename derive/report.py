@@ -247,8 +247,9 @@ def method_blocks(plan: Plan) -> list[Block]:
 
 
 def general_blocks(step: Eigen) -> list[Block]:
-    """The general method's derivation (ALGORITHMS.md 4.1-4.6): the split, the 14 equations
-    in general form, the elimination, the matrix polynomial."""
+    """The general method's derivation (docs/algorithms.md, "The general 6R method", its first
+    four sections): the split, the 14 equations in general form, the elimination, the matrix
+    polynomial."""
     f = rr.fundamental()
     out = [
         Block("h3", "The split (Raghavan and Roth)"),

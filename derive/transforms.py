@@ -1,7 +1,8 @@
 """Link transforms for standard and modified DH, their products, and forward kinematics.
 
 Both conventions are the same product of elementary factors grouped differently
-(ALGORITHMS.md section 1). With X_i = Rx(alpha_i) Tx(a_i) and Z_i = Rz(theta_i) Tz(d_i):
+(docs/algorithms.md, "One product for both conventions"). With X_i = Rx(alpha_i) Tx(a_i)
+and Z_i = Rz(theta_i) Tz(d_i):
 
 * modified (Craig): (i-1)_iT = X_{i-1} Z_i, so 0_nT = X_0 Z_1 X_1 ... X_{n-1} Z_n;
 * standard:         A_i = Z_i X_i,          so 0_nT = Z_1 X_1 ... Z_n X_n.
@@ -71,7 +72,7 @@ class Chain:
 
 
 def chain_from_spec(spec: ArmSpec) -> Chain:
-    """Exact canonical chain of a spec (section 1 of ALGORITHMS.md)."""
+    """Exact canonical chain of a spec (docs/algorithms.md, "One product for both conventions")."""
     n = spec.dof
     rows = [_twist(j.alpha, j.a, spec.angle_unit) for j in spec.joints]
     identity = Twist(sp.Integer(1), sp.Integer(0), sp.Integer(0))
@@ -236,7 +237,7 @@ def numbers_of(chain: Chain) -> dict[sp.Symbol, sp.Expr]:
 
 
 def reverse_chain(chain: Chain) -> Chain:
-    """The chain read from the tool back to the base (ALGORITHMS.md section 1).
+    """The chain read from the tool back to the base (docs/algorithms.md, "The reversed chain").
 
     T^-1 = E^-1 X_n^-1 Z_n^-1 ... X_1^-1 Z_1^-1 X_0^-1 B^-1 with X_i^-1 = X(-alpha_i, -a_i) and
     Z_i^-1 = Z(-theta_i, -d_i). Joint k of the reversed chain is joint n + 1 - k of the arm

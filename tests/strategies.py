@@ -75,7 +75,8 @@ def pieper_arms(draw) -> str:
 def reverse_rows_text(
     convention: str, rows: list, kinds: str, scale: float, prismatic: bool
 ) -> str:
-    """An arm whose axes 1-3 meet: the reversed chain of `rows` (ALGORITHMS.md section 1)."""
+    """An arm whose axes 1-3 meet: the reversed chain of `rows` (docs/algorithms.md, "The
+    reversed chain")."""
     n = len(rows)
     if convention == "modified":
         alpha = [r[0] for r in rows] + [0.0]

@@ -33,7 +33,8 @@ def matrices():
 def test_the_shape_the_literature_gives(matrices):
     _, f = matrices
     assert (f.P0.shape, f.Ps.shape, f.Pc.shape, f.Q.shape) == ((14, 9), (14, 9), (14, 9), (14, 8))
-    # l_z, p_z, p.p, p.l, (p x l)_z, v_z do not involve theta3 (ALGORITHMS.md 4.2)
+    # l_z, p_z, p.p, p.l, (p x l)_z, v_z do not involve theta3 (docs/algorithms.md, "The
+    # split and the 14 fundamental equations")
     free_of_theta3 = [i for i in range(14) if not any(f.Ps.row(i)) and not any(f.Pc.row(i))]
     assert free_of_theta3 == [2, 5, 6, 7, 10, 13]
     operations = sum(e.count_ops() for m in (f.P0, f.Ps, f.Pc, f.Q) for e in m)

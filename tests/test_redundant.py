@@ -280,7 +280,8 @@ def test_a_six_joint_arm_has_no_free_joints():
 
 
 def test_a_redundant_arm_without_a_closed_form_uses_the_general_method(tmp_path):
-    """Rethink Sawyer (FIELD_NOTES.md section 2): every lock leaves a general 6R."""
+    """Rethink Sawyer (docs/algorithms.md, "Free joints of 7-joint arms"): every lock leaves a
+    general 6R."""
     rows = [(-90, 81, 317, 0), (-90, 0, 192.5, 0), (-90, 0, 400, 0), (-90, 0, 168.5, 0)]
     rows += [(-90, 0, 400, 0), (-90, 0, 136.3, 0), (0, 0, 133.75, 0)]
     text = spec_text("sawyer", "standard", rows)

@@ -17,7 +17,8 @@ def flange_target(chain: Chain, target: sp.Matrix) -> Assign:
     """0_nT from the world target: base, X_0, Tz(d1) and Tz(dn), X_n, tool moved out.
 
     Tz(d1) and Tz(dn) move out only for revolute end joints (they commute with Rz(theta)),
-    so that the flange target has alpha_0 = a_0 = d_1 = d_n = 0 (ALGORITHMS.md section 1).
+    so that the flange target has alpha_0 = a_0 = d_1 = d_n = 0 (docs/algorithms.md, "The
+    flange target").
     """
     first, last = chain.joints[0], chain.joints[-1]
     head = [chain.base, x_factor(chain.twists[0])]

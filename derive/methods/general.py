@@ -1,5 +1,5 @@
 """The general method for any 6R arm: Raghavan and Roth's 14 equations, Manocha and Canny's
-eigen-solve (ALGORITHMS.md section 4).
+eigen-solve (docs/algorithms.md, "The general 6R method").
 
 Per arm, at generation:
 
@@ -15,7 +15,8 @@ Per arm, at generation:
    and the conditioning of the pencil's leading matrix); the better one is used first, the
    other is the fallback when a pose's answer is in doubt. Where both give a singular pencil
    (special geometry: det Sigma(x3) = 0 for every x3), the matrices come from a table
-   perturbed by 1e-4 and Newton steps polish onto the true arm (ALGORITHMS.md 4.9).
+   perturbed by 1e-4 and Newton steps polish onto the true arm (docs/algorithms.md,
+   "Choosing the split, singular pencils and the rescue").
 
 The run-time steps (null space of Q, pencil, eigenvalues, back-substitution, Newton, rescue)
 are in :mod:`derive.runtime.general` (Python) and :mod:`derive.runtime.kernel` (compiled).

@@ -1,4 +1,5 @@
-"""6R arms with three consecutive parallel axes (UR type; the blog post's arm), ALGORITHMS.md s. 3.
+"""6R arms with three consecutive parallel axes (UR type; the blog post's arm): docs/algorithms.md,
+"Three parallel axes".
 
 With axes 2, 3, 4 parallel, P = Z2 X2 Z3 X3 Z4 is planar: its third row (0, 0, +-1, d)
 does not depend on theta2..theta4. So the third row of M = (Z1 X1)^-1 0_6T equals the third row
@@ -250,7 +251,7 @@ def joints45_steps(
 
 
 def derive_234(chain: Chain, target: sp.Matrix, refs: tuple[sp.Expr, ...], prefix: str) -> IkPlan:
-    """The plan for axes 2, 3, 4 parallel (section 3.1-3.4)."""
+    """The plan for axes 2, 3, 4 parallel (docs/algorithms.md, "Axes 2-3-4: the third row")."""
     numbers = numbers_of(chain)
     mats = [m.xreplace(numbers) for m in flange_factors(chain)]
     base_part = product(mats[0:2])  # Z1 X1
@@ -357,7 +358,8 @@ def theta1_theta5_steps(
 def theta6_steps(
     e1: sp.Expr, e2: sp.Expr, g_value: sp.Matrix, elbow: Solve, refs: tuple[sp.Expr, ...]
 ) -> list[Step]:
-    """theta6 from entries (3,1), (3,2): h^T Rz(theta6) = m^T (section 3.3).
+    """theta6 from entries (3,1), (3,2): h^T Rz(theta6) = m^T (docs/algorithms.md, "Axes
+    2-3-4: the third row", step 3).
 
     Where h vanishes (z6 parallel to axes 2-4, e.g. theta5 = 0) theta6 is free, but not every
     value works: theta6 turns the wrist offset about the parallel axes and so moves the planar

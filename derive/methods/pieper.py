@@ -5,7 +5,7 @@ alpha_i, d_i as symbols), then with the arm's numbers substituted:
 
 1. Base, X_0 and Tz(d_1) go into the base, Tz(d_6) and X_6 into the tool, so that the
    flange target 0_6T = (B X_0 Tz(d1))^-1 T (Tz(d6) X_6 E)^-1 has alpha_0 = a_0 = d_1 = d_6 = 0
-   (ALGORITHMS.md section 1). Its position is the wrist centre 0P_4org.
+   (docs/algorithms.md, "The flange target"). Its position is the wrist centre 0P_4org.
 2. f(theta3) = 2_3T 3P_4org, g(theta2, theta3) = 1_2T f, (x, y, z) = 0_1T g.
 3. r = x^2 + y^2 + z^2 = 2 a1 (k1 c2 + k2 s2) + k3 and z = s(alpha1) (k1 s2 - k2 c2) + k4;
    k1..k4 are read off these derived expressions (and checked against the lecture's
@@ -73,7 +73,8 @@ def derive(chain: Chain, structure: Structure) -> IkPlan | str:
     """Pieper plan for the chain, or a one-line reason why the method does not apply.
 
     Axes 4, 5, 6 meeting in a point are solved directly; axes 1, 2, 3 meeting in a point by
-    solving the reversed chain for T^-1 (ALGORITHMS.md section 2.8).
+    solving the reversed chain for T^-1 (docs/algorithms.md, "Axes 1-2-3 meeting: the
+    reversed chain").
     """
     if chain.dof != 6:
         return f"Pieper: needs 6 joints, the arm has {chain.dof}"
@@ -186,7 +187,8 @@ def position_equations(
         length: the arm's size (sum of |a_i| and |d_i|), which scales the singularity tests.
         refs: reference values of the joints, for free joints.
         prismatic3: joint 3 is prismatic: the lecture's "theta_i or d_i"; f is affine in d3 and
-            the case's equation is a polynomial in d3 (ALGORITHMS.md section 2.7).
+            the case's equation is a polynomial in d3 (docs/algorithms.md, "A prismatic
+            joint 3").
     """
     general = k_functions()
     spec = {name: sp.expand(e.xreplace(numbers)) for name, e in general.items()}
@@ -354,7 +356,8 @@ def reach_guided(position: list[Step], wrist: list[Step]) -> list[Step]:
 
 
 def wrist_equations(numbers: dict, refs: tuple[sp.Expr, ...]) -> list[Step]:
-    """theta5, theta4, theta6 from W = Rz(t4) Rx(alpha4) Rz(t5) Rx(alpha5) Rz(t6) (section 2.6)."""
+    """theta5, theta4, theta6 from W = Rz(t4) Rx(alpha4) Rz(t5) Rx(alpha5) Rz(t6)
+    (docs/algorithms.md, "The wrist as Z-Y-Z Euler angles")."""
     rot03 = product(
         [
             (z_factor(general_joint(i)) * x_factor(general_twist(i))).xreplace(numbers)
