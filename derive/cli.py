@@ -547,6 +547,8 @@ def cmd_reach(args: argparse.Namespace) -> int:
             pyplot()  # say at once if matplotlib is missing
         if args.hdf5:
             reach.h5py_module()  # (likewise h5py)
+        if args.dask:
+            reach.dask_workers(args.dask)  # (a bad address, or no dask.distributed)
         done = reach.run(
             output,
             spec.name,
@@ -564,6 +566,7 @@ def cmd_reach(args: argparse.Namespace) -> int:
         print(
             f"{output}: {done.computed} chunk(s) computed in {done.seconds:.1f} s{rate}"
             + (f", {done.skipped} done before" if done.skipped else "")
+            + (f"; {done.repaired} damaged chunk(s) computed again" if done.repaired else "")
         )
         if args.bench and done.computed == 0:
             print("bench: nothing was computed (the map was complete): give a new -o")

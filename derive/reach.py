@@ -58,9 +58,10 @@ import sys
 import tempfile
 import threading
 import time
-from collections.abc import Iterable
+from collections.abc import Iterable, Iterator
 from concurrent.futures import Future, ProcessPoolExecutor, ThreadPoolExecutor, as_completed
-from dataclasses import asdict, dataclass
+from contextlib import contextmanager
+from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from types import ModuleType
 from typing import Any, TextIO
@@ -69,7 +70,8 @@ import numpy as np
 
 from derive.workspace import inside_limits, progress_line, section
 
-FORMAT = 1
+# 2: counts' fill value NOT_COMPUTED, index and column_index created with the other arrays
+FORMAT = 2
 RESOLUTION = 0.05
 DIRECTIONS = 200
 ROLLS = 8
@@ -84,6 +86,9 @@ PIECE = 8192
 PARENT_POLL = 0.5
 # the largest grid side accepted (voxels)
 MAX_SIDE = 1001
+# what a count not computed reads as (counts' fill value: a chunk file lost from the store);
+# a pose's count is at most its solver's MAX_SOLUTIONS (16)
+NOT_COMPUTED = 255
 # symmetry checks on the FK: random configurations, and the agreement asked (of REACH)
 SYMMETRY_SAMPLES = 8
 SYMMETRY_TOL = 1e-9
@@ -463,34 +468,98 @@ def open_store(
             )
     else:
         group = zarr.create_group(str(path), attributes=attrs)
-    side, m = layout.side, len(layout.columns)
-    D, K = layout.rotations.shape[:2]
-    bc, bz = layout.block
-    dof = _dof(source)
-    fixed = {
+    for key, data in _fixed_arrays(layout).items():
+        array = _member(path, group, key)
+        if array is None:
+            group.create_array(key, data=data, chunks=data.shape)
+            continue
+        _check_array(path, key, array, (data.shape, data.shape, data.dtype.name, 0))
+        if not np.array_equal(array[...], data):  # (a lost chunk file reads as zeros)
+            array[...] = data
+    # the done marks last: a store whose done array exists has every array
+    for key, spec in _chunked_arrays(layout, params, _dof(source)).items():
+        array = _member(path, group, key)
+        if array is None:
+            shape, chunks, dtype, fill = spec
+            group.create_array(key, shape=shape, chunks=chunks, dtype=dtype, fill_value=fill)
+        else:
+            _check_array(path, key, array, spec)
+    return group
+
+
+def _fixed_arrays(layout: Layout) -> dict[str, np.ndarray]:
+    """The arrays a layout gives (one chunk each; rewritten when a run finds them changed)."""
+    return {
         "centres": layout.centres,
         "columns": layout.columns,
         "column_of": layout.column_of,
         "directions": layout.rotations[:, 0, :, 2],
         "rolls": layout.rolls,
     }
-    chunked: dict[str, tuple[tuple[int, ...], tuple[int, ...], str, float]] = {
-        "counts": ((m, side, D, K), (bc, bz, D, K), "uint8", 0),
-        "done": ((layout.n_chunks,), (1,), "uint8", 0),
+
+
+# an array's shape, chunks, dtype and fill value
+ArraySpec = tuple[tuple[int, ...], tuple[int, ...], str, float]
+
+
+def _chunked_arrays(layout: Layout, params: Parameters, dof: int) -> dict[str, ArraySpec]:
+    """The computed arrays, done last. Fill values say "not computed" where they can: a
+    count NOT_COMPUTED, an index NaN (a first solution's NaN is also "none": counts tell)."""
+    side, m = layout.side, len(layout.columns)
+    D, K = layout.rotations.shape[:2]
+    bc, bz = layout.block
+    slab = max(1, min(side, 4_000_000 // (side * side)))  # the index's heights per chunk
+    chunked: dict[str, ArraySpec] = {
+        "counts": ((m, side, D, K), (bc, bz, D, K), "uint8", NOT_COMPUTED),
+        "column_index": ((m, side), (m, side), "float32", math.nan),
+        "index": ((side, side, side), (side, side, slab), "float32", math.nan),
     }
     if params.first:
         chunked["first"] = ((m, side, D, K, dof), (bc, bz, D, K, dof), "float32", math.nan)
-    present = set(group.array_keys())
-    for key, data in fixed.items():
-        if key not in present:
-            group.create_array(key, data=data, chunks=data.shape)
-    # the done marks last: a store whose done array exists has every array
-    for key, (shape, chunks, dtype, fill) in sorted(
-        chunked.items(), key=lambda kv: kv[0] == "done"
+    chunked["done"] = ((layout.n_chunks,), (1,), "uint8", 0)
+    return chunked
+
+
+def damaged(path: Path | str, what: str) -> ReachError:
+    """The error of a store damaged after it was written (files lost or changed)."""
+    return ReachError(
+        f"{path}: damaged: {what}; remove it (or that array's folder: what is lost is "
+        "computed again) and run the same command"
+    )
+
+
+def store_name(group: Any) -> str:
+    """Where a store's group is, for messages: its folder (a local store), else zarr's URL."""
+    return str(getattr(group.store, "root", group.store_path))
+
+
+def _member(path: Path, group: Any, key: str) -> Any:
+    """The array key of a store, None where it is missing; unreadable metadata is damage."""
+    try:
+        return group[key]
+    except KeyError:
+        return None
+    except Exception as exc:  # zarr raises several kinds for a document it cannot read
+        problem = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
+        raise damaged(path, f"{key}: unreadable ({problem[:120]})") from None
+
+
+def _check_array(path: Path, key: str, array: Any, spec: ArraySpec) -> None:
+    """Refuse an array of the store whose shape, chunks, dtype or fill value is not the map's."""
+    shape, chunks, dtype, fill = spec
+    found = tuple(getattr(array, "shape", ())), tuple(getattr(array, "chunks", ()))
+    if found[0] != shape:
+        raise damaged(path, f"{key}: shape {found[0]} where the map's is {shape}")
+    if found[1] != chunks:
+        raise damaged(path, f"{key}: chunks {found[1]} where the map's are {chunks}")
+    old = float(array.fill_value)
+    if np.dtype(array.dtype).name != dtype or not (
+        old == fill or (math.isnan(old) and math.isnan(fill))
     ):
-        if key not in present:
-            group.create_array(key, shape=shape, chunks=chunks, dtype=dtype, fill_value=fill)
-    return group
+        raise damaged(
+            path,
+            f"{key}: {array.dtype} filled with {old:g} where the map's is {dtype} with {fill:g}",
+        )
 
 
 def _dof(source: str) -> int:
@@ -501,10 +570,36 @@ def _dof(source: str) -> int:
     raise ReachError("the solver source has no DOF")  # pragma: no cover (generated always has)
 
 
-def pending(group: Any) -> list[int]:
-    """The chunks not yet written."""
-    done = group["done"][:]
-    return [int(c) for c in np.flatnonzero(done == 0)]
+def pending(path: Path, group: Any, layout: Layout) -> tuple[list[int], int]:
+    """The chunks to compute: those not marked done, and those marked done whose arrays were
+    lost since (a chunk file deleted or unreadable: counts that read NOT_COMPUTED, or no first
+    solution where there are solutions), which are unmarked (the map is then not complete).
+    Returns the chunks and how many of them were lost."""
+    try:
+        done = group["done"][:]
+    except Exception as exc:  # (a mark's chunk file that cannot be decoded)
+        raise damaged(path, f"done: unreadable ({type(exc).__name__})") from None
+    counts = group["counts"]
+    first = group.get("first")
+    lost = [int(c) for c in np.flatnonzero(done) if _lost(layout, int(c), counts, first)]
+    if lost:
+        group.attrs["complete"] = False
+        marks = group["done"]
+        for chunk in lost:
+            marks[chunk] = 0
+    return sorted([int(c) for c in np.flatnonzero(done == 0)] + lost), len(lost)
+
+
+def _lost(layout: Layout, chunk: int, counts: Any, first: Any) -> bool:
+    """A chunk marked done whose counts (or first solutions) are not all there."""
+    cols, heights = layout.chunk_slices(chunk)
+    try:
+        block = counts[cols, heights]
+        if (block == NOT_COMPUTED).any():
+            return True
+        return first is not None and bool(np.isnan(first[cols, heights][block > 0]).any())
+    except Exception:  # a chunk file that cannot be decoded: computed again, rewritten
+        return True
 
 
 def write_chunk(
@@ -523,29 +618,23 @@ def arrays(group: Any) -> dict[str, Any]:
     return {key: group[key] for key in group.array_keys()}
 
 
-def finish(group: Any, layout: Layout) -> None:
+def finish(path: Path, group: Any, layout: Layout) -> None:
     """The reachability index (per column and height, then per voxel) from the counts, read
     chunk by chunk, and the store marked complete. (The per-voxel arrays are small: a voxel
-    has directions x rolls poses.)"""
+    has directions x rolls poses.) Counts lost while the map was made are an error."""
     counts = group["counts"]
     column_index = np.zeros(counts.shape[:2], dtype=np.float32)
     for chunk in range(layout.n_chunks):
         cols, heights = layout.chunk_slices(chunk)
-        column_index[cols, heights] = (counts[cols, heights] > 0).mean(axis=(2, 3))
-    if "column_index" not in group:
-        group.create_array("column_index", data=column_index, chunks=column_index.shape)
-    else:
-        group["column_index"][:] = column_index
-    column_of = layout.column_of
-    side = layout.side
-    slab = max(1, min(side, 4_000_000 // (side * side)))
-    if "index" not in group:
-        group.create_array(
-            "index", shape=(side, side, side), chunks=(side, side, slab), dtype="float32"
-        )
+        block = counts[cols, heights]
+        if (block == NOT_COMPUTED).any():
+            raise damaged(path, f"chunk {chunk}'s counts were lost while the map was made")
+        column_index[cols, heights] = (block > 0).mean(axis=(2, 3))
+    group["column_index"][:] = column_index
     index = group["index"]
-    for k in range(0, side, slab):
-        index[:, :, k : k + slab] = column_index[:, k : k + slab][column_of]
+    slab = index.chunks[2]
+    for k in range(0, layout.side, slab):
+        index[:, :, k : k + slab] = column_index[:, k : k + slab][layout.column_of]
     group.attrs["complete"] = True
 
 
@@ -636,12 +725,14 @@ def _set_threads(threads: int) -> None:
 
 @dataclass(frozen=True)
 class Run:
-    """What a run did: chunks computed now and before, the poses solved now, seconds."""
+    """What a run did: chunks computed now and before, the poses solved now, seconds, and of
+    the chunks computed those that had been done but were lost from the store since."""
 
     computed: int
     skipped: int
     poses: int
     seconds: float
+    repaired: int = 0
 
 
 def run(
@@ -670,93 +761,127 @@ def run(
     stop_after: stop (with KeyboardInterrupt) after this many chunks (for tests of resuming)."""
     module = load_solver(name, source)
     layout = _layouts(module, convention, params)
-    group = open_store(path, name, digest, source, params, layout)
-    todo = pending(group)
-    skipped = layout.n_chunks - len(todo)
+    # the Dask cluster first: an address it refuses leaves nothing written
+    with _dask_client(dask, worker_threads) as session:
+        group = open_store(path, name, digest, source, params, layout)
+        todo, lost = pending(path, group, layout)
+        ticker = _Progress(progress, len(todo), stop_after)
+        if session is not None:
+            chunks = _dask_chunks(session, str(path), name, source, convention, params, todo)
+            for done, _ in enumerate(chunks, 1):
+                ticker.tick(done)
+        else:
+            _run_here(
+                path, (name, source, convention), module, layout, params, todo, processes, ticker
+            )
+    if progress is not None and todo:
+        progress.write("\n")
+    finish(path, group, layout)
     per_chunk = layout.solved / layout.n_chunks
-    start = time.perf_counter()
-    shown = 0.0
+    seconds = time.perf_counter() - ticker.start
+    return Run(len(todo), layout.n_chunks - len(todo), round(per_chunk * len(todo)), seconds, lost)
 
-    def tick(done: int) -> None:
-        nonlocal shown
+
+@dataclass
+class _Progress:
+    """A run's progress line (drawn at most every half second, and at the end) and the
+    tests' interruption after stop_after chunks."""
+
+    stream: TextIO | None
+    total: int
+    stop_after: int | None
+    start: float = field(default_factory=time.perf_counter)
+    shown: float = 0.0
+
+    def tick(self, done: int) -> None:
         now = time.perf_counter()
-        if progress is not None and (now - shown > 0.5 or done == len(todo)):
-            progress_line(progress, "reach", done, len(todo), start, "chunks")
-            shown = now
-        if stop_after is not None and done >= stop_after:
+        if self.stream is not None and (now - self.shown > 0.5 or done == self.total):
+            progress_line(self.stream, "reach", done, self.total, self.start, "chunks")
+            self.shown = now
+        if self.stop_after is not None and done >= self.stop_after:
             raise KeyboardInterrupt
 
+
+def _run_here(
+    path: Path,
+    arm: tuple[str, str, str],
+    module: ModuleType,
+    layout: Layout,
+    params: Parameters,
+    todo: list[int],
+    processes: int,
+    ticker: _Progress,
+) -> None:
+    """The chunks on this machine (see run): in worker processes, or in this one. arm: the
+    name, solver source and convention (what a worker process starts from)."""
     cores = os.cpu_count() or 1
     processes = min(processes or cores, len(todo))
-    if dask is None and processes > 1:
+    if processes > 1:
         threads = max(1, cores // processes)
         pool = ProcessPoolExecutor(
             max_workers=processes,
             mp_context=multiprocessing.get_context("spawn"),
             initializer=_start_local_worker,
-            initargs=(str(path), name, source, convention, params, threads),
+            initargs=(str(path), *arm, params, threads),
         )
         try:
             futures = [pool.submit(_worker_chunk, chunk) for chunk in todo]
             for done, future in enumerate(as_completed(futures), 1):
                 future.result()
-                tick(done)
+                ticker.tick(done)
         except BaseException:
             pool.shutdown(wait=True, cancel_futures=True)  # the chunks started are finished
             raise
         pool.shutdown()
-    elif dask is None:
-        # writes go to a thread (zarr's compression and I/O overlap the next chunk's solve);
-        # at most two chunks wait to be written
-        store = arrays(group)
-        with ThreadPoolExecutor(max_workers=1) as writer:
-            waiting: list[Future[None]] = []
-            for done, chunk in enumerate(todo, 1):
-                data = solve_chunk(module, layout, params, chunk)
-                waiting.append(writer.submit(write_chunk, store, layout, chunk, data))
-                if len(waiting) > 2:
-                    waiting.pop(0).result()
-                tick(done)
-            for write in waiting:
-                write.result()
-    elif todo:
-        chunks = _dask_chunks(
-            dask, str(path), name, source, convention, params, todo, worker_threads
-        )
-        for done, _ in enumerate(chunks, 1):
-            tick(done)
-    if progress is not None and todo:
-        progress.write("\n")
-    finish(group, layout)
-    return Run(len(todo), skipped, round(per_chunk * len(todo)), time.perf_counter() - start)
+        return
+    # writes go to a thread (zarr's compression and I/O overlap the next chunk's solve);
+    # at most two chunks wait to be written
+    store = arrays(_zarr().open_group(str(path), mode="r+"))
+    with ThreadPoolExecutor(max_workers=1) as writer:
+        waiting: list[Future[None]] = []
+        for done, chunk in enumerate(todo, 1):
+            data = solve_chunk(module, layout, params, chunk)
+            waiting.append(writer.submit(write_chunk, store, layout, chunk, data))
+            if len(waiting) > 2:
+                waiting.pop(0).result()
+            ticker.tick(done)
+        for write in waiting:
+            write.result()
 
 
-def _dask_chunks(
-    address: str,
-    path: str,
-    name: str,
-    source: str,
-    convention: str,
-    params: Parameters,
-    todo: list[int],
-    worker_threads: int,
-) -> Iterable[int]:
-    """Run the chunks as Dask tasks; yields each chunk as it is written."""
+def dask_workers(address: str) -> int:
+    """The worker processes of ``--dask local:N`` (0 for a scheduler's address), checked with
+    dask.distributed's presence before anything is made or written."""
     try:
-        from distributed import Client, LocalCluster
-        from distributed import as_completed as completed
+        import distributed  # noqa: F401
     except ImportError:
         from derive.extras import install_hint
 
         raise ReachError(f"--dask needs dask.distributed: {install_hint('scale')}") from None
+    if not address.startswith("local:"):
+        return 0
+    try:
+        workers = int(address.split(":", 1)[1])
+    except ValueError:
+        workers = 0
+    if workers < 1:
+        raise ReachError(f"--dask {address}: local:N with N >= 1 worker processes")
+    return workers
+
+
+@contextmanager
+def _dask_client(address: str | None, worker_threads: int) -> Iterator[tuple[Any, int] | None]:
+    """A Dask client of address (a LocalCluster of N worker processes for local:N) and
+    numba's threads per worker (0: each worker's cores / its task threads), closed on exit;
+    None without an address. (A map already complete still starts the cluster.)"""
+    if address is None:
+        yield None
+        return
+    from distributed import Client, LocalCluster
+
+    workers = dask_workers(address)
     cluster = None
-    if address.startswith("local:"):
-        try:
-            workers = int(address.split(":", 1)[1])
-        except ValueError:
-            workers = 0
-        if workers < 1:
-            raise ReachError(f"--dask {address}: local:N with N >= 1 worker processes")
+    if workers:
         threads = worker_threads or max(1, (os.cpu_count() or 1) // workers)
         import dask
 
@@ -773,38 +898,56 @@ def _dask_chunks(
             )
         client = Client(cluster)
     else:
-        threads = worker_threads  # 0: each worker's cores / its task threads (below)
+        threads = worker_threads
         try:
             client = Client(address, timeout="20s")
         except (OSError, TimeoutError, ValueError) as exc:
             raise ReachError(f"--dask {address}: cannot reach the scheduler ({exc})") from None
     try:
-        shared = client.scatter(source, broadcast=True)
-        if threads == 0:
-            client.run(_worker_threads)  # the setting stays with each worker process
-        # tasks of a few chunks (each task costs the scheduler a few ms), about 8 a task thread
-        slots = max(1, sum(client.nthreads().values()))
-        size = max(1, min(DASK_CHUNKS_PER_TASK, len(todo) // (8 * slots)))
-        futures = [
-            client.submit(
-                _chunk_task,
-                path,
-                name,
-                shared,
-                convention,
-                params,
-                todo[first : first + size],
-                threads,
-                pure=False,
-            )
-            for first in range(0, len(todo), size)
-        ]
-        for future in completed(futures):
-            yield from future.result()
+        yield client, threads
     finally:
         client.close()
         if cluster is not None:
             cluster.close()
+
+
+def _dask_chunks(
+    session: tuple[Any, int],
+    path: str,
+    name: str,
+    source: str,
+    convention: str,
+    params: Parameters,
+    todo: list[int],
+) -> Iterable[int]:
+    """Run the chunks as Dask tasks on session's client; yields each chunk as it is written."""
+    from distributed import as_completed as completed
+
+    client, threads = session
+    if not todo:
+        return
+    shared = client.scatter(source, broadcast=True)
+    if threads == 0:
+        client.run(_worker_threads)  # the setting stays with each worker process
+    # tasks of a few chunks (each task costs the scheduler a few ms), about 8 a task thread
+    slots = max(1, sum(client.nthreads().values()))
+    size = max(1, min(DASK_CHUNKS_PER_TASK, len(todo) // (8 * slots)))
+    futures = [
+        client.submit(
+            _chunk_task,
+            path,
+            name,
+            shared,
+            convention,
+            params,
+            todo[first : first + size],
+            threads,
+            pure=False,
+        )
+        for first in range(0, len(todo), size)
+    ]
+    for future in completed(futures):
+        yield from future.result()
 
 
 def _worker_threads(dask_worker: Any = None) -> int:
@@ -847,6 +990,8 @@ class ReachMap:
         """Every pose's count, (n, n, n, directions, rolls): the columns' spread to the
         voxels and rolls (for small maps: this holds the whole map)."""
         stored = self.group["counts"][:]
+        if (stored == NOT_COMPUTED).any():
+            raise damaged(store_name(self.group), "counts lost (run derive reach again)")
         full = stored[self.column_of]
         rolls = len(self.group["rolls"][:])
         return np.broadcast_to(full, (*full.shape[:-1], rolls)) if full.shape[-1] != rolls else full
@@ -876,12 +1021,18 @@ def load(path: Path) -> ReachMap:
         raise ReachError(f"{path}: not a reach map ({exc})") from None
     if not attrs.get("complete"):
         raise ReachError(f"{path}: the map is not complete (run derive reach again to finish it)")
+    try:
+        read = {key: group[key][:] for key in ("centres", "index", "column_of")}
+    except Exception as exc:  # (zarr's kinds of error for a document it cannot read)
+        raise damaged(path, f"unreadable ({type(exc).__name__})") from None
+    if np.isnan(read["index"]).any():
+        raise damaged(path, "index lost (run derive reach again to write it)")
     return ReachMap(
         group,
         np.array(attrs["frame"]).reshape(4, 4),
-        group["centres"][:],
-        group["index"][:],
-        group["column_of"][:],
+        read["centres"],
+        read["index"],
+        read["column_of"],
         attrs,
     )
 
@@ -936,8 +1087,23 @@ def export_hdf5(rmap: ReachMap, path: Path, progress: TextIO | None = sys.stderr
     """Write the map in Reuleaux's layout: /Spheres/sphere_dataset (x, y, z, index) of the
     voxels reached, attribute Resolution, and /Poses/poses_dataset, float32 rows (voxel x, y,
     z, pose x, y, z, quaternion x, y, z, w) of every pose with a solution; world coordinates.
-    Written height by height (memory: one horizontal slab of the map). Returns the poses."""
+    Written through a temporary file beside path (removed if the export fails). Returns the
+    poses."""
     h5py = h5py_module()
+    tmp = path.with_name(f".{path.name}.derive-tmp")
+    try:
+        with h5py.File(tmp, "w") as h5:
+            written = _reuleaux(h5, rmap, progress)
+    except BaseException:
+        tmp.unlink(missing_ok=True)
+        raise
+    os.replace(tmp, path)
+    return written
+
+
+def _reuleaux(h5: Any, rmap: ReachMap, progress: TextIO | None) -> int:
+    """export_hdf5's datasets, written height by height (memory: one horizontal slab of the
+    map). Returns the poses."""
     group = rmap.group
     counts = group["counts"]
     side = len(rmap.centres)
@@ -949,45 +1115,44 @@ def export_hdf5(rmap: ReachMap, path: Path, progress: TextIO | None = sys.stderr
     i, j = np.meshgrid(np.arange(side), np.arange(side), indexing="ij")
     azimuth = np.arctan2(c[j], c[i])
     frame = rmap.frame
-    tmp = path.with_name(f".{path.name}.derive-tmp")
     written = 0
     start = time.perf_counter()
-    with h5py.File(tmp, "w") as h5:
-        spheres = h5.create_group("Spheres").create_dataset(
-            "sphere_dataset", shape=(0, 4), maxshape=(None, 4), dtype="float64", chunks=True
-        )
-        spheres.attrs["Resolution"] = float(rmap.attrs["parameters"]["resolution"])
-        poses = h5.create_group("Poses").create_dataset(
-            "poses_dataset", shape=(0, 10), maxshape=(None, 10), dtype="float32", chunks=True
-        )
-        for k in range(side):
-            slab = counts[:, k][rmap.column_of]  # (side, side, D, rolls stored)
-            if stored_rolls != len(rolls):
-                slab = np.broadcast_to(slab, (*slab.shape[:3], len(rolls)))
-            points = np.stack([c[i], c[j], np.full(i.shape, c[k])], axis=-1)
-            world = points @ frame[:3, :3].T + frame[:3, 3]
-            reached = rmap.index[:, :, k] > 0
-            rows = np.concatenate([world[reached], rmap.index[:, :, k][reached][:, None]], axis=1)
-            spheres.resize(len(spheres) + len(rows), axis=0)
-            spheres[len(spheres) - len(rows) :] = rows
-            vi, vj, d, r = np.nonzero(slab > 0)
-            if len(vi):
-                spin = np.zeros((len(vi), 3, 3))
-                az = azimuth[vi, vj]
-                spin[:, 0, 0], spin[:, 0, 1] = np.cos(az), -np.sin(az)
-                spin[:, 1, 0], spin[:, 1, 1] = np.sin(az), np.cos(az)
-                spin[:, 2, 2] = 1.0
-                R = frame[:3, :3] @ spin @ rotations[d, r]
-                xyz = world[vi, vj]
-                block = np.concatenate([xyz, xyz, quaternions(R)], axis=1).astype(np.float32)
-                poses.resize(len(poses) + len(block), axis=0)
-                poses[len(poses) - len(block) :] = block
-                written += len(block)
-            if progress is not None:
-                progress_line(progress, "hdf5", k + 1, side, start, "heights")
+    spheres = h5.create_group("Spheres").create_dataset(
+        "sphere_dataset", shape=(0, 4), maxshape=(None, 4), dtype="float64", chunks=True
+    )
+    spheres.attrs["Resolution"] = float(rmap.attrs["parameters"]["resolution"])
+    poses = h5.create_group("Poses").create_dataset(
+        "poses_dataset", shape=(0, 10), maxshape=(None, 10), dtype="float32", chunks=True
+    )
+    for k in range(side):
+        slab = counts[:, k][rmap.column_of]  # (side, side, D, rolls stored)
+        if (slab == NOT_COMPUTED).any():
+            raise damaged(store_name(group), "counts lost (run derive reach again)")
+        if stored_rolls != len(rolls):
+            slab = np.broadcast_to(slab, (*slab.shape[:3], len(rolls)))
+        points = np.stack([c[i], c[j], np.full(i.shape, c[k])], axis=-1)
+        world = points @ frame[:3, :3].T + frame[:3, 3]
+        reached = rmap.index[:, :, k] > 0
+        rows = np.concatenate([world[reached], rmap.index[:, :, k][reached][:, None]], axis=1)
+        spheres.resize(len(spheres) + len(rows), axis=0)
+        spheres[len(spheres) - len(rows) :] = rows
+        vi, vj, d, r = np.nonzero(slab > 0)
+        if len(vi):
+            spin = np.zeros((len(vi), 3, 3))
+            az = azimuth[vi, vj]
+            spin[:, 0, 0], spin[:, 0, 1] = np.cos(az), -np.sin(az)
+            spin[:, 1, 0], spin[:, 1, 1] = np.sin(az), np.cos(az)
+            spin[:, 2, 2] = 1.0
+            R = frame[:3, :3] @ spin @ rotations[d, r]
+            xyz = world[vi, vj]
+            block = np.concatenate([xyz, xyz, quaternions(R)], axis=1).astype(np.float32)
+            poses.resize(len(poses) + len(block), axis=0)
+            poses[len(poses) - len(block) :] = block
+            written += len(block)
+        if progress is not None:
+            progress_line(progress, "hdf5", k + 1, side, start, "heights")
     if progress is not None:
         progress.write("\n")
-    os.replace(tmp, path)
     return written
 
 

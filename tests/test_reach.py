@@ -344,12 +344,17 @@ def test_the_command_writes_the_map_its_sections_and_says_what_it_did(tmp_path, 
         (["--directions", "0"], "--directions: from 1"),
         (["--plot", "m.pdf"], "--plot: m.pdf: the file must end in .svg or .png"),
         (["--dask", "local:0"], "--dask local:0: local:N with N >= 1"),
+        (["--dask", "local:two"], "--dask local:two: local:N with N >= 1"),
     ],
 )
-def test_bad_options_are_named(argv, message, tmp_path, capsys, monkeypatch):
+def test_bad_options_are_named_before_anything_is_written(
+    argv, message, tmp_path, capsys, monkeypatch
+):
     monkeypatch.chdir(tmp_path)
     assert main(["reach", "puma560", "-o", "m.zarr", *argv]) == 2
-    assert message in capsys.readouterr().err
+    err = capsys.readouterr().err
+    assert message in err and err.count("\n") == 1, err
+    assert list(tmp_path.iterdir()) == []
 
 
 def test_another_map_in_the_folder_is_refused_by_name(tmp_path, capsys):
@@ -377,3 +382,84 @@ def test_without_the_scale_extra_the_message_says_what_to_install(
     assert main(["reach", "puma560", "-o", str(tmp_path / "m.zarr"), *option]) == 2
     assert "pip install 'zarr>=3.1' 'dask>=2025.1'" in capsys.readouterr().err  # (not on PyPI)
     assert not (tmp_path / "m.zarr").exists()  # said before any work
+
+
+# a small map of several chunks, through the command
+SMALL_ARGV = ["puma560", "--resolution", "0.3", "--directions", "6", "--rolls", "3"]
+SMALL_ARGV += ["--chunk", "200", "--processes", "1"]
+
+
+def test_a_chunk_file_lost_from_a_finished_map_is_computed_again_not_read_as_zeros(
+    tmp_path, capsys
+):
+    path = tmp_path / "m.zarr"
+    assert main(["reach", *SMALL_ARGV, "-o", str(path)]) == 0
+    summary = capsys.readouterr().out.splitlines()[0]
+    assert " 88 voxels reached" in summary
+    whole = reach.load(path)
+    counts, index = whole.counts().copy(), whole.index.copy()
+    lost = sorted(p for p in (path / "counts" / "c").rglob("*") if p.is_file())
+    assert len(lost) == whole.group["done"].shape[0]  # every chunk is stored, zeros too
+    for chunk in lost:
+        chunk.unlink()
+    with pytest.raises(reach.ReachError, match="damaged"):
+        whole.counts()  # never zeros that were not computed
+    assert main(["reach", *SMALL_ARGV, "-o", str(path)]) == 0
+    lines = capsys.readouterr().out.splitlines()
+    assert lines[0] == summary
+    assert f"{len(lost)} damaged chunk(s) computed again" in lines[1]
+    again = reach.load(path)
+    assert np.array_equal(again.counts(), counts) and np.array_equal(again.index, index)
+
+
+def break_done(path: Path) -> None:
+    (path / "done" / "zarr.json").write_text("[]")
+
+
+def reshape_counts(path: Path) -> None:
+    meta = path / "counts" / "zarr.json"
+    import json
+
+    document = json.loads(meta.read_text())
+    document["shape"][0] += 1
+    meta.write_text(json.dumps(document))
+
+
+def lose_an_index_chunk(path: Path) -> None:
+    next(p for p in (path / "index" / "c").rglob("*") if p.is_file()).unlink()
+
+
+@pytest.mark.parametrize(
+    ("damage", "message"),
+    [
+        (break_done, "done: unreadable"),
+        (reshape_counts, "counts: shape (16, 9, 6, 1) where the map's is (15, 9, 6, 1)"),
+    ],
+)
+def test_a_damaged_store_is_refused_in_one_line(damage, message, tmp_path, capsys):
+    path = tmp_path / "m.zarr"
+    assert main(["reach", *SMALL_ARGV, "-o", str(path)]) == 0
+    damage(path)
+    capsys.readouterr()
+    assert main(["reach", *SMALL_ARGV, "-o", str(path)]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith(f"error: {path}: damaged: {message}") and err.count("\n") == 1, err
+    assert "remove" in err
+
+
+def test_a_lost_index_chunk_is_no_zeros_and_the_command_rewrites_it(tmp_path, capsys):
+    path = tmp_path / "m.zarr"
+    assert main(["reach", *SMALL_ARGV, "-o", str(path)]) == 0
+    index = reach.load(path).index.copy()
+    lose_an_index_chunk(path)
+    with pytest.raises(reach.ReachError, match="damaged: index"):
+        reach.load(path)
+    assert main(["reach", *SMALL_ARGV, "-o", str(path)]) == 0
+    assert np.array_equal(reach.load(path).index, index)
+
+
+def test_dask_missing_is_said_before_the_store_is_written(tmp_path, capsys, monkeypatch):
+    monkeypatch.setitem(sys.modules, "distributed", None)
+    assert main(["reach", *SMALL_ARGV, "-o", str(tmp_path / "m.zarr"), "--dask", "local:1"]) == 2
+    assert "--dask needs dask.distributed" in capsys.readouterr().err
+    assert list(tmp_path.iterdir()) == []
