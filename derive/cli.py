@@ -192,6 +192,12 @@ def load_specs(texts: list[str], options: urdf.Options | None = None) -> list[Ar
         specs = [resolve_spec(t, options) for t in texts]
     else:
         specs = [load_spec(p) for p in bundled_specs()]
+    unique_names(specs)
+    return specs
+
+
+def unique_names(specs: Iterable[ArmSpec]) -> None:
+    """Refuse two arms of one name (their files would replace each other), naming both."""
     seen: dict[str, str] = {}
     for spec in specs:
         if spec.name in seen:
@@ -200,17 +206,25 @@ def load_specs(texts: list[str], options: urdf.Options | None = None) -> list[Ar
                 f"{seen[spec.name]}; arm names must be unique"
             )
         seen[spec.name] = spec.source
-    return specs
 
 
 def cmd_generate(args: argparse.Namespace) -> int:
-    """Generate the module of each arm; report each arm on one line."""
+    """Generate the module of each arm; report each arm on one line. Every spec is read
+    first (two arms of one name are refused before anything is written); a spec that
+    cannot be read is said and the others are generated."""
     out = Path(args.out)
     failed, no_ik = [], []
+    specs: dict[str, ArmSpec] = {}
     for text in args.specs or [str(p) for p in bundled_specs()]:
+        try:
+            specs[text] = resolve_spec(text, urdf_options(args))
+        except (SpecError, UsageError, OSError) as exc:
+            print(f"error: {exc}", file=sys.stderr)
+            failed.append(text)
+    unique_names(specs.values())
+    for text, spec in specs.items():
         start = time.perf_counter()
         try:
-            spec = resolve_spec(text, urdf_options(args))
             plan, files = outputs_for(spec, args.figures, args.lang)
             for name, content in files.items():
                 write_atomic(out / name, content)

@@ -120,3 +120,18 @@ def test_mutated_bundled_specs_succeed_or_fail_cleanly(name, edits, tmp_path_fac
     if code == 2:
         assert err.startswith("error: ") and "Traceback" not in err
         assert not (folder / "out").exists() or not any((folder / "out").iterdir())
+
+
+def test_two_specs_of_one_name_are_refused_before_anything_is_written(tmp_path, capsys):
+    """Both would write NAME.py and NAME.md: the second would silently replace the first."""
+    first, second = tmp_path / "first.toml", tmp_path / "second.toml"
+    first.write_text(GOOD)
+    second.write_text(GOOD.replace("a = 1.0", "a = 2.0"))
+    out = tmp_path / "out"
+    assert main(["generate", str(first), str(second), "--out", str(out)]) == 2
+    captured = capsys.readouterr()
+    assert captured.out == ""
+    assert captured.err == (
+        f"error: {second}: name: 'arm' is also the name of {first}; arm names must be unique\n"
+    )
+    assert not out.exists()
