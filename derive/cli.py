@@ -141,8 +141,11 @@ def write_atomic(path: Path, text: str | bytes) -> None:
 
     The file gets the mode an existing file at ``path`` has, else the mode a new file gets
     under the process's umask (0644 under umask 022). Temporary files of earlier runs that
-    were killed while writing this file (``.NAME.*.derive-tmp``) are removed first.
+    were killed while writing this file (``.NAME.*.derive-tmp``) are removed first. A
+    symbolic link at ``path`` is followed (its target is replaced, the link stays); anything
+    else that is not a regular file is refused (see output_file).
     """
+    path = output_file(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     for leftover in path.parent.glob(f".{path.name}.*{TMP_SUFFIX}"):
         leftover.unlink(missing_ok=True)
@@ -163,6 +166,54 @@ def write_atomic(path: Path, text: str | bytes) -> None:
     except BaseException:
         Path(tmp).unlink(missing_ok=True)
         raise
+
+
+# what stat's file type is, for the messages refusing it
+NODE_KINDS = (
+    (stat.S_ISDIR, "a folder"),
+    (stat.S_ISFIFO, "a named pipe (FIFO)"),
+    (stat.S_ISCHR, "a character device"),
+    (stat.S_ISBLK, "a block device"),
+    (stat.S_ISSOCK, "a socket"),
+    (stat.S_ISREG, "a regular file"),
+)
+
+
+def node_kind(mode: int) -> str:
+    """What a file of this st_mode is, in words ("a named pipe (FIFO)")."""
+    return next((kind for test, kind in NODE_KINDS if test(mode)), "not a regular file")
+
+
+def output_file(path: Path) -> Path:
+    """The file that writing ``path`` replaces: ``path``, or for a symbolic link the file it
+    names in the end (the link stays a link; a dangling link's target is created). derive
+    replaces regular files only: a folder, a device (/dev/stdout too: ``-o -`` is standard
+    output where a command can print), a named pipe or a socket is refused, as is ``-``
+    where standard output is not an option."""
+    if str(path) == "-":
+        raise UsageError("-: this output cannot go to standard output; give a file name")
+    try:
+        mode = path.stat().st_mode
+    except FileNotFoundError:
+        mode = stat.S_IFREG
+    if not stat.S_ISREG(mode):
+        raise UsageError(
+            f"{path}: is {node_kind(mode)}; derive writes regular files only (or the "
+            "file a symbolic link names), never replaces anything else"
+        )
+    return Path(os.path.realpath(path)) if path.is_symlink() else path
+
+
+def output_folder(path: Path, option: str) -> Path:
+    """A folder to write files into (``option``'s): a folder, or a path where none is yet."""
+    if str(path) == "-":
+        raise UsageError(f"{option} -: {option} names a folder, not standard output")
+    if path.exists() and not path.is_dir():
+        raise UsageError(
+            f"{option} {path}: is {node_kind(path.stat().st_mode)}, not a folder; {option} "
+            "names the folder to write into (created if missing)"
+        )
+    return path
 
 
 def current_umask() -> int:
@@ -212,7 +263,7 @@ def cmd_generate(args: argparse.Namespace) -> int:
     """Generate the module of each arm; report each arm on one line. Every spec is read
     first (two arms of one name are refused before anything is written); a spec that
     cannot be read is said and the others are generated."""
-    out = Path(args.out)
+    out = output_folder(Path(args.out), "--out")
     failed, no_ik = [], []
     specs: dict[str, ArmSpec] = {}
     for text in args.specs or [str(p) for p in bundled_specs()]:
@@ -226,8 +277,9 @@ def cmd_generate(args: argparse.Namespace) -> int:
         start = time.perf_counter()
         try:
             plan, files = outputs_for(spec, args.figures, args.lang)
-            for name, content in files.items():
-                write_atomic(out / name, content)
+            targets = {output_file(out / name): content for name, content in files.items()}
+            for target, content in targets.items():  # (each checked before any is written)
+                write_atomic(target, content)
         except GenerationError as exc:
             if args.lang != "python" and not args.specs:  # a bundled arm C does not serve
                 print(f"{Path(text).stem}: skipped: {exc}")
@@ -267,7 +319,7 @@ C_MARKERS = {"c": "_ik.c", "cpp-ikfast": "_ikfast_solver.cpp"}
 
 def cmd_check(args: argparse.Namespace) -> int:
     """Compare DIR with a fresh generation; never writes into DIR."""
-    out = Path(args.out)
+    out = output_folder(Path(args.out), "--out")
     specs = load_specs(args.specs, urdf_options(args))
     expected: dict[str, bytes] = {}
     with tempfile.TemporaryDirectory() as tmp:
@@ -432,6 +484,7 @@ def figure_output(args: argparse.Namespace, default: str) -> tuple[Path, str]:
     fmt = output.suffix.lstrip(".").lower()
     if fmt not in ("svg", "png"):
         raise UsageError(f"-o: {output}: the file must end in .svg or .png")
+    output_file(output)  # (a file, or none yet: said before the work)
     return output, fmt
 
 
@@ -549,17 +602,19 @@ def cmd_reach(args: argparse.Namespace) -> int:
         symmetry=not args.no_symmetry,
         chunk=args.chunk,
     )
-    output = Path(args.output)
+    output = output_folder(Path(args.output), "-o")
     try:
         figure = None
         if args.output_plot:
             figure = Path(args.output_plot), Path(args.output_plot).suffix.lstrip(".").lower()
             if figure[1] not in ("svg", "png"):
                 raise UsageError(f"--plot: {figure[0]}: the file must end in .svg or .png")
+            output_file(figure[0])
             from derive.plot import pyplot
 
             pyplot()  # say at once if matplotlib is missing
         if args.hdf5:
+            output_file(Path(args.hdf5))
             reach.h5py_module()  # (likewise h5py)
         if args.dask:
             reach.dask_workers(args.dask)  # (a bad address, or no dask.distributed)
@@ -596,7 +651,7 @@ def cmd_reach(args: argparse.Namespace) -> int:
                 "worker process)"
             )
         if args.hdf5:
-            poses = reach.export_hdf5(rmap, Path(args.hdf5))
+            poses = reach.export_hdf5(rmap, output_file(Path(args.hdf5)))
             print(f"{args.hdf5}: written (Reuleaux layout, {poses:,} poses)")
         if figure is not None:
             from derive.plot import figure_bytes
@@ -726,8 +781,15 @@ def cmd_build(args: argparse.Namespace) -> int:
     from derive.cbuild import BuildError, build
 
     spec = resolve_spec(args.arm, urdf_options(args))
+    out = output_folder(Path(args.out), "-o")
+    for name in (f"lib{spec.name}_ik.so", f"{spec.name}_c.py"):
+        if output_file(out / name) != out / name:
+            raise UsageError(
+                f"{out / name}: is a symbolic link; derive build replaces its files in the -o "
+                "folder (give -o the folder the link points into)"
+            )
     try:
-        binding = build(build_plan(spec), Path(args.out))
+        binding = build(build_plan(spec), out)
     except BuildError as exc:
         raise UsageError(str(exc).replace("\n", " ")) from None
     print(f"{binding} (and {binding.with_name(f'lib{spec.name}_ik.so').name}): import it")
@@ -736,17 +798,36 @@ def cmd_build(args: argparse.Namespace) -> int:
 
 def cmd_report(args: argparse.Namespace) -> int:
     """Write (or print) the derivation report of one arm."""
+    output = text_output(args.output)
     spec = resolve_spec(args.arm, urdf_options(args))
     plan = build_plan(spec)
     module = import_source(spec.name, render_module(plan))
     example = worked_example(plan, module)
     figures = report_figures(spec, plan, module, example, args) if args.figures else ()
     text = render_report(plan, example, args.format, figures)
-    if args.output:
-        write_atomic(Path(args.output), text)
+    if output is not None:
+        write_atomic(output, text)
     else:
         sys.stdout.write(text)
     return 0
+
+
+# how -o of a text output is read (its help)
+TEXT_OUTPUT = (
+    "default or -: standard output; a symbolic link's file is replaced; a pipe, device or "
+    "socket is refused"
+)
+
+
+def text_output(option: str | None) -> Path | None:
+    """The file of a text output's -o, checked before any work (see output_file); None for
+    standard output (no -o, or ``-o -``)."""
+    if option is None or option == "-":
+        return None
+    try:
+        return output_file(Path(option))
+    except UsageError as exc:
+        raise UsageError(f"{exc} (-o - prints to standard output)") from None
 
 
 def report_figures(
@@ -755,8 +836,10 @@ def report_figures(
     """The report's pictures, written beside its output (or into the working folder), SVG
     for Markdown, PNG for LaTeX (which pdflatex includes). Returns (caption, file name)
     pairs."""
-    folder = Path(args.output).parent if args.output else Path(".")
+    folder = Path(args.output).parent if args.output not in (None, "-") else Path(".")
     made = figure_files(spec, module, example, "png" if args.format == "tex" else "svg")
+    for _, name, _ in made:
+        output_file(folder / name)  # (each checked before any is written)
     for _, name, data in made:
         write_atomic(folder / name, data)
     return tuple((caption, name) for caption, name, _ in made)
@@ -958,7 +1041,7 @@ def parser() -> argparse.ArgumentParser:
     report = sub.add_parser("report", help="the derivation, lecture style (Markdown or LaTeX)")
     report.add_argument("arm", help="spec file or bundled arm name")
     report.add_argument("--format", choices=("md", "tex"), default="md", help="md (default) or tex")
-    report.add_argument("-o", "--output", help="write to this file (default: standard output)")
+    report.add_argument("-o", "--output", help=f"write to this file ({TEXT_OUTPUT})")
     report.add_argument(
         "--figures",
         action="store_true",
@@ -998,7 +1081,7 @@ def parser() -> argparse.ArgumentParser:
         default="modified",
         help="DH convention of the spec (modified)",
     )
-    imp.add_argument("-o", "--output", help="write the spec here (default: standard output)")
+    imp.add_argument("-o", "--output", help=f"write the spec to this file ({TEXT_OUTPUT})")
     imp.set_defaults(run=cmd_import_urdf)
     for command in (gen, chk, fk, solve, plot, space, reach, report, bench, build, imp):
         add_urdf_arguments(command, required=command is imp)
@@ -1046,9 +1129,10 @@ def add_urdf_arguments(command: argparse.ArgumentParser, required: bool) -> None
 
 def cmd_import_urdf(args: argparse.Namespace) -> int:
     """Write (or print) the spec of a URDF chain; say what the conversion did on stderr."""
+    output = text_output(args.output)
     text, conversion = urdf.import_urdf(Path(args.urdf), urdf_options(args))
-    if args.output:
-        write_atomic(Path(args.output), text)
+    if output is not None:
+        write_atomic(output, text)
     else:
         sys.stdout.write(text)
     snaps = f"{len(conversion.snaps)} snap(s)" if conversion.snaps else "no snapping"

@@ -345,6 +345,7 @@ def test_the_command_writes_the_map_its_sections_and_says_what_it_did(tmp_path, 
         (["--plot", "m.pdf"], "--plot: m.pdf: the file must end in .svg or .png"),
         (["--dask", "local:0"], "--dask local:0: local:N with N >= 1"),
         (["--dask", "local:two"], "--dask local:two: local:N with N >= 1"),
+        (["--hdf5", "-"], "-: this output cannot go to standard output"),
     ],
 )
 def test_bad_options_are_named_before_anything_is_written(
