@@ -42,6 +42,8 @@ MAX_DEVIATION = 1e-4
 SAMPLES = 200
 # a link offset beyond this many reaches comes from nearly parallel axes (never a real arm)
 OFFSET_LIMIT = 100.0
+# a base or tool rotation further than this from orthonormal is refused, not repaired
+ORTHONORMAL_TOL = 1e-6
 
 Matrix = list[list[float]]
 Vector = tuple[float, float, float]
@@ -415,7 +417,7 @@ def convert(
             normal = _add(offset, z, -_dot(offset, z))
             length = math.sqrt(_dot(normal, normal))
             origins.append(start)
-            xs.append(_unit(normal) if length > ltol else _perpendicular(z))
+            xs.append(_across(normal, z) if length > ltol else _perpendicular(z))
             continue
         # skew or intersecting: the feet of the common normal
         w = _sub(p, q_point)
@@ -432,8 +434,8 @@ def convert(
             if distance > NOISE * reach:
                 snaps.append(f"axes {i + 1} and {i + 2}: {distance:.3g} apart: taken as meeting")
             xs.append(_unit(cross))
-        else:
-            xs.append(_unit(gap))
+        else:  # along z_i x z_i+1 (the gap's own direction is noise when it is short)
+            xs.append(_unit(cross if _dot(gap, cross) > 0 else _cross(z_next, z)))
     # DH rows from consecutive frames (frame 0 = frame 1 at q = 0)
     rows = []
     for i, joint in enumerate(moving):
@@ -463,12 +465,12 @@ def convert(
                 )
         limits = joint.limits if joint.kind != "continuous" else None
         rows.append((kind, alpha, a, d, theta, limits))
-    first = _frame(origins[0], xs[0], lines[0][1])
+    first = orthonormalise(_frame(origins[0], xs[0], lines[0][1]), where, "base", snaps)
     # frame n at q = 0 as the (snapped) rows build it: the tool closes the chain from there
     built = first
     for _kind, alpha, a, d, theta, _limits in rows:
         built = matmul(built, dh_modified(alpha, a, theta, d))
-    tool = matmul(inverse(built), tip_pose)
+    tool = orthonormalise(matmul(inverse(built), tip_pose), where, "tool", snaps)
     first = _snap_frame(first, angle_tol, ltol, snaps, "base")
     tool = _snap_frame(tool, angle_tol, ltol, snaps, "tool")
     for matrix, what in ((first, "base"), (tool, "tool")):
@@ -510,6 +512,32 @@ def _snap_frame(m: Matrix, angle_tol: float, ltol: float, snaps: list[str], what
     return out
 
 
+def orthonormalise(m: Matrix, where: str, what: str, snaps: list[str]) -> Matrix:
+    """m with its rotation made orthonormal by Gram-Schmidt: z kept (a joint's axis for the
+    base), x made perpendicular to it, y = z x x. A change above rounding noise is recorded
+    in snaps with how far the entries moved; one above ORTHONORMAL_TOL is refused."""
+    z = _unit((m[0][2], m[1][2], m[2][2]))
+    x = _across((m[0][0], m[1][0], m[2][0]), z)
+    out = _frame((m[0][3], m[1][3], m[2][3]), x, z)
+    moved = max(abs(out[i][j] - m[i][j]) for i in range(3) for j in range(3))
+    if not moved <= ORTHONORMAL_TOL:
+        raise UrdfError(
+            f"{where}: the {what} frame's rotation is {moved:.3g} from orthonormal; allowed "
+            f"{ORTHONORMAL_TOL:g} (a converter error)"
+        )
+    if moved <= NOISE:
+        return m
+    snaps.append(f"{what}: rotation re-orthonormalised (entries moved up to {moved:.2g})")
+    return out
+
+
+def _across(v: Vector, z: Vector) -> Vector:
+    """The unit vector along the part of v perpendicular to the unit vector z (projected
+    twice: one projection leaves rounding of v's size along z)."""
+    once = _add(v, z, -_dot(v, z))
+    return _unit(_add(once, z, -_dot(once, z)))
+
+
 def _perpendicular(z: Vector) -> Vector:
     """A unit vector perpendicular to z (the x axis where nothing else chooses one)."""
     helper = (1.0, 0.0, 0.0) if abs(z[0]) < 0.9 else (0.0, 1.0, 0.0)
@@ -528,15 +556,16 @@ def _frame(origin: Vector, x: Vector, z: Vector) -> Matrix:
 
 
 def _snap_angle(value: float, tol: float, snaps: list[str], what: str) -> float:
+    """value made the nearest multiple of 90 deg if within tol of it (-180 deg is 180 deg)."""
     quarter = round(value / (math.pi / 2))
-    target = quarter * (math.pi / 2)
-    if quarter == -2:
-        target = math.pi
-    if value != target and abs(value - target) <= tol:
-        if abs(value - target) > NOISE:
-            snaps.append(f"{what}: {math.degrees(value)!r} deg to {math.degrees(target):g} deg")
-        return target
-    return value
+    near = quarter * (math.pi / 2)
+    off = abs(value - near)
+    if value == near or off > tol:
+        return value
+    target = math.pi if abs(quarter) == 2 else near
+    if off > NOISE:
+        snaps.append(f"{what}: {math.degrees(value)!r} deg to {math.degrees(target):g} deg")
+    return target
 
 
 def _snap_length(value: float, tol: float, snaps: list[str], what: str, noise: float) -> float:

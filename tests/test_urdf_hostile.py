@@ -1,0 +1,134 @@
+"""URDF in, the red team's cases (issue 37): numbers that overflow, bad tolerances, expanded
+files that keep xmlns:xacro, undeclared attribute prefixes, nearly meeting axes with --exact,
+angles near -180 deg, and names megabytes long. Bad input gets one line and exit 2 with
+nothing written; what kinematics can take converts."""
+
+from __future__ import annotations
+
+import math
+import random
+from pathlib import Path
+
+import pytest
+from test_urdf import DATA, options
+
+from derive import urdf
+from derive.pipeline import build_plan
+
+
+def write(tmp_path: Path, text: str, name: str = "robot.urdf") -> Path:
+    path = tmp_path / name
+    path.write_text(text)
+    return path
+
+
+# --- 12: nearly meeting axes with --exact: the base rotation --------------------------------
+
+
+def nearly_meeting(rng: random.Random, gap: float) -> str:
+    """Two joints whose axes pass gap apart (a link frame turned by random rpy): the common
+    normal is short, and its direction from the feet of the normal is rounding noise."""
+    rpy1 = [rng.uniform(-3, 3) for _ in range(3)]
+    rpy2 = [rng.uniform(-3, 3) for _ in range(3)]
+    xyz2 = [gap, 0.0, rng.uniform(0.2, 0.5)]
+    frame = urdf.pose(xyz2, rpy2)
+    direction = (0.0, math.cos(0.3), math.sin(0.3))  # perpendicular to the gap, in link b
+    axis = [sum(frame[k][i] * direction[k] for k in range(3)) for i in range(3)]
+
+    def numbers(values: list[float]) -> str:
+        return " ".join(map(repr, values))
+
+    joint = (
+        '<joint name="{}" type="revolute"><parent link="{}"/><child link="{}"/>'
+        '<origin xyz="{}" rpy="{}"/><axis xyz="{}"/><limit lower="-1" upper="1"/></joint>'
+    )
+    body = "".join(f'<link name="{n}"/>' for n in "abc")
+    body += joint.format("j1", "a", "b", "0.1 0.2 0.3", numbers(rpy1), "0 0 1")
+    body += joint.format("j2", "b", "c", numbers(xyz2), numbers(rpy2), numbers(axis))
+    return f'<robot name="meet">{body}</robot>'
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_nearly_meeting_axes_convert_exactly_with_an_orthonormal_base(seed, tmp_path):
+    path = write(tmp_path, nearly_meeting(random.Random(seed), 3e-9))
+    _, conversion = urdf.import_urdf(path, options("a", "c", exact=True))
+    assert conversion.deviation <= 1e-9 and not conversion.snaps
+
+
+def test_a_rotation_is_reorthonormalised_within_its_tolerance_and_refused_beyond():
+    turn = urdf.pose([0.1, 0.2, 0.3], [0.3, -1.1, 2.0])
+    bent = [row[:] for row in turn]
+    bent[0][0] += 1e-7
+    snaps: list[str] = []
+    fixed = urdf.orthonormalise(bent, "robot.urdf", "base", snaps)
+    for i in range(3):
+        for j in range(3):
+            dot = sum(fixed[k][i] * fixed[k][j] for k in range(3))
+            assert abs(dot - (i == j)) <= 1e-15
+            assert abs(fixed[i][j] - turn[i][j]) <= 2e-7
+        assert fixed[i][2] == turn[i][2]  # z (the first joint's axis, for the base) is kept
+    assert len(snaps) == 1 and "base: rotation re-orthonormalised (entries moved" in snaps[0]
+    assert [r[3] for r in fixed] == [r[3] for r in turn]
+    quiet: list[str] = []
+    assert urdf.orthonormalise(turn, "robot.urdf", "base", quiet) == turn and not quiet
+    bent[1][2] += 1e-3
+    with pytest.raises(urdf.UrdfError, match=r"robot.urdf: the base frame.*allowed 1e-06"):
+        urdf.orthonormalise(bent, "robot.urdf", "base", [])
+
+
+# --- 13: angles near -180 deg ------------------------------------------------------------------
+
+
+def test_an_angle_near_minus_180_snaps_like_one_near_180():
+    for value in (math.pi - 4e-8, -math.pi + 4e-8):
+        snaps: list[str] = []
+        assert urdf._snap_angle(value, urdf.ANGLE_TOL, snaps, "alpha") == math.pi
+        assert len(snaps) == 1 and "to 180 deg" in snaps[0]
+    assert urdf._snap_angle(-math.pi + 1e-3, urdf.ANGLE_TOL, [], "alpha") == -math.pi + 1e-3
+
+
+def rpy_of(m: urdf.Matrix) -> tuple[float, float, float]:
+    """URDF rpy of a rotation (R = Rz(yaw) Ry(pitch) Rx(roll))."""
+    roll = math.atan2(m[2][1], m[2][2])
+    pitch = math.atan2(-m[2][0], math.hypot(m[0][0], m[1][0]))
+    return roll, pitch, math.atan2(m[1][0], m[0][0])
+
+
+def rewritten_ur5(seed: int) -> str:
+    """ur5.urdf with every inner link frame turned by a random rotation, the elbow's axis
+    reversed, and every number written with 7 decimals: the same arm, DH angles near +-180."""
+    path = DATA / "ur5.urdf"
+    chain = urdf.chain_between(urdf.read_urdf(path), "world", "tool0", str(path))
+    rng = random.Random(seed)
+    identity = urdf.pose([0.0] * 3, [0.0] * 3)
+    frames = {chain[0].parent: identity, chain[-1].child: identity}
+    for joint in chain[:-1]:
+        frames[joint.child] = urdf.pose([0.0] * 3, [rng.uniform(-3, 3) for _ in range(3)])
+    body = "".join(f'<link name="{n}"/>' for n in frames)
+
+    def numbers(values) -> str:
+        return " ".join(f"{v:.7f}" for v in values)
+
+    for joint in chain:
+        frame = frames[joint.child]
+        origin = urdf.matmul(urdf.matmul(urdf.inverse(frames[joint.parent]), joint.origin), frame)
+        axis = [sum(frame[k][i] * joint.axis[k] for k in range(3)) for i in range(3)]
+        if joint.name == "elbow_joint":
+            axis = [-v for v in axis]
+        body += (
+            f'<joint name="{joint.name}" type="{joint.kind}"><parent link="{joint.parent}"/>'
+            f'<child link="{joint.child}"/><origin xyz="{numbers(r[3] for r in origin[:3])}" '
+            f'rpy="{numbers(rpy_of(origin))}"/><axis xyz="{numbers(axis)}"/></joint>'
+        )
+    return f'<robot name="ur5">{body}</robot>'
+
+
+def test_a_ur5_with_arbitrary_link_frames_gets_the_clean_ones_method(tmp_path):
+    clean = build_plan(urdf.load_urdf(DATA / "ur5.urdf", options("world", "tool0")))
+    path = write(tmp_path, rewritten_ur5(0), "ur5.urdf")
+    text, _ = urdf.import_urdf(path, options("world", "tool0"))
+    assert "-179.99999" in text and "to 180 deg" in text  # the case this protects
+    noisy = build_plan(urdf.load_urdf(path, options("world", "tool0")))
+    assert clean.ik is not None and noisy.ik is not None
+    assert (noisy.ik.method, noisy.ik.case) == (clean.ik.method, clean.ik.case)
+    assert noisy.structure == clean.structure
