@@ -42,8 +42,20 @@ MAX_DEVIATION = 1e-4
 SAMPLES = 200
 # a link offset beyond this many reaches comes from nearly parallel axes (never a real arm)
 OFFSET_LIMIT = 100.0
+# the largest magnitude of a number in a URDF (metres, radians, axis components): no arm is
+# 1000 km long, and above it squares and degrees stay far from overflow
+MAX_NUMBER = 1e6
+# what the options may be: snapping beyond 0.1 rad or 0.1 of the arm's size changes the arm;
+# a deviation is a rotation entry or a fraction of the reach, so above 1 it bounds nothing
+TOLERANCE_RANGE = (0.0, 0.1)
+DEVIATION_RANGE = (0.0, 1.0)
 # a base or tool rotation further than this from orthonormal is refused, not repaired
 ORTHONORMAL_TOL = 1e-6
+# joints between base and tip, fixed ones included (an arm has tens; FK is checked in Python)
+MAX_CHAIN = 1000
+# error lines: names cut to this many characters, listings to this many names
+SHOWN = 40
+LISTED = 8
 
 Matrix = list[list[float]]
 Vector = tuple[float, float, float]
@@ -126,44 +138,67 @@ def read_urdf(path: Path) -> Robot:
     except SafeET.ParseError as exc:
         raise UrdfError(f"{where}: not well-formed XML: {exc}") from None
     if root.tag != "robot":
-        raise UrdfError(f"{where}: the root element is <{root.tag[:40]}>, not <robot>")
+        raise UrdfError(f"{where}: the root element is <{_cut(root.tag)}>, not <robot>")
     links: set[str] = set()
-    for link in root.findall("link"):
-        name = _name(link, where, "link")
+    for element in root.findall("link"):
+        name = _name(element, where, "link")
         if name in links:
-            raise UrdfError(f"{where}: link {name!r}: defined twice")
+            raise UrdfError(f"{where}: link {_shown(name)}: defined twice")
         links.add(name)
     joints: list[UrdfJoint] = []
+    names: set[str] = set()
     above: dict[str, UrdfJoint] = {}
     for element in root.findall("joint"):
         joint = _joint(element, where)
-        if any(j.name == joint.name for j in joints):
-            raise UrdfError(f"{where}: joint {joint.name!r}: defined twice")
+        if joint.name in names:
+            raise UrdfError(f"{where}: joint {_shown(joint.name)}: defined twice")
+        names.add(joint.name)
         for end in (joint.parent, joint.child):
             if end not in links:
-                raise UrdfError(f"{where}: joint {joint.name!r}: unknown link {end!r}")
+                raise UrdfError(f"{where}: joint {_shown(joint.name)}: unknown link {_shown(end)}")
         if joint.child in above:
             raise UrdfError(
-                f"{where}: joint {joint.name!r}: link {joint.child!r} is already the child of "
-                f"joint {above[joint.child].name!r}; a URDF is a tree"
+                f"{where}: joint {_shown(joint.name)}: link {_shown(joint.child)} is already "
+                f"the child of joint {_shown(above[joint.child].name)}; a URDF is a tree"
             )
         above[joint.child] = joint
         joints.append(joint)
+    rooted: set[str] = set()  # links whose way up ends at a root: each walked once
     for start in sorted(above):
         link, seen = start, set()
-        while link in above:
+        while link in above and link not in rooted:
             if link in seen:
                 raise UrdfError(
-                    f"{where}: joint {above[link].name!r}: the links form a cycle; a URDF is a tree"
+                    f"{where}: joint {_shown(above[link].name)}: the links form a cycle; "
+                    "a URDF is a tree"
                 )
             seen.add(link)
             link = above[link].parent
+        rooted |= seen
     return Robot(
         name=root.get("name", ""),
         links=frozenset(links),
         joints=tuple(joints),
         digest=hashlib.sha256(data).hexdigest()[:16],
     )
+
+
+def _cut(text: str) -> str:
+    """text cut to SHOWN characters for an error line (names can be megabytes long)."""
+    return text if len(text) <= SHOWN else text[:SHOWN] + "..."
+
+
+def _shown(text: str) -> str:
+    """text quoted and cut for an error line."""
+    return repr(_cut(text))
+
+
+def _listing(names: list[str]) -> str:
+    """The first LISTED of names, sorted and cut, and how many more there are."""
+    ordered = sorted(names)
+    shown = ", ".join(_shown(n) for n in ordered[:LISTED])
+    more = len(ordered) - LISTED
+    return shown + (f", ... and {more} more" if more > 0 else "")
 
 
 def _name(element, where: str, what: str) -> str:
@@ -174,24 +209,29 @@ def _name(element, where: str, what: str) -> str:
 
 
 def _numbers(text: str | None, count: int, where: str, default: tuple[float, ...]) -> list[float]:
+    """count numbers written in text (default if it is None), each finite and of magnitude
+    at most MAX_NUMBER; refused as written otherwise."""
     if text is None:
         return list(default)
     parts = text.split()
     try:
         values = [float(p) for p in parts]
     except ValueError:
-        raise UrdfError(f"{where}: {text[:40]!r} is not {count} numbers") from None
-    if len(values) != count or not all(map(math.isfinite, values)):
-        raise UrdfError(f"{where}: {text[:40]!r} is not {count} finite numbers")
+        values = []
+    if len(values) != count or not all(abs(v) <= MAX_NUMBER for v in values):
+        raise UrdfError(
+            f"{where}: {_shown(text)}; allowed: {count} finite numbers of magnitude at most "
+            f"{MAX_NUMBER:g}"
+        )
     return values
 
 
 def _joint(element, where: str) -> UrdfJoint:
     name = _name(element, where, "joint")
-    at = f"{where}: joint {name!r}"
+    at = f"{where}: joint {_shown(name)}"
     kind = element.get("type", "")
     if kind not in KNOWN_TYPES:
-        raise UrdfError(f"{at}: type {kind[:20]!r}; allowed: {', '.join(KNOWN_TYPES)}")
+        raise UrdfError(f"{at}: type {_shown(kind)}; allowed: {', '.join(KNOWN_TYPES)}")
     ends = []
     for tag in ("parent", "child"):
         node = element.find(tag)
@@ -232,8 +272,8 @@ def chain_between(robot: Robot, base: str, tip: str, where: str) -> list[UrdfJoi
     """The joints from base down to tip, in order."""
     for link, what in ((base, "--base"), (tip, "--tip")):
         if link not in robot.links:
-            known = ", ".join(sorted(robot.links)[:8])
-            raise UrdfError(f"{where}: {what} {link!r}: no such link; links: {known}, ...")
+            known = _listing(list(robot.links))
+            raise UrdfError(f"{where}: {what} {_shown(link)}: no such link; links: {known}")
     above = {j.child: j for j in robot.joints}
     path: list[UrdfJoint] = []
     link = tip
@@ -241,26 +281,31 @@ def chain_between(robot: Robot, base: str, tip: str, where: str) -> list[UrdfJoi
     while link != base:
         joint = above.get(link)
         if joint is None:
-            raise UrdfError(f"{where}: --tip {tip!r} is not below --base {base!r}")
+            raise UrdfError(f"{where}: --tip {_shown(tip)} is not below --base {_shown(base)}")
         if joint.parent in seen:
-            raise UrdfError(f"{where}: joint {joint.name!r}: the links form a cycle")
+            raise UrdfError(f"{where}: joint {_shown(joint.name)}: the links form a cycle")
         seen.add(joint.parent)
         path.append(joint)
         link = joint.parent
     path.reverse()
+    if len(path) > MAX_CHAIN:
+        raise UrdfError(
+            f"{where}: {len(path)} joints between {_shown(base)} and {_shown(tip)}; "
+            f"allowed at most {MAX_CHAIN}"
+        )
     for joint in path:
         if joint.kind in ("floating", "planar"):
             raise UrdfError(
-                f"{where}: joint {joint.name!r}: a {joint.kind} joint between base and tip; "
+                f"{where}: joint {_shown(joint.name)}: a {joint.kind} joint between base and tip; "
                 "allowed: revolute, continuous, prismatic, fixed"
             )
         if joint.mimic and joint.kind in MOVING:
             raise UrdfError(
-                f"{where}: joint {joint.name!r}: a mimic joint between base and tip is not "
+                f"{where}: joint {_shown(joint.name)}: a mimic joint between base and tip is not "
                 "supported (its value follows another joint's)"
             )
     if not any(j.kind in MOVING for j in path):
-        raise UrdfError(f"{where}: no moving joint between {base!r} and {tip!r}")
+        raise UrdfError(f"{where}: no moving joint between {_shown(base)} and {_shown(tip)}")
     return path
 
 
@@ -458,7 +503,7 @@ def convert(
         for value, what in ((a, "a"), (d, "d")):
             if abs(value) > OFFSET_LIMIT * reach:
                 raise UrdfError(
-                    f"{where}: joint {joint.name!r}: DH {what} = {value:.4g} "
+                    f"{where}: joint {_shown(joint.name)}: DH {what} = {value:.4g} "
                     f"({abs(value) / reach:.3g} times the arm's size): its axis is nearly "
                     "parallel to the previous one; take them as parallel with --angle-tol "
                     "above the angle between them, and check the deviation it reports"
@@ -730,6 +775,17 @@ class Options:
     exact: bool = False
     max_deviation: float = MAX_DEVIATION
     convention: str = "modified"
+
+    def __post_init__(self) -> None:
+        """Refuse tolerances that mean nothing: negative, NaN, or so large that snapping
+        would change the arm (or a deviation bound nothing)."""
+        for option, value, (lo, hi), unit in (
+            ("--angle-tol", self.angle_tol, TOLERANCE_RANGE, " rad"),
+            ("--length-tol", self.length_tol, TOLERANCE_RANGE, " of the arm's size"),
+            ("--max-deviation", self.max_deviation, DEVIATION_RANGE, " of the reach"),
+        ):
+            if not lo <= value <= hi:
+                raise UrdfError(f"{option} {value!r}: allowed: {lo:g} to {hi:g}{unit}")
 
 
 def import_urdf(path: Path, options: Options) -> tuple[str, Conversion]:

@@ -10,16 +10,95 @@ import random
 from pathlib import Path
 
 import pytest
-from test_urdf import DATA, options
+from test_urdf import DATA, options, two_joints, urdf_text
 
 from derive import urdf
+from derive.cli import main
 from derive.pipeline import build_plan
+
+
+@pytest.fixture
+def fails(tmp_path, capsys):
+    """`derive import-urdf ...` or `derive generate ...` run in this process (an exception
+    would fail the test as a traceback would): its single stderr line, after checking exit 2
+    and nothing written."""
+
+    def line(*args: str) -> str:
+        out = tmp_path / ("out.toml" if args[0] == "import-urdf" else "generated")
+        code = main([*args, "-o" if args[0] == "import-urdf" else "--out", str(out)])
+        err = capsys.readouterr().err
+        lines = err.strip().split("\n")
+        assert code == 2 and len(lines) == 1, (code, err[-2000:])
+        assert not out.exists()
+        return lines[0]
+
+    return line
 
 
 def write(tmp_path: Path, text: str, name: str = "robot.urdf") -> Path:
     path = tmp_path / name
     path.write_text(text)
     return path
+
+
+# --- 6: numbers that overflow, tolerances out of range ----------------------------------------
+
+
+@pytest.mark.parametrize(
+    ("changes", "written"),
+    [
+        ({"xyz": "1e308 0 0"}, "1e308 0 0"),
+        ({"xyz": "0 0 1e200"}, "0 0 1e200"),
+    ],
+)
+def test_an_origin_that_overflows_gets_one_line_naming_what_was_written(
+    changes, written, tmp_path, fails
+):
+    path = write(tmp_path, urdf_text(two_joints(**changes), ["a", "b", "c"]))
+    line = fails("import-urdf", str(path), "--base", "a", "--tip", "c")
+    assert "origin xyz" in line and written in line and "allowed" in line
+
+
+def test_an_axis_that_overflows_gets_one_line(tmp_path, fails):
+    text = urdf_text(two_joints(), ["a", "b", "c"])
+    text = text.replace('<axis xyz="0 0 1"/>', '<axis xyz="1e200 1e200 0"/>', 1)
+    path = write(tmp_path, text)
+    line = fails("import-urdf", str(path), "--base", "a", "--tip", "c")
+    assert "axis xyz" in line and "1e200 1e200 0" in line and "allowed" in line
+
+
+def test_a_huge_limit_is_reported_as_written_not_as_inf(tmp_path, fails):
+    text = urdf_text(two_joints(), ["a", "b", "c"]).replace('lower="-1"', 'lower="-1e308"')
+    path = write(tmp_path, text)
+    line = fails("import-urdf", str(path), "--base", "a", "--tip", "c")
+    assert "limit lower" in line and "-1e308" in line and "inf" not in line
+
+
+@pytest.mark.parametrize(
+    ("option", "value"),
+    [
+        ("--angle-tol", "-1"),
+        ("--angle-tol", "nan"),
+        ("--angle-tol", "inf"),
+        ("--angle-tol", "1e300"),
+        ("--length-tol", "-1"),
+        ("--length-tol", "nan"),
+        ("--length-tol", "1e300"),
+        ("--max-deviation", "-1"),
+        ("--max-deviation", "nan"),
+    ],
+)
+def test_a_tolerance_out_of_range_gets_one_line_stating_the_range(option, value, tmp_path, fails):
+    path = DATA / "ur5.urdf"
+    for command in ("import-urdf", "generate"):
+        args = (command, str(path), "--base", "world", "--tip", "tool0", option, value)
+        line = fails(*args)
+        assert option in line and "allowed: 0 to " in line
+
+
+def test_tolerances_in_range_are_taken():
+    urdf.Options(angle_tol=0.0, length_tol=0.0, max_deviation=0.0)
+    urdf.Options(angle_tol=0.1, length_tol=0.1, max_deviation=1.0)
 
 
 # --- 12: nearly meeting axes with --exact: the base rotation --------------------------------
@@ -132,3 +211,45 @@ def test_a_ur5_with_arbitrary_link_frames_gets_the_clean_ones_method(tmp_path):
     assert clean.ik is not None and noisy.ik is not None
     assert (noisy.ik.method, noisy.ik.case) == (clean.ik.method, clean.ik.case)
     assert noisy.structure == clean.structure
+
+
+# --- 14: error lines stay short ----------------------------------------------------------------
+
+
+def test_a_missing_base_lists_a_few_link_names_not_megabytes(tmp_path, fails):
+    long_names = [c * 600_000 for c in "abcdefgh"]
+    body = "".join(f'<link name="{n}"/>' for n in long_names)
+    body += "".join(f'<link name="link{k}"/>' for k in range(20_000))
+    path = write(tmp_path, f'<robot name="many">{body}</robot>')
+    wanted = "z" * 100_000
+    line = fails("import-urdf", str(path), "--base", wanted, "--tip", "a")
+    assert len(line) < 1000 and "no such link" in line and "and 20000 more" in line
+
+
+@pytest.mark.parametrize(
+    ("links", "joints"),
+    [
+        (["a", "b", "c", "x" * 200_000, "x" * 200_000], two_joints()),  # defined twice
+        (["a", "b", "c"], two_joints(child="y" * 200_000)),  # unknown link
+        (["a", "b", "c"], [*two_joints(), {"name": "n" * 200_000, "parent": "a", "child": "c"}]),
+    ],
+)
+def test_error_lines_naming_a_link_or_joint_stay_short(links, joints, tmp_path, fails):
+    path = write(tmp_path, urdf_text(joints, links))
+    line = fails("import-urdf", str(path), "--base", "a", "--tip", "c")
+    assert len(line) < 400, line[:400]
+
+
+def test_a_long_chain_is_read_in_linear_time_and_bounded(tmp_path, fails):
+    """20,000 fixed joints in a row: each name checked once and each link walked up once
+    (pairwise checks took minutes), and a chain longer than MAX_CHAIN is refused."""
+    count = 20_000
+    body = "".join(f'<link name="l{k}"/>' for k in range(count + 1))
+    body += "".join(
+        f'<joint name="j{k}" type="fixed"><parent link="l{k}"/><child link="l{k + 1}"/></joint>'
+        for k in range(count)
+    )
+    path = write(tmp_path, f'<robot name="long">{body}</robot>')
+    assert len(urdf.read_urdf(path).joints) == count
+    line = fails("import-urdf", str(path), "--base", "l0", "--tip", f"l{count}")
+    assert f"{count} joints between 'l0' and 'l{count}'; allowed at most 1000" in line
