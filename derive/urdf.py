@@ -23,10 +23,15 @@ import hashlib
 import math
 import random
 import re
+import sys
 from dataclasses import dataclass, field
 from pathlib import Path
+from xml.etree.ElementTree import TreeBuilder
+from xml.sax import SAXParseException
+from xml.sax.handler import ContentHandler
+from xml.sax.xmlreader import AttributesImpl
 
-import defusedxml.ElementTree as SafeET
+import defusedxml.sax as SafeSax
 from defusedxml import DefusedXmlException
 
 from derive.spec import ArmSpec, SpecError, parse_spec
@@ -88,6 +93,7 @@ class Robot:
     links: frozenset[str]
     joints: tuple[UrdfJoint, ...]
     digest: str
+    ignored: tuple[str, ...] = ()  # attributes with a prefix nobody declared (drake:...)
 
 
 @dataclass
@@ -99,6 +105,7 @@ class Conversion:
         joint_names: the URDF joint name of each row.
         base, tool: 4x4 matrices.
         snaps: one line per snap applied.
+        notes: what was ignored (one line each; not in the spec, said on stderr).
         deviation: the largest FK difference of the spec from the URDF over the samples.
         reach: the arm's size.
     """
@@ -111,6 +118,7 @@ class Conversion:
     deviation: float = 0.0
     reach: float = 1.0
     rounded: bool = True
+    notes: list[str] = field(default_factory=list)
 
 
 # --- reading ---------------------------------------------------------------------------------
@@ -126,17 +134,22 @@ def read_urdf(path: Path) -> Robot:
         data = path.read_bytes()
     except OSError as exc:
         raise UrdfError(f"{where}: cannot read: {exc.strerror}") from None
-    if b"xmlns:xacro" in data or b"<xacro:" in data:
-        raise UrdfError(
-            f"{where}: a xacro file; expand it first: `xacro {path.name} > robot.urdf` "
-            "(ROS's xacro, or `pip install xacro`)"
-        )
+    reader = _TreeReader()
     try:
-        root = SafeET.fromstring(data, forbid_dtd=True)
+        SafeSax.parseString(data, reader, forbid_dtd=True)
     except DefusedXmlException as exc:
         raise UrdfError(f"{where}: refused: {type(exc).__name__} (DTDs and entities)") from None
-    except SafeET.ParseError as exc:
-        raise UrdfError(f"{where}: not well-formed XML: {exc}") from None
+    except SAXParseException as exc:
+        raise UrdfError(
+            f"{where}: not well-formed XML: {exc.getMessage()}: line {exc.getLineNumber()}, "
+            f"column {exc.getColumnNumber()}"
+        ) from None
+    if reader.xacro:
+        raise UrdfError(
+            f"{where}: a xacro file ({reader.xacro}); expand it first: "
+            f"`xacro {path.name} > robot.urdf` (ROS's xacro, or `pip install xacro`)"
+        )
+    root = reader.builder.close()
     if root.tag != "robot":
         raise UrdfError(f"{where}: the root element is <{_cut(root.tag)}>, not <robot>")
     links: set[str] = set()
@@ -180,7 +193,57 @@ def read_urdf(path: Path) -> Robot:
         links=frozenset(links),
         joints=tuple(joints),
         digest=hashlib.sha256(data).hexdigest()[:16],
+        ignored=tuple(sorted(reader.undeclared)),
     )
+
+
+# the namespace xacro's elements live in (ROS wiki address, with or without www.)
+XACRO_NAMESPACE = re.compile(r"^https?://(www\.)?ros\.org/wiki/xacro/?$")
+
+
+class _TreeReader(ContentHandler):
+    """An element tree from SAX events, read without namespace processing: a prefix stays
+    part of the name, so a prefix nobody declared (``drake:acceleration``, as some URDFs
+    write) is no parse error. Such attributes are dropped and their names kept in
+    ``undeclared``; kinematics reads only unprefixed ones. ``xacro`` says what xacro would
+    still change (a xacro element, ``${...}`` or ``$(...)`` in a value), or is empty: an
+    expanded URDF that keeps ``xmlns:xacro`` on its robot element is a URDF."""
+
+    def __init__(self) -> None:
+        super().__init__()
+        self.builder = TreeBuilder()
+        self.scopes: list[dict[str, str]] = [{"xml": "http://www.w3.org/XML/1998/namespace"}]
+        self.undeclared: set[str] = set()
+        self.xacro = ""
+
+    def startElement(self, name: str, attrs: AttributesImpl) -> None:
+        declared = self.scopes[-1]
+        added = {k[6:]: attrs.getValue(k) for k in attrs.getNames() if k.startswith("xmlns:")}
+        if added:
+            declared = {**declared, **added}
+        self.scopes.append(declared)
+        prefix = name.partition(":")[0] if ":" in name else ""
+        if (
+            prefix
+            and not self.xacro
+            and (prefix == "xacro" or XACRO_NAMESPACE.match(declared.get(prefix, "")))
+        ):
+            self.xacro = f"element <{_cut(name)}>"
+        kept = {}
+        for key in attrs.getNames():
+            value = attrs.getValue(key)
+            if not self.xacro and ("${" in value or "$(" in value):
+                self.xacro = f'{_cut(key)}="{_cut(value)}"'
+            prefix = key.partition(":")[0] if ":" in key else ""
+            if prefix and prefix != "xmlns" and prefix not in declared:
+                self.undeclared.add(key)
+            else:
+                kept[key] = value
+        self.builder.start(name, kept)
+
+    def endElement(self, name: str) -> None:
+        self.scopes.pop()
+        self.builder.end(name)
 
 
 def _cut(text: str) -> str:
@@ -791,7 +854,8 @@ class Options:
 def import_urdf(path: Path, options: Options) -> tuple[str, Conversion]:
     """The spec text of the chain options.base .. options.tip of a URDF, and the conversion's
     record. The spec's FK is checked against the URDF's: within 1e-9 without snapping (else
-    the converter is wrong), within max_deviation with it (else the user must decide)."""
+    the converter is wrong), within max_deviation with it (else the user must decide). What
+    was ignored is said on stderr, one ``note:`` line each (also in the record's notes)."""
     where = str(path)
     if not options.base or not options.tip:
         raise UrdfError(f"{where}: a URDF needs --base LINK and --tip LINK")
@@ -810,6 +874,13 @@ def import_urdf(path: Path, options: Options) -> tuple[str, Conversion]:
             f"{where}: the spec's FK differs from the URDF's by {conversion.deviation:.3g} "
             f"{cause}; allowed {bound:g} (--max-deviation; --exact to switch snapping off)"
         )
+    if robot.ignored:
+        conversion.notes.append(
+            f"{where}: ignored {len(robot.ignored)} attribute(s) with a prefix no xmlns "
+            f"declares ({_listing(list(robot.ignored))}); kinematics does not read them"
+        )
+    for note in conversion.notes:
+        print(f"note: {note}", file=sys.stderr)
     return spec_text(*args), conversion
 
 

@@ -101,6 +101,85 @@ def test_tolerances_in_range_are_taken():
     urdf.Options(angle_tol=0.1, length_tol=0.1, max_deviation=1.0)
 
 
+# --- 10: expanded files that keep xmlns:xacro --------------------------------------------------
+
+# an expanded URDF as pybullet ships them (kuka_iiwa/model.urdf, franka_panda/panda.urdf):
+# the robot element still declares the xacro namespace; nothing is left for xacro to change
+EXPANDED = """<?xml version="1.0" ?>
+<robot name="lbr" xmlns:xacro="http://www.ros.org/wiki/xacro">
+  <material name="Grey"><color rgba="0.2 0.2 0.2 1.0"/></material>
+  <link name="base"><visual><geometry><mesh filename="meshes/base.stl"/></geometry>
+    <material name="Grey"/></visual>
+    <inertial><mass value="5"/><origin xyz="0 0 0.06"/>
+    <inertia ixx="0.05" ixy="0" ixz="0" iyy="0.06" iyz="0" izz="0.03"/></inertial></link>
+  <link name="l1"/><link name="l2"/><link name="l3"/>
+  <joint name="j1" type="revolute"><parent link="base"/><child link="l1"/>
+    <origin xyz="0 0 0.1575" rpy="0 0 0"/><axis xyz="0 0 1"/>
+    <limit effort="300" lower="-2.96" upper="2.96" velocity="10"/></joint>
+  <joint name="j2" type="revolute"><parent link="l1"/><child link="l2"/>
+    <origin xyz="0 0 0.2025" rpy="1.57079632679 0 3.14159265359"/><axis xyz="0 0 1"/>
+    <limit effort="300" lower="-2.09" upper="2.09" velocity="10"/></joint>
+  <joint name="j3" type="revolute"><parent link="l2"/><child link="l3"/>
+    <origin xyz="0 0.2045 0" rpy="1.57079632679 0 3.14159265359"/><axis xyz="0 0 1"/>
+    <limit effort="300" lower="-2.96" upper="2.96" velocity="10"/></joint>
+</robot>
+"""
+
+
+def test_an_expanded_urdf_that_keeps_xmlns_xacro_converts(tmp_path):
+    path = write(tmp_path, EXPANDED)
+    _, conversion = urdf.import_urdf(path, options("base", "l3"))
+    assert len(conversion.rows) == 3 and conversion.deviation <= urdf.MAX_DEVIATION
+
+
+@pytest.mark.parametrize(
+    ("change", "shown"),
+    [
+        (("<link name=\"l3\"/>", '<link name="l3"/><xacro:include filename="x.xacro"/>'),
+         "xacro:include"),
+        (('xyz="0 0 0.1575"', 'xyz="0 0 ${d1}"'), "${d1}"),
+        (('filename="meshes/base.stl"', 'filename="$(find lbr)/meshes/base.stl"'), "$(find"),
+    ],
+)  # fmt: skip
+def test_what_xacro_would_still_change_is_refused(change, shown, tmp_path, fails):
+    path = write(tmp_path, EXPANDED.replace(*change))
+    line = fails("import-urdf", str(path), "--base", "base", "--tip", "l3")
+    assert "xacro" in line and "expand it first" in line and shown in line
+
+
+# --- 11: undeclared attribute prefixes ---------------------------------------------------------
+
+
+def test_undeclared_attribute_prefixes_are_ignored_with_one_note(tmp_path, capsys):
+    text = urdf_text(two_joints(), ["a", "b", "c"]).replace(
+        '<limit lower="-1" upper="1"/>',
+        '<limit lower="-1" upper="1" drake:acceleration="2.5" drake:jerk="9"/>',
+    )
+    path = write(tmp_path, text)
+    out = tmp_path / "out.toml"
+    assert main(["import-urdf", str(path), "--base", "a", "--tip", "c", "-o", str(out)]) == 0
+    notes = [ln for ln in capsys.readouterr().err.split("\n") if ln.startswith("note:")]
+    assert len(notes) == 1 and "drake:acceleration" in notes[0] and "ignored" in notes[0]
+    assert out.exists()
+
+
+@pytest.mark.parametrize(
+    "head",
+    [
+        '<!DOCTYPE robot [<!ENTITY a "aaaaaaaaaa"><!ENTITY b "&a;&a;&a;&a;&a;&a;&a;&a;">]>',
+        '<!DOCTYPE r [<!ENTITY x SYSTEM "file:///etc/passwd">]>',
+        '<!DOCTYPE r SYSTEM "http://example.invalid/robot.dtd">',
+    ],
+)
+def test_a_file_with_undeclared_prefixes_still_gets_no_dtd_and_no_entities(head, tmp_path, fails):
+    text = urdf_text(two_joints(), ["a", "b", "c"], head).replace(
+        '<limit lower="-1"', '<limit drake:acceleration="2.5" lower="-1"'
+    )
+    path = write(tmp_path, text)
+    line = fails("import-urdf", str(path), "--base", "a", "--tip", "c")
+    assert "DTDs and entities" in line
+
+
 # --- 12: nearly meeting axes with --exact: the base rotation --------------------------------
 
 
