@@ -282,9 +282,9 @@ def _numbers(text: str | None, count: int, where: str, default: tuple[float, ...
     except ValueError:
         values = []
     if len(values) != count or not all(abs(v) <= MAX_NUMBER for v in values):
+        numbers = "a finite number" if count == 1 else f"{count} finite numbers"
         raise UrdfError(
-            f"{where}: {_shown(text)}; allowed: {count} finite numbers of magnitude at most "
-            f"{MAX_NUMBER:g}"
+            f"{where}: {_shown(text)}; allowed: {numbers} of magnitude at most {MAX_NUMBER:g}"
         )
     return values
 
