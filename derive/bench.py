@@ -19,6 +19,34 @@ import numpy as np
 from derive.verify import roundtrip, sample_joints
 
 
+def machine() -> str:
+    """One line naming what ran: Python, numpy and the BLAS behind numpy's linear algebra
+    (whose kernels, chosen per CPU at run time, decide the last bits of the general method's
+    SVDs and eigenvalues), and the CPU model."""
+    import platform
+
+    blas = "BLAS unknown"
+    try:
+        config = np.show_config(mode="dicts")
+        found = config["Build Dependencies"]["blas"]
+        blas = f"{found.get('name', '?')} {found.get('version', '?')}"
+        detail = str(found.get("openblas configuration", ""))
+        if detail:
+            blas += f" ({detail.split('  ', 1)[-1].strip()})"
+    except (KeyError, TypeError, ValueError):
+        pass
+    cpu = platform.processor() or platform.machine()
+    try:
+        with open("/proc/cpuinfo", encoding="utf-8") as info:
+            cpu = next(
+                (line.split(":", 1)[1].strip() for line in info if line.startswith("model name")),
+                cpu,
+            )
+    except OSError:
+        pass
+    return f"Python {platform.python_version()}, numpy {np.__version__}, {blas}; CPU {cpu}"
+
+
 def median_us(call, args_list: list, passes: int = 3) -> float:
     """Median over the argument list of call(*args)'s wall time in microseconds, each call's
     time the least of `passes` passes over the whole list.

@@ -454,7 +454,9 @@ def cmd_solve(args: argparse.Namespace) -> int:
     print(f"{len(sols)} solution(s) (degrees for R joints):")
     for k, q in enumerate(sols, start=1):
         shown = [math.degrees(v) if t == "R" else v for v, t in zip(q, spec.joint_types)]
-        residual = float(np.abs(module.fk(q) - pose).max())
+        # (the components the solver reproduces: the tool point only for a positioning arm)
+        rows = slice(None) if module.IK_COMPONENTS == "pose" else (slice(0, 3), 3)
+        residual = float(np.abs((module.fk(q) - pose)[rows]).max())
         outside = [
             f"q{i + 1}"
             for i, (v, (lo, hi)) in enumerate(zip(q, module.LIMITS))
@@ -694,8 +696,10 @@ def cmd_bench(args: argparse.Namespace) -> int:
     """Print generation time, solver timings and round-trip figures per arm."""
     import json
 
-    from derive.bench import measure
+    from derive.bench import machine, measure
 
+    if not args.json:
+        print(f"machine: {machine()}", flush=True)
     if args.lang == "c":
         return bench_c(args)
     results = []
@@ -706,6 +710,7 @@ def cmd_bench(args: argparse.Namespace) -> int:
         module = load_module(spec)
         figures = {
             "generate_s": generation,
+            "machine": machine(),
             **measure(module, args.samples, args.seed, args.batch, args.memory),
         }
         results.append(figures)

@@ -224,6 +224,7 @@ def test_bench_lang_c_prints_the_figures(capsys):
         out,
     ), out
     assert "median single call (each pose's least of 21)" in out
+    assert re.search(r"^machine: Python [\d.]+, numpy [\d.]+, .*; CPU ", out, re.M), out
 
 
 # the arms whose C goes through every routine of the C runtime: polynomial, half-angle and

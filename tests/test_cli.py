@@ -2,11 +2,13 @@
 
 from __future__ import annotations
 
+import re
 import shutil
 import subprocess
 import sys
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from derive.cli import main
@@ -141,3 +143,13 @@ def test_bench_reports_round_trip_figures(capsys):
     assert figures["name"] == "puma560" and figures["samples"] == 30
     assert figures["unsound"] == 0 and figures["completeness"] == 1.0
     assert figures["ik_us"] > 0 and figures["generate_s"] > 0
+    # which numpy and BLAS ran (issue 37 item 19: the general method's last bits hang on them)
+    assert f"numpy {np.__version__}" in figures["machine"] and "CPU" in figures["machine"]
+
+
+def test_solve_residual_is_over_what_the_solver_reproduces(capsys):
+    """A positioning arm (planar_2r) reproduces the tool point, not its heading: its second
+    solution printed 'residual 1.0e+00' (the rotation entries) though it is exact."""
+    assert main(["solve", "planar_2r", "--q", "0", "90"]) == 0
+    residuals = [float(r) for r in re.findall(r"residual (\S+)", capsys.readouterr().out)]
+    assert len(residuals) == 2 and max(residuals) < 1e-12
