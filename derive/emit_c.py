@@ -38,6 +38,8 @@ class PrintedC:
     free_text: str
     certify_tol: str
     reach: str
+    far: str
+    free_limit: str
     revolute: str
     limits: tuple[tuple[str, str], ...]
     fk_pose: tuple[str, ...]
@@ -251,6 +253,8 @@ def print_c(plan: Plan) -> PrintedC:
         free_text=f"Free joints: {text}." if text else "",
         certify_tol=repr(constants.CERTIFY_TOL),
         reach=repr(arm.reach),
+        far=repr(constants.FAR_REACH * arm.reach),
+        free_limit=repr(constants.FREE_LIMIT),
         revolute=", ".join("1" if k == "R" else "0" for k in arm.joint_types),
         limits=tuple((c.c_double(lo), c.c_double(hi)) for lo, hi in arm.limits),
         fk_pose=fk_pose,

@@ -9,8 +9,9 @@ joints only move its base and tool:
     B' = B X_0 Z_1 X_1 ... Z_k,        E' = Z_{n-m+1} X_{n-m+1} ... Z_n X_n E,
 
 so one derivation serves every free value: the flange target of the remainder holds the free
-joints' cos and sin (FIELD_NOTES.md section 2). A middle joint would put a free angle
-between two joints of the remainder, where no DH row can hold it; it is refused.
+joints' cos and sin (docs/algorithms.md, "Free joints of 7-joint arms"). A middle joint would
+put a free angle between two joints of the remainder, where no DH row can hold it; it is
+refused.
 
 The remainder is derived with its joints numbered 1..6 (the methods' own numbering); the plan
 is then renumbered to the arm's joints (:func:`lift`).

@@ -176,6 +176,18 @@ _SEAM = math.pi - _SEAM_BAND
 MAX_TURN_ROWS = 100_000
 
 
+# a free joint's value is taken modulo 2 pi (revolute) before it is solved with: at most
+# FREE_LIMIT radians (or FREE_LIMIT * REACH of length), where that reduction, and the cos
+# and sin of the value, are accurate to ~1e-10
+FREE_LIMIT = 1e6
+
+
+# a pose farther than FAR_REACH * REACH from the base along an axis is out of reach: revolute
+# joints reach REACH, no sliding joint a million times that, and the solvers' squares and
+# products of such positions would overflow
+FAR_REACH = 1e6
+
+
 def fk(q: ArrayLike) -> np.ndarray:
     """World pose of the tool frame (base and tool included) for joint vector q."""
     values = _real(q, "q")
@@ -241,6 +253,7 @@ def ik(
             is given for an arm without free joints, or is not len(FREE) finite numbers.
     """
     refs = _with_free(_reference(q_ref), free)
+    solve = _free_turns(refs)
     tol = _tolerance(tol)
     if within_limits:
 
@@ -252,13 +265,17 @@ def ik(
     if kernels is not None:
         A = _array44(T)
         if A is not None:  # else _pose says what is wrong with T
-            limited = within_limits and not all_turns
-            rows, status = kernels[1](A[None], tol, refs, limited)
+            # (the kernel picks variants near the values it solves with: near q_ref's own
+            # ones where a free value was reduced to a turn, result does)
+            limited = within_limits and not all_turns and solve == refs
+            rows, status = kernels[1](A[None], tol, solve, limited)
             if status == 0:
                 return rows if not within_limits or limited else result(rows)
     # the Python solver; for the compiled one a pose it did not settle, or an invalid one
     target = _pose(T)
-    return result(_finish(_ik_scalar(target, *refs, tol)))
+    if max(abs(target[3]), abs(target[7]), abs(target[11])) > _FAR:
+        return result(_finish([]))
+    return result(_finish(_ik_scalar(target, *solve, tol)))
 
 
 def _array44(T):
@@ -306,6 +323,8 @@ def ik_batch(
     if type(chunk) is bool or not isinstance(chunk, (int, np.integer)) or chunk < 1:
         raise ValueError(f"chunk must be a positive integer, got {chunk!r}")
     refs = _reference(q_ref)
+    if free is None:  # (else _free_rows reduces the values given)
+        refs = _free_turns(refs)
     kernels = _kernels(backend)
     if kernels is None:
         return _ik_batch_numpy(T, refs, free, tol, int(chunk))
@@ -356,7 +375,9 @@ def _with_free(refs, free):
         return refs
     if not FREE:
         raise ValueError("free: this arm has no free joints (FREE is empty)")
-    values = _real(free, "free").reshape(-1)
+    values = _real(free, "free")
+    if values.ndim == 0:
+        values = values.reshape(1)
     if values.shape != (len(FREE),) or not np.isfinite(values).all():
         raise ValueError(
             f"free must be {len(FREE)} finite number(s), one per joint in FREE = {FREE}"
@@ -364,6 +385,29 @@ def _with_free(refs, free):
     out = list(refs)
     for j, x in zip(FREE, values.tolist()):
         out[j - 1] = x
+    return tuple(out)
+
+
+def _free_turns(refs):
+    """refs with each revolute free joint's value reduced to (-pi, pi]: the value the solver
+    works with and returns, so that a returned row reproduces the pose with its own values.
+
+    Raises:
+        ValueError: a free value beyond FREE_LIMIT radians (FREE_LIMIT * REACH for a sliding
+            joint), where neither the reduction nor cos and sin are accurate.
+    """
+    if not FREE:
+        return refs
+    out = list(refs)
+    for j in FREE:
+        x = out[j - 1]
+        limit, unit = (FREE_LIMIT, "rad") if _REVOLUTE[j - 1] else (FREE_LIMIT * REACH, "")
+        if not abs(x) <= limit:
+            raise ValueError(
+                f"free joint q{j} = {x!r}: a free value must lie within +-{limit:g} {unit}".rstrip()
+            )
+        if _REVOLUTE[j - 1]:
+            out[j - 1] = math.remainder(x, _TWO_PI)
     return tuple(out)
 
 
@@ -382,8 +426,19 @@ def _free_rows(free, refs, n):
             f"free must be finite numbers of shape ({n}, {len(FREE)}): one value per pose "
             f"for each joint in FREE = {FREE}"
         )
+    limits = np.array([FREE_LIMIT if _REVOLUTE[j - 1] else FREE_LIMIT * REACH for j in FREE])
+    if not (np.abs(values) <= limits).all():
+        raise ValueError(
+            f"free values must lie within +-{FREE_LIMIT:g} rad (+-{FREE_LIMIT * REACH:g} for "
+            f"a sliding joint), one per pose for each joint in FREE = {FREE}"
+        )
+    turns = np.array([_REVOLUTE[j - 1] for j in FREE])
+    # fmod is exact; one addition of 2 pi brings its (-2 pi, 2 pi) to (-pi, pi]
+    reduced = np.fmod(values, _TWO_PI)
+    reduced = np.where(reduced > math.pi, reduced - _TWO_PI, reduced)
+    reduced = np.where(reduced <= -math.pi, reduced + _TWO_PI, reduced)
     rows = np.tile(np.array(refs), (n, 1))
-    rows[:, [j - 1 for j in FREE]] = values
+    rows[:, [j - 1 for j in FREE]] = np.where(turns, reduced, values)
     return rows
 
 
@@ -446,7 +501,8 @@ def _distances(rows, refs, w, metric, wrap):
         d -= _TWO_PI * np.rint(d / _TWO_PI) * _REV
     if metric == "max":
         return (w * np.abs(d)).max(axis=1, initial=0.0)
-    return (w * d * d).sum(axis=1)
+    with np.errstate(over="ignore"):  # a q_ref far out: inf, every row as far
+        return (w * d * d).sum(axis=1)
 
 
 def _pose(T):
@@ -669,19 +725,27 @@ _PERIODS = tuple(2.0 * math.pi if r else math.inf for r in _REVOLUTE)
 
 
 def _real(x: object, name: str) -> np.ndarray:
-    """x as a float64 array; ValueError for complex or non-numeric input."""
+    """x as a float64 array; ValueError for anything but real numbers (ints and floats:
+    not complex numbers, booleans, strings or None)."""
     if type(x) is np.ndarray and x.dtype == np.float64:
         return x
     try:
         a = np.asarray(x)
-        if a.dtype.kind == "c":
+        if a.dtype.kind not in "fiu" and not (
+            a.dtype.kind == "O"
+            and not any(v is None or isinstance(v, (bool, np.bool_, str, bytes)) for v in a.flat)
+        ):
             raise TypeError
         return a.astype(float)
     except (TypeError, ValueError):
-        raise ValueError(f"{name} must be an array of real numbers") from None
+        raise ValueError(f"{name} must be an array of real numbers (ints or floats)") from None
 
 
 _ONES = np.ones(DOF)
+
+
+# a pose farther than this along an axis is out of reach (constants.FAR_REACH)
+_FAR = FAR_REACH * REACH
 
 
 def _reference(q_ref: object, required: bool = False) -> tuple[float, ...]:
@@ -1037,9 +1101,10 @@ def _poly_angles(
     """Angles t whose u = tan(t/2) is a real root of the polynomial (highest degree first).
 
     The polynomial is solved in u, or in v = 1/u when its last coefficient is the larger
-    end, so that a vanishing leading coefficient (a root at u = infinity, t = pi; ALGORITHMS.md
-    2.4) is an ordinary root v = 0. When both ends vanish (below _LEAD_TOL of the largest
-    coefficient) the leading one is deflated as its exact root. Angles are wrapped to
+    end, so that a vanishing leading coefficient (a root at u = infinity, t = pi;
+    docs/algorithms.md, "Polynomials in u = tan(t/2) and the root at t = pi") is an ordinary
+    root v = 0. When both ends vanish (below _LEAD_TOL of the largest coefficient) the
+    leading one is deflated as its exact root. Angles are wrapped to
     (-pi, pi] (within 1e-12 of +-pi: pi), sorted, and equal ones (1e-12) merged. Near-double
     roots come out as complex pairs with a small imaginary part; they are accepted and
     polished. Every candidate is certified by forward kinematics afterwards, so a spurious
@@ -1397,7 +1462,8 @@ def _vpoly(coeffs, axis, like, angles, ref=0.0, free=0.0, unit=1.0):
 
 
 def _vpose(T):
-    """Per-row validity of poses (N, 4, 4) and the poses with invalid rows replaced."""
+    """Per-row validity of poses (N, 4, 4) and the poses with invalid rows replaced (a pose
+    farther than _FAR is out of reach: no valid slot, as an invalid one)."""
     T = _real(T, "T")
     if T.ndim != 3 or T.shape[1:] != (4, 4):
         raise ValueError(f"T must have shape (N, 4, 4), got {T.shape}")
@@ -1418,7 +1484,8 @@ def _vpose(T):
         ):
             worst = np.maximum(worst, np.abs(dot))
         det = a0 * (b1 * c2 - b2 * c1) - a1 * (b0 * c2 - b2 * c0) + a2 * (b0 * c1 - b1 * c0)
-        good = (worst <= POSE_TOL) & (det > 0.0) & np.isfinite(flat).all(axis=1)
+        near = np.abs(flat[:, [3, 7, 11]]).max(axis=1) <= _FAR
+        good = (worst <= POSE_TOL) & (det > 0.0) & np.isfinite(flat).all(axis=1) & near
     if good.all():
         return T, good
     return np.where(good[:, None, None], T, np.eye(4)), good
@@ -1458,11 +1525,14 @@ def _vfinish(Q, valid):
 
 
 def _kpose_ok(T, i):
-    """Whether T[i] is a finite rigid transform within POSE_TOL (as _vpose)."""
+    """Whether T[i] is a finite rigid transform within POSE_TOL, within _FAR of the base (as
+    _vpose; ik's Python solver answers a far pose with no row)."""
     for r in range(4):
         for c in range(4):
             if not math.isfinite(T[i, r, c]):
                 return False
+    if max(abs(T[i, 0, 3]), abs(T[i, 1, 3]), abs(T[i, 2, 3])) > _FAR:
+        return False
     worst = max(abs(T[i, 3, 0]), abs(T[i, 3, 1]), abs(T[i, 3, 2]), abs(T[i, 3, 3] - 1.0))
     for r in range(3):
         for s in range(r, 3):

@@ -412,6 +412,10 @@ static int dk_pose_ok(const double T[16])
 #define DK_UNSETTLED (-2)
 static const double DK_REACH = 2.0;
 static const int DK_REVOLUTE[DK_DOF] = {1, 1};
+/* a pose farther than DK_FAR along an axis is out of reach (FAR_REACH * REACH); a free
+   joint's value lies within DK_FREE_LIMIT radians (times DK_REACH for a length) */
+static const double DK_FAR = 2000000.0;
+static const double DK_FREE_LIMIT = 1000000.0;
 
 const double planar_2r_limits[DK_DOF][2] = {
     {-HUGE_VAL, HUGE_VAL},
@@ -591,11 +595,21 @@ int planar_2r_ik_ref(const double T[16], const double *free, const double *q_ref
     }
     for (j = 0; j < DK_DOF; j++) {
         ref[j] = q_ref ? q_ref[j] : 0.0;
-    }
-    if (free) {
-        for (j = 0; j < PLANAR_2R_FREE_COUNT; j++) {
-            ref[planar_2r_free_joints[j] - 1] = free[j];
+        if (!isfinite(ref[j])) {
+            return PLANAR_2R_INVALID_ARGUMENT;
         }
+    }
+    for (j = 0; j < PLANAR_2R_FREE_COUNT; j++) {
+        int k = planar_2r_free_joints[j] - 1;
+        ref[k] = free ? free[j] : ref[k];
+        /* (solved with, and returned as, its value in one turn: the rows reproduce T) */
+        if (!(fabs(ref[k]) <= DK_FREE_LIMIT * (DK_REVOLUTE[k] ? 1.0 : DK_REACH))) {
+            return PLANAR_2R_INVALID_ARGUMENT;
+        }
+        ref[k] = DK_REVOLUTE[k] ? remainder(ref[k], DK_TWO_PI) : ref[k];
+    }
+    if (fabs(T[3]) > DK_FAR || fabs(T[7]) > DK_FAR || fabs(T[11]) > DK_FAR) {
+        return 0;
     }
     {
         const double t[12] = {T[0], T[1], T[2],  T[3],  T[4],  T[5],
@@ -658,7 +672,7 @@ int planar_2r_nearest(const double T[16], const double *free, const double q_ref
             double d = rows[r][j] - q_ref[j];
             total += (weights ? weights[j] : 1.0) * d * d;
         }
-        if (total < least) {
+        if (best < 0 || total < least) { /* (q_ref far out: every distance inf, the first) */
             least = total;
             best = r;
         }

@@ -23,6 +23,7 @@ extern "C" {
 /* ik's return values below 0 */
 #define PUMA560_INVALID_POSE (-1)
 #define PUMA560_UNSETTLED (-2)
+#define PUMA560_INVALID_ARGUMENT (-3)
 
 /* (lower, upper) per joint: radians for R joints, length for P joints (HUGE_VAL: none) */
 extern const double puma560_limits[6][2];
@@ -34,11 +35,15 @@ void puma560_fk(const double q[6], double T[16]);
 
 /* Every solution of the pose T, each certified by forward kinematics (rotation within tol,
    position within tol * reach), revolute values in (-pi, pi], in the Python solver's order.
-   free: the free joints' values (PUMA560_FREE_COUNT of them; may be NULL: q_ref's, or 0).
+   free: the free joints' values (PUMA560_FREE_COUNT of them; may be NULL: q_ref's, or 0),
+   each within 1e6 rad (1e6 times the reach for a length); a revolute one is solved with, and
+   returned as, its value in (-pi, pi].
    q_ref (ik_ref; may be NULL: zeros): the value a joint the pose leaves free starts from.
-   Returns the number of solutions written to q, PUMA560_INVALID_POSE (T is no finite rigid
-   transform) or PUMA560_UNSETTLED (a root the closed forms cannot settle: ask the Python
-   solver). The rows of q past the count (all of them on UNSETTLED) hold no solution. */
+   Returns the number of solutions written to q (0 for a pose a million times the reach away),
+   PUMA560_INVALID_POSE (T is no finite rigid transform, or tol is not positive),
+   PUMA560_UNSETTLED (a root the closed forms cannot settle: ask the Python solver) or
+   PUMA560_INVALID_ARGUMENT (q_ref not finite, a free value beyond its limit). The rows of
+   q past the count (all of them on a negative code) hold no solution. */
 int puma560_ik(const double T[16], const double *free, double tol,
                 double q[8][6]);
 int puma560_ik_ref(const double T[16], const double *free, const double *q_ref, double tol,

@@ -549,3 +549,45 @@ def test_random_arms_in_c_give_the_python_solutions(text):
             differ += 1
     # near-double roots round apart at a few poses (as between the Python backends)
     assert differ <= 2, (differ, text)
+
+
+def test_the_binding_refuses_none_and_non_numbers_instead_of_crashing(generated, tmp_path):
+    """Issue 37 item 2: None became a NULL pointer (a segfault); a NaN q_ref reached C. The
+    binding follows the Python contract: ValueError."""
+    solver = import_path(cbuild.build(plan_of("puma560"), tmp_path))
+    T = solver.fk(np.full(6, 0.3))
+    calls = [
+        lambda: solver.ik(None),
+        lambda: solver.fk(None),
+        lambda: solver.nearest(None, np.zeros(6)),
+        lambda: solver.nearest(T, None),
+        lambda: solver.nearest(T, np.full(6, np.nan)),
+        lambda: solver.ik(T, q_ref=[np.inf] * 6),
+        lambda: solver.ik(np.full((4, 4), "1.0")),
+        lambda: solver.ik(np.eye(4, dtype=bool)),
+    ]
+    for call in calls:
+        with pytest.raises(ValueError):
+            call()
+    best = solver.nearest(T, np.full(6, 1e300))  # every distance inf: a solution, as Python's
+    assert best is not None and np.abs(solver.fk(best) - T).max() < 1e-9
+    far = np.eye(4)
+    far[0, 3] = 1e200
+    assert solver.ik(far).shape == (0, 6)
+
+
+def test_c_free_values_are_reduced_to_a_turn_and_bounded(generated, tmp_path):
+    """Issue 37 item 1, in C: a free value is solved with and returned as its value in one
+    turn (every row reproduces T); beyond 1e6 rad it is refused."""
+    m = generated("iiwa14")
+    solver = import_path(cbuild.build(plan_of("iiwa14"), tmp_path))
+    q0 = np.array([0.3, 0.5, -0.2, -1.0, 0.4, 0.6, 0.2])
+    T = m.fk(q0)
+    value = 0.2 + 2 * np.pi * 1000
+    rows = solver.ik(T, free=[value])
+    assert len(rows) == len(m.ik(T, free=[value], backend="python"))
+    for q in rows:
+        assert np.abs(m.fk(q) - T).max() < 1e-9 and abs(q[6] - 0.2) < 1e-9
+    for bad in (1e17, 1e300):
+        with pytest.raises(ValueError, match="free value"):
+            solver.ik(T, free=[bad])

@@ -155,3 +155,43 @@ def test_compiled_limits_and_nearest_match_python(ur5):
         np.testing.assert_allclose(compiled, ur5.nearest(T, ref), atol=1e-9)
         np.testing.assert_allclose(wrapped, ur5.nearest(T, ref, within_limits=False), atol=1e-9)
         np.testing.assert_allclose(compiled, q, atol=1e-6)  # q itself is inside +-360 deg
+
+
+# issue 37 item 17: strings, booleans and nested free values are not numbers
+@pytest.mark.parametrize(
+    "T", [np.full((4, 4), "1.0"), np.eye(4, dtype=bool), np.array([[None] * 4] * 4)]
+)
+def test_strings_and_booleans_are_not_poses(ur5, T):
+    with pytest.raises(ValueError, match="real numbers"):
+        ur5.ik(T)
+    with pytest.raises(ValueError, match="real numbers"):
+        ur5.ik_batch(T[None])
+    with pytest.raises(ValueError, match="real numbers"):
+        ur5.fk(T[0, :4].tolist() + T[1, :2].tolist())
+
+
+@pytest.mark.parametrize("free", ["0.5", [True], [[0.5]], np.array([[0.5]])])
+def test_free_values_must_be_numbers_one_per_free_joint(generated, free):
+    m = generated("iiwa14")
+    T = m.fk(np.zeros(7))
+    with pytest.raises(ValueError, match=r"free must be (1 finite|an array of real numbers)"):
+        m.ik(T, free=free, backend="python")
+
+
+# issue 37 item 4: poses far out of reach are answered with no row, without warnings
+FAR = [1e155, 1e200, 1.7e308]
+
+
+@pytest.mark.parametrize("name", ["parallel_6r", "manocha_canny", "puma560", "iiwa14"])
+def test_poses_far_out_of_reach_give_no_solution(generated, name, recwarn):
+    m = generated(name)
+    T = np.tile(np.eye(4), (len(FAR) + 1, 1, 1))
+    T[:-1, 0, 3] = FAR
+    T[-1] = m.fk(np.full(m.DOF, 0.3))
+    q = np.zeros(m.DOF)
+    for pose in T[:-1]:
+        assert m.ik(pose, backend="python").shape == (0, m.DOF)
+        assert m.nearest(pose, q) is None
+    _, valid = m.ik_batch(T, backend="python")
+    assert not valid[:-1].any() and valid[-1].any()
+    assert [str(w.message) for w in recwarn] == []

@@ -349,8 +349,15 @@ def test_panda_solutions_are_all_that_newton_finds(generated):
 RAIL = spec_text(
     "rail_puma",
     "standard",
-    [(-90, 0, 0, 0), (-90, 0, 0, 0), (0, 0.432, 0, 0), (90, -0.02, 0.149, 0)]
-    + [(-90, 0, 0.433, 0), (90, 0, 0, 0), (0, 0, 0, 0)],
+    [
+        (-90, 0, 0, 0),
+        (-90, 0, 0, 0),
+        (0, 0.432, 0, 0),
+        (90, -0.02, 0.149, 0),
+        (-90, 0, 0.433, 0),
+        (90, 0, 0, 0),
+        (0, 0, 0, 0),
+    ],
     kinds="PRRRRRR",
 ).replace('type = "P"\n', 'type = "P"\nlimits = [0.0, 3.0]\n', 1)
 
@@ -376,3 +383,41 @@ def test_telescoping_joints_on_one_axis_are_refused_in_one_line(tmp_path, capsys
     out = capsys.readouterr().out
     assert out.count("\n") == 1 and "FK only, no IK" in out
     assert "the remainder loses a degree of freedom" in out
+
+
+@pytest.mark.parametrize("name", REDUNDANT)
+def test_every_row_reproduces_the_pose_with_the_free_value_returned(generated, name):
+    """Issue 37 item 1: rows were certified with cos(1e17) (reduced exactly by libm) and
+    returned with 1e17 reduced modulo the double nearest 2 pi (4 rad off)."""
+    m = generated(name)
+    q0 = np.array([0.3, 0.5, -0.2, -1.0, 0.4, 0.6, 0.2])
+    T = m.fk(q0)
+    for value in (0.2 + 2 * math.pi * 1000, 0.2 - 2 * math.pi * 150_000):
+        rows = m.ik(T, free=[value], backend="python")
+        Q, valid = m.ik_batch(T[None], free=[value], backend="python")
+        assert len(rows) and valid.sum() == len(rows)
+        for q in [*rows, *Q[valid]]:
+            assert np.abs(m.fk(q) - T).max() < 1e-9
+            assert abs(q[6] - math.remainder(value, 2 * math.pi)) < 1e-15
+    for value in (1e17, 1e300, -2e6):
+        with pytest.raises(ValueError, match=r"within \+-1e\+06 rad"):
+            m.ik(T, free=[value], backend="python")
+        with pytest.raises(ValueError, match=r"within \+-1e\+06 rad"):
+            m.ik_batch(T[None], free=[value], backend="python")
+
+
+@pytest.mark.parametrize("name", REDUNDANT)
+def test_nearest_with_q_ref_far_outside_the_limits(generated, name, monkeypatch):
+    """Issue 37 item 3: a free joint's q_ref half a turn or more outside its limits gave an
+    IndexError (an empty search window) or numpy's 'Maximum allowed size exceeded'."""
+    m = generated(name)
+    monkeypatch.setattr(m, "BACKEND", "python")  # (nearest has no backend argument)
+    q0 = np.array([0.3, 0.5, -0.2, -1.0, 0.4, 0.6, 0.2])
+    T = m.fk(q0)
+    for ref in (q0 + 2 * math.pi, np.full(7, 1e6), np.full(7, 1e300), np.full(7, -1e300)):
+        q = m.nearest(T, ref)
+        assert q is not None and np.abs(m.fk(q) - T).max() < 1e-9
+        lo, hi = np.array(m.LIMITS).T
+        assert ((lo - 1e-9 <= q) & (q <= hi + 1e-9)).all()
+    q = m.nearest(T, q0 + 2 * math.pi, within_limits=False)
+    assert q is not None and np.abs(m.fk(q) - T).max() < 1e-9

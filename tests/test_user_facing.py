@@ -62,11 +62,6 @@ def test_fk_and_solve_print_zero_without_a_sign(capsys, monkeypatch):
 
 # files that cite a document their owner is still to replace (docs/algorithms.md has the
 # sections; see the section titles in issue 37's notes): allowed until they are changed
-PENDING = {
-    ("derive/runtime/general.py", "ALGORITHMS.md"),
-    ("derive/runtime/scalar.py", "ALGORITHMS.md"),
-    ("derive/free.py", "FIELD_NOTES.md"),
-}
 REPO_PATH = re.compile(
     r"(?<![\w./<-])((?:derive|tests|docs|templates|generated)/[\w./-]*"
     r"\.(?:md|py|json|toml|j2|yaml|png|svg))\b"
@@ -114,7 +109,7 @@ def test_every_file_a_docstring_comment_or_the_readme_cites_exists():
         for cited in DOCUMENT.findall(text):
             if cited not in names and not (ROOT / "docs" / cited).exists():
                 missing.add((where, cited))
-    assert sorted(missing - PENDING) == []
+    assert sorted(missing) == []
 
 
 def test_the_algorithms_page_has_every_section_the_code_cites():

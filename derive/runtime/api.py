@@ -20,6 +20,7 @@ from derive.runtime.arm import (
     FREE,
     LIMITS,
     MAX_SOLUTIONS,
+    REACH,
     _cs_columns,
     _fk_from_cs,
     _fk_q,
@@ -27,6 +28,7 @@ from derive.runtime.arm import (
     _ik_scalar,
 )
 from derive.runtime.common import (
+    _FAR,
     _LOWER,
     _ONES,
     _PERIODS,
@@ -44,6 +46,7 @@ from derive.runtime.constants import (
     BACKEND,
     CERTIFY_TOL,
     DEDUP_TOL,
+    FREE_LIMIT,
     MAX_TURN_ROWS,
     POSE_TOL,
 )
@@ -116,6 +119,7 @@ def ik(
             is given for an arm without free joints, or is not len(FREE) finite numbers.
     """
     refs = _with_free(_reference(q_ref), free)
+    solve = _free_turns(refs)
     tol = _tolerance(tol)
     if within_limits:
 
@@ -127,13 +131,17 @@ def ik(
     if kernels is not None:
         A = _array44(T)
         if A is not None:  # else _pose says what is wrong with T
-            limited = within_limits and not all_turns
-            rows, status = kernels[1](A[None], tol, refs, limited)
+            # (the kernel picks variants near the values it solves with: near q_ref's own
+            # ones where a free value was reduced to a turn, result does)
+            limited = within_limits and not all_turns and solve == refs
+            rows, status = kernels[1](A[None], tol, solve, limited)
             if status == 0:
                 return rows if not within_limits or limited else result(rows)
     # the Python solver; for the compiled one a pose it did not settle, or an invalid one
     target = _pose(T)
-    return result(_finish(_ik_scalar(target, *refs, tol)))
+    if max(abs(target[3]), abs(target[7]), abs(target[11])) > _FAR:
+        return result(_finish([]))
+    return result(_finish(_ik_scalar(target, *solve, tol)))
 
 
 def _array44(T):
@@ -181,6 +189,8 @@ def ik_batch(
     if type(chunk) is bool or not isinstance(chunk, (int, np.integer)) or chunk < 1:
         raise ValueError(f"chunk must be a positive integer, got {chunk!r}")
     refs = _reference(q_ref)
+    if free is None:  # (else _free_rows reduces the values given)
+        refs = _free_turns(refs)
     kernels = _kernels(backend)
     if kernels is None:
         return _ik_batch_numpy(T, refs, free, tol, int(chunk))
@@ -231,7 +241,9 @@ def _with_free(refs, free):
         return refs
     if not FREE:
         raise ValueError("free: this arm has no free joints (FREE is empty)")
-    values = _real(free, "free").reshape(-1)
+    values = _real(free, "free")
+    if values.ndim == 0:
+        values = values.reshape(1)
     if values.shape != (len(FREE),) or not np.isfinite(values).all():
         raise ValueError(
             f"free must be {len(FREE)} finite number(s), one per joint in FREE = {FREE}"
@@ -239,6 +251,29 @@ def _with_free(refs, free):
     out = list(refs)
     for j, x in zip(FREE, values.tolist()):
         out[j - 1] = x
+    return tuple(out)
+
+
+def _free_turns(refs):
+    """refs with each revolute free joint's value reduced to (-pi, pi]: the value the solver
+    works with and returns, so that a returned row reproduces the pose with its own values.
+
+    Raises:
+        ValueError: a free value beyond FREE_LIMIT radians (FREE_LIMIT * REACH for a sliding
+            joint), where neither the reduction nor cos and sin are accurate.
+    """
+    if not FREE:
+        return refs
+    out = list(refs)
+    for j in FREE:
+        x = out[j - 1]
+        limit, unit = (FREE_LIMIT, "rad") if _REVOLUTE[j - 1] else (FREE_LIMIT * REACH, "")
+        if not abs(x) <= limit:
+            raise ValueError(
+                f"free joint q{j} = {x!r}: a free value must lie within +-{limit:g} {unit}".rstrip()
+            )
+        if _REVOLUTE[j - 1]:
+            out[j - 1] = math.remainder(x, _TWO_PI)
     return tuple(out)
 
 
@@ -257,8 +292,19 @@ def _free_rows(free, refs, n):
             f"free must be finite numbers of shape ({n}, {len(FREE)}): one value per pose "
             f"for each joint in FREE = {FREE}"
         )
+    limits = np.array([FREE_LIMIT if _REVOLUTE[j - 1] else FREE_LIMIT * REACH for j in FREE])
+    if not (np.abs(values) <= limits).all():
+        raise ValueError(
+            f"free values must lie within +-{FREE_LIMIT:g} rad (+-{FREE_LIMIT * REACH:g} for "
+            f"a sliding joint), one per pose for each joint in FREE = {FREE}"
+        )
+    turns = np.array([_REVOLUTE[j - 1] for j in FREE])
+    # fmod is exact; one addition of 2 pi brings its (-2 pi, 2 pi) to (-pi, pi]
+    reduced = np.fmod(values, _TWO_PI)
+    reduced = np.where(reduced > math.pi, reduced - _TWO_PI, reduced)
+    reduced = np.where(reduced <= -math.pi, reduced + _TWO_PI, reduced)
     rows = np.tile(np.array(refs), (n, 1))
-    rows[:, [j - 1 for j in FREE]] = values
+    rows[:, [j - 1 for j in FREE]] = np.where(turns, reduced, values)
     return rows
 
 
@@ -321,7 +367,8 @@ def _distances(rows, refs, w, metric, wrap):
         d -= _TWO_PI * np.rint(d / _TWO_PI) * _REV
     if metric == "max":
         return (w * np.abs(d)).max(axis=1, initial=0.0)
-    return (w * d * d).sum(axis=1)
+    with np.errstate(over="ignore"):  # a q_ref far out: inf, every row as far
+        return (w * d * d).sum(axis=1)
 
 
 def _pose(T):

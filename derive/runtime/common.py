@@ -6,26 +6,34 @@ import math
 
 import numpy as np
 
-from derive.runtime.arm import _REVOLUTE, DOF, LIMITS
-from derive.runtime.constants import _SEAM_SNAP, _TWO_PI
+from derive.runtime.arm import _REVOLUTE, DOF, LIMITS, REACH
+from derive.runtime.constants import _SEAM_SNAP, _TWO_PI, FAR_REACH
 
 _PERIODS = tuple(2.0 * math.pi if r else math.inf for r in _REVOLUTE)
 
 
 def _real(x: object, name: str) -> np.ndarray:
-    """x as a float64 array; ValueError for complex or non-numeric input."""
+    """x as a float64 array; ValueError for anything but real numbers (ints and floats:
+    not complex numbers, booleans, strings or None)."""
     if type(x) is np.ndarray and x.dtype == np.float64:
         return x
     try:
         a = np.asarray(x)
-        if a.dtype.kind == "c":
+        if a.dtype.kind not in "fiu" and not (
+            a.dtype.kind == "O"
+            and not any(v is None or isinstance(v, (bool, np.bool_, str, bytes)) for v in a.flat)
+        ):
             raise TypeError
         return a.astype(float)
     except (TypeError, ValueError):
-        raise ValueError(f"{name} must be an array of real numbers") from None
+        raise ValueError(f"{name} must be an array of real numbers (ints or floats)") from None
 
 
 _ONES = np.ones(DOF)
+
+
+# a pose farther than this along an axis is out of reach (constants.FAR_REACH)
+_FAR = FAR_REACH * REACH
 
 
 def _reference(q_ref: object, required: bool = False) -> tuple[float, ...]:

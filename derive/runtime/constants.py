@@ -42,6 +42,14 @@ MAX_TURN_ROWS = 100_000
 FREE_STEP = 0.01
 NEAREST_BATCH = 16
 MAX_FREE_VALUES = 100_000
+# a free joint's value is taken modulo 2 pi (revolute) before it is solved with: at most
+# FREE_LIMIT radians (or FREE_LIMIT * REACH of length), where that reduction, and the cos
+# and sin of the value, are accurate to ~1e-10
+FREE_LIMIT = 1e6
+# a pose farther than FAR_REACH * REACH from the base along an axis is out of reach: revolute
+# joints reach REACH, no sliding joint a million times that, and the solvers' squares and
+# products of such positions would overflow
+FAR_REACH = 1e6
 # the general 6R method (derive/runtime/general.py): Q's rank counts singular values above
 # _RR_RANK_TOL of the largest; a Moebius map x3 = (a y + b) / (c y + d) is kept once the
 # leading matrix's condition number is below _RR_COND_LIMIT (else the best of the three; the

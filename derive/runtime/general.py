@@ -2,7 +2,8 @@
 
 The arm's printed code gives, per split (the arm's chain, or its reversal), the flange target
 in the split's standard-DH frame (12 numbers) and fills the Raghavan-Roth matrices P0, Ps, Pc
-and Q (``_rr_fill``). From there the steps are the same for every arm (ALGORITHMS.md 4.4-4.7):
+and Q (``_rr_fill``). From there the steps are the same for every arm (docs/algorithms.md,
+"The general 6R method"):
 
 1. the left null space N of Q (SVD) removes theta1 and theta2: N P(theta3) m45 = 0;
 2. the half-angle substitution and the dialytic lift give a 12 x 12 quadratic matrix
@@ -74,8 +75,9 @@ def _rr_half_angle(shift):
     return (ss, 2.0 * cs, -ss), (cs, -2.0 * ss, -cs), (1.0, 0.0, 1.0)
 
 
-# m45 (1 + x4^2)(1 + x5^2) = _RR_H45 [x4^i x5^j], column 3 i + j (ALGORITHMS.md 4.5, with the
-# half-angles of _RR_SHIFT45): rows are outer products of _rr_half_angle's coefficients
+# m45 (1 + x4^2)(1 + x5^2) = _RR_H45 [x4^i x5^j], column 3 i + j (docs/algorithms.md,
+# "Half-angles, the dialytic lift and the eigenproblem", with the half-angles of
+# _RR_SHIFT45): rows are outer products of _rr_half_angle's coefficients
 _RR_S4, _RR_C4, _RR_O4 = _rr_half_angle(_RR_SHIFT45[0])
 _RR_S5, _RR_C5, _RR_O5 = _rr_half_angle(_RR_SHIFT45[1])
 _RR_H45 = np.array(
@@ -310,10 +312,11 @@ def _rr_between(fill_rows, true_rows, t):
 
 
 def _rr_candidates(P0, Ps, Pc, Q, F, rows, slide=_RR_TURNS, imag_tol=_RR_IMAG_TOL, spurious=None):
-    """The unpolished joint values of one split from its matrices (ALGORITHMS.md 4.4-4.7),
-    whether the eigenvalues came in clusters (an answer in doubt), and which candidates are
-    extras (from nearly real pairs: one that does not polish puts nothing in doubt). Where
-    joint 3 slides (slide[0] set) the eigen-variable x3 is d3 itself, not tan(theta3 / 2)."""
+    """The unpolished joint values of one split from its matrices (docs/algorithms.md, "The
+    general 6R method"), whether the eigenvalues came in clusters (an answer in doubt), and
+    which candidates are extras (from nearly real pairs: one that does not polish puts nothing
+    in doubt). Where joint 3 slides (slide[0] set) the eigen-variable x3 is d3 itself, not
+    tan(theta3 / 2)."""
     found = _rr_eigenvalues(P0, Ps, Pc, Q, spurious)
     if found is None:  # (a singular pencil: None, where no eigenvalue is real gives [])
         return None, True, []

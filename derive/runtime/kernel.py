@@ -41,7 +41,7 @@ from derive.runtime.closed import (
     _reach_first2,
     _small_residual,
 )
-from derive.runtime.common import _LOWER, _UPPER
+from derive.runtime.common import _FAR, _LOWER, _UPPER
 from derive.runtime.constants import (
     _CLAMP_TOL,
     _CLUSTER_TOL,
@@ -73,11 +73,14 @@ from derive.runtime.general import _RR_H45, _RR_MIX, _RR_MONOMIAL_RULES, _RR_MOT
 
 
 def _kpose_ok(T, i):
-    """Whether T[i] is a finite rigid transform within POSE_TOL (as _vpose)."""
+    """Whether T[i] is a finite rigid transform within POSE_TOL, within _FAR of the base (as
+    _vpose; ik's Python solver answers a far pose with no row)."""
     for r in range(4):
         for c in range(4):
             if not math.isfinite(T[i, r, c]):
                 return False
+    if max(abs(T[i, 0, 3]), abs(T[i, 1, 3]), abs(T[i, 2, 3])) > _FAR:
+        return False
     worst = max(abs(T[i, 3, 0]), abs(T[i, 3, 1]), abs(T[i, 3, 2]), abs(T[i, 3, 3] - 1.0))
     for r in range(3):
         for s in range(r, 3):

@@ -12,7 +12,13 @@ from numpy.typing import ArrayLike
 from derive.runtime.api import _distances, _in_limits, _nearest_arguments, _pose, ik, ik_batch
 from derive.runtime.arm import _REVOLUTE, FREE, LIMITS, REACH
 from derive.runtime.common import _real, _reference
-from derive.runtime.constants import CERTIFY_TOL, FREE_STEP, MAX_FREE_VALUES, NEAREST_BATCH
+from derive.runtime.constants import (
+    _TWO_PI,
+    CERTIFY_TOL,
+    FREE_STEP,
+    MAX_FREE_VALUES,
+    NEAREST_BATCH,
+)
 
 
 def nearest(
@@ -52,8 +58,12 @@ def nearest(
     for j in FREE:
         lo, hi = LIMITS[j - 1] if within_limits else (-math.inf, math.inf)
         half = math.pi if _REVOLUTE[j - 1] else REACH
-        lo, hi = max(lo, refs[j - 1] - half), min(hi, refs[j - 1] + half)
-        start = min(max(refs[j - 1], lo), hi)
+        centre = refs[j - 1]
+        if _REVOLUTE[j - 1] and not within_limits:
+            centre = math.remainder(centre, _TWO_PI)  # (the result is wrapped)
+        # q_ref's value, or the limit nearest it: half a turn (or REACH) either side
+        start = min(max(centre, lo), hi)
+        lo, hi = max(lo, start - half), min(hi, start + half)
         if (hi - lo) / step >= MAX_FREE_VALUES:
             raise ValueError(f"free_step {step!r} gives more than {MAX_FREE_VALUES} values")
         k = np.arange(-math.floor((start - lo) / step), math.floor((hi - start) / step) + 1)
@@ -64,7 +74,7 @@ def nearest(
     columns = [j - 1 for j in FREE]
     own = np.tile(np.array(refs), (len(grid), 1))
     own[:, columns] = grid
-    bound = _distances(own, refs, w, metric, False)
+    bound = _distances(own, refs, w, metric, not within_limits)
     order = np.argsort(bound, kind="stable")
     best, least = None, math.inf
     # q_ref's own free values first (one ik: along a smooth path that usually settles it),
@@ -72,7 +82,7 @@ def nearest(
     starts = [0, *range(1, len(order), NEAREST_BATCH)]
     for first, end in zip(starts, [*starts[1:], len(order)]):
         chunk = order[first:end]
-        if bound[chunk[0]] >= least:
+        if best is not None and bound[chunk[0]] >= least:
             break
         if len(chunk) == 1:
             rows = ik(A, free=grid[chunk[0]], q_ref=refs)
@@ -86,7 +96,7 @@ def nearest(
             continue
         costs = _distances(rows, refs, w, metric, not within_limits)
         i = int(np.argmin(costs))
-        if costs[i] < least:
+        if best is None or costs[i] < least:
             best, least = rows[i], float(costs[i])
     return best
 

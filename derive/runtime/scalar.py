@@ -179,9 +179,10 @@ def _poly_angles(
     """Angles t whose u = tan(t/2) is a real root of the polynomial (highest degree first).
 
     The polynomial is solved in u, or in v = 1/u when its last coefficient is the larger
-    end, so that a vanishing leading coefficient (a root at u = infinity, t = pi; ALGORITHMS.md
-    2.4) is an ordinary root v = 0. When both ends vanish (below _LEAD_TOL of the largest
-    coefficient) the leading one is deflated as its exact root. Angles are wrapped to
+    end, so that a vanishing leading coefficient (a root at u = infinity, t = pi;
+    docs/algorithms.md, "Polynomials in u = tan(t/2) and the root at t = pi") is an ordinary
+    root v = 0. When both ends vanish (below _LEAD_TOL of the largest coefficient) the
+    leading one is deflated as its exact root. Angles are wrapped to
     (-pi, pi] (within 1e-12 of +-pi: pi), sorted, and equal ones (1e-12) merged. Near-double
     roots come out as complex pairs with a small imaginary part; they are accepted and
     polished. Every candidate is certified by forward kinematics afterwards, so a spurious

@@ -9,7 +9,7 @@ import math
 import numpy as np
 
 from derive.runtime.arm import _REVOLUTE
-from derive.runtime.common import _PERIODS, _real
+from derive.runtime.common import _FAR, _PERIODS, _real
 from derive.runtime.constants import (
     _CLAMP_TOL,
     _CLUSTER_TOL,
@@ -302,7 +302,8 @@ def _vpoly(coeffs, axis, like, angles, ref=0.0, free=0.0, unit=1.0):
 
 
 def _vpose(T):
-    """Per-row validity of poses (N, 4, 4) and the poses with invalid rows replaced."""
+    """Per-row validity of poses (N, 4, 4) and the poses with invalid rows replaced (a pose
+    farther than _FAR is out of reach: no valid slot, as an invalid one)."""
     T = _real(T, "T")
     if T.ndim != 3 or T.shape[1:] != (4, 4):
         raise ValueError(f"T must have shape (N, 4, 4), got {T.shape}")
@@ -323,7 +324,8 @@ def _vpose(T):
         ):
             worst = np.maximum(worst, np.abs(dot))
         det = a0 * (b1 * c2 - b2 * c1) - a1 * (b0 * c2 - b2 * c0) + a2 * (b0 * c1 - b1 * c0)
-        good = (worst <= POSE_TOL) & (det > 0.0) & np.isfinite(flat).all(axis=1)
+        near = np.abs(flat[:, [3, 7, 11]]).max(axis=1) <= _FAR
+        good = (worst <= POSE_TOL) & (det > 0.0) & np.isfinite(flat).all(axis=1) & near
     if good.all():
         return T, good
     return np.where(good[:, None, None], T, np.eye(4)), good
