@@ -264,11 +264,12 @@ def cmd_generate(args: argparse.Namespace) -> int:
     first (two arms of one name are refused before anything is written); a spec that
     cannot be read is said and the others are generated."""
     out = output_folder(Path(args.out), "--out")
+    options = urdf_options(args)  # (a bad option is one line, not one per arm)
     failed, no_ik = [], []
     specs: dict[str, ArmSpec] = {}
     for text in args.specs or [str(p) for p in bundled_specs()]:
         try:
-            specs[text] = resolve_spec(text, urdf_options(args))
+            specs[text] = resolve_spec(text, options)
         except (SpecError, UsageError, OSError) as exc:
             print(f"error: {exc}", file=sys.stderr)
             failed.append(text)

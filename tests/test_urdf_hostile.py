@@ -95,6 +95,9 @@ def test_a_tolerance_out_of_range_gets_one_line_stating_the_range(option, value,
         args = (command, str(path), "--base", "world", "--tip", "tool0", option, value)
         line = fails(*args)
         assert option in line and "allowed: 0 to " in line
+    # every bundled arm (no arm named): one line too, not one per arm
+    line = fails("generate", option, value)
+    assert option in line and "allowed: 0 to " in line
 
 
 def test_tolerances_in_range_are_taken():

@@ -128,3 +128,18 @@ def test_the_algorithms_page_has_every_section_the_code_cites():
 
 if __name__ == "__main__":
     sys.exit(pytest.main([__file__, "-n", "0", "-q"]))
+
+
+def test_the_readme_opens_with_the_two_commands_ci_runs():
+    """The README's first code block: one command sets up and generates the bundled arms, one
+    runs the tests; .ci/run installs the same extras and runs the same test command."""
+    readme = (ROOT / "README.md").read_text(encoding="utf-8")
+    first = readme.split("```sh\n", 1)[1].split("```", 1)[0].strip().splitlines()
+    assert first == [
+        "python3 -m venv .venv && .venv/bin/pip install -e '.[test,lint]' && "
+        ".venv/bin/derive generate",
+        ".venv/bin/python -m pytest",
+    ]
+    assert readme.index("```sh") < readme.index("## ")
+    ci = (ROOT / ".ci" / "run").read_text(encoding="utf-8")
+    assert "-e '.[test,lint]'" in ci and ".venv/bin/python -m pytest" in ci
