@@ -942,6 +942,11 @@ def _general(flanges, tol):
                 candidates, close, _ = _rr_split(k, F, F @ motion, leads)
                 _rr_merge(found, [_rr_to_arm(k, q) for q in candidates])
                 _rr_merge(near, [_rr_to_arm(k, q) for q in close])
+    if 0 < len(found) < MAX_SOLUTIONS and any(fill != true for _, fill, true, _ in _RR_SPLITS):
+        # a perturbed table walks two solutions that share the eigen-joint value (the PUMA's
+        # wrist flip) onto one now and then, whether the count stays even or not: their
+        # partners, tried for every row found (_rr_partners)
+        _rr_merge(found, _rr_partners(targets, found))
     if len(found) % 2:
         # an odd number (real solutions pair up where the pose is regular): one was missed,
         # most likely the partner of a found one with the same eigen-joint value (the PUMA's
@@ -976,6 +981,28 @@ class _RRLeads:
     def __init__(self):
         self.singular = False
         self.rows: list[np.ndarray] = []
+
+
+def _rr_partners(targets, rows):
+    """The wrist-flip partners of the rows: each row with the three joints at either end
+    turned as a spherical wrist's flip, (t1 + pi, -t2, t3 + pi) (an end with a sliding joint
+    left alone), polished by Newton's steps on split 0's frame and the arm's own table; the
+    arm's values of those that reach _RR_GOOD (the caller merges repeats). Where those axes
+    do not meet, Newton ends elsewhere or nowhere: nothing unsound is added either way."""
+    _, _, true_rows, slide = _RR_SPLITS[0]
+    slider = (3 if _RR_SPLITS[0][0] else 2) if slide[0] else -1
+    starts = []
+    for q in rows:
+        for first in (0, 3):
+            if first <= slider < first + 3:
+                continue
+            p = np.array(q, dtype=float)
+            p[first : first + 3] = (p[first] + math.pi, -p[first + 1], p[first + 2] + math.pi)
+            starts.append(_rr_from_arm(0, p))
+    if not starts:
+        return []
+    Q, errors = _rr_steps_many(true_rows, targets[0], np.array(starts), slide, False)
+    return [_rr_to_arm(0, q) for q in Q[errors <= _RR_GOOD]]
 
 
 def _rr_search(targets, rows):
@@ -1907,8 +1934,66 @@ def _kgeneral(flanges, out):
                 count, _ = _krr_split(k, targets[k], moved, out, count)
                 if count == limit:
                     return count
+    if 0 < count < limit and _krr_perturbed():
+        count = _krr_partners(targets[0], out, count)
     # (an odd count: the Python solver's search looks for the one missed)
     return count if count > 0 and count % 2 == 0 else -1
+
+
+def _krr_perturbed():
+    """Whether a split solves a perturbed table (the arm's own pencils are singular)."""
+    for k in range(len(_RR_SPLITS)):
+        fill = np.array(_RR_SPLITS[k][1])
+        true = np.array(_RR_SPLITS[k][2])
+        for i in range(6):
+            for j in range(4):
+                if fill[i, j] != true[i, j]:
+                    return True
+    return False
+
+
+def _krr_partners(F, out, count):
+    """_rr_partners in the kernel: the wrist-flip partners of out's count rows, polished on
+    split 0's frame, added where new until out is full; the new count."""
+    limit = out.size // 6
+    true = np.zeros((7, 4))
+    true[:6] = np.array(_RR_SPLITS[0][2])
+    true[6, 0], true[6, 1] = _RR_SPLITS[0][3]
+    slider = (3 if _RR_SPLITS[0][0] else 2) if true[6, 0] != 0.0 else -1
+    rows = count
+    for r in range(rows):
+        for first in (0, 3):
+            if first <= slider < first + 3 or count == limit:
+                continue
+            p = out[6 * r : 6 * r + 6].copy()
+            p[first] += math.pi
+            p[first + 1] = -p[first + 1]
+            p[first + 2] += math.pi
+            q = -p[::-1] if _RR_SPLITS[0][0] else p
+            if slider >= 0:
+                q[2] /= _RR_LENGTH
+            q, error = _krr_steps(true, F, q, False)
+            if error > _RR_GOOD:
+                continue
+            if slider >= 0:
+                q[2] *= _RR_LENGTH
+            if _RR_SPLITS[0][0]:
+                q = -q[::-1]
+            count = _krr_add(q, out, count)
+    return count
+
+
+def _krr_add(q, out, count):
+    """q added to out's count rows unless there already (angles modulo 2 pi, within 1e-7):
+    the new count."""
+    for r in range(count):
+        gap = 0.0
+        for j in range(6):
+            gap = max(gap, abs((q[j] - out[6 * r + j] + math.pi) % _TWO_PI - math.pi))
+        if gap <= 1e-7:
+            return count
+    out[6 * count : 6 * count + 6] = q
+    return count + 1
 
 
 def _krr_split(k, F, moved, out, count):
@@ -1951,19 +2036,9 @@ def _krr_split(k, F, moved, out, count):
             q[2] *= _RR_LENGTH
         if _RR_SPLITS[k][0]:  # the reversed chain: joint j is -q_{7-j}
             q = -q[::-1]
-        seen = False
-        for r in range(count):
-            gap = 0.0
-            for j in range(6):
-                gap = max(gap, abs((q[j] - out[6 * r + j] + math.pi) % _TWO_PI - math.pi))
-            if gap <= 1e-7:
-                seen = True
-                break
-        if not seen:
-            out[6 * count : 6 * count + 6] = q
-            count += 1
-            if count == limit:
-                return count, doubt
+        count = _krr_add(q, out, count)
+        if count == limit:
+            return count, doubt
     return count, doubt
 
 
@@ -3698,6 +3773,9 @@ _KERNEL = (
     '_kone',
     '_kbatch',
     '_kgeneral',
+    '_krr_perturbed',
+    '_krr_partners',
+    '_krr_add',
     '_krr_split',
     '_krr_candidates',
     '_krr_pencil',

@@ -1782,6 +1782,22 @@ static int dk_rr_add(int k, const double q[6], double out[DK_RR_ROWS][6], int co
     return count + 1;
 }
 
+/* whether a split solves a perturbed table (the arm's own pencils are singular) */
+static int dk_rr_perturbed(void)
+{
+    int k, i, j;
+    for (k = 0; k < DK_RR_SPLIT_COUNT; k++) {
+        for (i = 0; i < 6; i++) {
+            for (j = 0; j < 4; j++) {
+                if (DK_RR_FILL[k][i][j] != DK_RR_TRUE[k][i][j]) {
+                    return 1;
+                }
+            }
+        }
+    }
+    return 0;
+}
+
 /* split k's polished candidates for the target F (found from the pose `moved`) added to
    out[count..] where new, until DK_RR_ROWS; the new count; *doubt as dk_rr_candidates' */
 static int dk_rr_split(int k, const double F[4][4], const double moved[4][4],
@@ -1826,6 +1842,41 @@ static int dk_rr_split(int k, const double F[4][4], const double moved[4][4],
         count = dk_rr_add(k, q, out, count);
         if (count == DK_RR_ROWS) {
             return count;
+        }
+    }
+    return count;
+}
+
+/* The wrist-flip partners of out[0..count) (the Python solver's _rr_partners): each row with
+   the three joints at either end turned as a spherical wrist's flip, (t1 + pi, -t2, t3 + pi)
+   (an end with a sliding joint left alone), polished by Newton's steps on split 0's frame and
+   the arm's own table, added where they reach DK_RR_GOOD and are new. The new count. */
+static int dk_rr_partners(const double F[4][4], double out[DK_RR_ROWS][6], int count)
+{
+    const int rows = count;
+    const int slider = DK_RR_TRUE[0][6][0] != 0.0 ? (DK_RR_REVERSED[0] ? 3 : 2) : -1;
+    int r, first, j;
+    for (r = 0; r < rows && count < DK_RR_ROWS; r++) {
+        for (first = 0; first <= 3 && count < DK_RR_ROWS; first += 3) {
+            double p[6], q[6];
+            if (first <= slider && slider < first + 3) {
+                continue;
+            }
+            for (j = 0; j < 6; j++) {
+                p[j] = out[r][j];
+            }
+            p[first] += DK_PI;
+            p[first + 1] = -p[first + 1];
+            p[first + 2] += DK_PI;
+            for (j = 0; j < 6; j++) { /* the arm's values as split 0's */
+                q[j] = DK_RR_REVERSED[0] ? -p[5 - j] : p[j];
+            }
+            if (slider >= 0) {
+                q[2] /= DK_RR_LENGTH;
+            }
+            if (dk_rr_steps(DK_RR_TRUE[0], F, q, 0) <= DK_RR_GOOD) {
+                count = dk_rr_add(0, q, out, count);
+            }
         }
     }
     return count;
@@ -1914,6 +1965,11 @@ static int dk_general(const double flanges[DK_RR_SPLIT_COUNT][12], double out[DK
                 }
             }
         }
+    }
+    if (count > 0 && count < DK_RR_ROWS && dk_rr_perturbed()) {
+        /* a perturbed table walks two solutions that share the eigen-joint value (the PUMA's
+           wrist flip) onto one now and then, whether the count stays even or not */
+        count = dk_rr_partners(targets[0], out, count);
     }
     if (count % 2) {
         count = dk_rr_search(targets[0], out, count);

@@ -86,6 +86,16 @@ UR5_ROWS = [(90, 0, 0.089159, 0), (0, -0.425, 0, 0), (0, -0.39225, 0, 0)]
 UR5_ROWS += [(90, 0, 0.10915, 0), (-90, 0, 0.09465, 0), (0, 0, 0.0823, 0)]
 
 
+def general_and_closed(spec, folder):
+    """The modules of one arm by the general method and by its closed form."""
+    modules = []
+    for method in ("general", None):
+        path = folder / f"{spec.name}_{method or 'closed'}.py"
+        path.write_text(render_module(build_plan(spec, method)))
+        modules.append(import_path(path))
+    return modules
+
+
 @pytest.mark.parametrize("arm", ["puma560", "parallel_6r", "lecture_6r", "ur5"])
 def test_closed_form_arms_solved_again_by_the_general_method(arm, tmp_path):
     """The general method on arms a closed form solves: every solution it returns is one of the
@@ -101,12 +111,7 @@ def test_closed_form_arms_solved_again_by_the_general_method(arm, tmp_path):
         spec = parse_spec(spec_text("ur5", "standard", UR5_ROWS), "<ur5>")
     else:
         spec = resolve_spec(arm)
-    modules = []
-    for method in ("general", None):
-        path = tmp_path / f"{arm}_{method or 'closed'}.py"
-        path.write_text(render_module(build_plan(spec, method)))
-        modules.append(import_path(path))
-    general, closed = modules
+    general, closed = general_and_closed(spec, tmp_path)
     rng = np.random.default_rng(17)
     same = 0
     poses = 400
@@ -319,3 +324,27 @@ def test_the_search_stays_out_of_regular_poses_and_unreachable_ones(generated, m
     far[:, :3, 3] *= 4.0 / np.linalg.norm(T[:, :3, 3], axis=1)[:, None]
     rows = [len(m.ik(t, backend="python")) for t in np.concatenate((T, far))]
     assert calls == [] and min(rows[:60]) > 0 and max(rows[60:]) == 0
+
+
+def test_wrist_flip_partners_lost_in_pairs_are_found_without_an_odd_count(tmp_path):
+    """Issue 37 item 19: on a perturbed table two solutions sharing the eigen-joint value are
+    now and then walked onto one, and whether that happens hangs on the last bits of the
+    linear algebra (another machine lost one at pose 46 of the cross-check above). The
+    partner check does not wait for an odd count: here the splits lose one of every
+    wrist-flip pair (an even count, no doubt), and ik still returns the closed form's set."""
+    general, closed = general_and_closed(resolve_spec("puma560"), tmp_path)
+    original = general._rr_split
+
+    def lossy(k, F, moved, leads, *rest):
+        out, close, doubt = original(k, F, moved, leads, *rest)
+        # (the arm's theta5 below zero: one of every pair (theta4 + pi, -theta5, theta6 + pi))
+        return [q for q in out if general._rr_to_arm(k, q)[4] < 0.0], close, doubt
+
+    general._rr_split = lossy
+    rng = np.random.default_rng(37)
+    for _ in range(20):
+        T = closed.fk(rng.uniform(-math.pi, math.pi, 6))
+        expected, rows = closed.ik(T, backend="python"), general.ik(T, backend="python")
+        assert len(rows) == len(expected)
+        for row in rows:
+            assert np.abs(closed.fk(row) - T).max() <= 1e-9

@@ -129,6 +129,11 @@ def _general(flanges, tol):
                 candidates, close, _ = _rr_split(k, F, F @ motion, leads)
                 _rr_merge(found, [_rr_to_arm(k, q) for q in candidates])
                 _rr_merge(near, [_rr_to_arm(k, q) for q in close])
+    if 0 < len(found) < MAX_SOLUTIONS and any(fill != true for _, fill, true, _ in _RR_SPLITS):
+        # a perturbed table walks two solutions that share the eigen-joint value (the PUMA's
+        # wrist flip) onto one now and then, whether the count stays even or not: their
+        # partners, tried for every row found (_rr_partners)
+        _rr_merge(found, _rr_partners(targets, found))
     if len(found) % 2:
         # an odd number (real solutions pair up where the pose is regular): one was missed,
         # most likely the partner of a found one with the same eigen-joint value (the PUMA's
@@ -163,6 +168,28 @@ class _RRLeads:
     def __init__(self):
         self.singular = False
         self.rows: list[np.ndarray] = []
+
+
+def _rr_partners(targets, rows):
+    """The wrist-flip partners of the rows: each row with the three joints at either end
+    turned as a spherical wrist's flip, (t1 + pi, -t2, t3 + pi) (an end with a sliding joint
+    left alone), polished by Newton's steps on split 0's frame and the arm's own table; the
+    arm's values of those that reach _RR_GOOD (the caller merges repeats). Where those axes
+    do not meet, Newton ends elsewhere or nowhere: nothing unsound is added either way."""
+    _, _, true_rows, slide = _RR_SPLITS[0]
+    slider = (3 if _RR_SPLITS[0][0] else 2) if slide[0] else -1
+    starts = []
+    for q in rows:
+        for first in (0, 3):
+            if first <= slider < first + 3:
+                continue
+            p = np.array(q, dtype=float)
+            p[first : first + 3] = (p[first] + math.pi, -p[first + 1], p[first + 2] + math.pi)
+            starts.append(_rr_from_arm(0, p))
+    if not starts:
+        return []
+    Q, errors = _rr_steps_many(true_rows, targets[0], np.array(starts), slide, False)
+    return [_rr_to_arm(0, q) for q in Q[errors <= _RR_GOOD]]
 
 
 def _rr_search(targets, rows):

@@ -476,8 +476,66 @@ def _kgeneral(flanges, out):
                 count, _ = _krr_split(k, targets[k], moved, out, count)
                 if count == limit:
                     return count
+    if 0 < count < limit and _krr_perturbed():
+        count = _krr_partners(targets[0], out, count)
     # (an odd count: the Python solver's search looks for the one missed)
     return count if count > 0 and count % 2 == 0 else -1
+
+
+def _krr_perturbed():
+    """Whether a split solves a perturbed table (the arm's own pencils are singular)."""
+    for k in range(len(_RR_SPLITS)):
+        fill = np.array(_RR_SPLITS[k][1])
+        true = np.array(_RR_SPLITS[k][2])
+        for i in range(6):
+            for j in range(4):
+                if fill[i, j] != true[i, j]:
+                    return True
+    return False
+
+
+def _krr_partners(F, out, count):
+    """_rr_partners in the kernel: the wrist-flip partners of out's count rows, polished on
+    split 0's frame, added where new until out is full; the new count."""
+    limit = out.size // 6
+    true = np.zeros((7, 4))
+    true[:6] = np.array(_RR_SPLITS[0][2])
+    true[6, 0], true[6, 1] = _RR_SPLITS[0][3]
+    slider = (3 if _RR_SPLITS[0][0] else 2) if true[6, 0] != 0.0 else -1
+    rows = count
+    for r in range(rows):
+        for first in (0, 3):
+            if first <= slider < first + 3 or count == limit:
+                continue
+            p = out[6 * r : 6 * r + 6].copy()
+            p[first] += math.pi
+            p[first + 1] = -p[first + 1]
+            p[first + 2] += math.pi
+            q = -p[::-1] if _RR_SPLITS[0][0] else p
+            if slider >= 0:
+                q[2] /= _RR_LENGTH
+            q, error = _krr_steps(true, F, q, False)
+            if error > _RR_GOOD:
+                continue
+            if slider >= 0:
+                q[2] *= _RR_LENGTH
+            if _RR_SPLITS[0][0]:
+                q = -q[::-1]
+            count = _krr_add(q, out, count)
+    return count
+
+
+def _krr_add(q, out, count):
+    """q added to out's count rows unless there already (angles modulo 2 pi, within 1e-7):
+    the new count."""
+    for r in range(count):
+        gap = 0.0
+        for j in range(6):
+            gap = max(gap, abs((q[j] - out[6 * r + j] + math.pi) % _TWO_PI - math.pi))
+        if gap <= 1e-7:
+            return count
+    out[6 * count : 6 * count + 6] = q
+    return count + 1
 
 
 def _krr_split(k, F, moved, out, count):
@@ -520,19 +578,9 @@ def _krr_split(k, F, moved, out, count):
             q[2] *= _RR_LENGTH
         if _RR_SPLITS[k][0]:  # the reversed chain: joint j is -q_{7-j}
             q = -q[::-1]
-        seen = False
-        for r in range(count):
-            gap = 0.0
-            for j in range(6):
-                gap = max(gap, abs((q[j] - out[6 * r + j] + math.pi) % _TWO_PI - math.pi))
-            if gap <= 1e-7:
-                seen = True
-                break
-        if not seen:
-            out[6 * count : 6 * count + 6] = q
-            count += 1
-            if count == limit:
-                return count, doubt
+        count = _krr_add(q, out, count)
+        if count == limit:
+            return count, doubt
     return count, doubt
 
 
