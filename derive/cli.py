@@ -20,7 +20,7 @@ from functools import partial
 from importlib import resources
 from pathlib import Path
 from types import ModuleType
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, NoReturn
 
 if TYPE_CHECKING:
     from collections.abc import Iterable
@@ -201,7 +201,12 @@ def output_file(path: Path) -> Path:
             f"{path}: is {node_kind(mode)}; derive writes regular files only (or the "
             "file a symbolic link names), never replaces anything else"
         )
-    return Path(os.path.realpath(path)) if path.is_symlink() else path
+    if not path.is_symlink():
+        return path
+    target = Path(os.path.realpath(path))
+    if not target.parent.is_dir():  # (no folders made where a dangling link points)
+        raise UsageError(f"{path}: a symbolic link to {target}, whose folder does not exist")
+    return target
 
 
 def output_folder(path: Path, option: str) -> Path:
@@ -687,10 +692,16 @@ def free_values(
     if len(numbers) != len(free):
         names = ", ".join(f"q{j}" for j in free)
         raise UsageError(f"--free: give {len(free)} value(s), for {names}")
-    return [
+    values = [
         math.radians(v) if spec.joint_types[j - 1] == "R" and not args.rad else v
         for v, j in zip(numbers, free)
     ]
+    limit = module.FREE_LIMIT
+    for v, given, j in zip(values, numbers, free):
+        if spec.joint_types[j - 1] == "R" and not abs(v) <= limit:
+            shown = f"{math.degrees(limit):g} deg" if not args.rad else f"{limit:g} rad"
+            raise UsageError(f"--free: q{j} = {given:g}: allowed: within +-{shown}")
+    return values
 
 
 def cmd_bench(args: argparse.Namespace) -> int:
@@ -938,11 +949,32 @@ def bench_text(name: str, f: dict) -> str:
     )
 
 
+class Parser(argparse.ArgumentParser):
+    """argparse's parser, its errors one line on stderr (exit 2) as every other error here:
+    the usage is one `--help` away."""
+
+    def error(self, message: str) -> NoReturn:
+        self.exit(2, f"error: {self.prog}: {message} (see {self.prog} --help)\n")
+
+
+def count(least: int) -> Any:
+    """An argparse type: an integer of at least `least` (a count of samples or poses)."""
+
+    def parse(text: str) -> int:
+        try:
+            value = int(text)
+        except ValueError:
+            value = least - 1
+        if value < least:
+            raise argparse.ArgumentTypeError(f"{text!r}: allowed: an integer >= {least}")
+        return value
+
+    return parse
+
+
 def parser() -> argparse.ArgumentParser:
     """The argument parser of `derive`."""
-    top = argparse.ArgumentParser(
-        prog="derive", description="Closed-form IK solvers from DH tables."
-    )
+    top = Parser(prog="derive", description="Closed-form IK solvers from DH tables.")
     top.add_argument("--version", action="version", version=f"derive-ik {extras.version()}")
     sub = top.add_subparsers(dest="command", required=True)
     gen = sub.add_parser("generate", help="write generated/<name>.py and <name>.md for each arm")
@@ -1057,12 +1089,15 @@ def parser() -> argparse.ArgumentParser:
     bench = sub.add_parser("bench", help="time generation and solvers; round-trip figures")
     bench.add_argument("specs", nargs="*", help="spec files or bundled arm names (default: all)")
     bench.add_argument(
-        "--samples", "--n", type=int, default=10000, help="round-trip samples (10000)"
+        "--samples", "--n", type=count(1), default=10000, help="round-trip samples (10000)"
     )
     bench.add_argument("--seed", type=int, default=0, help="random seed (0)")
-    bench.add_argument("--batch", type=int, default=100_000, help="poses for ik_batch timing")
+    bench.add_argument("--batch", type=count(1), default=100_000, help="poses for ik_batch timing")
     bench.add_argument(
-        "--memory", type=int, default=0, help="also measure ik_batch peak memory on this many poses"
+        "--memory",
+        type=count(0),
+        default=0,
+        help="also measure ik_batch peak memory on this many poses",
     )
     bench.add_argument("--json", action="store_true", help="print figures as JSON")
     bench.add_argument(

@@ -35,6 +35,7 @@ import json
 import keyword
 import math
 import re
+import stat
 import sys
 import tomllib
 from dataclasses import asdict, dataclass
@@ -244,6 +245,8 @@ def load_spec(path: str | Path) -> ArmSpec:
     """
     where = str(path)
     try:
+        if not stat.S_ISREG(Path(path).stat().st_mode):  # (a pipe would block the read)
+            raise SpecError(f"{where}: not a regular file")
         raw = Path(path).read_bytes()
     except OSError as exc:
         raise SpecError(f"{where}: cannot read the spec file ({exc.strerror or exc})") from None

@@ -23,6 +23,7 @@ import hashlib
 import math
 import random
 import re
+import stat
 import sys
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -50,6 +51,8 @@ OFFSET_LIMIT = 100.0
 # the largest magnitude of a number in a URDF (metres, radians, axis components): no arm is
 # 1000 km long, and above it squares and degrees stay far from overflow
 MAX_NUMBER = 1e6
+# a number as a URDF writes one: decimal, ASCII, an optional exponent
+DECIMAL = re.compile(r"[+-]?(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?:[eE][+-]?[0-9]+)?", re.ASCII)
 # what the options may be: snapping beyond 0.1 rad or 0.1 of the arm's size changes the arm;
 # a deviation is a rotation entry or a fraction of the reach, so above 1 it bounds nothing
 TOLERANCE_RANGE = (0.0, 0.1)
@@ -128,7 +131,10 @@ def read_urdf(path: Path) -> Robot:
     """The links and joints of a URDF file."""
     where = str(path)
     try:
-        size = path.stat().st_size
+        status = path.stat()
+        if not stat.S_ISREG(status.st_mode):  # (a pipe would block the read)
+            raise UrdfError(f"{where}: not a regular file")
+        size = status.st_size
         if size > MAX_BYTES:
             raise UrdfError(f"{where}: {size} bytes; a URDF may have at most {MAX_BYTES}")
         data = path.read_bytes()
@@ -277,9 +283,11 @@ def _numbers(text: str | None, count: int, where: str, default: tuple[float, ...
     if text is None:
         return list(default)
     parts = text.split()
-    try:
+    # (decimal numbers in ASCII, as URDF's parsers read them: float() would also take
+    # "0.089_159" and other scripts' digits)
+    if all(DECIMAL.fullmatch(p) for p in parts):
         values = [float(p) for p in parts]
-    except ValueError:
+    else:
         values = []
     if len(values) != count or not all(abs(v) <= MAX_NUMBER for v in values):
         numbers = "a finite number" if count == 1 else f"{count} finite numbers"

@@ -192,7 +192,10 @@ def fk(q: ArrayLike) -> np.ndarray:
     values = _real(q, "q")
     if values.shape != (DOF,):
         raise ValueError(f"q must have shape ({DOF},), got {values.shape}")
-    e = _fk_q(values.tolist())
+    joints = values.tolist()
+    if not all(map(math.isfinite, joints)):
+        raise ValueError(f"q must be {DOF} finite numbers")
+    e = _fk_q(joints)
     return np.array([e[0:4], e[4:8], e[8:12], (0.0, 0.0, 0.0, 1.0)])
 
 
@@ -201,6 +204,8 @@ def fk_batch(Q: ArrayLike) -> np.ndarray:
     values = _real(Q, "Q")
     if values.ndim != 2 or values.shape[1] != DOF:
         raise ValueError(f"Q must have shape (N, {DOF}), got {values.shape}")
+    if not np.isfinite(values).all():
+        raise ValueError("Q must be finite numbers")
     out = np.zeros((values.shape[0], 4, 4))
     entries = _fk_from_cs(*_cs_columns(values))
     for k, value in enumerate(entries):
@@ -778,7 +783,7 @@ def _tolerance(tol: float) -> float:
         value = float(tol)
     except (TypeError, ValueError):
         value = math.nan
-    if type(tol) is bool or not (0.0 < value < math.inf):
+    if isinstance(tol, (bool, str, bytes)) or not (0.0 < value < math.inf):
         raise ValueError(f"tol must be a positive finite number, got {tol!r}")
     return value
 

@@ -565,6 +565,14 @@ def test_the_binding_refuses_none_and_non_numbers_instead_of_crashing(generated,
         lambda: solver.ik(T, q_ref=[np.inf] * 6),
         lambda: solver.ik(np.full((4, 4), "1.0")),
         lambda: solver.ik(np.eye(4, dtype=bool)),
+        # as the Python module (the red team's second round)
+        lambda: solver.nearest(T, np.zeros(6), weights=[-1.0] * 6),
+        lambda: solver.nearest(T, np.zeros(6), weights=[np.nan] * 6),
+        lambda: solver.within_limits(solver.ik(T), q_ref=[np.nan] * 6),
+        lambda: solver.within_limits(np.zeros((2, 5))),
+        lambda: solver.ik(T, tol=None),
+        lambda: solver.ik(T, tol="1e-6"),
+        lambda: solver.fk([np.nan] * 6),
     ]
     for call in calls:
         with pytest.raises(ValueError):
@@ -591,3 +599,5 @@ def test_c_free_values_are_reduced_to_a_turn_and_bounded(generated, tmp_path):
     for bad in (1e17, 1e300):
         with pytest.raises(ValueError, match="free value"):
             solver.ik(T, free=[bad])
+    with pytest.raises(ValueError, match="shape"):
+        solver.ik(T, free=[[0.5]])

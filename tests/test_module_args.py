@@ -195,3 +195,14 @@ def test_poses_far_out_of_reach_give_no_solution(generated, name, recwarn):
     _, valid = m.ik_batch(T, backend="python")
     assert not valid[:-1].any() and valid[-1].any()
     assert [str(w.message) for w in recwarn] == []
+
+
+def test_fk_refuses_what_ik_refuses(ur5):
+    """fk([nan] * 6) gave a NaN matrix and ik(T, tol="1e-6") took a string."""
+    for q in ([math.nan] * 6, [math.inf] + [0.0] * 5):
+        with pytest.raises(ValueError, match="finite"):
+            ur5.fk(q)
+        with pytest.raises(ValueError, match="finite"):
+            ur5.fk_batch([q])
+    with pytest.raises(ValueError, match="tol must be a positive finite number"):
+        ur5.ik(ur5.fk(np.zeros(6)), tol="1e-6")

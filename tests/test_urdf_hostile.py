@@ -6,6 +6,7 @@ nothing written; what kinematics can take converts."""
 from __future__ import annotations
 
 import math
+import os
 import random
 from pathlib import Path
 
@@ -336,3 +337,26 @@ def test_a_long_chain_is_read_in_linear_time_and_bounded(tmp_path, fails):
     assert len(urdf.read_urdf(path).joints) == count
     line = fails("import-urdf", str(path), "--base", "l0", "--tip", f"l{count}")
     assert f"{count} joints between 'l0' and 'l{count}'; allowed at most 1000" in line
+
+
+# --- what a new user's red team found after the above ------------------------------------------
+
+
+@pytest.mark.parametrize("written", ["0 0 0.089_159", "0 0 ٠.٠٨٩", "0 0 ０.０８９"])
+def test_numbers_are_ascii_decimals_as_urdf_parsers_read_them(written, tmp_path, fails):
+    """float() takes digit separators and other scripts' digits; a URDF parser does not."""
+    path = write(tmp_path, urdf_text(two_joints(xyz=written), ["a", "b", "c"]))
+    line = fails("import-urdf", str(path), "--base", "a", "--tip", "c")
+    assert "origin xyz" in line and "allowed" in line
+
+
+@pytest.mark.parametrize("suffix", [".urdf", ".toml"])
+def test_a_named_pipe_as_input_is_refused_not_read(suffix, tmp_path, fails):
+    """Reading a FIFO blocks until a writer comes: import-urdf hung."""
+    pipe = tmp_path / f"robot{suffix}"
+    os.mkfifo(pipe)
+    if suffix == ".urdf":
+        line = fails("import-urdf", str(pipe), "--base", "a", "--tip", "c")
+    else:
+        line = fails("generate", str(pipe))
+    assert "not a regular file" in line

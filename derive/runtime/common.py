@@ -67,7 +67,7 @@ def _tolerance(tol: float) -> float:
         value = float(tol)
     except (TypeError, ValueError):
         value = math.nan
-    if type(tol) is bool or not (0.0 < value < math.inf):
+    if isinstance(tol, (bool, str, bytes)) or not (0.0 < value < math.inf):
         raise ValueError(f"tol must be a positive finite number, got {tol!r}")
     return value
 
