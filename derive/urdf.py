@@ -96,7 +96,8 @@ class Robot:
     links: frozenset[str]
     joints: tuple[UrdfJoint, ...]
     digest: str
-    ignored: tuple[str, ...] = ()  # attributes with a prefix nobody declared (drake:...)
+    # attributes (drake:...) and <elements> with a prefix nobody declared
+    ignored: tuple[str, ...] = ()
 
 
 @dataclass
@@ -235,6 +236,8 @@ class _TreeReader(ContentHandler):
             and (prefix == "xacro" or XACRO_NAMESPACE.match(declared.get(prefix, "")))
         ):
             self.xacro = f"element <{_cut(name)}>"
+        elif prefix and prefix not in declared:
+            self.undeclared.add(f"<{name}>")  # (not a URDF element: never read)
         kept = {}
         for key in attrs.getNames():
             value = attrs.getValue(key)
@@ -868,7 +871,16 @@ def import_urdf(path: Path, options: Options) -> tuple[str, Conversion]:
     if not options.base or not options.tip:
         raise UrdfError(f"{where}: a URDF needs --base LINK and --tip LINK")
     robot = read_urdf(path)
-    chain = chain_between(robot, options.base, options.tip, where)
+    try:
+        chain = chain_between(robot, options.base, options.tip, where)
+    except UrdfError as exc:
+        elements = [n for n in robot.ignored if n.startswith("<")]
+        if not elements:
+            raise
+        raise UrdfError(
+            f"{exc} (elements with a prefix no xmlns declares were not read as URDF: "
+            f"{_listing(elements)})"
+        ) from None
     conversion = convert(chain, where, options.angle_tol, options.length_tol, options.exact)
     name = options.name or spec_name(robot.name or path.stem)
     args = (conversion, robot, path.name, options.base, options.tip, name, options.convention)
@@ -884,8 +896,8 @@ def import_urdf(path: Path, options: Options) -> tuple[str, Conversion]:
         )
     if robot.ignored:
         conversion.notes.append(
-            f"{where}: ignored {len(robot.ignored)} attribute(s) with a prefix no xmlns "
-            f"declares ({_listing(list(robot.ignored))}); kinematics does not read them"
+            f"{where}: ignored {len(robot.ignored)} attribute(s) or element(s) with a prefix "
+            f"no xmlns declares ({_listing(list(robot.ignored))}); kinematics does not read them"
         )
     for note in conversion.notes:
         print(f"note: {note}", file=sys.stderr)

@@ -360,3 +360,12 @@ def test_a_named_pipe_as_input_is_refused_not_read(suffix, tmp_path, fails):
     else:
         line = fails("generate", str(pipe))
     assert "not a regular file" in line
+
+
+def test_an_element_with_an_undeclared_prefix_is_named_where_the_chain_breaks(tmp_path, fails):
+    """<gz:joint> is no URDF joint: the chain's error said only 'tip is not below base'."""
+    text = urdf_text(two_joints(), ["a", "b", "c"])
+    text = text.replace("<joint ", "<gz:joint ", 1).replace("</joint>", "</gz:joint>", 1)
+    path = write(tmp_path, text)
+    line = fails("import-urdf", str(path), "--base", "a", "--tip", "c")
+    assert "<gz:joint>" in line and "no xmlns declares" in line
