@@ -1,4 +1,5 @@
-"""The command line; the only module that touches the filesystem.
+"""The command line: argparse and the commands (files are read through derive/inputs.py and
+written through derive/outputs.py).
 
 Exit codes: 0 ok, 1 check found differences, 2 bad input (one line on stderr, no
 traceback), 3 `generate --require-ik` found an arm without an IK method.
@@ -12,12 +13,10 @@ import importlib.util
 import math
 import os
 import resource
-import stat
 import sys
 import tempfile
 import time
 from functools import partial
-from importlib import resources
 from pathlib import Path
 from types import ModuleType
 from typing import TYPE_CHECKING, Any, NoReturn
@@ -27,6 +26,8 @@ if TYPE_CHECKING:
 
 from derive import extras, urdf
 from derive.emit import GenerationError, render_module
+from derive.inputs import bundled_specs, resolve_spec
+from derive.outputs import OutputError, output_file, output_folder, write_atomic
 from derive.pipeline import build_plan
 from derive.plan import Plan
 from derive.report import Example, render_report
@@ -38,29 +39,6 @@ DIFF_LINES = 40
 
 class UsageError(Exception):
     """Bad command-line input; the message is printed on one line and the exit code is 2."""
-
-
-def bundled_specs() -> list[Path]:
-    """The bundled arm spec files, sorted by name."""
-    folder = resources.files("derive.arms")
-    return sorted(
-        (Path(str(folder)) / p.name for p in folder.iterdir() if p.name.endswith(".toml")),
-        key=lambda p: p.name,
-    )
-
-
-def resolve_spec(text: str, options: urdf.Options | None = None) -> ArmSpec:
-    """A spec from a file path (a URDF with options' base and tip), or a bundled arm by name."""
-    path = Path(text)
-    if path.suffix.lower() == ".urdf":
-        return urdf.load_urdf(path, options or urdf.Options())
-    if path.suffix == ".toml" or path.exists():
-        return load_spec(path)
-    for candidate in bundled_specs():
-        if candidate.stem == text:
-            return load_spec(candidate)
-    names = ", ".join(p.stem for p in bundled_specs())
-    raise UsageError(f"{text}: no such spec file or bundled arm; bundled arms: {names}")
 
 
 LANGS = ("python", "c", "cpp-ikfast")
@@ -133,101 +111,6 @@ def worked_example(plan: Plan, module: ModuleType) -> Example:
     )
 
 
-TMP_SUFFIX = ".derive-tmp"
-
-
-def write_atomic(path: Path, text: str | bytes) -> None:
-    """Write through a temporary file and rename, so no partial file is ever visible.
-
-    The file gets the mode an existing file at ``path`` has, else the mode a new file gets
-    under the process's umask (0644 under umask 022). Temporary files of earlier runs that
-    were killed while writing this file (``.NAME.*.derive-tmp``) are removed first. A
-    symbolic link at ``path`` is followed (its target is replaced, the link stays); anything
-    else that is not a regular file is refused (see output_file).
-    """
-    path = output_file(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    for leftover in path.parent.glob(f".{path.name}.*{TMP_SUFFIX}"):
-        leftover.unlink(missing_ok=True)
-    try:
-        mode = stat.S_IMODE(path.stat().st_mode)
-    except FileNotFoundError:
-        mode = 0o666 & ~current_umask()
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=TMP_SUFFIX, dir=path.parent)
-    try:
-        if isinstance(text, bytes):
-            with os.fdopen(fd, "wb") as binary:
-                binary.write(text)
-        else:
-            with os.fdopen(fd, "w", encoding="utf-8", newline="\n") as handle:
-                handle.write(text)
-        os.chmod(tmp, mode)
-        os.replace(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
-
-
-# what stat's file type is, for the messages refusing it
-NODE_KINDS = (
-    (stat.S_ISDIR, "a folder"),
-    (stat.S_ISFIFO, "a named pipe (FIFO)"),
-    (stat.S_ISCHR, "a character device"),
-    (stat.S_ISBLK, "a block device"),
-    (stat.S_ISSOCK, "a socket"),
-    (stat.S_ISREG, "a regular file"),
-)
-
-
-def node_kind(mode: int) -> str:
-    """What a file of this st_mode is, in words ("a named pipe (FIFO)")."""
-    return next((kind for test, kind in NODE_KINDS if test(mode)), "not a regular file")
-
-
-def output_file(path: Path) -> Path:
-    """The file that writing ``path`` replaces: ``path``, or for a symbolic link the file it
-    names in the end (the link stays a link; a dangling link's target is created). derive
-    replaces regular files only: a folder, a device (/dev/stdout too: ``-o -`` is standard
-    output where a command can print), a named pipe or a socket is refused, as is ``-``
-    where standard output is not an option."""
-    if str(path) == "-":
-        raise UsageError("-: this output cannot go to standard output; give a file name")
-    try:
-        mode = path.stat().st_mode
-    except FileNotFoundError:
-        mode = stat.S_IFREG
-    if not stat.S_ISREG(mode):
-        raise UsageError(
-            f"{path}: is {node_kind(mode)}; derive writes regular files only (or the "
-            "file a symbolic link names), never replaces anything else"
-        )
-    if not path.is_symlink():
-        return path
-    target = Path(os.path.realpath(path))
-    if not target.parent.is_dir():  # (no folders made where a dangling link points)
-        raise UsageError(f"{path}: a symbolic link to {target}, whose folder does not exist")
-    return target
-
-
-def output_folder(path: Path, option: str) -> Path:
-    """A folder to write files into (``option``'s): a folder, or a path where none is yet."""
-    if str(path) == "-":
-        raise UsageError(f"{option} -: {option} names a folder, not standard output")
-    if path.exists() and not path.is_dir():
-        raise UsageError(
-            f"{option} {path}: is {node_kind(path.stat().st_mode)}, not a folder; {option} "
-            "names the folder to write into (created if missing)"
-        )
-    return path
-
-
-def current_umask() -> int:
-    """The process's umask (read by setting it and setting it back)."""
-    mask = os.umask(0o022)
-    os.umask(mask)
-    return mask
-
-
 def urdf_options(args: argparse.Namespace) -> urdf.Options:
     """The URDF conversion options of a command line."""
     return urdf.Options(
@@ -275,7 +158,7 @@ def cmd_generate(args: argparse.Namespace) -> int:
     for text in args.specs or [str(p) for p in bundled_specs()]:
         try:
             specs[text] = resolve_spec(text, options)
-        except (SpecError, UsageError, OSError) as exc:
+        except (SpecError, UsageError, OutputError, OSError) as exc:
             print(f"error: {exc}", file=sys.stderr)
             failed.append(text)
     unique_names(specs.values())
@@ -293,7 +176,7 @@ def cmd_generate(args: argparse.Namespace) -> int:
             print(f"error: {exc}", file=sys.stderr)
             failed.append(text)
             continue
-        except (SpecError, UsageError, OSError) as exc:
+        except (SpecError, UsageError, OutputError, OSError) as exc:
             print(f"error: {exc}", file=sys.stderr)
             failed.append(text)
             continue
@@ -843,8 +726,8 @@ def text_output(option: str | None) -> Path | None:
         return None
     try:
         return output_file(Path(option))
-    except UsageError as exc:
-        raise UsageError(f"{exc} (-o - prints to standard output)") from None
+    except OutputError as exc:
+        raise OutputError(f"{exc} (-o - prints to standard output)") from None
 
 
 def report_figures(
@@ -1192,7 +1075,7 @@ def main(argv: list[str] | None = None) -> int:
         code: int = args.run(args)
         sys.stdout.flush()  # a closed pipe shows here, inside the handler, not at exit
         return code
-    except (SpecError, UsageError, GenerationError) as exc:
+    except (SpecError, UsageError, OutputError, GenerationError) as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 2
     except BrokenPipeError:

@@ -15,7 +15,6 @@ from importlib import resources
 import jinja2
 import sympy as sp
 
-from derive import free
 from derive import symbols as sym
 from derive.assemble import assemble, import_block
 from derive.layout import wrap_code
@@ -187,7 +186,7 @@ def print_plan(plan: Plan) -> PrintedModule:
         general=general_code(plan),
         free=ik.free if ik else (),
         free_const=repr(ik.free) if ik else "()",
-        free_text=free.describe(ik, arm.dof) if ik else "",
+        free_text=ik.free_text if ik else "",
     )
 
 

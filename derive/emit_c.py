@@ -12,7 +12,6 @@ from typing import Any
 
 import numpy as np
 
-from derive import free
 from derive.emit import GENERATOR, GenerationError, check_printable, environment
 from derive.plan import Eigen, Plan, Poly, PolyD
 from derive.printers import c
@@ -237,7 +236,7 @@ def print_c(plan: Plan) -> PrintedC:
     solve = c.solve_lines(plan)
     fk_pose, fk_joints, fk_params = c.fk_lines(plan)
     upper = arm.name.upper()
-    text = free.describe(ik, arm.dof) if ik.free else ""
+    text = ik.free_text
     return PrintedC(
         name=arm.name,
         upper=upper,

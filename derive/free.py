@@ -186,7 +186,7 @@ def lift(ik: IkPlan, chain: Chain, free: tuple[int, ...]) -> IkPlan:
     steps += [renumber(step, rename, k) for step in ik.steps]
     remainder_outputs = iter(e.xreplace(rename) for e in ik.outputs)
     outputs = tuple(sym.q_ref(i) if i in free else next(remainder_outputs) for i in range(1, n + 1))
-    return replace(
+    lifted = replace(
         ik,
         steps=tuple(steps),
         outputs=outputs,
@@ -194,6 +194,7 @@ def lift(ik: IkPlan, chain: Chain, free: tuple[int, ...]) -> IkPlan:
         free=free,
         case=f"{ik.case}; joints {names} free (given), the remainder joints {k + 1}-{n - m} solved",
     )
+    return replace(lifted, free_text=describe(lifted, n))
 
 
 def renumber(step: Step, rename: dict[sp.Symbol, sp.Symbol], shift: int) -> Step:

@@ -290,6 +290,8 @@ class IkPlan:
             point only: arms that do not control the orientation).
         free: the joints (1-based) the caller gives values for (an arm of more than 6
             joints); their values are the reference values qr_i.
+        free_text: which joints are free and why, in words (derive/free.py), "" without
+            free joints: what emission and reports say of them.
     """
 
     method: str
@@ -301,6 +303,7 @@ class IkPlan:
     solves_for: str = "the full pose (rotation and position)"
     certify: str = "pose"
     free: tuple[int, ...] = ()
+    free_text: str = ""
 
 
 @dataclass(frozen=True)

@@ -18,7 +18,6 @@ from functools import partial
 import numpy as np
 import sympy as sp
 
-from derive import free
 from derive import raghavan_roth as rr
 from derive import symbols as sym
 from derive.emit import GENERATOR, environment
@@ -215,7 +214,7 @@ def method_blocks(plan: Plan) -> list[Block]:
         out.append(
             Block(
                 "p",
-                f"Free joints: {free.describe(ik, plan.arm.dof)}. The solver takes their values "
+                f"Free joints: {ik.free_text}. The solver takes their values "
                 "(`ik(T, free=...)`) and solves the other joints; in the steps below free joint "
                 "$i$'s value is $qr_{i}$ (`qr` for q_ref: the solver's reference values carry "
                 "it).",

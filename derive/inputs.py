@@ -1,0 +1,47 @@
+"""The formats an arm comes in, behind one registry: each reader lowers a file to the canonical
+spec (derive/spec.py's ArmSpec). A new format is one reader here and one line in READERS."""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from importlib import resources
+from pathlib import Path
+
+from derive import urdf
+from derive.spec import ArmSpec, SpecError, load_spec
+
+# a reader: the file and the URDF conversion options (the formats that convert take them)
+Reader = Callable[[Path, urdf.Options], ArmSpec]
+
+
+def _spec_file(path: Path, options: urdf.Options) -> ArmSpec:
+    """A spec file (TOML): read and validated as it is."""
+    return load_spec(path)
+
+
+# file suffix (lower case) -> reader
+READERS: dict[str, Reader] = {".toml": _spec_file, ".urdf": urdf.load_urdf}
+
+
+def bundled_specs() -> list[Path]:
+    """The bundled arm spec files, sorted by name."""
+    folder = resources.files("derive.arms")
+    return sorted(
+        (Path(str(folder)) / p.name for p in folder.iterdir() if p.name.endswith(".toml")),
+        key=lambda p: p.name,
+    )
+
+
+def resolve_spec(text: str, options: urdf.Options | None = None) -> ArmSpec:
+    """A spec from a file path (a URDF with options' base and tip), or a bundled arm by name."""
+    path = Path(text)
+    reader = READERS.get(path.suffix.lower())
+    if reader is not None:
+        return reader(path, options or urdf.Options())
+    if path.exists():  # (a spec file of another name)
+        return load_spec(path)
+    for candidate in bundled_specs():
+        if candidate.stem == text:
+            return load_spec(candidate)
+    names = ", ".join(p.stem for p in bundled_specs())
+    raise SpecError(f"{text}: no such spec file or bundled arm; bundled arms: {names}")
