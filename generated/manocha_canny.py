@@ -1939,21 +1939,23 @@ def _kgeneral(flanges, out):
                 count, _ = _krr_split(k, targets[k], moved, out, count)
                 if count == limit:
                     return count
-    if 0 < count < limit and _krr_perturbed():
+    perturbed = False
+    for k in range(splits):
+        perturbed = perturbed or _krr_perturbed(k)
+    if 0 < count < limit and perturbed:
         count = _krr_partners(targets[0], out, count)
     # (an odd count: the Python solver's search looks for the one missed)
     return count if count > 0 and count % 2 == 0 else -1
 
 
-def _krr_perturbed():
-    """Whether a split solves a perturbed table (the arm's own pencils are singular)."""
-    for k in range(len(_RR_SPLITS)):
-        fill = np.array(_RR_SPLITS[k][1])
-        true = np.array(_RR_SPLITS[k][2])
-        for i in range(6):
-            for j in range(4):
-                if fill[i, j] != true[i, j]:
-                    return True
+def _krr_perturbed(k):
+    """Whether split k solves a perturbed table (the arm's own pencils are singular)."""
+    fill = np.array(_RR_SPLITS[k][1])
+    true = np.array(_RR_SPLITS[k][2])
+    for i in range(6):
+        for j in range(4):
+            if fill[i, j] != true[i, j]:
+                return True
     return False
 
 
@@ -2013,11 +2015,7 @@ def _krr_split(k, F, moved, out, count):
     true[:6] = np.array(_RR_SPLITS[k][2])
     fill[6, 0], fill[6, 1] = _RR_SPLITS[k][3]
     true[6, 0], true[6, 1] = _RR_SPLITS[k][3]
-    perturbed = False
-    for i in range(6):
-        for j in range(4):
-            if fill[i, j] != true[i, j]:
-                perturbed = True
+    perturbed = _krr_perturbed(k)
     values = np.zeros(490)
     _rr_fill(
         k, moved[0, 2], moved[1, 2], moved[2, 2], moved[0, 3], moved[1, 3], moved[2, 3], values

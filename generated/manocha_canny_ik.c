@@ -1782,16 +1782,14 @@ static int dk_rr_add(int k, const double q[6], double out[DK_RR_ROWS][6], int co
     return count + 1;
 }
 
-/* whether a split solves a perturbed table (the arm's own pencils are singular) */
-static int dk_rr_perturbed(void)
+/* whether split k solves a perturbed table (the arm's own pencils are singular) */
+static int dk_rr_perturbed(int k)
 {
-    int k, i, j;
-    for (k = 0; k < DK_RR_SPLIT_COUNT; k++) {
-        for (i = 0; i < 6; i++) {
-            for (j = 0; j < 4; j++) {
-                if (DK_RR_FILL[k][i][j] != DK_RR_TRUE[k][i][j]) {
-                    return 1;
-                }
+    int i, j;
+    for (i = 0; i < 6; i++) {
+        for (j = 0; j < 4; j++) {
+            if (DK_RR_FILL[k][i][j] != DK_RR_TRUE[k][i][j]) {
+                return 1;
             }
         }
     }
@@ -1804,14 +1802,7 @@ static int dk_rr_split(int k, const double F[4][4], const double moved[4][4],
                        double out[DK_RR_ROWS][6], int count, int *doubt, double imag_tol)
 {
     double values[490], cands[DK_RR_CANDS][6], between[7][4];
-    int extra[DK_RR_CANDS], perturbed = 0, damped = 0, n, c, i, j;
-    for (i = 0; i < 6; i++) {
-        for (j = 0; j < 4; j++) {
-            if (DK_RR_FILL[k][i][j] != DK_RR_TRUE[k][i][j]) {
-                perturbed = 1;
-            }
-        }
-    }
+    int extra[DK_RR_CANDS], perturbed = dk_rr_perturbed(k), damped = 0, n, c, i, j;
     for (i = 0; i < 490; i++) {
         values[i] = 0.0;
     }
@@ -1926,7 +1917,7 @@ static int dk_rr_search(const double F[4][4], double out[DK_RR_ROWS][6], int cou
 static int dk_general(const double flanges[DK_RR_SPLIT_COUNT][12], double out[DK_RR_ROWS][6])
 {
     double targets[DK_RR_SPLIT_COUNT][4][4], moved[4][4];
-    int count = 0, doubt = 1, k, r, c, m, i;
+    int count = 0, doubt = 1, perturbed = 0, k, r, c, m, i;
     for (k = 0; k < DK_RR_SPLIT_COUNT; k++) {
         for (r = 0; r < 4; r++) {
             for (c = 0; c < 4; c++) {
@@ -1966,7 +1957,10 @@ static int dk_general(const double flanges[DK_RR_SPLIT_COUNT][12], double out[DK
             }
         }
     }
-    if (count > 0 && count < DK_RR_ROWS && dk_rr_perturbed()) {
+    for (k = 0; k < DK_RR_SPLIT_COUNT; k++) {
+        perturbed |= dk_rr_perturbed(k);
+    }
+    if (count > 0 && count < DK_RR_ROWS && perturbed) {
         /* a perturbed table walks two solutions that share the eigen-joint value (the PUMA's
            wrist flip) onto one now and then, whether the count stays even or not */
         count = dk_rr_partners(targets[0], out, count);
