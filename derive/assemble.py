@@ -23,16 +23,24 @@ from derive.runtime import MODULES
 # ruff's isort puts them (standard library, then numpy)
 IMPORTS = (
     ("import cmath", "cmath"),
+    ("import ctypes", "ctypes"),
+    ("import hashlib", "hashlib"),
     ("import math", "math"),
+    ("import os", "os"),
+    ("import shlex", "shlex"),
+    ("import shutil", "shutil"),
+    ("import subprocess", "subprocess"),
     ("import sys", "sys"),
+    ("import tempfile", "tempfile"),
     ("import threading", "threading"),
-    ("import types", "types"),
+    ("import warnings", "warnings"),
     ("from math import {}", "acos"),
     ("from math import {}", "atan2"),
     ("from math import {}", "cos"),
     ("from math import {}", "sin"),
     ("from math import {}", "sqrt"),
     ("from operator import sub as _sub", "_sub"),
+    ("from typing import Any", "Any"),
     ("import numpy as np", "np"),
     ("from numpy.typing import ArrayLike", "ArrayLike"),
 )
@@ -41,8 +49,6 @@ FK_ROOTS = ("fk", "fk_batch")
 IK_ROOTS = (*FK_ROOTS, "ik", "ik_batch", "nearest", "warmup", "CERTIFY_TOL", "BACKEND")
 # the public names a module with free joints adds
 FREE_ROOTS = ("ik_sweep",)
-# the compiled kernel's entry points (_compile builds them and what they call)
-KERNEL_ROOTS = ("_kbatch", "_kone", "_kpick")
 
 
 @dataclass(frozen=True)
@@ -54,7 +60,7 @@ class Piece:
         defines: the global names it binds.
         uses: every name it reads (globals and, harmlessly, locals).
         source: its text, with the comment lines just above it.
-        function: whether it is a function definition (the compiled kernel takes those).
+        function: whether it is a function definition.
     """
 
     module: str
@@ -143,11 +149,9 @@ class Assembly:
 
     Attributes:
         runtime: the copied runtime pieces' source, separated by two blank lines.
-        kernel: the names of the compiled kernel's functions, in copy order.
     """
 
     runtime: str
-    kernel: tuple[str, ...]
 
 
 def assemble(arm_source: str, has_ik: bool, free: bool = False) -> Assembly:
@@ -166,17 +170,5 @@ def assemble(arm_source: str, has_ik: bool, free: bool = False) -> Assembly:
         roots |= set(FREE_ROOTS)
     for piece in arm:
         roots |= piece.uses
-    kernel: tuple[str, ...] = ()
-    if has_ik:
-        roots |= set(KERNEL_ROOTS)
-        kernel = tuple(
-            name
-            for p in closure(KERNEL_ROOTS, everything)
-            if p.function
-            for name in sorted(p.defines)
-        )
     copied = tuple(p for p in closure(roots, everything) if p.module != "arm")
-    return Assembly(
-        runtime="\n\n\n".join(p.source for p in copied),
-        kernel=kernel,
-    )
+    return Assembly(runtime="\n\n\n".join(p.source for p in copied))

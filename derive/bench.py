@@ -82,16 +82,14 @@ def batch_agreement(module: ModuleType, poses: np.ndarray) -> int:
 
 
 def compiled_backend(module: ModuleType, pose: np.ndarray) -> dict:
-    """Whether the compiled backend is there: its threads and the seconds its first calls took
-    (numba compiling, or loading its cache); empty without numba."""
-    try:
-        import numba
-    except ImportError:
-        return {}
+    """Whether the C solver is there: ik_batch's threads and the seconds the first calls took
+    (compiling the C, or loading it from the cache); empty without it."""
     start = time.perf_counter()
-    module.ik(pose, backend="numba")
-    module.ik_batch(pose[None], backend="numba")
-    return {"threads": numba.get_num_threads(), "compile_s": time.perf_counter() - start}
+    if not module.warmup():
+        return {}
+    module.ik(pose, backend="c")
+    module.ik_batch(pose[None], backend="c")
+    return {"threads": module._THREADS, "compile_s": time.perf_counter() - start}
 
 
 def batch_us(module: ModuleType, poses: np.ndarray, **options) -> float:
@@ -117,13 +115,11 @@ def batch_figures(module: ModuleType, n: int, seed: int, memory_n: int, threads:
         "ik_batch_python_us": batch_us(module, poses, backend="python"),
     }
     if threads:
-        import numba
-
-        numba.set_num_threads(1)
+        setattr(module, "_THREADS", 1)  # noqa: B010 (the generated module's setting)
         try:
             figures["ik_batch_1thread_us"] = batch_us(module, poses)
         finally:
-            numba.set_num_threads(threads)
+            setattr(module, "_THREADS", threads)  # noqa: B010
     if memory_n:
         big = module.fk_batch(sample_joints(module, memory_n, rng))
         tracemalloc.start()
@@ -186,7 +182,7 @@ def measure(
     }
     if hasattr(module, "ik"):
         figures.update(compiled_backend(module, poses[0]))
-        figures["backend"] = "numba" if "threads" in figures else "python"
+        figures["backend"] = "c" if "threads" in figures else "python"
         module.ik(poses[0])
         figures["ik_us"] = median_us(module.ik, [(T,) for T in poses])
         figures["ik_python_us"] = median_us(

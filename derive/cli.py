@@ -9,7 +9,6 @@ from __future__ import annotations
 
 import argparse
 import difflib
-import importlib.util
 import math
 import os
 import resource
@@ -27,6 +26,8 @@ if TYPE_CHECKING:
 from derive import extras, urdf
 from derive.emit import GenerationError, render_module
 from derive.inputs import bundled_specs, resolve_spec
+from derive.languages import LANGUAGES, figure_files, is_planar, worked_example
+from derive.load import LoadError, load_solver, solver_sources
 from derive.outputs import OutputError, output_file, output_folder, write_atomic
 from derive.pipeline import build_plan
 from derive.plan import Plan
@@ -41,74 +42,12 @@ class UsageError(Exception):
     """Bad command-line input; the message is printed on one line and the exit code is 2."""
 
 
-LANGS = ("python", "c", "cpp-ikfast")
-
-
 def outputs_for(
     spec: ArmSpec, figures: bool = False, lang: str = "python"
 ) -> tuple[Plan, dict[str, str | bytes]]:
-    """The plan and file name -> content of everything generated for one arm (with figures:
-    the report's pictures too, embedded in it). lang "c": the C solver's files instead;
-    "cpp-ikfast": those and the MoveIt IKFast shim."""
+    """The plan and file name -> content of everything language lang writes for one arm."""
     plan = build_plan(spec)
-    if lang != "python":
-        return plan, c_outputs(plan, lang)
-    module_source = render_module(plan)
-    module = import_source(spec.name, module_source)
-    example = worked_example(plan, module)
-    files: dict[str, str | bytes] = {f"{spec.name}.py": module_source}
-    shown: tuple[tuple[str, str], ...] = ()
-    if figures and plan.ik is not None:
-        made = figure_files(spec, module, example, "svg")
-        files.update({name: data for _, name, data in made})
-        shown = tuple((caption, name) for caption, name, _ in made)
-    files[f"{spec.name}.md"] = render_report(plan, example, "md", shown)
-    return plan, files
-
-
-def c_outputs(plan: Plan, lang: str) -> dict[str, str | bytes]:
-    """The C solver's files (lang "c"), with the MoveIt IKFast shim (lang "cpp-ikfast")."""
-    from derive.emit_c import render_c, render_ikfast
-
-    files: dict[str, str | bytes] = dict(render_c(plan))
-    if lang == "cpp-ikfast":
-        files.update(render_ikfast(plan))
-    return files
-
-
-def worked_example(plan: Plan, module: ModuleType) -> Example:
-    """The report's example: the spec's pose, or fk of its joint values, and the solutions."""
-    import numpy as np
-
-    arm = plan.arm
-    if arm.example_pose is not None:
-        pose = np.array(arm.example_pose).reshape(4, 4)
-        how = "the world pose given in the spec's [example]"
-    else:
-        assert arm.example_q is not None  # a spec gives an example pose or joint values
-        pose = module.fk(list(arm.example_q))
-        shown = ", ".join(
-            f"{math.degrees(v):g}" if t == "R" else f"{v:g}"
-            for v, t in zip(arm.example_q, arm.joint_types)
-        )
-        how = f"the pose of q = ({shown}) (degrees for R joints)"
-    # one pose: the Python solver (compiling the numba one would cost seconds)
-    free = getattr(module, "FREE", ())
-    values = {}
-    if free:
-        given = arm.example_q if arm.example_q is not None else (0.0,) * arm.dof
-        values["free"] = [given[j - 1] for j in free]
-        given_values = [
-            math.degrees(given[j - 1]) if arm.joint_types[j - 1] == "R" else given[j - 1]
-            for j in free
-        ]
-        how += "; free joints " + ", ".join(f"q{j} = {v:g}" for j, v in zip(free, given_values))
-    solutions = module.ik(pose, backend="python", **values) if hasattr(module, "ik") else ()
-    return Example(
-        tuple(float(v) for v in pose.ravel()),
-        tuple(tuple(float(v) for v in row) for row in solutions),
-        how,
-    )
+    return plan, LANGUAGES[lang].files(spec, plan, figures)
 
 
 def urdf_options(args: argparse.Namespace) -> urdf.Options:
@@ -202,10 +141,6 @@ def cmd_generate(args: argparse.Namespace) -> int:
     return 0
 
 
-# the file whose presence says an arm was generated with --lang c or cpp-ikfast (in order)
-C_MARKERS = {"c": "_ik.c", "cpp-ikfast": "_ikfast_solver.cpp"}
-
-
 def cmd_check(args: argparse.Namespace) -> int:
     """Compare DIR with a fresh generation; never writes into DIR."""
     out = output_folder(Path(args.out), "--out")
@@ -214,10 +149,10 @@ def cmd_check(args: argparse.Namespace) -> int:
     with tempfile.TemporaryDirectory() as tmp:
         for spec in specs:
             plan, files = outputs_for(spec, args.figures)
-            # the C files of an arm generated with --lang c (or cpp-ikfast) are checked too
-            langs = [lang for lang, f in C_MARKERS.items() if (out / f"{spec.name}{f}").exists()]
-            if langs:
-                files.update(c_outputs(plan, langs[-1]))
+            # the files of other languages the arm was generated in (a marker file is there)
+            for language in LANGUAGES.values():
+                if language.marker and (out / f"{spec.name}{language.marker}").exists():
+                    files.update(language.files(spec, plan, args.figures))
             for name, content in files.items():
                 write_atomic(Path(tmp) / name, content)
         for path in sorted(Path(tmp).iterdir()):
@@ -241,8 +176,8 @@ def cmd_check(args: argparse.Namespace) -> int:
     for problem in problems:
         print(problem)
     specs_text = " ".join(args.specs)
-    if any(p.split(":")[0].endswith((".c", ".h", ".cpp")) for p in problems):
-        print(f"to update the C files: derive generate ARM --lang c (or cpp-ikfast) --out {out}")
+    if any(p.split(":")[0].endswith(".cpp") for p in problems):
+        print(f"to update the IKFast shims: derive generate ARM --lang cpp-ikfast --out {out}")
     print(
         f"to update: derive generate {specs_text + ' ' if specs_text else ''}--out {out}"
         + (" and delete the stale files" if any("stale" in p for p in problems) else "")
@@ -267,28 +202,8 @@ def describe_difference(path: Path, actual: bytes, expected: bytes) -> str:
 
 
 def load_module(spec: ArmSpec) -> ModuleType:
-    """Generate an arm's module and import it."""
-    return import_source(spec.name, render_module(build_plan(spec)))
-
-
-def import_source(name: str, content: str) -> ModuleType:
-    """Import generated module source through a temporary file. DERIVE_BACKEND in the
-    environment ("auto", "numba" or "python") sets the module's BACKEND: a module imported
-    from a temporary file compiles its kernels on every run (numba cannot cache them there),
-    which "python" skips."""
-    with tempfile.TemporaryDirectory() as tmp:
-        path = Path(tmp) / f"{name}.py"
-        path.write_text(content, encoding="utf-8")
-        loader_spec = importlib.util.spec_from_file_location(f"derive_ik_{name}", path)
-        assert loader_spec is not None and loader_spec.loader is not None
-        module = importlib.util.module_from_spec(loader_spec)
-        loader_spec.loader.exec_module(module)
-    backend = os.environ.get("DERIVE_BACKEND")
-    if backend is not None and hasattr(module, "BACKEND"):
-        if backend not in ("auto", "numba", "python"):
-            raise UsageError(f"DERIVE_BACKEND={backend[:20]!r}; allowed: auto, numba, python")
-        setattr(module, "BACKEND", backend)  # noqa: B010 (a generated module's setting)
-    return module
+    """Generate an arm's module (and its C) and import it (derive/load.py)."""
+    return load_solver(spec.name, solver_sources(build_plan(spec)))
 
 
 def parse_numbers(values: list[str], what: str) -> list[float]:
@@ -379,15 +294,6 @@ def figure_output(args: argparse.Namespace, default: str) -> tuple[Path, str]:
     return output, fmt
 
 
-def is_planar(spec: ArmSpec) -> bool:
-    """Every axis parallel: the workspace section is the arm's own plane."""
-    from derive.classify import classify
-    from derive.transforms import chain_from_spec
-
-    chain = chain_from_spec(spec)
-    return len(classify(chain).parallel) == chain.dof - 1
-
-
 def solve_arguments(
     spec: ArmSpec, module: ModuleType, args: argparse.Namespace
 ) -> tuple[Any, list[float], Any]:
@@ -462,7 +368,7 @@ def cmd_reach(args: argparse.Namespace) -> int:
 
     spec = resolve_spec(args.arm, urdf_options(args))
     plan = build_plan(spec)
-    source = render_module(plan)
+    source = solver_sources(plan)
     if plan.ik is None:
         raise UsageError(f"{spec.name}: no IK method applies to this arm")
     if plan.ik.certify == "position":
@@ -651,7 +557,7 @@ def bench_c(args: argparse.Namespace) -> int:
                 refs[:, j - 1] = Q[:, j - 1]
             least, median, single = harness.bench(T, refs)
         kw = [{"free": [r[j - 1] for j in module.FREE]} if module.FREE else {} for r in refs]
-        module.ik(T[0], **kw[0])  # compile (or load numba's cache) before timing
+        module.ik(T[0], **kw[0])  # compile the C (or load it from the cache) before timing
         python = median_us(partial(solve_with, module), list(zip(T, kw)))
         batch = math.inf
         free = {"free": refs[:, [j - 1 for j in module.FREE]]} if module.FREE else {}
@@ -701,7 +607,7 @@ def cmd_report(args: argparse.Namespace) -> int:
     output = text_output(args.output)
     spec = resolve_spec(args.arm, urdf_options(args))
     plan = build_plan(spec)
-    module = import_source(spec.name, render_module(plan))
+    module = load_solver(spec.name, solver_sources(plan))
     example = worked_example(plan, module)
     figures = report_figures(spec, plan, module, example, args) if args.figures else ()
     text = render_report(plan, example, args.format, figures)
@@ -745,45 +651,6 @@ def report_figures(
     return tuple((caption, name) for caption, name, _ in made)
 
 
-def figure_files(
-    spec: ArmSpec, module: ModuleType, example: Example, ext: str
-) -> tuple[tuple[str, str, bytes], ...]:
-    """The worked example's solutions and a workspace section, as (caption, file name, bytes)."""
-    import numpy as np
-
-    from derive.plot import PlotUnavailable, figure_bytes, solutions_figure, workspace_figure
-    from derive.workspace import workspace
-
-    pose = np.array(example.pose).reshape(4, 4)
-    planar = is_planar(spec)
-    try:
-        rows = np.array(example.solutions).reshape(-1, spec.dof)
-        title = f"{spec.name}: the worked example"
-        drawing, _ = solutions_figure(module, spec.convention, pose, rows, title)
-        solutions = figure_bytes(drawing, ext)
-        wmap = workspace(module, planar, spec.convention, REPORT_RESOLUTION, progress=None)
-        section = figure_bytes(workspace_figure(wmap, f"{spec.name}: workspace section"), ext)
-    except PlotUnavailable as exc:
-        raise UsageError(f"--figures: {exc}") from None
-    grid = f"{REPORT_RESOLUTION} x {REPORT_RESOLUTION}"
-    return (
-        (
-            f"The worked example's {len(example.solutions)} solutions.",
-            f"{spec.name}_solutions.{ext}",
-            solutions,
-        ),
-        (
-            f"Workspace section ({grid}): {wmap.summary()}.",
-            f"{spec.name}_workspace.{ext}",
-            section,
-        ),
-    )
-
-
-# the report's workspace section: grid points per side
-REPORT_RESOLUTION = 101
-
-
 def versus(ours: float, theirs: float) -> str:
     """How our time compares with another solver's: "ours 4.1x faster" or "ours 2.3x slower"."""
     if ours <= theirs:
@@ -799,9 +666,9 @@ def bench_text(name: str, f: dict) -> str:
     )
     if "ik_us" not in f:
         return line
-    if f["backend"] == "numba":
+    if f["backend"] == "c":
         line += (
-            f"\n  compiled (numba, {f['threads']} threads; first calls "
+            f"\n  compiled (C, ik_batch on {f['threads']} threads; first calls "
             f"{f['compile_s']:.1f} s): ik {f['ik_us']:.1f} us/pose (median); ik_batch "
             f"{f['ik_batch_us']:.2f} us/pose at N = {f['batch_n']}, "
             f"{f['ik_batch_1thread_us']:.2f} on one thread"
@@ -868,10 +735,10 @@ def parser() -> argparse.ArgumentParser:
     gen.add_argument("--require-ik", action="store_true", help="exit 3 if an arm has no IK method")
     gen.add_argument(
         "--lang",
-        choices=LANGS,
+        choices=tuple(LANGUAGES),
         default="python",
-        help="python (NAME.py, NAME.md; default), c (NAME_ik.h, NAME_ik.c: C99, math.h only) "
-        "or cpp-ikfast (the C files and NAME_ikfast_solver.cpp for MoveIt's IKFast plugin)",
+        help="; ".join(f"{lang.name}: {lang.summary}" for lang in LANGUAGES.values())
+        + " (default: python)",
     )
     gen.add_argument(
         "--figures",
@@ -951,7 +818,7 @@ def parser() -> argparse.ArgumentParser:
         "--worker-threads",
         type=int,
         default=0,
-        help="numba threads per Dask worker (default: cores / N for local:N, else a "
+        help="ik_batch threads per Dask worker (default: cores / N for local:N, else a "
         "worker's cores / its task threads)",
     )
     reach.add_argument("--hdf5", metavar="FILE.h5", help="also export in Reuleaux's HDF5 layout")
@@ -1075,7 +942,7 @@ def main(argv: list[str] | None = None) -> int:
         code: int = args.run(args)
         sys.stdout.flush()  # a closed pipe shows here, inside the handler, not at exit
         return code
-    except (SpecError, UsageError, OutputError, GenerationError) as exc:
+    except (SpecError, UsageError, OutputError, GenerationError, LoadError) as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 2
     except BrokenPipeError:

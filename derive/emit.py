@@ -19,7 +19,7 @@ from derive import symbols as sym
 from derive.assemble import assemble, import_block
 from derive.layout import wrap_code
 from derive.plan import Assign, Plan
-from derive.printers import kernel, scalar, vector
+from derive.printers import scalar
 from derive.printers.common import (
     SCALAR_FUNCTIONS,
     CodePrinter,
@@ -28,7 +28,6 @@ from derive.printers.common import (
     cs_arguments,
     float_literal,
     match_expression,
-    world_names,
 )
 from derive.printers.general import general_code
 
@@ -42,7 +41,7 @@ class GenerationError(ValueError):
 
 
 def check_printable(plan: Plan) -> None:
-    """Every expression of the plan prints in scalar and vectorised code, or a
+    """Every expression of the plan prints in scalar and vectorised (forward kinematics) code, or a
     GenerationError names the arm, the step and the function (before any code is written)."""
     parts: list[tuple[str, tuple[sp.Basic, ...]]] = [("forward kinematics", tuple(plan.fk_pose))]
     for step in plan.ik.steps if plan.ik else ():
@@ -121,14 +120,10 @@ class PrintedModule:
     refusal: str
     ik_body: tuple[tuple[int, str], ...]
     qref_names: str
-    ik_batch_body: tuple[str, ...]
-    kernel_body: tuple[tuple[int, str], ...]
-    kernel_buffer: int
-    kernel_reference: str
-    world_names: str
     match: str
     components: str
     general: str
+    c_source: str
     free: tuple[int, ...]
     free_const: str
     free_text: str
@@ -146,7 +141,6 @@ def print_plan(plan: Plan) -> PrintedModule:
     fk_pose_body, outputs = fk_pose_lines(plan)
     ik = plan.ik
     offsets = tuple(float(e.subs(sym.q(k + 1), 0)) for k, (_, e) in enumerate(plan.joint_defs))
-    kernel_body, kernel_buffer = kernel.kernel_lines(plan) if ik else ((), 0)
     return PrintedModule(
         name=arm.name,
         digest=arm.digest,
@@ -176,14 +170,10 @@ def print_plan(plan: Plan) -> PrintedModule:
         refusal=plan.refusal,
         ik_body=scalar.ik_lines(plan) if ik else (),
         qref_names=", ".join(f"qr{i}" for i in range(1, arm.dof + 1)),
-        ik_batch_body=vector.ik_batch_lines(plan) if ik else (),
-        kernel_body=kernel_body,
-        kernel_buffer=kernel_buffer,
-        kernel_reference=kernel.reference_tuple(arm.dof),
-        world_names=", ".join(world_names()),
         match=match_expression(ik.certify) if ik else "",
         components=ik.certify if ik else "",
         general=general_code(plan),
+        c_source=repr(f"{arm.name}_ik.c" if ik else ""),
         free=ik.free if ik else (),
         free_const=repr(ik.free) if ik else "()",
         free_text=ik.free_text if ik else "",
@@ -246,13 +236,9 @@ def render_module(plan: Plan) -> str:
     printed code (arm.py.j2) and the runtime routines that code uses (derive.assemble)."""
     printed = print_plan(plan)
     env = environment()
-    arm = env.get_template("arm.py.j2")
-    # the kernel's function list is part of the arm's code and follows from it: print the
-    # code once without it to find the routines it calls
-    draft = arm.render(m=printed, kernel_names="()")
-    parts = assemble(draft, bool(printed.has_ik), bool(printed.free))
+    arm_code = wrap_code(env.get_template("arm.py.j2").render(m=printed))
+    parts = assemble(arm_code, bool(printed.has_ik), bool(printed.free))
     layout = env.get_template("module.py.j2")
-    arm_code = wrap_code(arm.render(m=printed, kernel_names=_names_tuple(parts.kernel)))
 
     def render(imports: str) -> str:
         return layout.render(
@@ -266,8 +252,3 @@ def render_module(plan: Plan) -> str:
 
     # the imports are those the module's code uses, constants included
     return render(import_block(render("")))
-
-
-def _names_tuple(names: tuple[str, ...]) -> str:
-    """A tuple of strings as Python source, one per line."""
-    return "(\n" + "".join(f"    {name!r},\n" for name in names) + ")"

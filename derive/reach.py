@@ -49,13 +49,10 @@ Attributes: the arm's name and spec digest, the solver source's SHA-256, the par
 
 from __future__ import annotations
 
-import hashlib
-import importlib.util
 import math
 import multiprocessing
 import os
 import sys
-import tempfile
 import threading
 import time
 from collections.abc import Iterable, Iterator
@@ -68,6 +65,8 @@ from typing import Any, TextIO
 
 import numpy as np
 
+from derive.load import Sources, load_solver
+from derive.load import digest as sources_digest
 from derive.workspace import inside_limits, progress_line, section
 
 # 2: counts' fill value NOT_COMPUTED, index and column_index created with the other arrays
@@ -375,44 +374,6 @@ def solve_chunk(
 
 # --- loading the solver in any process (the local run and Dask workers) -------------------
 
-_SOLVERS: dict[str, ModuleType] = {}
-
-
-def solver_cache() -> Path:
-    """Where solver sources are kept so that numba caches their compiled kernels:
-    DERIVE_CACHE, else $XDG_CACHE_HOME/derive-ik, else ~/.cache/derive-ik."""
-    if "DERIVE_CACHE" in os.environ:
-        return Path(os.environ["DERIVE_CACHE"])
-    root = os.environ.get("XDG_CACHE_HOME") or str(Path.home() / ".cache")
-    return Path(root) / "derive-ik"
-
-
-def load_solver(name: str, source: str) -> ModuleType:
-    """Import a generated module's source (once per process), from a file named by its hash
-    in the solver cache, so that numba's cache of its kernels is found on the next run."""
-    sha = hashlib.sha256(source.encode()).hexdigest()[:16]
-    key = f"{name}_{sha}"
-    if key in _SOLVERS:
-        return _SOLVERS[key]
-    folder = solver_cache() / "solvers"
-    folder.mkdir(parents=True, exist_ok=True)
-    path = folder / f"{key}.py"
-    if not path.exists() or path.read_text(encoding="utf-8") != source:
-        fd, tmp = tempfile.mkstemp(prefix=f".{key}.", suffix=".tmp", dir=folder)
-        with os.fdopen(fd, "w", encoding="utf-8", newline="\n") as handle:
-            handle.write(source)
-        os.replace(tmp, path)  # atomic: workers sharing the folder see all of it or none
-    loader_spec = importlib.util.spec_from_file_location(f"derive_ik_reach_{key}", path)
-    assert loader_spec is not None and loader_spec.loader is not None
-    module = importlib.util.module_from_spec(loader_spec)
-    loader_spec.loader.exec_module(module)
-    backend = os.environ.get("DERIVE_BACKEND")
-    if backend in ("auto", "numba", "python"):
-        setattr(module, "BACKEND", backend)  # noqa: B010 (a generated module's setting)
-    _SOLVERS[key] = module
-    return module
-
-
 # --- the store --------------------------------------------------------------------------
 
 
@@ -427,13 +388,13 @@ def _zarr() -> Any:
 
 
 def _attributes(
-    name: str, digest: str, source: str, params: Parameters, layout: Layout
+    name: str, digest: str, source: Sources, params: Parameters, layout: Layout
 ) -> dict[str, Any]:
     return {
         "format": FORMAT,
         "arm": name,
         "spec_digest": digest,
-        "solver_sha256": hashlib.sha256(source.encode()).hexdigest(),
+        "solver_sha256": sources_digest(source),
         "parameters": asdict(params),
         "frame": [float(v) for v in layout.frame.ravel()],
         "side": layout.side,
@@ -447,7 +408,7 @@ def _attributes(
 
 
 def open_store(
-    path: Path, name: str, digest: str, source: str, params: Parameters, layout: Layout
+    path: Path, name: str, digest: str, source: Sources, params: Parameters, layout: Layout
 ) -> Any:
     """The store at path: created for these parameters, or an existing one made with the
     same (a resumed run, which also completes a store killed while it was being created);
@@ -562,9 +523,10 @@ def _check_array(path: Path, key: str, array: Any, spec: ArraySpec) -> None:
         )
 
 
-def _dof(source: str) -> int:
+def _dof(source: Sources) -> int:
     """DOF of a generated module's source (its `DOF = n` line)."""
-    for line in source.splitlines():
+    module = next(text for name, text in sorted(source.items()) if name.endswith(".py"))
+    for line in module.splitlines():
         if line.startswith("DOF = "):
             return int(line.split("=")[1])
     raise ReachError("the solver source has no DOF")  # pragma: no cover (generated always has)
@@ -644,7 +606,7 @@ def finish(path: Path, group: Any, layout: Layout) -> None:
 def _chunk_task(
     path: str,
     name: str,
-    source: str,
+    source: Sources,
     convention: str,
     params: Parameters,
     chunks: list[int],
@@ -653,7 +615,7 @@ def _chunk_task(
     """Chunks in a Dask worker: the solver, layout and arrays set up on the worker's first
     task of a map (opening a store's arrays reads their metadata: about 10 ms), then each
     chunk solved and written. Returns the chunks."""
-    key = (path, name, hashlib.sha256(source.encode()).hexdigest(), convention, params)
+    key = (path, name, sources_digest(source), convention, params)
     if _WORKER.get("key") != key:
         _start_worker(path, name, source, convention, params, threads)
         _WORKER["key"] = key
@@ -662,23 +624,27 @@ def _chunk_task(
 
 # a local worker process's solver, layout and arrays (set once by _start_worker)
 _WORKER: dict[str, Any] = {}
+_SOLVER_MODULES: list[ModuleType] = []
 
 
 def _start_worker(
-    path: str, name: str, source: str, convention: str, params: Parameters, threads: int
+    path: str, name: str, source: Sources, convention: str, params: Parameters, threads: int
 ) -> None:
-    """A worker process: numba's threads (0: as they are), the solver, the layout, the
+    """A worker process: the solver, its ik_batch threads (0: as they are), the layout, the
     store."""
+    module = load_solver(name, source)
+    _SOLVER_MODULES.append(module)
     if threads > 0:
         _set_threads(threads)
-    module = load_solver(name, source)
+    elif _THREADS[0]:
+        setattr(module, "_THREADS", _THREADS[0])  # noqa: B010 (the module's setting)
     layout = _layouts(module, convention, params)
     store = arrays(_zarr().open_group(path, mode="r+"))
     _WORKER.update(module=module, layout=layout, params=params, store=store, key=None)
 
 
 def _start_local_worker(
-    path: str, name: str, source: str, convention: str, params: Parameters, threads: int
+    path: str, name: str, source: Sources, convention: str, params: Parameters, threads: int
 ) -> None:
     """A local worker process: as _start_worker, and it ends itself when the command that
     started it is gone (a command killed by SIGKILL leaves its workers waiting on a queue no
@@ -713,14 +679,16 @@ def _layouts(module: ModuleType, convention: str, params: Parameters) -> Layout:
     return _LAYOUTS[key]
 
 
+# the threads the solvers' ik_batch uses in this process (0: as the module chooses)
+_THREADS: list[int] = [0]
+
+
 def _set_threads(threads: int) -> None:
-    """numba's threads in this process (the compiled batch solver runs on them)."""
-    try:
-        import numba
-    except ImportError:
-        return
-    limit = int(getattr(numba.config, "NUMBA_NUM_THREADS", threads))  # (the pool's size)
-    numba.set_num_threads(max(1, min(threads, limit)))
+    """The threads of the solvers' ik_batch in this process (each splits its poses over
+    them: the module's _THREADS), from now on."""
+    _THREADS[0] = max(1, threads)
+    for module in _SOLVER_MODULES:
+        setattr(module, "_THREADS", _THREADS[0])  # noqa: B010 (the module's setting)
 
 
 @dataclass(frozen=True)
@@ -739,7 +707,7 @@ def run(
     path: Path,
     name: str,
     digest: str,
-    source: str,
+    source: Sources,
     convention: str,
     params: Parameters,
     dask: str | None = None,
@@ -750,9 +718,9 @@ def run(
 ) -> Run:
     """Make (or finish) the map at path. dask: None runs here on all cores; "local:N" on a
     LocalCluster of N worker processes; an address ("tcp://host:port") on that cluster.
-    worker_threads: numba's threads in each Dask worker (0: its cores / N for local:N, else
+    worker_threads: ik_batch's threads in each Dask worker (0: its cores / N for local:N, else
     the worker machine's cores / the worker's task threads).
-    processes: without dask, worker processes here (0: one per core), each with numba's
+    processes: without dask, worker processes here (0: one per core), each with ik_batch's
     threads = cores / processes; 1 solves in this process. Processes rather than threads:
     a process's Python work (making poses, counting, writing) then overlaps the others'
     solving (measured here: two 1-thread processes 4.4 M poses/s together, one 2-thread
@@ -804,7 +772,7 @@ class _Progress:
 
 def _run_here(
     path: Path,
-    arm: tuple[str, str, str],
+    arm: tuple[str, Sources, str],
     module: ModuleType,
     layout: Layout,
     params: Parameters,
@@ -872,7 +840,7 @@ def dask_workers(address: str) -> int:
 @contextmanager
 def _dask_client(address: str | None, worker_threads: int) -> Iterator[tuple[Any, int] | None]:
     """A Dask client of address (a LocalCluster of N worker processes for local:N) and
-    numba's threads per worker (0: each worker's cores / its task threads), closed on exit;
+    ik_batch's threads per worker (0: each worker's cores / its task threads), closed on exit;
     None without an address. (A map already complete still starts the cluster.)"""
     if address is None:
         yield None
@@ -915,7 +883,7 @@ def _dask_chunks(
     session: tuple[Any, int],
     path: str,
     name: str,
-    source: str,
+    source: Sources,
     convention: str,
     params: Parameters,
     todo: list[int],
@@ -951,14 +919,14 @@ def _dask_chunks(
 
 
 def _worker_threads(dask_worker: Any = None) -> int:
-    """On a worker: numba's threads set to its cores divided by the worker's task threads."""
+    """On a worker: ik_batch's threads set to its cores divided by the worker's task threads."""
     nthreads = getattr(getattr(dask_worker, "state", dask_worker), "nthreads", 1) or 1
     threads = max(1, (os.cpu_count() or 1) // int(nthreads))
     _set_threads(threads)
     return threads
 
 
-def batch_alone(name: str, source: str, convention: str, params: Parameters) -> Run:
+def batch_alone(name: str, source: Sources, convention: str, params: Parameters) -> Run:
     """ik_batch alone on a map's solved poses, chunk by chunk as the run makes them (the
     poses made outside the timing): what the run's throughput is measured against."""
     module = load_solver(name, source)

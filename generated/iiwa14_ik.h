@@ -59,6 +59,15 @@ int iiwa14_within_limits(double q[][7], int n, const double *q_ref);
 int iiwa14_nearest(const double T[16], const double *free, const double q_ref[7],
                    const double *weights, double tol, double q[7]);
 
+/* ik_ref of n poses: T[16 i ..] with q_ref (and free values) refs[ref_stride i ..]
+   (ref_stride 0: one q_ref for all, DOF: one per pose) into q[8 7 i ..], the rows past
+   each pose's count zeroed; counts[i]: the count or ik's negative code. */
+void iiwa14_ik_batch(const double *T, long n, const double *refs, long ref_stride,
+                     double tol, double *q, int *counts);
+
+/* fk of n joint vectors Q[DOF i ..] into T[16 i ..] */
+void iiwa14_fk_batch(const double *Q, long n, double *T);
+
 #ifdef __cplusplus
 }
 #endif

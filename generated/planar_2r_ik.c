@@ -685,3 +685,28 @@ int planar_2r_nearest(const double T[16], const double *free, const double q_ref
     }
     return 1;
 }
+
+void planar_2r_ik_batch(const double *T, long n, const double *refs, long ref_stride,
+                        double tol, double *q, int *counts)
+{
+    long i;
+    int r, j;
+    for (i = 0; i < n; i++) {
+        double (*rows)[DK_DOF] = (double (*)[DK_DOF])(q + i * DK_MAX * DK_DOF);
+        int count = planar_2r_ik_ref(T + 16 * i, NULL, refs + ref_stride * i, tol, rows);
+        for (r = count < 0 ? 0 : count; r < DK_MAX; r++) {
+            for (j = 0; j < DK_DOF; j++) {
+                rows[r][j] = 0.0;
+            }
+        }
+        counts[i] = count;
+    }
+}
+
+void planar_2r_fk_batch(const double *Q, long n, double *T)
+{
+    long i;
+    for (i = 0; i < n; i++) {
+        planar_2r_fk(Q + DK_DOF * i, T + 16 * i);
+    }
+}

@@ -5,6 +5,8 @@ from __future__ import annotations
 import importlib.util
 import itertools
 import math
+import os
+import shutil
 import sys
 from pathlib import Path
 from types import ModuleType
@@ -13,7 +15,7 @@ import numpy as np
 import pytest
 from hypothesis import HealthCheck, Phase, settings
 
-from derive.emit import render_module
+from derive.load import solver_sources
 from derive.pipeline import build_plan
 from derive.spec import parse_spec
 
@@ -49,10 +51,10 @@ settings.register_profile(
 settings.load_profile("ci")
 
 
-# tests of the compiled solvers need numba, which the test extra installs
-needs_numba = pytest.mark.skipif(
-    importlib.util.find_spec("numba") is None,
-    reason="numba is not installed (the test extra installs it)",
+# tests of the compiled (C) solvers need a C compiler
+needs_cc = pytest.mark.skipif(
+    not (os.environ.get("CC") or shutil.which("cc") or shutil.which("gcc")),
+    reason="no C compiler (set CC, or install cc)",
 )
 
 
@@ -78,15 +80,17 @@ def generated():
     return get
 
 
-def build_module(text: str, folder: Path) -> ModuleType:
-    """Generate the module of a spec given as TOML text into folder and import it."""
+def build_module(text: str, folder: Path, c: bool = False) -> ModuleType:
+    """Generate the module of a spec given as TOML text, with its C files, into a folder of
+    its own in folder and import it. Its BACKEND is "python" unless c (the C solver is
+    compiled on its first call: tests of it pass c=True or name backend="c")."""
     spec = parse_spec(text, "<test spec>")
-    path = folder / f"{spec.name}_{next(_counter)}.py"
-    path.write_text(render_module(build_plan(spec)), encoding="utf-8")
-    module = import_path(path)
-    if hasattr(module, "BACKEND"):
-        # numba would compile each throwaway arm's solver (seconds); tests of the compiled
-        # solver name backend="numba"
+    folder = folder / f"{spec.name}_{next(_counter)}"
+    folder.mkdir()
+    for name, content in solver_sources(build_plan(spec)).items():
+        (folder / name).write_text(content, encoding="utf-8")
+    module = import_path(folder / f"{spec.name}.py")
+    if hasattr(module, "BACKEND") and not c:
         module.BACKEND = "python"
     return module
 

@@ -10,7 +10,7 @@ import pytest
 
 from derive.verify import SINGULAR_SIGMA, jacobian_nullity, sample_joints
 
-from conftest import BUNDLED, needs_numba
+from conftest import BUNDLED, needs_cc
 
 
 def same_rows(a: np.ndarray, b: np.ndarray, revolute: np.ndarray, tol: float) -> bool:
@@ -46,10 +46,10 @@ def test_ik_batch_equals_ik_pose_by_pose(generated, name):
             np.testing.assert_allclose(m.fk(row), T[i], atol=1e-6 * max(1.0, m.REACH))
 
 
-@needs_numba
+@needs_cc
 @pytest.mark.parametrize("name", BUNDLED)
 def test_backends_give_the_same_solutions(generated, name):
-    """The compiled solver (numba) and the Python one: ik and ik_batch, the same rows in the
+    """The C solver and the Python one: ik and ik_batch, the same rows in the
     same order, on random poses (20% of joints at degenerate values). The general method
     has no reference value to give a free joint: at a singular pose (a self-motion, e.g.
     theta3 + theta6 fixed when axes 3 and 6 line up) each backend returns its own certified
@@ -60,49 +60,56 @@ def test_backends_give_the_same_solutions(generated, name):
         Q = np.array([q for q in Q if jacobian_nullity(m, q)[0] > SINGULAR_SIGMA])
     T = m.fk_batch(Q)
     revolute = np.array([k == "R" for k in m.JOINT_TYPES])
-    compiled, valid_c = m.ik_batch(T, backend="numba")
-    vector, valid_v = m.ik_batch(T, backend="python")
-    assert np.array_equal(valid_c, valid_v)
+    compiled, valid_c = m.ik_batch(T, backend="c")
+    python, valid_p = m.ik_batch(T, backend="python")
+    assert np.array_equal(valid_c, valid_p)
     for i in range(len(T)):
         reference = m.ik(T[i], backend="python")
-        assert same_rows(reference, m.ik(T[i], backend="numba"), revolute, 1e-6), i
+        assert same_rows(reference, m.ik(T[i], backend="c"), revolute, 1e-6), i
         assert same_rows(reference, compiled[i][valid_c[i]], revolute, 1e-6), i
-        assert same_rows(reference, vector[i][valid_v[i]], revolute, 1e-6), i
+        assert same_rows(reference, python[i][valid_p[i]], revolute, 1e-6), i
         assert not compiled[i][~valid_c[i]].any()
 
 
-@needs_numba
+@needs_cc
 def test_compiled_solver_takes_free_joints_from_q_ref(generated):
-    """At a singular wrist theta4 is free: the compiled solver settles the pose itself, with
+    """At a singular wrist theta4 is free: the C solver settles the pose itself, with
     theta4 from q_ref, exactly as the Python solver does."""
     m = generated("puma560")
     q = np.radians([20.0, -30.0, 40.0, 10.0, 0.0, 25.0])
     T = m.fk(q)
     q_ref = np.radians([0.0, 0.0, 0.0, 33.0, 0.0, 0.0])
-    rows, status = m._compile()[1](T[None], m.CERTIFY_TOL, tuple(q_ref), False)
-    assert status == 0  # settled in compiled code
+    pose, at, out, out_at, ref, ref_at = m._scratch()
+    pose[...], ref[:] = T, q_ref
+    n = m._native_solver("c").ik(at, None, ref_at, m.CERTIFY_TOL, out_at)
+    assert n >= 0  # settled in C (not handed to the Python solver)
+    rows = out[:n].copy()
     expected = m.ik(T, q_ref=q_ref, backend="python")
     assert np.isclose(expected[:, 3], math.radians(33.0)).any()  # the singular branch
     revolute = np.ones(6, dtype=bool)
     # theta5 = acos(W33) at W33 ~ 1 is settled to sqrt(eps) only (~2e-8 here): the two
     # backends' rounding of W33 moves it by ~5e-9
     assert same_rows(expected, rows, revolute, 1e-7)
-    assert same_rows(expected, m.ik(T, q_ref=q_ref, backend="numba"), revolute, 1e-7)
-    Qb, valid = m.ik_batch(T[None], q_ref=q_ref, backend="numba")
+    assert same_rows(expected, m.ik(T, q_ref=q_ref, backend="c"), revolute, 1e-7)
+    Qb, valid = m.ik_batch(T[None], q_ref=q_ref, backend="c")
     assert same_rows(expected, Qb[0][valid[0]], revolute, 1e-7)
 
 
-@needs_numba
+@needs_cc
 def test_compiled_batch_from_several_threads_at_once(generated):
-    """numba's default thread pool aborts the process if entered twice at once: ik_batch
-    serialises its compiled calls, so threads get their own correct results."""
+    """ik_batch splits its poses over threads of its own: callers on several threads at once
+    each get their own correct results (and ik's per-thread buffers stay apart)."""
     m = generated("puma560")
     T = m.fk_batch(sample_joints(m, 3000, np.random.default_rng(41)))
-    expected = m.ik_batch(T, backend="numba")
+    expected = m.ik_batch(T, backend="c")
     with ThreadPoolExecutor(4) as pool:
-        results = list(pool.map(lambda _: m.ik_batch(T, backend="numba"), range(8)))
+        results = list(pool.map(lambda _: m.ik_batch(T, backend="c"), range(8)))
     for Q, valid in results:
         assert np.array_equal(Q, expected[0]) and np.array_equal(valid, expected[1])
+    with ThreadPoolExecutor(4) as pool:
+        singles = list(pool.map(lambda i: m.ik(T[i], backend="c"), range(len(T))))
+    for i, rows in enumerate(singles):
+        assert np.array_equal(rows, expected[0][i][expected[1][i]]), i
 
 
 def test_backend_argument_is_checked(generated, monkeypatch):
@@ -111,9 +118,9 @@ def test_backend_argument_is_checked(generated, monkeypatch):
         m.ik(np.eye(4), backend="fortran")
     with pytest.raises(ValueError, match="backend"):
         m.ik_batch(np.eye(4)[None], backend="C")
-    monkeypatch.setattr(m, "_compiled", False)  # as in a process without numba
-    with pytest.raises(ImportError, match="numba"):
-        m.ik(np.eye(4), backend="numba")
+    monkeypatch.setattr(m, "_native", "no C compiler")  # as in a process without one
+    with pytest.raises(RuntimeError, match="backend='c': no C compiler"):
+        m.ik(np.eye(4), backend="c")
     assert m.ik_batch(np.eye(4)[None])[1].any()  # "auto" falls back to the Python solver
 
 
@@ -144,55 +151,9 @@ def test_ik_batch_slot_count_is_the_maximum(generated):
         ((1.0, 0.0, 1.0, 0.0, 0.25), []),  # (x^2 + 1/2)^2: no real root
     ],
 )
-def test_multiple_roots_are_found_by_scalar_and_vectorised_routines(generated, coeffs, roots):
-    m = generated("puma560")
-    scalar = m._poly_real(coeffs)
+def test_multiple_roots_are_found_once(coeffs, roots):
+    from derive.runtime.scalar import _poly_real
+
+    scalar = _poly_real(coeffs)
     assert len(scalar) == len(roots)
     assert np.allclose(scalar, roots, atol=1e-9)
-    x, ok, free = m._vpoly(tuple(np.array([c]) for c in coeffs), 0, np.ones(1, bool), False)
-    assert not free.any()
-    assert np.allclose(np.sort(x[ok]), roots, atol=1e-9)
-
-
-def kangle_cases() -> list[tuple[float, float]]:
-    rng = np.random.default_rng(43)
-    ys = rng.normal(size=20000) * 10.0 ** rng.uniform(-8, 8, 20000)
-    xs = rng.normal(size=20000) * 10.0 ** rng.uniform(-8, 8, 20000)
-    return list(zip(ys.tolist(), xs.tolist()))
-
-
-SIGNED_EDGES = [
-    (0.0, 0.0),
-    (-0.0, 0.0),
-    (0.0, -0.0),
-    (-0.0, -0.0),
-    (0.0, -1.0),
-    (-0.0, -1.0),
-    (1e-310, 1.0),
-    (1.0, 1e-310),
-    (math.inf, 1.0),
-    (1.0, -math.inf),
-    (-math.inf, -math.inf),
-    (3.0, 3.0),
-    (-3.0, -3.0),
-    (1.0, 8.0),
-    (8.0, -1.0),
-]
-
-
-@pytest.mark.parametrize("compiled", [False, pytest.param(True, marks=needs_numba)])
-def test_compiled_solvers_atan2_is_accurate_to_a_few_units_in_the_last_place(generated, compiled):
-    """_kangle, the kernel's own atan2, against the library's (correctly rounded): within
-    1e-15 absolute and relative on random quadrants and magnitudes, exactly equal on zeros of
-    either sign, infinities and the segment boundaries; nan stays nan."""
-    m = generated("planar_2r")
-    if compiled:
-        m._compile()
-    kangle = m._kangle
-    for y, x in kangle_cases():
-        exact = math.atan2(y, x)
-        assert abs(kangle(y, x) - exact) <= 1e-15 * min(1.0, abs(exact)) + 1e-300, (y, x)
-    for y, x in SIGNED_EDGES:
-        assert math.copysign(1.0, kangle(y, x)) == math.copysign(1.0, math.atan2(y, x)), (y, x)
-        assert abs(kangle(y, x) - math.atan2(y, x)) <= 4.5e-16, (y, x)
-    assert math.isnan(kangle(math.nan, 1.0)) and math.isnan(kangle(1.0, math.nan))

@@ -31,7 +31,12 @@ def test_generate_writes_module_and_reports_structure(tmp_path, capsys):
     line = capsys.readouterr().out.strip()
     assert line.startswith("user_arm: spherical wrist at joints 4-6; IK pieper")
     assert line.endswith(" s")
-    assert sorted(p.name for p in (tmp_path / "out").iterdir()) == ["user_arm.md", "user_arm.py"]
+    assert sorted(p.name for p in (tmp_path / "out").iterdir()) == [
+        "user_arm.md",
+        "user_arm.py",
+        "user_arm_ik.c",
+        "user_arm_ik.h",
+    ]
 
 
 def test_bad_spec_exits_2_without_traceback_or_file(tmp_path):
@@ -54,7 +59,12 @@ def test_failure_part_way_keeps_earlier_files(tmp_path, capsys):
     err = capsys.readouterr().err
     assert f"1 arm(s) failed ({bad}); the other arms were written" in err
     assert (out / "user_arm.py").is_file()
-    assert sorted(p.name for p in out.iterdir()) == ["user_arm.md", "user_arm.py"]
+    assert sorted(p.name for p in out.iterdir()) == [
+        "user_arm.md",
+        "user_arm.py",
+        "user_arm_ik.c",
+        "user_arm_ik.h",
+    ]
 
 
 def test_unknown_arm_name_exits_2(capsys):
@@ -73,7 +83,7 @@ def test_require_ik_exits_3_for_fk_only_arm(tmp_path):
 
 def test_check_detects_edited_removed_and_extra_files(tmp_path, capsys):
     # the committed output (test_regeneration checks it is today's), copied: one whole
-    # generation fewer, and the C files of the arms generated with --lang c come along
+    # generation fewer)
     out = tmp_path / "gen"
     shutil.copytree(GENERATED, out, ignore=shutil.ignore_patterns("__pycache__"))
     assert main(["check", "puma560", "--out", str(out)]) == 0
@@ -94,13 +104,13 @@ def test_check_detects_edited_removed_and_extra_files(tmp_path, capsys):
     assert main(["check", "puma560", "--out", str(out)]) == 1
     assert "puma560.py: missing" in capsys.readouterr().out
     target.write_text(original)
-    # an arm generated with --lang c has its C files checked too
+    # the C files the module runs are checked with it
     c_file = out / "puma560_ik.c"
     c_text = c_file.read_text()
     c_file.write_text(c_text.replace("#define DK_MAX 8", "#define DK_MAX 9"))
     assert main(["check", "puma560", "--out", str(out)]) == 1
     report = capsys.readouterr().out
-    assert f"{c_file}: differs" in report and "derive generate ARM --lang c" in report
+    assert f"{c_file}: differs" in report and "to update: derive generate puma560" in report
     c_file.write_text(c_text)
     (out / "old_arm.py").write_text("")
     (out / "old_arm_ik.c").write_text("")

@@ -62,6 +62,8 @@ def test_leftovers_of_a_killed_run_are_removed(tmp_path):
     assert sorted(p.name for p in out.iterdir() if not p.name.startswith(".")) == [
         "edge_arm.md",
         "edge_arm.py",
+        "edge_arm_ik.c",
+        "edge_arm_ik.h",
     ]
 
 

@@ -1,63 +1,125 @@
-"""The compiled backend is an addition, not a replacement: the module's Python functions stay
-Python, and numba's cache serves a module imported by path as well as by name."""
+"""The C solver behind a generated module: compiled on the first call into the per-user cache
+keyed by the C source's digest, found there by the next process (under any module name), and
+without a compiler or without the C files one notice and the Python solver's answers."""
 
 from __future__ import annotations
 
+import os
 import shutil
 import subprocess
 import sys
-import types
 
 import numpy as np
+import pytest
 
 from derive.verify import sample_joints
 
-from conftest import GENERATED, import_path, needs_numba
+from conftest import GENERATED, import_path, needs_cc
 
-# import by path under a name of its own, warm up, and say where the machine code came from
+# import by path under a name of its own, solve a pose in C, print the library's path
 PROBE = """
 import importlib.util, sys
 spec = importlib.util.spec_from_file_location(sys.argv[2], sys.argv[1])
 m = importlib.util.module_from_spec(spec)
 spec.loader.exec_module(m)
 assert m.warmup()
-kone = m._compile()[1]
-print(sum(kone.stats.cache_hits.values()), sum(kone.stats.cache_misses.values()))
+T = m.fk([0.3] * m.DOF)
+assert len(m.ik(T, backend="c")) >= 1
+print(m._native.lib._name)
 """
 
 
-@needs_numba
-def test_python_backend_is_the_same_before_and_after_a_compiled_call(tmp_path):
-    shutil.copy(GENERATED / "puma560.py", tmp_path / "puma560.py")
-    m = import_path(tmp_path / "puma560.py")
-    poses = m.fk_batch(sample_joints(m, 300, np.random.default_rng(3)))
-    before = [m.ik(T, backend="python") for T in poses]
-    batch_before = m.ik_batch(poses, backend="python")
-    helpers = {n: getattr(m, n) for n in m._KERNEL}
-    assert m.warmup()
-    m.ik(poses[0], backend="numba")
-    m.ik_batch(poses, backend="numba")
-    for name, function in helpers.items():
-        assert getattr(m, name) is function and type(function) is types.FunctionType, name
-    after = [m.ik(T, backend="python") for T in poses]
-    batch_after = m.ik_batch(poses, backend="python")
-    assert all(np.array_equal(a, b) for a, b in zip(before, after))
-    assert all(np.array_equal(a, b) for a, b in zip(batch_before, batch_after))
+def copy_arm(name: str, folder, c: bool = True):
+    """The bundled arm's module (and, with c, its C files) copied into folder."""
+    files = [f"{name}.py"] + ([f"{name}_ik.c", f"{name}_ik.h"] if c else [])
+    for file in files:
+        shutil.copy(GENERATED / file, folder / file)
+    return folder / f"{name}.py"
 
 
-@needs_numba
-def test_numba_cache_serves_a_module_imported_by_path(tmp_path):
-    shutil.copy(GENERATED / "planar_2r.py", tmp_path / "planar_2r.py")
-    runs = []
-    for name in ("first_import_name", "another_import_name"):
-        result = subprocess.run(
-            [sys.executable, "-c", PROBE, str(tmp_path / "planar_2r.py"), name],
-            capture_output=True,
+def probe(path, name: str, env: dict) -> str:
+    done = subprocess.run(
+        [sys.executable, "-c", PROBE, str(path), name],
+        capture_output=True,
+        text=True,
+        timeout=300,
+        env=env,
+    )
+    assert done.returncode == 0, done.stderr
+    return done.stdout.strip()
+
+
+@needs_cc
+def test_the_c_solver_is_compiled_once_into_the_cache_and_found_by_the_next_process(tmp_path):
+    path = copy_arm("planar_2r", tmp_path)
+    env = dict(os.environ, DERIVE_IK_CACHE=str(tmp_path / "cache"))
+    first = probe(path, "first_import_name", env)
+    built = sorted((tmp_path / "cache").glob("planar_2r-*"))
+    assert [str(p) for p in built] == [first]
+    stamp = built[0].stat().st_mtime_ns
+    assert probe(path, "another_import_name", env) == first  # the same library, not rebuilt
+    assert built[0].stat().st_mtime_ns == stamp
+    # a changed C source is another digest: compiled again, beside the first
+    source = tmp_path / "planar_2r_ik.c"
+    source.write_text(source.read_text() + "\n/* changed */\n")
+    second = probe(path, "third_import_name", env)
+    assert second != first and len(list((tmp_path / "cache").glob("planar_2r-*"))) == 2
+    assert not [p for p in (tmp_path / "cache").iterdir() if p.is_dir()]  # no leftovers
+
+
+@needs_cc
+def test_processes_compiling_at_once_each_get_a_whole_library(tmp_path):
+    path = copy_arm("lecture_rrr", tmp_path)
+    env = dict(os.environ, DERIVE_IK_CACHE=str(tmp_path / "cache"))
+    runs = [
+        subprocess.Popen(
+            [sys.executable, "-c", PROBE, str(path), f"name{k}"],
+            stdout=subprocess.PIPE,
+            stderr=subprocess.PIPE,
             text=True,
-            timeout=600,
+            env=env,
         )
-        assert result.returncode == 0, result.stderr
-        runs.append(tuple(int(x) for x in result.stdout.split()))
-    assert runs[0] == (0, 1)  # compiled, and written to __pycache__
-    assert runs[1] == (1, 0)  # loaded from the cache, under another module name
-    assert any((tmp_path / "__pycache__").glob("planar_2r._kone-*.nbi"))
+        for k in range(3)
+    ]
+    outputs = [run.communicate(timeout=300) for run in runs]
+    assert all(run.returncode == 0 for run in runs), [err for _, err in outputs]
+    assert len({out.strip() for out, _ in outputs}) == 1
+
+
+def test_without_a_compiler_one_notice_and_the_python_solver(tmp_path, monkeypatch):
+    monkeypatch.setenv("CC", str(tmp_path / "no-such-compiler"))
+    monkeypatch.setenv("DERIVE_IK_CACHE", str(tmp_path / "cache"))
+    m = import_path(copy_arm("puma560", tmp_path))
+    with pytest.warns(RuntimeWarning, match="puma560: solving in Python") as notices:
+        poses = m.fk_batch(sample_joints(m, 20, np.random.default_rng(3)))
+        rows = [m.ik(T) for T in poses]
+        Q, valid = m.ik_batch(poses)
+        m.nearest(poses[0], np.zeros(6))
+    assert len(notices) == 1
+    for T, r, q, ok in zip(poses, rows, Q, valid):
+        expected = m.ik(T, backend="python")
+        assert np.array_equal(r, expected) and np.array_equal(q[ok], expected)
+    assert not m.warmup()
+    with pytest.raises(RuntimeError, match=r"backend=.c.: .*no-such-compiler"):
+        m.ik(poses[0], backend="c")
+
+
+def test_a_module_copied_without_its_c_files_says_so_once_and_solves_in_python(tmp_path):
+    m = import_path(copy_arm("planar_2r", tmp_path, c=False))
+    T = m.fk([0.4, 0.5])
+    with pytest.warns(RuntimeWarning, match=r"planar_2r_ik\.c \(and its \.h\) not found"):
+        rows = m.ik(T)
+    assert np.abs(rows - m.ik(T, backend="python")).max() == 0.0
+    with pytest.raises(ValueError, match="backend must be 'auto', 'c' or 'python'"):
+        m.ik(T, backend="numba")
+
+
+@needs_cc
+def test_a_failing_compiler_is_named_with_its_message(tmp_path, monkeypatch):
+    path = copy_arm("planar_2r", tmp_path)
+    (tmp_path / "planar_2r_ik.c").write_text("this is not C\n")
+    monkeypatch.setenv("DERIVE_IK_CACHE", str(tmp_path / "cache"))
+    m = import_path(path)
+    with pytest.warns(RuntimeWarning, match=r"failed on .*planar_2r_ik\.c: .*error"):
+        m.ik(m.fk([0.1, 0.2]))
+    assert not list((tmp_path / "cache").glob("planar_2r-*"))  # nothing half-built kept

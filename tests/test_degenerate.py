@@ -8,7 +8,7 @@ import math
 import numpy as np
 import pytest
 
-from conftest import build_module, needs_numba, spec_text
+from conftest import build_module, needs_cc, spec_text
 from degenerate import WORST, contains, run_suite, solve_checked
 
 # arm -> (elbow joint, joints solved by a half-angle step or a cs1 step, wrist joint)
@@ -21,7 +21,7 @@ BUNDLED_SUITES = {
 }
 
 
-@pytest.mark.parametrize("backend", ["python", pytest.param("numba", marks=needs_numba)])
+@pytest.mark.parametrize("backend", ["python", pytest.param("c", marks=needs_cc)])
 @pytest.mark.parametrize("name", sorted(BUNDLED_SUITES))
 def test_degenerate_suite_of_bundled_arm(generated, name, backend):
     elbow, pi_joints, wrist = BUNDLED_SUITES[name]

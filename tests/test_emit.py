@@ -42,7 +42,7 @@ def derive_imports() -> dict[str, set[str]]:
 
 def test_no_import_cycle_in_derive():
     graph = derive_imports()
-    assert "derive.printers.common" in graph["derive.printers.kernel"]  # the graph sees imports
+    assert "derive.printers.common" in graph["derive.printers.scalar"]  # the graph sees imports
     state: dict[str, int] = {}
 
     def visit(module: str, path: tuple[str, ...]) -> None:

@@ -4,7 +4,6 @@ arms of any geometry, and the closed-form arms solved again by the general metho
 from __future__ import annotations
 
 import math
-import os
 import tempfile
 import zlib
 from pathlib import Path
@@ -20,7 +19,7 @@ from derive.spec import parse_spec
 from derive.verify import roundtrip, sample_joints
 
 from cases import GENERAL_CASES
-from conftest import build_module, import_path, slider_text, spec_text
+from conftest import build_module, import_path, needs_cc, slider_text, spec_text
 from strategies import general_arms
 
 
@@ -155,27 +154,17 @@ def test_an_arm_with_joint_4_prismatic_singular_everywhere_is_refused():
     assert "general: the arm's Jacobian has rank below 6 at every configuration" in plan.refusal
 
 
-# numba compiles a general arm's kernel in 70-150 s: the compiled case runs where asked
-LONG = os.environ.get("DERIVE_LONG_TESTS") == "1"
-
-
 @pytest.mark.parametrize(
     ("kinds", "convention", "backend"),
     [
         ("RRPRRR", "standard", "python"),
         ("RRRPRR", "modified", "python"),
-        pytest.param(
-            "RRPRRR",
-            "modified",
-            "numba",
-            marks=pytest.mark.skipif(not LONG, reason="compiles for ~2 min: DERIVE_LONG_TESTS=1"),
-        ),
+        pytest.param("RRPRRR", "modified", "c", marks=needs_cc),
     ],
 )
 def test_a_prismatic_joint_3_or_4_is_the_eigen_joint(kinds, convention, backend, tmp_path):
     """Joint 3 prismatic (or joint 4: the reversed chain's joint 3): d3 is the eigen-variable
-    (no half-angle); every solution sound, every sample's q found (Python and compiled; the C
-    port: tests/test_c.py)."""
+    (no half-angle); every solution sound, every sample's q found (Python and C)."""
     text = slider_text(kinds, convention)
     plan = build_plan(parse_spec(text, "<test>"))
     assert plan.ik is not None and plan.ik.method == "general", plan.refusal

@@ -8,7 +8,7 @@ import tracemalloc
 import numpy as np
 import pytest
 
-from conftest import build_module, needs_numba
+from conftest import build_module, needs_cc
 
 UR5_ROWS = [
     (90.0, 0.0, 0.089159),
@@ -136,17 +136,17 @@ def test_q_ref_shape_and_values_are_checked(ur5, q_ref):
         ur5.nearest(T, q_ref)
 
 
-@needs_numba
+@needs_cc
 def test_compiled_limits_and_nearest_match_python(ur5):
-    """within_limits and nearest run compiled when numba is there: the same rows and picks."""
+    """within_limits and nearest run in C when it is there: the same rows and picks."""
     rng = np.random.default_rng(5)
     for q in rng.uniform(-2 * math.pi, 2 * math.pi, (50, 6)):
         T = ur5.fk(q)
         ref = q + rng.normal(0.0, 0.01, 6)
-        rows = {b: ur5.ik(T, within_limits=True, q_ref=ref, backend=b) for b in ("python", "numba")}
-        assert rows["python"].shape == rows["numba"].shape
-        assert np.abs(rows["python"] - rows["numba"]).max(initial=0.0) < 1e-9
-        ur5.BACKEND = "numba"
+        rows = {b: ur5.ik(T, within_limits=True, q_ref=ref, backend=b) for b in ("python", "c")}
+        assert rows["python"].shape == rows["c"].shape
+        assert np.abs(rows["python"] - rows["c"]).max(initial=0.0) < 1e-9
+        ur5.BACKEND = "c"
         try:
             compiled = ur5.nearest(T, ref)
             wrapped = ur5.nearest(T, ref, within_limits=False)

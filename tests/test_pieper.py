@@ -12,7 +12,7 @@ from derive.spec import parse_spec
 from derive.verify import roundtrip, sample_joints
 
 from cases import PIEPER_CASES, PUMA_REPORT_FLAGS, PUMA_REPORT_SOLUTIONS
-from conftest import build_module, needs_numba, spec_text, wrapped_close
+from conftest import build_module, needs_cc, spec_text, wrapped_close
 
 
 def cup_pose() -> np.ndarray:
@@ -149,7 +149,7 @@ def test_out_of_reach_pose_returns_empty(generated):
         assert sols.shape == (0, 6)
 
 
-@pytest.mark.parametrize("backend", ["python", pytest.param("numba", marks=needs_numba)])
+@pytest.mark.parametrize("backend", ["python", pytest.param("c", marks=needs_cc)])
 def test_bad_poses_raise_value_error(generated, backend):
     """The compiled ik checks the pose in compiled code; what it rejects gets the Python
     solver's message."""

@@ -125,12 +125,14 @@ def test_generate_with_figures_embeds_them_and_check_reproduces_them(tmp_path, c
     assert names == [
         "planar_2r.md",
         "planar_2r.py",
+        "planar_2r_ik.c",
+        "planar_2r_ik.h",
         "planar_2r_solutions.svg",
         "planar_2r_workspace.svg",
     ]
     assert "](planar_2r_workspace.svg)" in (out / "planar_2r.md").read_text()
     assert main(["check", "planar_2r", "--figures", "--out", str(out)]) == 0
-    assert "up to date (4 files)" in capsys.readouterr().out
+    assert "up to date (6 files)" in capsys.readouterr().out
 
 
 def test_panel_titles_clear_the_row_above_and_the_axes_are_labelled(generated):

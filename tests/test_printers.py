@@ -62,7 +62,7 @@ def test_generated_modules_hold_no_function_they_never_call(name):
     tree = ast.parse(module_source(name))
     defined = {n.name for n in tree.body if isinstance(n, ast.FunctionDef | ast.ClassDef)}
     used = {n.id for n in ast.walk(tree) if isinstance(n, ast.Name)}
-    # the compiled kernel's functions are named in _KERNEL (strings), the public API by users
+    # functions named in strings (none today), the public API by users
     named = {n.value for n in ast.walk(tree) if isinstance(n, ast.Constant)}
     public = {"fk", "fk_batch", "ik", "ik_batch", "ik_sweep", "nearest", "warmup"}
     unused = sorted(defined - used - named - public)

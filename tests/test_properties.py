@@ -22,7 +22,7 @@ from derive.pipeline import build_plan
 from derive.spec import parse_spec
 from derive.verify import roundtrip, sample_joints
 
-from conftest import build_module, needs_numba, spec_text
+from conftest import build_module, needs_cc, spec_text
 from degenerate import run_suite
 from strategies import end_parallel_arms, parallel_arms, pieper_arms, planar_arms
 
@@ -31,13 +31,15 @@ def verify_family(
     text: str, methods: tuple[str, ...], elbow: int, wrist: int | None, backend: str = "python"
 ) -> None:
     """Generate, import and verify one arm with ik's `backend`; `methods` are those its
-    family may be solved by. The Python solver is the default: numba compiles a solver in
-    seconds, too slow for hundreds of arms; COMPILED below checks fewer arms compiled."""
+    family may be solved by. The Python solver is the default; COMPILED below checks fewer
+    arms in C (each compiles in about a second)."""
     plan = build_plan(parse_spec(text, "<hypothesis>"))
     assert plan.ik is not None, (plan.refusal, text)
     assert plan.ik.method in methods, (plan.ik.method, text)
     with tempfile.TemporaryDirectory() as tmp:
         m = build_module(text, Path(tmp))
+        if backend == "c":
+            m._native_solver("c")  # compiled before its folder goes
     rng = np.random.default_rng(zlib.crc32(text.encode()))  # the same on every run
     result = roundtrip(m, sample_joints(m, 12, rng), backend)
     assert result.unsound == [], (result.summary(), text)
@@ -79,31 +81,31 @@ def test_random_planar_arms(text):
     verify_family(text, ("planar",), 2, None)
 
 
-# The compiled solvers (numba) of a few random arms per family, through the same checks.
+# The C solvers of a few random arms per family, through the same checks.
 COMPILED = settings(
     max_examples=3, deadline=None, derandomize=True, suppress_health_check=[HealthCheck.too_slow]
 )
 
 
-@needs_numba
+@needs_cc
 @COMPILED
 @given(st.one_of(pieper_arms(), parallel_arms()))
 def test_compiled_random_spatial_arms(text):
-    verify_family(text, ("pieper", "three-parallel"), 3, 5, backend="numba")
+    verify_family(text, ("pieper", "three-parallel"), 3, 5, backend="c")
 
 
-@needs_numba
+@needs_cc
 @COMPILED
 @given(end_parallel_arms())
 def test_compiled_random_arms_with_axes_1_2_3_or_4_5_6_parallel(text):
-    verify_family(text, ("three-parallel", "pieper", "planar"), 2, None, backend="numba")
+    verify_family(text, ("three-parallel", "pieper", "planar"), 2, None, backend="c")
 
 
-@needs_numba
+@needs_cc
 @COMPILED
 @given(planar_arms())
 def test_compiled_random_planar_arms(text):
-    verify_family(text, ("planar",), 2, None, backend="numba")
+    verify_family(text, ("planar",), 2, None, backend="c")
 
 
 # Arms the property tests once found failing, kept as fixed cases. 1 and 3: reversed chains
@@ -253,12 +255,12 @@ REGRESSIONS = (
 )
 
 
-# every regression arm in Python; every other one compiled too (each compile takes ~13 s of
-# CI's 20 minutes; the compiled solver follows the Python one step by step)
+# every regression arm in Python; every other one in C too (the C solver follows the Python
+# one step by step)
 @pytest.mark.parametrize(
     ("convention", "kinds", "travel", "rows", "backend"),
     [(*arm, "python") for arm in REGRESSIONS]
-    + [pytest.param(*arm, "numba", marks=needs_numba) for arm in REGRESSIONS[::2]],
+    + [pytest.param(*arm, "c", marks=needs_cc) for arm in REGRESSIONS[::2]],
 )
 def test_regression_arms(convention, kinds, travel, rows, backend):
     text = spec_text("regression_arm", convention, rows, kinds=kinds)

@@ -17,7 +17,7 @@ import pytest
 
 from derive import reach
 from derive.cli import main, resolve_spec
-from derive.emit import render_module
+from derive.load import solver_sources
 from derive.pipeline import build_plan
 
 pytest.importorskip("zarr", reason="reach maps need zarr (the scale and test extras have it)")
@@ -32,12 +32,12 @@ def _python_solver(monkeypatch, tmp_path_factory):
     """The maps here are small: numpy's batch solver (no compile); solver files in a
     temporary cache."""
     monkeypatch.setenv("DERIVE_BACKEND", "python")
-    monkeypatch.setenv("DERIVE_CACHE", str(tmp_path_factory.getbasetemp() / "cache"))
+    monkeypatch.setenv("DERIVE_IK_CACHE", str(tmp_path_factory.getbasetemp() / "cache"))
 
 
 def arm(name: str) -> tuple[str, str, str, str]:
     spec = resolve_spec(name)
-    return spec.name, spec.digest(), render_module(build_plan(spec)), spec.convention
+    return spec.name, spec.digest(), solver_sources(build_plan(spec)), spec.convention
 
 
 def make(path: Path, name: str, processes: int = 1, **params) -> reach.ReachMap:

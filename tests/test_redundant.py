@@ -16,7 +16,7 @@ from derive.pipeline import build_plan
 from derive.spec import SpecError, parse_spec
 from derive.verify import roundtrip, sample_joints
 
-from conftest import build_module, needs_numba, spec_text
+from conftest import build_module, needs_cc, spec_text
 from strategies import LENGTH, OFFSETS, SCALE, rows_for, scaled
 
 REDUNDANT = ("iiwa14", "panda")
@@ -41,7 +41,7 @@ def test_bundled_arms_free_the_last_joint(generated, name):
     assert "Free joints: q7" in m.__doc__
 
 
-@pytest.mark.parametrize("backend", ["python", pytest.param("numba", marks=needs_numba)])
+@pytest.mark.parametrize("backend", ["python", pytest.param("c", marks=needs_cc)])
 @pytest.mark.parametrize("name", REDUNDANT)
 def test_bundled_round_trips(generated, name, backend):
     m = generated(name)
@@ -64,7 +64,7 @@ def test_panda_with_q7_given_has_up_to_eight_solutions(generated):
             assert np.abs(m.fk(row) - m.fk(q)).max() <= 1e-9
 
 
-@pytest.mark.parametrize("backend", ["python", pytest.param("numba", marks=needs_numba)])
+@pytest.mark.parametrize("backend", ["python", pytest.param("c", marks=needs_cc)])
 @pytest.mark.parametrize("name", REDUNDANT)
 def test_ik_batch_takes_a_free_value_per_pose(generated, name, backend):
     m = generated(name)

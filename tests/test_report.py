@@ -11,8 +11,9 @@ import pytest
 import sympy as sp
 from sympy.parsing.latex import parse_latex
 
-from derive.cli import import_source, main, resolve_spec, worked_example
-from derive.emit import render_module
+from derive.cli import main, resolve_spec
+from derive.languages import worked_example
+from derive.load import load_solver, solver_sources
 from derive.pipeline import build_plan
 from derive.report import report_blocks
 
@@ -106,7 +107,7 @@ def test_puma_report_lists_the_eight_solutions():
 @pytest.mark.parametrize("name", [n for n in BUNDLED if n not in ("iiwa14", "panda")])
 def test_every_math_fragment_parses_back(name):
     plan = build_plan(resolve_spec(name))
-    module = import_source(name, render_module(plan))
+    module = load_solver(name, solver_sources(plan))
     blocks = report_blocks(plan, worked_example(plan, module))
     maths = [b.math for b in blocks if b.kind == "math"]
     assert len(maths) > 10

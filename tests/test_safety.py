@@ -78,7 +78,12 @@ def test_no_partial_file_when_rendering_fails(tmp_path, monkeypatch):
     monkeypatch.setattr(cli.os, "replace", broken)
     assert main(["generate", "planar_2r", "--out", str(out)]) == 2
     assert (out / "planar_2r.py").read_bytes() == original
-    assert sorted(p.name for p in out.iterdir()) == ["planar_2r.md", "planar_2r.py"]
+    assert sorted(p.name for p in out.iterdir()) == [
+        "planar_2r.md",
+        "planar_2r.py",
+        "planar_2r_ik.c",
+        "planar_2r_ik.h",
+    ]
 
 
 MUTATIONS = st.lists(

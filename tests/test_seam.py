@@ -7,7 +7,7 @@ import math
 import numpy as np
 import pytest
 
-from conftest import BUNDLED, needs_numba
+from conftest import BUNDLED, needs_cc
 
 SEAM_SHARE = 0.2
 POSES = 10_000
@@ -93,12 +93,15 @@ def tally(m, backends: tuple[str, ...]) -> dict[str, dict[str, int]]:
 # 4 at the seam and 1 whose theta6 is 1.3e-8 above -pi in one backend and 1.2e-8 above pi in
 # the other (its rows differ by 5e-8 throughout: a near-singular pose, q5 near -90 deg);
 # panda has one pose beyond 1e-12.
+# parallel_6r in C (since the C solver replaced numba's, issue 38): 3 of 10,000 poses have a
+# joint exactly pi in one solver and pi -+ 1e-12..1e-9 in the other (the C solver's own
+# asin table and atan2 round apart from the math library's near pi), 8 more by rounding.
 ALLOWED = {
     "iiwa14": {"rounding": 30, "seam": 10, "turn": 2},
     "panda": {"rounding": 5},
     "lecture_6r": {"rounding": 500, "seam": 50},
     "manocha_canny": {"rounding": 10, "seam": 5, "turn": 12, "count": 5},
-    "parallel_6r": {"rounding": 20, "count": 1},
+    "parallel_6r": {"rounding": 20, "count": 1, "seam": 5},
     "puma560": {"rounding": 30, "seam": 10},
 }
 
@@ -121,7 +124,7 @@ def test_python_ik_and_ik_batch_agree_at_the_seam(generated, name):
     check(name, counts)
 
 
-@needs_numba
+@needs_cc
 @pytest.mark.parametrize("name", BUNDLED)
 def test_compiled_and_python_agree_at_the_seam(generated, name):
-    check(name, tally(generated(name), ("python", "numba")))
+    check(name, tally(generated(name), ("python", "c")))

@@ -1,5 +1,5 @@
-"""Printing SymPy expressions and plan pieces as Python source, shared by the backends'
-printers (scalar, vector, kernel) and emit (forward kinematics).
+"""Printing SymPy expressions and plan pieces as Python source, shared by the Python solver's
+printer (scalar) and emit (forward kinematics).
 
 Printing is deterministic: numbers print as Python float literals (the shortest repr), terms
 in SymPy's canonical order, CSE with ``order="canonical"`` and a fresh ``x0, x1, ...``
@@ -143,13 +143,11 @@ def same_joints(plan: Plan) -> bool:
     return True
 
 
-def match_expression(certify: str, vector: bool = False) -> str:
-    """The certification test of entries e against target t, unrolled (elementwise if vector)."""
+def match_expression(certify: str) -> str:
+    """The certification test of entries e against target t, unrolled."""
     rotation = () if certify == "position" else (0, 1, 2, 4, 5, 6, 8, 9, 10)
     tests = [f"abs(e[{k}] - t[{k}]) <= tol" for k in rotation]
     tests += [f"abs(e[{k}] - t[{k}]) <= ptol" for k in (3, 7, 11)]
-    if vector:
-        return " & ".join(f"({t})" for t in tests)
     return " and ".join(tests)
 
 

@@ -1,6 +1,6 @@
 """The general method's printed pieces: the splits' constants and _rr_fill, the straight-line
 code giving the Raghavan-Roth matrices of a pose. The same text serves the Python solver and
-the compiled one (numba compiles it as it is)."""
+the C one prints its own from the same entries (derive/printers/c.py)."""
 
 from __future__ import annotations
 
@@ -41,7 +41,7 @@ def pad(values: tuple[int, ...], width: int) -> tuple[int, ...]:
 
 def spurious_counts(step: Eigen) -> tuple[list[int], int]:
     """Per split, the columns of Split.spurious (2 per vector), and the width every split's
-    table is padded to: a vector's columns at least (no empty arrays in numba or C, and GCC's
+    table is padded to: a vector's columns at least (no empty arrays in C, and GCC's
     bounds checks see the columns the C routine names)."""
     counts = [len(split.spurious[0]) if split.spurious else 0 for split in step.splits]
     return counts, max(2, *counts)

@@ -1,7 +1,7 @@
 """The generated modules' runtime: every routine a generated solver calls that is not about
 one arm, as ordinary Python that is linted, type-checked and tested here.
 
-A generated module is standalone (math and numpy; numba optional): the emitter
+A generated module is standalone (math, numpy and ctypes): the emitter
 (:mod:`derive.assemble`) copies into it the source of exactly the routines its arm's code
 calls, with everything they call, in the order of :data:`MODULES`, and prints the names of
 :mod:`derive.runtime.arm` from the arm's plan. In a generated module everything lives in one
@@ -11,17 +11,17 @@ Modules, in copy order:
 
 =============  ==========================================================================
 ``constants``  tolerances and settings (CERTIFY_TOL, BACKEND, the seam, ...)
+``native``     the arm's C solver: compiled on first use into a per-user cache, loaded
+               through ctypes
 ``api``        fk, fk_batch, ik, ik_batch, nearest, warmup: wrapping and dropping
-               repeats, joint limits, the choice of backend and the kernels' build
+               repeats, joint limits, the choice between the C and the Python solver
 ``common``     argument checks and joint-value helpers the others share
 ``redundant``  ik_sweep and the searching nearest of arms with free joints (copied only
                into their modules, whose nearest it replaces)
-``closed``     closed forms shared by the Python and compiled solvers (quadratic,
-               quartic, atan2, Newton steps, the free-joint reach searches)
+``closed``     closed forms of the Python solver (quadratic, quartic, atan2, Newton
+               steps, the free-joint reach searches)
 ``general``    the general 6R method in the Python solver (numpy's eigensolver)
 ``scalar``     the Python solver's step routines (``a cos + b sin = e``, polynomials)
-``vector``     the numpy batch solver's step routines (one array axis per branch)
-``kernel``     the compiled solver's routines, in the subset of Python numba compiles
 =============  ==========================================================================
 
 ``arm`` is never copied: it stands in for the names each generated module prints for its
@@ -29,5 +29,5 @@ arm (DOF, LIMITS, the forward kinematics, the solver bodies), so that this packa
 """
 
 MODULES = (
-    "constants", "api", "common", "redundant", "closed", "general", "scalar", "vector", "kernel",
+    "constants", "native", "api", "common", "redundant", "closed", "general", "scalar",
 )  # fmt: skip

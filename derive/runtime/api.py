@@ -1,20 +1,17 @@
 """The generated module's public functions and their plumbing: argument checks, wrapping and
-dropping repeats, joint limits, the choice of backend and the compiled kernels' build."""
+dropping repeats, joint limits, and the choice between the compiled C solver (native.py) and
+the Python one."""
 
 from __future__ import annotations
 
 import math
-import sys
-import threading
-import types
 from operator import sub as _sub
 
 import numpy as np
 from numpy.typing import ArrayLike
 
 from derive.runtime.arm import (
-    _KERNEL,
-    _KERNEL_SPACE,
+    _C_SOURCE,
     _REVOLUTE,
     DOF,
     FREE,
@@ -24,7 +21,6 @@ from derive.runtime.arm import (
     _cs_columns,
     _fk_from_cs,
     _fk_q,
-    _ik_candidates,
     _ik_scalar,
 )
 from derive.runtime.common import (
@@ -43,15 +39,13 @@ from derive.runtime.common import (
 from derive.runtime.constants import (
     _SEAM,
     _TWO_PI,
-    BACKEND,
     CERTIFY_TOL,
     DEDUP_TOL,
     FREE_LIMIT,
     MAX_TURN_ROWS,
     POSE_TOL,
 )
-from derive.runtime.kernel import _FASTMATH, _KSTRICT, _kpick
-from derive.runtime.vector import _vfinish, _vpose
+from derive.runtime.native import _UNSETTLED, _batch_threads, _native_solver, _scratch
 
 
 def fk(q: ArrayLike) -> np.ndarray:
@@ -73,6 +67,12 @@ def fk_batch(Q: ArrayLike) -> np.ndarray:
         raise ValueError(f"Q must have shape (N, {DOF}), got {values.shape}")
     if not np.isfinite(values).all():
         raise ValueError("Q must be finite numbers")
+    native = _native_solver(None) if _C_SOURCE else None
+    if native is not None:
+        Q = np.ascontiguousarray(values)
+        out = np.empty((Q.shape[0], 4, 4))
+        native.fk_batch(Q.ctypes.data, Q.shape[0], out.ctypes.data)
+        return out
     out = np.zeros((values.shape[0], 4, 4))
     entries = _fk_from_cs(*_cs_columns(values))
     for k, value in enumerate(entries):
@@ -108,12 +108,12 @@ def ik(
             matches T within tol in rotation entries and tol * REACH in position. For an arm
             that does not control every pose component this is also the test that T's other
             components are reachable: if they are not, the result is empty.
-        backend: "numba" runs the solver compiled (numba compiles it on the first call of a
-            process, or at warmup(), and caches the machine code beside this file); "python"
-            runs it as Python; "auto" is "numba" when numba is installed; None (default):
-            BACKEND, which is "auto" unless you set it. The two agree to rounding (far below
-            tol); poses the compiled closed forms do not settle (a free joint, a split
-            multiple root) are solved in Python either way.
+        backend: "c" runs the arm's C solver (compiled on the first call of a process, or
+            at warmup(), into a per-user cache: see _c_library); "python" runs the Python
+            solver; "auto" is "c" where the C solver compiles; None (default): BACKEND,
+            which is "auto" unless you set it. The two agree to rounding (far below tol);
+            poses the C solver does not settle (a split multiple root) are solved in Python
+            either way.
         all_turns: with within_limits, every variant of every solution inside the limits
             (all k per joint, as a product; at most MAX_TURN_ROWS rows, else ValueError).
 
@@ -132,16 +132,23 @@ def ik(
             return _in_limits(rows, refs, all_turns)
     else:
         result = _as_rows
-    kernels = _kernels(backend)
-    if kernels is not None:
-        A = _array44(T)
-        if A is not None:  # else _pose says what is wrong with T
-            # (the kernel picks variants near the values it solves with: near q_ref's own
-            # ones where a free value was reduced to a turn, result does)
-            limited = within_limits and not all_turns and solve == refs
-            rows, status = kernels[1](A[None], tol, solve, limited)
-            if status == 0:
-                return rows if not within_limits or limited else result(rows)
+    native = _native_solver(backend)
+    if native is not None:
+        A = T if type(T) is np.ndarray and T.dtype == np.float64 else _array44(T)
+        if A is not None and A.shape == (4, 4):  # else _pose says what is wrong with T
+            pose, at, rows, rows_at, ref, ref_at = _scratch()
+            pose[...] = A
+            given = None
+            if solve is not _ZEROS:
+                ref[:] = solve
+                given = ref_at
+            n = native.ik(at, None, given, tol, rows_at)
+            if n >= 0:
+                # (C picks variants near the values it solves with: near q_ref's own ones
+                # where a free value was reduced to a turn, result does)
+                if within_limits and not all_turns and solve == refs:
+                    return rows[: native.within_limits(rows_at, n, given)].copy()
+                return result(rows[:n].copy())
     # the Python solver; for the compiled one a pose it did not settle, or an invalid one
     target = _pose(T)
     if max(abs(target[3]), abs(target[7]), abs(target[11])) > _FAR:
@@ -151,11 +158,10 @@ def ik(
 
 def _array44(T):
     """T as a float64 array if it is 4x4, else None."""
-    if type(T) is not np.ndarray or T.dtype != np.float64:
-        try:
-            T = _real(T, "T")
-        except ValueError:
-            return None
+    try:
+        T = _real(T, "T")
+    except ValueError:
+        return None
     return T if T.shape == (4, 4) else None
 
 
@@ -176,19 +182,19 @@ def ik_batch(
             FREE has one); default: q_ref's values for every pose.
         q_ref: as for ik (one joint vector for all poses).
         tol: as for ik.
-        chunk: poses the python backend solves together; memory grows with it, not with N.
-        backend: "numba" solves the poses in a compiled loop, on every core (compiled as for
-            ik); "python" solves them with vectorised numpy; "auto" and None as for ik. Both
-            give ik's solutions.
+        chunk: accepted for compatibility (the poses are solved one by one, in C over
+            every core, or in Python).
+        backend: "c" solves the poses in C, split over every core (_THREADS threads, each
+            call releasing the GIL); "python" solves them one by one with the Python
+            solver; "auto" and None as for ik. Both give ik's solutions.
 
     Returns:
         (Q, valid): Q (N, M, DOF) with M = MAX_SOLUTIONS, the most solutions a pose can
         have; valid (N, M) marks the slots that hold a solution: for each pose the first
         slots, holding the rows ik returns, in the same order; the other slots are zero.
-        within_limits is not offered here. Poses the closed forms alone do not settle (a
-        free joint, a split multiple root) are solved by ik. A pose that is not a valid
-        transform (not finite, rotation not orthonormal within POSE_TOL) gets no valid slot
-        instead of an exception.
+        within_limits is not offered here. A pose that is not a valid transform (not
+        finite, rotation not orthonormal within POSE_TOL) gets no valid slot instead of an
+        exception.
     """
     tol = _tolerance(tol)
     if type(chunk) is bool or not isinstance(chunk, (int, np.integer)) or chunk < 1:
@@ -196,47 +202,41 @@ def ik_batch(
     refs = _reference(q_ref)
     if free is None:  # (else _free_rows reduces the values given)
         refs = _free_turns(refs)
-    kernels = _kernels(backend)
-    if kernels is None:
-        return _ik_batch_numpy(T, refs, free, tol, int(chunk))
+    native = _native_solver(backend)
     T = np.ascontiguousarray(_real(T, "T"))
     if T.ndim != 3 or T.shape[1:] != (4, 4):
         raise ValueError(f"T must have shape (N, 4, 4), got {T.shape}")
     n = T.shape[0]
     per_pose = _free_rows(free, refs, n)
-    # np.full writes its memory here: np.zeros would leave the page faults to the kernel's
-    # threads, which contend for them (about a third of the kernel's time)
-    Q = np.full((n, MAX_SOLUTIONS, DOF), 0.0)
-    valid = np.full((n, MAX_SOLUTIONS), False)
-    retry = np.zeros(n, dtype=bool)
-    qref = np.array([refs]) if per_pose is None else per_pose
-    with _BATCH_LOCK:  # numba's default thread pool must not be entered twice at once
-        kernels[0](T, float(tol), qref, Q, valid, retry)
-    for i in np.flatnonzero(retry):
-        ref_i = refs if per_pose is None else per_pose[i]
-        _settle(Q, valid, i, ik(T[i], q_ref=ref_i, tol=tol, backend="python"))
-    return Q, valid
+    Q = np.empty((n, MAX_SOLUTIONS, DOF))
+    counts = np.full(n, _UNSETTLED, dtype=np.intc)
+    if native is not None:
+        qref = np.array(refs) if per_pose is None else per_pose
+        stride = 0 if per_pose is None else DOF
+        size, cells = T.itemsize, MAX_SOLUTIONS * DOF
 
+        def part(first, count):
+            native.ik_batch(
+                T.ctypes.data + 16 * size * first,
+                count,
+                qref.ctypes.data + stride * size * first,
+                stride,
+                tol,
+                Q.ctypes.data + cells * size * first,
+                counts.ctypes.data + counts.itemsize * first,
+            )
 
-def _ik_batch_numpy(T, refs, free, tol, chunk):
-    """ik_batch's numpy backend: chunks of poses, every branch along its own array axis."""
-    T, good = _vpose(T)
-    n = T.shape[0]
-    per_pose = _free_rows(free, refs, n)
-    Q = np.zeros((n, MAX_SOLUTIONS, DOF))
-    valid = np.zeros((n, MAX_SOLUTIONS), dtype=bool)
-    for start in range(0, n, chunk):
-        part = slice(start, min(n, start + chunk))
-        args = list(refs)
-        for j in FREE if per_pose is not None else ():
-            args[j - 1] = per_pose[part, j - 1]
-        cand, ok, retry = _ik_candidates(T[part], *args, tol)
-        Q[part], valid[part] = _vfinish(cand, ok & good[part, None])
-        for i in start + np.flatnonzero(retry & good[part]):
-            # a free joint whose first value left a branch without solution (rare): the
-            # scalar solver tries its further values
-            ref_i = refs if per_pose is None else per_pose[i]
+        _batch_threads(part, n)
+    else:
+        Q.fill(0.0)
+    valid = np.arange(MAX_SOLUTIONS) < counts[:, None]
+    # the poses C did not settle (a split multiple root), or all of them in Python
+    for i in np.flatnonzero(counts == _UNSETTLED):
+        ref_i = refs if per_pose is None else tuple(per_pose[i].tolist())
+        try:
             _settle(Q, valid, i, ik(T[i], q_ref=ref_i, tol=tol, backend="python"))
+        except ValueError:  # not a valid transform: no valid slot
+            Q[i] = 0.0
     return Q, valid
 
 
@@ -341,14 +341,19 @@ def nearest(
             w_i |dq_i|).
     """
     refs, w = _nearest_arguments(q_ref, weights, metric)
+    native = _native_solver(None)
+    A = _array44(T) if native is not None and metric == "l2" and within_limits else None
+    if native is not None and A is not None:
+        pose, at, rows, rows_at, ref, ref_at = _scratch()
+        pose[...], ref[:] = A, refs
+        w_at = None if weights is None else np.ascontiguousarray(w).ctypes.data
+        found = native.nearest(at, None, ref_at, w_at, CERTIFY_TOL, rows_at)
+        if found >= 0:
+            return rows[0].copy() if found else None
     sols = ik(T, within_limits=within_limits, q_ref=refs)
     if len(sols) == 0:
         return None
-    if metric == "max":
-        return sols[int(np.argmin(_distances(sols, refs, w, metric, not within_limits)))]
-    kernels = _kernels(None)
-    pick = _kpick if kernels is None else kernels[2]
-    return sols[pick(sols, refs, w, not within_limits)]
+    return sols[int(np.argmin(_distances(sols, refs, w, metric, not within_limits)))]
 
 
 def _nearest_arguments(q_ref, weights, metric):
@@ -503,87 +508,7 @@ def _turns(q):
     return options
 
 
-_compiled = None
-_BATCH_LOCK = threading.Lock()
-_COMPILE_LOCK = threading.Lock()
-# the name under which the compiled kernels' namespace is registered in sys.modules
-
-
-def _kernels(backend):
-    """The compiled (_kbatch, _kone) for a backend argument, or None for the Python solver."""
-    if backend is None:
-        backend = BACKEND
-    if backend == "python":
-        return None
-    if backend not in ("auto", "numba"):
-        raise ValueError(f"backend must be 'auto', 'numba' or 'python', got {backend!r}")
-    kernels = _compile()
-    if kernels is None and backend == "numba":
-        raise ImportError("backend='numba' needs numba (pip install numba)")
-    return kernels
-
-
-def _compile():
-    """(_kbatch, _kone, _kpick) compiled by numba, once per process; None without numba."""
-    global _compiled
-    if _compiled is not None:  # the hot path: no lock
-        return _compiled or None
-    with _COMPILE_LOCK:
-        if _compiled is None:
-            _compiled = _build_kernels() or False
-    return _compiled or None
-
-
-def _build_kernels():
-    """The kernel functions compiled by numba as copies that call each other in a namespace of
-    their own, so that this module's functions stay Python whatever ran before.
-
-    The namespace is registered as the module _KERNEL_SPACE: numba reloads machine code
-    from its cache (in __pycache__ beside this file, when that folder is writable) only for
-    functions whose module it can import by name, and this file may have been imported by
-    path under any name.
-    """
-    try:
-        import numba
-    except ImportError:
-        return None
-    space = sys.modules.get(_KERNEL_SPACE)
-    if space is None or getattr(space, "_KERNEL_SOURCE", None) != __file__:
-        space = types.ModuleType(_KERNEL_SPACE)
-        sys.modules[_KERNEL_SPACE] = space
-    for cache in (True, False):
-        names = space.__dict__
-        names.update({k: v for k, v in globals().items() if not k.startswith("__")})
-        names.update(_prange=numba.prange, _KERNEL_SOURCE=__file__)
-        try:
-            for name in _KERNEL:
-                python = globals()[name]
-                copy = types.FunctionType(
-                    python.__code__, names, python.__name__, python.__defaults__, python.__closure__
-                )
-                copy.__qualname__ = python.__qualname__
-                fast = set() if name in _KSTRICT else _FASTMATH
-                names[name] = numba.njit(
-                    fastmath=fast,
-                    parallel=name == "_kbatch",
-                    cache=cache,
-                    nogil=True,
-                    error_model="numpy",
-                )(copy)
-            return names["_kbatch"], names["_kone"], names["_kpick"]
-        except RuntimeError:  # no cache where numba cannot write one: compile without
-            continue
-    return None
-
-
 def warmup() -> bool:
-    """Compile (or load from numba's cache) the compiled solver now, not at the first ik:
-    call it at a program's start. Returns whether the compiled solver is available."""
-    kernels = _compile()
-    if kernels is None:
-        return False
-    T = fk(_ZEROS)
-    ik(T, backend="numba")
-    ik_batch(T[None], backend="numba")
-    kernels[2](np.zeros((1, DOF)), _ZEROS, _ONES, True)
-    return True
+    """Compile (or load from the cache) the C solver now, not at the first ik: call it at a
+    program's start. Returns whether the C solver is available."""
+    return _native_solver(None) is not None

@@ -1,7 +1,7 @@
 """Stand-ins for the names a generated module prints for its arm; never copied.
 
 The runtime's routines refer to these names as globals. A generated module defines them from
-the arm's plan (constants, forward kinematics, the bodies of the three solvers); here they
+the arm's plan (constants, forward kinematics, the body of the solver); here they
 describe a sample arm of one revolute and one prismatic joint, and the arm's functions raise,
 so that the runtime imports, type-checks and its routines can be tested on their own.
 """
@@ -26,20 +26,15 @@ FREE: tuple[int, ...] = ()
 # "pose" or "position": what certification compares
 IK_COMPONENTS = "pose"
 _REVOLUTE = (True, False)
-# the compiled kernel's functions (the closure of _kbatch, _kone and _kpick)
-_KERNEL: tuple[str, ...] = ()
-# the name of the compiled kernels' namespace in sys.modules
-_KERNEL_SPACE = "_derive_ik_kernels_sample"
-# the compiled solver's scratch per pose (for the values of polynomial steps)
-_KBUF = 1
+# the arm's C solver, beside the module ("" where the arm has none): derive/runtime/native.py
+_C_SOURCE = ""
 
 
 def _missing(*args: Any) -> Any:
     raise NotImplementedError("printed per arm by derive's emitter")
 
 
-_fk_from_cs = _fk_q = _cs_columns = _keep = _ik_scalar = _ik_candidates = _missing
-_ksolve = _kreference = _kfk_q = _rr_fill = _missing
+_fk_from_cs = _fk_q = _cs_columns = _keep = _ik_scalar = _rr_fill = _missing
 BASE = TOOL = np.eye(4)
 # the general method's splits: (reversed, rows the matrices were filled from, the arm's rows,
 # (1.0, theta3) where joint 3 slides else (0.0, 0.0)), rows (d, a, cos alpha, sin alpha) of

@@ -1,12 +1,12 @@
-"""Closed forms shared by the Python and the compiled solvers, in the subset of Python numba
-compiles: roots of quadratics and quartics, a fast atan2, wrapping, Newton steps, and the
-searches for a free joint's first value."""
+"""Closed forms of the Python solver (the C solver has its own: templates/runtime.c.j2):
+roots of quadratics and quartics, a fast atan2, wrapping, Newton steps, and the searches for
+a free joint's first value."""
 
 from __future__ import annotations
 
 import cmath
 import math
-from math import acos, atan2, cos, sin, sqrt
+from math import atan2, cos, sin, sqrt
 
 import numpy as np
 
@@ -150,62 +150,6 @@ def _kquartic(B, C, D, E):
     h = q / (2.0 * s)
     y1, y2 = _kquadratic(-s, p / 2.0 + m + h)
     y3, y4 = _kquadratic(s, p / 2.0 + m - h)
-    return y1 - a, y2 - a, y3 - a, y4 - a
-
-
-def _kquadratic_real(b, c):
-    """Both roots of x^2 + b x + c for real b, c, without cancellation, as complex numbers
-    (a complex pair where the discriminant is negative)."""
-    disc = b * b - 4.0 * c
-    if disc < 0.0:
-        re, im = -0.5 * b, 0.5 * sqrt(-disc)
-        return complex(re, im), complex(re, -im)
-    q = -0.5 * (b + math.copysign(sqrt(disc), b))
-    if q == 0.0:
-        return complex(0.0, 0.0), complex(0.0, 0.0)
-    return complex(q, 0.0), complex(c / q, 0.0)
-
-
-def _kquartic_real(B, C, D, E):
-    """The four roots of x^4 + B x^3 + C x^2 + D x + E for real coefficients (Ferrari in real
-    arithmetic: the resolvent cubic's largest real root, polished by Newton, then two real
-    quadratics); where that root is not positive or is ill-conditioned, _kquartic's complex
-    arithmetic."""
-    a = B / 4.0
-    p = C - 6.0 * a * a
-    q = D - 2.0 * a * C + 8.0 * a * a * a
-    r = E - a * D + a * a * C - 3.0 * a * a * a * a
-    a2, a1, a0 = p, p * p / 4.0 - r, -q * q / 8.0
-    P = a1 - a2 * a2 / 3.0
-    Q = 2.0 * a2 * a2 * a2 / 27.0 - a2 * a1 / 3.0 + a0
-    delta = Q * Q / 4.0 + P * P * P / 27.0
-    if delta > 0.0:
-        w = -0.5 * Q - math.copysign(sqrt(delta), Q)
-        A = math.copysign(abs(w) ** (1.0 / 3.0), w)
-        z = A - P / (3.0 * A) if A != 0.0 else 0.0
-    elif sqrt(max(0.0, -P / 3.0)) > 0.0:
-        rho = sqrt(-P / 3.0)
-        cos3 = max(-1.0, min(1.0, -0.5 * Q / rho / rho / rho))
-        z = 2.0 * rho * math.cos(acos(cos3) / 3.0)
-    else:
-        z = 0.0
-    m = z - a2 / 3.0
-    # m a (near) multiple root of the cubic (the quartic has a multiple root) is
-    # ill-conditioned in real arithmetic, as is m <= 0
-    slope = (3.0 * m + 2.0 * a2) * m + a1
-    if not m > 0.0 or abs(slope) <= 1e-3 * (3.0 * m * m + abs(2.0 * a2 * m) + abs(a1)):
-        return _kquartic(complex(B), complex(C), complex(D), complex(E))
-    for _ in range(2):
-        slope = (3.0 * m + 2.0 * a2) * m + a1
-        step = (((m + a2) * m + a1) * m + a0) / slope if slope != 0.0 else 0.0
-        if abs(step) <= 1e-3 * (1.0 + abs(m)):
-            m -= step
-    s = sqrt(2.0 * max(m, 0.0))
-    if not s > 0.0:
-        return _kquartic(complex(B), complex(C), complex(D), complex(E))
-    h = q / (2.0 * s)
-    y1, y2 = _kquadratic_real(-s, p / 2.0 + m + h)
-    y3, y4 = _kquadratic_real(s, p / 2.0 + m - h)
     return y1 - a, y2 - a, y3 - a, y4 - a
 
 

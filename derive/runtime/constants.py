@@ -2,8 +2,8 @@
 
 import math
 
-# the backend of ik and ik_batch calls that name none: "auto" (numba when installed),
-# "numba" or "python"
+# the backend of ik and ik_batch calls that name none: "auto" (the arm's C solver where it
+# compiles), "c" or "python"
 BACKEND = "auto"
 CERTIFY_TOL = 1e-6
 POSE_TOL = 1e-6

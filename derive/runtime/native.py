@@ -1,0 +1,185 @@
+"""The arm's C solver behind the generated module: the C file beside the module (`_C_SOURCE`,
+written by `derive generate` with the module) compiled on first use into a per-user cache
+keyed by its digest, and loaded through ctypes (no Python headers, no build step).
+
+The compiler is $CC (split as a shell would), else cc, gcc or clang on PATH, else zig's from
+the `ziglang` package (`pip install ziglang`, or derive-ik's `compiler` extra). The cache folder is
+$DERIVE_IK_CACHE, else $XDG_CACHE_HOME/derive-ik, else ~/.cache/derive-ik (%LOCALAPPDATA% on
+Windows). Without a compiler or the C file the module says so once and solves in Python.
+"""
+
+from __future__ import annotations
+
+import ctypes
+import hashlib
+import os
+import shlex
+import shutil
+import subprocess
+import sys
+import tempfile
+import threading
+import warnings
+from typing import Any
+
+import numpy as np
+
+from derive.runtime.arm import _C_SOURCE, DOF, MAX_SOLUTIONS, NAME
+from derive.runtime.constants import BACKEND
+
+# how the C solver is compiled (part of the cache key): C99, optimised, position-independent
+C_FLAGS = ("-std=c99", "-O2", "-fPIC", "-shared")
+# ik_batch splits its poses over this many threads (each call releases the GIL), at least
+# _BATCH_GRAIN poses each
+_THREADS = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count()
+_BATCH_GRAIN = 256
+# the C solver's return value for a pose it does not settle (the Python solver does)
+_UNSETTLED = -2
+
+
+class _Native:
+    """The compiled solver's entry points, taking addresses of contiguous float64 data (see
+    the C header: <NAME>_ik.h)."""
+
+    def __init__(self, lib: Any):
+        v, d, i, n = ctypes.c_void_p, ctypes.c_double, ctypes.c_int, ctypes.c_long
+        self.lib = lib
+        self.fk_batch = _entry(lib, "fk_batch", (v, n, v), None)
+        self.ik = _entry(lib, "ik_ref", (v, v, v, d, v), i)
+        self.within_limits = _entry(lib, "within_limits", (v, i, v), i)
+        self.nearest = _entry(lib, "nearest", (v, v, v, v, d, v), i)
+        self.ik_batch = _entry(lib, "ik_batch", (v, n, v, n, d, v, v), None)
+
+
+def _entry(lib: Any, name: str, argtypes: tuple, restype: Any) -> Any:
+    """The C function <NAME>_<name> with its argument and result types set."""
+    function = getattr(lib, f"{NAME}_{name}")
+    function.argtypes = argtypes
+    function.restype = restype
+    return function
+
+
+_native: Any = None
+_NATIVE_LOCK = threading.Lock()
+_LOCAL = threading.local()
+
+
+def _scratch() -> tuple[np.ndarray, int, np.ndarray, int, np.ndarray, int]:
+    """This thread's buffers for one pose and their addresses: (T (4, 4), rows (MAX_SOLUTIONS,
+    DOF), q_ref (DOF,)), each followed by its address (asking an array for its address costs
+    more than the C solver's work on a pose: it is asked once per thread)."""
+    try:
+        return _LOCAL.buffers
+    except AttributeError:
+        T, rows, ref = np.empty((4, 4)), np.empty((MAX_SOLUTIONS, DOF)), np.empty(DOF)
+        _LOCAL.buffers = (T, T.ctypes.data, rows, rows.ctypes.data, ref, ref.ctypes.data)
+        return _LOCAL.buffers
+
+
+def _native_solver(backend: str | None) -> _Native | None:
+    """The compiled solver for a backend argument ("auto": the C one where it compiles, "c":
+    the C one or an error, "python": None; None: BACKEND)."""
+    if backend is None:
+        backend = BACKEND
+    if backend == "python":
+        return None
+    if backend not in ("auto", "c"):
+        raise ValueError(f"backend must be 'auto', 'c' or 'python', got {backend!r}")
+    global _native
+    if _native is None:
+        with _NATIVE_LOCK:
+            if _native is None:
+                lib, why = _c_library()
+                if lib is None:
+                    warnings.warn(f"{NAME}: solving in Python: {why}", RuntimeWarning, 3)
+                _native = _Native(lib) if lib is not None else why
+    if type(_native) is str and backend == "c":
+        raise RuntimeError(f"backend='c': {_native}")
+    return None if type(_native) is str else _native
+
+
+def _c_compiler() -> list[str] | None:
+    """The compiler command: $CC, else cc, gcc or clang on PATH, else zig's (the ziglang
+    package); None if there is none."""
+    named = os.environ.get("CC", "").strip()
+    if named:
+        return shlex.split(named)
+    for name in ("cc", "gcc", "clang"):
+        found = shutil.which(name)
+        if found:
+            return [found]
+    try:
+        import ziglang  # type: ignore[import-not-found]  # noqa: F401
+    except ImportError:
+        return None
+    return [sys.executable, "-m", "ziglang", "cc"]
+
+
+def _cache_folder() -> str:
+    """Where compiled solvers are kept: $DERIVE_IK_CACHE, $XDG_CACHE_HOME/derive-ik,
+    %LOCALAPPDATA%/derive-ik or ~/.cache/derive-ik."""
+    named = os.environ.get("DERIVE_IK_CACHE")
+    if named:
+        return named
+    root = os.environ.get("XDG_CACHE_HOME") or os.environ.get("LOCALAPPDATA")
+    return os.path.join(root or os.path.join(os.path.expanduser("~"), ".cache"), "derive-ik")
+
+
+def _c_library() -> tuple[Any, str]:
+    """The compiled C solver, loaded (compiled first where the cache has no library for this
+    source, compiler and flags), and ""; or None and why not."""
+    if not _C_SOURCE:
+        return None, "this arm has no C solver"
+    source = os.path.join(os.path.dirname(os.path.abspath(__file__)), _C_SOURCE)
+    try:
+        with open(source, "rb") as file:
+            c_text = file.read()
+        with open(source[:-2] + ".h", "rb") as file:
+            h_text = file.read()
+    except OSError:
+        return None, f"{_C_SOURCE} (and its .h) not found beside {__file__}"
+    compiler = _c_compiler()
+    if compiler is None:
+        return None, "no C compiler (set CC, install cc, or pip install ziglang)"
+    key = hashlib.sha256(
+        b"\0".join((c_text, h_text, shlex.join([*compiler, *C_FLAGS]).encode()))
+    ).hexdigest()[:24]
+    suffix = ".dll" if os.name == "nt" else ".dylib" if sys.platform == "darwin" else ".so"
+    folder = _cache_folder()
+    target = os.path.join(folder, f"{NAME}-{key}{suffix}")
+    try:
+        if not os.path.exists(target):
+            os.makedirs(folder, exist_ok=True)
+            # the bytes hashed are the bytes compiled; the library appears whole or not at all
+            with tempfile.TemporaryDirectory(dir=folder) as tmp:
+                for name, text in ((_C_SOURCE, c_text), (_C_SOURCE[:-2] + ".h", h_text)):
+                    with open(os.path.join(tmp, name), "wb") as file:
+                        file.write(text)
+                built = os.path.join(tmp, "built" + suffix)
+                command = [*compiler, *C_FLAGS, os.path.join(tmp, _C_SOURCE), "-o", built, "-lm"]
+                done = subprocess.run(command, capture_output=True, text=True, check=False)
+                if done.returncode != 0:
+                    errors = [ln for ln in done.stderr.splitlines() if "error" in ln] or [""]
+                    said = errors[0].replace(tmp + os.sep, "")[:300]
+                    return None, f"{shlex.join(compiler)} failed on {source}: {said}"
+                os.replace(built, target)
+        return ctypes.CDLL(target), ""
+    except OSError as exc:
+        return None, f"cannot compile into {folder} (set DERIVE_IK_CACHE): {exc}"
+
+
+def _batch_threads(call: Any, n: int) -> None:
+    """call(first, count) over n poses in up to _THREADS threads (call releases the GIL)."""
+    parts = max(1, min(_THREADS or 1, n // _BATCH_GRAIN))
+    if parts == 1:
+        call(0, n)
+        return
+    bounds = [n * k // parts for k in range(parts + 1)]
+    threads = [
+        threading.Thread(target=call, args=(bounds[k], bounds[k + 1] - bounds[k]))
+        for k in range(parts)
+    ]
+    for thread in threads:
+        thread.start()
+    for thread in threads:
+        thread.join()
