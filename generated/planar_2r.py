@@ -156,12 +156,6 @@ _SEAM = math.pi - _SEAM_BAND
 MAX_TURN_ROWS = 100_000
 
 
-# a free joint's value is taken modulo 2 pi (revolute) before it is solved with: at most
-# FREE_LIMIT radians (or FREE_LIMIT * REACH of length), where that reduction, and the cos
-# and sin of the value, are accurate to ~1e-10
-FREE_LIMIT = 1e6
-
-
 # a pose farther than FAR_REACH * REACH from the base along an axis is out of reach: revolute
 # joints reach REACH, no sliding joint a million times that, and the solvers' squares and
 # products of such positions would overflow
@@ -529,76 +523,21 @@ def ik_batch(
 
 
 def _with_free(refs, free):
-    """q_ref's values with the free joints' values from free (None: q_ref's own)."""
-    if free is None:
-        return refs
-    if not FREE:
+    """q_ref's values (this arm has no free joints: free must be None; derive/runtime/
+    redundant.py has the version of arms with free joints)."""
+    if free is not None:
         raise ValueError("free: this arm has no free joints (FREE is empty)")
-    values = _real(free, "free")
-    if values.ndim == 0:
-        values = values.reshape(1)
-    if values.shape != (len(FREE),) or not np.isfinite(values).all():
-        raise ValueError(
-            f"free must be {len(FREE)} finite number(s), one per joint in FREE = {FREE}"
-        )
-    out = list(refs)
-    for j, x in zip(FREE, values.tolist()):
-        out[j - 1] = x
-    return tuple(out)
+    return refs
 
 
 def _free_turns(refs):
-    """refs with each revolute free joint's value reduced to (-pi, pi]: the value the solver
-    works with and returns, so that a returned row reproduces the pose with its own values.
-
-    Raises:
-        ValueError: a free value beyond FREE_LIMIT radians (FREE_LIMIT * REACH for a sliding
-            joint), where neither the reduction nor cos and sin are accurate.
-    """
-    if not FREE:
-        return refs
-    out = list(refs)
-    for j in FREE:
-        x = out[j - 1]
-        limit, unit = (FREE_LIMIT, "rad") if _REVOLUTE[j - 1] else (FREE_LIMIT * REACH, "")
-        if not abs(x) <= limit:
-            raise ValueError(
-                f"free joint q{j} = {x!r}: a free value must lie within +-{limit:g} {unit}".rstrip()
-            )
-        if _REVOLUTE[j - 1]:
-            out[j - 1] = math.remainder(x, _TWO_PI)
-    return tuple(out)
+    """refs as they are: no free joint's value to reduce (see _with_free)."""
+    return refs
 
 
 def _free_rows(free, refs, n):
-    """Per pose, q_ref's values with the free joints' values from free ((n, len(FREE)), or
-    (n,) where FREE has one), as an (n, DOF) array; None for free=None."""
-    if free is None:
-        return None
-    if not FREE:
-        raise ValueError("free: this arm has no free joints (FREE is empty)")
-    values = _real(free, "free")
-    if values.ndim == 1 and len(FREE) == 1:
-        values = values[:, None]
-    if values.shape != (n, len(FREE)) or not np.isfinite(values).all():
-        raise ValueError(
-            f"free must be finite numbers of shape ({n}, {len(FREE)}): one value per pose "
-            f"for each joint in FREE = {FREE}"
-        )
-    limits = np.array([FREE_LIMIT if _REVOLUTE[j - 1] else FREE_LIMIT * REACH for j in FREE])
-    if not (np.abs(values) <= limits).all():
-        raise ValueError(
-            f"free values must lie within +-{FREE_LIMIT:g} rad (+-{FREE_LIMIT * REACH:g} for "
-            f"a sliding joint), one per pose for each joint in FREE = {FREE}"
-        )
-    turns = np.array([_REVOLUTE[j - 1] for j in FREE])
-    # fmod is exact; one addition of 2 pi brings its (-2 pi, 2 pi) to (-pi, pi]
-    reduced = np.fmod(values, _TWO_PI)
-    reduced = np.where(reduced > math.pi, reduced - _TWO_PI, reduced)
-    reduced = np.where(reduced <= -math.pi, reduced + _TWO_PI, reduced)
-    rows = np.tile(np.array(refs), (n, 1))
-    rows[:, [j - 1 for j in FREE]] = np.where(turns, reduced, values)
-    return rows
+    """None: no per-pose free values (see _with_free)."""
+    return _with_free(None, free)
 
 
 def _settle(Q, valid, i, sols):
