@@ -1,6 +1,7 @@
 """plan -> the C99 solver: `<name>_ik.h` and `<name>_ik.c` (templates/arm.h.j2, arm.c.j2,
-runtime.c.j2), printed by derive/printers/c.py. Deterministic as the Python output: the
-same plan gives the same bytes."""
+general_arm.c.j2), printed by derive/printers/c.py, with the routines of the C runtime
+(derive/c/) the arm's code uses. Deterministic as the Python output: the same plan gives the
+same bytes."""
 
 from __future__ import annotations
 
@@ -12,7 +13,9 @@ from typing import Any
 
 import numpy as np
 
+from derive.assemble import assemble_c
 from derive.emit import GENERATOR, GenerationError, check_printable, environment
+from derive.layout import wrap_c
 from derive.plan import Eigen, Plan, Poly, PolyD
 from derive.printers import c
 from derive.printers.general import eigen_step, pad, spurious_counts
@@ -79,9 +82,8 @@ class RuntimeConstants:
 
 
 def general_constants(plan: Plan) -> dict[str, object]:
-    """The general method's constants and dk_rr_fill for templates/general.c.j2."""
-    from derive.runtime import general
-
+    """A general arm's tables and dk_rr_fill for templates/general_arm.c.j2 (the method's
+    constants are derive/c/general.c's own)."""
     step = eigen_step(plan)
     assert step is not None
 
@@ -94,36 +96,8 @@ def general_constants(plan: Plan) -> dict[str, object]:
         return "{" + ", ".join(nested(v) for v in values) + "}"
 
     return {
-        "RANK_TOL": repr(constants._RR_RANK_TOL),
-        "COND_LIMIT": repr(constants._RR_COND_LIMIT),
-        "IMAG_TOL": repr(constants._RR_IMAG_TOL),
-        "IMAG_LOOSE": repr(constants._RR_IMAG_LOOSE),
-        "CLUSTER_TOL": repr(constants._RR_CLUSTER_TOL),
-        "NULL2_TOL": repr(constants._RR_NULL2_TOL),
-        "GOOD": repr(constants._RR_GOOD),
-        "NEWTON_STEPS": constants._RR_NEWTON_STEPS,
-        "NEWTON_REACH": repr(constants._RR_NEWTON_REACH),
-        "NEWTON_DONE": repr(constants._RR_NEWTON_DONE[0]),
-        "NEWTON_DONE_STEP": repr(constants._RR_NEWTON_DONE[1]),
         "SPLIT_COUNT": len(step.splits),
         "LENGTH": repr(float(step.unit)),
-        "MOEBIUS": nested(constants._RR_MOEBIUS),
-        "PATH_COUNT": len(constants._RR_PATH),
-        "PATH": nested(constants._RR_PATH),
-        "H45": nested(general._RR_H45.tolist()),
-        "SHIFT4": repr(constants._RR_SHIFT45[0]),
-        "SHIFT5": repr(constants._RR_SHIFT45[1]),
-        "PAIR_TOL": repr(constants._RR_PAIR_TOL),
-        "MIX": nested(general._RR_MIX.tolist()),
-        "RULES": nested(general._RR_MONOMIAL_RULES),
-        "MOTION_COUNT": len(general._RR_MOTIONS),
-        "MOTIONS": nested(general._RR_MOTIONS.tolist()),
-        "SEARCH_FROM": repr(constants._RR_SEARCH_FROM),
-        "SEARCH_BAIL": repr(constants._RR_SEARCH_BAIL),
-        "SEARCH_STEPS": constants._RR_SEARCH_STEPS,
-        "SEARCH_SLIDE": repr(constants._RR_SEARCH_SLIDE),
-        "SEARCH_COUNT": len(general._RR_SEARCH_STARTS),
-        "SEARCH_STARTS": nested(general._RR_SEARCH_STARTS.tolist()),
         "REVERSED": "{" + ", ".join("1" if s.reversed else "0" for s in step.splits) + "}",
         "FILL": nested([(*s.fill_rows, (*s.slide, 0.0, 0.0)) for s in step.splits]),
         "TRUE": nested([(*s.true_rows, (*s.slide, 0.0, 0.0)) for s in step.splits]),
@@ -156,7 +130,7 @@ def spurious_constants(step: Eigen) -> dict[str, object]:
     }
 
 
-# dk_uangle's table (templates/runtime.c.j2): the Taylor coefficients of asin at
+# dk_uangle's table (derive/c/runtime.c): the Taylor coefficients of asin at
 # UNIT_ANGLE_SEGMENTS + 1 points evenly spaced over [0, UNIT_ANGLE_TOP], to degree
 # UNIT_ANGLE_DEGREE. An offset of at most half a spacing (0.0028) from a point at most 0.72,
 # 0.28 from asin's singularity at 1, leaves terms beyond the degree below about 0.01^9 = 1e-18
@@ -264,28 +238,6 @@ def print_c(plan: Plan) -> PrintedC:
     )
 
 
-# the runtime's routines dk_solve may call, and those each of them calls
-ROUTINES = {
-    "dk_general": (),
-    "dk_poly": (),
-    "dk_cs1": (),
-    "dk_cs1r": ("dk_cs1",),
-    "dk_cs2": ("dk_one",),
-    "dk_cs2r": ("dk_one",),
-    "dk_atan2": ("dk_one",),
-    "dk_flipped": (),
-    "dk_seam": (),
-    "dk_unit_seam": (),
-}
-
-
-def routines(solve: tuple[tuple[int, str], ...]) -> frozenset[str]:
-    """The runtime routines dk_solve calls, with those they call (the C file holds only
-    these: an unused static function is an error under -Werror)."""
-    called = {name for name in ROUTINES for _, line in solve if f"{name}(" in line}
-    return frozenset(called.union(*(ROUTINES[name] for name in called)))
-
-
 def poly_max(plan: Plan) -> int:
     """The most roots one of the plan's polynomials has (4 at least: the closed forms' size
     of the C runtime's arrays; above it dk_roots has the Aberth iteration for other degrees)."""
@@ -295,21 +247,26 @@ def poly_max(plan: Plan) -> int:
 
 
 def render_c(plan: Plan) -> dict[str, str]:
-    """The C solver's files of an arm: {file name: text}."""
+    """The C solver's files of an arm: {file name: text}. The arm's code is printed from its
+    plan (templates/arm.c.j2; a general arm's tables: general_arm.c.j2), and the routines of
+    the C runtime (derive/c/) it uses are copied in with what they use (assemble_c)."""
     printed = print_c(plan)
     env = environment()
+    general = ""
+    if eigen_step(plan) is not None:
+        tables = env.get_template("general_arm.c.j2").render(g=general_constants(plan))
+        general = "\n" + tables
     args = {
         "m": printed,
-        "c": runtime_constants(),
         "generator": GENERATOR,
-        "uses": routines(printed.solve),
-        "poly_max": (size := poly_max(plan)),
-        "poly_zeros": ", ".join(["0"] * size),
-        "g": general_constants(plan) if "dk_general" in routines(printed.solve) else None,
+        "poly_max": poly_max(plan),
+        "arm_general": general,
     }
+    arm = env.get_template("arm.c.j2")
+    runtime = assemble_c(arm.render(**args, runtime=""))
     return {
-        f"{printed.name}_ik.h": env.get_template("arm.h.j2").render(**args),
-        f"{printed.name}_ik.c": env.get_template("arm.c.j2").render(**args),
+        f"{printed.name}_ik.h": wrap_c(env.get_template("arm.h.j2").render(**args)),
+        f"{printed.name}_ik.c": wrap_c(arm.render(**args, runtime=runtime)),
     }
 
 

@@ -170,3 +170,25 @@ def _break_points(text: str) -> list[int]:
         if depth > 0 and gap == " " and after.string not in ")]},:":
             points.append(before.end[1])
     return points
+
+
+def wrap_c(code: str, width: int = WIDTH) -> str:
+    """Every line of generated C longer than width broken greedily at its spaces, each
+    continuation indented two steps deeper than the line (C does not care where a line
+    breaks between tokens, nor inside a comment). Preprocessor lines and lines holding a
+    string literal are left whole (the generated C has none that long)."""
+    out: list[str] = []
+    for line in code.split("\n"):
+        if len(line) <= width or line.lstrip().startswith("#") or '"' in line:
+            out.append(line)
+            continue
+        indent = line[: len(line) - len(line.lstrip())] + 2 * INDENT
+        rest, first = line, True
+        while len(rest) > width:
+            cut = rest.rfind(" ", len(indent) + 1 if not first else len(indent) // 2, width + 1)
+            if cut <= len(rest) - len(rest.lstrip()):
+                break  # one token longer than the line: left as it is
+            out.append(rest[:cut].rstrip())
+            rest, first = indent + rest[cut + 1 :].lstrip(), False
+        out.append(rest)
+    return "\n".join(out)

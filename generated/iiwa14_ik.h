@@ -6,7 +6,9 @@
 
    Inverse kinematics: pieper method, at most 8 solutions per pose.
    Poses are 4x4 homogeneous transforms, row-major (T[4 * row + column], as the Python
-   solver's T.ravel()); joint values are radians (R) and lengths (P). Free joints: q7 (end joint: the given value only moves the tool of joints 1-6, which the pieper method solves, so one derivation serves every value).
+   solver's T.ravel()); joint values are radians (R) and lengths (P). Free joints: q7 (end joint:
+           the given value only moves the tool of joints 1-6, which the pieper method solves, so one
+           derivation serves every value).
 */
 #ifndef IIWA14_IK_H
 #define IIWA14_IK_H

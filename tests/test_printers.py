@@ -58,6 +58,25 @@ def test_generated_lines_fit_in_100_characters(name):
 
 
 @pytest.mark.parametrize("name", BUNDLED)
+def test_generated_c_lines_fit_in_100_characters(name):
+    for suffix in ("_ik.c", "_ik.h"):
+        text = (ROOT / "generated" / f"{name}{suffix}").read_text()
+        long = [n for n, line in enumerate(text.split("\n"), 1) if len(line) > 100]
+        assert not long, f"{name}{suffix} lines {long[:5]} are longer than 100 characters"
+
+
+def test_c_lines_break_between_tokens_only():
+    from derive.layout import wrap_c
+
+    table = "static const double X[40] = {" + ", ".join(repr(k / 7) for k in range(40)) + "};"
+    wrapped = wrap_c("    " + table)
+    assert max(map(len, wrapped.split("\n"))) <= 100
+    assert wrapped.split() == ("    " + table).split()  # the same tokens, only new breaks
+    define = "#define LONG " + " + ".join(["1.0"] * 40)
+    assert wrap_c(define) == define  # a preprocessor line stays whole
+
+
+@pytest.mark.parametrize("name", BUNDLED)
 def test_generated_modules_hold_no_function_they_never_call(name):
     tree = ast.parse(module_source(name))
     defined = {n.name for n in tree.body if isinstance(n, ast.FunctionDef | ast.ClassDef)}

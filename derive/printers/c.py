@@ -2,7 +2,7 @@
 as C99, from the same plan the Python printers read (templates/arm.c.j2 lays them out).
 
 dk_solve follows the Python solver's steps (derive/printers/scalar.py) with the C runtime's
-closed forms (templates/runtime.c.j2): one loop per Solve
+closed forms (derive/c/runtime.c): one loop per Solve
 step over the joint's values; a free joint steps through its values (5 degree steps out from
 its first one) until one gives a certified solution, as the Python solver does. Roots failing
 the residual test are refined by Aberth iterations and split multiple roots merged (numpy's

@@ -1,4 +1,4 @@
-"""Closed forms of the Python solver (the C solver has its own: templates/runtime.c.j2):
+"""Closed forms of the Python solver (the C solver has its own: derive/c/runtime.c):
 roots of quadratics and quartics, a fast atan2, wrapping, Newton steps, and the searches for
 a free joint's first value."""
 
