@@ -252,6 +252,12 @@ def _scratch() -> tuple[np.ndarray, int, np.ndarray, int, np.ndarray, int]:
         return _LOCAL.buffers
 
 
+def _loaded() -> _Native | None:
+    """The C solver if it has been loaded (ik's fast path: None before the first call and
+    where there is none)."""
+    return _native if type(_native) is _Native else None
+
+
 def _native_solver(backend: str | None) -> _Native | None:
     """The compiled solver for a backend argument ("auto": the C one where it compiles, "c":
     the C one or an error, "python": None; None: BACKEND)."""
@@ -436,6 +442,24 @@ def ik(
             positive finite number; all_turns would give more than MAX_TURN_ROWS rows; free
             is given for an arm without free joints, or is not len(FREE) finite numbers.
     """
+    native = _loaded()
+    if (
+        native is not None
+        and free is None
+        and q_ref is None
+        and not within_limits
+        and tol is CERTIFY_TOL
+        and backend is None
+        and BACKEND != "python"
+        and type(T) is np.ndarray
+        and T.shape == (4, 4)
+        and T.dtype == np.float64
+    ):  # the common call, in C with nothing to check or choose (the rest: below)
+        pose, at, rows, rows_at, _, _ = _scratch()
+        pose[...] = T
+        n = native.ik(at, None, None, tol, rows_at)
+        if n >= 0:
+            return rows[:n].copy()
     refs = _with_free(_reference(q_ref), free)
     solve = _free_turns(refs)
     tol = _tolerance(tol)

@@ -112,6 +112,25 @@ def test_compiled_batch_from_several_threads_at_once(generated):
         assert np.array_equal(rows, expected[0][i][expected[1][i]]), i
 
 
+@needs_cc
+def test_the_plain_call_in_c_gives_what_the_checked_path_gives(generated):
+    """ik(T) with no options takes a short path into C (nothing to check or choose): the same
+    rows as backend="c", for any layout of a float64 T; a T it cannot take (a list, a NaN)
+    goes the long way and gets its answer or its error."""
+    m = generated("puma560")
+    assert m.warmup()
+    poses = m.fk_batch(sample_joints(m, 300, np.random.default_rng(43)))
+    for T in poses:
+        expected = m.ik(T, backend="c")
+        assert np.array_equal(m.ik(T), expected)
+        assert np.array_equal(m.ik(np.asfortranarray(T)), expected)
+        assert np.array_equal(m.ik(T.tolist()), expected)
+    bad = poses[0].copy()
+    bad[0, 0] = np.nan
+    with pytest.raises(ValueError, match="non-finite"):
+        m.ik(bad)
+
+
 def test_backend_argument_is_checked(generated, monkeypatch):
     m = generated("planar_2r")
     with pytest.raises(ValueError, match="backend"):

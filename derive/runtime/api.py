@@ -37,12 +37,19 @@ from derive.runtime.common import (
 from derive.runtime.constants import (
     _SEAM,
     _TWO_PI,
+    BACKEND,
     CERTIFY_TOL,
     DEDUP_TOL,
     MAX_TURN_ROWS,
     POSE_TOL,
 )
-from derive.runtime.native import _UNSETTLED, _batch_threads, _native_solver, _scratch
+from derive.runtime.native import (
+    _UNSETTLED,
+    _batch_threads,
+    _loaded,
+    _native_solver,
+    _scratch,
+)
 
 
 def fk(q: ArrayLike) -> np.ndarray:
@@ -120,6 +127,24 @@ def ik(
             positive finite number; all_turns would give more than MAX_TURN_ROWS rows; free
             is given for an arm without free joints, or is not len(FREE) finite numbers.
     """
+    native = _loaded()
+    if (
+        native is not None
+        and free is None
+        and q_ref is None
+        and not within_limits
+        and tol is CERTIFY_TOL
+        and backend is None
+        and BACKEND != "python"
+        and type(T) is np.ndarray
+        and T.shape == (4, 4)
+        and T.dtype == np.float64
+    ):  # the common call, in C with nothing to check or choose (the rest: below)
+        pose, at, rows, rows_at, _, _ = _scratch()
+        pose[...] = T
+        n = native.ik(at, None, None, tol, rows_at)
+        if n >= 0:
+            return rows[:n].copy()
     refs = _with_free(_reference(q_ref), free)
     solve = _free_turns(refs)
     tol = _tolerance(tol)

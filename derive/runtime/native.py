@@ -76,6 +76,12 @@ def _scratch() -> tuple[np.ndarray, int, np.ndarray, int, np.ndarray, int]:
         return _LOCAL.buffers
 
 
+def _loaded() -> _Native | None:
+    """The C solver if it has been loaded (ik's fast path: None before the first call and
+    where there is none)."""
+    return _native if type(_native) is _Native else None
+
+
 def _native_solver(backend: str | None) -> _Native | None:
     """The compiled solver for a backend argument ("auto": the C one where it compiles, "c":
     the C one or an error, "python": None; None: BACKEND)."""
