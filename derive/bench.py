@@ -13,6 +13,7 @@ import time
 import tracemalloc
 from functools import partial
 from types import ModuleType
+from typing import Any
 
 import numpy as np
 
@@ -215,3 +216,56 @@ def measure(
             summary=result.summary(),
         )
     return figures
+
+
+def solve_with(module: ModuleType, T: Any, values: dict) -> Any:
+    """module.ik(T, **values) (a named function: the benchmark's callable)."""
+    return module.ik(T, **values)
+
+
+def versus(ours: float, theirs: float) -> str:
+    """How our time compares with another solver's: "ours 4.1x faster" or "ours 2.3x slower"."""
+    if ours <= theirs:
+        return f"ours {theirs / ours:.1f}x faster"
+    return f"ours {ours / theirs:.1f}x slower"
+
+
+def bench_text(name: str, f: dict) -> str:
+    """The human-readable lines of one arm's benchmark figures."""
+    line = (
+        f"{name}: generate {f['generate_s']:.2f} s; fk {f['fk_us']:.1f} us (single calls: "
+        "the median over the poses of each pose's least of 3 calls)"
+    )
+    if "ik_us" not in f:
+        return line
+    if f["backend"] == "c":
+        line += (
+            f"\n  compiled (C, ik_batch on {f['threads']} threads; first calls "
+            f"{f['compile_s']:.1f} s): ik {f['ik_us']:.1f} us/pose (median); ik_batch "
+            f"{f['ik_batch_us']:.2f} us/pose at N = {f['batch_n']}, "
+            f"{f['ik_batch_1thread_us']:.2f} on one thread"
+        )
+    line += f"\n  nearest (within limits) {f['nearest_us']:.1f} us/pose (median)"
+    if "ik_sweep_us" in f:
+        line += f"; ik_sweep (64 free values) {f['ik_sweep_us']:.1f} us/pose (median)"
+    line += (
+        f"\n  python: ik {f['ik_python_us']:.1f} us/pose (median); ik_batch "
+        f"{f['ik_batch_python_us']:.2f} us/pose at N = {f['batch_n']}"
+    )
+    if "ik_batch_peak_mb" in f:
+        line += (
+            f"\n  ik_batch peak {f['ik_batch_peak_mb']:.0f} MB for {f['memory_n']} poses "
+            f"(input {f['input_mb']:.0f} MB)"
+        )
+    if "eaik_skipped" in f:
+        line += f"\n  {f['eaik_skipped']}"
+    if "eaik_ik_us" in f:
+        line += (
+            f"\n  EAIK on the same poses: ik {f['eaik_ik_us']:.1f} us "
+            f"({versus(f['ik_us'], f['eaik_ik_us'])}), batch {f['eaik_batch_us']:.2f} "
+            f"us/pose ({versus(f['ik_batch_us'], f['eaik_batch_us'])})"
+        )
+    return (
+        line + f"\n  ik_batch equals the Python ik on {f['batch_agrees']}/{f['samples']} poses"
+        f"\n  {f['summary']}"
+    )

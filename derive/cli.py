@@ -8,7 +8,6 @@ traceback), 3 `generate --require-ik` found an arm without an IK method.
 from __future__ import annotations
 
 import argparse
-import difflib
 import math
 import os
 import resource
@@ -28,14 +27,19 @@ from derive.emit import GenerationError, render_module
 from derive.inputs import bundled_specs, resolve_spec
 from derive.languages import LANGUAGES, figure_files, is_planar, worked_example
 from derive.load import LoadError, load_solver, solver_sources
-from derive.outputs import OutputError, output_file, output_folder, write_atomic
+from derive.outputs import (
+    OutputError,
+    describe_difference,
+    output_file,
+    output_folder,
+    write_atomic,
+)
 from derive.pipeline import build_plan
 from derive.plan import Plan
 from derive.report import Example, render_report
 from derive.spec import ArmSpec, SpecError, load_spec
 
 DEFAULT_OUT = "generated"
-DIFF_LINES = 40
 
 
 class UsageError(Exception):
@@ -183,22 +187,6 @@ def cmd_check(args: argparse.Namespace) -> int:
         + (" and delete the stale files" if any("stale" in p for p in problems) else "")
     )
     return 1
-
-
-def describe_difference(path: Path, actual: bytes, expected: bytes) -> str:
-    """Why a file's bytes differ from the regenerated ones: a unified diff of the lines, or
-    what differs when the lines are equal (line endings, encoding)."""
-    old = actual.decode("utf-8", errors="replace").splitlines()
-    new = expected.decode("utf-8").splitlines()
-    if old == new:
-        return (
-            f"{path}: differs from the regenerated file in bytes, not in lines (line "
-            "endings or a byte-order mark; generated files are UTF-8 with \\n newlines)"
-        )
-    diff = list(difflib.unified_diff(old, new, str(path), f"{path} (regenerated)", lineterm=""))
-    shown = "\n".join(diff[:DIFF_LINES])
-    more = f"\n... {len(diff) - DIFF_LINES} more diff lines" if len(diff) > DIFF_LINES else ""
-    return f"{path}: differs from the regenerated file\n{shown}{more}"
 
 
 def load_module(spec: ArmSpec) -> ModuleType:
@@ -497,7 +485,7 @@ def cmd_bench(args: argparse.Namespace) -> int:
     """Print generation time, solver timings and round-trip figures per arm."""
     import json
 
-    from derive.bench import machine, measure
+    from derive.bench import bench_text, machine, measure
 
     if not args.json:
         print(f"machine: {machine()}", flush=True)
@@ -522,11 +510,6 @@ def cmd_bench(args: argparse.Namespace) -> int:
     return 0
 
 
-def solve_with(module: ModuleType, T: Any, values: dict) -> Any:
-    """module.ik(T, **values) (a named function: the benchmark's callable)."""
-    return module.ik(T, **values)
-
-
 # the C benchmark's compiler flags: what a controller's release build would use on this CPU
 BENCH_CFLAGS = ("-O3", "-march=native")
 
@@ -536,7 +519,7 @@ def bench_c(args: argparse.Namespace) -> int:
     --samples random poses (no joint at a special value), beside the compiled Python ik."""
     import numpy as np
 
-    from derive.bench import eaik_figures, median_us
+    from derive.bench import eaik_figures, median_us, solve_with
     from derive.cbuild import BuildError, Harness
     from derive.verify import sample_joints
 
@@ -649,54 +632,6 @@ def report_figures(
     for _, name, data in made:
         write_atomic(folder / name, data)
     return tuple((caption, name) for caption, name, _ in made)
-
-
-def versus(ours: float, theirs: float) -> str:
-    """How our time compares with another solver's: "ours 4.1x faster" or "ours 2.3x slower"."""
-    if ours <= theirs:
-        return f"ours {theirs / ours:.1f}x faster"
-    return f"ours {ours / theirs:.1f}x slower"
-
-
-def bench_text(name: str, f: dict) -> str:
-    """The human-readable lines of one arm's benchmark figures."""
-    line = (
-        f"{name}: generate {f['generate_s']:.2f} s; fk {f['fk_us']:.1f} us (single calls: "
-        "the median over the poses of each pose's least of 3 calls)"
-    )
-    if "ik_us" not in f:
-        return line
-    if f["backend"] == "c":
-        line += (
-            f"\n  compiled (C, ik_batch on {f['threads']} threads; first calls "
-            f"{f['compile_s']:.1f} s): ik {f['ik_us']:.1f} us/pose (median); ik_batch "
-            f"{f['ik_batch_us']:.2f} us/pose at N = {f['batch_n']}, "
-            f"{f['ik_batch_1thread_us']:.2f} on one thread"
-        )
-    line += f"\n  nearest (within limits) {f['nearest_us']:.1f} us/pose (median)"
-    if "ik_sweep_us" in f:
-        line += f"; ik_sweep (64 free values) {f['ik_sweep_us']:.1f} us/pose (median)"
-    line += (
-        f"\n  python: ik {f['ik_python_us']:.1f} us/pose (median); ik_batch "
-        f"{f['ik_batch_python_us']:.2f} us/pose at N = {f['batch_n']}"
-    )
-    if "ik_batch_peak_mb" in f:
-        line += (
-            f"\n  ik_batch peak {f['ik_batch_peak_mb']:.0f} MB for {f['memory_n']} poses "
-            f"(input {f['input_mb']:.0f} MB)"
-        )
-    if "eaik_skipped" in f:
-        line += f"\n  {f['eaik_skipped']}"
-    if "eaik_ik_us" in f:
-        line += (
-            f"\n  EAIK on the same poses: ik {f['eaik_ik_us']:.1f} us "
-            f"({versus(f['ik_us'], f['eaik_ik_us'])}), batch {f['eaik_batch_us']:.2f} "
-            f"us/pose ({versus(f['ik_batch_us'], f['eaik_batch_us'])})"
-        )
-    return (
-        line + f"\n  ik_batch equals the Python ik on {f['batch_agrees']}/{f['samples']} poses"
-        f"\n  {f['summary']}"
-    )
 
 
 class Parser(argparse.ArgumentParser):

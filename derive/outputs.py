@@ -3,6 +3,7 @@ through symbolic links to their targets. Every command's output goes through her
 
 from __future__ import annotations
 
+import difflib
 import os
 import stat
 import tempfile
@@ -106,3 +107,23 @@ def current_umask() -> int:
     mask = os.umask(0o022)
     os.umask(mask)
     return mask
+
+
+# the most diff lines `derive check` prints for one file
+DIFF_LINES = 40
+
+
+def describe_difference(path: Path, actual: bytes, expected: bytes) -> str:
+    """Why a file's bytes differ from the regenerated ones: a unified diff of the lines, or
+    what differs when the lines are equal (line endings, encoding)."""
+    old = actual.decode("utf-8", errors="replace").splitlines()
+    new = expected.decode("utf-8").splitlines()
+    if old == new:
+        return (
+            f"{path}: differs from the regenerated file in bytes, not in lines (line "
+            "endings or a byte-order mark; generated files are UTF-8 with \\n newlines)"
+        )
+    diff = list(difflib.unified_diff(old, new, str(path), f"{path} (regenerated)", lineterm=""))
+    shown = "\n".join(diff[:DIFF_LINES])
+    more = f"\n... {len(diff) - DIFF_LINES} more diff lines" if len(diff) > DIFF_LINES else ""
+    return f"{path}: differs from the regenerated file\n{shown}{more}"
