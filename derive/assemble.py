@@ -41,6 +41,7 @@ IMPORTS = (
     ("from math import {}", "sin"),
     ("from math import {}", "sqrt"),
     ("from operator import sub as _sub", "_sub"),
+    ("from time import time as _time", "_time"),
     ("from typing import Any", "Any"),
     ("import numpy as np", "np"),
     ("from numpy.typing import ArrayLike", "ArrayLike"),

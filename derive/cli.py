@@ -299,8 +299,8 @@ def solve_arguments(
         pose = np.array([*numbers[:12], 0.0, 0.0, 0.0, 1.0]).reshape(4, 4)
     free = free_values(spec, module, args, q)
     try:
-        # one pose: not worth compiling
-        sols = module.ik(pose, backend="python", **({"free": free} if free else {}))
+        # (the module's BACKEND: C where it compiles, once per machine; DERIVE_BACKEND sets it)
+        sols = module.ik(pose, **({"free": free} if free else {}))
     except ValueError as exc:
         raise UsageError(f"--pose: {exc}") from None
     return pose, free, sols

@@ -13,6 +13,7 @@ import hashlib
 import importlib.util
 import os
 import tempfile
+import warnings
 from pathlib import Path
 from types import ModuleType
 
@@ -63,7 +64,8 @@ def load_solver(name: str, sources: Sources) -> ModuleType:
     or "python") sets the module's BACKEND.
 
     Raises:
-        LoadError: DERIVE_BACKEND holds another value.
+        LoadError: DERIVE_BACKEND holds another value, or is "c" where the C solver cannot
+            be had.
     """
     backend = os.environ.get("DERIVE_BACKEND")
     if backend is not None and backend not in BACKENDS:
@@ -89,4 +91,11 @@ def load_solver(name: str, sources: Sources) -> ModuleType:
     module = _LOADED[key]
     if backend is not None and hasattr(module, "BACKEND"):
         setattr(module, "BACKEND", backend)  # noqa: B010 (a generated module's setting)
+        if backend == "c":
+            try:
+                with warnings.catch_warnings():  # (the error below says it once)
+                    warnings.simplefilter("ignore")
+                    module.warmup()
+            except RuntimeError as exc:  # (no compiler, or no C for this arm)
+                raise LoadError(f"DERIVE_BACKEND=c: {exc}") from None
     return module

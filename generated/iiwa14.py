@@ -36,7 +36,8 @@ API:
              backend=None) -> (Q (N, M, DOF), valid (N, M))
     ik_sweep(T, *, n=None, step=None, within_limits=True, q_ref=None, tol=CERTIFY_TOL,
              backend=None) -> (values (M, len(FREE)), Q (M, DOF))
-    nearest(T, q_ref, *, within_limits=True, weights=None, metric="l2", free_step=FREE_STEP)
+    nearest(T, q_ref, *, within_limits=True, weights=None, metric="l2", free_step=FREE_STEP,
+            backend=None)
         -> (DOF,) ndarray or None
     warmup() -> bool: compile the C solver (or load it from the cache) now
 
@@ -72,6 +73,7 @@ import threading
 import warnings
 from math import acos, atan2, cos, sin, sqrt
 from operator import sub as _sub
+from time import time as _time
 from typing import Any
 
 import numpy as np
@@ -240,6 +242,14 @@ _BATCH_GRAIN = 256
 _UNSETTLED = -2
 
 
+# a compiler that has not finished after this many seconds is given up (the Python solver
+# answers); the bundled arms compile in 0.2-2.5 s
+COMPILE_TIMEOUT = 120.0
+
+
+_TMP_PREFIX = "building-"
+
+
 class _Native:
     """The compiled solver's entry points, taking addresses of contiguous float64 data (see
     the C header: <NAME>_ik.h)."""
@@ -339,8 +349,8 @@ def _cache_folder() -> str:
 
 
 def _c_library() -> tuple[Any, str]:
-    """The compiled C solver, loaded (compiled first where the cache has no library for this
-    source, compiler and flags), and ""; or None and why not."""
+    """The compiled C solver, loaded (compiled first where the cache holds no sound library
+    for this source, compiler and flags), and ""; or None and why not."""
     if not _C_SOURCE:
         return None, "this arm has no C solver"
     source = os.path.join(os.path.dirname(os.path.abspath(__file__)), _C_SOURCE)
@@ -354,31 +364,77 @@ def _c_library() -> tuple[Any, str]:
     compiler = _c_compiler()
     if compiler is None:
         return None, "no C compiler (set CC, install cc, or pip install ziglang)"
+    if shutil.which(compiler[0]) is None:
+        return None, f"the C compiler {compiler[0]!r} (from $CC) is not found"
     key = hashlib.sha256(
         b"\0".join((c_text, h_text, shlex.join([*compiler, *C_FLAGS]).encode()))
     ).hexdigest()[:24]
     suffix = ".dll" if os.name == "nt" else ".dylib" if sys.platform == "darwin" else ".so"
     folder = _cache_folder()
     target = os.path.join(folder, f"{NAME}-{key}{suffix}")
-    try:
-        if not os.path.exists(target):
+    if not _sound(target):  # (absent, or damaged since it was built: built again)
+        try:
             os.makedirs(folder, exist_ok=True)
-            # the bytes hashed are the bytes compiled; the library appears whole or not at all
-            with tempfile.TemporaryDirectory(dir=folder) as tmp:
-                for name, text in ((_C_SOURCE, c_text), (_C_SOURCE[:-2] + ".h", h_text)):
-                    with open(os.path.join(tmp, name), "wb") as file:
-                        file.write(text)
-                built = os.path.join(tmp, "built" + suffix)
-                command = [*compiler, *C_FLAGS, os.path.join(tmp, _C_SOURCE), "-o", built, "-lm"]
-                done = subprocess.run(command, capture_output=True, text=True, check=False)
-                if done.returncode != 0:
-                    errors = [ln for ln in done.stderr.splitlines() if "error" in ln] or [""]
-                    said = errors[0].replace(tmp + os.sep, "")[:300]
-                    return None, f"{shlex.join(compiler)} failed on {source}: {said}"
-                os.replace(built, target)
+            why = _build(compiler, source, c_text, h_text, folder, target)
+        except OSError as exc:
+            return None, f"cannot write the compiled solver into {folder}: {exc}"
+        if why:
+            return None, why
+    try:
         return ctypes.CDLL(target), ""
     except OSError as exc:
-        return None, f"cannot compile into {folder} (set DERIVE_IK_CACHE): {exc}"
+        return None, f"cannot load {target}: {exc}"
+
+
+def _sound(library: str) -> bool:
+    """Whether a cached library is there and whole: its SHA-256 is the one recorded beside it
+    when it was built (a library cut short would crash the process that loads it)."""
+    try:
+        with open(library, "rb") as file:
+            digest = hashlib.sha256(file.read()).hexdigest()
+        with open(library + ".sha256", encoding="ascii") as file:
+            return file.read().strip() == digest
+    except OSError:
+        return False
+
+
+def _build(
+    compiler: list[str], source: str, c_text: bytes, h_text: bytes, folder: str, target: str
+) -> str:
+    """Compile the C into target (with its .sha256), in a temporary folder of the cache (the
+    bytes hashed are the bytes compiled; the library appears whole or not at all); "" or why
+    it failed. Temporary folders a killed process left, an hour old, are removed first."""
+    for name in os.listdir(folder):
+        left = os.path.join(folder, name)
+        stale = name.startswith(_TMP_PREFIX) and os.path.isdir(left)
+        if stale and os.path.getmtime(left) < _time() - 3600.0:
+            shutil.rmtree(left, ignore_errors=True)
+    with tempfile.TemporaryDirectory(prefix=_TMP_PREFIX, dir=folder) as tmp:
+        for name, text in ((_C_SOURCE, c_text), (_C_SOURCE[:-2] + ".h", h_text)):
+            with open(os.path.join(tmp, name), "wb") as file:
+                file.write(text)
+        built = os.path.join(tmp, "built" + os.path.splitext(target)[1])
+        command = [*compiler, *C_FLAGS, os.path.join(tmp, _C_SOURCE), "-o", built, "-lm"]
+        try:
+            done = subprocess.run(
+                command, capture_output=True, text=True, check=False, timeout=COMPILE_TIMEOUT
+            )
+        except subprocess.TimeoutExpired:
+            return f"{shlex.join(compiler)} took more than {COMPILE_TIMEOUT:g} s on {source}"
+        if done.returncode != 0:
+            lines = [ln for ln in done.stderr.splitlines() if ln.strip()]
+            said = next((ln for ln in lines if "error" in ln), lines[0] if lines else "")
+            said = said.replace(tmp + os.sep, "")[:300]
+            return (
+                f"{shlex.join(compiler)} failed (exit {done.returncode}) on {source}: {said}"
+            ).rstrip(": ")
+        with open(built, "rb") as file:
+            digest = hashlib.sha256(file.read()).hexdigest()
+        with open(built + ".sha256", "w", encoding="ascii") as file:
+            file.write(digest + "\n")
+        os.replace(built + ".sha256", target + ".sha256")
+        os.replace(built, target)
+    return ""
 
 
 def _batch_threads(call: Any, n: int) -> None:
@@ -542,7 +598,8 @@ def ik_batch(
     chunk: int = 4096,
     backend: str | None = None,
 ) -> tuple[np.ndarray, np.ndarray]:
-    """All solutions for many world poses at once, without a Python loop over poses.
+    """All solutions for many world poses at once: in C, split over the cores (the Python
+    fallback loops over the poses).
 
     Args:
         T: (N, 4, 4) poses.
@@ -866,6 +923,7 @@ def nearest(
     weights: ArrayLike | None = None,
     metric: str = "l2",
     free_step: float = FREE_STEP,
+    backend: str | None = None,
 ) -> np.ndarray | None:
     """The solution closest to q_ref over the free joints' values, or None.
 
@@ -882,6 +940,7 @@ def nearest(
         metric: "l2" (weighted squared distance, sum of w_i dq_i^2) or "max" (max of
             w_i |dq_i|).
         free_step: the free joints' step (radians, or length for a prismatic joint).
+        backend: as for ik.
     """
     refs, w = _nearest_arguments(q_ref, weights, metric)
     step = float(free_step)
@@ -922,10 +981,10 @@ def nearest(
         if best is not None and bound[chunk[0]] >= least:
             break
         if len(chunk) == 1:
-            rows = ik(A, free=grid[chunk[0]], q_ref=refs)
+            rows = ik(A, free=grid[chunk[0]], q_ref=refs, backend=backend)
         else:
             poses = np.repeat(A[None], len(chunk), axis=0)
-            Q, valid = ik_batch(poses, free=grid[chunk], q_ref=refs)
+            Q, valid = ik_batch(poses, free=grid[chunk], q_ref=refs, backend=backend)
             rows = Q[valid]
         if within_limits:
             rows = _in_limits(rows, refs, False)

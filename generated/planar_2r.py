@@ -27,7 +27,8 @@ API:
         -> (n, DOF) ndarray, all solutions
     ik_batch(T: (N, 4, 4), *, q_ref=None, tol=CERTIFY_TOL, chunk=4096, backend=None)
         -> (Q (N, M, DOF), valid (N, M))
-    nearest(T, q_ref, *, within_limits=True, weights=None, metric="l2") -> (DOF,) ndarray or None
+    nearest(T, q_ref, *, within_limits=True, weights=None, metric="l2", backend=None)
+        -> (DOF,) ndarray or None
     warmup() -> bool: compile the C solver (or load it from the cache) now
 
 Every solution `ik` returns has been checked by forward kinematics against T (tolerance
@@ -56,6 +57,7 @@ import threading
 import warnings
 from math import acos, atan2, cos, sin, sqrt
 from operator import sub as _sub
+from time import time as _time
 from typing import Any
 
 import numpy as np
@@ -178,6 +180,14 @@ _BATCH_GRAIN = 256
 _UNSETTLED = -2
 
 
+# a compiler that has not finished after this many seconds is given up (the Python solver
+# answers); the bundled arms compile in 0.2-2.5 s
+COMPILE_TIMEOUT = 120.0
+
+
+_TMP_PREFIX = "building-"
+
+
 class _Native:
     """The compiled solver's entry points, taking addresses of contiguous float64 data (see
     the C header: <NAME>_ik.h)."""
@@ -277,8 +287,8 @@ def _cache_folder() -> str:
 
 
 def _c_library() -> tuple[Any, str]:
-    """The compiled C solver, loaded (compiled first where the cache has no library for this
-    source, compiler and flags), and ""; or None and why not."""
+    """The compiled C solver, loaded (compiled first where the cache holds no sound library
+    for this source, compiler and flags), and ""; or None and why not."""
     if not _C_SOURCE:
         return None, "this arm has no C solver"
     source = os.path.join(os.path.dirname(os.path.abspath(__file__)), _C_SOURCE)
@@ -292,31 +302,77 @@ def _c_library() -> tuple[Any, str]:
     compiler = _c_compiler()
     if compiler is None:
         return None, "no C compiler (set CC, install cc, or pip install ziglang)"
+    if shutil.which(compiler[0]) is None:
+        return None, f"the C compiler {compiler[0]!r} (from $CC) is not found"
     key = hashlib.sha256(
         b"\0".join((c_text, h_text, shlex.join([*compiler, *C_FLAGS]).encode()))
     ).hexdigest()[:24]
     suffix = ".dll" if os.name == "nt" else ".dylib" if sys.platform == "darwin" else ".so"
     folder = _cache_folder()
     target = os.path.join(folder, f"{NAME}-{key}{suffix}")
-    try:
-        if not os.path.exists(target):
+    if not _sound(target):  # (absent, or damaged since it was built: built again)
+        try:
             os.makedirs(folder, exist_ok=True)
-            # the bytes hashed are the bytes compiled; the library appears whole or not at all
-            with tempfile.TemporaryDirectory(dir=folder) as tmp:
-                for name, text in ((_C_SOURCE, c_text), (_C_SOURCE[:-2] + ".h", h_text)):
-                    with open(os.path.join(tmp, name), "wb") as file:
-                        file.write(text)
-                built = os.path.join(tmp, "built" + suffix)
-                command = [*compiler, *C_FLAGS, os.path.join(tmp, _C_SOURCE), "-o", built, "-lm"]
-                done = subprocess.run(command, capture_output=True, text=True, check=False)
-                if done.returncode != 0:
-                    errors = [ln for ln in done.stderr.splitlines() if "error" in ln] or [""]
-                    said = errors[0].replace(tmp + os.sep, "")[:300]
-                    return None, f"{shlex.join(compiler)} failed on {source}: {said}"
-                os.replace(built, target)
+            why = _build(compiler, source, c_text, h_text, folder, target)
+        except OSError as exc:
+            return None, f"cannot write the compiled solver into {folder}: {exc}"
+        if why:
+            return None, why
+    try:
         return ctypes.CDLL(target), ""
     except OSError as exc:
-        return None, f"cannot compile into {folder} (set DERIVE_IK_CACHE): {exc}"
+        return None, f"cannot load {target}: {exc}"
+
+
+def _sound(library: str) -> bool:
+    """Whether a cached library is there and whole: its SHA-256 is the one recorded beside it
+    when it was built (a library cut short would crash the process that loads it)."""
+    try:
+        with open(library, "rb") as file:
+            digest = hashlib.sha256(file.read()).hexdigest()
+        with open(library + ".sha256", encoding="ascii") as file:
+            return file.read().strip() == digest
+    except OSError:
+        return False
+
+
+def _build(
+    compiler: list[str], source: str, c_text: bytes, h_text: bytes, folder: str, target: str
+) -> str:
+    """Compile the C into target (with its .sha256), in a temporary folder of the cache (the
+    bytes hashed are the bytes compiled; the library appears whole or not at all); "" or why
+    it failed. Temporary folders a killed process left, an hour old, are removed first."""
+    for name in os.listdir(folder):
+        left = os.path.join(folder, name)
+        stale = name.startswith(_TMP_PREFIX) and os.path.isdir(left)
+        if stale and os.path.getmtime(left) < _time() - 3600.0:
+            shutil.rmtree(left, ignore_errors=True)
+    with tempfile.TemporaryDirectory(prefix=_TMP_PREFIX, dir=folder) as tmp:
+        for name, text in ((_C_SOURCE, c_text), (_C_SOURCE[:-2] + ".h", h_text)):
+            with open(os.path.join(tmp, name), "wb") as file:
+                file.write(text)
+        built = os.path.join(tmp, "built" + os.path.splitext(target)[1])
+        command = [*compiler, *C_FLAGS, os.path.join(tmp, _C_SOURCE), "-o", built, "-lm"]
+        try:
+            done = subprocess.run(
+                command, capture_output=True, text=True, check=False, timeout=COMPILE_TIMEOUT
+            )
+        except subprocess.TimeoutExpired:
+            return f"{shlex.join(compiler)} took more than {COMPILE_TIMEOUT:g} s on {source}"
+        if done.returncode != 0:
+            lines = [ln for ln in done.stderr.splitlines() if ln.strip()]
+            said = next((ln for ln in lines if "error" in ln), lines[0] if lines else "")
+            said = said.replace(tmp + os.sep, "")[:300]
+            return (
+                f"{shlex.join(compiler)} failed (exit {done.returncode}) on {source}: {said}"
+            ).rstrip(": ")
+        with open(built, "rb") as file:
+            digest = hashlib.sha256(file.read()).hexdigest()
+        with open(built + ".sha256", "w", encoding="ascii") as file:
+            file.write(digest + "\n")
+        os.replace(built + ".sha256", target + ".sha256")
+        os.replace(built, target)
+    return ""
 
 
 def _batch_threads(call: Any, n: int) -> None:
@@ -480,7 +536,8 @@ def ik_batch(
     chunk: int = 4096,
     backend: str | None = None,
 ) -> tuple[np.ndarray, np.ndarray]:
-    """All solutions for many world poses at once, without a Python loop over poses.
+    """All solutions for many world poses at once: in C, split over the cores (the Python
+    fallback loops over the poses).
 
     Args:
         T: (N, 4, 4) poses.
@@ -578,6 +635,7 @@ def nearest(
     within_limits: bool = True,
     weights: ArrayLike | None = None,
     metric: str = "l2",
+    backend: str | None = None,
 ) -> np.ndarray | None:
     """The solution closest to q_ref, or None.
 
@@ -590,9 +648,10 @@ def nearest(
         weights: DOF finite non-negative numbers (default ones).
         metric: "l2" (weighted squared distance, sum of w_i dq_i^2) or "max" (max of
             w_i |dq_i|).
+        backend: as for ik.
     """
     refs, w = _nearest_arguments(q_ref, weights, metric)
-    native = _native_solver(None)
+    native = _native_solver(backend)
     A = _array44(T) if native is not None and metric == "l2" and within_limits else None
     if native is not None and A is not None:
         pose, at, rows, rows_at, ref, ref_at = _scratch()
@@ -601,7 +660,7 @@ def nearest(
         found = native.nearest(at, None, ref_at, w_at, CERTIFY_TOL, rows_at)
         if found >= 0:
             return rows[0].copy() if found else None
-    sols = ik(T, within_limits=within_limits, q_ref=refs)
+    sols = ik(T, within_limits=within_limits, q_ref=refs, backend=backend)
     if len(sols) == 0:
         return None
     return sols[int(np.argmin(_distances(sols, refs, w, metric, not within_limits)))]

@@ -8,6 +8,7 @@ import os
 import shutil
 import subprocess
 import sys
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -54,7 +55,7 @@ def test_the_c_solver_is_compiled_once_into_the_cache_and_found_by_the_next_proc
     path = copy_arm("planar_2r", tmp_path)
     env = dict(os.environ, DERIVE_IK_CACHE=str(tmp_path / "cache"))
     first = probe(path, "first_import_name", env)
-    built = sorted((tmp_path / "cache").glob("planar_2r-*"))
+    built = sorted((tmp_path / "cache").glob("planar_2r-*.so"))
     assert [str(p) for p in built] == [first]
     stamp = built[0].stat().st_mtime_ns
     assert probe(path, "another_import_name", env) == first  # the same library, not rebuilt
@@ -63,7 +64,7 @@ def test_the_c_solver_is_compiled_once_into_the_cache_and_found_by_the_next_proc
     source = tmp_path / "planar_2r_ik.c"
     source.write_text(source.read_text() + "\n/* changed */\n")
     second = probe(path, "third_import_name", env)
-    assert second != first and len(list((tmp_path / "cache").glob("planar_2r-*"))) == 2
+    assert second != first and len(list((tmp_path / "cache").glob("planar_2r-*.so"))) == 2
     assert not [p for p in (tmp_path / "cache").iterdir() if p.is_dir()]  # no leftovers
 
 
@@ -100,7 +101,9 @@ def test_without_a_compiler_one_notice_and_the_python_solver(tmp_path, monkeypat
         expected = m.ik(T, backend="python")
         assert np.array_equal(r, expected) and np.array_equal(q[ok], expected)
     assert not m.warmup()
-    with pytest.raises(RuntimeError, match=r"backend=.c.: .*no-such-compiler"):
+    with pytest.raises(
+        RuntimeError, match=r"backend='c': the C compiler .*no-such-compiler.* not found"
+    ):
         m.ik(poses[0], backend="c")
 
 
@@ -120,6 +123,61 @@ def test_a_failing_compiler_is_named_with_its_message(tmp_path, monkeypatch):
     (tmp_path / "planar_2r_ik.c").write_text("this is not C\n")
     monkeypatch.setenv("DERIVE_IK_CACHE", str(tmp_path / "cache"))
     m = import_path(path)
-    with pytest.warns(RuntimeWarning, match=r"failed on .*planar_2r_ik\.c: .*error"):
+    with pytest.warns(RuntimeWarning, match=r"failed \(exit \d+\) on .*planar_2r_ik\.c: .*error"):
         m.ik(m.fk([0.1, 0.2]))
     assert not list((tmp_path / "cache").glob("planar_2r-*"))  # nothing half-built kept
+
+
+@needs_cc
+def test_a_damaged_library_in_the_cache_is_built_again_not_loaded(tmp_path):
+    """A library cut short (a crash would follow loading it) or overwritten fails the SHA-256
+    recorded beside it when it was built: the next process builds it again."""
+    path = copy_arm("planar_2r", tmp_path)
+    env = dict(os.environ, DERIVE_IK_CACHE=str(tmp_path / "cache"))
+    library = Path(probe(path, "first", env))
+    whole = library.read_bytes()
+    assert (library.parent / (library.name + ".sha256")).is_file()
+    for damaged in (whole[:1000], b"garbage"):
+        library.write_bytes(damaged)
+        assert probe(path, "again", env) == str(library)
+        assert library.read_bytes() != damaged  # built again
+
+
+@needs_cc
+def test_a_compiler_that_fails_silently_or_hangs_is_named_with_what_it_did(tmp_path, monkeypatch):
+    path = copy_arm("planar_2r", tmp_path)
+    monkeypatch.setenv("DERIVE_IK_CACHE", str(tmp_path / "cache"))
+    monkeypatch.setenv("CC", "false")
+    m = import_path(path)
+    with pytest.warns(RuntimeWarning, match=r"false failed \(exit 1\) on .*planar_2r_ik\.c"):
+        assert not m.warmup()
+    hang = tmp_path / "hang.sh"
+    hang.write_text("#!/bin/sh\nsleep 30\n")
+    hang.chmod(0o755)
+    monkeypatch.setenv("CC", str(hang))
+    m = import_path(path)
+    monkeypatch.setattr(m, "COMPILE_TIMEOUT", 0.5)
+    with pytest.warns(RuntimeWarning, match=r"hang\.sh took more than 0\.5 s"):
+        assert not m.warmup()
+    assert [p.name for p in (tmp_path / "cache").iterdir()] == []  # nothing left behind
+
+
+def test_derive_backend_c_without_a_compiler_is_one_line(tmp_path):
+    env = dict(
+        os.environ,
+        CC=str(tmp_path / "no-such-compiler"),
+        DERIVE_IK_CACHE=str(tmp_path / "cache"),
+        DERIVE_BACKEND="c",
+    )
+    done = subprocess.run(
+        [sys.executable, "-m", "derive", "solve", "planar_2r", "--q", "10", "20"],
+        capture_output=True,
+        text=True,
+        env=env,
+        timeout=300,
+    )
+    assert done.returncode == 2
+    assert done.stderr.strip().splitlines() == [
+        f"error: DERIVE_BACKEND=c: backend='c': the C compiler "
+        f"'{tmp_path / 'no-such-compiler'}' (from $CC) is not found"
+    ]

@@ -196,7 +196,8 @@ def ik_batch(
     chunk: int = 4096,
     backend: str | None = None,
 ) -> tuple[np.ndarray, np.ndarray]:
-    """All solutions for many world poses at once, without a Python loop over poses.
+    """All solutions for many world poses at once: in C, split over the cores (the Python
+    fallback loops over the poses).
 
     Args:
         T: (N, 4, 4) poses.
@@ -294,6 +295,7 @@ def nearest(
     within_limits: bool = True,
     weights: ArrayLike | None = None,
     metric: str = "l2",
+    backend: str | None = None,
 ) -> np.ndarray | None:
     """The solution closest to q_ref, or None.
 
@@ -306,9 +308,10 @@ def nearest(
         weights: DOF finite non-negative numbers (default ones).
         metric: "l2" (weighted squared distance, sum of w_i dq_i^2) or "max" (max of
             w_i |dq_i|).
+        backend: as for ik.
     """
     refs, w = _nearest_arguments(q_ref, weights, metric)
-    native = _native_solver(None)
+    native = _native_solver(backend)
     A = _array44(T) if native is not None and metric == "l2" and within_limits else None
     if native is not None and A is not None:
         pose, at, rows, rows_at, ref, ref_at = _scratch()
@@ -317,7 +320,7 @@ def nearest(
         found = native.nearest(at, None, ref_at, w_at, CERTIFY_TOL, rows_at)
         if found >= 0:
             return rows[0].copy() if found else None
-    sols = ik(T, within_limits=within_limits, q_ref=refs)
+    sols = ik(T, within_limits=within_limits, q_ref=refs, backend=backend)
     if len(sols) == 0:
         return None
     return sols[int(np.argmin(_distances(sols, refs, w, metric, not within_limits)))]

@@ -30,6 +30,7 @@ def nearest(
     weights: ArrayLike | None = None,
     metric: str = "l2",
     free_step: float = FREE_STEP,
+    backend: str | None = None,
 ) -> np.ndarray | None:
     """The solution closest to q_ref over the free joints' values, or None.
 
@@ -46,6 +47,7 @@ def nearest(
         metric: "l2" (weighted squared distance, sum of w_i dq_i^2) or "max" (max of
             w_i |dq_i|).
         free_step: the free joints' step (radians, or length for a prismatic joint).
+        backend: as for ik.
     """
     refs, w = _nearest_arguments(q_ref, weights, metric)
     step = float(free_step)
@@ -86,10 +88,10 @@ def nearest(
         if best is not None and bound[chunk[0]] >= least:
             break
         if len(chunk) == 1:
-            rows = ik(A, free=grid[chunk[0]], q_ref=refs)
+            rows = ik(A, free=grid[chunk[0]], q_ref=refs, backend=backend)
         else:
             poses = np.repeat(A[None], len(chunk), axis=0)
-            Q, valid = ik_batch(poses, free=grid[chunk], q_ref=refs)
+            Q, valid = ik_batch(poses, free=grid[chunk], q_ref=refs, backend=backend)
             rows = Q[valid]
         if within_limits:
             rows = _in_limits(rows, refs, False)
