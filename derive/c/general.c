@@ -1478,6 +1478,7 @@ static int dk_general(const double flanges[DK_RR_SPLIT_COUNT][12], double out[DK
     }
     for (k = 0; k < DK_RR_SPLIT_COUNT; k++) {
         count = dk_rr_split(k, targets[k], targets[k], out, count, &doubt, DK_RR_IMAG_TOL);
+        perturbed |= dk_rr_perturbed(k); /* (a perturbed table walked: the partners below) */
         if (count == DK_RR_ROWS) {
             return count;
         }
@@ -1499,18 +1500,17 @@ static int dk_general(const double flanges[DK_RR_SPLIT_COUNT][12], double out[DK
                     }
                 }
                 count = dk_rr_split(k, targets[k], moved, out, count, &ignored, DK_RR_IMAG_TOL);
+                perturbed |= dk_rr_perturbed(k);
                 if (count == DK_RR_ROWS) {
                     return count;
                 }
             }
         }
     }
-    for (k = 0; k < DK_RR_SPLIT_COUNT; k++) {
-        perturbed |= dk_rr_perturbed(k);
-    }
     if (count > 0 && count < DK_RR_ROWS && perturbed) {
         /* a perturbed table walks two solutions that share the eigen-joint value (the PUMA's
-           wrist flip) onto one now and then, whether the count stays even or not */
+           wrist flip) onto one now and then, whether the count stays even or not: where such
+           a table answered */
         count = dk_rr_partners(targets[0], out, count);
     }
     if (count % 2) {
