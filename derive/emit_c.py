@@ -6,8 +6,6 @@ same bytes."""
 from __future__ import annotations
 
 import functools
-import math
-from collections.abc import Iterable
 from dataclasses import dataclass
 from typing import Any
 
@@ -19,7 +17,7 @@ from derive.layout import wrap_c
 from derive.plan import Eigen, Plan, Poly, PolyD
 from derive.printers import c
 from derive.printers.general import eigen_step, pad, spurious_counts
-from derive.runtime import closed, constants
+from derive.runtime import constants
 
 
 @dataclass(frozen=True)
@@ -50,35 +48,6 @@ class PrintedC:
     solve: tuple[tuple[int, str], ...]
     # dk_solve brings every revolute output to ik's range (c.seamed_outputs): dk_finish copies
     seamed: bool
-
-
-@dataclass(frozen=True)
-class RuntimeConstants:
-    """The runtime's tolerances as C literals (from derive/runtime/constants.py)."""
-
-    FREE_TOL: str
-    CLAMP_TOL: str
-    FOLD_TOL: str
-    LEAD_TOL: str
-    ROOT_IMAG_TOL: str
-    CLUSTER_TOL: str
-    MERGE_TOL: str
-    RESIDUAL_TOL: str
-    DEDUP_TOL: str
-    POSE_TOL: str
-    SEAM: str
-    SEAM_SNAP: str
-    PI: str
-    TWO_PI: str
-    FREE_COUNT: int
-    FREE_STEPS: str
-    ANGLE_AT: str
-    TAN_AT: str
-    UNIT_ANGLE: str
-    UNIT_ANGLE_COUNT: int
-    UNIT_ANGLE_TERMS: int
-    UNIT_ANGLE_SEGMENTS: int
-    UNIT_ANGLE_TOP: str
 
 
 def general_constants(plan: Plan) -> dict[str, object]:
@@ -160,41 +129,6 @@ def unit_angle_table() -> list[list[float]]:
             terms = [mpmath.asin(x)] + [g[i - 1] / mpmath.factorial(i) for i in degrees]
             rows.append([float(t) for t in terms])
     return rows
-
-
-def runtime_constants() -> RuntimeConstants:
-    steps = [repr(s) for s in constants._FREE_STEPS]
-    rows = [", ".join(steps[k : k + 4]) for k in range(0, len(steps), 4)]
-    return RuntimeConstants(
-        FREE_TOL=repr(constants._FREE_TOL),
-        CLAMP_TOL=repr(constants._CLAMP_TOL),
-        FOLD_TOL=repr(constants._FOLD_TOL),
-        LEAD_TOL=repr(constants._LEAD_TOL),
-        ROOT_IMAG_TOL=repr(constants._ROOT_IMAG_TOL),
-        CLUSTER_TOL=repr(constants._CLUSTER_TOL),
-        MERGE_TOL=repr(constants._MERGE_TOL),
-        RESIDUAL_TOL=repr(constants._RESIDUAL_TOL),
-        DEDUP_TOL=repr(constants.DEDUP_TOL),
-        POSE_TOL=repr(constants.POSE_TOL),
-        SEAM=repr(constants._SEAM),
-        SEAM_SNAP=repr(constants._SEAM_SNAP),
-        PI=repr(math.pi),
-        TWO_PI=repr(constants._TWO_PI),
-        FREE_COUNT=len(steps),
-        FREE_STEPS=",\n".join(f"    {row}" for row in rows),
-        ANGLE_AT=_c_array(closed._ANGLE_AT),
-        TAN_AT=_c_array(closed._TAN_AT),
-        UNIT_ANGLE=",\n".join(f"    {_c_array(row)}" for row in unit_angle_table()),
-        UNIT_ANGLE_COUNT=UNIT_ANGLE_SEGMENTS + 1,
-        UNIT_ANGLE_TERMS=UNIT_ANGLE_DEGREE + 1,
-        UNIT_ANGLE_SEGMENTS=UNIT_ANGLE_SEGMENTS,
-        UNIT_ANGLE_TOP=repr(UNIT_ANGLE_TOP),
-    )
-
-
-def _c_array(values: Iterable[float]) -> str:
-    """A C array initialiser of doubles."""
-    return "{" + ", ".join(repr(float(v)) for v in values) + "}"
 
 
 def print_c(plan: Plan) -> PrintedC:

@@ -18,6 +18,7 @@ from pathlib import Path
 from types import ModuleType
 
 from derive.plan import Plan
+from derive.runtime.native import _cache_folder
 
 # a solver's files: {file name: text}; the module is "<name>.py", the C "<name>_ik.c" and .h
 Sources = dict[str, str]
@@ -42,12 +43,9 @@ def solver_sources(plan: Plan) -> Sources:
 
 
 def solver_cache() -> Path:
-    """The per-user cache: DERIVE_IK_CACHE, else $XDG_CACHE_HOME/derive-ik, else
-    ~/.cache/derive-ik (the generated modules compile their C into the same folder)."""
-    if os.environ.get("DERIVE_IK_CACHE"):
-        return Path(os.environ["DERIVE_IK_CACHE"])
-    root = os.environ.get("XDG_CACHE_HOME") or os.environ.get("LOCALAPPDATA")
-    return Path(root or Path.home() / ".cache") / "derive-ik"
+    """The per-user cache the generated modules compile their C into (their own rule:
+    DERIVE_IK_CACHE, else $XDG_CACHE_HOME/derive-ik, else ~/.cache/derive-ik)."""
+    return Path(_cache_folder())
 
 
 def digest(sources: Sources) -> str:

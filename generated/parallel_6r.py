@@ -508,8 +508,8 @@ def ik(
         result = _as_rows
     native = _native_solver(backend)
     if native is not None:
-        A = T if type(T) is np.ndarray and T.dtype == np.float64 else _array44(T)
-        if A is not None and A.shape == (4, 4):  # else _pose says what is wrong with T
+        A = _array44(T)
+        if A is not None:  # else _pose says what is wrong with T
             pose, at, rows, rows_at, ref, ref_at = _scratch()
             pose[...] = A
             given = None
