@@ -127,6 +127,9 @@ class PrintedModule:
     free: tuple[int, ...]
     free_const: str
     free_text: str
+    seed_tol: str
+    correction: str
+    correction_doc: str
 
 
 def print_plan(plan: Plan) -> PrintedModule:
@@ -177,6 +180,49 @@ def print_plan(plan: Plan) -> PrintedModule:
         free=ik.free if ik else (),
         free_const=repr(ik.free) if ik else "()",
         free_text=ik.free_text if ik else "",
+        seed_tol=repr(plan.correction.seed_tol) if plan.correction else "0.0",
+        correction=correction_constants(plan),
+        correction_doc=correction_text(plan),
+    )
+
+
+def correction_constants(plan: Plan) -> str:
+    """The exact chain and the joints its refinement moves, where the closed form solves a
+    nominal table (derive/nominal.py); "" elsewhere."""
+    fix = plan.correction
+    if fix is None or plan.ik is None:
+        return ""
+    solved = tuple(i for i in range(plan.arm.dof) if i + 1 not in plan.ik.free)
+    return (
+        "# the closed form solves this nominal table (alpha, a, d, theta), radians; its answers\n"
+        "# are refined onto the exact chain below (derive/nominal.py)\n"
+        f"NOMINAL_DH = {_tuple_of_tuples(fix.nominal_dh)}\n"
+        "# the largest FK difference of the nominal arm from this one (rotation entries;\n"
+        "# positions / REACH)\n"
+        f"NOMINAL_DEVIATION = {fix.deviation:.3g}\n"
+        "# the exact chain: T(q) = F_0 J_1(q_1) F_1 ... J_n(q_n) F_n, J_i = Rz(q_i) (R) or\n"
+        "# Tz(q_i) (P); each F_i's top three rows, row-major\n"
+        f"_CHAIN = {_tuple_of_tuples(fix.frames)}\n"
+        "# the joints (0-based) the refinement moves (free joints keep the caller's values)\n"
+        f"_SOLVED = {solved!r}\n"
+    )
+
+
+def correction_text(plan: Plan) -> str:
+    """The module docstring's paragraph on the refinement, "" where there is none."""
+    fix = plan.correction
+    if fix is None:
+        return ""
+    return (
+        "Exact answers from a nominal closed form: the table above is not exactly special, "
+        f"but within the structure tolerance {fix.tol:g} of NOMINAL_DH ({len(fix.changes)} "
+        "parameters snapped; forward kinematics differ by up to NOMINAL_DEVIATION = "
+        f"{fix.deviation:.2g}). The closed form solves NOMINAL_DH and Newton's steps refine "
+        "every solution onto this arm's exact chain (_CHAIN); fk, and the certification of "
+        "every row, are this arm's. Rows keep the nominal arm's branch order. An arm this "
+        "close to a special one can have more real solutions than it near some poses; those "
+        "the nominal arm lacks are not returned (derive generate --method general gives the "
+        "complete set, slower)."
     )
 
 

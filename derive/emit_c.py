@@ -48,6 +48,13 @@ class PrintedC:
     solve: tuple[tuple[int, str], ...]
     # dk_solve brings every revolute output to ik's range (c.seamed_outputs): dk_finish copies
     seamed: bool
+    # how far the solver's equations may miss and still seed a refinement (0.0: exact arms)
+    seed_tol: str = "0.0"
+    # the exact chain's frames (each a line of 12 numbers) and the joints (0-based) its
+    # refinement moves, where the closed form solves a nominal table; () elsewhere
+    chain: tuple[str, ...] = ()
+    solved: tuple[int, ...] = ()
+    refine_rows: int = 6
 
 
 def general_constants(plan: Plan) -> dict[str, object]:
@@ -169,6 +176,12 @@ def print_c(plan: Plan) -> PrintedC:
         fk_params=fk_params,
         solve=solve,
         seamed=bool(c.seamed_outputs(plan)),
+        seed_tol=repr(plan.correction.seed_tol) if plan.correction else "0.0",
+        chain=tuple(", ".join(map(repr, f)) for f in plan.correction.frames)
+        if plan.correction
+        else (),
+        solved=tuple(i for i in range(arm.dof) if i + 1 not in ik.free) if plan.correction else (),
+        refine_rows=3 if ik.certify == "position" else 6,
     )
 
 

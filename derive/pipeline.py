@@ -10,7 +10,8 @@ from derive import free
 from derive import symbols as sym
 from derive.classify import Structure, classify
 from derive.methods import general, parallel, pieper, planar
-from derive.plan import ArmInfo, IkPlan, Plan
+from derive.nominal import STRUCTURE_TOL, Nominal, chain_frames, deviation, nominal
+from derive.plan import ArmInfo, Correction, IkPlan, Plan
 from derive.spec import ArmSpec
 from derive.transforms import Chain, chain_from_spec, frame_matrix, link_transform, world_transform
 
@@ -26,24 +27,79 @@ METHODS = {
 def build_plan(spec: ArmSpec, method: str | None = None) -> Plan:
     """Derive everything the generated module and the report need for one arm; with method
     (a key of METHODS), that method only (the general one also solves special arms: the tests
-    compare it with the closed forms)."""
+    compare it with the closed forms).
+
+    The closed forms are tried on the arm's own table, then on its nominal table
+    (derive/nominal.py: the structure parameters within the spec's structure_tol of a
+    special value snapped), whose answers the module refines onto the arm's; the general
+    method last, on the arm's own table."""
     chain = chain_from_spec(spec)
     structure = classify(chain)
     if method is not None and method not in METHODS:
         raise ValueError(f"no method {method!r}; methods: {', '.join(METHODS)}")
     names = (method,) if method else tuple(METHODS)
-    if chain.dof > free.REMAINDER_DOF:
-        ik, refusal = choose_free(chain, spec.free, names)
-    else:
-        ik, refusal = choose_method(chain, structure, names)
+    closed = tuple(name for name in names if name != general.NAME)
+    ik, refusal = choose(chain, structure, spec.free, closed)
+    correction = None
+    facts = structure.describe(chain.dof)
+    if ik is None and closed:
+        tol = STRUCTURE_TOL if spec.structure_tol is None else spec.structure_tol
+        near = nominal(spec, tol)
+        if near.changes:
+            near_chain = chain_from_spec(near.spec)
+            near_structure = classify(near_chain)
+            near_ik, _ = choose(near_chain, near_structure, spec.free, closed)
+            if near_ik is not None:
+                ik, refusal = near_ik, ""
+                correction = make_correction(spec, chain, near, near_chain)
+                facts = tuple(
+                    f"{fact} (nominal table)" for fact in near_structure.describe(chain.dof)
+                )
+    if ik is None and general.NAME in names:
+        ik, why = choose(chain, structure, spec.free, (general.NAME,))
+        reasons = [r for r in (refusal, why) if r]
+        refusal = "; ".join(dict.fromkeys(reasons)) if ik is None else ""
     return Plan(
         arm=arm_info(spec, chain),
-        structure=structure.describe(chain.dof),
+        structure=facts,
         fk_pose=world_transform(chain, expand=False),
         links=tuple(link_transform(chain, i) for i in range(1, chain.dof + 1)),
         joint_defs=joint_definitions(chain),
         ik=ik,
         refusal=refusal,
+        correction=correction,
+    )
+
+
+def choose(
+    chain: Chain, structure: Structure, named: tuple[int, ...] | None, names: tuple[str, ...]
+) -> tuple[IkPlan | None, str]:
+    """The first of the named methods that solves the chain (an arm of more than 6 joints:
+    with free joints), or None and why none does."""
+    if chain.dof > free.REMAINDER_DOF:
+        return choose_free(chain, named, names)
+    return choose_method(chain, structure, names)
+
+
+# how far the nominal solver's equations may miss, relative, and still seed a refinement, in
+# units of the nominal arm's deviation (an acos argument of a short link misses by more than
+# the deviation: it is a ratio of lengths), and at most
+SEED_FACTOR = 100.0
+SEED_MAX = 0.1
+
+
+def make_correction(spec: ArmSpec, chain: Chain, near: Nominal, near_chain: Chain) -> Correction:
+    """How the nominal table's answers are refined onto the arm's (derive/nominal.py)."""
+    info = arm_info(near.spec, near_chain)
+    frames = chain_frames(chain)
+    moved = deviation(frames, chain_frames(near_chain), spec.joint_types, info.reach)
+    return Correction(
+        nominal_dh=info.dh,
+        changes=near.changes,
+        tol=near.tol,
+        deviation=moved,
+        frames=frames,
+        seed_tol=min(SEED_MAX, max(1e-9, SEED_FACTOR * moved)),
     )
 
 

@@ -307,6 +307,31 @@ class IkPlan:
 
 
 @dataclass(frozen=True)
+class Correction:
+    """The closed form solves a nominal table near the arm's; its answers are refined onto the
+    arm's exact chain (derive/nominal.py).
+
+    Attributes:
+        nominal_dh: the nominal rows (alpha, a, d, theta), radians and length units.
+        changes: one line per parameter snapping changed.
+        tol: the structure tolerance.
+        deviation: the largest forward-kinematics difference of the nominal arm from the
+            exact one (rotation entries; positions divided by the reach).
+        frames: the exact chain's fixed frames F_0 .. F_n (12 floats each).
+        seed_tol: how far the nominal solver's equations may miss (relative) and still seed
+            a refinement: an acos argument up to 1 + seed_tol, a root up to sqrt(seed_tol)
+            off the real line.
+    """
+
+    nominal_dh: tuple[tuple[float, float, float, float], ...]
+    changes: tuple[str, ...]
+    tol: float
+    deviation: float
+    frames: tuple[tuple[float, ...], ...]
+    seed_tol: float
+
+
+@dataclass(frozen=True)
 class Plan:
     """Everything emit and report need for one arm.
 
@@ -318,6 +343,8 @@ class Plan:
         joint_defs: (symbol, expression in q_i) defining theta_i or d_i for each joint.
         ik: the IK plan, or None when no method applies.
         refusal: why no IK method applies (one line), or "" when ik is set.
+        correction: where ik solves a nominal table near the arm's, how its answers are
+            refined onto the arm's; None where ik solves the arm's own table.
     """
 
     arm: ArmInfo
@@ -327,3 +354,4 @@ class Plan:
     joint_defs: tuple[tuple[sp.Symbol, sp.Expr], ...]
     ik: IkPlan | None
     refusal: str = ""
+    correction: Correction | None = None

@@ -608,9 +608,62 @@ def wrist_matrices(plan: Plan, q: tuple[float, ...], flange: np.ndarray) -> list
     ]
 
 
+def correction_blocks(plan: Plan) -> list[Block]:
+    """Where the closed form solves a nominal table near the arm's: the two tables, how far
+    apart, and the correction step (derive/nominal.py)."""
+    fix = plan.correction
+    if fix is None:
+        return []
+    header = ("i", "alpha exact [deg]", "alpha nominal", "a exact", "a nominal", "d exact",
+              "d nominal")  # fmt: skip
+    rows = [header]
+    for i, (exact, near) in enumerate(zip(plan.arm.dh, fix.nominal_dh), start=1):
+        rows.append(
+            (
+                str(i),
+                f"{math.degrees(exact[0]):.6g}",
+                f"{math.degrees(near[0]):g}",
+                f"{exact[1]:.6g}",
+                f"{near[1]:g}",
+                f"{exact[2]:.6g}",
+                f"{near[2]:g}",
+            )
+        )
+    return [
+        Block("h3", "The nominal table, and the correction onto the exact one"),
+        Block(
+            "p",
+            "This arm's table is not exactly special, and no closed form solves it. Within the "
+            f"structure tolerance {fix.tol:g} (twists in radians, lengths as a fraction of the "
+            f"arm's size) it is near one that is: snapping {len(fix.changes)} parameters "
+            "gives the nominal table below, and the method above is the nominal table's. "
+            "The forward kinematics of the two differ by up to "
+            f"{fix.deviation:.2g} (rotation entries; positions divided by the reach).",
+        ),
+        Block("table", rows=tuple(rows)),
+        Block(
+            "p",
+            "Every nominal solution is a seed: Newton's steps on the exact chain, damped by "
+            "the error's square, bring it onto this arm, and only what reproduces the pose on "
+            "the exact chain is returned. With e the pose error (position difference over the "
+            "reach; rotation error half the sum of the cross products of the current and "
+            "target rotation's columns) and J the geometric Jacobian of the exact chain:",
+        ),
+        Block("math", "q_{k+1}", "q_k + (J^T J + |e|^2 I)^{-1} J^T e"),
+        Block(
+            "p",
+            "Where an equation of the nominal arm just misses (an acos argument above 1 by at "
+            f"at most {fix.seed_tol:.2g}, a double root split off the real line by at most "
+            f"{math.sqrt(fix.seed_tol):.2g}) its boundary value still seeds a refinement: the "
+            "exact arm may reach what the nominal one does not.",
+        ),
+    ]
+
+
 def report_blocks(plan: Plan, example: Example) -> tuple[Block, ...]:
     """All blocks of the report, in order."""
     blocks = arm_blocks(plan) + link_blocks(plan) + method_blocks(plan)
+    blocks += correction_blocks(plan)
     if plan.ik is not None:
         blocks += step_blocks(plan)
     return tuple(blocks + example_blocks(plan, example))

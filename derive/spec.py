@@ -26,6 +26,11 @@ Spec format (all keys other than those listed are errors)::
     [ik]                        # optional
     free = [7]                  # the joints (1-based) an arm of more than 6 joints leaves
                                 # free: ik takes their values; default: derive chooses
+    structure_tol = 1e-3        # twists within this many radians of a multiple of 90 deg
+                                # and lengths within this fraction of the arm's size of 0
+                                # are taken as special to choose a closed form, whose
+                                # answers are then refined onto the exact table
+                                # (derive/nominal.py); 0: only exact special values
 """
 
 from __future__ import annotations
@@ -78,7 +83,9 @@ TOP_KEYS = (
     "name", "convention", "angle_unit", "length_unit", "joint", "base", "tool", "example", "source",
     "ik",
 )  # fmt: skip
-IK_KEYS = ("free",)
+IK_KEYS = ("free", "structure_tol")
+# what [ik] structure_tol may be: beyond 0.1 rad or 0.1 of the arm's size it changes the arm
+STRUCTURE_TOL_RANGE = (0.0, 0.1)
 SOURCE_KEYS = ("urdf", "sha256", "base", "tip", "joints", "snaps", "deviation")
 # the text a [source] table may hold (it reaches the report, never the generated code)
 SOURCE_TEXT = re.compile(r"[A-Za-z0-9_ .,:;()+\-<>'=/]{1,200}")
@@ -166,6 +173,7 @@ class ArmSpec:
         source: the file the spec came from (for messages), or "<memory>".
         origin: the URDF the spec was converted from, or None.
         free: the joints (1-based, ascending) named free in [ik], or None (derive chooses).
+        structure_tol: [ik] structure_tol, or None (derive.nominal.STRUCTURE_TOL).
     """
 
     name: str
@@ -180,6 +188,7 @@ class ArmSpec:
     source: str = "<memory>"
     origin: Source | None = None
     free: tuple[int, ...] | None = None
+    structure_tol: float | None = None
 
     @property
     def dof(self) -> int:
@@ -221,8 +230,13 @@ class ArmSpec:
         }
         if self.origin is not None:  # (absent from the digests of specs without one)
             data["source"] = asdict(self.origin)
+        ik: dict[str, object] = {}
         if self.free is not None:  # (likewise)
-            data["ik"] = {"free": list(self.free)}
+            ik["free"] = list(self.free)
+        if self.structure_tol is not None:  # (likewise)
+            ik["structure_tol"] = self.structure_tol
+        if ik:
+            data["ik"] = ik
         return data
 
     def digest(self) -> str:
@@ -326,7 +340,22 @@ def _validate(data: dict, where: str) -> ArmSpec:
         where,
         _source(data.get("source"), where, len(joints)),
         _free(data.get("ik"), where, joints),
+        _structure_tol(data.get("ik"), where),
     )
+
+
+def _structure_tol(table: object, where: str) -> float | None:
+    """The optional [ik] structure_tol (the table itself is checked by _free)."""
+    if not isinstance(table, dict) or "structure_tol" not in table:
+        return None
+    value = table["structure_tol"]
+    lo, hi = STRUCTURE_TOL_RANGE
+    if type(value) not in (int, float) or not lo <= value <= hi:
+        raise SpecError(
+            f"{where}: ik.structure_tol: {str(value)[:40]} is not allowed; a number from "
+            f"{lo:g} to {hi:g} (radians for twists, a fraction of the arm's size for lengths)"
+        )
+    return float(value)
 
 
 def _free(table: object, where: str, joints: tuple[Joint, ...]) -> tuple[int, ...] | None:

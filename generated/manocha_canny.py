@@ -111,6 +111,8 @@ METHOD = "general"
 MAX_SOLUTIONS = 16
 # the joints (1-based) whose values the caller gives: ik(T, free=...)
 FREE = ()
+# how far the solver's equations may miss and still seed a refinement (0: exact arms)
+_SEED_TOL = 0.0
 # the arm's C solver, beside this file (with its .h; "": none): compiled on the first call
 _C_SOURCE = 'manocha_canny_ik.c'
 

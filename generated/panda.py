@@ -124,6 +124,8 @@ METHOD = "pieper"
 MAX_SOLUTIONS = 8
 # the joints (1-based) whose values the caller gives: ik(T, free=...)
 FREE = (7,)
+# how far the solver's equations may miss and still seed a refinement (0: exact arms)
+_SEED_TOL = 0.0
 # the arm's C solver, beside this file (with its .h; "": none): compiled on the first call
 _C_SOURCE = 'panda_ik.c'
 
@@ -1223,8 +1225,9 @@ def _free(t: float) -> _Free:
 
 def _cs1(a: float, b: float, e: float, scale: float = 0.0, ref: float = 0.0) -> tuple[float, ...]:
     """Angles t with a cos t + b sin t = e: atan2(b, a) +- acos(e / sqrt(a^2 + b^2)), the
-    acos argument clamped when it exceeds 1 by at most _CLAMP_TOL, and taken as +-1 within
-    _FOLD_TOL below (the double root).
+    acos argument clamped when it exceeds 1 by at most _CLAMP_TOL (and _SEED_TOL: a nominal
+    table's equation seeds the refinement onto the exact arm at its boundary), and taken as
+    +-1 within _FOLD_TOL below (the double root).
 
     When a^2 + b^2 and e^2 are both at most _FREE_TOL * scale the equation holds for every
     t (the angle is free; e.g. the elbow folded onto axis 1): _free(ref).
@@ -1235,7 +1238,7 @@ def _cs1(a: float, b: float, e: float, scale: float = 0.0, ref: float = 0.0) -> 
     if rho == 0.0:
         return ()
     ratio = e / rho
-    if abs(ratio) > 1.0 + _CLAMP_TOL:
+    if abs(ratio) > 1.0 + _CLAMP_TOL + _SEED_TOL:
         return ()
     base = atan2(b, a)
     if abs(ratio) >= 1.0 - _FOLD_TOL:
@@ -1382,6 +1385,13 @@ def _accept(p: list[float], zs: list[complex], check: bool = True) -> list[float
             return None
         out.append(x)
         k += 1
+    if _SEED_TOL:  # a nominal table's near-double root, split by the arm's difference
+        near = math.sqrt(_SEED_TOL)
+        out += [
+            z.real
+            for z in map(complex, zs)
+            if _ROOT_IMAG_TOL * (1.0 + abs(z)) < z.imag <= near * (1.0 + abs(z))
+        ]
     return out
 
 

@@ -9,6 +9,9 @@
 
 /* the size of the polynomial steps' arrays: the most roots one of this arm's polynomials has */
 #define DK_POLY_MAX 4
+/* how far the solver's equations may miss and still seed a refinement onto the exact chain
+   (0: the closed form solves the arm's own table) */
+#define DK_SEED_TOL (0.0)
 
 /* --- routines shared by every generated C solver (derive/c/, the ones this arm uses) ------- */
 
@@ -885,6 +888,15 @@ static int dk_accept(const double *p, int d, const dk_cx *zs, int m, int check, 
         }
         out[count++] = x;
     }
+    if (DK_SEED_TOL > 0.0) { /* a nominal near-double root, split by the arm's difference */
+        const double near = sqrt(DK_SEED_TOL);
+        for (k = 0; k < m; k++) {
+            const double size = 1.0 + dk_cx_abs(zs[k]);
+            if (zs[k].im > DK_ROOT_IMAG_TOL * size && zs[k].im <= near * size) {
+                out[count++] = zs[k].re;
+            }
+        }
+    }
     return count;
 }
 
@@ -1120,7 +1132,7 @@ static int dk_cs1(dk_values *v, double a, double b, double e, double scale, doub
     }
     inverse = 1.0 / rho;
     ratio = e * inverse;
-    if (fabs(ratio) > 1.0 + DK_CLAMP_TOL) {
+    if (fabs(ratio) > 1.0 + DK_CLAMP_TOL + DK_SEED_TOL) {
         return 0;
     }
     if (fabs(ratio) >= 1.0 - DK_FOLD_TOL) {

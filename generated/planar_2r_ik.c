@@ -9,6 +9,9 @@
 
 /* the size of the polynomial steps' arrays: the most roots one of this arm's polynomials has */
 #define DK_POLY_MAX 4
+/* how far the solver's equations may miss and still seed a refinement onto the exact chain
+   (0: the closed form solves the arm's own table) */
+#define DK_SEED_TOL (0.0)
 
 /* --- routines shared by every generated C solver (derive/c/, the ones this arm uses) ------- */
 
@@ -571,7 +574,7 @@ static int dk_cs1(dk_values *v, double a, double b, double e, double scale, doub
     }
     inverse = 1.0 / rho;
     ratio = e * inverse;
-    if (fabs(ratio) > 1.0 + DK_CLAMP_TOL) {
+    if (fabs(ratio) > 1.0 + DK_CLAMP_TOL + DK_SEED_TOL) {
         return 0;
     }
     if (fabs(ratio) >= 1.0 - DK_FOLD_TOL) {

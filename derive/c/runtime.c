@@ -916,6 +916,15 @@ static int dk_accept(const double *p, int d, const dk_cx *zs, int m, int check, 
         }
         out[count++] = x;
     }
+    if (DK_SEED_TOL > 0.0) { /* a nominal near-double root, split by the arm's difference */
+        const double near = sqrt(DK_SEED_TOL);
+        for (k = 0; k < m; k++) {
+            const double size = 1.0 + dk_cx_abs(zs[k]);
+            if (zs[k].im > DK_ROOT_IMAG_TOL * size && zs[k].im <= near * size) {
+                out[count++] = zs[k].re;
+            }
+        }
+    }
     return count;
 }
 
@@ -1151,7 +1160,7 @@ static int dk_cs1(dk_values *v, double a, double b, double e, double scale, doub
     }
     inverse = 1.0 / rho;
     ratio = e * inverse;
-    if (fabs(ratio) > 1.0 + DK_CLAMP_TOL) {
+    if (fabs(ratio) > 1.0 + DK_CLAMP_TOL + DK_SEED_TOL) {
         return 0;
     }
     if (fabs(ratio) >= 1.0 - DK_FOLD_TOL) {
@@ -1322,4 +1331,189 @@ static int dk_pose_ok(const double T[16])
     det = T[0] * (T[5] * T[10] - T[6] * T[9]) - T[1] * (T[4] * T[10] - T[6] * T[8]) +
           T[2] * (T[4] * T[9] - T[5] * T[8]);
     return ok && det > 0.0;
+}
+
+
+/* --- refinement onto the exact arm (derive/runtime/refine.py, which says why) ------------ */
+
+/* (the chain's DK_REFINE_N joints, DK_REFINE_M of them moved, and DK_REFINE_ROWS pose
+   components: the arm's, defined before the runtime) at most this many steps per candidate; a
+   step longer than DK_REFINE_STRIDE is shortened to it; done at DK_REFINE_DONE, given up after
+   DK_REFINE_PATIENCE steps in a row that do not reduce the error; the step from an error
+   within DK_REFINE_LAST (that reduced it) is the last */
+#define DK_REFINE_STEPS 30
+#define DK_REFINE_STRIDE (0.5)
+#define DK_REFINE_DONE (1e-14)
+#define DK_REFINE_PATIENCE 3
+#define DK_REFINE_LAST (1e-10)
+/* a refined row is kept if its pose error is within the smaller of this and ik's tol */
+#define DK_REFINE_TOL (1e-10)
+
+/* x := A^-1 x for the symmetric positive definite A, by Cholesky's factorisation in place; 0
+   where A is not positive definite */
+static int dk_cholesky_solve(double A[DK_REFINE_M][DK_REFINE_M], double x[DK_REFINE_M])
+{
+    int i, j, k;
+    for (j = 0; j < DK_REFINE_M; j++) {
+        double d = A[j][j];
+        for (k = 0; k < j; k++) {
+            d -= A[j][k] * A[j][k];
+        }
+        if (!(d > 0.0)) {
+            return 0;
+        }
+        A[j][j] = sqrt(d);
+        for (i = j + 1; i < DK_REFINE_M; i++) {
+            double v = A[i][j];
+            for (k = 0; k < j; k++) {
+                v -= A[i][k] * A[j][k];
+            }
+            A[i][j] = v / A[j][j];
+        }
+    }
+    for (i = 0; i < DK_REFINE_M; i++) { /* L y = x */
+        for (k = 0; k < i; k++) {
+            x[i] -= A[i][k] * x[k];
+        }
+        x[i] /= A[i][i];
+    }
+    for (i = DK_REFINE_M - 1; i >= 0; i--) { /* L^T x = y */
+        for (k = i + 1; k < DK_REFINE_M; k++) {
+            x[i] -= A[k][i] * x[k];
+        }
+        x[i] /= A[i][i];
+    }
+    return 1;
+}
+
+/* Newton's steps, damped by the error's square, on the chain of fixed frames (12 entries each:
+   T(q) = F_0 J_1(q_1) F_1 ... J_n(q_n) F_n) towards the pose t (12 top entries), moving the
+   joints in solved: q in place (the best point met); the pose error there (the largest
+   rotation entry's difference, unless DK_REFINE_ROWS is 3; positions / reach) */
+static double dk_refine(const double chain[DK_REFINE_N + 1][12], const int revolute[DK_REFINE_N],
+                        const int solved[DK_REFINE_M], double reach, const double t[12],
+                        double q[DK_REFINE_N])
+{
+    double cur[DK_REFINE_N], best = HUGE_VAL;
+    int worse = 0, last, it, i, r, c, k;
+    for (i = 0; i < DK_REFINE_N; i++) {
+        cur[i] = q[i];
+    }
+    for (it = 0; it < DK_REFINE_STEPS; it++) {
+        double pose[12], axes[DK_REFINE_N][3], origins[DK_REFINE_N][3], error[6];
+        double J[6][DK_REFINE_M], normal[DK_REFINE_M][DK_REFINE_M];
+        double step[DK_REFINE_M], size = 0.0, mu = 0.0, longest = 0.0;
+        for (k = 0; k < 12; k++) {
+            pose[k] = chain[0][k];
+        }
+        for (i = 0; i < DK_REFINE_N; i++) {
+            const double *f = chain[i + 1];
+            for (r = 0; r < 3; r++) {
+                axes[i][r] = pose[4 * r + 2];
+                origins[i][r] = pose[4 * r + 3];
+            }
+            if (revolute[i]) {
+                const double cq = cos(cur[i]), sq = sin(cur[i]);
+                for (r = 0; r < 3; r++) {
+                    const double x = pose[4 * r], y = pose[4 * r + 1];
+                    pose[4 * r] = cq * x + sq * y;
+                    pose[4 * r + 1] = cq * y - sq * x;
+                }
+            } else {
+                for (r = 0; r < 3; r++) {
+                    pose[4 * r + 3] += cur[i] * pose[4 * r + 2];
+                }
+            }
+            for (r = 0; r < 3; r++) { /* pose := pose F_{i+1} */
+                const double p0 = pose[4 * r], p1 = pose[4 * r + 1], p2 = pose[4 * r + 2];
+                for (c = 0; c < 4; c++) {
+                    pose[4 * r + c] = p0 * f[c] + p1 * f[4 + c] + p2 * f[8 + c] +
+                                      (c == 3 ? pose[4 * r + 3] : 0.0);
+                }
+            }
+        }
+        for (r = 0; r < 3; r++) {
+            int a = (r + 1) % 3, b = (r + 2) % 3;
+            double total = 0.0;
+            error[r] = (t[4 * r + 3] - pose[4 * r + 3]) / reach;
+            size = fabs(error[r]) > size ? fabs(error[r]) : size;
+            for (k = 0; k < 3; k++) {
+                total += pose[4 * a + k] * t[4 * b + k] - pose[4 * b + k] * t[4 * a + k];
+                if (DK_REFINE_ROWS == 6) {
+                    const double gap = fabs(t[4 * r + k] - pose[4 * r + k]);
+                    size = gap > size ? gap : size;
+                }
+            }
+            error[3 + r] = 0.5 * total;
+        }
+        if (size < best) {
+            best = size;
+            worse = 0;
+            for (i = 0; i < DK_REFINE_N; i++) {
+                q[i] = cur[i];
+            }
+        } else { /* (near a singular configuration the error can grow before it converges) */
+            worse++;
+        }
+        if (size <= DK_REFINE_DONE || worse == DK_REFINE_PATIENCE) {
+            break;
+        }
+        last = size <= DK_REFINE_LAST && worse == 0;
+        for (k = 0; k < DK_REFINE_M; k++) {
+            const int j = solved[k];
+            const double *z = axes[j];
+            if (revolute[j]) {
+                const double dx = pose[3] - origins[j][0], dy = pose[7] - origins[j][1];
+                const double dz = pose[11] - origins[j][2];
+                J[0][k] = (z[1] * dz - z[2] * dy) / reach;
+                J[1][k] = (z[2] * dx - z[0] * dz) / reach;
+                J[2][k] = (z[0] * dy - z[1] * dx) / reach;
+                J[3][k] = z[0];
+                J[4][k] = z[1];
+                J[5][k] = z[2];
+            } else {
+                for (r = 0; r < 3; r++) {
+                    J[r][k] = z[r] / reach;
+                    J[3 + r][k] = 0.0;
+                }
+            }
+        }
+        for (r = 0; r < DK_REFINE_ROWS; r++) {
+            mu += error[r] * error[r];
+        }
+        for (i = 0; i < DK_REFINE_M; i++) { /* (J^T J + mu) step = J^T error */
+            step[i] = 0.0;
+            for (r = 0; r < DK_REFINE_ROWS; r++) {
+                step[i] += J[r][i] * error[r];
+            }
+            for (c = 0; c <= i; c++) {
+                double v = 0.0;
+                for (r = 0; r < DK_REFINE_ROWS; r++) {
+                    v += J[r][i] * J[r][c];
+                }
+                normal[i][c] = normal[c][i] = v;
+            }
+            normal[i][i] += mu;
+        }
+        if (!dk_cholesky_solve(normal, step)) {
+            break;
+        }
+        for (k = 0; k < DK_REFINE_M; k++) {
+            longest = fabs(step[k]) > longest ? fabs(step[k]) : longest;
+        }
+        if (!(longest < HUGE_VAL)) {
+            break;
+        }
+        for (k = 0; k < DK_REFINE_M; k++) {
+            cur[solved[k]] += longest > DK_REFINE_STRIDE ? step[k] * (DK_REFINE_STRIDE / longest)
+                                                         : step[k];
+        }
+        if (last) { /* (Newton's step from there: the error squared, not measured) */
+            for (i = 0; i < DK_REFINE_N; i++) {
+                q[i] = cur[i];
+            }
+            break;
+        }
+    }
+    return best;
 }

@@ -6,6 +6,10 @@
 #include <stddef.h>
 
 #define DK_POLY_MAX 6
+#define DK_SEED_TOL (0.0)
+#define DK_REFINE_N 2
+#define DK_REFINE_M 2
+#define DK_REFINE_ROWS 6
 
 #define DK_RR_SPLIT_COUNT 1
 #define DK_RR_LENGTH (1.0)

@@ -258,17 +258,20 @@ def solve_lines(plan: Plan) -> tuple[tuple[int, str], ...]:
         key=lambda s: int(s[2:]),
     )
     body = [_assign(r, f"ref[{int(r[2:]) - 1}]", 0, scope) for r in refs] + body
-    body += [Line(0, "const double ptol = tol * DK_REACH;"), Line(0, "int n = 0;")]
+    fix = plan.correction is not None
+    if not fix:
+        body.append(Line(0, "const double ptol = tol * DK_REACH;"))
+    body.append(Line(0, "int n = 0;"))
     # whether two rows can repeat: where two values of one step lie within DK_DEDUP_TOL (or
-    # always, where a row's joints are not the steps' values themselves)
-    body.append(Line(0, f"int dk_close = {0 if branches_are_outputs(plan) else 1};"))
+    # always, where a row's joints are not the steps' values themselves, or are refined)
+    body.append(Line(0, f"int dk_close = {0 if branches_are_outputs(plan) and not fix else 1};"))
     depth = 0
     closing: list[Line] = []
     # lines ending a loop's body, before its free-joint check (by the loop's closing line)
     endings: dict[int, list[Line]] = {}
     flip = wrist_flip(plan)
-    seamed = seamed_outputs(plan)
-    hoisted = HoistedFK.of(plan) if same_joints(plan) else None
+    seamed = seamed_outputs(plan) if not fix else frozenset()
+    hoisted = HoistedFK.of(plan) if same_joints(plan) and not fix else None
     for live in steps:
         step = live.step
         if isinstance(step, Assign):
@@ -361,18 +364,33 @@ def solve_lines(plan: Plan) -> tuple[tuple[int, str], ...]:
             ]
         depth += 1
     outputs = [printer.doprint(e) for e in plan.ik.outputs]
-    if hoisted is not None:
+    if fix:  # refined onto the exact chain, certified there
+        body.append(Line(depth, "if (n < DK_MAX) {"))
+        body.append(Line(depth + 1, f"double dk_q[DK_DOF] = {{{', '.join(outputs)}}};"))
+        body.append(
+            Line(
+                depth + 1,
+                "if (dk_refine(DK_CHAIN, DK_REVOLUTE, DK_SOLVED, DK_REACH, t, dk_q) <= "
+                "fmin(tol, DK_REFINE_TOL)) {",
+            )
+        )
+        body += [Line(depth + 2, f"found[n][{k}] = dk_q[{k}];") for k in range(len(outputs))]
+        body.append(Line(depth + 2, "n++;"))
+        body.append(Line(depth + 1, "}"))
+        body.append(Line(depth, "}"))
+    elif hoisted is not None:
         body += hoisted.ready(set(cs_arguments(plan).split(", ")), depth, printer)
         entries = ", ".join(f"dk_e{k}" for k in range(12))
         body.append(Line(depth, f"const double e[12] = {{{entries}}};"))
     else:
         body.append(Line(depth, "double e[12];"))
         body += _arm_cs_lines(plan, printer, depth, scope)
-    position = "1" if plan.ik.certify == "position" else "0"
-    body.append(Line(depth, f"if (n < DK_MAX && dk_match(e, t, tol, ptol, {position})) {{"))
-    body += [Line(depth + 1, f"found[n][{k}] = {v};") for k, v in enumerate(outputs)]
-    body.append(Line(depth + 1, "n++;"))
-    body.append(Line(depth, "}"))
+    if not fix:
+        position = "1" if plan.ik.certify == "position" else "0"
+        body.append(Line(depth, f"if (n < DK_MAX && dk_match(e, t, tol, ptol, {position})) {{"))
+        body += [Line(depth + 1, f"found[n][{k}] = {v};") for k, v in enumerate(outputs)]
+        body.append(Line(depth + 1, "n++;"))
+        body.append(Line(depth, "}"))
     for line in reversed(closing):
         body += endings.get(id(line), [])
         if line.text:  # a free joint's loop ends at its first value that gave a solution

@@ -72,7 +72,9 @@ def ik_lines(plan: Plan) -> tuple[tuple[int, str], ...]:
             loops.append((depth, step.joint))
         depth += 1
     outputs = ", ".join(printer.doprint(e) for e in plan.ik.outputs)
-    if same_joints(plan):
+    if plan.correction is not None:  # refined onto the exact chain, certified there
+        lines.append(Line(depth, f"_seed(found, target, ({outputs},), tol)"))
+    elif same_joints(plan):
         fk = f"_fk_from_cs({cs_arguments(plan)})"
         lines.append(Line(depth, f"_keep(found, target, ({outputs},), {fk}, tol)"))
     else:

@@ -22,6 +22,8 @@ Modules, in copy order:
                steps, the free-joint reach searches)
 ``general``    the general 6R method in the Python solver (numpy's eigensolver)
 ``scalar``     the Python solver's step routines (``a cos + b sin = e``, polynomials)
+``refine``     Newton's steps onto the exact chain, for an arm whose closed form solves a
+               nominal table near its own (derive/nominal.py)
 =============  ==========================================================================
 
 ``arm`` is never copied: it stands in for the names each generated module prints for its
@@ -29,5 +31,5 @@ arm (DOF, LIMITS, the forward kinematics, the solver bodies), so that this packa
 """
 
 MODULES = (
-    "constants", "native", "api", "common", "redundant", "closed", "general", "scalar",
+    "constants", "native", "api", "common", "redundant", "closed", "general", "scalar", "refine",
 )  # fmt: skip

@@ -26,6 +26,17 @@ FREE: tuple[int, ...] = ()
 # "pose" or "position": what certification compares
 IK_COMPONENTS = "pose"
 _REVOLUTE = (True, False)
+# how far the solver's equations may miss and still seed a refinement onto the exact chain
+# (0.0: the closed form solves the arm's own table)
+_SEED_TOL = 0.0
+# the exact chain's fixed frames (top three rows, row-major) and the joints (0-based) the
+# refinement moves: derive/runtime/refine.py
+_CHAIN: tuple[tuple[float, ...], ...] = (
+    (1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0),
+    (1.0, 0.0, 0.0, 0.5, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0),
+    (1.0, 0.0, 0.0, 0.5, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0),
+)
+_SOLVED: tuple[int, ...] = (0, 1)
 # the arm's C solver, beside the module ("" where the arm has none): derive/runtime/native.py
 _C_SOURCE = ""
 

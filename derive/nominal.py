@@ -1,0 +1,152 @@
+"""The nominal arm of an exact one: the table a closed form solves, and how far it is.
+
+Real arms are never exactly special: a calibration moves every DH parameter a little, a URDF
+writes pi/2 as 1.5708. Their tables have no closed form, but a table a little away does. The
+nominal table snaps each parameter that shapes the structure to the special value within the
+structure tolerance (spec `[ik] structure_tol`): twists alpha (and a prismatic joint's fixed
+theta) to a multiple of 90 deg within `tol` radians, lengths a (and a revolute joint's d) to 0
+within `tol` times the arm's size. Joint offsets (a revolute joint's theta, a prismatic one's
+d), the base and the tool do not shape the structure and are kept.
+
+The generated module solves the nominal table in closed form and refines every solution by
+Newton's steps on the exact chain (derive/runtime/refine.py, dk_refine in derive/c/runtime.c),
+which it holds as fixed frames: T(q) = F_0 J_1(q_1) F_1 ... J_n(q_n) F_n with J_i a rotation
+about (R) or a translation along (P) the z axis (docs/algorithms.md, "Nominal closed form,
+exact answers").
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, replace
+
+import numpy as np
+import sympy as sp
+
+from derive.spec import ArmSpec, Joint
+from derive.transforms import Chain, rot_z, trans, x_factor
+
+# the default structure tolerance: a calibration moves twists by ~0.02 deg (3.5e-4 rad) and
+# lengths by ~0.2 mm of a 1 m arm; a URDF's 1.5708 is 3.7e-6 from pi/2
+STRUCTURE_TOL = 1e-3
+# joint vectors the nominal table's forward kinematics is compared with the exact one's on
+SAMPLES = 256
+
+
+@dataclass(frozen=True)
+class Nominal:
+    """The nominal table of an arm and what snapping changed.
+
+    Attributes:
+        spec: the arm with the snapped table (the closed form's).
+        changes: one line per snapped parameter ("row 2 alpha: 0.02 deg to 0 deg").
+        tol: the structure tolerance used.
+    """
+
+    spec: ArmSpec
+    changes: tuple[str, ...]
+    tol: float
+
+
+def nominal(spec: ArmSpec, tol: float = STRUCTURE_TOL) -> Nominal:
+    """The spec with every structure parameter within tol of its special value snapped."""
+    size = sum(abs(j.a) + abs(j.d) for j in spec.joints) or 1.0
+    quarter = 90.0 if spec.angle_unit == "deg" else math.pi / 2
+    to_rad = math.radians if spec.angle_unit == "deg" else float
+    unit = "deg" if spec.angle_unit == "deg" else "rad"
+    changes: list[str] = []
+    joints: list[Joint] = []
+
+    def angle(value: float, what: str) -> float:
+        target = quarter * round(value / quarter)
+        if value != target and abs(to_rad(value - target)) <= tol:
+            changes.append(f"{what}: {value!r} {unit} to {target:g} {unit}")
+            return float(target)
+        return value
+
+    def length(value: float, what: str) -> float:
+        if value != 0.0 and abs(value) <= tol * size:
+            changes.append(f"{what}: {value!r} to 0")
+            return 0.0
+        return value
+
+    for i, j in enumerate(spec.joints, start=1):
+        row = f"row {i}"
+        alpha = angle(j.alpha, f"{row} alpha")
+        a = length(j.a, f"{row} a")
+        if j.kind == "R":
+            joints.append(replace(j, alpha=alpha, a=a, d=length(j.d, f"{row} d")))
+        else:
+            joints.append(replace(j, alpha=alpha, a=a, theta=angle(j.theta, f"{row} theta")))
+    return Nominal(replace(spec, joints=tuple(joints)), tuple(changes), tol)
+
+
+def chain_frames(chain: Chain) -> tuple[tuple[float, ...], ...]:
+    """The fixed frames F_0 .. F_n of the chain, 12 floats each (the top three rows,
+    row-major): T(q) = F_0 J_1(q_1) F_1 ... J_n(q_n) F_n, J_i = Rz(q_i) (R) or Tz(q_i) (P).
+
+    The canonical chain is B X_0 Z_1 X_1 ... Z_n X_n E with Z_i = Rz(theta_i) Tz(d_i); Z_i at
+    q_i = 0 times J_i(q_i) is Z_i (Rz and Tz commute), so F_0 = B X_0 Z_1(0),
+    F_i = X_i Z_{i+1}(0) and F_n = X_n E."""
+    at_zero = []
+    for j in chain.joints:
+        if j.kind == "R":
+            at_zero.append(rot_z(*_cos_sin(j.offset)) * trans(0, 0, j.d))
+        else:
+            at_zero.append(rot_z(*_cos_sin(j.theta)) * trans(0, 0, j.offset))
+    n = chain.dof
+    frames = []
+    for i in range(n + 1):
+        m = x_factor(chain.twists[i])
+        if i == 0:
+            m = chain.base * m
+        if i < n:
+            m = m * at_zero[i]
+        else:
+            m = m * chain.tool
+        frames.append(tuple(float(sp.N(m[r, c], 30)) for r in range(3) for c in range(4)))
+    return tuple(frames)
+
+
+def _cos_sin(angle: sp.Expr) -> tuple[sp.Expr, sp.Expr]:
+    return sp.cos(angle), sp.sin(angle)
+
+
+def frames_fk(frames: tuple[tuple[float, ...], ...], kinds: str, Q: np.ndarray) -> np.ndarray:
+    """World poses (N, 4, 4) of joint vectors Q (N, n) on a chain of fixed frames."""
+    out = np.broadcast_to(_square(frames[0]), (len(Q), 4, 4)).copy()
+    for i, kind in enumerate(kinds):
+        q = Q[:, i]
+        joint = np.zeros((len(Q), 4, 4))
+        joint[:, 2, 2] = joint[:, 3, 3] = 1.0
+        if kind == "R":
+            c, s = np.cos(q), np.sin(q)
+            joint[:, 0, 0] = joint[:, 1, 1] = c
+            joint[:, 0, 1] = -s
+            joint[:, 1, 0] = s
+        else:
+            joint[:, 0, 0] = joint[:, 1, 1] = 1.0
+            joint[:, 2, 3] = q
+        out = out @ joint @ _square(frames[i + 1])
+    return out
+
+
+def _square(frame: tuple[float, ...]) -> np.ndarray:
+    return np.array([*np.reshape(frame, (3, 4)), (0.0, 0.0, 0.0, 1.0)])
+
+
+def deviation(
+    exact: tuple[tuple[float, ...], ...],
+    snapped: tuple[tuple[float, ...], ...],
+    kinds: str,
+    reach: float,
+) -> float:
+    """The largest forward-kinematics difference of two chains over SAMPLES joint vectors
+    (a fixed seed): rotation entries as they are, positions divided by reach."""
+    rng = np.random.default_rng(0)
+    Q = rng.uniform(-math.pi, math.pi, (SAMPLES, len(kinds)))
+    Q[:, [k for k, kind in enumerate(kinds) if kind == "P"]] *= reach / math.pi
+    a, b = frames_fk(exact, kinds, Q), frames_fk(snapped, kinds, Q)
+    rotation = np.max(np.abs(a[:, :3, :3] - b[:, :3, :3]))
+    position = np.max(np.abs(a[:, :3, 3] - b[:, :3, 3])) / reach
+    return float(max(rotation, position))

@@ -1,0 +1,191 @@
+"""Calibrated arms: a nominal closed form, answers refined onto the exact table
+(derive/nominal.py, derive/runtime/refine.py, dk_refine in derive/c/runtime.c)."""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+
+import numpy as np
+import pytest
+
+from derive.nominal import chain_frames, frames_fk, nominal
+from derive.pipeline import build_plan
+from derive.spec import SpecError, load_spec, parse_spec
+from derive.transforms import chain_from_spec
+
+from conftest import build_module, needs_cc
+
+# public standard-DH tables (alpha deg, a m, d m, theta deg): UR5 (Universal Robots' DH
+# parameters page), KUKA KR6 R900 sixx (its data sheet's dimensions), PUMA 560 (the course
+# project's, derive/arms/puma560.toml)
+TABLES = {
+    "ur5": [
+        (90, 0, 0.089159, 0),
+        (0, -0.425, 0, 0),
+        (0, -0.39225, 0, 0),
+        (90, 0, 0.10915, 0),
+        (-90, 0, 0.09465, 0),
+        (0, 0, 0.0823, 0),
+    ],
+    "kr6": [
+        (-90, 0.025, 0.4, 0),
+        (0, 0.455, 0, 0),
+        (-90, 0.035, 0, 0),
+        (90, 0, 0.42, 0),
+        (-90, 0, 0, 0),
+        (0, 0, 0.08, 0),
+    ],
+    "puma": [
+        (-90, 0, 0, 0),
+        (0, 0.432, 0, 0),
+        (90, -0.02, 0.149, 0),
+        (-90, 0, 0.433, 0),
+        (90, 0, 0, 0),
+        (0, 0, 0, 0),
+    ],
+}
+METHODS = {"ur5": "three-parallel", "kr6": "pieper", "puma": "pieper"}
+
+
+def calibrated(name: str, seed: int = 7) -> str:
+    """The arm's spec with every parameter moved as a calibration moves it: alpha and theta
+    by up to 0.02 deg, a and d by up to 0.2 mm."""
+    rng = np.random.default_rng(seed)
+    rows = []
+    for alpha, a, d, theta in TABLES[name]:
+        da, dt = (float(x) for x in rng.uniform(-0.02, 0.02, 2))
+        la, ld = (float(x) for x in rng.uniform(-2e-4, 2e-4, 2))
+        rows.append(
+            f'[[joint]]\ntype = "R"\nalpha = {alpha + da!r}\na = {a + la!r}\n'
+            f"d = {d + ld!r}\ntheta = {theta + dt!r}\nlimits = [-180.0, 180.0]\n"
+        )
+    head = f'name = "{name}_cal"\nconvention = "standard"\nangle_unit = "deg"\nlength_unit = "m"\n'
+    return head + "\n".join(rows)
+
+
+def test_nominal_snaps_the_structure_parameters_within_the_tolerance_only():
+    spec = parse_spec(calibrated("puma"), "<test>")
+    near = nominal(spec, 1e-3)
+    for exact, snapped in zip(spec.joints, near.spec.joints):
+        assert snapped.alpha % 90.0 == 0.0 and abs(snapped.alpha - exact.alpha) <= 0.02
+        assert snapped.a in (0.0, exact.a) and snapped.d in (0.0, exact.d)
+        assert snapped.theta == exact.theta  # a revolute joint's offset shapes nothing
+    assert len(near.changes) >= 6 and all(": " in line for line in near.changes)
+    assert nominal(spec, 0.0).changes == ()
+    # the shoulder offset d = 0.149 and the link lengths are not small: kept
+    assert near.spec.joints[2].d == spec.joints[2].d and near.spec.joints[1].a == spec.joints[1].a
+
+
+def test_the_chain_of_fixed_frames_is_the_table_s_forward_kinematics(generated):
+    for name in ("puma560", "iiwa14", "lecture_6r"):
+        module = generated(name)
+        spec = load_spec(f"derive/arms/{name}.toml")
+        Q = np.random.default_rng(1).uniform(-3, 3, (50, module.DOF))
+        frames = chain_frames(chain_from_spec(spec))
+        assert np.allclose(frames_fk(frames, spec.joint_types, Q), module.fk_batch(Q), atol=1e-12)
+
+
+@pytest.mark.parametrize(
+    ("value", "ok"), [(0.0, True), (1e-4, True), (-1e-3, False), (0.5, False), ('"x"', False)]
+)
+def test_structure_tol_is_checked(value, ok):
+    text = calibrated("ur5") + f"\n[ik]\nstructure_tol = {value}\n"
+    if ok:
+        assert parse_spec(text, "<t>").structure_tol == float(value)
+    else:
+        with pytest.raises(SpecError, match=r"ik\.structure_tol: .* is not allowed; a number"):
+            parse_spec(text, "<t>")
+
+
+def test_a_calibrated_arm_gets_its_nominal_closed_form_and_the_exact_table():
+    spec = parse_spec(calibrated("ur5"), "<test>")
+    plan = build_plan(spec)
+    assert plan.ik is not None and plan.ik.method == "three-parallel"
+    assert plan.correction is not None
+    assert 1e-6 < plan.correction.deviation < 1e-2
+    assert plan.structure[0].endswith("(nominal table)")
+    # the module's table is the spec's, exact
+    assert plan.arm.dh[1][0] == math.radians(spec.joints[1].alpha)
+
+
+def _scaled_jacobian_sigma(module, q: np.ndarray) -> float:
+    pose, axes, origins = module._chain_pose(q)
+    J = np.zeros((6, len(module._SOLVED)))
+    for k, i in enumerate(module._SOLVED):
+        J[:3, k] = np.cross(axes[i], pose[:3, 3] - origins[i]) / module.REACH
+        J[3:, k] = axes[i]
+    return float(np.linalg.svd(J, compute_uv=False)[-1])
+
+
+def _round_trips(module, backend: str, n: int) -> tuple[int, int, int, float]:
+    """(regular samples, those whose joint vector was missed, samples answered with
+    nothing, the worst row's pose error)."""
+    rng = np.random.default_rng(3)
+    regular = missed = empty = 0
+    worst = 0.0
+    for _ in range(n):
+        q = rng.uniform(-math.pi, math.pi, module.DOF)
+        T = module.fk(q)
+        rows = module.ik(T, backend=backend)
+        if len(rows) == 0:
+            empty += 1
+        for row in rows:
+            E = module.fk(row)
+            worst = max(
+                worst,
+                np.max(np.abs(E[:3, :3] - T[:3, :3])),
+                np.max(np.abs(E[:3, 3] - T[:3, 3])) / module.REACH,
+            )
+        if _scaled_jacobian_sigma(module, q) >= 0.05:  # regular (the tool moves every way)
+            regular += 1
+            gaps = np.abs(np.remainder(rows - q + math.pi, 2 * math.pi) - math.pi)
+            missed += not bool(len(rows)) or bool(np.min(np.max(gaps, axis=1)) > 1e-8)
+    return regular, missed, empty, worst
+
+
+@pytest.mark.parametrize("name", sorted(TABLES))
+def test_calibrated_arms_answer_exactly_in_python(name, tmp_path):
+    module = build_module(calibrated(name), tmp_path)
+    assert METHODS[name] == module.METHOD and module.NOMINAL_DEVIATION > 0
+    regular, missed, empty, worst = _round_trips(module, "python", 150)
+    assert regular >= 50
+    assert missed == 0
+    assert worst <= 1e-10
+    # at most a few samples near a singular configuration go unanswered (measured: 0-2 of
+    # 300; the closing note of issue 39 says which)
+    assert empty <= 3
+
+
+@needs_cc
+@pytest.mark.parametrize("name", sorted(TABLES))
+def test_calibrated_arms_answer_exactly_in_c_as_in_python(name, tmp_path):
+    module = build_module(calibrated(name), tmp_path, c=True)
+    regular, missed, empty, worst = _round_trips(module, "c", 600)
+    assert regular >= 200 and missed == 0 and worst <= 1e-10 and empty <= 6
+    rng = np.random.default_rng(5)
+    for q in rng.uniform(-math.pi, math.pi, (200, module.DOF)):
+        T = module.fk(q)
+        a, b = module.ik(T, backend="c"), module.ik(T, backend="python")
+        assert a.shape == b.shape
+        assert np.allclose(a, b, atol=1e-9)
+
+
+@needs_cc
+def test_a_calibrated_wrist_at_its_nominal_singularity_is_answered(tmp_path):
+    module = build_module(calibrated("puma"), tmp_path, c=True)
+    rng = np.random.default_rng(11)
+    for q in rng.uniform(-2.5, 2.5, (100, 6)):
+        q[4] = 0.0  # the nominal wrist's singular configuration (theta5 = 0)
+        T = module.fk(q)
+        for backend in ("c", "python"):
+            rows = module.ik(T, backend=backend)
+            assert len(rows) > 0
+            for row in rows:
+                assert np.max(np.abs(module.fk(row) - T)) <= 1e-10
+
+
+def test_structure_tol_zero_keeps_the_exact_table_and_no_correction():
+    spec = parse_spec(calibrated("ur5") + "\n[ik]\nstructure_tol = 0.0\n", "<test>")
+    plan = build_plan(dataclasses.replace(spec), method="three-parallel")
+    assert plan.ik is None and plan.correction is None
