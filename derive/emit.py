@@ -214,15 +214,19 @@ def correction_text(plan: Plan) -> str:
     if fix is None:
         return ""
     return (
-        "Exact answers from a nominal closed form: the table above is not exactly special, "
-        f"but within the structure tolerance {fix.tol:g} of NOMINAL_DH ({len(fix.changes)} "
-        "parameters snapped; forward kinematics differ by up to NOMINAL_DEVIATION = "
-        f"{fix.deviation:.2g}). The closed form solves NOMINAL_DH and Newton's steps refine "
-        "every solution onto this arm's exact chain (_CHAIN); fk, and the certification of "
-        "every row, are this arm's. Rows keep the nominal arm's branch order. An arm this "
-        "close to a special one can have more real solutions than it near some poses; those "
-        "the nominal arm lacks are not returned (derive generate --method general gives the "
-        "complete set, slower)."
+        "Exact answers from a nominal table: the solver above solves NOMINAL_DH "
+        + (
+            f"(the table snapped within the structure tolerance {fix.tol:g}: "
+            f"{len(fix.changes)} parameters)"
+            if fix.changes
+            else "(the table above, fitted to the URDF's frames)"
+        )
+        + ", whose forward kinematics differ from this arm's exact chain (_CHAIN) by up to "
+        f"NOMINAL_DEVIATION = {fix.deviation:.2g}. Newton's steps refine every solution onto "
+        "_CHAIN; fk, and the certification of every row, are the exact chain's. Rows keep the "
+        "nominal arm's branch order. An arm this close to a special one can have more real "
+        "solutions than it near some poses; those the nominal arm lacks are not returned "
+        "(derive generate --method general gives the complete set, slower)."
     )
 
 

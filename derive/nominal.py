@@ -23,6 +23,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 import sympy as sp
 
+from derive import symbols as sym
 from derive.spec import ArmSpec, Joint
 from derive.transforms import Chain, rot_z, trans, x_factor
 
@@ -106,6 +107,37 @@ def chain_frames(chain: Chain) -> tuple[tuple[float, ...], ...]:
             m = m * chain.tool
         frames.append(tuple(float(sp.N(m[r, c], 30)) for r in range(3) for c in range(4)))
     return tuple(frames)
+
+
+def frames_pose(frames: tuple[tuple[float, ...], ...], chain: Chain) -> sp.Matrix:
+    """The world pose of a chain of fixed frames in the joint symbols of chain (c_i, s_i of
+    theta_i = q_i + offset, or d_i = q_i + offset): F_0 Z_1 G_1 ... Z_n G_n with Z_i the joint's
+    Rz(theta_i) or Tz(d_i) and G_i = Rz(-offset_i) F_i or Tz(-offset_i) F_i (unexpanded: CSE
+    prints it in fewer operations)."""
+    out = _exact_matrix(_square(frames[0]))
+    for j, frame in zip(chain.joints, frames[1:]):
+        offset = float(j.offset)
+        if j.kind == "R":
+            c, s = math.cos(-offset), math.sin(-offset)
+            undo = np.array([[c, -s, 0, 0], [s, c, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1.0]])
+            move = rot_z(sym.c(j.index), sym.s(j.index))
+        else:
+            undo = np.eye(4)
+            undo[2, 3] = -offset
+            move = trans(0, 0, sym.d(j.index))
+        out = out * move * _exact_matrix(undo @ _square(frame))
+    return out
+
+
+def _exact_matrix(m: np.ndarray) -> sp.Matrix:
+    """A numeric 4x4 as SymPy numbers: 0 and 1 exact, the rest 17-digit floats."""
+
+    def number(v: float) -> sp.Expr:
+        if v in (0.0, 1.0, -1.0):
+            return sp.Integer(int(v))
+        return sp.Float(float(v), 17)
+
+    return sp.Matrix(4, 4, [number(v) for v in m.reshape(-1)])
 
 
 def _cos_sin(angle: sp.Expr) -> tuple[sp.Expr, sp.Expr]:

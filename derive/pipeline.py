@@ -10,7 +10,14 @@ from derive import free
 from derive import symbols as sym
 from derive.classify import Structure, classify
 from derive.methods import general, parallel, pieper, planar
-from derive.nominal import STRUCTURE_TOL, Nominal, chain_frames, deviation, nominal
+from derive.nominal import (
+    STRUCTURE_TOL,
+    Nominal,
+    chain_frames,
+    deviation,
+    frames_pose,
+    nominal,
+)
 from derive.plan import ArmInfo, Correction, IkPlan, Plan
 from derive.spec import ArmSpec
 from derive.transforms import Chain, chain_from_spec, frame_matrix, link_transform, world_transform
@@ -39,6 +46,8 @@ def build_plan(spec: ArmSpec, method: str | None = None) -> Plan:
         raise ValueError(f"no method {method!r}; methods: {', '.join(METHODS)}")
     names = (method,) if method else tuple(METHODS)
     closed = tuple(name for name in names if name != general.NAME)
+    # the exact geometry: the spec's [exact] frames (a URDF's), else its table's
+    frames = spec.exact if spec.exact is not None else chain_frames(chain)
     ik, refusal = choose(chain, structure, spec.free, closed)
     correction = None
     facts = structure.describe(chain.dof)
@@ -51,7 +60,7 @@ def build_plan(spec: ArmSpec, method: str | None = None) -> Plan:
             near_ik, _ = choose(near_chain, near_structure, spec.free, closed)
             if near_ik is not None:
                 ik, refusal = near_ik, ""
-                correction = make_correction(spec, chain, near, near_chain)
+                correction = make_correction(near, near_chain, frames)
                 facts = tuple(
                     f"{fact} (nominal table)" for fact in near_structure.describe(chain.dof)
                 )
@@ -59,10 +68,18 @@ def build_plan(spec: ArmSpec, method: str | None = None) -> Plan:
         ik, why = choose(chain, structure, spec.free, (general.NAME,))
         reasons = [r for r in (refusal, why) if r]
         refusal = "; ".join(dict.fromkeys(reasons)) if ik is None else ""
+    if ik is not None and correction is None and spec.exact is not None:
+        # the table is the nominal one of the [exact] frames (a URDF's, snapped)
+        correction = make_correction(Nominal(spec, (), 0.0), chain, frames)
+        if correction.deviation <= EXACT_ENOUGH:
+            correction = None
+    pose = world_transform(chain, expand=False)
+    if spec.exact is not None:
+        pose = frames_pose(spec.exact, chain)
     return Plan(
         arm=arm_info(spec, chain),
         structure=facts,
-        fk_pose=world_transform(chain, expand=False),
+        fk_pose=pose,
         links=tuple(link_transform(chain, i) for i in range(1, chain.dof + 1)),
         joint_defs=joint_definitions(chain),
         ik=ik,
@@ -88,11 +105,16 @@ SEED_FACTOR = 100.0
 SEED_MAX = 0.1
 
 
-def make_correction(spec: ArmSpec, chain: Chain, near: Nominal, near_chain: Chain) -> Correction:
-    """How the nominal table's answers are refined onto the arm's (derive/nominal.py)."""
+# a table within this of its exact frames (rounding) needs no refinement
+EXACT_ENOUGH = 1e-13
+
+
+def make_correction(
+    near: Nominal, near_chain: Chain, frames: tuple[tuple[float, ...], ...]
+) -> Correction:
+    """How the nominal table's answers are refined onto the exact frames (derive/nominal.py)."""
     info = arm_info(near.spec, near_chain)
-    frames = chain_frames(chain)
-    moved = deviation(frames, chain_frames(near_chain), spec.joint_types, info.reach)
+    moved = deviation(frames, chain_frames(near_chain), near.spec.joint_types, info.reach)
     return Correction(
         nominal_dh=info.dh,
         changes=near.changes,

@@ -31,6 +31,12 @@ Spec format (all keys other than those listed are errors)::
                                 # are taken as special to choose a closed form, whose
                                 # answers are then refined onto the exact table
                                 # (derive/nominal.py); 0: only exact special values
+    [exact]                     # optional (derive import-urdf writes it): the arm's exact
+    frames = [[...], ...]       # geometry as n + 1 fixed frames, 12 numbers each (the top
+                                # three rows of F_i, row-major; lengths in length_unit):
+                                # T(q) = F_0 J_1(q_1) F_1 ... J_n(q_n) F_n, J_i = Rz(q_i)
+                                # (R) or Tz(q_i) (P). The table above is then the nominal
+                                # one the closed form solves; fk is the frames'
 """
 
 from __future__ import annotations
@@ -81,6 +87,7 @@ SHADOWED_MODULES = frozenset(
 )
 TOP_KEYS = (
     "name", "convention", "angle_unit", "length_unit", "joint", "base", "tool", "example", "source",
+    "exact",
     "ik",
 )  # fmt: skip
 IK_KEYS = ("free", "structure_tol")
@@ -174,6 +181,7 @@ class ArmSpec:
         origin: the URDF the spec was converted from, or None.
         free: the joints (1-based, ascending) named free in [ik], or None (derive chooses).
         structure_tol: [ik] structure_tol, or None (derive.nominal.STRUCTURE_TOL).
+        exact: [exact] frames (n + 1 tuples of 12 floats), or None (the table is exact).
     """
 
     name: str
@@ -189,6 +197,7 @@ class ArmSpec:
     origin: Source | None = None
     free: tuple[int, ...] | None = None
     structure_tol: float | None = None
+    exact: tuple[tuple[float, ...], ...] | None = None
 
     @property
     def dof(self) -> int:
@@ -208,7 +217,7 @@ class ArmSpec:
                 return None
             return {"matrix": f.matrix, "translation": f.translation, "rpy": f.rpy}
 
-        data = {
+        data: dict[str, object] = {
             "name": self.name,
             "convention": self.convention,
             "angle_unit": self.angle_unit,
@@ -237,6 +246,8 @@ class ArmSpec:
             ik["structure_tol"] = self.structure_tol
         if ik:
             data["ik"] = ik
+        if self.exact is not None:  # (likewise)
+            data["exact"] = [list(f) for f in self.exact]
         return data
 
     def digest(self) -> str:
@@ -341,7 +352,34 @@ def _validate(data: dict, where: str) -> ArmSpec:
         _source(data.get("source"), where, len(joints)),
         _free(data.get("ik"), where, joints),
         _structure_tol(data.get("ik"), where),
+        _exact(data.get("exact"), where, len(joints)),
     )
+
+
+def _exact(table: object, where: str, dof: int) -> tuple[tuple[float, ...], ...] | None:
+    """The optional [exact] table: `frames`, dof + 1 rigid frames of 12 numbers each."""
+    if table is None:
+        return None
+    if not isinstance(table, dict):
+        raise SpecError(f"{where}: exact: must be a table with `frames`")
+    _no_unknown_keys(table, ("frames",), where, "exact.")
+    frames = table.get("frames")
+    if not isinstance(frames, list) or len(frames) != dof + 1:
+        raise SpecError(
+            f"{where}: exact.frames: must be {dof + 1} frames (one more than the joints) of "
+            "12 numbers each"
+        )
+    out = []
+    for i, frame in enumerate(frames):
+        field = f"exact.frames[{i}]"
+        if not isinstance(frame, list) or len(frame) != 12:
+            raise SpecError(f"{where}: {field}: must be a list of 12 numbers")
+        # (any magnitude up to MAX_MAGNITUDE: the frames are only computed with, never
+        # derived from, and a URDF's rotations hold rounding noise such as 6e-17)
+        flat = tuple(_frame_entry(v, where, f"{field}[{k}]") for k, v in enumerate(frame))
+        _check_rigid((*flat, 0.0, 0.0, 0.0, 1.0), where, field)
+        out.append(flat)
+    return tuple(out)
 
 
 def _structure_tol(table: object, where: str) -> float | None:
@@ -464,6 +502,19 @@ def _choice_or_text(data: dict, key: str, where: str, choices: tuple[str, ...] =
     if choices and value not in choices:
         raise SpecError(f"{where}: {key}: {value[:40]!r} is not allowed; allowed: {allowed}")
     return value
+
+
+def _frame_entry(value: object, where: str, field: str) -> float:
+    """A number of an [exact] frame: finite, magnitude at most MAX_MAGNITUDE (any small one:
+    the frames are computed with, never derived from, and a URDF's hold noise like 6e-17)."""
+    if (
+        isinstance(value, (int, float))
+        and not isinstance(value, bool)
+        and math.isfinite(value)
+        and abs(value) < MIN_MAGNITUDE
+    ):
+        return float(value)
+    return _number(value, where, field)
 
 
 def _number(value: object, where: str, field: str) -> float:

@@ -111,6 +111,9 @@ class Conversion:
         snaps: one line per snap applied.
         notes: what was ignored (one line each; not in the spec, said on stderr).
         deviation: the largest FK difference of the spec from the URDF over the samples.
+        frames: the URDF's own chain as fixed frames (derive/nominal.py): F_0 .. F_n, the
+            top three rows of each, row-major; the spec keeps them as [exact] where
+            snapping moved its table.
         reach: the arm's size.
     """
 
@@ -123,6 +126,7 @@ class Conversion:
     reach: float = 1.0
     rounded: bool = True
     notes: list[str] = field(default_factory=list)
+    frames: list[list[float]] = field(default_factory=list)
 
 
 # --- reading ---------------------------------------------------------------------------------
@@ -609,7 +613,41 @@ def convert(
         snaps=snaps,
         reach=reach,
         rounded=not exact,
+        frames=exact_frames(path),
     )
+
+
+def exact_frames(path: list[UrdfJoint]) -> list[list[float]]:
+    """The chain as fixed frames, T(q) = F_0 J_1(q_1) F_1 ... J_n(q_n) F_n with J_i a
+    rotation about z or a translation along it (derive/nominal.py): each moving joint's
+    frame turned so that its axis is z (R_i e_z = axis), F_i = R_i^T (origins up to the next
+    moving joint) R_(i+1); the top three rows of each, row-major."""
+    frames: list[list[float]] = []
+    acc = [[float(i == j) for j in range(4)] for i in range(4)]
+    for joint in path:
+        acc = matmul(acc, joint.origin)
+        if joint.kind in MOVING:
+            turn = _onto_z(joint.axis)
+            acc = matmul(acc, turn)
+            frames.append([acc[r][c] for r in range(3) for c in range(4)])
+            acc = inverse(turn)
+    frames.append([acc[r][c] for r in range(3) for c in range(4)])
+    return frames
+
+
+def _onto_z(axis: Vector) -> Matrix:
+    """A rotation R (4x4) with R e_z = axis (a unit vector)."""
+    x, y, z = axis
+    if z < -1.0 + 1e-12:  # (the half turn about x)
+        return [[1.0, 0.0, 0.0, 0.0], [0.0, -1.0, 0.0, 0.0], [0.0, 0.0, -1.0, 0.0], [0, 0, 0, 1.0]]
+    # Rodrigues' rotation about e_z x axis by the angle between them, written without it
+    k = 1.0 / (1.0 + z)
+    return [
+        [1.0 - k * x * x, -k * x * y, x, 0.0],
+        [-k * x * y, 1.0 - k * y * y, y, 0.0],
+        [-x, -y, z, 0.0],
+        [0.0, 0.0, 0.0, 1.0],
+    ]
 
 
 def _snap_frame(m: Matrix, angle_tol: float, ltol: float, snaps: list[str], what: str) -> Matrix:
@@ -817,6 +855,16 @@ def spec_text(
     def strings(values: list[str]) -> str:
         return "[" + ", ".join(f'"{_label(v)}"' for v in values) + "]"
 
+    if conversion.snaps:
+        lines += [
+            "",
+            "# the URDF's own geometry: the table above is snapped (its structure picks the",
+            "# closed form); fk, and every answer, are these frames' (derive/nominal.py)",
+            "[exact]",
+            "frames = [",
+            *(f"    [{', '.join(_exact_number(v) for v in f)}]," for f in conversion.frames),
+            "]",
+        ]
     lines += [
         "",
         "# where this spec came from (the report shows it)",
@@ -830,6 +878,12 @@ def spec_text(
         f"deviation = {float(f'{conversion.deviation:.2g}')!r}",
     ]
     return "\n".join(lines) + "\n"
+
+
+def _exact_number(x: float) -> str:
+    """A frame entry as TOML: every digit (rounding noise below 1e-15 as 0)."""
+    x = float(x) + 0.0
+    return "0.0" if abs(x) < 1e-15 else repr(x)
 
 
 def _label(text: str) -> str:

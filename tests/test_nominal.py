@@ -111,9 +111,10 @@ def test_a_calibrated_arm_gets_its_nominal_closed_form_and_the_exact_table():
 
 def _scaled_jacobian_sigma(module, q: np.ndarray) -> float:
     pose, axes, origins = module._chain_pose(q)
+    tip = np.array(pose[3::4])
     J = np.zeros((6, len(module._SOLVED)))
     for k, i in enumerate(module._SOLVED):
-        J[:3, k] = np.cross(axes[i], pose[:3, 3] - origins[i]) / module.REACH
+        J[:3, k] = np.cross(axes[i], tip - np.array(origins[i])) / module.REACH
         J[3:, k] = axes[i]
     return float(np.linalg.svd(J, compute_uv=False)[-1])
 
@@ -189,3 +190,42 @@ def test_structure_tol_zero_keeps_the_exact_table_and_no_correction():
     spec = parse_spec(calibrated("ur5") + "\n[ik]\nstructure_tol = 0.0\n", "<test>")
     plan = build_plan(dataclasses.replace(spec), method="three-parallel")
     assert plan.ik is None and plan.correction is None
+
+
+@needs_cc
+def test_a_urdf_with_cad_decimals_is_answered_exactly_against_its_own_fk(tmp_path):
+    """pybullet's xArm6 writes pi/2 as 1.5708 (tests/data/urdf/SOURCES.md): its snapped
+    table missed every pose by ~1.4e-5 before; now the spec keeps the URDF's frames and the
+    rows are refined onto them (the general method solves the snapped table here)."""
+    from pathlib import Path
+
+    from derive import urdf
+    from derive.load import solver_sources
+
+    path = Path(__file__).parent / "data" / "urdf" / "xarm6.urdf"
+    chain = urdf.chain_between(urdf.read_urdf(path), "world", "link6", str(path))
+    spec = urdf.load_urdf(path, urdf.Options(base="world", tip="link6"))
+    assert spec.exact is not None
+    folder = tmp_path / "xarm6"
+    folder.mkdir()
+    for name, text in solver_sources(build_plan(spec)).items():
+        (folder / name).write_text(text, encoding="utf-8")
+    from conftest import import_path
+
+    module = import_path(folder / "xarm6.py")
+    assert module.NOMINAL_DEVIATION > 1e-6
+    rng = np.random.default_rng(5)
+    regular = missed = empty = 0
+    for _ in range(200):
+        q = rng.uniform(-math.pi, math.pi, 6)
+        T = np.array(urdf.urdf_fk(chain, list(q)))
+        assert np.max(np.abs(module.fk(q) - T)) <= 1e-12
+        rows = module.ik(T, backend="c")
+        empty += len(rows) == 0
+        for row in rows:
+            assert np.max(np.abs(np.array(urdf.urdf_fk(chain, list(row))) - T)) <= 1e-9
+        if _scaled_jacobian_sigma(module, q) >= 0.05:
+            regular += 1
+            gaps = np.abs(np.remainder(rows - q + math.pi, 2 * math.pi) - math.pi)
+            missed += not bool(len(rows)) or bool(np.min(np.max(gaps, axis=1)) > 1e-8)
+    assert regular >= 100 and missed == 0 and empty <= 2

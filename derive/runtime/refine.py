@@ -17,12 +17,8 @@ from __future__ import annotations
 
 import math
 
-import numpy as np
-
 from derive.runtime.arm import _CHAIN, _REVOLUTE, _SOLVED, IK_COMPONENTS, REACH
 
-# the exact chain's frames as 4x4 arrays
-_FRAMES = np.array([np.vstack((np.reshape(f, (3, 4)), (0.0, 0.0, 0.0, 1.0))) for f in _CHAIN])
 # at most this many steps per candidate (a seed on a singular configuration converges
 # linearly); a step longer than _REFINE_STRIDE (radians, or
 # REACH of length) is shortened to it, so that a far seed does not jump branches
@@ -48,63 +44,101 @@ def _seed(found, t, q, tol):
 
 def _refine(q, t):
     """q after Newton's steps towards t on the exact chain, and its pose error there (the
-    largest rotation entry's difference, or position difference / REACH)."""
-    target = np.array((*t, 0.0, 0.0, 0.0, 1.0)).reshape(4, 4)
+    largest rotation entry's difference, or position difference / REACH). Plain floats:
+    numpy's calls cost more than this size of arithmetic."""
     rows = 6 if IK_COMPONENTS == "pose" else 3
-    cur = np.array(q, dtype=float)
-    best, best_size, worse = cur.copy(), math.inf, 0
+    m = len(_SOLVED)
+    cur = [float(x) for x in q]
+    best, best_size, worse = list(cur), math.inf, 0
     for _ in range(_REFINE_STEPS):
         pose, axes, origins = _chain_pose(cur)
-        gap = (target[:3, 3] - pose[:3, 3]) / REACH
-        size = float(np.max(np.abs(gap)))
-        if rows == 6:
-            size = max(size, float(np.max(np.abs(target[:3, :3] - pose[:3, :3]))))
+        error = [(t[4 * r + 3] - pose[4 * r + 3]) / REACH for r in range(3)]
+        size = max(map(abs, error))
+        for r in range(3):
+            a, b = 4 * ((r + 1) % 3), 4 * ((r + 2) % 3)
+            error.append(
+                0.5 * sum(pose[a + k] * t[b + k] - pose[b + k] * t[a + k] for k in range(3))
+            )
+            if rows == 6:
+                size = max(size, abs(t[4 * r] - pose[4 * r]), abs(t[4 * r + 1] - pose[4 * r + 1]),
+                           abs(t[4 * r + 2] - pose[4 * r + 2]))  # fmt: skip
         if size < best_size:
-            best, best_size, worse = cur.copy(), size, 0
+            best, best_size, worse = list(cur), size, 0
         else:  # (near a singular configuration the error can grow before it converges)
             worse += 1
         if size <= _REFINE_DONE or worse == _REFINE_PATIENCE:
             break
         last = size <= _REFINE_LAST and worse == 0
-        error = np.concatenate((gap, 0.5 * np.cross(pose[:3, :3].T, target[:3, :3].T).sum(0)))
-        J = np.zeros((6, len(_SOLVED)))
-        for k, i in enumerate(_SOLVED):
+        columns = []
+        for i in _SOLVED:
+            z, o = axes[i], origins[i]
             if _REVOLUTE[i]:
-                J[:3, k] = np.cross(axes[i], pose[:3, 3] - origins[i]) / REACH
-                J[3:, k] = axes[i]
+                dx, dy, dz = pose[3] - o[0], pose[7] - o[1], pose[11] - o[2]
+                column = ((z[1] * dz - z[2] * dy) / REACH, (z[2] * dx - z[0] * dz) / REACH,
+                          (z[0] * dy - z[1] * dx) / REACH, z[0], z[1], z[2])  # fmt: skip
             else:
-                J[:3, k] = axes[i] / REACH
-        J, error = J[:rows], error[:rows]
-        normal = J.T @ J + float(error @ error) * np.eye(len(_SOLVED))
-        try:
-            step = np.linalg.solve(normal, J.T @ error)
-        except np.linalg.LinAlgError:
+                column = (z[0] / REACH, z[1] / REACH, z[2] / REACH, 0.0, 0.0, 0.0)
+            columns.append(column[:rows])
+        mu = sum(e * e for e in error[:rows])
+        step = [sum(c * e for c, e in zip(column, error)) for column in columns]
+        normal = [
+            [sum(a * b for a, b in zip(columns[i], columns[j])) + (mu if i == j else 0.0)
+             for j in range(m)]
+            for i in range(m)
+        ]  # fmt: skip
+        if not _cholesky_solve(normal, step):
             break
-        longest = float(np.max(np.abs(step)))
+        longest = max(map(abs, step))
         if not longest < math.inf:
             break
-        if longest > _REFINE_STRIDE:
-            step *= _REFINE_STRIDE / longest
-        cur[list(_SOLVED)] += step
+        shrink = _REFINE_STRIDE / longest if longest > _REFINE_STRIDE else 1.0
+        for k, i in enumerate(_SOLVED):
+            cur[i] += step[k] * shrink
         if last:  # (Newton's step from there: the error squared, not measured)
             best = cur
             break
-    return tuple(best.tolist()), best_size
+    return tuple(best), best_size
+
+
+def _cholesky_solve(A, x):
+    """x := A^-1 x (in place) for the symmetric positive definite A (overwritten by its
+    Cholesky factor); False where A is not positive definite."""
+    m = len(x)
+    for j in range(m):
+        d = A[j][j] - sum(A[j][k] * A[j][k] for k in range(j))
+        if not d > 0.0:
+            return False
+        A[j][j] = math.sqrt(d)
+        for i in range(j + 1, m):
+            A[i][j] = (A[i][j] - sum(A[i][k] * A[j][k] for k in range(j))) / A[j][j]
+    for i in range(m):
+        x[i] = (x[i] - sum(A[i][k] * x[k] for k in range(i))) / A[i][i]
+    for i in reversed(range(m)):
+        x[i] = (x[i] - sum(A[k][i] * x[k] for k in range(i + 1, m))) / A[i][i]
+    return True
 
 
 def _chain_pose(q):
-    """The exact chain's pose at q, with each joint's axis and a point on it (world frame)."""
-    pose = _FRAMES[0].copy()
+    """The exact chain's pose at q (12 floats, the top three rows), with each joint's axis
+    and a point on it (world frame)."""
+    pose = list(_CHAIN[0])
     axes, origins = [], []
     for i, revolute in enumerate(_REVOLUTE):
-        axes.append(pose[:3, 2].copy())
-        origins.append(pose[:3, 3].copy())
+        axes.append((pose[2], pose[6], pose[10]))
+        origins.append((pose[3], pose[7], pose[11]))
         if revolute:
             c, s = math.cos(q[i]), math.sin(q[i])
-            x, y = pose[:, 0].copy(), pose[:, 1]
-            pose[:, 0] = c * x + s * y
-            pose[:, 1] = c * y - s * x
+            for r in (0, 4, 8):
+                x, y = pose[r], pose[r + 1]
+                pose[r], pose[r + 1] = c * x + s * y, c * y - s * x
         else:
-            pose[:, 3] += q[i] * pose[:, 2]
-        pose = pose @ _FRAMES[i + 1]
+            for r in (0, 4, 8):
+                pose[r + 3] += q[i] * pose[r + 2]
+        f = _CHAIN[i + 1]
+        for r in (0, 4, 8):
+            p0, p1, p2, p3 = pose[r], pose[r + 1], pose[r + 2], pose[r + 3]
+            pose[r] = p0 * f[0] + p1 * f[4] + p2 * f[8]
+            pose[r + 1] = p0 * f[1] + p1 * f[5] + p2 * f[9]
+            pose[r + 2] = p0 * f[2] + p1 * f[6] + p2 * f[10]
+            pose[r + 3] = p0 * f[3] + p1 * f[7] + p2 * f[11] + p3
     return pose, axes, origins

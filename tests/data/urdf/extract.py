@@ -5,7 +5,7 @@ kinematics needs: the robot's name, link names, and each joint's type, parent, c
 axis, limit and mimic; nothing else. Usage (the wheels from `pip download --no-deps`):
 
     python tests/data/urdf/extract.py example_robot_data-6.0.0-0-py3-none-any.whl \\
-        rtb_data-2.0.0-py3-none-any.whl
+        rtb_data-2.0.0-py3-none-any.whl pybullet-3.2.7-cp311-cp311-manylinux_2_17_x86_64.whl
 
 SOURCES.md beside this file says where each copy comes from and under which licence.
 """
@@ -36,6 +36,7 @@ WANTED = (
     ("irb140", "rtb_data", "abb_irb140_description/urdf/irb140.urdf"),
     ("lbr_iiwa_14_r820", "rtb_data", "kuka_lbr_iiwa/urdf/lbr_iiwa_14_r820.urdf"),
     ("al5d", "rtb_data", "lynxmotion_al5d_description/urdf/al5d_robot.urdf"),
+    ("xarm6", "pybullet", "pybullet_data/xarm/xarm6_robot.urdf"),
 )
 
 
