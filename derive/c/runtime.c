@@ -1341,10 +1341,10 @@ static int dk_pose_ok(const double T[16])
    step longer than DK_REFINE_STRIDE is shortened to it; done at DK_REFINE_DONE, given up after
    DK_REFINE_PATIENCE steps in a row that do not reduce the error; the step from an error
    within DK_REFINE_LAST (that reduced it) is the last */
-#define DK_REFINE_STEPS 30
+#define DK_REFINE_STEPS 60
 #define DK_REFINE_STRIDE (0.5)
 #define DK_REFINE_DONE (1e-14)
-#define DK_REFINE_PATIENCE 3
+#define DK_REFINE_PATIENCE 10
 #define DK_REFINE_LAST (1e-10)
 /* a refined row is kept if its pose error is within the smaller of this and ik's tol */
 #define DK_REFINE_TOL (1e-10)

@@ -22,12 +22,12 @@ from derive.runtime.arm import _CHAIN, _REVOLUTE, _SOLVED, IK_COMPONENTS, REACH
 # at most this many steps per candidate (a seed on a singular configuration converges
 # linearly); a step longer than _REFINE_STRIDE (radians, or
 # REACH of length) is shortened to it, so that a far seed does not jump branches
-_REFINE_STEPS = 30
+_REFINE_STEPS = 60
 _REFINE_STRIDE = 0.5
 # done at this pose error (a few roundings); given up after this many steps in a row that
 # do not reduce it; the step from an error within _REFINE_LAST (that reduced it) is the last
 _REFINE_DONE = 1e-14
-_REFINE_PATIENCE = 3
+_REFINE_PATIENCE = 10
 _REFINE_LAST = 1e-10
 # a refined row is returned if its pose error is within the smaller of this and ik's tol
 _REFINE_TOL = 1e-10
