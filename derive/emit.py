@@ -50,13 +50,31 @@ def check_printable(plan: Plan) -> None:
     for where, exprs in parts:
         for printer in (CodePrinter(), CodePrinter("np.")):
             try:
-                for expr in exprs:
-                    printer.doprint(expr)
+                for call in _calls(exprs):
+                    printer.doprint(call)
             except UnprintableError as exc:
                 raise GenerationError(
                     f"{plan.arm.name}: {where}: the generated code has no function {exc}; "
                     f"it calls only {', '.join(sorted(SCALAR_FUNCTIONS))}"
                 ) from None
+
+
+def _calls(exprs: tuple[sp.Basic, ...]) -> list[sp.Basic]:
+    """The function applications in exprs, each once: a walk over the expressions' graph,
+    not their trees (a URDF's dense frames multiply into entries whose trees are exponential
+    in the joints, while their graphs stay small)."""
+    seen: set[int] = set()
+    calls: dict[sp.Basic, None] = {}
+    stack = list(exprs)
+    while stack:
+        node = stack.pop()
+        if id(node) in seen:
+            continue
+        seen.add(id(node))
+        if isinstance(node, sp.Function):
+            calls[node.func(*(sp.Dummy() for _ in node.args))] = None
+        stack.extend(node.args)
+    return list(calls)
 
 
 def fk_pose_lines(plan: Plan) -> tuple[tuple[str, ...], tuple[str, ...]]:
