@@ -205,25 +205,43 @@ def print_plan(plan: Plan) -> PrintedModule:
 
 
 def correction_constants(plan: Plan) -> str:
-    """The exact chain and the joints its refinement moves, where the closed form solves a
-    nominal table (derive/nominal.py); "" elsewhere."""
-    fix = plan.correction
-    if fix is None or plan.ik is None:
+    """The exact chain and the joints its Newton steps move (ik_approximate's, and the
+    refinement of a closed form that solves a nominal table: derive/nominal.py), with the
+    nominal table where there is one; "" without IK."""
+    if plan.ik is None:
         return ""
     solved = tuple(i for i in range(plan.arm.dof) if i + 1 not in plan.ik.free)
-    return (
-        "# the closed form solves this nominal table (alpha, a, d, theta), radians; its answers\n"
-        "# are refined onto the exact chain below (derive/nominal.py)\n"
-        f"NOMINAL_DH = {_tuple_of_tuples(fix.nominal_dh)}\n"
-        "# the largest FK difference of the nominal arm from this one (rotation entries;\n"
-        "# positions / REACH)\n"
-        f"NOMINAL_DEVIATION = {fix.deviation:.3g}\n"
+    fix = plan.correction
+    nominal = ""
+    if fix is not None:
+        nominal = (
+            "# the closed form solves this nominal table (alpha, a, d, theta), radians; its\n"
+            "# answers are refined onto the exact chain below (derive/nominal.py)\n"
+            f"NOMINAL_DH = {_tuple_of_tuples(fix.nominal_dh)}\n"
+            "# the largest FK difference of the nominal arm from this one (rotation entries;\n"
+            "# positions / REACH)\n"
+            f"NOMINAL_DEVIATION = {fix.deviation:.3g}\n"
+        )
+    return nominal + (
         "# the exact chain: T(q) = F_0 J_1(q_1) F_1 ... J_n(q_n) F_n, J_i = Rz(q_i) (R) or\n"
         "# Tz(q_i) (P); each F_i's top three rows, row-major\n"
-        f"_CHAIN = {_tuple_of_tuples(fix.frames)}\n"
-        "# the joints (0-based) the refinement moves (free joints keep the caller's values)\n"
+        f"_CHAIN = {_frames_literal(plan.frames)}\n"
+        "# the joints (0-based) Newton's steps on it move (free joints keep the caller's values)\n"
         f"_SOLVED = {solved!r}\n"
     )
+
+
+def _frames_literal(frames: tuple[tuple[float, ...], ...]) -> str:
+    """Frames of 12 numbers as a tuple literal, each frame's rows on lines of their own (the
+    module stays within 100 columns)."""
+    out = ["("]
+    for frame in frames:
+        out.append("    (")
+        for r in range(3):
+            out.append("        " + " ".join(f"{_tuple(frame[4 * r : 4 * r + 4])[1:-1]},".split()))
+        out.append("    ),")
+    out.append(")")
+    return "\n".join(out)
 
 
 def correction_text(plan: Plan) -> str:

@@ -85,6 +85,7 @@ def build_plan(spec: ArmSpec, method: str | None = None) -> Plan:
         ik=ik,
         refusal=refusal,
         correction=correction,
+        frames=frames,
     )
 
 

@@ -345,6 +345,8 @@ class Plan:
         refusal: why no IK method applies (one line), or "" when ik is set.
         correction: where ik solves a nominal table near the arm's, how its answers are
             refined onto the arm's; None where ik solves the arm's own table.
+        frames: the arm's exact chain as fixed frames F_0 .. F_n, 12 floats each
+            (derive/nominal.py): what ik_approximate's steps, and a correction's, move on.
     """
 
     arm: ArmInfo
@@ -355,3 +357,4 @@ class Plan:
     ik: IkPlan | None
     refusal: str = ""
     correction: Correction | None = None
+    frames: tuple[tuple[float, ...], ...] = ()

@@ -38,6 +38,9 @@ API:
     nearest(T, q_ref, *, within_limits=True, weights=None, metric="l2", free_step=FREE_STEP,
             backend=None)
         -> (DOF,) ndarray or None
+    ik_approximate(T, *, free=None, q_ref=None, tol=CERTIFY_TOL, backend=None)
+        -> (Q (n, DOF), residual (n,), exact (n,)): ik's rows, or where T is out of reach the
+        nearest configuration of each branch
     warmup() -> bool: compile the C solver (or load it from the cache) now
 
 Free joints: q7 (end joint: the given value only moves the tool of joints 1-6, which the pieper
@@ -126,6 +129,52 @@ MAX_SOLUTIONS = 8
 FREE = (7,)
 # how far the solver's equations may miss and still seed a refinement (0: exact arms)
 _SEED_TOL = 0.0
+# the exact chain: T(q) = F_0 J_1(q_1) F_1 ... J_n(q_n) F_n, J_i = Rz(q_i) (R) or
+# Tz(q_i) (P); each F_i's top three rows, row-major
+_CHAIN = (
+    (
+        1.0, 0.0, 0.0, 0.0,
+        0.0, 1.0, 0.0, 0.0,
+        0.0, 0.0, 1.0, 0.333,
+    ),
+    (
+        1.0, 0.0, 0.0, 0.0,
+        0.0, 0.0, 1.0, 0.0,
+        0.0, -1.0, 0.0, 0.0,
+    ),
+    (
+        1.0, 0.0, 0.0, 0.0,
+        0.0, 0.0, -1.0, -0.316,
+        0.0, 1.0, 0.0, 0.0,
+    ),
+    (
+        1.0, 0.0, 0.0, 0.0825,
+        0.0, 0.0, -1.0, 0.0,
+        0.0, 1.0, 0.0, 0.0,
+    ),
+    (
+        1.0, 0.0, 0.0, -0.0825,
+        0.0, 0.0, 1.0, 0.384,
+        0.0, -1.0, 0.0, 0.0,
+    ),
+    (
+        1.0, 0.0, 0.0, 0.0,
+        0.0, 0.0, -1.0, 0.0,
+        0.0, 1.0, 0.0, 0.0,
+    ),
+    (
+        1.0, 0.0, 0.0, 0.088,
+        0.0, 0.0, -1.0, 0.0,
+        0.0, 1.0, 0.0, 0.0,
+    ),
+    (
+        1.0, 0.0, 0.0, 0.0,
+        0.0, 1.0, 0.0, 0.0,
+        0.0, 0.0, 1.0, 0.107,
+    ),
+)
+# the joints (0-based) Newton's steps on it move (free joints keep the caller's values)
+_SOLVED = (0, 1, 2, 3, 4, 5)
 # the arm's C solver, beside this file (with its .h; "": none): compiled on the first call
 _C_SOURCE = 'panda_ik.c'
 
@@ -579,6 +628,59 @@ def ik(
     if max(abs(target[3]), abs(target[7]), abs(target[11])) > _FAR:
         return result(_finish([]))
     return result(_finish(_ik_scalar(target, *solve, tol)))
+
+
+def ik_approximate(
+    T: ArrayLike,
+    *,
+    free: ArrayLike | None = None,
+    q_ref: ArrayLike | None = None,
+    tol: float = CERTIFY_TOL,
+    backend: str | None = None,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """ik's solutions where T is reached; where it is not (slightly out of reach, or a
+    rotation the arm cannot take), the nearest configuration of each branch instead, each
+    with its residual and a flag. Opt-in: ik never returns an approximate row.
+
+    The nearest configurations: the solver's equations solved at their boundary where they
+    miss (an acos argument beyond 1 taken as +-1, a complex root's real part), each such
+    seed then moved by damped Newton steps on the exact chain to the least-squares point of
+    the pose error (positions divided by REACH, and the rotation error), so that the result
+    depends on how far out of reach T is, not on the derivation. Where the solver gives no
+    seed (the general method's arms: their candidates are eigenvalues) q_ref's
+    configuration is the one seed. In Python (the C solver answers the reachable case).
+
+    Returns:
+        (Q, residual, exact): Q (n, DOF) in branch order as ik's; residual (n,) the largest
+        difference of fk(Q[i]) from T (rotation entries, positions divided by REACH; the
+        position only for an arm solved for its position); exact (n,) residual <= tol, True
+        for every row where T is reached.
+    """
+    rows = ik(T, free=free, q_ref=q_ref, tol=tol, backend=backend)
+    target = _pose(T)
+    if not len(rows):
+        refs = _with_free(_reference(q_ref), free)
+        _LOOSE.on = True
+        try:
+            seeds = _ik_scalar(target, *_free_turns(refs), math.inf)
+        finally:
+            _LOOSE.on = False
+        # (none: the general method's candidates are eigenvalues, with no boundary to
+        # solve at; then q_ref's configuration is the one seed)
+        seeds = seeds or [_free_turns(refs)]
+        rows = _as_rows(_finish([_least_squares(q, target) for q in seeds]))
+    residual = np.array([_residual(target, q) for q in rows.tolist()])
+    return rows, residual, residual <= _tolerance(tol)
+
+
+def _residual(t, q):
+    """The largest difference of the pose of q from t (12 top entries): positions divided
+    by REACH; rotation entries unless the arm is solved for its position."""
+    e = _fk_q(q)
+    size = max(abs(e[k] - t[k]) for k in (3, 7, 11)) / REACH
+    if IK_COMPONENTS == "pose":
+        size = max(size, *(abs(e[k] - t[k]) for k in (0, 1, 2, 4, 5, 6, 8, 9, 10)))
+    return size
 
 
 def _array44(T):
@@ -1212,6 +1314,16 @@ def _newton(c: list[float] | np.ndarray, x: float) -> float:
     return x
 
 
+class _Loose(threading.local):
+    """Per thread: whether the solver is seeding ik_approximate (then an equation that misses
+    is solved at its boundary, and a complex root gives its real part)."""
+
+    on = False
+
+
+_LOOSE = _Loose()
+
+
 class _Free(tuple):
     """The values a free joint tries, first the preferred one, then 5 degree steps out from
     it in both directions. The solver stops at the first value that gives a certified
@@ -1233,12 +1345,12 @@ def _cs1(a: float, b: float, e: float, scale: float = 0.0, ref: float = 0.0) -> 
     t (the angle is free; e.g. the elbow folded onto axis 1): _free(ref).
     """
     rho = sqrt(a * a + b * b)
-    if rho * rho <= _FREE_TOL * scale:
-        return _free(ref) if e * e <= _FREE_TOL * scale else ()
+    if rho * rho <= _FREE_TOL * scale:  # (seeding ik_approximate, any value is a seed)
+        return _free(ref) if e * e <= _FREE_TOL * scale or _LOOSE.on else ()
     if rho == 0.0:
-        return ()
+        return (ref,) if _LOOSE.on else ()
     ratio = e / rho
-    if abs(ratio) > 1.0 + _CLAMP_TOL + _SEED_TOL:
+    if abs(ratio) > 1.0 + _CLAMP_TOL + _SEED_TOL and not _LOOSE.on:
         return ()
     base = atan2(b, a)
     if abs(ratio) >= 1.0 - _FOLD_TOL:
@@ -1385,8 +1497,9 @@ def _accept(p: list[float], zs: list[complex], check: bool = True) -> list[float
             return None
         out.append(x)
         k += 1
-    if _SEED_TOL:  # a nominal table's near-double root, split by the arm's difference
-        near = math.sqrt(_SEED_TOL)
+    if _SEED_TOL or _LOOSE.on:  # a nominal table's near-double root, split by the arm's
+        # difference (or any complex root, seeding ik_approximate)
+        near = math.inf if _LOOSE.on else math.sqrt(_SEED_TOL)
         out += [
             z.real
             for z in map(complex, zs)
@@ -1409,6 +1522,136 @@ def _clusters(zs: list[complex]) -> list[tuple[complex, bool]]:
         else:
             out.append((z, True))
     return out
+
+
+# ik_approximate's least squares: at most this many steps, done where the gradient of half
+# the squared error is this flat
+_LSQ_STEPS = 200
+
+
+_LSQ_FLAT = 1e-13
+
+
+def _least_squares(q, t):
+    """q moved to a least-squares point of the pose error towards t on the exact chain
+    (Levenberg-Marquardt, its damping adapted to each step's success): ik_approximate's
+    nearest configuration of q's branch where t is out of reach."""
+    m = len(_SOLVED)
+    cur = [float(x) for x in q]
+    error, columns, _ = _pose_error(cur, t, True)
+    value = 0.5 * sum(e * e for e in error)
+    damping = 1e-3
+    for _ in range(_LSQ_STEPS):
+        gradient = [sum(c * e for c, e in zip(column, error)) for column in columns]
+        if max(map(abs, gradient)) <= _LSQ_FLAT:
+            break
+        normal = [[sum(a * b for a, b in zip(columns[i], columns[j])) for j in range(m)]
+                  for i in range(m)]  # fmt: skip
+        for i in range(m):
+            normal[i][i] += damping * (normal[i][i] + 1e-12)
+        step = list(gradient)
+        if not _cholesky_solve(normal, step):
+            damping *= 4.0
+            continue
+        trial = list(cur)
+        for k, i in enumerate(_SOLVED):
+            trial[i] += step[k]
+        trial_error, trial_columns, _ = _pose_error(trial, t, True)
+        trial_value = 0.5 * sum(e * e for e in trial_error)
+        if trial_value < value:
+            cur, error, columns, value = trial, trial_error, trial_columns, trial_value
+            damping = max(damping / 3.0, 1e-12)
+        else:
+            damping *= 4.0
+            if damping > 1e12:
+                break
+    return tuple(cur)
+
+
+def _pose_error(q, t, exact):
+    """The pose error towards t at q on the exact chain: the residual (positions divided by
+    REACH; with IK_COMPONENTS "pose", the rotation error 1/2 sum_k r_k x t_k), the columns of
+    its Jacobian (minus the residual's derivative) for the joints in _SOLVED, and its size
+    (the largest rotation entry's difference, or position difference / REACH). Exact: the
+    rotation rows are the error's own derivative, 1/2 sum_k t_k x (z x r_k); else the
+    geometric Jacobian's z, which they equal where the error vanishes (Newton's steps)."""
+    rows = 6 if IK_COMPONENTS == "pose" else 3
+    pose, axes, origins = _chain_pose(q)
+    error = [(t[4 * r + 3] - pose[4 * r + 3]) / REACH for r in range(3)]
+    size = max(map(abs, error))
+    if rows == 6:
+        for r in range(3):
+            a, b = 4 * ((r + 1) % 3), 4 * ((r + 2) % 3)
+            error.append(
+                0.5 * sum(pose[a + k] * t[b + k] - pose[b + k] * t[a + k] for k in range(3))
+            )
+            size = max(size, abs(t[4 * r] - pose[4 * r]), abs(t[4 * r + 1] - pose[4 * r + 1]),
+                       abs(t[4 * r + 2] - pose[4 * r + 2]))  # fmt: skip
+    columns = []
+    for i in _SOLVED:
+        z, o = axes[i], origins[i]
+        if _REVOLUTE[i]:
+            dx, dy, dz = pose[3] - o[0], pose[7] - o[1], pose[11] - o[2]
+            column = [(z[1] * dz - z[2] * dy) / REACH, (z[2] * dx - z[0] * dz) / REACH,
+                      (z[0] * dy - z[1] * dx) / REACH, z[0], z[1], z[2]]  # fmt: skip
+            if exact and rows == 6:
+                column[3:] = [0.0, 0.0, 0.0]
+                for k in range(3):
+                    r_k = (pose[k], pose[4 + k], pose[8 + k])
+                    t_k = (t[k], t[4 + k], t[8 + k])
+                    w = (z[1] * r_k[2] - z[2] * r_k[1], z[2] * r_k[0] - z[0] * r_k[2],
+                         z[0] * r_k[1] - z[1] * r_k[0])  # fmt: skip
+                    column[3] += 0.5 * (t_k[1] * w[2] - t_k[2] * w[1])
+                    column[4] += 0.5 * (t_k[2] * w[0] - t_k[0] * w[2])
+                    column[5] += 0.5 * (t_k[0] * w[1] - t_k[1] * w[0])
+        else:
+            column = [z[0] / REACH, z[1] / REACH, z[2] / REACH, 0.0, 0.0, 0.0]
+        columns.append(column[:rows])
+    return error, columns, size
+
+
+def _cholesky_solve(A, x):
+    """x := A^-1 x (in place) for the symmetric positive definite A (overwritten by its
+    Cholesky factor); False where A is not positive definite."""
+    m = len(x)
+    for j in range(m):
+        d = A[j][j] - sum(A[j][k] * A[j][k] for k in range(j))
+        if not d > 0.0:
+            return False
+        A[j][j] = math.sqrt(d)
+        for i in range(j + 1, m):
+            A[i][j] = (A[i][j] - sum(A[i][k] * A[j][k] for k in range(j))) / A[j][j]
+    for i in range(m):
+        x[i] = (x[i] - sum(A[i][k] * x[k] for k in range(i))) / A[i][i]
+    for i in reversed(range(m)):
+        x[i] = (x[i] - sum(A[k][i] * x[k] for k in range(i + 1, m))) / A[i][i]
+    return True
+
+
+def _chain_pose(q):
+    """The exact chain's pose at q (12 floats, the top three rows), with each joint's axis
+    and a point on it (world frame)."""
+    pose = list(_CHAIN[0])
+    axes, origins = [], []
+    for i, revolute in enumerate(_REVOLUTE):
+        axes.append((pose[2], pose[6], pose[10]))
+        origins.append((pose[3], pose[7], pose[11]))
+        if revolute:
+            c, s = math.cos(q[i]), math.sin(q[i])
+            for r in (0, 4, 8):
+                x, y = pose[r], pose[r + 1]
+                pose[r], pose[r + 1] = c * x + s * y, c * y - s * x
+        else:
+            for r in (0, 4, 8):
+                pose[r + 3] += q[i] * pose[r + 2]
+        f = _CHAIN[i + 1]
+        for r in (0, 4, 8):
+            p0, p1, p2, p3 = pose[r], pose[r + 1], pose[r + 2], pose[r + 3]
+            pose[r] = p0 * f[0] + p1 * f[4] + p2 * f[8]
+            pose[r + 1] = p0 * f[1] + p1 * f[5] + p2 * f[9]
+            pose[r + 2] = p0 * f[2] + p1 * f[6] + p2 * f[10]
+            pose[r + 3] = p0 * f[3] + p1 * f[7] + p2 * f[11] + p3
+    return pose, axes, origins
 
 
 # --- the arm's own code, printed from its plan ------------------------------------------------

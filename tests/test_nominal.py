@@ -369,3 +369,49 @@ def test_industrial_arms_written_as_noisy_urdfs_are_answered_exactly(name, tmp_p
             gaps = np.abs(np.remainder(rows - q + math.pi, 2 * math.pi) - math.pi)
             missed += bool(np.min(np.max(gaps, axis=1)) > 1e-8)
     assert regular >= 100 and missed == 0
+
+
+def _objective(module, q: np.ndarray, T: np.ndarray) -> float:
+    """Half the squared pose error ik_approximate minimises (derive/runtime/refine.py)."""
+    E = module.fk(q)
+    gap = (T[:3, 3] - E[:3, 3]) / module.REACH
+    if module.IK_COMPONENTS != "pose":
+        return 0.5 * float(gap @ gap)
+    turn = 0.5 * np.cross(E[:3, :3].T, T[:3, :3].T).sum(0)
+    return 0.5 * float(gap @ gap + turn @ turn)
+
+
+@pytest.mark.parametrize("name", ["puma560", "iiwa14", "lecture_rrr", "manocha_canny"])
+def test_ik_approximate_gives_the_nearest_configurations_out_of_reach(name, generated):
+    module = generated(name)
+    rng = np.random.default_rng(4)
+    tested = 0
+    for _ in range(8):
+        q = rng.uniform(-2, 2, module.DOF)
+        free = {"free": q[[j - 1 for j in module.FREE]]} if module.FREE else {}
+        T = module.fk(q)
+        rows, residual, exact = module.ik_approximate(T, backend="python", **free)
+        assert np.array_equal(rows, module.ik(T, backend="python", **free))
+        assert exact.all() and (residual <= 1e-9).all()
+
+        def moved(s: float, T: np.ndarray = T) -> np.ndarray:
+            out = T.copy()
+            out[:3, 3] *= s
+            return out
+
+        lo, hi = 1.0, 3.0  # the scale of the position where the pose leaves the reach
+        if len(module.ik(moved(hi), **free)):
+            continue
+        for _ in range(20):
+            mid = 0.5 * (lo + hi)
+            lo, hi = (mid, hi) if len(module.ik(moved(mid), **free)) else (lo, mid)
+        far = moved(hi + 0.01)  # slightly out of reach
+        rows, residual, exact = module.ik_approximate(far, backend="python", **free)
+        assert len(module.ik(far, **free)) == 0  # (ik itself stays exact-only)
+        assert len(rows) > 0 and not exact.any() and (residual > module.CERTIFY_TOL).all()
+        t = module._pose(far)
+        for row in rows:  # each a least-squares point: the error's gradient vanishes
+            error, columns, _ = module._pose_error(list(row), t, True)
+            assert max(abs(float(np.dot(c, error))) for c in columns) <= 1e-9
+        tested += 1
+    assert tested >= 3

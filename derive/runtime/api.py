@@ -14,8 +14,10 @@ from derive.runtime.arm import (
     _C_SOURCE,
     _REVOLUTE,
     DOF,
+    IK_COMPONENTS,
     LIMITS,
     MAX_SOLUTIONS,
+    REACH,
     _cs_columns,
     _fk_from_cs,
     _fk_q,
@@ -50,6 +52,8 @@ from derive.runtime.native import (
     _native_solver,
     _scratch,
 )
+from derive.runtime.refine import _least_squares
+from derive.runtime.scalar import _LOOSE
 
 
 def fk(q: ArrayLike) -> np.ndarray:
@@ -176,6 +180,59 @@ def ik(
     if max(abs(target[3]), abs(target[7]), abs(target[11])) > _FAR:
         return result(_finish([]))
     return result(_finish(_ik_scalar(target, *solve, tol)))
+
+
+def ik_approximate(
+    T: ArrayLike,
+    *,
+    free: ArrayLike | None = None,
+    q_ref: ArrayLike | None = None,
+    tol: float = CERTIFY_TOL,
+    backend: str | None = None,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """ik's solutions where T is reached; where it is not (slightly out of reach, or a
+    rotation the arm cannot take), the nearest configuration of each branch instead, each
+    with its residual and a flag. Opt-in: ik never returns an approximate row.
+
+    The nearest configurations: the solver's equations solved at their boundary where they
+    miss (an acos argument beyond 1 taken as +-1, a complex root's real part), each such
+    seed then moved by damped Newton steps on the exact chain to the least-squares point of
+    the pose error (positions divided by REACH, and the rotation error), so that the result
+    depends on how far out of reach T is, not on the derivation. Where the solver gives no
+    seed (the general method's arms: their candidates are eigenvalues) q_ref's
+    configuration is the one seed. In Python (the C solver answers the reachable case).
+
+    Returns:
+        (Q, residual, exact): Q (n, DOF) in branch order as ik's; residual (n,) the largest
+        difference of fk(Q[i]) from T (rotation entries, positions divided by REACH; the
+        position only for an arm solved for its position); exact (n,) residual <= tol, True
+        for every row where T is reached.
+    """
+    rows = ik(T, free=free, q_ref=q_ref, tol=tol, backend=backend)
+    target = _pose(T)
+    if not len(rows):
+        refs = _with_free(_reference(q_ref), free)
+        _LOOSE.on = True
+        try:
+            seeds = _ik_scalar(target, *_free_turns(refs), math.inf)
+        finally:
+            _LOOSE.on = False
+        # (none: the general method's candidates are eigenvalues, with no boundary to
+        # solve at; then q_ref's configuration is the one seed)
+        seeds = seeds or [_free_turns(refs)]
+        rows = _as_rows(_finish([_least_squares(q, target) for q in seeds]))
+    residual = np.array([_residual(target, q) for q in rows.tolist()])
+    return rows, residual, residual <= _tolerance(tol)
+
+
+def _residual(t, q):
+    """The largest difference of the pose of q from t (12 top entries): positions divided
+    by REACH; rotation entries unless the arm is solved for its position."""
+    e = _fk_q(q)
+    size = max(abs(e[k] - t[k]) for k in (3, 7, 11)) / REACH
+    if IK_COMPONENTS == "pose":
+        size = max(size, *(abs(e[k] - t[k]) for k in (0, 1, 2, 4, 5, 6, 8, 9, 10)))
+    return size
 
 
 def _array44(T):

@@ -18,6 +18,7 @@ from __future__ import annotations
 import math
 
 from derive.runtime.arm import _CHAIN, _REVOLUTE, _SOLVED, IK_COMPONENTS, REACH
+from derive.runtime.scalar import _LOOSE
 
 # at most this many steps per candidate (a seed on a singular configuration converges
 # linearly); a step longer than _REFINE_STRIDE (radians, or
@@ -31,6 +32,10 @@ _REFINE_PATIENCE = 10
 _REFINE_LAST = 1e-10
 # a refined row is returned if its pose error is within the smaller of this and ik's tol
 _REFINE_TOL = 1e-10
+# ik_approximate's least squares: at most this many steps, done where the gradient of half
+# the squared error is this flat
+_LSQ_STEPS = 200
+_LSQ_FLAT = 1e-13
 
 
 def _seed(found, t, q, tol):
@@ -38,7 +43,7 @@ def _seed(found, t, q, tol):
     12 top entries) within tol and _REFINE_TOL (rotation entries; positions within that times
     REACH)."""
     q, size = _refine(q, t)
-    if size <= min(tol, _REFINE_TOL):
+    if size <= min(tol, _REFINE_TOL) or _LOOSE.on:  # (ik_approximate keeps every seed)
         found.append(q)
 
 
@@ -46,22 +51,11 @@ def _refine(q, t):
     """q after Newton's steps towards t on the exact chain, and its pose error there (the
     largest rotation entry's difference, or position difference / REACH). Plain floats:
     numpy's calls cost more than this size of arithmetic."""
-    rows = 6 if IK_COMPONENTS == "pose" else 3
     m = len(_SOLVED)
     cur = [float(x) for x in q]
     best, best_size, worse = list(cur), math.inf, 0
     for _ in range(_REFINE_STEPS):
-        pose, axes, origins = _chain_pose(cur)
-        error = [(t[4 * r + 3] - pose[4 * r + 3]) / REACH for r in range(3)]
-        size = max(map(abs, error))
-        for r in range(3):
-            a, b = 4 * ((r + 1) % 3), 4 * ((r + 2) % 3)
-            error.append(
-                0.5 * sum(pose[a + k] * t[b + k] - pose[b + k] * t[a + k] for k in range(3))
-            )
-            if rows == 6:
-                size = max(size, abs(t[4 * r] - pose[4 * r]), abs(t[4 * r + 1] - pose[4 * r + 1]),
-                           abs(t[4 * r + 2] - pose[4 * r + 2]))  # fmt: skip
+        error, columns, size = _pose_error(cur, t, False)
         if size < best_size:
             best, best_size, worse = list(cur), size, 0
         else:  # (near a singular configuration the error can grow before it converges)
@@ -69,17 +63,7 @@ def _refine(q, t):
         if size <= _REFINE_DONE or worse == _REFINE_PATIENCE:
             break
         last = size <= _REFINE_LAST and worse == 0
-        columns = []
-        for i in _SOLVED:
-            z, o = axes[i], origins[i]
-            if _REVOLUTE[i]:
-                dx, dy, dz = pose[3] - o[0], pose[7] - o[1], pose[11] - o[2]
-                column = ((z[1] * dz - z[2] * dy) / REACH, (z[2] * dx - z[0] * dz) / REACH,
-                          (z[0] * dy - z[1] * dx) / REACH, z[0], z[1], z[2])  # fmt: skip
-            else:
-                column = (z[0] / REACH, z[1] / REACH, z[2] / REACH, 0.0, 0.0, 0.0)
-            columns.append(column[:rows])
-        mu = sum(e * e for e in error[:rows])
+        mu = sum(e * e for e in error)
         step = [sum(c * e for c, e in zip(column, error)) for column in columns]
         normal = [
             [sum(a * b for a, b in zip(columns[i], columns[j])) + (mu if i == j else 0.0)
@@ -98,6 +82,84 @@ def _refine(q, t):
             best = cur
             break
     return tuple(best), best_size
+
+
+def _least_squares(q, t):
+    """q moved to a least-squares point of the pose error towards t on the exact chain
+    (Levenberg-Marquardt, its damping adapted to each step's success): ik_approximate's
+    nearest configuration of q's branch where t is out of reach."""
+    m = len(_SOLVED)
+    cur = [float(x) for x in q]
+    error, columns, _ = _pose_error(cur, t, True)
+    value = 0.5 * sum(e * e for e in error)
+    damping = 1e-3
+    for _ in range(_LSQ_STEPS):
+        gradient = [sum(c * e for c, e in zip(column, error)) for column in columns]
+        if max(map(abs, gradient)) <= _LSQ_FLAT:
+            break
+        normal = [[sum(a * b for a, b in zip(columns[i], columns[j])) for j in range(m)]
+                  for i in range(m)]  # fmt: skip
+        for i in range(m):
+            normal[i][i] += damping * (normal[i][i] + 1e-12)
+        step = list(gradient)
+        if not _cholesky_solve(normal, step):
+            damping *= 4.0
+            continue
+        trial = list(cur)
+        for k, i in enumerate(_SOLVED):
+            trial[i] += step[k]
+        trial_error, trial_columns, _ = _pose_error(trial, t, True)
+        trial_value = 0.5 * sum(e * e for e in trial_error)
+        if trial_value < value:
+            cur, error, columns, value = trial, trial_error, trial_columns, trial_value
+            damping = max(damping / 3.0, 1e-12)
+        else:
+            damping *= 4.0
+            if damping > 1e12:
+                break
+    return tuple(cur)
+
+
+def _pose_error(q, t, exact):
+    """The pose error towards t at q on the exact chain: the residual (positions divided by
+    REACH; with IK_COMPONENTS "pose", the rotation error 1/2 sum_k r_k x t_k), the columns of
+    its Jacobian (minus the residual's derivative) for the joints in _SOLVED, and its size
+    (the largest rotation entry's difference, or position difference / REACH). Exact: the
+    rotation rows are the error's own derivative, 1/2 sum_k t_k x (z x r_k); else the
+    geometric Jacobian's z, which they equal where the error vanishes (Newton's steps)."""
+    rows = 6 if IK_COMPONENTS == "pose" else 3
+    pose, axes, origins = _chain_pose(q)
+    error = [(t[4 * r + 3] - pose[4 * r + 3]) / REACH for r in range(3)]
+    size = max(map(abs, error))
+    if rows == 6:
+        for r in range(3):
+            a, b = 4 * ((r + 1) % 3), 4 * ((r + 2) % 3)
+            error.append(
+                0.5 * sum(pose[a + k] * t[b + k] - pose[b + k] * t[a + k] for k in range(3))
+            )
+            size = max(size, abs(t[4 * r] - pose[4 * r]), abs(t[4 * r + 1] - pose[4 * r + 1]),
+                       abs(t[4 * r + 2] - pose[4 * r + 2]))  # fmt: skip
+    columns = []
+    for i in _SOLVED:
+        z, o = axes[i], origins[i]
+        if _REVOLUTE[i]:
+            dx, dy, dz = pose[3] - o[0], pose[7] - o[1], pose[11] - o[2]
+            column = [(z[1] * dz - z[2] * dy) / REACH, (z[2] * dx - z[0] * dz) / REACH,
+                      (z[0] * dy - z[1] * dx) / REACH, z[0], z[1], z[2]]  # fmt: skip
+            if exact and rows == 6:
+                column[3:] = [0.0, 0.0, 0.0]
+                for k in range(3):
+                    r_k = (pose[k], pose[4 + k], pose[8 + k])
+                    t_k = (t[k], t[4 + k], t[8 + k])
+                    w = (z[1] * r_k[2] - z[2] * r_k[1], z[2] * r_k[0] - z[0] * r_k[2],
+                         z[0] * r_k[1] - z[1] * r_k[0])  # fmt: skip
+                    column[3] += 0.5 * (t_k[1] * w[2] - t_k[2] * w[1])
+                    column[4] += 0.5 * (t_k[2] * w[0] - t_k[0] * w[2])
+                    column[5] += 0.5 * (t_k[0] * w[1] - t_k[1] * w[0])
+        else:
+            column = [z[0] / REACH, z[1] / REACH, z[2] / REACH, 0.0, 0.0, 0.0]
+        columns.append(column[:rows])
+    return error, columns, size
 
 
 def _cholesky_solve(A, x):

@@ -4,6 +4,7 @@ the pose leaves the joint free, whose values the solver tries in turn)."""
 from __future__ import annotations
 
 import math
+import threading
 from math import acos, atan2, sqrt
 
 import numpy as np
@@ -30,6 +31,16 @@ from derive.runtime.constants import (
 )
 
 
+class _Loose(threading.local):
+    """Per thread: whether the solver is seeding ik_approximate (then an equation that misses
+    is solved at its boundary, and a complex root gives its real part)."""
+
+    on = False
+
+
+_LOOSE = _Loose()
+
+
 class _Free(tuple):
     """The values a free joint tries, first the preferred one, then 5 degree steps out from
     it in both directions. The solver stops at the first value that gives a certified
@@ -51,12 +62,12 @@ def _cs1(a: float, b: float, e: float, scale: float = 0.0, ref: float = 0.0) -> 
     t (the angle is free; e.g. the elbow folded onto axis 1): _free(ref).
     """
     rho = sqrt(a * a + b * b)
-    if rho * rho <= _FREE_TOL * scale:
-        return _free(ref) if e * e <= _FREE_TOL * scale else ()
+    if rho * rho <= _FREE_TOL * scale:  # (seeding ik_approximate, any value is a seed)
+        return _free(ref) if e * e <= _FREE_TOL * scale or _LOOSE.on else ()
     if rho == 0.0:
-        return ()
+        return (ref,) if _LOOSE.on else ()
     ratio = e / rho
-    if abs(ratio) > 1.0 + _CLAMP_TOL + _SEED_TOL:
+    if abs(ratio) > 1.0 + _CLAMP_TOL + _SEED_TOL and not _LOOSE.on:
         return ()
     base = atan2(b, a)
     if abs(ratio) >= 1.0 - _FOLD_TOL:
@@ -283,8 +294,9 @@ def _accept(p: list[float], zs: list[complex], check: bool = True) -> list[float
             return None
         out.append(x)
         k += 1
-    if _SEED_TOL:  # a nominal table's near-double root, split by the arm's difference
-        near = math.sqrt(_SEED_TOL)
+    if _SEED_TOL or _LOOSE.on:  # a nominal table's near-double root, split by the arm's
+        # difference (or any complex root, seeding ik_approximate)
+        near = math.inf if _LOOSE.on else math.sqrt(_SEED_TOL)
         out += [
             z.real
             for z in map(complex, zs)
