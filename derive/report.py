@@ -633,14 +633,21 @@ def correction_blocks(plan: Plan) -> list[Block]:
         Block("h3", "The nominal table, and the correction onto the exact one"),
         Block(
             "p",
-            "This arm's table is not exactly special, and no closed form solves it. Within the "
-            f"structure tolerance {fix.tol:g} (twists in radians, lengths as a fraction of the "
-            f"arm's size) it is near one that is: snapping {len(fix.changes)} parameters "
-            "gives the nominal table below, and the method above is the nominal table's. "
-            "The forward kinematics of the two differ by up to "
+            (
+                "This arm's table is not exactly special, and no closed form solves it. Within "
+                f"the structure tolerance {fix.tol:g} (twists in radians, lengths as a fraction "
+                f"of the arm's size) it is near one that is: snapping {len(fix.changes)} "
+                "parameters gives the nominal table below, and the method above is the nominal "
+                "table's."
+                if fix.changes
+                else "This arm's exact geometry is its URDF's, kept in the spec as [exact] "
+                "frames; the table, fitted to it with the URDF's rounding snapped (section 1), "
+                "is the nominal one the method above solves."
+            )
+            + " The forward kinematics of the two differ by up to "
             f"{fix.deviation:.2g} (rotation entries; positions divided by the reach).",
         ),
-        Block("table", rows=tuple(rows)),
+        *([Block("table", rows=tuple(rows))] if fix.changes else []),
         Block(
             "p",
             "Every nominal solution is a seed: Newton's steps on the exact chain, damped by "
