@@ -19,7 +19,7 @@ from derive.nominal import (
     nominal,
 )
 from derive.plan import ArmInfo, Correction, IkPlan, Plan
-from derive.spec import ArmSpec
+from derive.spec import ArmSpec, SpecError
 from derive.transforms import Chain, chain_from_spec, frame_matrix, link_transform, world_transform
 
 # Tried in order; each returns a plan, or a one-line reason why it does not apply.
@@ -59,20 +59,36 @@ def build_plan(spec: ArmSpec, method: str | None = None) -> Plan:
             near_structure = classify(near_chain)
             near_ik, _ = choose(near_chain, near_structure, spec.free, closed)
             if near_ik is not None:
-                ik, refusal = near_ik, ""
-                correction = make_correction(near, near_chain, frames)
-                facts = tuple(
-                    f"{fact} (nominal table)" for fact in near_structure.describe(chain.dof)
-                )
+                fix = make_correction(near, near_chain, frames)
+                if fix.deviation <= NOMINAL_MAX:
+                    ik, refusal, correction = near_ik, "", fix
+                    facts = tuple(
+                        f"{fact} (nominal table)" for fact in near_structure.describe(chain.dof)
+                    )
+                else:  # (snapping that far changes the arm: its seeds would not reach)
+                    refusal = (
+                        f"the table within structure_tol {tol:g} of a special one moves the "
+                        f"arm by {fix.deviation:.3g} (at most {NOMINAL_MAX:g} is refined)"
+                    )
     if ik is None and general.NAME in names:
         ik, why = choose(chain, structure, spec.free, (general.NAME,))
         reasons = [r for r in (refusal, why) if r]
         refusal = "; ".join(dict.fromkeys(reasons)) if ik is None else ""
-    if ik is not None and correction is None and spec.exact is not None:
+    if correction is None and spec.exact is not None:
         # the table is the nominal one of the [exact] frames (a URDF's, snapped)
         correction = make_correction(Nominal(spec, (), 0.0), chain, frames)
-        if correction.deviation <= EXACT_ENOUGH:
+        if correction.deviation > NOMINAL_MAX:
+            raise SpecError(
+                f"{spec.source}: exact.frames: the arm they describe differs from the table's "
+                f"by {correction.deviation:.3g} in forward kinematics (allowed {NOMINAL_MAX:g}:"
+                " rotation entries, positions over the reach); the table must describe the "
+                "same arm (were rows, [base] or [tool] edited after derive import-urdf? import "
+                "the URDF again, or delete [exact])"
+            )
+        if correction.deviation <= EXACT_ENOUGH or ik is None:
             correction = None
+        else:
+            facts = tuple(f"{fact} (nominal table)" for fact in facts)
     pose = world_transform(chain, expand=False)
     if spec.exact is not None:
         pose = frames_pose(spec.exact, chain)
@@ -108,6 +124,10 @@ SEED_MAX = 0.1
 
 # a table within this of its exact frames (rounding) needs no refinement
 EXACT_ENOUGH = 1e-13
+# a nominal table farther than this from the arm (forward kinematics: rotation entries,
+# positions over the reach) is not refined from: its seeds need not reach the arm's
+# solutions (calibrations move an arm by about 1e-3, a URDF's rounding by 1e-5)
+NOMINAL_MAX = 1e-2
 
 
 def make_correction(

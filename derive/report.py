@@ -660,7 +660,7 @@ def correction_blocks(plan: Plan) -> list[Block]:
         Block(
             "p",
             "Where an equation of the nominal arm just misses (an acos argument above 1 by at "
-            f"at most {fix.seed_tol:.2g}, a double root split off the real line by at most "
+            f"most {fix.seed_tol:.2g}, a double root split off the real line by at most "
             f"{math.sqrt(fix.seed_tol):.2g}) its boundary value still seeds a refinement: the "
             "exact arm may reach what the nominal one does not.",
         ),

@@ -377,7 +377,7 @@ def _exact(table: object, where: str, dof: int) -> tuple[tuple[float, ...], ...]
         # (any magnitude up to MAX_MAGNITUDE: the frames are only computed with, never
         # derived from, and a URDF's rotations hold rounding noise such as 6e-17)
         flat = tuple(_frame_entry(v, where, f"{field}[{k}]") for k, v in enumerate(frame))
-        _check_rigid((*flat, 0.0, 0.0, 0.0, 1.0), where, field)
+        _check_rigid((*flat, 0.0, 0.0, 0.0, 1.0), where, field, "")
         out.append(flat)
     return tuple(out)
 
@@ -388,7 +388,9 @@ def _structure_tol(table: object, where: str) -> float | None:
         return None
     value = table["structure_tol"]
     lo, hi = STRUCTURE_TOL_RANGE
-    if type(value) not in (int, float) or not lo <= value <= hi:
+    if type(value) not in (int, float):
+        raise SpecError(f"{where}: ik.structure_tol: must be a number (got {type(value).__name__})")
+    if not lo <= value <= hi:
         raise SpecError(
             f"{where}: ik.structure_tol: {str(value)[:40]} is not allowed; a number from "
             f"{lo:g} to {hi:g} (radians for twists, a fraction of the arm's size for lengths)"
@@ -595,17 +597,17 @@ def _frame(table: object, where: str, field: str, angle_unit: str) -> Frame | No
     return Frame(None, (x, y, z), (roll, pitch, yaw))
 
 
-def _check_rigid(flat: tuple[float, ...], where: str, field: str) -> None:
+def _check_rigid(flat: tuple[float, ...], where: str, field: str, key: str = ".matrix") -> None:
     """Reject a matrix that is not [R t; 0 0 0 1] with R orthonormal and det R = +1."""
     if flat[12:] != (0.0, 0.0, 0.0, 1.0):
-        raise SpecError(f"{where}: {field}.matrix: last row must be [0, 0, 0, 1]")
+        raise SpecError(f"{where}: {field}{key}: last row must be [0, 0, 0, 1]")
     rot = [flat[0:3], flat[4:7], flat[8:11]]
     for i in range(3):
         for j in range(3):
             dot = sum(rot[k][i] * rot[k][j] for k in range(3))
             if abs(dot - (1.0 if i == j else 0.0)) > RIGID_TOL:
                 raise SpecError(
-                    f"{where}: {field}.matrix: rotation part is not orthonormal "
+                    f"{where}: {field}{key}: rotation part is not orthonormal "
                     f"(tolerance {RIGID_TOL}); a rigid transform is required"
                 )
     det = (
@@ -615,6 +617,6 @@ def _check_rigid(flat: tuple[float, ...], where: str, field: str) -> None:
     )
     if det < 0:
         raise SpecError(
-            f"{where}: {field}.matrix: rotation part is a reflection (det -1); "
+            f"{where}: {field}{key}: rotation part is a reflection (det -1); "
             "a rigid transform is required"
         )

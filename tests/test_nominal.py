@@ -135,7 +135,7 @@ def test_structure_tol_is_checked(value, ok):
     if ok:
         assert parse_spec(text, "<t>").structure_tol == float(value)
     else:
-        with pytest.raises(SpecError, match=r"ik\.structure_tol: .* is not allowed; a number"):
+        with pytest.raises(SpecError, match=r"ik\.structure_tol: (.* is not allowed; a|must be a)"):
             parse_spec(text, "<t>")
 
 
@@ -415,3 +415,26 @@ def test_ik_approximate_gives_the_nearest_configurations_out_of_reach(name, gene
             assert max(abs(float(np.dot(c, error))) for c in columns) <= 1e-9
         tested += 1
     assert tested >= 3
+
+
+def test_exact_frames_that_are_not_the_table_s_arm_are_refused():
+    """An [exact] table must describe the table's arm (say, a [tool] edited after
+    import-urdf would otherwise be ignored, the frames overriding it)."""
+    frames = "\n".join(["[exact]", "frames = ["] + ["[1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, "
+                        "0.0, 0.0, 1.0, 0.0],"] * 7 + ["]"])  # fmt: skip
+    spec = parse_spec(calibrated("ur5") + "\n" + frames + "\n", "my.toml")
+    with pytest.raises(SpecError, match=r"my\.toml: exact\.frames: the arm they describe differs"):
+        build_plan(spec)
+
+
+def test_a_structure_tol_that_moves_the_arm_far_is_not_refined_from():
+    text = calibrated("ur5").replace('name = "ur5_cal"', 'name = "ur5_far"')
+    spec = parse_spec(text + "\n[ik]\nstructure_tol = 0.1\n", "<test>")
+    plan = build_plan(spec, method="three-parallel")  # (the general method would answer)
+    assert plan.ik is None and plan.correction is None
+    assert "moves the arm by" in plan.refusal and "at most 0.01 is refined" in plan.refusal
+
+
+def test_structure_tol_of_the_wrong_type_says_so():
+    with pytest.raises(SpecError, match=r"ik\.structure_tol: must be a number \(got str\)"):
+        parse_spec(calibrated("ur5") + '\n[ik]\nstructure_tol = "1e-3"\n', "<t>")
