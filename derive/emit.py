@@ -210,7 +210,6 @@ def correction_constants(plan: Plan) -> str:
     nominal table where there is one; "" without IK."""
     if plan.ik is None:
         return ""
-    solved = tuple(i for i in range(plan.arm.dof) if i + 1 not in plan.ik.free)
     fix = plan.correction
     nominal = ""
     if fix is not None:
@@ -227,7 +226,7 @@ def correction_constants(plan: Plan) -> str:
         "# Tz(q_i) (P); each F_i's top three rows, row-major\n"
         f"_CHAIN = {_frames_literal(plan.frames)}\n"
         "# the joints (0-based) Newton's steps on it move (free joints keep the caller's values)\n"
-        f"_SOLVED = {solved!r}\n"
+        f"_SOLVED = {plan.solved!r}\n"
     )
 
 

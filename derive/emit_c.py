@@ -177,10 +177,8 @@ def print_c(plan: Plan) -> PrintedC:
         solve=solve,
         seamed=bool(c.seamed_outputs(plan)),
         seed_tol=repr(plan.correction.seed_tol) if plan.correction else "0.0",
-        chain=tuple(", ".join(map(repr, f)) for f in plan.correction.frames)
-        if plan.correction
-        else (),
-        solved=tuple(i for i in range(arm.dof) if i + 1 not in ik.free) if plan.correction else (),
+        chain=tuple(", ".join(map(repr, f)) for f in plan.frames) if plan.correction else (),
+        solved=plan.solved if plan.correction else (),
         refine_rows=3 if ik.certify == "position" else 6,
     )
 

@@ -92,9 +92,9 @@ def chain_frames(chain: Chain) -> tuple[tuple[float, ...], ...]:
     at_zero = []
     for j in chain.joints:
         if j.kind == "R":
-            at_zero.append(rot_z(*_cos_sin(j.offset)) * trans(0, 0, j.d))
+            at_zero.append(rot_z(*sym.cos_sin(j.offset)) * trans(0, 0, j.d))
         else:
-            at_zero.append(rot_z(*_cos_sin(j.theta)) * trans(0, 0, j.offset))
+            at_zero.append(rot_z(*sym.cos_sin(j.theta)) * trans(0, 0, j.offset))
     n = chain.dof
     frames = []
     for i in range(n + 1):
@@ -138,10 +138,6 @@ def _exact_matrix(m: np.ndarray) -> sp.Matrix:
         return sp.Float(float(v), 17)
 
     return sp.Matrix(4, 4, [number(v) for v in m.reshape(-1)])
-
-
-def _cos_sin(angle: sp.Expr) -> tuple[sp.Expr, sp.Expr]:
-    return sp.cos(angle), sp.sin(angle)
 
 
 def frames_fk(frames: tuple[tuple[float, ...], ...], kinds: str, Q: np.ndarray) -> np.ndarray:

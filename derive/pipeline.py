@@ -141,7 +141,6 @@ def make_correction(
         changes=near.changes,
         tol=near.tol,
         deviation=moved,
-        frames=frames,
         seed_tol=min(SEED_MAX, max(1e-9, SEED_FACTOR * moved)),
     )
 

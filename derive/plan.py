@@ -316,8 +316,8 @@ class Correction:
         changes: one line per parameter snapping changed.
         tol: the structure tolerance.
         deviation: the largest forward-kinematics difference of the nominal arm from the
-            exact one (rotation entries; positions divided by the reach).
-        frames: the exact chain's fixed frames F_0 .. F_n (12 floats each).
+            exact one (rotation entries; positions divided by the reach; the exact chain is
+            the plan's frames).
         seed_tol: how far the nominal solver's equations may miss (relative) and still seed
             a refinement: an acos argument up to 1 + seed_tol, a root up to sqrt(seed_tol)
             off the real line.
@@ -327,7 +327,6 @@ class Correction:
     changes: tuple[str, ...]
     tol: float
     deviation: float
-    frames: tuple[tuple[float, ...], ...]
     seed_tol: float
 
 
@@ -358,3 +357,10 @@ class Plan:
     refusal: str = ""
     correction: Correction | None = None
     frames: tuple[tuple[float, ...], ...] = ()
+
+    @property
+    def solved(self) -> tuple[int, ...]:
+        """The joints (0-based) Newton's steps on the exact chain move: all but the free
+        ones."""
+        free = self.ik.free if self.ik else ()
+        return tuple(i for i in range(self.arm.dof) if i + 1 not in free)

@@ -592,18 +592,8 @@ def ik_approximate(
         # solve at; then q_ref's configuration is the one seed)
         seeds = seeds or [_free_turns(refs)]
         rows = _as_rows(_finish([_least_squares(q, target) for q in seeds]))
-    residual = np.array([_residual(target, q) for q in rows.tolist()])
+    residual = np.array([_pose_error(q, target, False)[2] for q in rows.tolist()])
     return rows, residual, residual <= _tolerance(tol)
-
-
-def _residual(t, q):
-    """The largest difference of the pose of q from t (12 top entries): positions divided
-    by REACH; rotation entries unless the arm is solved for its position."""
-    e = _fk_q(q)
-    size = max(abs(e[k] - t[k]) for k in (3, 7, 11)) / REACH
-    if IK_COMPONENTS == "pose":
-        size = max(size, *(abs(e[k] - t[k]) for k in (0, 1, 2, 4, 5, 6, 8, 9, 10)))
-    return size
 
 
 def _array44(T):
