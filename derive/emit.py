@@ -260,8 +260,10 @@ def correction_text(plan: Plan) -> str:
         f"NOMINAL_DEVIATION = {fix.deviation:.2g}. Newton's steps refine every solution onto "
         "_CHAIN; fk, and the certification of every row, are the exact chain's. Rows keep the "
         "nominal arm's branch order. An arm this close to a special one can have more real "
-        "solutions than it near some poses; those the nominal arm lacks are not returned "
-        "(derive generate --method general gives the complete set, slower)."
+        "solutions than it near some poses. Where a nominal equation fixes a joint only "
+        "roughly (two links of nearly equal length folded back), seeds all round find them "
+        "(up to 16 rows); elsewhere those the nominal arm lacks are not returned (derive "
+        "generate --method general gives the complete set, slower)."
     )
 
 

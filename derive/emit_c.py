@@ -205,6 +205,7 @@ def render_c(plan: Plan) -> dict[str, str]:
         "m": printed,
         "generator": GENERATOR,
         "poly_max": poly_max(plan),
+        "values_max": max(poly_max(plan), constants._SPREAD_COUNT if plan.correction else 0),
         "arm_general": general,
     }
     arm = env.get_template("arm.c.j2")

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import math
 
 import sympy as sp
@@ -89,6 +90,17 @@ def build_plan(spec: ArmSpec, method: str | None = None) -> Plan:
             correction = None
         else:
             facts = tuple(f"{fact} (nominal table)" for fact in facts)
+    if (
+        correction is not None
+        and ik is not None
+        and ik.certify == "pose"
+        and chain.dof - len(ik.free) == 6
+        and ik.max_solutions < GENERAL_MOST
+    ):
+        # the exact arm is a general 6R one: more solutions than its nominal's where they are
+        # close (a calibrated PUMA has 11 with its elbow folded back, its wrist centre near
+        # axis 2), at most 16
+        ik = dataclasses.replace(ik, max_solutions=GENERAL_MOST)
     pose = world_transform(chain, expand=False)
     if spec.exact is not None:
         pose = frames_pose(spec.exact, chain)
@@ -122,6 +134,8 @@ SEED_FACTOR = 100.0
 SEED_MAX = 0.1
 
 
+# the most solutions of a 6R arm's pose (a general one's: Lee and Liang, Raghavan and Roth)
+GENERAL_MOST = 16
 # a table within this of its exact frames (rounding) needs no refinement
 EXACT_ENOUGH = 1e-13
 # a nominal table farther than this from the arm (forward kinematics: rotation entries,

@@ -9,6 +9,8 @@
 
 /* the size of the polynomial steps' arrays: the most roots one of this arm's polynomials has */
 #define DK_POLY_MAX 4
+/* the most values one joint's step gives (the polynomials' roots; a nominal fold's seeds) */
+#define DK_VALUES_MAX 4
 /* how far the solver's equations may miss and still seed a refinement onto the exact chain
    (0: the closed form solves the arm's own table) */
 #define DK_SEED_TOL (0.0)
@@ -45,6 +47,10 @@
 
 #define DK_TWO_PI (6.283185307179586)
 
+#define DK_SPREAD_WIDTH (0.2)
+
+#define DK_SPREAD_COUNT 8
+
 /* the values a free joint tries, as offsets from its first value: 0, +5, -5, +10, ... deg */
 #define DK_FREE_COUNT 72
 
@@ -69,13 +75,14 @@ static const double DK_FREE_STEPS[DK_FREE_COUNT] = {
     -2.9670597283903604, 3.0543261909900767, -3.0543261909900767, 3.141592653589793
 };
 
-/* The values of one joint: at most 4 (a quartic's roots), or a free joint's DK_FREE_COUNT
-   values stepped out from ref (one value, ref, for a free length). */
+/* The values of one joint: at most DK_VALUES_MAX (a polynomial's roots; a nominal fold's
+   DK_SPREAD_COUNT seeds), or a free joint's DK_FREE_COUNT values stepped out from ref (one
+   value, ref, for a free length). */
 typedef struct {
     int n;
     int free;
     double ref;
-    double t[DK_POLY_MAX], c[DK_POLY_MAX], s[DK_POLY_MAX];
+    double t[DK_VALUES_MAX], c[DK_VALUES_MAX], s[DK_VALUES_MAX];
 } dk_values;
 
 static void dk_value(const dk_values *v, int k, double *t, double *c, double *s)
@@ -1128,6 +1135,17 @@ static int dk_cs1(dk_values *v, double a, double b, double e, double scale, doub
         return 0;
     }
     if (rho == 0.0) {
+        return 0;
+    }
+    if (rho <= DK_SPREAD_WIDTH * DK_SEED_TOL * sqrt(scale)) { /* a nominal fold: seeds all round */
+        const double first = atan2(b, a);
+        int k;
+        v->n = DK_SPREAD_COUNT < DK_VALUES_MAX ? DK_SPREAD_COUNT : DK_VALUES_MAX;
+        for (k = 0; k < v->n; k++) {
+            v->t[k] = first + DK_TWO_PI * k / DK_SPREAD_COUNT;
+            v->c[k] = cos(v->t[k]);
+            v->s[k] = sin(v->t[k]);
+        }
         return 0;
     }
     inverse = 1.0 / rho;

@@ -216,6 +216,16 @@ _FREE_STEPS = tuple(math.radians(5.0 * ((k + 1) // 2) * (1 if k % 2 else -1)) fo
 _TWO_PI = 2.0 * math.pi
 
 
+# A nominal table's a cos + b sin = e whose a and b nearly cancel (two links of nearly equal
+# length folded back) fixes the angle only roughly: within _SPREAD_WIDTH _SEED_TOL sqrt(scale)
+# of sqrt(a^2 + b^2) = 0 the arm's difference can move it anywhere, and _SPREAD_COUNT seeds
+# all round the circle go to the refinement onto the exact arm
+_SPREAD_WIDTH = 0.2
+
+
+_SPREAD_COUNT = 8
+
+
 # The seam: rounding puts a joint at pi on either side of it, and one solution would get two
 # values a full turn apart. A revolute value within _SEAM_BAND above -pi is returned as its
 # equivalent just above pi (the value is kept; only the turn changes), and one within
@@ -1129,8 +1139,10 @@ def _free(t: float) -> _Free:
 def _cs1(a: float, b: float, e: float, scale: float = 0.0, ref: float = 0.0) -> tuple[float, ...]:
     """Angles t with a cos t + b sin t = e: atan2(b, a) +- acos(e / sqrt(a^2 + b^2)), the
     acos argument clamped when it exceeds 1 by at most _CLAMP_TOL (and _SEED_TOL: a nominal
-    table's equation seeds the refinement onto the exact arm at its boundary), and taken as
-    +-1 within _FOLD_TOL below (the double root).
+    table's equation seeds the refinement onto the exact arm at its boundary; where
+    sqrt(a^2 + b^2) itself is within _SPREAD_WIDTH _SEED_TOL sqrt(scale), as where two links
+    of nearly equal length fold back, _SPREAD_COUNT seeds all round), and taken as +-1 within
+    _FOLD_TOL below (the double root).
 
     When a^2 + b^2 and e^2 are both at most _FREE_TOL * scale the equation holds for every
     t (the angle is free; e.g. the elbow folded onto axis 1): _free(ref).
@@ -1140,6 +1152,9 @@ def _cs1(a: float, b: float, e: float, scale: float = 0.0, ref: float = 0.0) -> 
         return _free(ref) if e * e <= _FREE_TOL * scale or _LOOSE.on else ()
     if rho == 0.0:
         return (ref,) if _LOOSE.on else ()
+    if rho <= _SPREAD_WIDTH * _SEED_TOL * sqrt(scale) and not _LOOSE.on:
+        first = atan2(b, a)  # (a nominal fold: seeds all round)
+        return tuple(first + _TWO_PI * k / _SPREAD_COUNT for k in range(_SPREAD_COUNT))
     ratio = e / rho
     if abs(ratio) > 1.0 + _CLAMP_TOL + _SEED_TOL and not _LOOSE.on:
         return ()

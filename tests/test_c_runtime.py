@@ -14,7 +14,7 @@ import pytest
 from derive import emit_c
 from derive.assemble import assemble_c, c_runtime_pieces, split_c
 from derive.cbuild import WARNINGS, c_compiler
-from derive.runtime import closed, constants, general
+from derive.runtime import closed, constants, general, refine
 
 from conftest import GENERATED, needs_cc
 
@@ -60,8 +60,12 @@ def test_the_c_runtime_holds_the_python_runtimes_constants():
         assert float(found[f"DK_{name}"]) == getattr(constants, f"_{name}"), name
     for name in ("CLUSTER_TOL", "RESIDUAL_TOL", "SEAM", "SEAM_SNAP"):
         assert float(found[f"DK_{name}"]) == getattr(constants, f"_{name}"), name
+    for name in ("SPREAD_WIDTH", "SPREAD_COUNT"):
+        assert float(found[f"DK_{name}"]) == getattr(constants, f"_{name}"), name
     for name in ("DEDUP_TOL", "POSE_TOL"):
         assert float(found[f"DK_{name}"]) == getattr(constants, name), name
+    for name in ("STEPS", "STRIDE", "DONE", "PATIENCE", "LAST", "TRUST", "TOL"):
+        assert float(found[f"DK_REFINE_{name}"]) == getattr(refine, f"_REFINE_{name}"), name
     assert float(found["DK_PI"]) == np.pi and float(found["DK_TWO_PI"]) == 2 * np.pi
     assert table(runtime, "DK_FREE_STEPS").tolist() == list(constants._FREE_STEPS)
     assert table(runtime, "DK_ANGLE_AT").tolist() == list(closed._ANGLE_AT)

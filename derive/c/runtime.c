@@ -22,6 +22,8 @@
 #define DK_SEAM_SNAP (1e-12)
 #define DK_PI (3.141592653589793)
 #define DK_TWO_PI (6.283185307179586)
+#define DK_SPREAD_WIDTH (0.2)
+#define DK_SPREAD_COUNT 8
 
 /* the values a free joint tries, as offsets from its first value: 0, +5, -5, +10, ... deg */
 #define DK_FREE_COUNT 72
@@ -46,13 +48,14 @@ static const double DK_FREE_STEPS[DK_FREE_COUNT] = {
     -2.9670597283903604, 3.0543261909900767, -3.0543261909900767, 3.141592653589793
 };
 
-/* The values of one joint: at most 4 (a quartic's roots), or a free joint's DK_FREE_COUNT
-   values stepped out from ref (one value, ref, for a free length). */
+/* The values of one joint: at most DK_VALUES_MAX (a polynomial's roots; a nominal fold's
+   DK_SPREAD_COUNT seeds), or a free joint's DK_FREE_COUNT values stepped out from ref (one
+   value, ref, for a free length). */
 typedef struct {
     int n;
     int free;
     double ref;
-    double t[DK_POLY_MAX], c[DK_POLY_MAX], s[DK_POLY_MAX];
+    double t[DK_VALUES_MAX], c[DK_VALUES_MAX], s[DK_VALUES_MAX];
 } dk_values;
 
 static void dk_value(const dk_values *v, int k, double *t, double *c, double *s)
@@ -1158,6 +1161,17 @@ static int dk_cs1(dk_values *v, double a, double b, double e, double scale, doub
     if (rho == 0.0) {
         return 0;
     }
+    if (rho <= DK_SPREAD_WIDTH * DK_SEED_TOL * sqrt(scale)) { /* a nominal fold: seeds all round */
+        const double first = atan2(b, a);
+        int k;
+        v->n = DK_SPREAD_COUNT < DK_VALUES_MAX ? DK_SPREAD_COUNT : DK_VALUES_MAX;
+        for (k = 0; k < v->n; k++) {
+            v->t[k] = first + DK_TWO_PI * k / DK_SPREAD_COUNT;
+            v->c[k] = cos(v->t[k]);
+            v->s[k] = sin(v->t[k]);
+        }
+        return 0;
+    }
     inverse = 1.0 / rho;
     ratio = e * inverse;
     if (fabs(ratio) > 1.0 + DK_CLAMP_TOL + DK_SEED_TOL) {
@@ -1340,12 +1354,14 @@ static int dk_pose_ok(const double T[16])
    components: the arm's, defined before the runtime) at most this many steps per candidate; a
    step longer than DK_REFINE_STRIDE is shortened to it; done at DK_REFINE_DONE, given up after
    DK_REFINE_PATIENCE steps in a row that do not reduce the error; the step from an error
-   within DK_REFINE_LAST (that reduced it) is the last */
+   within DK_REFINE_LAST (that reduced it) is the last, if it is within DK_REFINE_TRUST times
+   that error (near a singular configuration Newton's step can be long, and miss) */
 #define DK_REFINE_STEPS 60
 #define DK_REFINE_STRIDE (0.5)
 #define DK_REFINE_DONE (1e-14)
 #define DK_REFINE_PATIENCE 10
 #define DK_REFINE_LAST (1e-10)
+#define DK_REFINE_TRUST (100.0)
 /* a refined row is kept if its pose error is within the smaller of this and ik's tol */
 #define DK_REFINE_TOL (1e-10)
 
@@ -1384,6 +1400,30 @@ static int dk_cholesky_solve(double A[DK_REFINE_M][DK_REFINE_M], double x[DK_REF
         x[i] /= A[i][i];
     }
     return 1;
+}
+
+/* whether q is one of the first n rows of found (within DK_DEDUP_TOL, revolute joints a full
+   turn apart the same): seeds that refine onto one solution (a nominal fold's seeds all round)
+   take one of the solver's DK_MAX places, not several */
+static int dk_seen(const double (*found)[DK_REFINE_N], int n, const int revolute[DK_REFINE_N],
+                   const double q[DK_REFINE_N])
+{
+    int r, j;
+    for (r = 0; r < n; r++) {
+        double worst = 0.0;
+        for (j = 0; j < DK_REFINE_N; j++) {
+            double d = fabs(q[j] - found[r][j]);
+            if (revolute[j]) {
+                d = fmod(d, DK_TWO_PI);
+                d = d > DK_PI ? DK_TWO_PI - d : d;
+            }
+            worst = d > worst ? d : worst;
+        }
+        if (worst <= DK_DEDUP_TOL) {
+            return 1;
+        }
+    }
+    return 0;
 }
 
 /* Newton's steps, damped by the error's square, on the chain of fixed frames (12 entries each:
@@ -1508,7 +1548,8 @@ static double dk_refine(const double chain[DK_REFINE_N + 1][12], const int revol
             cur[solved[k]] += longest > DK_REFINE_STRIDE ? step[k] * (DK_REFINE_STRIDE / longest)
                                                          : step[k];
         }
-        if (last) { /* (Newton's step from there: the error squared, not measured) */
+        if (last && longest <= DK_REFINE_TRUST * size) { /* (Newton's step from there: the
+                                                            error squared, not measured) */
             for (i = 0; i < DK_REFINE_N; i++) {
                 q[i] = cur[i];
             }

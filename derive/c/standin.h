@@ -6,6 +6,7 @@
 #include <stddef.h>
 
 #define DK_POLY_MAX 6
+#define DK_VALUES_MAX 8
 #define DK_SEED_TOL (0.0)
 #define DK_REFINE_N 2
 #define DK_REFINE_M 2

@@ -371,7 +371,7 @@ def solve_lines(plan: Plan) -> tuple[tuple[int, str], ...]:
             Line(
                 depth + 1,
                 "if (dk_refine(DK_CHAIN, DK_REVOLUTE, DK_SOLVED, DK_REACH, t, dk_q) <= "
-                "fmin(tol, DK_REFINE_TOL)) {",
+                "fmin(tol, DK_REFINE_TOL) && !dk_seen(found, n, DK_REVOLUTE, dk_q)) {",
             )
         )
         body += [Line(depth + 2, f"found[n][{k}] = dk_q[{k}];") for k in range(len(outputs))]

@@ -26,6 +26,12 @@ _FREE_TOL = 1e-14  # squared sizes: a joint is free below 1e-7 of its equation's
 # the values a free joint tries, as offsets from its preferred value: 0, +5, -5, +10, ... deg
 _FREE_STEPS = tuple(math.radians(5.0 * ((k + 1) // 2) * (1 if k % 2 else -1)) for k in range(72))
 _TWO_PI = 2.0 * math.pi
+# A nominal table's a cos + b sin = e whose a and b nearly cancel (two links of nearly equal
+# length folded back) fixes the angle only roughly: within _SPREAD_WIDTH _SEED_TOL sqrt(scale)
+# of sqrt(a^2 + b^2) = 0 the arm's difference can move it anywhere, and _SPREAD_COUNT seeds
+# all round the circle go to the refinement onto the exact arm
+_SPREAD_WIDTH = 0.2
+_SPREAD_COUNT = 8
 # The seam: rounding puts a joint at pi on either side of it, and one solution would get two
 # values a full turn apart. A revolute value within _SEAM_BAND above -pi is returned as its
 # equivalent just above pi (the value is kept; only the turn changes), and one within

@@ -30,6 +30,9 @@ _REFINE_STRIDE = 0.5
 _REFINE_DONE = 1e-14
 _REFINE_PATIENCE = 10
 _REFINE_LAST = 1e-10
+# ... if it is at most this many times that error long (else measured: near a singular
+# configuration Newton's step can be long, and miss)
+_REFINE_TRUST = 100.0
 # a refined row is returned if its pose error is within the smaller of this and ik's tol
 _REFINE_TOL = 1e-10
 # ik_approximate's least squares: at most this many steps, done where the gradient of half
@@ -78,8 +81,8 @@ def _refine(q, t):
         shrink = _REFINE_STRIDE / longest if longest > _REFINE_STRIDE else 1.0
         for k, i in enumerate(_SOLVED):
             cur[i] += step[k] * shrink
-        if last:  # (Newton's step from there: the error squared, not measured)
-            best = cur
+        if last and longest <= _REFINE_TRUST * size:
+            best = cur  # (Newton's step from there: the error squared, not measured)
             break
     return tuple(best), best_size
 

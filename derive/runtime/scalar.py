@@ -28,6 +28,9 @@ from derive.runtime.constants import (
     _LEAD_TOL,
     _MERGE_TOL,
     _ROOT_IMAG_TOL,
+    _SPREAD_COUNT,
+    _SPREAD_WIDTH,
+    _TWO_PI,
 )
 
 
@@ -55,8 +58,10 @@ def _free(t: float) -> _Free:
 def _cs1(a: float, b: float, e: float, scale: float = 0.0, ref: float = 0.0) -> tuple[float, ...]:
     """Angles t with a cos t + b sin t = e: atan2(b, a) +- acos(e / sqrt(a^2 + b^2)), the
     acos argument clamped when it exceeds 1 by at most _CLAMP_TOL (and _SEED_TOL: a nominal
-    table's equation seeds the refinement onto the exact arm at its boundary), and taken as
-    +-1 within _FOLD_TOL below (the double root).
+    table's equation seeds the refinement onto the exact arm at its boundary; where
+    sqrt(a^2 + b^2) itself is within _SPREAD_WIDTH _SEED_TOL sqrt(scale), as where two links
+    of nearly equal length fold back, _SPREAD_COUNT seeds all round), and taken as +-1 within
+    _FOLD_TOL below (the double root).
 
     When a^2 + b^2 and e^2 are both at most _FREE_TOL * scale the equation holds for every
     t (the angle is free; e.g. the elbow folded onto axis 1): _free(ref).
@@ -66,6 +71,9 @@ def _cs1(a: float, b: float, e: float, scale: float = 0.0, ref: float = 0.0) -> 
         return _free(ref) if e * e <= _FREE_TOL * scale or _LOOSE.on else ()
     if rho == 0.0:
         return (ref,) if _LOOSE.on else ()
+    if rho <= _SPREAD_WIDTH * _SEED_TOL * sqrt(scale) and not _LOOSE.on:
+        first = atan2(b, a)  # (a nominal fold: seeds all round)
+        return tuple(first + _TWO_PI * k / _SPREAD_COUNT for k in range(_SPREAD_COUNT))
     ratio = e / rho
     if abs(ratio) > 1.0 + _CLAMP_TOL + _SEED_TOL and not _LOOSE.on:
         return ()
