@@ -14,6 +14,7 @@ import resource
 import sys
 import tempfile
 import time
+from collections.abc import Callable
 from functools import partial
 from pathlib import Path
 from types import ModuleType
@@ -22,7 +23,7 @@ from typing import TYPE_CHECKING, Any, NoReturn
 if TYPE_CHECKING:
     from collections.abc import Iterable
 
-from derive import extras, urdf
+from derive import extras, mjcf, urdf
 from derive.emit import GenerationError, render_module
 from derive.inputs import bundled_specs, resolve_spec
 from derive.languages import LANGUAGES, figure_files, is_planar, worked_example
@@ -809,8 +810,21 @@ def parser() -> argparse.ArgumentParser:
     )
     imp.add_argument("-o", "--output", help=f"write the spec to this file ({TEXT_OUTPUT})")
     imp.set_defaults(run=cmd_import_urdf)
-    for command in (gen, chk, fk, solve, plot, space, reach, report, bench, build, imp):
-        add_urdf_arguments(command, required=command is imp)
+    imj = sub.add_parser(
+        "import-mjcf",
+        help="write the spec of an MJCF (MuJoCo XML) chain from base to tip body (extra: mjcf)",
+    )
+    imj.add_argument("mjcf", help="the MJCF file (MuJoCo's compiler reads it)")
+    imj.add_argument(
+        "--convention",
+        choices=("modified", "standard"),
+        default="modified",
+        help="DH convention of the spec (modified)",
+    )
+    imj.add_argument("-o", "--output", help=f"write the spec to this file ({TEXT_OUTPUT})")
+    imj.set_defaults(run=cmd_import_mjcf)
+    for command in (gen, chk, fk, solve, plot, space, reach, report, bench, build, imp, imj):
+        add_urdf_arguments(command, required=command in (imp, imj))
     return top
 
 
@@ -828,9 +842,13 @@ def add_pose_arguments(command: argparse.ArgumentParser) -> None:
 
 def add_urdf_arguments(command: argparse.ArgumentParser, required: bool) -> None:
     """The options of a URDF's conversion (used where an arm is a .urdf file)."""
-    group = command.add_argument_group("URDF input (ARM.urdf)")
-    group.add_argument("--base", required=required, help="the URDF link the chain starts from")
-    group.add_argument("--tip", required=required, help="the URDF link the chain ends at")
+    group = command.add_argument_group("URDF or MJCF input (ARM.urdf, ARM.xml)")
+    group.add_argument(
+        "--base", required=required, help="the URDF link (MJCF body) the chain starts from"
+    )
+    group.add_argument(
+        "--tip", required=required, help="the URDF link (MJCF body) the chain ends at"
+    )
     group.add_argument("--name", help="the arm's name (default: the URDF robot's)")
     group.add_argument(
         "--angle-tol",
@@ -855,15 +873,30 @@ def add_urdf_arguments(command: argparse.ArgumentParser, required: bool) -> None
 
 def cmd_import_urdf(args: argparse.Namespace) -> int:
     """Write (or print) the spec of a URDF chain; say what the conversion did on stderr."""
+    return write_import(args, args.urdf, "URDF", urdf.import_urdf)
+
+
+def cmd_import_mjcf(args: argparse.Namespace) -> int:
+    """Write (or print) the spec of an MJCF chain; say what the conversion did on stderr."""
+    return write_import(args, args.mjcf, "MJCF", mjcf.import_mjcf)
+
+
+def write_import(
+    args: argparse.Namespace,
+    source: str,
+    kind: str,
+    convert: Callable[[Path, urdf.Options], tuple[str, urdf.Conversion]],
+) -> int:
+    """import-urdf's and import-mjcf's work: the spec to the output, the record to stderr."""
     output = text_output(args.output)
-    text, conversion = urdf.import_urdf(Path(args.urdf), urdf_options(args))
+    text, conversion = convert(Path(source), urdf_options(args))
     if output is not None:
         write_atomic(output, text)
     else:
         sys.stdout.write(text)
     snaps = f"{len(conversion.snaps)} snap(s)" if conversion.snaps else "no snapping"
     print(
-        f"{args.urdf}: {len(conversion.rows)} joints; {snaps}; FK deviation from the URDF "
+        f"{source}: {len(conversion.rows)} joints; {snaps}; FK deviation from the {kind} "
         f"{conversion.deviation:.2g} (of the reach, {urdf.SAMPLES} random joint vectors)",
         file=sys.stderr,
     )

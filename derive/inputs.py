@@ -7,7 +7,7 @@ from collections.abc import Callable
 from importlib import resources
 from pathlib import Path
 
-from derive import urdf
+from derive import mjcf, urdf
 from derive.spec import ArmSpec, SpecError, load_spec
 
 # a reader: the file and the URDF conversion options (the formats that convert take them)
@@ -20,7 +20,12 @@ def _spec_file(path: Path, options: urdf.Options) -> ArmSpec:
 
 
 # file suffix (lower case) -> reader
-READERS: dict[str, Reader] = {".toml": _spec_file, ".urdf": urdf.load_urdf}
+READERS: dict[str, Reader] = {
+    ".toml": _spec_file,
+    ".urdf": urdf.load_urdf,
+    ".xml": mjcf.load_mjcf,
+    ".mjcf": mjcf.load_mjcf,
+}
 
 
 def bundled_specs() -> list[Path]:
@@ -33,7 +38,8 @@ def bundled_specs() -> list[Path]:
 
 
 def resolve_spec(text: str, options: urdf.Options | None = None) -> ArmSpec:
-    """A spec from a file path (a URDF with options' base and tip), or a bundled arm by name."""
+    """A spec from a file path (a URDF or MJCF with options' base and tip), or a bundled arm
+    by name."""
     path = Path(text)
     reader = READERS.get(path.suffix.lower())
     if reader is not None:

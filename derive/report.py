@@ -136,20 +136,22 @@ def urdf_blocks(plan: Plan) -> list[Block]:
     origin = plan.arm.origin
     if origin is None:
         return []
-    rows = [("row", "URDF joint")] + [(str(k), name) for k, name in enumerate(origin.joints, 1)]
+    kind = origin.format
+    part = "body" if kind == "MJCF" else "link"
+    rows = [("row", f"{kind} joint")] + [(str(k), name) for k, name in enumerate(origin.joints, 1)]
     snaps = "; ".join(origin.snaps) if origin.snaps else "none"
     return [
-        Block("h3", "From the URDF"),
+        Block("h3", f"From the {kind}"),
         Block(
             "p",
-            f"Converted from {origin.urdf} (sha256 {origin.sha256}...), the chain from link "
-            f"{origin.base} to link {origin.tip}: base and tool frames above close it. Joint "
-            "values mean what they mean in the URDF.",
+            f"Converted from {origin.urdf} (sha256 {origin.sha256}...), the chain from {part} "
+            f"{origin.base} to {part} {origin.tip}: base and tool frames above close it. Joint "
+            f"values mean what they mean in the {kind}.",
         ),
         Block("table", rows=tuple(rows)),
         Block(
             "p",
-            f"Snaps applied: {snaps}. FK of this table against the URDF's on 200 random joint "
+            f"Snaps applied: {snaps}. FK of this table against the {kind}'s on 200 random joint "
             f"vectors: largest difference {origin.deviation:.2g} (rotation entries, and "
             "positions divided by the arm's size).",
         ),

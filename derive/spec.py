@@ -93,7 +93,9 @@ TOP_KEYS = (
 IK_KEYS = ("free", "structure_tol")
 # what [ik] structure_tol may be: beyond 0.1 rad or 0.1 of the arm's size it changes the arm
 STRUCTURE_TOL_RANGE = (0.0, 0.1)
-SOURCE_KEYS = ("urdf", "sha256", "base", "tip", "joints", "snaps", "deviation")
+SOURCE_KEYS = ("urdf", "sha256", "base", "tip", "joints", "snaps", "deviation", "format")
+# the formats a spec is converted from ([source] format; URDF when absent)
+SOURCE_FORMATS = ("URDF", "MJCF")
 # the text a [source] table may hold (it reaches the report, never the generated code)
 SOURCE_TEXT = re.compile(r"[A-Za-z0-9_ .,:;()+\-<>'=/]{1,200}")
 JOINT_KEYS = ("type", "alpha", "a", "d", "theta", "limits")
@@ -152,6 +154,8 @@ class Source:
         snaps: the snaps the conversion applied, one line each.
         deviation: the largest FK difference of the spec from the URDF (rotation entries,
             positions divided by the arm's size) on random joint values.
+        format: the file's format: "URDF", or "MJCF" (then urdf is the MJCF file's name,
+            base and tip are bodies).
     """
 
     urdf: str
@@ -161,6 +165,7 @@ class Source:
     joints: tuple[str, ...]
     snaps: tuple[str, ...]
     deviation: float
+    format: str = "URDF"
 
 
 @dataclass(frozen=True)
@@ -460,6 +465,10 @@ def _source(table: object, where: str, dof: int) -> Source | None:
         raise SpecError(
             f"{where}: source.deviation: {str(deviation)[:40]}; allowed: a number, 0 or more"
         )
+    kind = table.get("format", "URDF")
+    if kind not in SOURCE_FORMATS:
+        allowed = " | ".join(f'"{c}"' for c in SOURCE_FORMATS)
+        raise SpecError(f"{where}: source.format: {str(kind)[:40]!r}; allowed: {allowed}")
     return Source(
         urdf=text("urdf", table["urdf"]),
         sha256=sha,
@@ -468,6 +477,7 @@ def _source(table: object, where: str, dof: int) -> Source | None:
         joints=texts("joints", dof),
         snaps=texts("snaps", None),
         deviation=deviation,
+        format=kind,
     )
 
 

@@ -796,6 +796,8 @@ def spec_text(
     tip: str,
     name: str,
     convention: str = "modified",
+    kind: str = "URDF",
+    part: str = "link",
 ) -> str:
     """The spec as canonical TOML, with the conversion's record as comments and [source].
 
@@ -813,14 +815,14 @@ def spec_text(
         return repr(float(f"{x:.15g}")) if conversion.snaps or conversion.rounded else repr(x)
 
     lines = [
-        f"# Converted by derive-ik from the URDF {source!r} (sha256 {robot.digest}...),",
-        f"# robot {robot.name!r}, from link {base!r} to link {tip!r}. Joint values mean what",
-        "# they mean in the URDF (same axis direction, same zero).",
+        f"# Converted by derive-ik from the {kind} {source!r} (sha256 {robot.digest}...),",
+        f"# robot {robot.name!r}, from {part} {base!r} to {part} {tip!r}. Joint values mean what",
+        f"# they mean in the {kind} (same axis direction, same zero).",
     ]
     for snap in conversion.snaps:
         lines.append(f"# snapped: {snap}")
     lines.append(
-        f"# FK of this spec against the URDF's on {SAMPLES} random joint vectors: largest "
+        f"# FK of this spec against the {kind}'s on {SAMPLES} random joint vectors: largest "
         f"difference {conversion.deviation:.2g}"
     )
     lines.append("# (rotation entries, and positions divided by the arm's size)")
@@ -834,19 +836,19 @@ def spec_text(
     if convention == "standard":
         twists = [(r[1], r[2]) for r in rows[1:]] + [(0.0, 0.0)]
         rows = [(r[0], t[0], t[1], r[3], r[4], r[5]) for r, t in zip(rows, twists)]
-    for k, (kind, alpha, a, d, theta, limits) in enumerate(rows):
+    for k, (joint_type, alpha, a, d, theta, limits) in enumerate(rows):
         lines += [
             "",
-            f"# row {k + 1}: URDF joint {conversion.joint_names[k]!r}",
+            f"# row {k + 1}: {kind} joint {conversion.joint_names[k]!r}",
             "[[joint]]",
-            f'type = "{kind}"',
+            f'type = "{joint_type}"',
             f"alpha = {number(math.degrees(alpha))}",
             f"a = {number(a)}",
             f"d = {number(d)}",
             f"theta = {number(math.degrees(theta))}",
         ]
         if limits is not None:
-            lo, hi = (math.degrees(v) for v in limits) if kind == "R" else limits
+            lo, hi = (math.degrees(v) for v in limits) if joint_type == "R" else limits
             lines.append(f"limits = [{number(lo)}, {number(hi)}]")
     for title, matrix in (("base", conversion.base), ("tool", conversion.tool)):
         entries = ", ".join("[" + ", ".join(number(v) for v in row) + "]" for row in matrix)
@@ -858,7 +860,7 @@ def spec_text(
     if conversion.snaps:
         lines += [
             "",
-            "# the URDF's own geometry: the table above is snapped (its structure picks the",
+            f"# the {kind}'s own geometry: the table above is snapped (its structure picks the",
             "# closed form); fk, and every answer, are these frames' (derive/nominal.py)",
             "[exact]",
             "frames = [",
@@ -877,6 +879,8 @@ def spec_text(
         f"snaps = {strings(conversion.snaps)}",
         f"deviation = {float(f'{conversion.deviation:.2g}')!r}",
     ]
+    if kind != "URDF":
+        lines.append(f'format = "{kind}"')
     return "\n".join(lines) + "\n"
 
 
@@ -935,9 +939,25 @@ def import_urdf(path: Path, options: Options) -> tuple[str, Conversion]:
             f"{exc} (elements with a prefix no xmlns declares were not read as URDF: "
             f"{_listing(elements)})"
         ) from None
+    return import_chain(robot, chain, path, options)
+
+
+def import_chain(
+    robot: Robot,
+    chain: list[UrdfJoint],
+    path: Path,
+    options: Options,
+    source: str = "URDF",
+    part: str = "link",
+) -> tuple[str, Conversion]:
+    """import_urdf's conversion of a chain read from a file of the format source (whose
+    frames are parts: URDF links, MJCF bodies; derive/mjcf.py)."""
+    where = str(path)
+    assert options.base is not None and options.tip is not None
     conversion = convert(chain, where, options.angle_tol, options.length_tol, options.exact)
     name = options.name or spec_name(robot.name or path.stem)
-    args = (conversion, robot, path.name, options.base, options.tip, name, options.convention)
+    args = (conversion, robot, path.name, options.base, options.tip, name, options.convention,
+            source, part)  # fmt: skip
     draft = spec_text(*args)
     spec = parse_spec(draft, where=f"{where} (converted)")
     conversion.deviation = measure(spec, chain, conversion.reach)
@@ -945,7 +965,7 @@ def import_urdf(path: Path, options: Options) -> tuple[str, Conversion]:
     if not conversion.deviation <= bound:
         cause = "after snapping" if conversion.snaps else "without snapping (a converter error)"
         raise UrdfError(
-            f"{where}: the spec's FK differs from the URDF's by {conversion.deviation:.3g} "
+            f"{where}: the spec's FK differs from the {source}'s by {conversion.deviation:.3g} "
             f"{cause}; allowed {bound:g} (--max-deviation; --exact to switch snapping off)"
         )
     if robot.ignored:

@@ -1,0 +1,239 @@
+"""MJCF in: a MuJoCo model's chain between two bodies as a spec, through the URDF path.
+
+MuJoCo's own compiler reads the file (the optional ``mjcf`` extra), so default classes,
+``<include>``, ``<frame>``, ``euler``/``axisangle`` orientations and the compiler's angle unit
+mean what MuJoCo makes of them; meshes the file names but the folder lacks are left out
+(kinematics does not need them). The compiled model gives each body's pose in its parent at
+qpos0 and each joint's anchor and axis in its body. A body with joints j_1 .. j_k moves as
+MuJoCo moves it,
+
+    parent -> body = (pos, quat) Tr(p_1) M_1(q_1 - ref_1) Tr(-p_1) ... Tr(p_k) M_k Tr(-p_k)
+
+(M a rotation about the joint's axis or a translation along it), which is a URDF chain: each
+joint's origin carries the translations, and a fixed joint ends at the body's frame. That
+chain is checked first against MuJoCo's own forward kinematics (mj_kinematics) on random joint
+vectors (a difference above 1e-9 is a converter error, refused), then converted as a URDF is
+(derive/urdf.py: snapping, [exact] frames, the measured deviation).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import hashlib
+import math
+import random
+import stat
+from pathlib import Path
+from typing import Any
+
+from derive import extras, urdf
+from derive.spec import ArmSpec, parse_spec
+from derive.urdf import Matrix, Robot, UrdfError, UrdfJoint, Vector
+
+# MuJoCo's joint types (mjtJoint): free, ball, slide, hinge
+FREE, BALL, SLIDE, HINGE = 0, 1, 2, 3
+# the compiled chain against MuJoCo's own FK: this many joint vectors, this close
+CHECK_SAMPLES = 20
+CHECK_TOL = 1e-9
+# MuJoCo's compiler message, cut to this many characters
+COMPILE_SHOWN = 300
+
+
+def _mujoco(where: str) -> Any:
+    try:
+        import mujoco  # type: ignore[import-untyped,import-not-found,unused-ignore]  # (extra)
+    except ImportError:
+        raise UrdfError(
+            f"{where}: reading MJCF needs MuJoCo's compiler: {extras.install_hint('mjcf')}"
+        ) from None
+    return mujoco
+
+
+def compile_model(path: Path) -> Any:
+    """The MuJoCo model of an MJCF file (meshes it names but cannot find left out)."""
+    where = str(path)
+    mujoco = _mujoco(where)
+    try:
+        status = path.stat()
+    except OSError as exc:
+        raise UrdfError(f"{where}: cannot read: {exc.strerror}") from None
+    if not stat.S_ISREG(status.st_mode):
+        raise UrdfError(f"{where}: not a regular file")
+    if status.st_size > urdf.MAX_BYTES:
+        raise UrdfError(
+            f"{where}: {status.st_size} bytes; an MJCF may have at most {urdf.MAX_BYTES}"
+        )
+    try:
+        return mujoco.MjModel.from_xml_path(str(path))
+    except ValueError as first:
+        try:  # (meshes, heightfields and textures are not kinematics)
+            spec = mujoco.MjSpec.from_file(str(path))
+            for geom in spec.geoms:
+                if geom.type in (mujoco.mjtGeom.mjGEOM_MESH, mujoco.mjtGeom.mjGEOM_HFIELD):
+                    geom.type = mujoco.mjtGeom.mjGEOM_SPHERE
+                    geom.size = [0.01, 0.0, 0.0]
+                    geom.meshname = ""
+                    geom.hfieldname = ""
+            for kind in ("meshes", "hfields", "skins", "textures"):
+                for element in list(getattr(spec, kind)):
+                    spec.delete(element)
+            for material in spec.materials:
+                material.textures = [""] * len(material.textures)
+            spec.compiler.boundmass = 1e-6  # (bodies without geoms: MuJoCo wants mass)
+            spec.compiler.boundinertia = 1e-9
+            return spec.compile()
+        except Exception:  # (MuJoCo's first message says what is wrong)
+            message = " ".join(str(first).split())[:COMPILE_SHOWN]
+            raise UrdfError(f"{where}: MuJoCo cannot compile it: {message}") from None
+
+
+def _rotation(quat: Any) -> Matrix:
+    w, x, y, z = (float(v) for v in quat)
+    n = math.sqrt(w * w + x * x + y * y + z * z)
+    w, x, y, z = w / n, x / n, y / n, z / n
+    return [
+        [1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y), 0.0],
+        [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x), 0.0],
+        [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y), 0.0],
+        [0.0, 0.0, 0.0, 1.0],
+    ]
+
+
+def _shift(p: Vector, k: float = 1.0) -> Matrix:
+    return [
+        [1.0, 0.0, 0.0, k * p[0]],
+        [0.0, 1.0, 0.0, k * p[1]],
+        [0.0, 0.0, 1.0, k * p[2]],
+        [0.0, 0.0, 0.0, 1.0],
+    ]
+
+
+def _names(model: Any, count: int, kind: Any, label: str) -> list[str]:
+    """The elements' names; an unnamed one is label + its index."""
+    mujoco = _mujoco("")
+    out = []
+    for i in range(count):
+        name = mujoco.mj_id2name(model, kind, i)
+        out.append(name if name else f"{label}{i}")
+    return out
+
+
+def model_robot(
+    model: Any, where: str, digest: str
+) -> tuple[Robot, dict[str, int], dict[str, int]]:
+    """The model's bodies as links and its joints as URDF joints (module docstring), and the
+    MuJoCo indices of the bodies and of the hinge and slide joints by name."""
+    mujoco = _mujoco(where)
+    bodies = _names(model, model.nbody, mujoco.mjtObj.mjOBJ_BODY, "body")
+    names = _names(model, model.njnt, mujoco.mjtObj.mjOBJ_JOINT, "joint")
+    links = set(bodies)
+    joints: list[UrdfJoint] = []
+    index: dict[str, int] = {}
+    for b in range(1, model.nbody):
+        body, above = bodies[b], bodies[int(model.body_parentid[b])]
+        place = urdf.matmul(_shift(_vector(model.body_pos[b])), _rotation(model.body_quat[b]))
+        first = int(model.body_jntadr[b])
+        for j in range(first, first + int(model.body_jntnum[b])):
+            kind, name = int(model.jnt_type[j]), names[j]
+            anchor = _vector(model.jnt_pos[j])
+            if kind in (FREE, BALL):  # (chain_between refuses it between base and tip)
+                joint = UrdfJoint(name, "floating", above, f"{body}#{name}", place,
+                                  (0.0, 0.0, 1.0), None, False)  # fmt: skip
+                place = _identity()
+            else:
+                limits = (
+                    tuple(float(v) for v in model.jnt_range[j]) if model.jnt_limited[j] else None
+                )
+                joint = UrdfJoint(
+                    name,
+                    "revolute" if kind == HINGE else "prismatic",
+                    above,
+                    f"{body}#{name}",
+                    urdf.matmul(place, _shift(anchor)),
+                    _vector(model.jnt_axis[j]),
+                    limits,  # type: ignore[arg-type]
+                    False,
+                )
+                ref = float(model.qpos0[model.jnt_qposadr[j]])
+                if ref != 0.0:  # (MuJoCo moves the joint by q - qpos0)
+                    origin = urdf.matmul(joint.origin, urdf.motion(joint, -ref))
+                    joint = dataclasses.replace(joint, origin=origin)
+                index[name] = j
+                place = _shift(anchor, -1.0)
+            joints.append(joint)
+            links.add(joint.child)
+            above = joint.child
+        joints.append(UrdfJoint(f"{body}#frame", "fixed", above, body, place, (0.0, 0.0, 1.0),
+                                None, False))  # fmt: skip
+    model_name = mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_MODEL, 0) or ""
+    body_index = {name: b for b, name in enumerate(bodies)}
+    return Robot(model_name, frozenset(links), tuple(joints), digest), index, body_index
+
+
+def _vector(values: Any) -> Vector:
+    x, y, z = (float(v) for v in values)
+    return (x, y, z)
+
+
+def _identity() -> Matrix:
+    return [[float(i == j) for j in range(4)] for i in range(4)]
+
+
+def check_against_mujoco(
+    model: Any, chain: list[UrdfJoint], index: dict[str, int], ids: list[int], where: str
+) -> None:
+    """Refuse the chain unless its FK is MuJoCo's (tip body in the base body's frame) within
+    CHECK_TOL on CHECK_SAMPLES random joint vectors: else the reading above is wrong."""
+    mujoco = _mujoco(where)
+    data = mujoco.MjData(model)
+    rng = random.Random(0)
+    moving = [j for j in chain if j.kind in urdf.MOVING]
+    worst = 0.0
+    for _ in range(CHECK_SAMPLES):
+        q = [rng.uniform(-math.pi, math.pi) for _ in moving]
+        data.qpos[:] = model.qpos0
+        for joint, value in zip(moving, q):
+            data.qpos[model.jnt_qposadr[index[joint.name]]] = value
+        mujoco.mj_kinematics(model, data)
+        frames = []
+        for i in ids:
+            m = _identity()
+            for r in range(3):
+                m[r][:3] = [float(v) for v in data.xmat[i][3 * r : 3 * r + 3]]
+                m[r][3] = float(data.xpos[i][r])
+            frames.append(m)
+        expected = urdf.matmul(urdf.inverse(frames[0]), frames[1])
+        got = urdf.urdf_fk(chain, q)
+        worst = max(worst, *(abs(got[r][c] - expected[r][c]) for r in range(3) for c in range(4)))
+    if not worst <= CHECK_TOL:
+        raise UrdfError(
+            f"{where}: the chain read from MuJoCo's model differs from MuJoCo's own forward "
+            f"kinematics by {worst:.3g} (a converter error; please report it with the file)"
+        )
+
+
+def import_mjcf(path: Path, options: urdf.Options) -> tuple[str, urdf.Conversion]:
+    """The spec text of the chain options.base .. options.tip (bodies) of an MJCF file, and
+    the conversion's record (derive/urdf.py's import_chain)."""
+    where = str(path)
+    if not options.base or not options.tip:
+        raise UrdfError(f"{where}: an MJCF needs --base BODY and --tip BODY")
+    model = compile_model(path)
+    digest = hashlib.sha256(path.read_bytes()).hexdigest()[:16]
+    robot, index, bodies = model_robot(model, where, digest)
+    for body, what in ((options.base, "--base"), (options.tip, "--tip")):
+        if body not in bodies:
+            raise UrdfError(
+                f"{where}: {what} {urdf._shown(body)}: no such body; bodies: "
+                f"{urdf._listing(sorted(bodies))}"
+            )
+    chain = urdf.chain_between(robot, options.base, options.tip, where)
+    ids = [bodies[options.base], bodies[options.tip]]
+    check_against_mujoco(model, chain, index, ids, where)
+    return urdf.import_chain(robot, chain, path, options, source="MJCF", part="body")
+
+
+def load_mjcf(path: Path, options: urdf.Options) -> ArmSpec:
+    """The spec of an MJCF chain, as load_spec gives it for a spec file."""
+    text, _ = import_mjcf(path, options)
+    return parse_spec(text, where=f"{path} ({options.base} .. {options.tip})")

@@ -1,0 +1,133 @@
+"""MJCF in (derive/mjcf.py): MuJoCo's compiler reads the file; the chain is checked against
+MuJoCo's own forward kinematics, converted as a URDF is, and the generated module's fk and ik
+are MuJoCo's arm's (tests/data/mjcf/SOURCES.md: the files and their licences)."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from derive import cli, mjcf
+from derive.spec import SpecError, parse_spec
+from derive.urdf import Options
+
+from conftest import build_module
+
+mujoco = pytest.importorskip("mujoco")
+
+DATA = Path(__file__).parent / "data" / "mjcf"
+
+
+def mujoco_pose(path: Path, base: str, tip: str, joints: list[str], q: np.ndarray) -> np.ndarray:
+    """The tip body's pose in the base body's frame, by MuJoCo (meshes left out)."""
+    model = mjcf.compile_model(path)
+    data = mujoco.MjData(model)
+    data.qpos[:] = model.qpos0
+    for name, value in zip(joints, q):
+        data.qpos[model.jnt_qposadr[model.joint(name).id]] = value
+    mujoco.mj_kinematics(model, data)
+    frames = []
+    for body in (base, tip):
+        i = model.body(body).id
+        frame = np.eye(4)
+        frame[:3, :3] = data.xmat[i].reshape(3, 3)
+        frame[:3, 3] = data.xpos[i]
+        frames.append(frame)
+    return np.linalg.inv(frames[0]) @ frames[1]
+
+
+def test_the_so_arm100_with_euler_1_57079_keeps_its_exact_frames(tmp_path):
+    path = DATA / "so_arm100.xml"
+    options = Options(base="so_arm100_right", tip="so_arm100_right/Fixed_Jaw")
+    text, conversion = mjcf.import_mjcf(path, options)
+    assert len(conversion.rows) == 5 and conversion.snaps and "[exact]" in text
+    assert 'format = "MJCF"' in text and "# row 1: MJCF joint 'so_arm100_right/Rotation'" in text
+    spec = parse_spec(text, "<so_arm100>")
+    assert spec.origin is not None and spec.origin.format == "MJCF"
+    module = build_module(text, tmp_path)
+    rng = np.random.default_rng(1)
+    for q in rng.uniform(-math.pi, math.pi, (20, 5)):
+        expected = mujoco_pose(path, options.base, options.tip, list(spec.origin.joints), q)
+        assert np.max(np.abs(module.fk(q) - expected)) <= 1e-12
+
+
+def test_the_jaco_arm_is_solved_against_mujoco_s_own_kinematics(tmp_path):
+    path = DATA / "jaco_arm.xml"
+    options = Options(base="b_base", tip="b_6")
+    text, conversion = mjcf.import_mjcf(path, options)
+    assert len(conversion.rows) == 6 and conversion.deviation <= 1e-12
+    spec = parse_spec(text, "<jaco>")
+    assert spec.origin is not None
+    module = build_module(text, tmp_path)
+    assert module.METHOD == "general"
+    joints = list(spec.origin.joints)
+    rng = np.random.default_rng(2)
+    found = 0
+    for q in rng.uniform(-math.pi, math.pi, (12, 6)):
+        T = mujoco_pose(path, options.base, options.tip, joints, q)
+        rows = module.ik(T)
+        assert len(rows) > 0
+        for row in rows:
+            E = mujoco_pose(path, options.base, options.tip, joints, row)
+            assert np.max(np.abs(E[:3, :3] - T[:3, :3])) <= 1e-9
+            assert np.max(np.abs(E[:3, 3] - T[:3, 3])) <= 1e-9 * module.REACH
+        gaps = np.abs(np.remainder(rows - q + math.pi, 2 * math.pi) - math.pi)
+        found += bool(np.min(np.max(gaps, axis=1)) <= 1e-7)
+    assert found == 12
+
+
+def test_ref_slide_anchors_and_two_joints_in_one_body_mean_what_mujoco_means(tmp_path):
+    xml = tmp_path / "odd.xml"
+    xml.write_text(
+        '<mujoco><worldbody><body name="a"><joint name="h" axis="0 1 0" ref="0.3" '
+        'pos="0.1 0 0"/><geom size="0.1"/><body name="b" pos="0 0 1"><joint name="s" '
+        'type="slide" axis="1 0 0" ref="0.05"/><geom size="0.1"/><body name="c" pos="0 0 1" '
+        'euler="0.3 0.2 0.1"><joint name="h2" axis="1 1 0"/><joint name="h3" axis="0 0 1" '
+        'pos="0.2 0 0"/><geom size="0.1"/></body></body></body></worldbody></mujoco>'
+    )
+    text, _ = mjcf.import_mjcf(xml, Options(base="world", tip="c"))
+    module = build_module(text, tmp_path)
+    rng = np.random.default_rng(3)
+    for q in rng.uniform(-1.0, 1.0, (20, 4)):
+        expected = mujoco_pose(xml, "world", "c", ["h", "s", "h2", "h3"], q)
+        assert np.max(np.abs(module.fk(q) - expected)) <= 1e-12
+
+
+@pytest.mark.parametrize(
+    ("xml", "base", "tip", "message"),
+    [
+        ("jaco_arm.xml", "b_base", "nope", "--tip 'nope': no such body; bodies: 'b_1'"),
+        ("not xml", "a", "b", "MuJoCo cannot compile it: XML parse error"),
+        (
+            '<mujoco><worldbody><body name="a"><joint type="ball"/><body name="b"/></body>'
+            "</worldbody></mujoco>",
+            "world",
+            "b",
+            "a floating joint between base and tip",
+        ),
+    ],
+)
+def test_bad_mjcf_input_is_one_line_naming_the_file(xml, base, tip, message, tmp_path, capsys):
+    path = DATA / xml if xml.endswith(".xml") else tmp_path / "bad.xml"
+    if not xml.endswith(".xml"):
+        path.write_text(xml)
+    assert cli.main(["import-mjcf", str(path), "--base", base, "--tip", tip]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith(f"error: {path}: ") and message in err and err.count("\n") == 1
+
+
+def test_without_mujoco_the_reader_says_which_extra_to_install(monkeypatch):
+    monkeypatch.setitem(__import__("sys").modules, "mujoco", None)
+    with pytest.raises(SpecError, match=r"MuJoCo's compiler: pip install 'mujoco==4\.0\.1'"):
+        mjcf.import_mjcf(DATA / "jaco_arm.xml", Options(base="b_base", tip="b_6"))
+
+
+def test_derive_generate_takes_an_mjcf_file(tmp_path, capsys):
+    out = tmp_path / "out"
+    chain = ["--base", "so_arm100_right", "--tip", "so_arm100_right/Fixed_Jaw"]
+    code = cli.main(["generate", str(DATA / "so_arm100.xml"), *chain, "--out", str(out)])
+    assert code == 0
+    assert (out / "so_arm100.py").exists() and (out / "so_arm100.md").exists()
