@@ -10,7 +10,7 @@ import sympy as sp
 from derive import free
 from derive import symbols as sym
 from derive.classify import Structure, classify
-from derive.methods import general, parallel, pieper, planar
+from derive.methods import general, parallel, pieper, planar, position
 from derive.nominal import (
     STRUCTURE_TOL,
     Nominal,
@@ -28,6 +28,7 @@ METHODS = {
     pieper.NAME: pieper.derive,
     parallel.NAME: parallel.derive,
     planar.NAME: planar.derive,
+    position.NAME: position.derive,
     general.NAME: general.derive,
 }
 

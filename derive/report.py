@@ -223,6 +223,20 @@ def method_blocks(plan: Plan) -> list[Block]:
             )
         )
     details = dict(ik.details)
+    if "tool_point_a3" in details:  # (derive/methods/position.py)
+        out.append(Block("h3", "The tool point as the wrist centre"))
+        out.append(
+            Block(
+                "p",
+                "The arm controls a position: its tool point p in frame 3 (the translation of "
+                "$X_3 E$) is taken as Pieper's wrist centre $^3P_{4org} = (a_3, -\\sin\\alpha_3 "
+                "d_4, \\cos\\alpha_3 d_4)$, with $a_3 = p_x$, $d_4 = \\sqrt{p_y^2 + p_z^2}$ and "
+                "$\\alpha_3 = \\operatorname{atan2}(-p_y, p_z)$:",
+            )
+        )
+        for name, symbol in (("a3", "a_{3}"), ("d4", "d_{4}"), ("cos_alpha3", "\\cos\\alpha_{3}"),
+                             ("sin_alpha3", "\\sin\\alpha_{3}")):  # fmt: skip
+            out.append(Block("math", symbol, tex(details[f"tool_point_{name}"])))
     if "general_f1" in details:
         out.append(Block("h3", "Pieper's functions, general form (lecture, Pieper -2 to -4)"))
         for name in ("f1", "f2", "f3", "g1", "g2", "g3", "k1", "k2", "k3", "k4"):

@@ -1,0 +1,141 @@
+"""Three-joint spatial arms: the tool point's position (IKFast's Translation3D), Pieper's
+position part with the tool point as the wrist centre (derive/methods/position.py)."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from derive.pipeline import build_plan
+from derive.report import method_blocks
+from derive.spec import parse_spec
+
+from conftest import build_module, needs_cc, spec_text
+
+# (rows alpha, a, d, theta in deg and m; joint kinds; tool point in frame 3; the case)
+ARMS = {
+    # yaw, then two pitch axes (the elbow manipulator): a1 = 0, r = k3
+    "anthro3": ([(0, 0, 0.4, 0), (90, 0, 0, 0), (0, 0.45, 0, 0)], "RRR", (0.4, 0, 0), "a1 = 0"),
+    # offsets everywhere: the general case's quartic
+    "offset3": (
+        [(0, 0, 0.4, 0), (90, 0.1, 0.05, 0), (0, 0.45, 0, 0)],
+        "RRR",
+        (0.4, 0.02, 0),
+        "general",
+    ),
+    # axes 1 and 2 parallel, axis 3 across them: sin(alpha1) = 0, z = k4
+    "scara3": ([(0, 0, 0.4, 0), (0, 0.3, 0, 0), (90, 0.25, 0, 0)], "RRR", (0.1, 0, 0.05), "sin"),
+    # the Stanford arm's position part: a prismatic joint 3, a polynomial in d3
+    "stanford3": ([(0, 0, 0.4, 0), (-90, 0, 0.1, 0), (90, 0, 0, 0)], "RRP", (0, 0, 0.1), "d3"),
+    # no twist a multiple of 90 deg
+    "skew3": (
+        [(0, 0, 0.3, 0), (-70, 0.05, 0.0, 0), (20, 0.4, 0.02, 0)],
+        "RRR",
+        (0.35, 0.01, 0.03),
+        "general",
+    ),
+}
+
+
+def arm_text(name: str) -> str:
+    rows, kinds, (x, y, z), _ = ARMS[name]
+    tool = f"\n[tool]\nmatrix = [[1, 0, 0, {x}], [0, 1, 0, {y}], [0, 0, 1, {z}], [0, 0, 0, 1]]\n"
+    return spec_text(name, "modified", rows, kinds=kinds, extra=tool)
+
+
+def position_sigma(module, q: np.ndarray, step: float = 1e-6) -> float:
+    """The smallest singular value of the tool point's Jacobian, over the reach."""
+    J = np.zeros((3, module.DOF))
+    for i in range(module.DOF):
+        dq = np.zeros(module.DOF)
+        dq[i] = step
+        J[:, i] = (module.fk(q + dq)[:3, 3] - module.fk(q - dq)[:3, 3]) / (2 * step)
+    return float(np.linalg.svd(J / module.REACH, compute_uv=False)[-1])
+
+
+def round_trips(module, backend: str, n: int, seed: int) -> tuple[int, int, int, float]:
+    """(regular samples, those whose joint vector was missed, samples answered with
+    nothing, the worst row's position error over the reach)."""
+    rng = np.random.default_rng(seed)
+    regular = missed = empty = 0
+    worst = 0.0
+    for q in rng.uniform(-math.pi, math.pi, (n, module.DOF)):
+        if module.DOF == 3 and ARMS[module.NAME][1][2] == "P":
+            q[2] = rng.uniform(0.05, 0.8)
+        T = module.fk(q)
+        rows = module.ik(T, backend=backend)
+        empty += len(rows) == 0
+        for row in rows:
+            worst = max(worst, float(np.max(np.abs(module.fk(row)[:3, 3] - T[:3, 3]))))
+        if position_sigma(module, q) >= 0.05:
+            regular += 1
+            gaps = np.abs(np.remainder(rows - q + math.pi, 2 * math.pi) - math.pi)
+            missed += not len(rows) or bool(np.min(np.max(gaps, axis=1)) > 1e-8)
+    return regular, missed, empty, worst / module.REACH
+
+
+@pytest.mark.parametrize("name", sorted(ARMS))
+def test_three_joint_arms_get_the_position_method_with_its_case(name):
+    plan = build_plan(parse_spec(arm_text(name), "<test>"))
+    assert plan.ik is not None and plan.ik.method == "position"
+    assert plan.ik.certify == "position" and plan.ik.max_solutions == 4
+    assert ARMS[name][3] in plan.ik.case
+
+
+@pytest.mark.parametrize("name", sorted(ARMS))
+def test_every_row_reaches_the_point_and_the_sampled_vector_is_among_them(name, tmp_path):
+    module = build_module(arm_text(name), tmp_path)
+    assert name == module.NAME
+    regular, missed, empty, worst = round_trips(module, "python", 300, 1)
+    assert regular >= 100 and missed == 0 and empty == 0 and worst <= 1e-10
+
+
+@needs_cc
+@pytest.mark.parametrize("name", sorted(ARMS))
+def test_the_c_solver_agrees_on_many_samples(name, tmp_path):
+    module = build_module(arm_text(name), tmp_path, c=True)
+    regular, missed, empty, worst = round_trips(module, "c", 3000, 2)
+    assert regular >= 1000 and missed == 0 and empty == 0 and worst <= 1e-10
+    rng = np.random.default_rng(4)
+    for q in rng.uniform(-math.pi, math.pi, (100, 3)):
+        T = module.fk(q)
+        a, b = module.ik(T, backend="c"), module.ik(T, backend="python")
+        assert a.shape == b.shape and np.allclose(a, b, atol=1e-9)
+
+
+@pytest.mark.parametrize(
+    ("q", "rows"),
+    [
+        ((0.3, math.pi / 2, 0.0), 1),  # the tool point on axis 1: theta1 free (takes q_ref)
+        ((0.2, 0.5, 0.0), 2),  # elbow stretched: a double root
+        ((0.2, 0.5, math.pi), 2),  # elbow folded back
+    ],
+)
+def test_degenerate_positions_are_answered(q, rows, tmp_path):
+    module = build_module(arm_text("anthro3"), tmp_path)
+    T = module.fk(np.array(q))
+    found = module.ik(T)
+    assert len(found) == rows
+    for row in found:
+        assert np.max(np.abs(module.fk(row)[:3, 3] - T[:3, 3])) <= 1e-12
+    if rows == 1:
+        assert found[0][0] == 0.0 and abs(abs(found[0][1]) - math.pi / 2) <= 1e-9
+
+
+def test_the_module_says_what_it_solves_for(tmp_path):
+    module = build_module(arm_text("offset3"), tmp_path)
+    assert module.METHOD == "position"
+    assert "the tool point's position" in module.__doc__
+
+
+def test_the_report_shows_the_tool_point_as_the_wrist_centre():
+    plan = build_plan(parse_spec(arm_text("offset3"), "<test>"))
+    blocks = method_blocks(plan)
+    heads = [b.text for b in blocks if b.kind == "h3"]
+    assert "The tool point as the wrist centre" in heads
+    maths = {b.text: b.math for b in blocks if b.kind == "math"}
+    # the tool point (0.4, 0.02, 0) in frame 3: a3 = 0.4, d4 = 0.02, alpha3 = -90 deg
+    assert maths["a_{3}"] == "0.4" and maths["d_{4}"] == "0.02"
+    assert maths["\\sin\\alpha_{3}"] == "-1" and maths["\\cos\\alpha_{3}"] == "0"
