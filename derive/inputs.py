@@ -3,6 +3,7 @@ spec (derive/spec.py's ArmSpec). A new format is one reader here and one line in
 
 from __future__ import annotations
 
+import re
 from collections.abc import Callable
 from importlib import resources
 from pathlib import Path
@@ -19,11 +20,25 @@ def _spec_file(path: Path, options: urdf.Options) -> ArmSpec:
     return load_spec(path)
 
 
+def _xml_file(path: Path, options: urdf.Options) -> ArmSpec:
+    """An .xml file: a URDF if its root element is <robot> (URDFs are often named .xml),
+    else MJCF (MuJoCo's compiler reads it)."""
+    try:
+        with path.open("rb") as stream:
+            head = stream.read(65536)
+    except OSError:
+        head = b""  # (the reader says why it cannot read the file)
+    root = re.search(rb"<\s*([A-Za-z_][\w.-]*)", re.sub(rb"<[?!][^>]*>", b"", head))
+    if root is not None and root.group(1) == b"robot":
+        return urdf.load_urdf(path, options)
+    return mjcf.load_mjcf(path, options)
+
+
 # file suffix (lower case) -> reader
 READERS: dict[str, Reader] = {
     ".toml": _spec_file,
     ".urdf": urdf.load_urdf,
-    ".xml": mjcf.load_mjcf,
+    ".xml": _xml_file,
     ".mjcf": mjcf.load_mjcf,
 }
 

@@ -11,6 +11,7 @@ import numpy as np
 import pytest
 
 from derive import cli, mjcf
+from derive.inputs import resolve_spec
 from derive.spec import SpecError, parse_spec
 from derive.urdf import Options
 
@@ -131,3 +132,13 @@ def test_derive_generate_takes_an_mjcf_file(tmp_path, capsys):
     code = cli.main(["generate", str(DATA / "so_arm100.xml"), *chain, "--out", str(out)])
     assert code == 0
     assert (out / "so_arm100.py").exists() and (out / "so_arm100.md").exists()
+
+
+def test_a_urdf_named_xml_is_read_as_a_urdf(tmp_path):
+    copy = tmp_path / "ur5.xml"
+    copy.write_bytes((DATA.parent / "urdf" / "ur5.urdf").read_bytes())
+    options = Options(base="world", tip="tool0")
+    spec = resolve_spec(str(copy), options)
+    assert spec.origin is not None and spec.origin.format == "URDF"
+    mj = resolve_spec(str(DATA / "jaco_arm.xml"), Options(base="b_base", tip="b_6"))
+    assert mj.origin is not None and mj.origin.format == "MJCF"
