@@ -30,8 +30,8 @@ from derive import extras, urdf
 from derive.spec import ArmSpec, parse_spec
 from derive.urdf import Matrix, Robot, UrdfError, UrdfJoint, Vector
 
-# MuJoCo's joint types (mjtJoint): free, ball, slide, hinge
-FREE, BALL, SLIDE, HINGE = 0, 1, 2, 3
+# MuJoCo's joint types (mjtJoint) other than slide (2)
+FREE, BALL, HINGE = 0, 1, 3
 # the compiled chain against MuJoCo's own FK: this many joint vectors, this close
 CHECK_SAMPLES = 20
 CHECK_TOL = 1e-9
@@ -87,24 +87,24 @@ def compile_model(path: Path) -> Any:
             raise UrdfError(f"{where}: MuJoCo cannot compile it: {message}") from None
 
 
-def _rotation(quat: Any) -> Matrix:
+def _frame(
+    position: Any, rotation: Any = ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0))
+) -> Matrix:
+    """The 4x4 transform of a position and a rotation's rows (the identity by default)."""
+    return [[*(float(v) for v in rotation[r]), float(position[r])] for r in range(3)] + [
+        [0.0, 0.0, 0.0, 1.0]
+    ]
+
+
+def _quaternion(quat: Any) -> list[list[float]]:
+    """The rotation's rows of a quaternion (w, x, y, z), normalised."""
     w, x, y, z = (float(v) for v in quat)
     n = math.sqrt(w * w + x * x + y * y + z * z)
     w, x, y, z = w / n, x / n, y / n, z / n
     return [
-        [1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y), 0.0],
-        [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x), 0.0],
-        [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y), 0.0],
-        [0.0, 0.0, 0.0, 1.0],
-    ]
-
-
-def _shift(p: Vector, k: float = 1.0) -> Matrix:
-    return [
-        [1.0, 0.0, 0.0, k * p[0]],
-        [0.0, 1.0, 0.0, k * p[1]],
-        [0.0, 0.0, 1.0, k * p[2]],
-        [0.0, 0.0, 0.0, 1.0],
+        [1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
+        [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
+        [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)],
     ]
 
 
@@ -131,7 +131,7 @@ def model_robot(
     index: dict[str, int] = {}
     for b in range(1, model.nbody):
         body, above = bodies[b], bodies[int(model.body_parentid[b])]
-        place = urdf.matmul(_shift(_vector(model.body_pos[b])), _rotation(model.body_quat[b]))
+        place = _frame(model.body_pos[b], _quaternion(model.body_quat[b]))
         first = int(model.body_jntadr[b])
         for j in range(first, first + int(model.body_jntnum[b])):
             kind, name = int(model.jnt_type[j]), names[j]
@@ -139,7 +139,7 @@ def model_robot(
             if kind in (FREE, BALL):  # (chain_between refuses it between base and tip)
                 joint = UrdfJoint(name, "floating", above, f"{body}#{name}", place,
                                   (0.0, 0.0, 1.0), None, False)  # fmt: skip
-                place = _identity()
+                place = _frame((0.0, 0.0, 0.0))
             else:
                 limits = (
                     tuple(float(v) for v in model.jnt_range[j]) if model.jnt_limited[j] else None
@@ -149,7 +149,7 @@ def model_robot(
                     "revolute" if kind == HINGE else "prismatic",
                     above,
                     f"{body}#{name}",
-                    urdf.matmul(place, _shift(anchor)),
+                    urdf.matmul(place, _frame(anchor)),
                     _vector(model.jnt_axis[j]),
                     limits,  # type: ignore[arg-type]
                     False,
@@ -159,7 +159,7 @@ def model_robot(
                     origin = urdf.matmul(joint.origin, urdf.motion(joint, -ref))
                     joint = dataclasses.replace(joint, origin=origin)
                 index[name] = j
-                place = _shift(anchor, -1.0)
+                place = _frame([-v for v in anchor])
             joints.append(joint)
             links.add(joint.child)
             above = joint.child
@@ -173,10 +173,6 @@ def model_robot(
 def _vector(values: Any) -> Vector:
     x, y, z = (float(v) for v in values)
     return (x, y, z)
-
-
-def _identity() -> Matrix:
-    return [[float(i == j) for j in range(4)] for i in range(4)]
 
 
 def check_against_mujoco(
@@ -195,13 +191,7 @@ def check_against_mujoco(
         for joint, value in zip(moving, q):
             data.qpos[model.jnt_qposadr[index[joint.name]]] = value
         mujoco.mj_kinematics(model, data)
-        frames = []
-        for i in ids:
-            m = _identity()
-            for r in range(3):
-                m[r][:3] = [float(v) for v in data.xmat[i][3 * r : 3 * r + 3]]
-                m[r][3] = float(data.xpos[i][r])
-            frames.append(m)
+        frames = [_frame(data.xpos[i], data.xmat[i].reshape(3, 3)) for i in ids]
         expected = urdf.matmul(urdf.inverse(frames[0]), frames[1])
         got = urdf.urdf_fk(chain, q)
         worst = max(worst, *(abs(got[r][c] - expected[r][c]) for r in range(3) for c in range(4)))
