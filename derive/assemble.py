@@ -53,6 +53,8 @@ IK_ROOTS = (
 )  # fmt: skip
 # the public names a module with free joints adds
 FREE_ROOTS = ("ik_sweep",)
+# the public names a module solved for a task adds (derive/tasks.py)
+TASK_ROOTS = {"direction": ("ik_direction",), "lookat": ("ik_lookat",)}
 
 
 @dataclass(frozen=True)
@@ -158,9 +160,9 @@ class Assembly:
     runtime: str
 
 
-def assemble(arm_source: str, has_ik: bool, free: bool = False) -> Assembly:
+def assemble(arm_source: str, has_ik: bool, free: bool = False, task: str = "pose") -> Assembly:
     """The runtime pieces for a module whose arm-specific code is arm_source (free: the arm
-    has free joints, and ik_sweep)."""
+    has free joints, and ik_sweep; task: what its ik solves for, and its task function)."""
     runtime = runtime_pieces()
     if free:  # redundant's public functions replace api's of the same names
         replaced = {n for p in runtime if p.module == "redundant" for n in p.defines}
@@ -172,6 +174,8 @@ def assemble(arm_source: str, has_ik: bool, free: bool = False) -> Assembly:
     roots = set(IK_ROOTS if has_ik else FK_ROOTS)
     if has_ik and free:
         roots |= set(FREE_ROOTS)
+    if has_ik:
+        roots |= set(TASK_ROOTS.get(task, ()))
     for piece in arm:
         roots |= piece.uses
     copied = tuple(p for p in closure(roots, everything) if p.module != "arm")

@@ -232,11 +232,16 @@ def cmd_fk(args: argparse.Namespace) -> int:
 
 def cmd_solve(args: argparse.Namespace) -> int:
     """Print every IK solution of a pose, its FK residual and the joints outside limits."""
-    import numpy as np
 
     spec, module = ik_module(args)
     pose, free, sols = solve_arguments(spec, module, args)
-    print("pose:")
+    task = getattr(module, "IK_COMPONENTS", "pose")
+    if task == "pose":
+        print("pose:")
+    else:
+        axis = "xyz"[getattr(module, "TOOL_AXIS", 2)]
+        reads = TASK_READS[task].format(axis=axis)
+        print(f"target (the {task} task reads {reads}):")
     print(format_pose(pose))
     if free:
         given = [
@@ -247,9 +252,8 @@ def cmd_solve(args: argparse.Namespace) -> int:
     print(f"{len(sols)} solution(s) (degrees for R joints):")
     for k, q in enumerate(sols, start=1):
         shown = [math.degrees(v) if t == "R" else v for v, t in zip(q, spec.joint_types)]
-        # (the components the solver reproduces: the tool point only for a positioning arm)
-        rows = slice(None) if module.IK_COMPONENTS == "pose" else (slice(0, 3), 3)
-        residual = float(np.abs((module.fk(q) - pose)[rows]).max())
+        # (the components the solver reproduces: its task's)
+        residual = task_residual(module, q, pose)
         outside = [
             f"q{i + 1}"
             for i, (v, (lo, hi)) in enumerate(zip(q, module.LIMITS))
@@ -290,9 +294,19 @@ def solve_arguments(
     import numpy as np
 
     q = None
-    if args.q is not None:
+    task = getattr(module, "IK_COMPONENTS", "pose")
+    if args.direction is not None and (args.point is None or task != "direction"):
+        raise UsageError(
+            "--direction: only with --point, for an arm solved for the position and direction "
+            f"of a tool axis ({spec.name}'s task: {task})"
+        )
+    if args.point is not None:
+        pose = task_pose(spec, module, args)
+    elif args.q is not None:
         q = joint_vector(spec, parse_numbers(args.q, "--q"), args.rad)
         pose = module.fk(q)
+        if task == "lookat":  # (every configuration sees its own tool point: look ahead)
+            pose[:3, 3] += module.REACH * pose[:3, module.TOOL_AXIS]
     else:
         numbers = parse_numbers([args.pose], "--pose")
         if len(numbers) not in (12, 16):
@@ -305,6 +319,61 @@ def solve_arguments(
     except ValueError as exc:
         raise UsageError(f"--pose: {exc}") from None
     return pose, free, sols
+
+
+# what each task reads of a target pose (derive/tasks.py)
+TASK_READS = {
+    "position": "its position",
+    "direction": "its position and its {axis} column",
+    "lookat": "its position, the point looked at",
+}
+
+
+def task_pose(spec: ArmSpec, module: ModuleType, args: argparse.Namespace) -> Any:
+    """The pose ik reads an arm's task from: --point's position and, for a direction task,
+    --direction as the tool axis's column (the module's own _task_pose completes the frame)."""
+    import numpy as np
+
+    task = getattr(module, "IK_COMPONENTS", "pose")
+    if task == "pose":
+        raise UsageError(f"--point: {spec.name} is solved for the full pose; give --pose or --q")
+    point = parse_numbers(args.point, "--point")
+    if len(point) != 3:
+        raise UsageError(f"--point: give 3 numbers, x y z (got {len(point)})")
+    if task == "position":
+        pose = np.eye(4)
+        pose[:3, 3] = point
+        return pose
+    direction = None
+    if task == "direction":
+        if args.direction is None:
+            raise UsageError(
+                f"--point: {spec.name} is solved for a point and a direction: give --direction"
+            )
+        direction = parse_numbers(args.direction, "--direction")
+        if len(direction) != 3 or not any(direction):
+            raise UsageError("--direction: give 3 numbers, dx dy dz, not all 0")
+    return module._task_pose(point, direction)
+
+
+def task_residual(module: ModuleType, q: Any, pose: Any) -> float:
+    """How far fk(q) misses the components of pose the arm's task reads: the whole pose, the
+    tool point, the point and the tool axis, or the ray's distance from the point."""
+    import numpy as np
+
+    E = module.fk(q)
+    task = getattr(module, "IK_COMPONENTS", "pose")
+    if task == "pose":
+        return float(np.abs(E - pose).max())
+    position = float(np.abs(E[:3, 3] - pose[:3, 3]).max())
+    if task == "position":
+        return position
+    axis = module.TOOL_AXIS
+    if task == "direction":
+        return max(position, float(np.abs(E[:3, axis] - pose[:3, axis]).max()))
+    v = pose[:3, 3] - E[:3, 3]
+    along = float(v @ E[:3, axis])
+    return float(np.abs(v - along * E[:3, axis]).max()) if along >= 0 else float(np.linalg.norm(v))
 
 
 def cmd_plot(args: argparse.Namespace) -> int:
@@ -834,6 +903,15 @@ def add_pose_arguments(command: argparse.ArgumentParser) -> None:
     group = command.add_mutually_exclusive_group(required=True)
     group.add_argument("--pose", help="'r11 r12 r13 px r21 ... pz' (12 or 16 numbers)")
     group.add_argument("--q", nargs="+", help="solve the pose of these joint values")
+    group.add_argument(
+        "--point",
+        nargs="+",
+        help="an arm solved for a task: the tool point (position, direction) or the point "
+        "looked at (lookat), 'x y z'",
+    )
+    command.add_argument(
+        "--direction", nargs="+", help="with --point: the tool axis's direction, 'dx dy dz'"
+    )
     command.add_argument("--rad", action="store_true", help="--q and --free values are in radians")
     command.add_argument(
         "--free", nargs="+", help="an arm with free joints: their values (default: --q's, or 0)"

@@ -148,6 +148,7 @@ class PrintedModule:
     seed_tol: str
     correction: str
     correction_doc: str
+    tool_axis: int = 2
 
 
 def print_plan(plan: Plan) -> PrintedModule:
@@ -191,7 +192,8 @@ def print_plan(plan: Plan) -> PrintedModule:
         refusal=plan.refusal,
         ik_body=scalar.ik_lines(plan) if ik else (),
         qref_names=", ".join(f"qr{i}" for i in range(1, arm.dof + 1)),
-        match=match_expression(ik.certify) if ik else "",
+        match=match_expression(ik.certify, ik.tool_axis) if ik else "",
+        tool_axis=ik.tool_axis if ik else 2,
         components=ik.certify if ik else "",
         general=general_code(plan),
         c_source=repr(f"{arm.name}_ik.c" if ik else ""),
@@ -324,7 +326,9 @@ def render_module(plan: Plan) -> str:
     printed = print_plan(plan)
     env = environment()
     arm_code = wrap_code(env.get_template("arm.py.j2").render(m=printed))
-    parts = assemble(arm_code, bool(printed.has_ik), bool(printed.free))
+    parts = assemble(
+        arm_code, bool(printed.has_ik), bool(printed.free), printed.components or "pose"
+    )
     layout = env.get_template("module.py.j2")
 
     def render(imports: str) -> str:

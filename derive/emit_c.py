@@ -18,6 +18,7 @@ from derive.plan import Eigen, Plan, Poly, PolyD
 from derive.printers import c
 from derive.printers.general import eigen_step, pad, spurious_counts
 from derive.runtime import constants
+from derive.tasks import TASK_CODES
 
 
 @dataclass(frozen=True)
@@ -55,6 +56,9 @@ class PrintedC:
     chain: tuple[str, ...] = ()
     solved: tuple[int, ...] = ()
     refine_rows: int = 6
+    # the task's code (derive/tasks.py TASK_CODES) and its tool axis
+    task_code: int = 0
+    tool_axis: int = 2
 
 
 def general_constants(plan: Plan) -> dict[str, object]:
@@ -179,7 +183,9 @@ def print_c(plan: Plan) -> PrintedC:
         seed_tol=repr(plan.correction.seed_tol) if plan.correction else "0.0",
         chain=tuple(", ".join(map(repr, f)) for f in plan.frames) if plan.correction else (),
         solved=plan.solved if plan.correction else (),
-        refine_rows=3 if ik.certify == "position" else 6,
+        refine_rows=3 if ik.certify in ("position", "lookat") else 6,
+        task_code=TASK_CODES[ik.certify],
+        tool_axis=ik.tool_axis,
     )
 
 

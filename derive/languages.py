@@ -102,6 +102,12 @@ def worked_example(plan: Plan, module: ModuleType) -> Example:
             for v, t in zip(arm.example_q, arm.joint_types)
         )
         how = f"the pose of q = ({shown}) (degrees for R joints)"
+    if getattr(module, "IK_COMPONENTS", "") == "lookat" and arm.example_pose is None:
+        # (the tool point itself is seen from every direction: look at a point one reach ahead)
+        pose = pose.copy()
+        pose[:3, 3] += arm.reach * pose[:3, module.TOOL_AXIS]
+        how += f", its point moved one reach ({arm.reach:.4g}) along the tool axis: the point"
+        how += " looked at"
     # one pose: the Python solver (the example shows what the lecture's steps give)
     free = getattr(module, "FREE", ())
     values = {}

@@ -7,10 +7,11 @@ import math
 
 import sympy as sp
 
-from derive import free
+from derive import free, tasks
 from derive import symbols as sym
 from derive.classify import Structure, classify
 from derive.methods import general, parallel, pieper, planar, position
+from derive.methods.common import NotApplicable
 from derive.nominal import (
     STRUCTURE_TOL,
     Nominal,
@@ -50,7 +51,8 @@ def build_plan(spec: ArmSpec, method: str | None = None) -> Plan:
     closed = tuple(name for name in names if name != general.NAME)
     # the exact geometry: the spec's [exact] frames (a URDF's), else its table's
     frames = spec.exact if spec.exact is not None else chain_frames(chain)
-    ik, refusal = choose(chain, structure, spec.free, closed)
+    task = task_of(spec, chain)
+    ik, refusal = choose(chain, structure, spec.free, closed, task)
     correction = None
     facts = structure.describe(chain.dof)
     if ik is None and closed:
@@ -59,7 +61,7 @@ def build_plan(spec: ArmSpec, method: str | None = None) -> Plan:
         if near.changes:
             near_chain = chain_from_spec(near.spec)
             near_structure = classify(near_chain)
-            near_ik, _ = choose(near_chain, near_structure, spec.free, closed)
+            near_ik, _ = choose(near_chain, near_structure, spec.free, closed, task)
             if near_ik is not None:
                 fix = make_correction(near, near_chain, frames)
                 if fix.deviation <= NOMINAL_MAX:
@@ -73,7 +75,7 @@ def build_plan(spec: ArmSpec, method: str | None = None) -> Plan:
                         f"arm by {fix.deviation:.3g} (at most {NOMINAL_MAX:g} is refined)"
                     )
     if ik is None and general.NAME in names:
-        ik, why = choose(chain, structure, spec.free, (general.NAME,))
+        ik, why = choose(chain, structure, spec.free, (general.NAME,), task)
         reasons = [r for r in (refusal, why) if r]
         refusal = "; ".join(dict.fromkeys(reasons)) if ik is None else ""
     if correction is None and spec.exact is not None:
@@ -102,15 +104,24 @@ def build_plan(spec: ArmSpec, method: str | None = None) -> Plan:
         # close (a calibrated PUMA has 11 with its elbow folded back, its wrist centre near
         # axis 2), at most 16
         ik = dataclasses.replace(ik, max_solutions=GENERAL_MOST)
+    if task is not None and (ik is None or ik.certify == task.kind):
+        shown = task if ik is None else dataclasses.replace(task, axis=ik.tool_axis)
+        why = task.why
+        if ik is not None and ik.tool_axis != 2 and not task.fixed:
+            why += f" (the first of the tool z, x, y axes that works: {shown.axis_name})"
+        facts = (*facts, f"task: {shown.describe()}: {why}")
     pose = world_transform(chain, expand=False)
     if spec.exact is not None:
         pose = frames_pose(spec.exact, chain)
+    joint_defs = joint_definitions(chain)
+    if ik is not None and ik.relabel != 0:
+        pose, joint_defs = relabelled(pose, joint_defs, chain, ik.relabel)
     return Plan(
         arm=arm_info(spec, chain),
         structure=facts,
         fk_pose=pose,
         links=tuple(link_transform(chain, i) for i in range(1, chain.dof + 1)),
-        joint_defs=joint_definitions(chain),
+        joint_defs=joint_defs,
         ik=ik,
         refusal=refusal,
         correction=correction,
@@ -118,11 +129,78 @@ def build_plan(spec: ArmSpec, method: str | None = None) -> Plan:
     )
 
 
+# a task's `why` where the spec names it
+NAMED = "named in the spec"
+
+
+def task_of(spec: ArmSpec, chain: Chain) -> tasks.Task | None:
+    """The task the spec names, or the one its joints choose (derive/tasks.py); None: the
+    methods' own problem (a pose, a three-joint arm's position).
+
+    Raises:
+        SpecError: the task does not fit the arm's joints.
+    """
+    n, kinds = spec.dof, spec.joint_types
+    where = f"{spec.source}: ik.task"
+    if spec.task is None:
+        task = tasks.default_task(chain)
+    elif spec.task == "pose":
+        if n < 6:
+            raise SpecError(f'{where}: "pose" needs at least 6 joints, the arm has {n}')
+        task = None
+    elif spec.task == "position":
+        if n != 3:
+            raise SpecError(f'{where}: "position" needs 3 joints, the arm has {n}')
+        task = None
+    elif spec.task == "direction":
+        if n != 5:
+            raise SpecError(
+                f'{where}: "direction" needs 5 joints, the arm has {n} (more joints than '
+                "a task needs, as free joints, are not supported yet)"
+            )
+        task = tasks.Task("direction", 2, NAMED)
+    else:
+        if kinds != "RR":
+            raise SpecError(f'{where}: "lookat" needs 2 revolute joints, the arm has {kinds}')
+        task = tasks.Task("lookat", 2, NAMED)
+    if spec.tool_axis is not None:
+        if task is None:
+            raise SpecError(
+                f'{spec.source}: ik.tool_axis: only the "direction" and "lookat" tasks '
+                "have a tool axis"
+            )
+        task = dataclasses.replace(task, axis=tasks.AXES.index(spec.tool_axis), fixed=True)
+    return task
+
+
 def choose(
-    chain: Chain, structure: Structure, named: tuple[int, ...] | None, names: tuple[str, ...]
+    chain: Chain,
+    structure: Structure,
+    named: tuple[int, ...] | None,
+    names: tuple[str, ...],
+    task: tasks.Task | None = None,
 ) -> tuple[IkPlan | None, str]:
     """The first of the named methods that solves the chain (an arm of more than 6 joints:
-    with free joints), or None and why none does."""
+    with free joints; a task's arm: extended by its virtual joint, about the task's tool axis,
+    else about the first of z, x, y that works), or None and why none does."""
+    if task is not None and task.virtual:
+        reasons = []
+        if task.why != NAMED:  # (the joints chose it: a method of the arm's own comes first)
+            ik, why = choose(chain, structure, named, names)
+            if ik is not None:
+                return ik, why
+        for axis in (task.axis,) if task.fixed else (2, 0, 1):
+            aimed = dataclasses.replace(task, axis=axis)
+            try:
+                extended = tasks.extend(chain, aimed)
+            except NotApplicable as exc:
+                reasons.append(f"tool {tasks.AXES[axis]} axis: {exc}")
+                continue
+            ik, why = choose_method(extended, classify(extended), names)
+            if ik is not None:
+                return tasks.lower(ik, chain, extended, aimed), ""
+            reasons.append(f"tool {tasks.AXES[axis]} axis: {why}")
+        return None, "; ".join(reasons)
     if chain.dof > free.REMAINDER_DOF:
         return choose_free(chain, named, names)
     return choose_method(chain, structure, names)
@@ -207,6 +285,31 @@ def choose_free(
                 return free.lift(result, chain, choice), ""
             reasons.append(f"{label}: {result}")
     return None, "; ".join(reasons)
+
+
+def relabelled(
+    pose: sp.Matrix,
+    joint_defs: tuple[tuple[sp.Symbol, sp.Expr], ...],
+    chain: Chain,
+    shift: sp.Expr,
+) -> tuple[sp.Matrix, tuple[tuple[sp.Symbol, sp.Expr], ...]]:
+    """The forward kinematics and joint definitions in the steps' variable of joint n, which
+    exceeds the arm's by shift (a task's virtual joint moves joint n's frame: derive/tasks.py):
+    theta_n = q_n + offset + shift, and the pose's c_n, s_n those of theta_n - shift (d_n
+    - shift for a prismatic joint)."""
+    n = chain.dof
+    last = chain.joints[-1]
+    if last.kind == "R":
+        cs, ss = sp.cos(shift), sp.sin(shift)
+        if not (cs.is_Rational and ss.is_Rational):
+            cs, ss = sp.Float(float(cs), 17), sp.Float(float(ss), 17)
+        c, s = sym.c(n), sym.s(n)
+        pose = pose.xreplace({c: c * cs + s * ss, s: s * cs - c * ss})
+    else:
+        pose = pose.xreplace({sym.d(n): sym.d(n) - shift})
+    target, expr = joint_defs[-1]
+    moved = sym.q(n) + sp.Float(float(expr.subs(sym.q(n), 0) + shift), 17)
+    return pose, (*joint_defs[:-1], (target, moved))
 
 
 def joint_definitions(chain: Chain) -> tuple[tuple[sp.Symbol, sp.Expr], ...]:

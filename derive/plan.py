@@ -286,12 +286,22 @@ class IkPlan:
         outputs: q_1..q_n as expressions of the solved joint quantities.
         details: derivation facts for the report: name -> expression (sorted by name).
         solves_for: the pose components the solver is defined on, in words.
-        certify: "pose" (every solution reproduces the whole pose) or "position" (the tool
-            point only: arms that do not control the orientation).
+        certify: the task's components every solution reproduces (derive/tasks.py): "pose"
+            (the whole pose), "position" (the tool point only: arms that do not control the
+            orientation), "direction" (the tool point and the tool axis's direction) or
+            "lookat" (the tool axis's ray through the target point).
         free: the joints (1-based) the caller gives values for (an arm of more than 6
             joints); their values are the reference values qr_i.
         free_text: which joints are free and why, in words (derive/free.py), "" without
             free joints: what emission and reports say of them.
+        tool_axis: the tool axis (0 x, 1 y, 2 z) of the "direction" and "lookat" tasks
+            (derive/tasks.py).
+        relabel: how much the steps' theta_n (d_n of a prismatic joint n) exceeds the
+            arm's own: a task's virtual joint moves joint n's DH frame (derive/tasks.py);
+            the plan's forward kinematics are written in the steps' variable.
+        virtual: a task's virtual joint's value on a solution's branch, for the report:
+            (cos, sin) of its angle, or (its length,), in the world pose's entries and the
+            arm's joints' c_i, s_i (d_i); () without one.
     """
 
     method: str
@@ -304,6 +314,9 @@ class IkPlan:
     certify: str = "pose"
     free: tuple[int, ...] = ()
     free_text: str = ""
+    tool_axis: int = 2
+    relabel: sp.Expr = sp.S.Zero
+    virtual: tuple[sp.Expr, ...] = ()
 
 
 @dataclass(frozen=True)

@@ -223,6 +223,8 @@ def method_blocks(plan: Plan) -> list[Block]:
             )
         )
     details = dict(ik.details)
+    if "task_virtual_joint" in details:  # (derive/tasks.py)
+        out += task_blocks(plan, details)
     if "tool_point_a3" in details:  # (derive/methods/position.py)
         out.append(Block("h3", "The tool point as the wrist centre"))
         out.append(
@@ -258,6 +260,55 @@ def method_blocks(plan: Plan) -> list[Block]:
     for step in ik.steps:
         if isinstance(step, Eigen):
             out += general_blocks(step)
+    return out
+
+
+def task_blocks(plan: Plan, details: dict[str, sp.Expr]) -> list[Block]:
+    """The task's virtual joint (derive/tasks.py), lecture style."""
+    assert plan.ik is not None
+    n = plan.arm.dof
+    v = n + 1
+    axis = "xyz"[plan.ik.tool_axis]
+    if plan.ik.certify == "direction":
+        what = (
+            f"The arm has {n} joints; the task fixes the tool point $p$ and the direction $d$ of "
+            f"the tool {axis} axis, five numbers. A virtual revolute joint {v} about the tool "
+            f"{axis} axis, through the tool point, turns the tool frame about that axis without "
+            f"moving $p$ or the axis: the arm reaches $(p, d)$ exactly where the arm with joint "
+            f"{v} reaches a pose of origin $p$ whose {axis} axis is $d$ (any such pose: the "
+            f"value of joint {v} absorbs the rest). The steps below solve that arm's pose and "
+            f"drop the value of joint {v}."
+        )
+    else:
+        what = (
+            f"The arm has {n} joints; the task asks that the tool {axis} axis, from the tool "
+            f"point forward, pass through the point $p$. A virtual prismatic joint {v} slides a "
+            f"point along that axis from the tool point: the arm looks at $p$ exactly where the "
+            f"arm with joint {v} puts that point at $p$ with $d_{{{v}}} \\geq 0$ (the distance). "
+            f"The steps below solve that arm's position and drop $d_{{{v}}}$; a row whose "
+            "point lies behind the tool fails the certification."
+        )
+    out = [Block("h3", "The task as one more joint"), Block("p", what)]
+    shift = details["task_relabel"]
+    out.append(
+        Block(
+            "p",
+            f"Joint {v} is one more DH link after joint {n}: the common normal of axis {n} and "
+            f"the tool {axis} axis gives the twist and length below; the tool sits $s$ along "
+            f"the axis from the normal's foot"
+            + (
+                f", and the normal's direction moves joint {n}'s x axis, so that $\\theta_{{{n}}}$"
+                f" in the steps is the arm's plus {math.degrees(float(shift)):g} deg"
+                if shift != 0
+                else ""
+            )
+            + ":",
+        )
+    )
+    out.append(Block("math", f"\\cos\\alpha_{{{n}}}", tex(details["task_cos_alpha"])))
+    out.append(Block("math", f"\\sin\\alpha_{{{n}}}", tex(details["task_sin_alpha"])))
+    out.append(Block("math", f"a_{{{n}}}", tex(details["task_a"])))
+    out.append(Block("math", "s", tex(details["task_s"])))
     return out
 
 
@@ -497,7 +548,7 @@ def walk(plan: Plan, pose: np.ndarray, q: tuple[float, ...]) -> list[tuple[str, 
         args = [float(a.xreplace(env)) for a in step.args]
         shown = ", ".join(number(x) for x in args)
         t = joint_symbol(step)
-        value = values[t]
+        value = values[t] if t in values else virtual_value(plan, values, env)
         env[t] = value
         if step.kind != "polyd":
             env[sym.c(step.joint)], env[sym.s(step.joint)] = math.cos(value), math.sin(value)
@@ -510,6 +561,23 @@ def walk(plan: Plan, pose: np.ndarray, q: tuple[float, ...]) -> list[tuple[str, 
         else:
             lines.append((f"{tex(t)}\\ (\\text{{{step.kind}}}: {shown})", number(value)))
     return lines
+
+
+def virtual_value(plan: Plan, values: dict[sp.Symbol, float], env: dict[sp.Symbol, float]) -> float:
+    """A task's virtual joint's value on the branch (derive/tasks.py), from the world pose
+    and the solution's joints."""
+    assert plan.ik is not None and plan.ik.virtual
+    known = dict(env)
+    for var, value in values.items():
+        name = str(var)
+        if name.startswith("theta"):
+            known[sym.c(int(name[5:]))], known[sym.s(int(name[5:]))] = (
+                math.cos(value),
+                math.sin(value),
+            )
+        known[var] = value
+    numbers = [float(e.xreplace(known)) for e in plan.ik.virtual]
+    return math.atan2(numbers[1], numbers[0]) if len(numbers) == 2 else numbers[0]
 
 
 def assigned(plan: Plan, pose: np.ndarray, q: tuple[float, ...]) -> dict[sp.Symbol, float]:

@@ -31,6 +31,12 @@ Spec format (all keys other than those listed are errors)::
                                 # are taken as special to choose a closed form, whose
                                 # answers are then refined onto the exact table
                                 # (derive/nominal.py); 0: only exact special values
+    task = "direction"          # what ik solves for: "pose" (6 joints), "position" (3),
+                                # "direction" (5: the tool point and the direction of a
+                                # tool axis), "lookat" (2: the tool axis's ray through a
+                                # point); default: the joints choose (derive/tasks.py)
+    tool_axis = "z"             # the tool axis of "direction" and "lookat" (x, y or z;
+                                # default z, or the first that works)
     [exact]                     # optional (derive import-urdf writes it): the arm's exact
     frames = [[...], ...]       # geometry as n + 1 fixed frames, 12 numbers each (the top
                                 # three rows of F_i, row-major; lengths in length_unit):
@@ -90,7 +96,10 @@ TOP_KEYS = (
     "exact",
     "ik",
 )  # fmt: skip
-IK_KEYS = ("free", "structure_tol")
+IK_KEYS = ("free", "structure_tol", "task", "tool_axis")
+# what [ik] task and tool_axis may be (derive/tasks.py)
+IK_TASKS = ("pose", "position", "direction", "lookat")
+TOOL_AXES = ("x", "y", "z")
 # what [ik] structure_tol may be: beyond 0.1 rad or 0.1 of the arm's size it changes the arm
 STRUCTURE_TOL_RANGE = (0.0, 0.1)
 SOURCE_KEYS = ("urdf", "sha256", "base", "tip", "joints", "snaps", "deviation", "format")
@@ -186,6 +195,8 @@ class ArmSpec:
         origin: the URDF the spec was converted from, or None.
         free: the joints (1-based, ascending) named free in [ik], or None (derive chooses).
         structure_tol: [ik] structure_tol, or None (derive.nominal.STRUCTURE_TOL).
+        task: [ik] task, or None (the joints choose: derive/tasks.py).
+        tool_axis: [ik] tool_axis, or None (z, or the first that works).
         exact: [exact] frames (n + 1 tuples of 12 floats), or None (the table is exact).
     """
 
@@ -203,6 +214,8 @@ class ArmSpec:
     free: tuple[int, ...] | None = None
     structure_tol: float | None = None
     exact: tuple[tuple[float, ...], ...] | None = None
+    task: str | None = None
+    tool_axis: str | None = None
 
     @property
     def dof(self) -> int:
@@ -249,6 +262,10 @@ class ArmSpec:
             ik["free"] = list(self.free)
         if self.structure_tol is not None:  # (likewise)
             ik["structure_tol"] = self.structure_tol
+        if self.task is not None:  # (likewise)
+            ik["task"] = self.task
+        if self.tool_axis is not None:  # (likewise)
+            ik["tool_axis"] = self.tool_axis
         if ik:
             data["ik"] = ik
         if self.exact is not None:  # (likewise)
@@ -358,7 +375,23 @@ def _validate(data: dict, where: str) -> ArmSpec:
         _free(data.get("ik"), where, joints),
         _structure_tol(data.get("ik"), where),
         _exact(data.get("exact"), where, len(joints)),
+        _choice(data.get("ik"), where, "task", IK_TASKS),
+        _choice(data.get("ik"), where, "tool_axis", TOOL_AXES),
     )
+
+
+def _choice(table: object, where: str, key: str, allowed: tuple[str, ...]) -> str | None:
+    """An optional [ik] key whose value is one of allowed (the table is checked by _free)."""
+    if not isinstance(table, dict) or key not in table:
+        return None
+    value = table[key]
+    if value not in allowed:
+        shown = repr(value)[:40] if isinstance(value, str) else type(value).__name__
+        raise SpecError(
+            f"{where}: ik.{key}: {shown} is not allowed; one of "
+            + ", ".join(f'"{a}"' for a in allowed)
+        )
+    return str(value)
 
 
 def _exact(table: object, where: str, dof: int) -> tuple[tuple[float, ...], ...] | None:

@@ -102,25 +102,64 @@ def sample_joints(
 
 
 def pose_error(module: ModuleType, q: np.ndarray, T: np.ndarray) -> tuple[float, float]:
-    """(rotation error in rad, position error / REACH) of fk(q) against T.
-
-    For a solver of the position only (IK_COMPONENTS == "position") the rotation error is 0.
+    """(rotation error in rad, position error / REACH) of fk(q) against T, on the components
+    the solver's task reads (derive/tasks.py): all of them; the position only (rotation error
+    0); the position and the tool axis TOOL_AXIS ("direction"); the distance of T's point from
+    the ray of the tool axis, infinite behind the tool ("lookat", rotation error 0).
     """
     P = module.fk(q)
+    task = module.IK_COMPONENTS
+    axis = getattr(module, "TOOL_AXIS", 2)
+    if task == "lookat":
+        v = T[:3, 3] - P[:3, 3]
+        along = float(v @ P[:3, axis])
+        gap = float(np.abs(v - along * P[:3, axis]).max()) if along >= 0.0 else math.inf
+        return 0.0, gap / module.REACH
     rot = float(np.abs(P[:3, :3] - T[:3, :3]).max())
-    if module.IK_COMPONENTS == "position":
+    if task == "position":
         rot = 0.0
+    elif task == "direction":
+        rot = float(np.abs(P[:3, axis] - T[:3, axis]).max())
     pos = float(np.abs(P[:3, 3] - T[:3, 3]).max()) / module.REACH
     return rot, pos
+
+
+def targets(module: ModuleType, Q: np.ndarray) -> np.ndarray:
+    """The poses whose task the joint vectors Q (n, DOF) solve: fk_batch, with a look-at's
+    point one REACH ahead on the tool axis (the tool point itself lies on every ray)."""
+    T = module.fk_batch(Q)
+    if module.IK_COMPONENTS == "lookat":
+        T[:, :3, 3] += module.REACH * T[:, :3, getattr(module, "TOOL_AXIS", 2)]
+    return T
+
+
+def task_components(module: ModuleType, q: np.ndarray) -> np.ndarray:
+    """What the solver's task reads of fk(q), as one vector (positions / REACH): the pose's
+    top rows, the position, the position and the tool axis, or for a look-at the point one
+    REACH ahead on the tool axis (the ray, through a point at a typical distance)."""
+    P = module.fk(q)
+    task = module.IK_COMPONENTS
+    axis = getattr(module, "TOOL_AXIS", 2)
+    position = P[:3, 3] / module.REACH
+    if task == "position":
+        return position
+    if task == "direction":
+        return np.concatenate([position, P[:3, axis]])
+    if task == "lookat":
+        return position + P[:3, axis]
+    top = P[:3, :].copy()
+    top[:, 3] /= module.REACH
+    return top.ravel()
 
 
 def jacobian_nullity(module: ModuleType, q: np.ndarray) -> tuple[float, np.ndarray]:
     """Smallest singular value of the normalised Jacobian at q and its right singular vector.
 
-    Columns are central differences of fk (rotation entries, and position / REACH); only the
-    position rows for a solver of the position (IK_COMPONENTS == "position"). An arm's free
+    Columns are central differences of the task's components (task_components: the pose's
+    rotation entries and position / REACH, or what a task reads of them). An arm's free
     joints (FREE) are given, not solved: their columns are left out (their entries of the
-    vector are 0).
+    vector are 0). A look-at's rows are the point one REACH ahead with its motion along the
+    ray (which does not change what the arm looks at) projected out.
     """
     h = 1e-6
     cols = []
@@ -129,9 +168,11 @@ def jacobian_nullity(module: ModuleType, q: np.ndarray) -> tuple[float, np.ndarr
     for j in solved:
         step = np.zeros(module.DOF)
         step[j] = h if module.JOINT_TYPES[j] == "R" else h * module.REACH
-        d = (module.fk(q + step) - module.fk(q - step)) / (2 * h)
-        d[:3, 3] /= module.REACH
-        cols.append(d[:3, 3] if module.IK_COMPONENTS == "position" else d[:3, :].ravel())
+        d = (task_components(module, q + step) - task_components(module, q - step)) / (2 * h)
+        if module.IK_COMPONENTS == "lookat":
+            u = module.fk(q)[:3, getattr(module, "TOOL_AXIS", 2)]
+            d = d - (d @ u) * u
+        cols.append(d)
     J = np.array(cols).T
     _, sigma, vt = np.linalg.svd(J)
     null = np.zeros(module.DOF)

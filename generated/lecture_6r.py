@@ -107,8 +107,12 @@ TOOL = np.array((
 REACH = 1327.0
 _OFFSETS = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
 _REVOLUTE = (True, True, True, True, True, True)
-# "pose": solutions reproduce the whole pose; "position": the tool point only.
+# what every solution reproduces (the task, derive/tasks.py): "pose" the whole pose;
+# "position" the tool point; "direction" the tool point and the direction of the tool axis
+# TOOL_AXIS; "lookat" the ray of the tool axis TOOL_AXIS, from the tool point, through a point
 IK_COMPONENTS = "pose"
+# the tool axis of the "direction" and "lookat" tasks: 0 x, 1 y, 2 z
+TOOL_AXIS = 2
 # the solution method (derive/methods/)
 METHOD = "pieper"
 # the most solutions a pose can have by this derivation (ik_batch's M)
@@ -225,6 +229,13 @@ _SPREAD_WIDTH = 0.2
 
 
 _SPREAD_COUNT = 8
+
+
+# ... and its acos argument up to _SEED_BAND beyond 1 (or _SEED_TOL, if larger) still seeds
+# the refinement, at the boundary: a step before it near a singular configuration amplifies
+# the arm's difference (measured: the SO-ARM100 from its MJCF, deviation 4.2e-6, its virtual
+# wrist 0.2 deg from straight put the law of cosines 2.1% beyond 1 at a pose the arm reaches)
+_SEED_BAND = 0.05
 
 
 # The seam: rounding puts a joint at pi on either side of it, and one solution would get two
@@ -1133,13 +1144,28 @@ class _Free(tuple):
     +-90 deg reaches only part of the orientations)."""
 
 
+# how far beyond 1 a nominal table's acos argument still seeds the refinement (0: exact arms)
+_SEED_MISS = max(_SEED_TOL, _SEED_BAND) if _SEED_TOL > 0.0 else 0.0
+
+
+def _ray_gap(e, t, axis):
+    """The distance of the point t's position from the ray of e's tool axis (0 x, 1 y, 2 z)
+    from e's origin (a pose's 12 top entries each): the look-at task's miss."""
+    v = (t[3] - e[3], t[7] - e[7], t[11] - e[11])
+    u = (e[axis], e[4 + axis], e[8 + axis])
+    along = v[0] * u[0] + v[1] * u[1] + v[2] * u[2]
+    if along < 0.0:
+        return math.sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2])
+    return max(abs(v[0] - along * u[0]), abs(v[1] - along * u[1]), abs(v[2] - along * u[2]))
+
+
 def _free(t: float) -> _Free:
     return _Free([t + step for step in _FREE_STEPS])
 
 
 def _cs1(a: float, b: float, e: float, scale: float = 0.0, ref: float = 0.0) -> tuple[float, ...]:
     """Angles t with a cos t + b sin t = e: atan2(b, a) +- acos(e / sqrt(a^2 + b^2)), the
-    acos argument clamped when it exceeds 1 by at most _CLAMP_TOL (and _SEED_TOL: a nominal
+    acos argument clamped when it exceeds 1 by at most _CLAMP_TOL (and _SEED_MISS: a nominal
     table's equation seeds the refinement onto the exact arm at its boundary; where
     sqrt(a^2 + b^2) itself is within _SPREAD_WIDTH _SEED_TOL sqrt(scale), as where two links
     of nearly equal length fold back, _SPREAD_COUNT seeds all round), and taken as +-1 within
@@ -1157,7 +1183,7 @@ def _cs1(a: float, b: float, e: float, scale: float = 0.0, ref: float = 0.0) -> 
         first = atan2(b, a)  # (a nominal fold: seeds all round)
         return tuple(first + _TWO_PI * k / _SPREAD_COUNT for k in range(_SPREAD_COUNT))
     ratio = e / rho
-    if abs(ratio) > 1.0 + _CLAMP_TOL + _SEED_TOL and not _LOOSE.on:
+    if abs(ratio) > 1.0 + _CLAMP_TOL + _SEED_MISS and not _LOOSE.on:
         return ()
     base = atan2(b, a)
     if abs(ratio) >= 1.0 - _FOLD_TOL:
@@ -1381,12 +1407,19 @@ def _pose_error(q, t, exact):
     its Jacobian (minus the residual's derivative) for the joints in _SOLVED, and its size
     (the largest rotation entry's difference, or position difference / REACH). Exact: the
     rotation rows are the error's own derivative, 1/2 sum_k t_k x (z x r_k); else the
-    geometric Jacobian's z, which they equal where the error vanishes (Newton's steps)."""
-    rows = 6 if IK_COMPONENTS == "pose" else 3
+    geometric Jacobian's z, which they equal where the error vanishes (Newton's steps).
+    The tasks (derive/tasks.py): "direction" has the rotation rows u x t_u (u the tool axis
+    TOOL_AXIS, t_u the target's), derivative t_u x (z x u); "lookat" has, as its three rows,
+    minus the target point's offset from the ray, v - (v.u) u with v = p - o, / REACH."""
+    task, x = IK_COMPONENTS, TOOL_AXIS
+    rows = 6 if task in ("pose", "direction") else 3
     pose, axes, origins = _chain_pose(q)
     error = [(t[4 * r + 3] - pose[4 * r + 3]) / REACH for r in range(3)]
     size = max(map(abs, error))
-    if rows == 6:
+    u = (pose[x], pose[4 + x], pose[8 + x])
+    v = [t[4 * r + 3] - pose[4 * r + 3] for r in range(3)]
+    along = v[0] * u[0] + v[1] * u[1] + v[2] * u[2]
+    if task == "pose":
         for r in range(3):
             a, b = 4 * ((r + 1) % 3), 4 * ((r + 2) % 3)
             error.append(
@@ -1394,6 +1427,14 @@ def _pose_error(q, t, exact):
             )
             size = max(size, abs(t[4 * r] - pose[4 * r]), abs(t[4 * r + 1] - pose[4 * r + 1]),
                        abs(t[4 * r + 2] - pose[4 * r + 2]))  # fmt: skip
+    elif task == "direction":
+        for r in range(3):
+            a, b = 4 * ((r + 1) % 3) + x, 4 * ((r + 2) % 3) + x
+            error.append(pose[a] * t[b] - pose[b] * t[a])
+            size = max(size, abs(t[4 * r + x] - pose[4 * r + x]))
+    elif task == "lookat":
+        error = [-(v[r] - along * u[r]) / REACH for r in range(3)]
+        size = _ray_gap(pose, t, x) / REACH
     columns = []
     for i in _SOLVED:
         z, o = axes[i], origins[i]
@@ -1401,7 +1442,8 @@ def _pose_error(q, t, exact):
             dx, dy, dz = pose[3] - o[0], pose[7] - o[1], pose[11] - o[2]
             column = [(z[1] * dz - z[2] * dy) / REACH, (z[2] * dx - z[0] * dz) / REACH,
                       (z[0] * dy - z[1] * dx) / REACH, z[0], z[1], z[2]]  # fmt: skip
-            if exact and rows == 6:
+            du = (z[1] * u[2] - z[2] * u[1], z[2] * u[0] - z[0] * u[2], z[0] * u[1] - z[1] * u[0])
+            if exact and rows == 6 and task == "pose":
                 column[3:] = [0.0, 0.0, 0.0]
                 for k in range(3):
                     r_k = (pose[k], pose[4 + k], pose[8 + k])
@@ -1413,6 +1455,15 @@ def _pose_error(q, t, exact):
                     column[5] += 0.5 * (t_k[0] * w[1] - t_k[1] * w[0])
         else:
             column = [z[0] / REACH, z[1] / REACH, z[2] / REACH, 0.0, 0.0, 0.0]
+            du = (0.0, 0.0, 0.0)
+        if task == "direction":
+            tu = (t[x], t[4 + x], t[8 + x])
+            column[3:] = [tu[1] * du[2] - tu[2] * du[1], tu[2] * du[0] - tu[0] * du[2],
+                          tu[0] * du[1] - tu[1] * du[0]]  # fmt: skip
+        elif task == "lookat":
+            dv = [-column[r] * REACH for r in range(3)]
+            dalong = sum(dv[r] * u[r] + v[r] * du[r] for r in range(3))
+            column[:3] = [(dv[r] - dalong * u[r] - along * du[r]) / REACH for r in range(3)]
         columns.append(column[:rows])
     return error, columns, size
 

@@ -51,6 +51,12 @@
 
 #define DK_SPREAD_COUNT 8
 
+#define DK_SEED_BAND (0.05)
+
+/* how far beyond 1 a nominal table's acos argument still seeds the refinement (0: exact arms;
+   derive/runtime/constants.py, _SEED_BAND, says why) */
+#define DK_SEED_MISS (DK_SEED_TOL > 0.0 ? fmax(DK_SEED_TOL, DK_SEED_BAND) : 0.0)
+
 /* the values a free joint tries, as offsets from its first value: 0, +5, -5, +10, ... deg */
 #define DK_FREE_COUNT 72
 
@@ -1150,7 +1156,7 @@ static int dk_cs1(dk_values *v, double a, double b, double e, double scale, doub
     }
     inverse = 1.0 / rho;
     ratio = e * inverse;
-    if (fabs(ratio) > 1.0 + DK_CLAMP_TOL + DK_SEED_TOL) {
+    if (fabs(ratio) > 1.0 + DK_CLAMP_TOL + DK_SEED_MISS) {
         return 0;
     }
     if (fabs(ratio) >= 1.0 - DK_FOLD_TOL) {
@@ -1225,18 +1231,44 @@ static int dk_atan2(dk_values *v, double y, double x, double ref)
     return dk_one(v, y, x);
 }
 
-/* whether e (a pose's 12 top entries) matches t: rotation within tol (unless position only),
-   position within ptol (no early exit: the comparisons are cheaper than the branches) */
-static int dk_match(const double e[12], const double t[12], double tol, double ptol,
-                    int position_only)
+/* the distance of the point t's position from the ray of e's tool axis (0 x, 1 y, 2 z) from
+   e's origin (a pose's 12 top entries each): the look-at task's miss */
+static double dk_ray_gap(const double e[12], const double t[12], int axis)
+{
+    const double v0 = t[3] - e[3], v1 = t[7] - e[7], v2 = t[11] - e[11];
+    const double u0 = e[axis], u1 = e[4 + axis], u2 = e[8 + axis];
+    const double along = v0 * u0 + v1 * u1 + v2 * u2;
+    if (along < 0.0) {
+        return sqrt(v0 * v0 + v1 * v1 + v2 * v2);
+    }
+    return fmax(fmax(fabs(v0 - along * u0), fabs(v1 - along * u1)), fabs(v2 - along * u2));
+}
+
+/* whether e (a pose's 12 top entries) matches t in the task's components (0 the pose, 1 the
+   position, 2 the position and tool axis `axis`'s direction, 3 the ray of that axis through
+   t's position): rotation entries within tol, positions within ptol (no early exit: the
+   comparisons are cheaper than the branches) */
+static int dk_match(const double e[12], const double t[12], double tol, double ptol, int task,
+                    int axis)
 {
     const int position = (fabs(e[3] - t[3]) <= ptol) & (fabs(e[7] - t[7]) <= ptol) &
                          (fabs(e[11] - t[11]) <= ptol);
-    const int rotation =
-        (fabs(e[0] - t[0]) <= tol) & (fabs(e[1] - t[1]) <= tol) & (fabs(e[2] - t[2]) <= tol) &
-        (fabs(e[4] - t[4]) <= tol) & (fabs(e[5] - t[5]) <= tol) & (fabs(e[6] - t[6]) <= tol) &
-        (fabs(e[8] - t[8]) <= tol) & (fabs(e[9] - t[9]) <= tol) & (fabs(e[10] - t[10]) <= tol);
-    return position & (rotation | position_only);
+    if (task == 3) {
+        return dk_ray_gap(e, t, axis) <= ptol;
+    }
+    if (task == 2) {
+        return position & (fabs(e[axis] - t[axis]) <= tol) &
+               (fabs(e[4 + axis] - t[4 + axis]) <= tol) &
+               (fabs(e[8 + axis] - t[8 + axis]) <= tol);
+    }
+    {
+        const int rotation = (fabs(e[0] - t[0]) <= tol) & (fabs(e[1] - t[1]) <= tol) &
+                             (fabs(e[2] - t[2]) <= tol) & (fabs(e[4] - t[4]) <= tol) &
+                             (fabs(e[5] - t[5]) <= tol) & (fabs(e[6] - t[6]) <= tol) &
+                             (fabs(e[8] - t[8]) <= tol) & (fabs(e[9] - t[9]) <= tol) &
+                             (fabs(e[10] - t[10]) <= tol);
+        return position & (rotation | (task == 1));
+    }
 }
 
 /* whether T (16 entries, row-major) is a finite rigid transform within DK_POSE_TOL */
@@ -1571,7 +1603,7 @@ static int dk_solve(const double t[12], double tol, const double ref[DK_DOF],
                             const double dk_c7 = c7, dk_s7 = s7;
                             dk_fk_cs(dk_c1, dk_s1, dk_c2, dk_s2, dk_c3, dk_s3, dk_c4, dk_s4, dk_c5,
                                     dk_s5, dk_c6, dk_s6, dk_c7, dk_s7, e);
-                            if (n < DK_MAX && dk_match(e, t, tol, ptol, 0)) {
+                            if (n < DK_MAX && dk_match(e, t, tol, ptol, 0, 2)) {
                                 found[n][0] = -theta6;
                                 found[n][1] = -theta5;
                                 found[n][2] = -theta4;

@@ -25,11 +25,14 @@ BUNDLED = (
     "iiwa14",
     "lecture_6r",
     "lecture_rrr",
+    "locobot_head",
     "manocha_canny",
     "panda",
     "parallel_6r",
     "planar_2r",
     "puma560",
+    "so_arm100",
+    "youbot",
 )
 _counter = itertools.count()
 

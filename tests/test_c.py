@@ -50,6 +50,19 @@ POSES_FOR = {"manocha_canny": 2_000}
 # farther apart than 1e-6 on 10,000 (1.1%; the Python solver and its compiled kernel differ
 # on 0.3%). Every regular sample's own q is among the C rows there too (checked below).
 BEYOND = {"lecture_6r": 10, "parallel_6r": 4, "iiwa14": 15, "panda": 15}
+BEYOND |= {"youbot": 3, "locobot_head": 1}
+# (so_arm100's rows are refined onto its exact chain: each backend's Newton steps stop within
+# 1e-10 of the pose, and near a singular configuration (its roll near 90 deg) that leaves the
+# joint values up to 1e-6 apart; measured 140 of 10,000, allowed 150)
+BEYOND |= {"so_arm100": 150}
+# Below this smallest singular value a sample's own q may be missing from the rows: the
+# sample is singular. A nominal table refined onto the exact arm (so_arm100, from its MJCF)
+# misses one more: where the nominal arm is singular the exact one can have two solutions
+# close together, and the nominal seed refines onto one of them (measured: sample 841, the
+# roll 2.3 deg from 90 deg, sigma 1.1e-5; both solvers return the other solution, 0.01 rad
+# away, exact to 1e-16)
+SINGULAR = verify.SINGULAR_SIGMA
+SINGULAR_FOR = {"so_arm100": 1e-4}
 COUNT = {"parallel_6r": 1, "manocha_canny": 40}
 TURN = {"manocha_canny": 12}
 
@@ -87,7 +100,7 @@ def poses(m, n: int, seed: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     refs = np.zeros_like(Q)
     for j in m.FREE:
         refs[:, j - 1] = Q[:, j - 1]
-    return Q, m.fk_batch(Q), refs
+    return Q, verify.targets(m, Q), refs
 
 
 def python_rows(m, T: np.ndarray, refs: np.ndarray) -> list[np.ndarray]:
@@ -104,7 +117,7 @@ def test_c_solver_gives_the_python_solutions(generated, harnesses, name):
     m = generated(name)
     Q, T, refs = poses(m, POSES_FOR.get(name, POSES), 5)
     harness = harnesses(name)
-    np.testing.assert_allclose(harness.fk(Q), T, atol=1e-12)
+    np.testing.assert_allclose(harness.fk(Q), m.fk_batch(Q), atol=1e-12)
     counts, QC = harness.solve(T, refs)
     assert (counts >= 0).all(), "a pose the C solver did not settle"
     P = python_rows(m, T, refs)
@@ -112,9 +125,9 @@ def test_c_solver_gives_the_python_solutions(generated, harnesses, name):
     found = np.arange(QC.shape[1])[None, :] < counts[:, None]
     E = m.fk_batch(QC[found])
     owner = T[np.nonzero(found)[0]]
-    assert np.abs(E[:, :3, 3] - owner[:, :3, 3]).max(initial=0.0) <= 1e-6 * m.REACH
-    if m.IK_COMPONENTS == "pose":
-        assert np.abs(E[:, :3, :3] - owner[:, :3, :3]).max(initial=0.0) <= 1e-6
+    assert E.shape[0] == len(owner)
+    for row, pose in zip(QC[found], owner):
+        assert max(verify.pose_error(m, row, pose)) <= 1e-6
     beyond = other_count = turn = 0
     revolute = np.array([k == "R" for k in m.JOINT_TYPES])
     every = np.ones(m.DOF, bool)
@@ -122,13 +135,18 @@ def test_c_solver_gives_the_python_solutions(generated, harnesses, name):
         rows, c_rows = P[i], QC[i, : counts[i]]
         # complete: the sample's own q is among the rows, unless the sample is singular
         if not any(verify.same_joints(r, Q[i], revolute, every) for r in c_rows):
-            assert verify.jacobian_nullity(m, Q[i])[0] < verify.SINGULAR_SIGMA, i
+            assert verify.jacobian_nullity(m, Q[i])[0] < SINGULAR_FOR.get(name, SINGULAR), i
         # no repeats (the C solver looks for them only where two branch values nearly meet)
         gaps = np.abs(c_rows[:, None, :] - c_rows[None, :, :])
         gaps[..., revolute] = np.minimum(gaps[..., revolute], 2 * np.pi - gaps[..., revolute])
         apart = gaps.max(axis=2, initial=0.0) + np.eye(len(c_rows))
         assert apart.min(initial=1.0) > 1e-6, (i, c_rows)
         if len(rows) != len(c_rows):
+            if hasattr(m, "NOMINAL_DH") and verify.jacobian_nullity(m, Q[i])[0] < SINGULAR:
+                # (a curve of solutions: each solver refines its seeds onto its own points of
+                # it, as the general method's do: tests/test_batch.py, curve_at_singular)
+                assert len(rows) and len(c_rows), i
+                continue
             other_count += 1
             continue
         if len(rows):

@@ -69,14 +69,16 @@ def test_failure_part_way_keeps_earlier_files(tmp_path, capsys):
 
 def test_unknown_arm_name_exits_2(capsys):
     assert main(["fk", "no_such_arm", "0"]) == 2
-    assert "bundled arms: iiwa14, lecture_6r, lecture_rrr, manocha_canny, panda" in (
+    assert "bundled arms: iiwa14, lecture_6r, lecture_rrr, locobot_head, manocha_canny" in (
         capsys.readouterr().err
     )
 
 
 def test_require_ik_exits_3_for_fk_only_arm(tmp_path):
-    spec = tmp_path / "two.toml"
-    spec.write_text(spec_text("two", "standard", [(90, 0, 1, 0), (90, 1, 0, 0)]))
+    # (four joints: no task of a pose's, position's or look-at's fits them)
+    spec = tmp_path / "four.toml"
+    rows = [(90, 0, 1, 0), (90, 1, 0, 0), (0, 0.5, 0, 0), (90, 0.3, 0, 0)]
+    spec.write_text(spec_text("four", "standard", rows))
     assert main(["generate", str(spec), "--out", str(tmp_path)]) == 0
     assert main(["generate", str(spec), "--out", str(tmp_path), "--require-ik"]) == 3
 

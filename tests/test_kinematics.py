@@ -139,8 +139,29 @@ def test_fk_equals_independent_numpy_fk(generated, name):
     spec = load_spec(ROOT / "derive" / "arms" / f"{name}.toml")
     rng = np.random.default_rng(7)
     for q in rng.uniform(-math.pi, math.pi, (50, m.DOF)):
-        expected = reference_fk(spec.convention, m.DH, m.JOINT_TYPES, q, m.BASE, m.TOOL)
+        if spec.exact is None:
+            expected = reference_fk(spec.convention, m.DH, m.JOINT_TYPES, q, m.BASE, m.TOOL)
+        else:  # (fk is the exact frames' T(q) = F_0 J_1(q_1) F_1 ... J_n(q_n) F_n)
+            expected = frames_fk(spec.exact, m.JOINT_TYPES, q)
         assert np.abs(m.fk(q) - expected).max() < 1e-12 * max(1.0, m.REACH)
+
+
+def frames_fk(frames, kinds: str, q) -> np.ndarray:
+    """The pose of a chain of fixed frames (12 numbers each) and joints about or along z."""
+    T = np.eye(4)
+    for k, frame in enumerate(frames):
+        F = np.eye(4)
+        F[:3, :] = np.array(frame).reshape(3, 4)
+        if k:
+            J = np.eye(4)
+            if kinds[k - 1] == "R":
+                c, s = math.cos(q[k - 1]), math.sin(q[k - 1])
+                J[:2, :2] = [[c, -s], [s, c]]
+            else:
+                J[2, 3] = q[k - 1]
+            T = T @ J
+        T = T @ F
+    return T
 
 
 @pytest.mark.parametrize("name", BUNDLED)

@@ -24,6 +24,10 @@
 #define DK_TWO_PI (6.283185307179586)
 #define DK_SPREAD_WIDTH (0.2)
 #define DK_SPREAD_COUNT 8
+#define DK_SEED_BAND (0.05)
+/* how far beyond 1 a nominal table's acos argument still seeds the refinement (0: exact arms;
+   derive/runtime/constants.py, _SEED_BAND, says why) */
+#define DK_SEED_MISS (DK_SEED_TOL > 0.0 ? fmax(DK_SEED_TOL, DK_SEED_BAND) : 0.0)
 
 /* the values a free joint tries, as offsets from its first value: 0, +5, -5, +10, ... deg */
 #define DK_FREE_COUNT 72
@@ -1174,7 +1178,7 @@ static int dk_cs1(dk_values *v, double a, double b, double e, double scale, doub
     }
     inverse = 1.0 / rho;
     ratio = e * inverse;
-    if (fabs(ratio) > 1.0 + DK_CLAMP_TOL + DK_SEED_TOL) {
+    if (fabs(ratio) > 1.0 + DK_CLAMP_TOL + DK_SEED_MISS) {
         return 0;
     }
     if (fabs(ratio) >= 1.0 - DK_FOLD_TOL) {
@@ -1311,18 +1315,44 @@ static int dk_atan2(dk_values *v, double y, double x, double ref)
     return dk_one(v, y, x);
 }
 
-/* whether e (a pose's 12 top entries) matches t: rotation within tol (unless position only),
-   position within ptol (no early exit: the comparisons are cheaper than the branches) */
-static int dk_match(const double e[12], const double t[12], double tol, double ptol,
-                    int position_only)
+/* the distance of the point t's position from the ray of e's tool axis (0 x, 1 y, 2 z) from
+   e's origin (a pose's 12 top entries each): the look-at task's miss */
+static double dk_ray_gap(const double e[12], const double t[12], int axis)
+{
+    const double v0 = t[3] - e[3], v1 = t[7] - e[7], v2 = t[11] - e[11];
+    const double u0 = e[axis], u1 = e[4 + axis], u2 = e[8 + axis];
+    const double along = v0 * u0 + v1 * u1 + v2 * u2;
+    if (along < 0.0) {
+        return sqrt(v0 * v0 + v1 * v1 + v2 * v2);
+    }
+    return fmax(fmax(fabs(v0 - along * u0), fabs(v1 - along * u1)), fabs(v2 - along * u2));
+}
+
+/* whether e (a pose's 12 top entries) matches t in the task's components (0 the pose, 1 the
+   position, 2 the position and tool axis `axis`'s direction, 3 the ray of that axis through
+   t's position): rotation entries within tol, positions within ptol (no early exit: the
+   comparisons are cheaper than the branches) */
+static int dk_match(const double e[12], const double t[12], double tol, double ptol, int task,
+                    int axis)
 {
     const int position = (fabs(e[3] - t[3]) <= ptol) & (fabs(e[7] - t[7]) <= ptol) &
                          (fabs(e[11] - t[11]) <= ptol);
-    const int rotation =
-        (fabs(e[0] - t[0]) <= tol) & (fabs(e[1] - t[1]) <= tol) & (fabs(e[2] - t[2]) <= tol) &
-        (fabs(e[4] - t[4]) <= tol) & (fabs(e[5] - t[5]) <= tol) & (fabs(e[6] - t[6]) <= tol) &
-        (fabs(e[8] - t[8]) <= tol) & (fabs(e[9] - t[9]) <= tol) & (fabs(e[10] - t[10]) <= tol);
-    return position & (rotation | position_only);
+    if (task == 3) {
+        return dk_ray_gap(e, t, axis) <= ptol;
+    }
+    if (task == 2) {
+        return position & (fabs(e[axis] - t[axis]) <= tol) &
+               (fabs(e[4 + axis] - t[4 + axis]) <= tol) &
+               (fabs(e[8 + axis] - t[8 + axis]) <= tol);
+    }
+    {
+        const int rotation = (fabs(e[0] - t[0]) <= tol) & (fabs(e[1] - t[1]) <= tol) &
+                             (fabs(e[2] - t[2]) <= tol) & (fabs(e[4] - t[4]) <= tol) &
+                             (fabs(e[5] - t[5]) <= tol) & (fabs(e[6] - t[6]) <= tol) &
+                             (fabs(e[8] - t[8]) <= tol) & (fabs(e[9] - t[9]) <= tol) &
+                             (fabs(e[10] - t[10]) <= tol);
+        return position & (rotation | (task == 1));
+    }
 }
 
 /* whether T (16 entries, row-major) is a finite rigid transform within DK_POSE_TOL */
@@ -1426,6 +1456,43 @@ static int dk_seen(const double (*found)[DK_REFINE_N], int n, const int revolute
     return 0;
 }
 
+/* a task's Jacobian column k (the "direction" and "lookat" tasks, DK_REFINE_TASK 2 and 3):
+   given the column of the pose's position rows (J[0..2][k], set), the derivative of the
+   direction error u x t_u (rows 3..5: t_u x (z x u)), or of the ray offset v - (v.u) u, v the
+   target point minus the origin (rows 0..2), for a revolute joint's axis z (NULL: a prismatic
+   joint, which moves the origin only) */
+static void dk_task_column(const double pose[12], const double t[12], double J[6][DK_REFINE_M],
+                           int k, const double *z, double reach)
+{
+    const int x = DK_REFINE_AXIS;
+    const double u[3] = {pose[x], pose[4 + x], pose[8 + x]};
+    double du[3] = {0.0, 0.0, 0.0}, v[3], dv[3], along = 0.0, dalong = 0.0;
+    int r;
+    if (z != NULL) {
+        du[0] = z[1] * u[2] - z[2] * u[1];
+        du[1] = z[2] * u[0] - z[0] * u[2];
+        du[2] = z[0] * u[1] - z[1] * u[0];
+    }
+    if (DK_REFINE_TASK == 2) {
+        const double tu[3] = {t[x], t[4 + x], t[8 + x]};
+        J[3][k] = tu[1] * du[2] - tu[2] * du[1];
+        J[4][k] = tu[2] * du[0] - tu[0] * du[2];
+        J[5][k] = tu[0] * du[1] - tu[1] * du[0];
+        return;
+    }
+    for (r = 0; r < 3; r++) {
+        v[r] = t[4 * r + 3] - pose[4 * r + 3];
+        dv[r] = -J[r][k] * reach;
+        along += v[r] * u[r];
+    }
+    for (r = 0; r < 3; r++) {
+        dalong += dv[r] * u[r] + v[r] * du[r];
+    }
+    for (r = 0; r < 3; r++) {
+        J[r][k] = (dv[r] - dalong * u[r] - along * du[r]) / reach;
+    }
+}
+
 /* Newton's steps, damped by the error's square, on the chain of fixed frames (12 entries each:
    T(q) = F_0 J_1(q_1) F_1 ... J_n(q_n) F_n) towards the pose t (12 top entries), moving the
    joints in solved: q in place (the best point met); the pose error there (the largest
@@ -1479,12 +1546,29 @@ static double dk_refine(const double chain[DK_REFINE_N + 1][12], const int revol
             size = fabs(error[r]) > size ? fabs(error[r]) : size;
             for (k = 0; k < 3; k++) {
                 total += pose[4 * a + k] * t[4 * b + k] - pose[4 * b + k] * t[4 * a + k];
-                if (DK_REFINE_ROWS == 6) {
+                if (DK_REFINE_TASK == 0) {
                     const double gap = fabs(t[4 * r + k] - pose[4 * r + k]);
                     size = gap > size ? gap : size;
                 }
             }
             error[3 + r] = 0.5 * total;
+            if (DK_REFINE_TASK == 2) { /* u x t_u: u the tool axis, t_u the target's */
+                const int x = DK_REFINE_AXIS;
+                const double gap = fabs(t[4 * r + x] - pose[4 * r + x]);
+                error[3 + r] = pose[4 * a + x] * t[4 * b + x] - pose[4 * b + x] * t[4 * a + x];
+                size = gap > size ? gap : size;
+            }
+        }
+        if (DK_REFINE_TASK == 3) { /* minus the target point's offset from the ray, / reach */
+            const int x = DK_REFINE_AXIS;
+            double along = 0.0;
+            for (r = 0; r < 3; r++) {
+                along += (t[4 * r + 3] - pose[4 * r + 3]) * pose[4 * r + x];
+            }
+            for (r = 0; r < 3; r++) {
+                error[r] = -(t[4 * r + 3] - pose[4 * r + 3] - along * pose[4 * r + x]) / reach;
+            }
+            size = dk_ray_gap(pose, t, x) / reach;
         }
         if (size < best) {
             best = size;
@@ -1516,6 +1600,9 @@ static double dk_refine(const double chain[DK_REFINE_N + 1][12], const int revol
                     J[r][k] = z[r] / reach;
                     J[3 + r][k] = 0.0;
                 }
+            }
+            if (DK_REFINE_TASK >= 2) {
+                dk_task_column(pose, t, J, k, revolute[j] ? z : NULL, reach);
             }
         }
         for (r = 0; r < DK_REFINE_ROWS; r++) {

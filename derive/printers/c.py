@@ -43,6 +43,7 @@ from derive.printers.common import (
     world_names,
 )
 from derive.printers.general import eigen_step, fill_entries
+from derive.tasks import TASK_CODES
 
 
 class CPrinter(CodePrinter):
@@ -386,8 +387,9 @@ def solve_lines(plan: Plan) -> tuple[tuple[int, str], ...]:
         body.append(Line(depth, "double e[12];"))
         body += _arm_cs_lines(plan, printer, depth, scope)
     if not fix:
-        position = "1" if plan.ik.certify == "position" else "0"
-        body.append(Line(depth, f"if (n < DK_MAX && dk_match(e, t, tol, ptol, {position})) {{"))
+        task = TASK_CODES[plan.ik.certify]
+        axis = plan.ik.tool_axis
+        body.append(Line(depth, f"if (n < DK_MAX && dk_match(e, t, tol, ptol, {task}, {axis})) {{"))
         body += [Line(depth + 1, f"found[n][{k}] = {v};") for k, v in enumerate(outputs)]
         body.append(Line(depth + 1, "n++;"))
         body.append(Line(depth, "}"))

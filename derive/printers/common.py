@@ -143,9 +143,15 @@ def same_joints(plan: Plan) -> bool:
     return True
 
 
-def match_expression(certify: str) -> str:
-    """The certification test of entries e against target t, unrolled."""
-    rotation = () if certify == "position" else (0, 1, 2, 4, 5, 6, 8, 9, 10)
+def match_expression(certify: str, axis: int = 2) -> str:
+    """The certification test of entries e against target t in the task's components
+    (derive/tasks.py), unrolled: rotation entries within tol, positions within ptol."""
+    if certify == "lookat":
+        return "_ray_gap(e, t, TOOL_AXIS) <= ptol"
+    rotation: tuple[int, ...] = {
+        "pose": (0, 1, 2, 4, 5, 6, 8, 9, 10),
+        "direction": (axis, 4 + axis, 8 + axis),
+    }.get(certify, ())
     tests = [f"abs(e[{k}] - t[{k}]) <= tol" for k in rotation]
     tests += [f"abs(e[{k}] - t[{k}]) <= ptol" for k in (3, 7, 11)]
     return " and ".join(tests)
@@ -184,7 +190,8 @@ def live_steps(plan: Plan) -> tuple[tuple[Live, ...], frozenset[str]]:
     the solver uses)."""
     assert plan.ik is not None
     live = {str(s) for e in plan.ik.outputs for s in e.free_symbols}
-    if same_joints(plan):
+    if same_joints(plan) and plan.correction is None:  # (certified by fk from the cs; a
+        # corrected arm's rows are refined and certified on its exact chain instead)
         live |= set(cs_arguments(plan).split(", "))
     out = []
     for step in reversed(plan.ik.steps):

@@ -18,6 +18,8 @@ Modules, in copy order:
 ``common``     argument checks and joint-value helpers the others share
 ``redundant``  ik_sweep and the searching nearest of arms with free joints (copied only
                into their modules, whose nearest it replaces)
+``task``       ik_direction and ik_lookat of arms solved for a task (derive/tasks.py;
+               copied only into their modules)
 ``closed``     closed forms of the Python solver (quadratic, quartic, atan2, Newton
                steps, the free-joint reach searches)
 ``general``    the general 6R method in the Python solver (numpy's eigensolver)
@@ -31,5 +33,6 @@ arm (DOF, LIMITS, the forward kinematics, the solver bodies), so that this packa
 """
 
 MODULES = (
-    "constants", "native", "api", "common", "redundant", "closed", "general", "scalar", "refine",
+    "constants", "native", "api", "common", "redundant", "task", "closed", "general", "scalar",
+    "refine",
 )  # fmt: skip

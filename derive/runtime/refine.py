@@ -17,8 +17,8 @@ from __future__ import annotations
 
 import math
 
-from derive.runtime.arm import _CHAIN, _REVOLUTE, _SOLVED, IK_COMPONENTS, REACH
-from derive.runtime.scalar import _LOOSE
+from derive.runtime.arm import _CHAIN, _REVOLUTE, _SOLVED, IK_COMPONENTS, REACH, TOOL_AXIS
+from derive.runtime.scalar import _LOOSE, _ray_gap
 
 # at most this many steps per candidate (a seed on a singular configuration converges
 # linearly); a step longer than _REFINE_STRIDE (radians, or
@@ -129,12 +129,19 @@ def _pose_error(q, t, exact):
     its Jacobian (minus the residual's derivative) for the joints in _SOLVED, and its size
     (the largest rotation entry's difference, or position difference / REACH). Exact: the
     rotation rows are the error's own derivative, 1/2 sum_k t_k x (z x r_k); else the
-    geometric Jacobian's z, which they equal where the error vanishes (Newton's steps)."""
-    rows = 6 if IK_COMPONENTS == "pose" else 3
+    geometric Jacobian's z, which they equal where the error vanishes (Newton's steps).
+    The tasks (derive/tasks.py): "direction" has the rotation rows u x t_u (u the tool axis
+    TOOL_AXIS, t_u the target's), derivative t_u x (z x u); "lookat" has, as its three rows,
+    minus the target point's offset from the ray, v - (v.u) u with v = p - o, / REACH."""
+    task, x = IK_COMPONENTS, TOOL_AXIS
+    rows = 6 if task in ("pose", "direction") else 3
     pose, axes, origins = _chain_pose(q)
     error = [(t[4 * r + 3] - pose[4 * r + 3]) / REACH for r in range(3)]
     size = max(map(abs, error))
-    if rows == 6:
+    u = (pose[x], pose[4 + x], pose[8 + x])
+    v = [t[4 * r + 3] - pose[4 * r + 3] for r in range(3)]
+    along = v[0] * u[0] + v[1] * u[1] + v[2] * u[2]
+    if task == "pose":
         for r in range(3):
             a, b = 4 * ((r + 1) % 3), 4 * ((r + 2) % 3)
             error.append(
@@ -142,6 +149,14 @@ def _pose_error(q, t, exact):
             )
             size = max(size, abs(t[4 * r] - pose[4 * r]), abs(t[4 * r + 1] - pose[4 * r + 1]),
                        abs(t[4 * r + 2] - pose[4 * r + 2]))  # fmt: skip
+    elif task == "direction":
+        for r in range(3):
+            a, b = 4 * ((r + 1) % 3) + x, 4 * ((r + 2) % 3) + x
+            error.append(pose[a] * t[b] - pose[b] * t[a])
+            size = max(size, abs(t[4 * r + x] - pose[4 * r + x]))
+    elif task == "lookat":
+        error = [-(v[r] - along * u[r]) / REACH for r in range(3)]
+        size = _ray_gap(pose, t, x) / REACH
     columns = []
     for i in _SOLVED:
         z, o = axes[i], origins[i]
@@ -149,7 +164,8 @@ def _pose_error(q, t, exact):
             dx, dy, dz = pose[3] - o[0], pose[7] - o[1], pose[11] - o[2]
             column = [(z[1] * dz - z[2] * dy) / REACH, (z[2] * dx - z[0] * dz) / REACH,
                       (z[0] * dy - z[1] * dx) / REACH, z[0], z[1], z[2]]  # fmt: skip
-            if exact and rows == 6:
+            du = (z[1] * u[2] - z[2] * u[1], z[2] * u[0] - z[0] * u[2], z[0] * u[1] - z[1] * u[0])
+            if exact and rows == 6 and task == "pose":
                 column[3:] = [0.0, 0.0, 0.0]
                 for k in range(3):
                     r_k = (pose[k], pose[4 + k], pose[8 + k])
@@ -161,6 +177,15 @@ def _pose_error(q, t, exact):
                     column[5] += 0.5 * (t_k[0] * w[1] - t_k[1] * w[0])
         else:
             column = [z[0] / REACH, z[1] / REACH, z[2] / REACH, 0.0, 0.0, 0.0]
+            du = (0.0, 0.0, 0.0)
+        if task == "direction":
+            tu = (t[x], t[4 + x], t[8 + x])
+            column[3:] = [tu[1] * du[2] - tu[2] * du[1], tu[2] * du[0] - tu[0] * du[2],
+                          tu[0] * du[1] - tu[1] * du[0]]  # fmt: skip
+        elif task == "lookat":
+            dv = [-column[r] * REACH for r in range(3)]
+            dalong = sum(dv[r] * u[r] + v[r] * du[r] for r in range(3))
+            column[:3] = [(dv[r] - dalong * u[r] - along * du[r]) / REACH for r in range(3)]
         columns.append(column[:rows])
     return error, columns, size
 

@@ -28,6 +28,7 @@ from derive.runtime.constants import (
     _LEAD_TOL,
     _MERGE_TOL,
     _ROOT_IMAG_TOL,
+    _SEED_BAND,
     _SPREAD_COUNT,
     _SPREAD_WIDTH,
     _TWO_PI,
@@ -51,13 +52,28 @@ class _Free(tuple):
     +-90 deg reaches only part of the orientations)."""
 
 
+# how far beyond 1 a nominal table's acos argument still seeds the refinement (0: exact arms)
+_SEED_MISS = max(_SEED_TOL, _SEED_BAND) if _SEED_TOL > 0.0 else 0.0
+
+
+def _ray_gap(e, t, axis):
+    """The distance of the point t's position from the ray of e's tool axis (0 x, 1 y, 2 z)
+    from e's origin (a pose's 12 top entries each): the look-at task's miss."""
+    v = (t[3] - e[3], t[7] - e[7], t[11] - e[11])
+    u = (e[axis], e[4 + axis], e[8 + axis])
+    along = v[0] * u[0] + v[1] * u[1] + v[2] * u[2]
+    if along < 0.0:
+        return math.sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2])
+    return max(abs(v[0] - along * u[0]), abs(v[1] - along * u[1]), abs(v[2] - along * u[2]))
+
+
 def _free(t: float) -> _Free:
     return _Free([t + step for step in _FREE_STEPS])
 
 
 def _cs1(a: float, b: float, e: float, scale: float = 0.0, ref: float = 0.0) -> tuple[float, ...]:
     """Angles t with a cos t + b sin t = e: atan2(b, a) +- acos(e / sqrt(a^2 + b^2)), the
-    acos argument clamped when it exceeds 1 by at most _CLAMP_TOL (and _SEED_TOL: a nominal
+    acos argument clamped when it exceeds 1 by at most _CLAMP_TOL (and _SEED_MISS: a nominal
     table's equation seeds the refinement onto the exact arm at its boundary; where
     sqrt(a^2 + b^2) itself is within _SPREAD_WIDTH _SEED_TOL sqrt(scale), as where two links
     of nearly equal length fold back, _SPREAD_COUNT seeds all round), and taken as +-1 within
@@ -75,7 +91,7 @@ def _cs1(a: float, b: float, e: float, scale: float = 0.0, ref: float = 0.0) -> 
         first = atan2(b, a)  # (a nominal fold: seeds all round)
         return tuple(first + _TWO_PI * k / _SPREAD_COUNT for k in range(_SPREAD_COUNT))
     ratio = e / rho
-    if abs(ratio) > 1.0 + _CLAMP_TOL + _SEED_TOL and not _LOOSE.on:
+    if abs(ratio) > 1.0 + _CLAMP_TOL + _SEED_MISS and not _LOOSE.on:
         return ()
     base = atan2(b, a)
     if abs(ratio) >= 1.0 - _FOLD_TOL:

@@ -37,6 +37,7 @@ WANTED = (
     ("lbr_iiwa_14_r820", "rtb_data", "kuka_lbr_iiwa/urdf/lbr_iiwa_14_r820.urdf"),
     ("al5d", "rtb_data", "lynxmotion_al5d_description/urdf/al5d_robot.urdf"),
     ("xarm6", "pybullet", "pybullet_data/xarm/xarm6_robot.urdf"),
+    ("locobot", "nav_planning", "nav_planning/resources/robot/locobot/locobot.urdf"),
 )
 
 

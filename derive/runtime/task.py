@@ -1,0 +1,91 @@
+"""The task functions of an arm solved for fewer components than a pose (derive/tasks.py):
+ik_direction(p, d) and ik_lookat(p) build a pose whose components the task reads and call
+ik, which certifies every row on those components (IK_COMPONENTS, TOOL_AXIS)."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from derive.runtime.api import ik
+from derive.runtime.arm import TOOL_AXIS
+from derive.runtime.common import _real
+from derive.runtime.constants import CERTIFY_TOL
+
+
+def ik_direction(
+    p: ArrayLike,
+    d: ArrayLike,
+    *,
+    within_limits: bool = False,
+    q_ref: ArrayLike | None = None,
+    tol: float = CERTIFY_TOL,
+    backend: str | None = None,
+) -> np.ndarray:
+    """All solutions that put the tool point at p with the tool axis TOOL_AXIS along d
+    (IKFast's TranslationDirection5D), as an (n, DOF) array; empty if unreachable.
+
+    Args:
+        p: the tool point in the world, 3 numbers.
+        d: the tool axis's direction in the world, 3 numbers (not all 0; normalised here).
+        within_limits, q_ref, tol, backend: as ik's. Every row reproduces p within
+            tol * REACH and the unit d within tol per entry.
+
+    Raises:
+        ValueError: p or d is not 3 finite numbers, or d is 0.
+    """
+    return ik(_task_pose(p, d), within_limits=within_limits, q_ref=q_ref, tol=tol, backend=backend)
+
+
+def ik_lookat(
+    p: ArrayLike,
+    *,
+    within_limits: bool = False,
+    q_ref: ArrayLike | None = None,
+    tol: float = CERTIFY_TOL,
+    backend: str | None = None,
+) -> np.ndarray:
+    """All solutions whose tool axis TOOL_AXIS, from the tool point forward, passes through
+    the point p (IKFast's Lookat3D), as an (n, DOF) array; empty if no configuration looks
+    at p.
+
+    Args:
+        p: the point in the world, 3 numbers.
+        within_limits, q_ref, tol, backend: as ik's. Every row's ray passes within
+            tol * REACH of p.
+
+    Raises:
+        ValueError: p is not 3 finite numbers.
+    """
+    return ik(
+        _task_pose(p, None), within_limits=within_limits, q_ref=q_ref, tol=tol, backend=backend
+    )
+
+
+def _task_pose(p: ArrayLike, d: ArrayLike | None) -> np.ndarray:
+    """A pose with origin p and, where d is given, column TOOL_AXIS along d (the other two
+    columns complete it to a right-handed frame: the task does not read them)."""
+    point = _real(p, "p")
+    if point.shape != (3,) or not np.isfinite(point).all():
+        raise ValueError(f"p must be 3 finite numbers, got {point}")
+    T = np.eye(4)
+    T[:3, 3] = point
+    if d is None:
+        return T
+    axis = _real(d, "d")
+    if axis.shape != (3,) or not np.isfinite(axis).all():
+        raise ValueError(f"d must be 3 finite numbers, got {axis}")
+    size = math.sqrt(float(axis @ axis))
+    if not size > 0.0:
+        raise ValueError("d must be a direction: not all 0")
+    u = axis / size
+    helper = np.zeros(3)
+    helper[int(np.argmin(np.abs(u)))] = 1.0
+    a = helper - (helper @ u) * u
+    a /= math.sqrt(float(a @ a))
+    b = np.cross(u, a)
+    for k, column in enumerate((u, a, b)):  # (a cyclic order keeps the frame right-handed)
+        T[:3, (TOOL_AXIS + k) % 3] = column
+    return T

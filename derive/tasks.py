@@ -1,0 +1,237 @@
+"""IK tasks of arms with fewer joints than a pose needs (IKFast's IK types), reduced to the
+pose and position problems the methods already solve by one virtual joint.
+
+* "pose" (Transform6D): the whole pose; the methods' own problem.
+* "position" (Translation3D): the tool point; a three-joint arm (derive/methods/position.py).
+* "direction" (TranslationDirection5D): the tool point and the direction of one tool axis u
+  (z by default). A virtual revolute joint about u through the tool point turns the tool frame
+  about u without moving the point or u, so the arm reaches (p, d) exactly where the arm with
+  the virtual joint reaches any pose of origin p and axis d: a five-joint arm's task is a
+  six-joint arm's pose (Pieper, three parallel axes, the general method). Its value is
+  dropped.
+* "lookat" (Lookat3D): the tool axis u, from the tool point forward, passes through a point p
+  (a pan-tilt head, a camera). A virtual prismatic joint along u carries a point along the ray;
+  the two-joint arm looks at p where the three-joint arm's point reaches p with the virtual
+  joint's value (the distance) >= 0: a position problem.
+
+The virtual joint is the line L through the tool point o along u, written as one more DH link
+after joint n (the frame of joint n after Z_n has its axis as z): the common normal of z and L
+gives the twist (alpha, a), its direction phi about z and its foot delta along z (absorbed by
+joint n's offset and d, so the arm's own joint values do not change), and the tool sits s along
+L from the normal's foot. The extended chain's last frame has origin o and axis column u for
+every value of the virtual joint (docs/algorithms.md, "Tasks").
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from dataclasses import dataclass
+
+import sympy as sp
+
+from derive import symbols as sym
+from derive.methods.common import NotApplicable
+from derive.plan import Assign, IkPlan, Solve, Step
+from derive.transforms import Chain, JointZ, Twist, product, trans, world_transform, x_factor
+
+TASKS = ("pose", "position", "direction", "lookat")
+# the tasks' numbers in the C solver (dk_match, DK_REFINE_TASK)
+TASK_CODES = {"pose": 0, "position": 1, "direction": 2, "lookat": 3}
+AXES = ("x", "y", "z")
+
+# what each task's solver is defined on, in words (the module docstring and the report)
+SOLVES_FOR = {
+    "direction": "the tool point's position and the direction of the tool {axis} axis",
+    "lookat": "the tool {axis} axis's ray, from the tool point, through a point",
+}
+# IKFast's names of the tasks
+IKFAST_NAMES = {
+    "pose": "Transform6D",
+    "position": "Translation3D",
+    "direction": "TranslationDirection5D",
+    "lookat": "Lookat3D",
+}
+
+
+@dataclass(frozen=True)
+class Task:
+    """What the solver solves for.
+
+    Attributes:
+        kind: one of TASKS.
+        axis: the tool axis (0 x, 1 y, 2 z) of "direction" and "lookat".
+        why: how it was chosen, in words (the summary line and the report).
+        fixed: the spec names the axis (else z, or the first of x, y that works).
+    """
+
+    kind: str
+    axis: int = 2
+    why: str = ""
+    fixed: bool = False
+
+    @property
+    def axis_name(self) -> str:
+        """The tool axis's letter."""
+        return AXES[self.axis]
+
+    @property
+    def virtual(self) -> bool:
+        """Whether the task is solved through a virtual joint."""
+        return self.kind in ("direction", "lookat")
+
+    def describe(self) -> str:
+        """The task in words, with IKFast's name."""
+        words = {
+            "pose": "the full pose",
+            "position": "the tool point's position",
+            "direction": f"position + direction of the tool {self.axis_name} axis",
+            "lookat": f"look-at: the tool {self.axis_name} axis through a point",
+        }[self.kind]
+        return f"{words} ({IKFAST_NAMES[self.kind]})"
+
+
+def default_task(chain: Chain) -> Task | None:
+    """The task an arm's joints choose where the spec names none; None: the methods' own
+    (the pose, a three-joint arm's position, a planar arm's)."""
+    kinds = "".join(j.kind for j in chain.joints)
+    if chain.dof == 5:
+        return Task("direction", 2, "five joints: position + direction of a tool axis")
+    if kinds == "RR" and chain.twists[1].sa != 0:
+        return Task("lookat", 2, "two revolute joints, not parallel: a pan-tilt's look-at")
+    return None
+
+
+# rotations A with A e_z = e_axis: the virtual joint turns about the tool's chosen axis
+_ALIGN = {
+    0: sp.Matrix([[0, 0, 1, 0], [0, 1, 0, 0], [-1, 0, 0, 0], [0, 0, 0, 1]]),  # Ry(90 deg)
+    1: sp.Matrix([[1, 0, 0, 0], [0, 0, -1, 0], [0, 1, 0, 0], [0, 0, 0, 1]]),  # Rx(-90 deg)
+    2: sp.eye(4),
+}
+
+
+def extend(chain: Chain, task: Task) -> Chain:
+    """The chain with the task's virtual joint after joint n (module docstring).
+
+    Raises:
+        NotApplicable: the virtual joint's line is joint n's axis (joint n then moves neither
+            the tool point nor the axis: the task has one joint too few).
+    """
+    n = chain.dof
+    frame = product([x_factor(chain.twists[-1]), chain.tool, _ALIGN[task.axis]])
+    o = [sp.nsimplify(sp.simplify(frame[i, 3]), rational=False) for i in range(3)]
+    u = [sp.simplify(frame[i, 2]) for i in range(3)]
+    if u[0] == 0 and u[1] == 0:  # L parallel to joint n's axis
+        r2 = sp.simplify(o[0] ** 2 + o[1] ** 2)
+        if r2 == 0:
+            raise NotApplicable(
+                f"the tool {task.axis_name} axis is joint {n}'s axis: joint {n} moves neither "
+                "the tool point nor that axis (choose another tool axis)"
+            )
+        a = sp.sqrt(r2)
+        cphi, sphi = sp.simplify(o[0] / a), sp.simplify(o[1] / a)
+        ca, sa, delta = u[2], sp.Integer(0), sp.Integer(0)
+        s = sp.simplify(o[2] * u[2])
+    else:
+        sa = sp.sqrt(sp.simplify(u[0] ** 2 + u[1] ** 2))
+        cphi, sphi = sp.simplify(-u[1] / sa), sp.simplify(u[0] / sa)
+        ca = u[2]
+        a = sp.simplify(o[0] * cphi + o[1] * sphi)
+        along = sp.simplify((o[2] * u[2] - sum(oi * ui for oi, ui in zip(o, u))) / sa**2)
+        delta = sp.simplify(o[2] + along * u[2])
+        s = sp.simplify(-along)
+    phi = sp.atan2(sphi, cphi)
+    last = chain.joints[-1]
+    if last.kind == "R":
+        moved = JointZ(n, "R", sp.simplify(last.offset + phi), last.theta, last.d + delta)
+    else:
+        moved = JointZ(n, "P", last.offset + delta, sp.simplify(last.theta + phi), last.d)
+    kind = "R" if task.kind == "direction" else "P"
+    zero = sp.Integer(0)
+    virtual = (
+        JointZ(n + 1, "R", zero, sym.theta(n + 1), zero)
+        if kind == "R"
+        else JointZ(n + 1, "P", zero, zero, sym.d(n + 1))
+    )
+    identity = Twist(sp.Integer(1), zero, zero)
+    return Chain(
+        (*chain.twists[:-1], Twist(sp.simplify(ca), sa, a), identity),
+        (*chain.joints[:-1], moved, virtual),
+        chain.base,
+        trans(0, 0, s) * _ALIGN[task.axis].T,
+        chain.convention,
+    )
+
+
+def lower(ik: IkPlan, chain: Chain, extended: Chain, task: Task) -> IkPlan:
+    """The extended chain's plan as the arm's: the virtual joint's value dropped from the
+    outputs (its reference value 0), certified on the task's components."""
+    n = chain.dof
+    zero = {sym.q_ref(n + 1): sp.Integer(0)}
+    steps = tuple(_substitute(step, zero) for step in ik.steps)
+    return dataclasses.replace(
+        ik,
+        steps=steps,
+        outputs=ik.outputs[:n],
+        details=tuple(sorted({**dict(ik.details), **link_details(chain, extended)}.items())),
+        solves_for=SOLVES_FOR[task.kind].format(axis=task.axis_name),
+        certify=task.kind,
+        case=f"{task.describe()} as the pose of the arm with a virtual joint {n + 1}: {ik.case}"
+        if task.kind == "direction"
+        else f"{task.describe()} as the position of the arm with a virtual joint {n + 1} "
+        f"sliding along the axis: {ik.case}",
+        tool_axis=task.axis,
+        relabel=relabel(chain, extended),
+        virtual=virtual_value(extended, task),
+    )
+
+
+def virtual_value(extended: Chain, task: Task) -> tuple[sp.Expr, ...]:
+    """The virtual joint's value where the extended arm reaches the target W (for the
+    report's worked example): its last frame at value 0 is F_0, and F_0^-1 F = A Rz(v) A^T,
+    so (cos v, sin v) are entries (1,1), (2,1) of A^T R_0^T R_W A; a slide's length is
+    (p - o) . u, o and u F_0's origin and axis column."""
+    n1 = extended.dof
+    world = world_transform(extended, expand=False)
+    target = sym.world_pose()
+    if task.kind == "direction":
+        rest = world.xreplace({sym.c(n1): sp.Integer(1), sym.s(n1): sp.Integer(0)})
+        align = _ALIGN[task.axis][:3, :3]
+        m = align.T * rest[:3, :3].T * target[:3, :3] * align
+        return (m[0, 0], m[1, 0])
+    rest = world.xreplace({sym.d(n1): sp.Integer(0)})
+    return (sum((target[i, 3] - rest[i, 3]) * rest[i, task.axis] for i in range(3)),)
+
+
+def link_details(chain: Chain, extended: Chain) -> dict[str, sp.Expr]:
+    """The virtual joint's link for the report: its twist (cos, sin alpha_n and a_n), joint
+    n's shift in theta (or d) and in d, and the tool's distance s along the axis."""
+    n = chain.dof
+    twist = extended.twists[n]
+    old, new = chain.joints[-1], extended.joints[-2]
+    return {
+        "task_cos_alpha": twist.ca,
+        "task_sin_alpha": twist.sa,
+        "task_a": twist.a,
+        "task_relabel": relabel(chain, extended),
+        "task_shift_d": sp.simplify(new.d - old.d) if old.kind == "R" else sp.Integer(0),
+        "task_s": extended.tool[2, 3],
+        "task_virtual_joint": sp.Integer(n + 1),
+    }
+
+
+def relabel(chain: Chain, extended: Chain) -> sp.Expr:
+    """How much the extended chain's theta_n (d_n of a prismatic joint n) exceeds the arm's."""
+    old, new = chain.joints[-1], extended.joints[-2]
+    return sp.simplify(new.offset - old.offset)
+
+
+def _substitute(step: Step, values: dict[sp.Symbol, sp.Integer]) -> Step:
+    """One step with symbols replaced by values."""
+    if isinstance(step, Assign):
+        return Assign(step.targets, tuple(e.xreplace(values) for e in step.exprs), step.note)
+    assert isinstance(step, Solve)
+    changes: dict[str, object] = {
+        "args": tuple(e.xreplace(values) for e in step.args),
+        "ref": step.ref.xreplace(values),
+    }
+    return dataclasses.replace(step, **changes)  # type: ignore[arg-type]
