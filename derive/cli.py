@@ -429,6 +429,11 @@ def cmd_reach(args: argparse.Namespace) -> int:
     source = solver_sources(plan)
     if plan.ik is None:
         raise UsageError(f"{spec.name}: no IK method applies to this arm")
+    if plan.ik.certify == "lookat":
+        raise UsageError(
+            f"{spec.name}: its solver looks at a point; reach maps sample orientations "
+            "(use derive workspace)"
+        )
     if plan.ik.certify == "position":
         raise UsageError(
             f"{spec.name}: its solver places the tool point only; reach maps sample "

@@ -52,16 +52,16 @@ def build_plan(spec: ArmSpec, method: str | None = None) -> Plan:
     # the exact geometry: the spec's [exact] frames (a URDF's), else its table's
     frames = spec.exact if spec.exact is not None else chain_frames(chain)
     task = task_of(spec, chain)
-    ik, refusal = choose(chain, structure, spec.free, closed, task)
+    tol = STRUCTURE_TOL if spec.structure_tol is None else spec.structure_tol
+    ik, refusal = choose(chain, structure, spec.free, closed, task, tol)
     correction = None
     facts = structure.describe(chain.dof)
     if ik is None and closed:
-        tol = STRUCTURE_TOL if spec.structure_tol is None else spec.structure_tol
         near = nominal(spec, tol)
         if near.changes:
             near_chain = chain_from_spec(near.spec)
             near_structure = classify(near_chain)
-            near_ik, _ = choose(near_chain, near_structure, spec.free, closed, task)
+            near_ik, _ = choose(near_chain, near_structure, spec.free, closed, task, tol)
             if near_ik is not None:
                 fix = make_correction(near, near_chain, frames)
                 if fix.deviation <= NOMINAL_MAX:
@@ -75,7 +75,7 @@ def build_plan(spec: ArmSpec, method: str | None = None) -> Plan:
                         f"arm by {fix.deviation:.3g} (at most {NOMINAL_MAX:g} is refined)"
                     )
     if ik is None and general.NAME in names:
-        ik, why = choose(chain, structure, spec.free, (general.NAME,), task)
+        ik, why = choose(chain, structure, spec.free, (general.NAME,), task, tol)
         reasons = [r for r in (refusal, why) if r]
         refusal = "; ".join(dict.fromkeys(reasons)) if ik is None else ""
     if correction is None and spec.exact is not None:
@@ -93,6 +93,8 @@ def build_plan(spec: ArmSpec, method: str | None = None) -> Plan:
             correction = None
         else:
             facts = tuple(f"{fact} (nominal table)" for fact in facts)
+    if ik is not None and ik.task_snap > 0.0:
+        correction = snapped_task(correction, ik, arm_info(spec, chain).dh, tol)
     if (
         correction is not None
         and ik is not None
@@ -179,6 +181,7 @@ def choose(
     named: tuple[int, ...] | None,
     names: tuple[str, ...],
     task: tasks.Task | None = None,
+    tol: float = STRUCTURE_TOL,
 ) -> tuple[IkPlan | None, str]:
     """The first of the named methods that solves the chain (an arm of more than 6 joints:
     with free joints; a task's arm: extended by its virtual joint, about the task's tool axis,
@@ -192,13 +195,21 @@ def choose(
         for axis in (task.axis,) if task.fixed else (2, 0, 1):
             aimed = dataclasses.replace(task, axis=axis)
             try:
-                extended = tasks.extend(chain, aimed)
+                extended, snap = tasks.extend_snapped(chain, aimed, tol)
             except NotApplicable as exc:
                 reasons.append(f"tool {tasks.AXES[axis]} axis: {exc}")
                 continue
             ik, why = choose_method(extended, classify(extended), names)
+            if snap > 0.0:
+                # the exact virtual link where its case is the snapped one's (no refinement:
+                # a look-at camera 9e-6 m off its axis); the snapped one where snapping gives
+                # a special case (a5 = 0: the exact a5 = 6e-7 left a degenerate quartic)
+                exact = tasks.extend(chain, aimed)
+                exact_ik, _ = choose_method(exact, classify(exact), names)
+                if exact_ik is not None and (ik is None or exact_ik.case == ik.case):
+                    ik, extended, snap = exact_ik, exact, 0.0
             if ik is not None:
-                return tasks.lower(ik, chain, extended, aimed), ""
+                return tasks.lower(ik, chain, extended, aimed, snap), ""
             reasons.append(f"tool {tasks.AXES[axis]} axis: {why}")
         return None, "; ".join(reasons)
     if chain.dof > free.REMAINDER_DOF:
@@ -221,6 +232,28 @@ EXACT_ENOUGH = 1e-13
 # positions over the reach) is not refined from: its seeds need not reach the arm's
 # solutions (calibrations move an arm by about 1e-3, a URDF's rounding by 1e-5)
 NOMINAL_MAX = 1e-2
+
+
+def snapped_task(
+    correction: Correction | None,
+    ik: IkPlan,
+    dh: tuple[tuple[float, float, float, float], ...],
+    tol: float,
+) -> Correction:
+    """The correction of a task whose virtual link was snapped (derive/tasks.py): the closed
+    form solves the snapped extended arm, whose answers miss the arm's task by about the snap,
+    so they are refined onto the arm's exact chain (with its nominal table's, where it has
+    one)."""
+    change = f"the virtual link of the task, by {ik.task_snap:.3g} (rad, or of the arm's size)"
+    if correction is None:
+        correction = Correction(dh, (), tol, 0.0, 0.0)
+    deviation = max(correction.deviation, ik.task_snap)
+    return dataclasses.replace(
+        correction,
+        changes=(*correction.changes, change),
+        deviation=deviation,
+        seed_tol=min(SEED_MAX, max(1e-9, SEED_FACTOR * deviation)),
+    )
 
 
 def make_correction(

@@ -302,6 +302,9 @@ class IkPlan:
         virtual: a task's virtual joint's value on a solution's branch, for the report:
             (cos, sin) of its angle, or (its length,), in the world pose's entries and the
             arm's joints' c_i, s_i (d_i); () without one.
+        task_snap: how far snapping moved the virtual link (derive/tasks.py, extend_snapped:
+            radians, or a length over the arm's size); its rows are then refined onto the
+            arm's exact chain.
     """
 
     method: str
@@ -317,6 +320,7 @@ class IkPlan:
     tool_axis: int = 2
     relabel: sp.Expr = sp.S.Zero
     virtual: tuple[sp.Expr, ...] = ()
+    task_snap: float = 0.0
 
 
 @dataclass(frozen=True)

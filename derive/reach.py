@@ -124,6 +124,8 @@ class Layout:
         rolls: the roll angles (all of them, also where one is stored).
         block: (columns, heights) per chunk.
         joint1, roll: the symmetries used.
+        axis: the tool axis the directions are of: z, or a direction task's (TOOL_AXIS,
+            derive/tasks.py), whose roll about it the task ignores.
     """
 
     frame: np.ndarray
@@ -135,6 +137,7 @@ class Layout:
     block: tuple[int, int]
     joint1: bool
     roll: bool
+    axis: int = 2
 
     @property
     def side(self) -> int:
@@ -269,8 +272,12 @@ def make_layout(module: ModuleType, convention: str, params: Parameters) -> Layo
         column_of = np.arange(side * side)
         columns = np.stack([i.ravel(), j.ravel()], axis=1) * params.resolution
     rolls = 2.0 * math.pi * np.arange(params.rolls) / params.rolls
-    rotations = tool_rotations(
-        fibonacci_directions(params.directions), rolls[:1] if roll else rolls
+    axis = 2
+    if getattr(module, "IK_COMPONENTS", "pose") == "direction":  # (derive/tasks.py)
+        axis, roll = int(module.TOOL_AXIS), True  # (the task ignores the roll about its axis)
+    rotations = aimed(
+        tool_rotations(fibonacci_directions(params.directions), rolls[:1] if roll else rolls),
+        axis,
     )
     per_cell = rotations.shape[0] * rotations.shape[1]
     cells = max(1, params.chunk // per_cell)
@@ -286,7 +293,17 @@ def make_layout(module: ModuleType, convention: str, params: Parameters) -> Layo
         (bc, bz),
         joint1,
         roll,
+        axis,
     )
+
+
+def aimed(rotations: np.ndarray, axis: int) -> np.ndarray:
+    """Rotations (..., 3, 3) with their columns turned cyclically so that the z column becomes
+    column axis (a direction task's tool axis; right-handed still)."""
+    out = np.empty_like(rotations)
+    for k in range(3):
+        out[..., (axis + k) % 3] = rotations[..., (2 + k) % 3]
+    return out
 
 
 def chunk_poses(layout: Layout, chunk: int) -> np.ndarray:
@@ -404,7 +421,7 @@ def _attributes(
         "poses_solved": layout.solved,
         "reduction": layout.reduction,
         "block": list(layout.block),
-    }
+    } | ({"tool_axis": layout.axis} if layout.axis != 2 else {})
 
 
 def open_store(
@@ -454,7 +471,7 @@ def _fixed_arrays(layout: Layout) -> dict[str, np.ndarray]:
         "centres": layout.centres,
         "columns": layout.columns,
         "column_of": layout.column_of,
-        "directions": layout.rotations[:, 0, :, 2],
+        "directions": layout.rotations[:, 0, :, layout.axis],
         "rolls": layout.rolls,
     }
 
@@ -1077,7 +1094,7 @@ def _reuleaux(h5: Any, rmap: ReachMap, progress: TextIO | None) -> int:
     side = len(rmap.centres)
     directions = group["directions"][:]
     rolls = group["rolls"][:]
-    rotations = tool_rotations(directions, rolls)
+    rotations = aimed(tool_rotations(directions, rolls), int(rmap.attrs.get("tool_axis", 2)))
     stored_rolls = counts.shape[3]
     c = rmap.centres
     i, j = np.meshgrid(np.arange(side), np.arange(side), indexing="ij")

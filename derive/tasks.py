@@ -25,6 +25,7 @@ every value of the virtual joint (docs/algorithms.md, "Tasks").
 from __future__ import annotations
 
 import dataclasses
+import math
 from dataclasses import dataclass
 
 import sympy as sp
@@ -109,8 +110,19 @@ _ALIGN = {
 }
 
 
-def extend(chain: Chain, task: Task) -> Chain:
-    """The chain with the task's virtual joint after joint n (module docstring).
+def extend(chain: Chain, task: Task, tol: float = 0.0) -> Chain:
+    """The chain with the task's virtual joint after joint n (module docstring; snapped as
+    extend_snapped's)."""
+    return extend_snapped(chain, task, tol)[0]
+
+
+def extend_snapped(chain: Chain, task: Task, tol: float = 0.0) -> tuple[Chain, float]:
+    """The chain with the task's virtual joint after joint n (module docstring), and how far
+    snapping moved the virtual link: with tol (the structure tolerance) its twist within tol
+    rad of a multiple of 90 deg and its length within tol of the arm's size of 0 are snapped
+    (a URDF's noise: an SO-101's tool axis 6e-7 m off its roll axis made the quartic in
+    theta1 nearly degenerate); the snap is the twist's change (rad) or the length's over the
+    arm's size, the larger (0: none).
 
     Raises:
         NotApplicable: the virtual joint's line is joint n's axis (joint n then moves neither
@@ -120,17 +132,22 @@ def extend(chain: Chain, task: Task) -> Chain:
     frame = product([x_factor(chain.twists[-1]), chain.tool, _ALIGN[task.axis]])
     o = [sp.nsimplify(sp.simplify(frame[i, 3]), rational=False) for i in range(3)]
     u = [sp.simplify(frame[i, 2]) for i in range(3)]
-    if u[0] == 0 and u[1] == 0:  # L parallel to joint n's axis
+    size = arm_size(chain)
+    across = math.sqrt(float(u[0] ** 2 + u[1] ** 2))
+    snap = 0.0
+    if across <= math.sin(tol):  # L parallel to joint n's axis (within tol)
+        snap = max(snap, math.asin(min(across, 1.0)))
         r2 = sp.simplify(o[0] ** 2 + o[1] ** 2)
-        if r2 == 0:
+        if math.sqrt(float(r2)) <= tol * size:
             raise NotApplicable(
                 f"the tool {task.axis_name} axis is joint {n}'s axis: joint {n} moves neither "
                 "the tool point nor that axis (choose another tool axis)"
             )
         a = sp.sqrt(r2)
         cphi, sphi = sp.simplify(o[0] / a), sp.simplify(o[1] / a)
-        ca, sa, delta = u[2], sp.Integer(0), sp.Integer(0)
-        s = sp.simplify(o[2] * u[2])
+        ca = sp.Integer(1) if float(u[2]) > 0 else sp.Integer(-1)
+        sa, delta = sp.Integer(0), sp.Integer(0)
+        s = sp.simplify(o[2] * ca)
     else:
         sa = sp.sqrt(sp.simplify(u[0] ** 2 + u[1] ** 2))
         cphi, sphi = sp.simplify(-u[1] / sa), sp.simplify(u[0] / sa)
@@ -139,6 +156,12 @@ def extend(chain: Chain, task: Task) -> Chain:
         along = sp.simplify((o[2] * u[2] - sum(oi * ui for oi, ui in zip(o, u))) / sa**2)
         delta = sp.simplify(o[2] + along * u[2])
         s = sp.simplify(-along)
+        if ca != 0 and abs(float(ca)) <= math.sin(tol):  # (a right angle, within tol)
+            snap = max(snap, math.asin(abs(float(ca))))
+            ca, sa = sp.Integer(0), sp.Integer(1)
+        if a != 0 and abs(float(a)) <= tol * size:
+            snap = max(snap, abs(float(a)) / size)
+            a = sp.Integer(0)
     phi = sp.atan2(sphi, cphi)
     last = chain.joints[-1]
     if last.kind == "R":
@@ -153,18 +176,28 @@ def extend(chain: Chain, task: Task) -> Chain:
         else JointZ(n + 1, "P", zero, zero, sym.d(n + 1))
     )
     identity = Twist(sp.Integer(1), zero, zero)
-    return Chain(
+    extended = Chain(
         (*chain.twists[:-1], Twist(sp.simplify(ca), sa, a), identity),
         (*chain.joints[:-1], moved, virtual),
         chain.base,
         trans(0, 0, s) * _ALIGN[task.axis].T,
         chain.convention,
     )
+    return extended, snap
 
 
-def lower(ik: IkPlan, chain: Chain, extended: Chain, task: Task) -> IkPlan:
+def arm_size(chain: Chain) -> float:
+    """The arm's size for the snapping of lengths: its |a| and |d| and its tool's offset."""
+    size = sum(abs(float(t.a)) for t in chain.twists)
+    size += sum(abs(float(j.d)) for j in chain.joints if j.kind == "R")
+    size += math.sqrt(sum(float(v) ** 2 for v in chain.tool[:3, 3]))
+    return size or 1.0
+
+
+def lower(ik: IkPlan, chain: Chain, extended: Chain, task: Task, snap: float = 0.0) -> IkPlan:
     """The extended chain's plan as the arm's: the virtual joint's value dropped from the
-    outputs (its reference value 0), certified on the task's components."""
+    outputs (its reference value 0), certified on the task's components; snap: how far the
+    virtual link was snapped (its rows are then refined onto the arm: derive/pipeline.py)."""
     n = chain.dof
     zero = {sym.q_ref(n + 1): sp.Integer(0)}
     steps = tuple(_substitute(step, zero) for step in ik.steps)
@@ -182,6 +215,7 @@ def lower(ik: IkPlan, chain: Chain, extended: Chain, task: Task) -> IkPlan:
         tool_axis=task.axis,
         relabel=relabel(chain, extended),
         virtual=virtual_value(extended, task),
+        task_snap=snap,
     )
 
 

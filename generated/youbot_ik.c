@@ -791,6 +791,8 @@ static int dk_pose_ok(const double T[16])
 /* --- the arm's own code, printed from its plan ------------------------------------------- */
 
 #define DK_DOF 5
+/* the tool axis of the task (0 x, 1 y, 2 z) */
+#define DK_TOOL_AXIS 0
 #define DK_MAX 8
 #define DK_UNSETTLED (-2)
 static const double DK_REACH = 0.6875;
@@ -1192,6 +1194,61 @@ int youbot_ik(const double T[16], const double *free, double tol,
                double q[DK_MAX][DK_DOF])
 {
     return youbot_ik_ref(T, free, NULL, tol, q);
+}
+
+/* the pose ik reads the task from: origin p and, with d, column DK_TOOL_AXIS along d (the
+   other two complete a right-handed frame as the Python module's _task_pose does); 0 where
+   p or d is not finite or d is 0 */
+static int dk_task_pose(const double p[3], const double *d, double T[16])
+{
+    int k, r;
+    for (k = 0; k < 16; k++) {
+        T[k] = k % 5 == 0 ? 1.0 : 0.0;
+    }
+    for (r = 0; r < 3; r++) {
+        if (!isfinite(p[r])) {
+            return 0;
+        }
+        T[4 * r + 3] = p[r];
+    }
+    if (d != NULL) {
+        double u[3], a[3], b[3], size = sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]), dot;
+        int least = 0;
+        if (!(size > 0.0 && size < HUGE_VAL)) {
+            return 0;
+        }
+        for (r = 0; r < 3; r++) {
+            u[r] = d[r] / size;
+            least = fabs(u[r]) < fabs(u[least]) ? r : least;
+        }
+        dot = u[least];
+        for (r = 0; r < 3; r++) {
+            a[r] = (r == least ? 1.0 : 0.0) - dot * u[r];
+        }
+        size = sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]);
+        for (r = 0; r < 3; r++) {
+            a[r] /= size;
+        }
+        b[0] = u[1] * a[2] - u[2] * a[1];
+        b[1] = u[2] * a[0] - u[0] * a[2];
+        b[2] = u[0] * a[1] - u[1] * a[0];
+        for (r = 0; r < 3; r++) {
+            T[4 * r + DK_TOOL_AXIS] = u[r];
+            T[4 * r + (DK_TOOL_AXIS + 1) % 3] = a[r];
+            T[4 * r + (DK_TOOL_AXIS + 2) % 3] = b[r];
+        }
+    }
+    return 1;
+}
+
+int youbot_ik_direction(const double p[3], const double d[3], const double *q_ref,
+                         double tol, double q[DK_MAX][DK_DOF])
+{
+    double T[16];
+    if (!dk_task_pose(p, d, T)) {
+        return YOUBOT_INVALID_ARGUMENT;
+    }
+    return youbot_ik_ref(T, NULL, q_ref, tol, q);
 }
 
 int youbot_within_limits(double q[][DK_DOF], int n, const double *q_ref)

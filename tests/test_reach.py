@@ -464,3 +464,30 @@ def test_dask_missing_is_said_before_the_store_is_written(tmp_path, capsys, monk
     assert main(["reach", *SMALL_ARGV, "-o", str(tmp_path / "m.zarr"), "--dask", "local:1"]) == 2
     assert "--dask needs dask.distributed" in capsys.readouterr().err
     assert list(tmp_path.iterdir()) == []
+
+
+def test_a_direction_task_s_map_counts_ik_direction(tmp_path, generated):
+    """A five-joint arm's map (derive/tasks.py): positions x directions of its tool axis (the
+    youBot's x), the roll about it ignored (one stored); each count is ik_direction's."""
+    rmap = make(tmp_path / "m.zarr", "youbot")
+    assert rmap.attrs["tool_axis"] == 0 and rmap.attrs["roll_symmetry"]
+    module = generated("youbot")
+    counts = rmap.counts()
+    F, c = rmap.frame, rmap.centres
+    directions = rmap.group["directions"][:]
+    for i, j, k in np.ndindex(len(c), len(c), len(c)):
+        az = math.atan2(c[j], c[i])
+        spin = np.array(
+            [[math.cos(az), -math.sin(az), 0], [math.sin(az), math.cos(az), 0], [0, 0, 1]]
+        )
+        point = F[:3, :3] @ [c[i], c[j], c[k]] + F[:3, 3]
+        for d, u in enumerate(directions):
+            expected = len(module.ik_direction(point, F[:3, :3] @ spin @ u))
+            assert (counts[i, j, k, d] == expected).all(), (i, j, k, d)
+    assert (counts > 0).any() and (counts == 0).any()
+
+
+def test_a_look_at_arm_is_sent_to_the_workspace_command(capsys):
+    assert main(["reach", "locobot_head", "-o", "never.zarr"]) == 2
+    assert "looks at a point" in capsys.readouterr().err
+    assert not Path("never.zarr").exists()
