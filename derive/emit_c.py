@@ -226,15 +226,19 @@ def render_ikfast(plan: Plan) -> dict[str, str]:
     """The MoveIt IKFast plugin shim of an arm: {file name: text}.
 
     Raises:
-        GenerationError: the arm's solver is not a 6-DOF pose solver (IKP_Transform6D).
+        GenerationError: the arm's solver is neither a 6-DOF pose solver (IKP_Transform6D)
+            nor a task's (IKP_TranslationDirection5D, IKP_Lookat3D).
     """
     printed = print_c(plan)
     assert plan.ik is not None
-    if plan.ik.certify != "pose" or printed.dof - len(printed.free) != 6:
+    if plan.ik.certify == "position" or (
+        plan.ik.certify == "pose" and printed.dof - len(printed.free) != 6
+    ):
         raise GenerationError(
             f"{printed.name}: the IKFast shim serves arms solved for the whole pose with 6 "
-            f"joints besides the free ones (IKP_Transform6D); this arm has {printed.dof} joints "
-            f"({len(printed.free)} free), solved for {plan.ik.solves_for}"
+            "joints besides the free ones (IKP_Transform6D), or for a task's direction "
+            f"(IKP_TranslationDirection5D) or look-at (IKP_Lookat3D); this arm has {printed.dof} "
+            f"joints ({len(printed.free)} free), solved for {plan.ik.solves_for}"
         )
     text = environment().get_template("ikfast.cpp.j2").render(m=printed, generator=GENERATOR)
     return {f"{printed.name}_ikfast_solver.cpp": text}

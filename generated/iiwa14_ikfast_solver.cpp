@@ -52,7 +52,8 @@ IKFAST_API void ComputeFk(const IkReal *j, IkReal *eetrans, IkReal *eerot)
 IKFAST_API bool ComputeIk(const IkReal *eetrans, const IkReal *eerot, const IkReal *pfree,
                           ikfast::IkSolutionListBase<IkReal> &solutions)
 {
-    double T[16] = {0.0}, q[8][7];
+    double q[8][7];
+    double T[16] = {0.0};
     for (int r = 0; r < 3; r++) {
         T[4 * r + 3] = eetrans[r];
         for (int c = 0; c < 3; c++) {

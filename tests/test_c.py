@@ -316,6 +316,54 @@ def test_ikfast_shim_compiles_and_answers(generated, tmp_path, name):
     assert at == len(out)
 
 
+@pytest.mark.parametrize(
+    ("name", "kind"), [("youbot", "0x56000007"), ("locobot_head", "0x23000006")]
+)
+def test_ikfast_shim_of_a_task_arm(generated, tmp_path, name, kind):
+    """IKP_TranslationDirection5D (eetrans the point, eerot[0..2] the direction of the tool
+    axis) and IKP_Lookat3D (eetrans the point looked at): the module's task rows, and
+    ComputeFk gives the point and the axis back."""
+    compiler = shutil.which("g++") or shutil.which("c++")
+    if compiler is None:
+        pytest.skip("no C++ compiler")
+    plan = plan_of(name)
+    for file, text in {**render_c(plan), **render_ikfast(plan)}.items():
+        (tmp_path / file).write_text(text)
+    driver = tmp_path / "driver"
+    flags = ["-std=c++11", "-Wall", "-Wextra", "-Werror", "-O2"]
+    build = [compiler, *flags, f"-I{ROOT / 'tests' / 'ikfast'}", f"-I{tmp_path}"]
+    build += [f'-DSHIM="{name}_ikfast_solver.cpp"', str(ROOT / "tests" / "ikfast" / "driver.cpp")]
+    subprocess.run([*build, "-o", str(driver)], check=True, capture_output=True)
+    info = subprocess.run([driver, "info"], check=True, capture_output=True, text=True).stdout
+    m = generated(name)
+    assert info.split()[:4] == [str(m.DOF), "0", "8", kind]
+    _, T, _ = poses(m, 200, 12)
+    x = m.TOOL_AXIS
+    data = np.zeros((len(T), 12))
+    data[:, 9:] = T[:, :3, 3]
+    if m.IK_COMPONENTS == "direction":
+        data[:, :3] = T[:, :3, x]
+    out = subprocess.run([driver], input=data.tobytes(), check=True, capture_output=True).stdout
+    at = 0
+    for i in range(len(T)):
+        (count,) = np.frombuffer(out[at : at + 4], dtype=np.int32)
+        at += 4
+        rows = np.frombuffer(out[at : at + 8 * count * (m.DOF + 12)], dtype=np.float64)
+        at += 8 * count * (m.DOF + 12)
+        rows = rows.reshape(count, m.DOF + 12)
+        if m.IK_COMPONENTS == "direction":
+            expected = m.ik_direction(T[i, :3, 3], T[i, :3, x], backend="python")
+        else:
+            expected = m.ik_lookat(T[i, :3, 3], backend="python")
+        assert count == len(expected), i
+        np.testing.assert_allclose(rows[:, : m.DOF], expected, atol=1e-6)
+        for row in rows:  # ComputeFk: the tool point, and the axis in eerot[0..2]
+            E = m.fk(row[: m.DOF])
+            np.testing.assert_allclose(row[m.DOF : m.DOF + 3], E[:3, x], atol=1e-12)
+            np.testing.assert_allclose(row[m.DOF + 9 :], E[:3, 3], atol=1e-12)
+    assert at == len(out)
+
+
 def test_arms_the_shim_cannot_serve_are_refused_by_name(tmp_path):
     from derive.emit import GenerationError
 
