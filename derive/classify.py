@@ -57,6 +57,8 @@ class Structure:
             facts.append(f"axes {i} and {i + 1} coincide (degenerate)")
         if n >= 2 and len(self.parallel) == n - 1:
             facts.insert(0, "planar: all axes parallel")
+        if not facts and n < 3:
+            facts.append("axes 1 and 2 neither parallel nor the same" if n == 2 else "one axis")
         if not facts:
             facts.append("no three consecutive axes meet or are parallel")
         return tuple(facts)

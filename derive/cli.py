@@ -295,11 +295,15 @@ def solve_arguments(
 
     q = None
     task = getattr(module, "IK_COMPONENTS", "pose")
-    if args.direction is not None and (args.point is None or task != "direction"):
+    if args.direction is not None and task != "direction":
         raise UsageError(
-            "--direction: only with --point, for an arm solved for the position and direction "
-            f"of a tool axis ({spec.name}'s task: {task})"
+            f"--direction: {spec.name} is solved for "
+            + {"lookat": "a look-at: give the point only (--point)"}.get(
+                task, f"the {task}; --direction is for an arm solved for a point and a direction"
+            )
         )
+    if args.direction is not None and args.point is None:
+        raise UsageError("--direction: give the tool point too (--point x y z)")
     if args.point is not None:
         pose = task_pose(spec, module, args)
     elif args.q is not None:

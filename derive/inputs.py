@@ -38,6 +38,7 @@ def _xml_file(path: Path, options: urdf.Options) -> ArmSpec:
 READERS: dict[str, Reader] = {
     ".toml": _spec_file,
     ".urdf": urdf.load_urdf,
+    ".xacro": urdf.load_urdf,  # (it says to expand the file first)
     ".xml": _xml_file,
     ".mjcf": mjcf.load_mjcf,
 }

@@ -12,8 +12,8 @@ Arm: locobot_head, modified DH, lengths in m, angles of the table in degrees.
     1  R     0                  0         0    q1 + 0
     2  R     -90                0.025034  0    q2 + 0
 
-Structure: no three consecutive axes meet or are parallel; task: look-at: the tool z axis
-through a point (Lookat3D): two revolute joints, not parallel: a pan-tilt's look-at.
+Structure: axes 1 and 2 neither parallel nor the same; task: look-at: the tool z axis through a
+point (Lookat3D): two revolute joints, not parallel: a pan-tilt's look-at.
 Inverse kinematics: position method, case look-at: the tool z axis through a point (Lookat3D) as
 the position of the arm with a virtual joint 3 sliding along the axis: tool point as Pieper's
 wrist centre: general: (r - k3)^2/(4 a1^2) + (z - k4)^2/s(alpha1)^2 = k1^2 + k2^2, degree 4 in

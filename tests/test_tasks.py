@@ -350,9 +350,10 @@ def test_derive_solve_takes_a_task_s_point_and_direction(capsys):
         (["youbot", "--point", "0.2", "0.1", "0.3"], "give --direction"),
         (["youbot", "--point", "0.2", "0.1"], "--point: give 3 numbers"),
         (["youbot", "--point", "0.2 0.1 0.3", "--direction", "0 0 0"], "not all 0"),
-        (["locobot_head", "--point", "1 0 0", "--direction", "1 0 0"], "--direction: only"),
+        (["locobot_head", "--point", "1 0 0", "--direction", "1 0 0"], "give the point only"),
+        (["youbot", "--q", "0 0 0 0 0", "--direction", "1 0 0"], "give the tool point too"),
         (["puma560", "--point", "1 0 0"], "is solved for the full pose; give --pose or --q"),
-        (["puma560", "--q", "0 0 0 0 0 0", "--direction", "1 0 0"], "--direction: only"),
+        (["puma560", "--q", "0 0 0 0 0 0", "--direction", "1 0 0"], "is solved for the pose"),
     ],
 )
 def test_derive_solve_refuses_a_task_target_that_does_not_fit(capsys, args, message):

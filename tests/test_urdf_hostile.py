@@ -369,3 +369,12 @@ def test_an_element_with_an_undeclared_prefix_is_named_where_the_chain_breaks(tm
     path = write(tmp_path, text)
     line = fails("import-urdf", str(path), "--base", "a", "--tip", "c")
     assert "<gz:joint>" in line and "no xmlns declares" in line
+
+
+def test_a_file_named_urdf_xacro_is_read_as_a_urdf_and_said_to_expand(tmp_path, fails):
+    """`derive generate robot.urdf.xacro` (a new user's first try): the URDF reader, whose
+    message says to expand it, not the spec reader's "not valid TOML"."""
+    path = tmp_path / "lbr.urdf.xacro"
+    path.write_text(EXPANDED.replace('xyz="0 0 0.1575"', 'xyz="0 0 ${d1}"'))
+    line = fails("generate", str(path), "--base", "base", "--tip", "l3")
+    assert "expand it first" in line and "TOML" not in line
