@@ -34,7 +34,7 @@ pytestmark = pytest.mark.skipif(
 C_ARMS = BUNDLED
 POSES = 10_000
 # the general method's Python solver takes about 2 ms a pose (the closed forms 50 us)
-POSES_FOR = {"manocha_canny": 2_000}
+POSES_FOR = {"manocha_canny": 2_000, "so_arm100": 3_000}
 # Rows that differ from the Python solver's by more than 1e-9 (but at most 1e-6), and poses
 # with another number of rows, measured on these poses (seed 5, 20% of the joints at 0,
 # +-90, 180 deg). Everywhere else the rows agree to 1e-9 (most to 1e-12). These are poses
@@ -53,12 +53,13 @@ BEYOND = {"lecture_6r": 10, "parallel_6r": 4, "iiwa14": 15, "panda": 15}
 BEYOND |= {"youbot": 3, "locobot_head": 1}
 # (so_arm100's rows are refined onto its exact chain: each backend's Newton steps stop within
 # 1e-10 of the pose, and near a singular configuration (its roll near 90 deg) that leaves the
-# joint values up to 1e-6 apart; measured 140 of 10,000, allowed 150)
-BEYOND |= {"so_arm100": 150}
+# joint values up to 1e-6 apart; measured 38 of its 3,000 poses (140 of 10,000), allowed 45.
+# Its Python solver refines every row: 3,000 poses, not 10,000, keep CI inside its time)
+BEYOND |= {"so_arm100": 45}
 # Below this smallest singular value a sample's own q may be missing from the rows: the
 # sample is singular. A nominal table refined onto the exact arm (so_arm100, from its MJCF)
 # misses one more: where the nominal arm is singular the exact one can have two solutions
-# close together, and the nominal seed refines onto one of them (measured: sample 841, the
+# close together, and the nominal seed refines onto one of them (measured on 10,000 poses: 841, the
 # roll 2.3 deg from 90 deg, sigma 1.1e-5; both solvers return the other solution, 0.01 rad
 # away, exact to 1e-16)
 SINGULAR = verify.SINGULAR_SIGMA
@@ -141,12 +142,14 @@ def test_c_solver_gives_the_python_solutions(generated, harnesses, name):
         gaps[..., revolute] = np.minimum(gaps[..., revolute], 2 * np.pi - gaps[..., revolute])
         apart = gaps.max(axis=2, initial=0.0) + np.eye(len(c_rows))
         assert apart.min(initial=1.0) > 1e-6, (i, c_rows)
+        differ = len(rows) != len(c_rows) or (len(rows) and np.abs(rows - c_rows).max() > 1e-6)
+        if differ and hasattr(m, "NOMINAL_DH") and verify.jacobian_nullity(m, Q[i])[0] < SINGULAR:
+            # (a curve of solutions: each solver refines its seeds onto its own points of it,
+            # as the general method's do: tests/test_batch.py, curve_at_singular; so_arm100
+            # with its roll at -90 deg, sample 1482)
+            assert len(rows) and len(c_rows), i
+            continue
         if len(rows) != len(c_rows):
-            if hasattr(m, "NOMINAL_DH") and verify.jacobian_nullity(m, Q[i])[0] < SINGULAR:
-                # (a curve of solutions: each solver refines its seeds onto its own points of
-                # it, as the general method's do: tests/test_batch.py, curve_at_singular)
-                assert len(rows) and len(c_rows), i
-                continue
             other_count += 1
             continue
         if len(rows):
