@@ -361,23 +361,12 @@ def task_pose(spec: ArmSpec, module: ModuleType, args: argparse.Namespace) -> An
 
 
 def task_residual(module: ModuleType, q: Any, pose: Any) -> float:
-    """How far fk(q) misses the components of pose the arm's task reads: the whole pose, the
-    tool point, the point and the tool axis, or the ray's distance from the point."""
-    import numpy as np
+    """How far fk(q) misses the components of pose the arm's task reads (verify.pose_error's
+    two errors, the position's in length units)."""
+    from derive.verify import pose_error
 
-    E = module.fk(q)
-    task = getattr(module, "IK_COMPONENTS", "pose")
-    if task == "pose":
-        return float(np.abs(E - pose).max())
-    position = float(np.abs(E[:3, 3] - pose[:3, 3]).max())
-    if task == "position":
-        return position
-    axis = module.TOOL_AXIS
-    if task == "direction":
-        return max(position, float(np.abs(E[:3, axis] - pose[:3, axis]).max()))
-    v = pose[:3, 3] - E[:3, 3]
-    along = float(v @ E[:3, axis])
-    return float(np.abs(v - along * E[:3, axis]).max()) if along >= 0 else float(np.linalg.norm(v))
+    rotation, position = pose_error(module, q, pose)
+    return max(rotation, position * module.REACH)
 
 
 def cmd_plot(args: argparse.Namespace) -> int:

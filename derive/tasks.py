@@ -130,7 +130,7 @@ def extend_snapped(chain: Chain, task: Task, tol: float = 0.0) -> tuple[Chain, f
     """
     n = chain.dof
     frame = product([x_factor(chain.twists[-1]), chain.tool, _ALIGN[task.axis]])
-    o = [sp.nsimplify(sp.simplify(frame[i, 3]), rational=False) for i in range(3)]
+    o = [sp.simplify(frame[i, 3]) for i in range(3)]
     u = [sp.simplify(frame[i, 2]) for i in range(3)]
     size = arm_size(chain)
     across = math.sqrt(float(u[0] ** 2 + u[1] ** 2))
