@@ -8,7 +8,6 @@ import os
 import re
 import shutil
 import subprocess
-import sys
 import tempfile
 import zlib
 from pathlib import Path
@@ -191,8 +190,9 @@ def test_general_method_with_a_prismatic_joint_in_c(kinds, convention, tmp_path)
 
 def test_general_method_in_c_finds_the_wrist_flip_partners_of_the_puma(tmp_path):
     """The PUMA by the general method (a perturbed table) in C: the closed form's solution
-    sets on 400 random poses, the Python solver's rows to 1e-9 (as sets). Before the search
-    on odd counts (dk_rr_search) poses 46 and 346 had 7 of their 8 solutions."""
+    sets on 400 random poses, and the Python general solver's rows to 1e-9 (as sets) on 80 of
+    them and on poses 46 and 346, which had 7 of their 8 solutions before the search on odd
+    counts (dk_rr_search). (The Python general solver on all 400 took 15 s of CI.)"""
     from derive.cli import resolve_spec
 
     spec = resolve_spec("puma560")
@@ -206,6 +206,8 @@ def test_general_method_in_c_finds_the_wrist_flip_partners_of_the_puma(tmp_path)
     for i in range(len(T)):
         rows, expected = QC[i, : counts[i]], closed.ik(T[i], backend="python")
         assert len(rows) == len(expected), i
+        if i >= 80 and i not in (46, 346):
+            continue
         python = general.ik(T[i], backend="python")
         gaps = np.abs((rows[:, None] - python[None] + np.pi) % (2 * np.pi) - np.pi)
         assert gaps.max(axis=2).min(axis=1).max(initial=0.0) <= 1e-9, i
@@ -390,28 +392,6 @@ def test_c_files_compile_without_warnings_at_other_optimisation_levels(tmp_path,
             [*command, str(tmp_path / "arm.o")], capture_output=True, text=True, check=False
         )
         assert done.returncode == 0, f"{path.name} {opt}:\n{done.stderr}"
-
-
-def test_c_files_are_byte_deterministic_across_hash_seeds(tmp_path):
-    """`derive generate --lang c` of every bundled arm under PYTHONHASHSEED=1 gives the
-    committed bytes (generated under another seed), and the IKFast shim is the same under
-    seeds 1 and 2."""
-    generate = [sys.executable, "-m", "derive", "generate"]
-    outputs = []
-    for seed, arms in (("1", ()), ("2", ("puma560",))):
-        out = tmp_path / seed
-        env = dict(os.environ, PYTHONHASHSEED=seed)
-        if not arms:
-            command = [*generate, "--lang", "c", "--out", str(out)]
-            subprocess.run(command, check=True, env=env, capture_output=True)
-        command = [*generate, "puma560", "--lang", "cpp-ikfast", "--out", str(out)]
-        subprocess.run(command, check=True, env=env, capture_output=True)
-        outputs.append({p.name: p.read_bytes() for p in sorted(out.iterdir())})
-    assert outputs[1] == {name: outputs[0][name] for name in outputs[1]}
-    assert sorted(outputs[1]) == ["puma560_ik.c", "puma560_ik.h", "puma560_ikfast_solver.cpp"]
-    assert len(outputs[0]) == 2 * len(BUNDLED) + 1
-    for file, data in outputs[0].items():
-        assert (GENERATED / file).read_bytes() == data, file
 
 
 def test_the_wrist_flip_is_taken_where_both_wrist_twists_are_right_angles(tmp_path):

@@ -1,6 +1,7 @@
 """Golden check: the committed generated/ is exactly what the generator writes today.
 
-Kept apart from behaviour tests. To update after an intended change: `derive generate`.
+Kept apart from behaviour tests. To update after an intended change: `derive generate` (and
+`derive generate puma560 iiwa14 --lang cpp-ikfast` for the IKFast shims).
 """
 
 from __future__ import annotations
@@ -9,29 +10,22 @@ import os
 import subprocess
 import sys
 
-from derive.cli import main
-
 from conftest import ROOT
 
 
-def test_committed_generated_is_up_to_date(capsys):
-    code = main(["check", "--out", str(ROOT / "generated")])
-    out = capsys.readouterr().out
-    assert code == 0, f"generated/ is stale; run `derive generate` to update:\n{out}"
-
-
-def test_output_is_identical_under_different_hash_seeds(tmp_path):
-    outputs = []
-    for seed in ("0", "12345"):
-        folder = tmp_path / seed
-        env = {**os.environ, "PYTHONHASHSEED": seed}
-        subprocess.run(
-            [sys.executable, "-m", "derive", "generate", "--out", str(folder)],
-            check=True,
-            env=env,
-            cwd=ROOT,
-            capture_output=True,
-        )
-        outputs.append({p.name: p.read_bytes() for p in sorted(folder.iterdir())})
-    assert outputs[0] == outputs[1]
-    assert len(outputs[0]) >= 5
+def test_committed_generated_is_up_to_date_under_another_hash_seed():
+    """`derive check` regenerates every committed file (Python, Markdown, C, header and IKFast
+    shim) under PYTHONHASHSEED=12345 and compares bytes. generated/ was written under some
+    other seed (and CI's own `derive check` runs under a random one), so a pass says both that
+    generated/ is current and that the output does not depend on the hash seed."""
+    env = {**os.environ, "PYTHONHASHSEED": "12345"}
+    result = subprocess.run(
+        [sys.executable, "-m", "derive", "check", "--out", str(ROOT / "generated")],
+        env=env,
+        cwd=ROOT,
+        capture_output=True,
+        text=True,
+    )
+    assert result.returncode == 0, f"generated/ is stale or seed-dependent:\n{result.stdout}"
+    committed = len([p for p in (ROOT / "generated").iterdir() if p.suffix != ".svg"])
+    assert f"up to date ({committed} files)" in result.stdout, result.stdout
