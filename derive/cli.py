@@ -38,7 +38,7 @@ from derive.outputs import (
 from derive.pipeline import build_plan
 from derive.plan import Plan
 from derive.report import Example, render_report
-from derive.spec import ArmSpec, SpecError, load_spec
+from derive.spec import IK_METHODS, IK_TASKS, TOOL_AXES, ArmSpec, SpecError, load_spec
 
 DEFAULT_OUT = "generated"
 
@@ -66,6 +66,9 @@ def urdf_options(args: argparse.Namespace) -> urdf.Options:
         exact=args.exact,
         max_deviation=args.max_deviation,
         convention=getattr(args, "convention", "modified"),
+        task=args.task,
+        tool_axis=args.tool_axis,
+        method=args.method,
     )
 
 
@@ -920,10 +923,10 @@ def add_urdf_arguments(command: argparse.ArgumentParser, required: bool) -> None
     """The options of a URDF's conversion (used where an arm is a .urdf file)."""
     group = command.add_argument_group("URDF or MJCF input (ARM.urdf, ARM.xml)")
     group.add_argument(
-        "--base", required=required, help="the URDF link (MJCF body) the chain starts from"
+        "--base", required=required, help="the URDF link (MJCF body or site) the chain starts from"
     )
     group.add_argument(
-        "--tip", required=required, help="the URDF link (MJCF body) the chain ends at"
+        "--tip", required=required, help="the URDF link (MJCF body or site) the chain ends at"
     )
     group.add_argument("--name", help="the arm's name (default: the URDF robot's)")
     group.add_argument(
@@ -939,6 +942,23 @@ def add_urdf_arguments(command: argparse.ArgumentParser, required: bool) -> None
         help=f"snap lengths this close to 0, relative to the arm's size ({urdf.LENGTH_TOL:g})",
     )
     group.add_argument("--exact", action="store_true", help="no snapping")
+    group.add_argument(
+        "--task",
+        choices=IK_TASKS,
+        help="what ik solves for (the spec's [ik] task; default: the joints choose)",
+    )
+    group.add_argument(
+        "--tool-axis",
+        choices=TOOL_AXES,
+        help='the tool axis of the "direction" and "lookat" tasks (default: z, else the first '
+        "of x, y that works)",
+    )
+    group.add_argument(
+        "--method",
+        choices=IK_METHODS,
+        help="this IK method only (the spec's [ik] method; default: the first that applies; "
+        "general: an arm near a special one gets its complete solution set, slower)",
+    )
     group.add_argument(
         "--max-deviation",
         type=float,

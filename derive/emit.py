@@ -264,8 +264,9 @@ def correction_text(plan: Plan) -> str:
         "nominal arm's branch order. An arm this close to a special one can have more real "
         "solutions than it near some poses. Where a nominal equation fixes a joint only "
         "roughly (two links of nearly equal length folded back), seeds all round find them "
-        "(up to 16 rows); elsewhere those the nominal arm lacks are not returned (derive "
-        "generate --method general gives the complete set, slower)."
+        "(up to 16 rows); elsewhere those the nominal arm lacks are not returned (the general "
+        'method gives the complete set, slower: [ik] method = "general" in the spec, or '
+        "--method general with a URDF or MJCF)."
     )
 
 

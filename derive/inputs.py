@@ -34,14 +34,38 @@ def _xml_file(path: Path, options: urdf.Options) -> ArmSpec:
     return mjcf.load_mjcf(path, options)
 
 
+def _sdf_file(path: Path, options: urdf.Options) -> ArmSpec:
+    """An SDFormat file (Gazebo's): refused, naming the formats that are read."""
+    raise SpecError(f"{path}: an SDFormat (.sdf) file; {FORMATS}")
+
+
+# what the readers read, for messages
+FORMATS = (
+    "derive reads spec files (.toml), URDF (.urdf, or .xml with a <robot> root) and MJCF "
+    "(.xml, .mjcf)"
+)
+
 # file suffix (lower case) -> reader
 READERS: dict[str, Reader] = {
+    ".sdf": _sdf_file,
     ".toml": _spec_file,
     ".urdf": urdf.load_urdf,
     ".xacro": urdf.load_urdf,  # (it says to expand the file first)
     ".xml": _xml_file,
     ".mjcf": mjcf.load_mjcf,
 }
+
+
+def conversion_options(options: urdf.Options | None) -> list[str]:
+    """The command line options of a conversion that options sets (not to their defaults)."""
+    if options is None:
+        return []
+    default = urdf.Options()
+    flags = {"base": "--base", "tip": "--tip", "name": "--name", "exact": "--exact",
+             "task": "--task", "tool_axis": "--tool-axis", "angle_tol": "--angle-tol",
+             "length_tol": "--length-tol", "max_deviation": "--max-deviation",
+             "convention": "--convention", "method": "--method"}  # fmt: skip
+    return [flag for key, flag in flags.items() if getattr(options, key) != getattr(default, key)]
 
 
 def bundled_specs() -> list[Path]:
@@ -58,10 +82,22 @@ def resolve_spec(text: str, options: urdf.Options | None = None) -> ArmSpec:
     by name."""
     path = Path(text)
     reader = READERS.get(path.suffix.lower())
-    if reader is not None:
+    if reader is not None and reader is not _spec_file:
         return reader(path, options or urdf.Options())
+    if given := conversion_options(options):
+        raise SpecError(
+            f"{text}: {', '.join(given)}: options of a URDF or MJCF file's conversion, and "
+            "this arm is a spec (in a spec, [ik] task and tool_axis name the task)"
+        )
+    if reader is not None:
+        return reader(path, urdf.Options())
     if path.exists():  # (a spec file of another name)
-        return load_spec(path)
+        try:
+            return load_spec(path)
+        except SpecError as exc:
+            if "not valid TOML" not in str(exc):
+                raise
+            raise SpecError(f"{exc}; {FORMATS}") from None
     for candidate in bundled_specs():
         if candidate.stem == text:
             return load_spec(candidate)

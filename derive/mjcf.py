@@ -120,9 +120,11 @@ def _names(model: Any, count: int, kind: Any, label: str) -> list[str]:
 
 def model_robot(
     model: Any, where: str, digest: str
-) -> tuple[Robot, dict[str, int], dict[str, int]]:
-    """The model's bodies as links and its joints as URDF joints (module docstring), and the
-    MuJoCo indices of the bodies and of the hinge and slide joints by name."""
+) -> tuple[Robot, dict[str, int], dict[str, tuple[str, int]]]:
+    """The model's bodies as links and its joints as URDF joints (module docstring), its
+    named sites as links fixed to their bodies (a gripper's tool point is often a site), and
+    the MuJoCo indices of the hinge and slide joints by name and of the bodies and sites
+    ("body" or "site", index) by name (a site of a body's name is left out)."""
     mujoco = _mujoco(where)
     bodies = _names(model, model.nbody, mujoco.mjtObj.mjOBJ_BODY, "body")
     names = _names(model, model.njnt, mujoco.mjtObj.mjOBJ_JOINT, "joint")
@@ -165,9 +167,19 @@ def model_robot(
             above = joint.child
         joints.append(UrdfJoint(f"{body}#frame", "fixed", above, body, place, (0.0, 0.0, 1.0),
                                 None, False))  # fmt: skip
+    places = {name: ("body", b) for b, name in enumerate(bodies)}
+    for i in range(model.nsite):
+        name = mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_SITE, i)
+        if not name or name in links:
+            continue
+        body = bodies[int(model.site_bodyid[i])]
+        place = _frame(model.site_pos[i], _quaternion(model.site_quat[i]))
+        joints.append(UrdfJoint(f"{name}#site", "fixed", body, name, place, (0.0, 0.0, 1.0),
+                                None, False))  # fmt: skip
+        links.add(name)
+        places[name] = ("site", i)
     model_name = mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_MODEL, 0) or ""
-    body_index = {name: b for b, name in enumerate(bodies)}
-    return Robot(model_name, frozenset(links), tuple(joints), digest), index, body_index
+    return Robot(model_name, frozenset(links), tuple(joints), digest), index, places
 
 
 def _vector(values: Any) -> Vector:
@@ -176,10 +188,15 @@ def _vector(values: Any) -> Vector:
 
 
 def check_against_mujoco(
-    model: Any, chain: list[UrdfJoint], index: dict[str, int], ids: list[int], where: str
+    model: Any,
+    chain: list[UrdfJoint],
+    index: dict[str, int],
+    ids: list[tuple[str, int]],
+    where: str,
 ) -> None:
-    """Refuse the chain unless its FK is MuJoCo's (tip body in the base body's frame) within
-    CHECK_TOL on CHECK_SAMPLES random joint vectors: else the reading above is wrong."""
+    """Refuse the chain unless its FK is MuJoCo's (the tip body or site in the base's frame)
+    within CHECK_TOL on CHECK_SAMPLES random joint vectors: else the reading above is
+    wrong."""
     mujoco = _mujoco(where)
     data = mujoco.MjData(model)
     rng = random.Random(0)
@@ -191,7 +208,12 @@ def check_against_mujoco(
         for joint, value in zip(moving, q):
             data.qpos[model.jnt_qposadr[index[joint.name]]] = value
         mujoco.mj_kinematics(model, data)
-        frames = [_frame(data.xpos[i], data.xmat[i].reshape(3, 3)) for i in ids]
+        frames = [
+            _frame(data.xpos[i], data.xmat[i].reshape(3, 3))
+            if kind == "body"
+            else _frame(data.site_xpos[i], data.site_xmat[i].reshape(3, 3))
+            for kind, i in ids
+        ]
         expected = urdf.matmul(urdf.inverse(frames[0]), frames[1])
         got = urdf.urdf_fk(chain, q)
         worst = max(worst, *(abs(got[r][c] - expected[r][c]) for r in range(3) for c in range(4)))
@@ -210,15 +232,17 @@ def import_mjcf(path: Path, options: urdf.Options) -> tuple[str, urdf.Conversion
         raise UrdfError(f"{where}: an MJCF needs --base BODY and --tip BODY")
     model = compile_model(path)
     digest = hashlib.sha256(path.read_bytes()).hexdigest()[:16]
-    robot, index, bodies = model_robot(model, where, digest)
-    for body, what in ((options.base, "--base"), (options.tip, "--tip")):
-        if body not in bodies:
+    robot, index, places = model_robot(model, where, digest)
+    for name, what in ((options.base, "--base"), (options.tip, "--tip")):
+        if name not in places:
+            bodies = sorted(n for n, (kind, _) in places.items() if kind == "body")
+            sites = sorted(n for n, (kind, _) in places.items() if kind == "site")
             raise UrdfError(
-                f"{where}: {what} {urdf._shown(body)}: no such body; bodies: "
-                f"{urdf._listing(sorted(bodies))}"
+                f"{where}: {what} {urdf._shown(name)}: no such body or site; bodies: "
+                f"{urdf._listing(bodies)}" + (f"; sites: {urdf._listing(sites)}" if sites else "")
             )
     chain = urdf.chain_between(robot, options.base, options.tip, where)
-    ids = [bodies[options.base], bodies[options.tip]]
+    ids = [places[options.base], places[options.tip]]
     check_against_mujoco(model, chain, index, ids, where)
     return urdf.import_chain(robot, chain, path, options, source="MJCF", part="body")
 

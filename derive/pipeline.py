@@ -36,8 +36,8 @@ METHODS = {
 
 def build_plan(spec: ArmSpec, method: str | None = None) -> Plan:
     """Derive everything the generated module and the report need for one arm; with method
-    (a key of METHODS), that method only (the general one also solves special arms: the tests
-    compare it with the closed forms).
+    (a key of METHODS; default the spec's [ik] method), that method only (the general one
+    also solves special arms: the tests compare it with the closed forms).
 
     The closed forms are tried on the arm's own table, then on its nominal table
     (derive/nominal.py: the structure parameters within the spec's structure_tol of a
@@ -45,6 +45,7 @@ def build_plan(spec: ArmSpec, method: str | None = None) -> Plan:
     method last, on the arm's own table."""
     chain = chain_from_spec(spec)
     structure = classify(chain)
+    method = method or spec.method
     if method is not None and method not in METHODS:
         raise ValueError(f"no method {method!r}; methods: {', '.join(METHODS)}")
     names = (method,) if method else tuple(METHODS)
@@ -110,7 +111,10 @@ def build_plan(spec: ArmSpec, method: str | None = None) -> Plan:
         shown = task if ik is None else dataclasses.replace(task, axis=ik.tool_axis)
         why = task.why
         if ik is not None and ik.tool_axis != 2 and not task.fixed:
-            why += f" (the first of the tool z, x, y axes that works: {shown.axis_name})"
+            why += (
+                f" (the first that works of the tool z, x, y axes, those parallel to joint "
+                f"{chain.dof}'s axis last: {shown.axis_name})"
+            )
         facts = (*facts, f"task: {shown.describe()}: {why}")
     pose = world_transform(chain, expand=False)
     if spec.exact is not None:
@@ -192,7 +196,7 @@ def choose(
             ik, why = choose(chain, structure, named, names)
             if ik is not None:
                 return ik, why
-        for axis in (task.axis,) if task.fixed else (2, 0, 1):
+        for axis in (task.axis,) if task.fixed else tasks.axis_order(chain, tol):
             aimed = dataclasses.replace(task, axis=axis)
             try:
                 extended, snap = tasks.extend_snapped(chain, aimed, tol)

@@ -37,6 +37,9 @@ Spec format (all keys other than those listed are errors)::
                                 # point); default: the joints choose (derive/tasks.py)
     tool_axis = "z"             # the tool axis of "direction" and "lookat" (x, y or z;
                                 # default z, or the first that works)
+    method = "general"          # this method only (pieper, three-parallel, planar, position,
+                                # general); default: the first that applies. "general"
+                                # gives an arm near a special one its complete solutions
     [exact]                     # optional (derive import-urdf writes it): the arm's exact
     frames = [[...], ...]       # geometry as n + 1 fixed frames, 12 numbers each (the top
                                 # three rows of F_i, row-major; lengths in length_unit):
@@ -96,7 +99,10 @@ TOP_KEYS = (
     "exact",
     "ik",
 )  # fmt: skip
-IK_KEYS = ("free", "structure_tol", "task", "tool_axis")
+IK_KEYS = ("free", "structure_tol", "task", "tool_axis", "method")
+# what [ik] method may be (derive/pipeline.py's METHODS: one method only, not the first that
+# applies; "general" gives a calibrated arm its complete solution set)
+IK_METHODS = ("pieper", "three-parallel", "planar", "position", "general")
 # what [ik] task and tool_axis may be (derive/tasks.py)
 IK_TASKS = ("pose", "position", "direction", "lookat")
 TOOL_AXES = ("x", "y", "z")
@@ -197,6 +203,7 @@ class ArmSpec:
         structure_tol: [ik] structure_tol, or None (derive.nominal.STRUCTURE_TOL).
         task: [ik] task, or None (the joints choose: derive/tasks.py).
         tool_axis: [ik] tool_axis, or None (z, or the first that works).
+        method: [ik] method, or None (the first method that applies).
         exact: [exact] frames (n + 1 tuples of 12 floats), or None (the table is exact).
     """
 
@@ -216,6 +223,7 @@ class ArmSpec:
     exact: tuple[tuple[float, ...], ...] | None = None
     task: str | None = None
     tool_axis: str | None = None
+    method: str | None = None
 
     @property
     def dof(self) -> int:
@@ -266,6 +274,8 @@ class ArmSpec:
             ik["task"] = self.task
         if self.tool_axis is not None:  # (likewise)
             ik["tool_axis"] = self.tool_axis
+        if self.method is not None:  # (likewise)
+            ik["method"] = self.method
         if ik:
             data["ik"] = ik
         if self.exact is not None:  # (likewise)
@@ -377,6 +387,7 @@ def _validate(data: dict, where: str) -> ArmSpec:
         _exact(data.get("exact"), where, len(joints)),
         _choice(data.get("ik"), where, "task", IK_TASKS),
         _choice(data.get("ik"), where, "tool_axis", TOOL_AXES),
+        _choice(data.get("ik"), where, "method", IK_METHODS),
     )
 
 

@@ -129,9 +129,7 @@ def extend_snapped(chain: Chain, task: Task, tol: float = 0.0) -> tuple[Chain, f
             the tool point nor the axis: the task has one joint too few).
     """
     n = chain.dof
-    frame = product([x_factor(chain.twists[-1]), chain.tool, _ALIGN[task.axis]])
-    o = [sp.simplify(frame[i, 3]) for i in range(3)]
-    u = [sp.simplify(frame[i, 2]) for i in range(3)]
+    o, u = tool_line(chain, task.axis)
     size = arm_size(chain)
     across = math.sqrt(float(u[0] ** 2 + u[1] ** 2))
     snap = 0.0
@@ -184,6 +182,27 @@ def extend_snapped(chain: Chain, task: Task, tol: float = 0.0) -> tuple[Chain, f
         chain.convention,
     )
     return extended, snap
+
+
+def tool_line(chain: Chain, axis: int) -> tuple[list[sp.Expr], list[sp.Expr]]:
+    """The tool point o and the tool axis's direction u in joint n's frame after Z_n."""
+    frame = product([x_factor(chain.twists[-1]), chain.tool, _ALIGN[axis]])
+    return [sp.simplify(frame[i, 3]) for i in range(3)], [
+        sp.simplify(frame[i, 2]) for i in range(3)
+    ]
+
+
+def axis_order(chain: Chain, tol: float) -> tuple[int, ...]:
+    """The tool axes a task tries where the spec names none: z, x, y, those parallel to
+    joint n's axis (within tol) last. Joint n turns such an axis about a parallel line, so it
+    points the same way for every q_n and joint n serves the tool point only through the
+    lever between the lines (8 mm on an SO-101's gripper frame: the task is ill-conditioned
+    everywhere and lost solutions)."""
+    across = {}
+    for axis in (2, 0, 1):
+        u = tool_line(chain, axis)[1]
+        across[axis] = math.sqrt(float(u[0] ** 2 + u[1] ** 2))
+    return tuple(sorted(across, key=lambda axis: across[axis] <= math.sin(tol)))
 
 
 def arm_size(chain: Chain) -> float:

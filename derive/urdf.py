@@ -35,7 +35,7 @@ from xml.sax.xmlreader import AttributesImpl
 import defusedxml.sax as SafeSax
 from defusedxml import DefusedXmlException
 
-from derive.spec import ArmSpec, SpecError, parse_spec
+from derive.spec import IK_METHODS, IK_TASKS, TOOL_AXES, ArmSpec, SpecError, parse_spec
 
 MAX_BYTES = 10_000_000
 MOVING = ("revolute", "continuous", "prismatic")
@@ -798,6 +798,7 @@ def spec_text(
     convention: str = "modified",
     kind: str = "URDF",
     part: str = "link",
+    ik: tuple[tuple[str, str], ...] = (),
 ) -> str:
     """The spec as canonical TOML, with the conversion's record as comments and [source].
 
@@ -832,6 +833,9 @@ def spec_text(
         'angle_unit = "deg"',
         'length_unit = "m"',
     ]
+    if ik:
+        lines += ["", "# from the command line (--task, --tool-axis, --method)", "[ik]"]
+        lines += [f'{key} = "{value}"' for key, value in ik]
     rows = conversion.rows
     if convention == "standard":
         twists = [(r[1], r[2]) for r in rows[1:]] + [(0.0, 0.0)]
@@ -907,10 +911,20 @@ class Options:
     exact: bool = False
     max_deviation: float = MAX_DEVIATION
     convention: str = "modified"
+    task: str | None = None
+    tool_axis: str | None = None
+    method: str | None = None
 
     def __post_init__(self) -> None:
         """Refuse tolerances that mean nothing: negative, NaN, or so large that snapping
-        would change the arm (or a deviation bound nothing)."""
+        would change the arm (or a deviation bound nothing), and unknown tasks and axes."""
+        for option, choice, allowed in (
+            ("--task", self.task, IK_TASKS),
+            ("--tool-axis", self.tool_axis, TOOL_AXES),
+            ("--method", self.method, IK_METHODS),
+        ):
+            if choice is not None and choice not in allowed:
+                raise UrdfError(f"{option} {choice!r}: allowed: {', '.join(allowed)}")
         for option, value, (lo, hi), unit in (
             ("--angle-tol", self.angle_tol, TOLERANCE_RANGE, " rad"),
             ("--length-tol", self.length_tol, TOLERANCE_RANGE, " of the arm's size"),
@@ -956,8 +970,10 @@ def import_chain(
     assert options.base is not None and options.tip is not None
     conversion = convert(chain, where, options.angle_tol, options.length_tol, options.exact)
     name = options.name or spec_name(robot.name or path.stem)
+    given = (("task", options.task), ("tool_axis", options.tool_axis), ("method", options.method))
+    ik = tuple((key, value) for key, value in given if value)
     args = (conversion, robot, path.name, options.base, options.tip, name, options.convention,
-            source, part)  # fmt: skip
+            source, part, ik)  # fmt: skip
     draft = spec_text(*args)
     spec = parse_spec(draft, where=f"{where} (converted)")
     conversion.deviation = measure(spec, chain, conversion.reach)

@@ -66,7 +66,8 @@ certification of every row, are the exact chain's. Rows keep the nominal arm's b
 arm this close to a special one can have more real solutions than it near some poses. Where a
 nominal equation fixes a joint only roughly (two links of nearly equal length folded back),
 seeds all round find them (up to 16 rows); elsewhere those the nominal arm lacks are not
-returned (derive generate --method general gives the complete set, slower).
+returned (the general method gives the complete set, slower: [ik] method = "general" in the
+spec, or --method general with a URDF or MJCF).
 """
 
 from __future__ import annotations

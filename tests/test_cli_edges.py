@@ -314,3 +314,49 @@ def test_solve_names_free_when_a_free_value_is_out_of_range(capsys):
     assert main(argv) == 2
     err = capsys.readouterr().err
     assert err.startswith("error: --free: q7 = 1e+17: allowed: within +-") and "deg" in err
+
+
+@pytest.mark.parametrize(
+    ("argv", "message"),
+    [
+        (
+            ["generate", "puma560", "--task", "direction"],
+            "puma560: --task: options of a URDF or MJCF file's conversion",
+        ),
+        (
+            ["solve", "puma560", "--base", "a", "--tip", "b", "--q", "0", "0", "0", "0", "0", "0"],
+            "puma560: --base, --tip: options of a URDF or MJCF file's conversion",
+        ),
+        (["generate", "arm.sdf"], "arm.sdf: an SDFormat (.sdf) file; derive reads spec files"),
+        (["generate", "arm.model"], "not valid TOML (Invalid statement (at line 1, column 1)); "),
+    ],
+)
+def test_input_that_is_not_read_as_given_is_one_line(argv, message, tmp_path, capsys):
+    """A conversion's options on a spec would be ignored, an SDFormat or unknown file read as
+    TOML: each is refused in one line that says what is read."""
+    for name in ("arm.sdf", "arm.model"):
+        (tmp_path / name).write_text("<sdf version='1.7'><model name='m'/></sdf>\n")
+    argv = [str(tmp_path / a) if a.startswith("arm.") else a for a in argv]
+    assert main([*argv, "--out", str(tmp_path / "out")] if argv[0] == "generate" else argv) == 2
+    err = capsys.readouterr().err
+    assert message in err and err.count("\n") == 1, err
+    assert not (tmp_path / "out").exists()
+
+
+def test_a_spec_s_method_is_the_only_one_tried():
+    """[ik] method = "general" gives an arm the general method (a calibrated arm's complete
+    solution set); an unknown method is refused with the allowed ones."""
+    from derive.pipeline import METHODS, build_plan
+    from derive.spec import IK_METHODS, SpecError, parse_spec
+
+    assert tuple(METHODS) == IK_METHODS
+    rows = [(0, 0, 0, 0), (-90, 0, 0, 0), (0, 0.4, 0.1, 0), (-90, 0.02, 0.43, 0)]
+    rows += [(90, 0, 0, 0), (-90, 0, 0, 0)]
+    text = spec_text("six_r", "modified", rows)
+    assert build_plan(parse_spec(text, "<six_r>")).ik.method == "pieper"
+    general = parse_spec(text + '\n[ik]\nmethod = "general"\n', "<six_r>")
+    assert build_plan(general).ik.method == "general"
+    with pytest.raises(
+        SpecError, match=r'six_r.toml: ik.method: \'fast\' is not allowed; one of "pieper"'
+    ):
+        parse_spec(text + '\n[ik]\nmethod = "fast"\n', "six_r.toml")

@@ -12,6 +12,7 @@ import pytest
 
 from derive import cli, mjcf
 from derive.inputs import resolve_spec
+from derive.pipeline import build_plan
 from derive.spec import SpecError, parse_spec
 from derive.urdf import Options
 
@@ -97,10 +98,46 @@ def test_ref_slide_anchors_and_two_joints_in_one_body_mean_what_mujoco_means(tmp
         assert np.max(np.abs(module.fk(q) - expected)) <= 1e-12
 
 
+def test_a_site_is_a_tip(tmp_path):
+    """A gripper's tool frame is often a site: --tip takes it (the jaco's wristsite, turned
+    on its body b_6), and fk is MuJoCo's site pose."""
+    path = DATA / "jaco_arm.xml"
+    text, _ = mjcf.import_mjcf(path, Options(base="b_base", tip="wristsite"))
+    spec = parse_spec(text, "<jaco site>")
+    assert spec.origin is not None
+    module = build_module(text, tmp_path)
+    model = mjcf.compile_model(path)
+    data = mujoco.MjData(model)
+    rng = np.random.default_rng(4)
+    for q in rng.uniform(-math.pi, math.pi, (10, 6)):
+        data.qpos[:] = model.qpos0
+        for name, value in zip(spec.origin.joints, q):
+            data.qpos[model.jnt_qposadr[model.joint(name).id]] = value
+        mujoco.mj_kinematics(model, data)
+        base, site = np.eye(4), np.eye(4)
+        i, k = model.body("b_base").id, model.site("wristsite").id
+        base[:3, :3], base[:3, 3] = data.xmat[i].reshape(3, 3), data.xpos[i]
+        site[:3, :3], site[:3, 3] = data.site_xmat[k].reshape(3, 3), data.site_xpos[k]
+        assert np.max(np.abs(module.fk(q) - np.linalg.inv(base) @ site)) <= 1e-12
+
+
+def test_task_tool_axis_and_method_options_reach_the_spec(tmp_path, capsys):
+    """--task, --tool-axis and --method of a conversion are the spec's [ik] keys."""
+    chain = ["--base", "so_arm100_right", "--tip", "so_arm100_right/Fixed_Jaw"]
+    spec_file = tmp_path / "so.toml"
+    options = ["--task", "direction", "--tool-axis", "x", "--method", "general"]
+    command = ["import-mjcf", str(DATA / "so_arm100.xml"), *chain, *options, "-o"]
+    assert cli.main([*command, str(spec_file)]) == 0
+    spec = resolve_spec(str(spec_file))
+    assert (spec.task, spec.tool_axis, spec.method) == ("direction", "x", "general")
+    plan = build_plan(spec)
+    assert plan.ik is not None and plan.ik.tool_axis == 0 and plan.ik.method == "general"
+
+
 @pytest.mark.parametrize(
     ("xml", "base", "tip", "message"),
     [
-        ("jaco_arm.xml", "b_base", "nope", "--tip 'nope': no such body; bodies: 'b_1'"),
+        ("jaco_arm.xml", "b_base", "nope", "--tip 'nope': no such body or site; bodies: 'b_1'"),
         ("not xml", "a", "b", "MuJoCo cannot compile it: XML parse error"),
         (
             '<mujoco><worldbody><body name="a"><joint type="ball"/><body name="b"/></body>'
