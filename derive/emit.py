@@ -149,6 +149,7 @@ class PrintedModule:
     correction: str
     correction_doc: str
     tool_axis: int = 2
+    task_doc: str = ""
 
 
 def print_plan(plan: Plan) -> PrintedModule:
@@ -203,6 +204,37 @@ def print_plan(plan: Plan) -> PrintedModule:
         seed_tol=repr(plan.correction.seed_tol) if plan.correction else "0.0",
         correction=correction_constants(plan),
         correction_doc=correction_text(plan),
+        task_doc=task_text(plan),
+    )
+
+
+def task_text(plan: Plan) -> str:
+    """The module docstring's paragraph on a task of fewer components than a pose
+    (derive/tasks.py), "" for the methods' own problems."""
+    ik = plan.ik
+    if ik is None or ik.certify not in ("direction", "lookat"):
+        return ""
+    reads = "position and its column TOOL_AXIS" if ik.certify == "direction" else "position"
+    if ik.certify == "lookat":
+        reads += " (the point looked at)"
+    details = dict(ik.details)
+    if "task_spun_joint" in details:
+        n = int(details["task_spun_joint"])
+        how = (
+            f"from the arm's own pose: joint {n} turns about the tool axis through the tool point "
+            f"(it moves neither), so it plays the part of a virtual joint and its value is the "
+            "caller's (FREE)"
+        )
+    else:
+        how = (
+            "as a pose or a position of the arm with one more, virtual, joint (derive/tasks.py), "
+            "whose value is dropped"
+        )
+    fewer = "fewer than a pose needs" if plan.arm.dof < 6 else "more than the task needs"
+    return (
+        f"The task: the arm has {plan.arm.dof} joints, {fewer}; its solver is derived for "
+        f"{ik.solves_for} (IK_COMPONENTS, TOOL_AXIS), {how}. `ik(T)` reads only T's {reads}; "
+        "every row reproduces them."
     )
 
 

@@ -164,7 +164,7 @@ def lift(ik: IkPlan, chain: Chain, free: tuple[int, ...]) -> IkPlan:
     n = chain.dof
     k, m = split(free, n)
     rename: dict[sp.Symbol, sp.Symbol] = {}
-    for r in range(1, REMAINDER_DOF + 1):
+    for r in range(1, n - len(free) + 1):
         for f in (sym.theta, sym.c, sym.s, sym.d, sym.q, sym.q_ref):
             rename[f(r)] = f(r + k)
     head: list[sp.Symbol] = []

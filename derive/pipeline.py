@@ -159,11 +159,8 @@ def task_of(spec: ArmSpec, chain: Chain) -> tasks.Task | None:
             raise SpecError(f'{where}: "position" needs 3 joints, the arm has {n}')
         task = None
     elif spec.task == "direction":
-        if n != 5:
-            raise SpecError(
-                f'{where}: "direction" needs 5 joints, the arm has {n} (more joints than '
-                "a task needs, as free joints, are not supported yet)"
-            )
+        if n < 5:
+            raise SpecError(f'{where}: "direction" needs at least 5 joints, the arm has {n}')
         task = tasks.Task("direction", 2, NAMED)
     else:
         if kinds != "RR":
@@ -196,20 +193,35 @@ def choose(
             ik, why = choose(chain, structure, named, names)
             if ik is not None:
                 return ik, why
+        n = chain.dof
         for axis in (task.axis,) if task.fixed else tasks.axis_order(chain, tol):
             aimed = dataclasses.replace(task, axis=axis)
+            if task.kind == "direction" and n > 5 and tasks.spins(chain, axis, tol):
+                # joint n turns about the tool axis: it is the virtual joint, and free
+                if named is not None and n not in named:
+                    reasons.append(
+                        f"tool {tasks.AXES[axis]} axis: it is joint {n}'s axis, so q{n} is "
+                        f"free, and [ik] free names {', '.join(f'q{i}' for i in named)}"
+                    )
+                    continue
+                rest = None if named is None else tuple(i for i in named if i != n)
+                ik, why = choose_pose(chain, structure, rest or None, names, n)
+                if ik is not None:
+                    return tasks.lower_spun(ik, chain, aimed), ""
+                reasons.append(f"tool {tasks.AXES[axis]} axis: {why}")
+                continue
             try:
                 extended, snap = tasks.extend_snapped(chain, aimed, tol)
             except NotApplicable as exc:
                 reasons.append(f"tool {tasks.AXES[axis]} axis: {exc}")
                 continue
-            ik, why = choose_method(extended, classify(extended), names)
+            ik, why = choose_pose(extended, classify(extended), named, names, n + 1)
             if snap > 0.0:
                 # the exact virtual link where its case is the snapped one's (no refinement:
                 # a look-at camera 9e-6 m off its axis); the snapped one where snapping gives
                 # a special case (a5 = 0: the exact a5 = 6e-7 left a degenerate quartic)
                 exact = tasks.extend(chain, aimed)
-                exact_ik, _ = choose_method(exact, classify(exact), names)
+                exact_ik, _ = choose_pose(exact, classify(exact), named, names, n + 1)
                 if exact_ik is not None and (ik is None or exact_ik.case == ik.case):
                     ik, extended, snap = exact_ik, exact, 0.0
             if ik is not None:
@@ -291,15 +303,44 @@ def choose_method(
     return None, "; ".join(reasons)
 
 
+def choose_pose(
+    chain: Chain,
+    structure: Structure,
+    named: tuple[int, ...] | None,
+    names: tuple[str, ...],
+    reserved: int,
+) -> tuple[IkPlan | None, str]:
+    """The pose problem of a task's chain (joint reserved is the task's virtual joint, or
+    the arm's joint that plays it), with free joints where it has more than 6, never the
+    reserved one."""
+    if chain.dof > free.REMAINDER_DOF:
+        return choose_free(chain, named, names, reserved)
+    return choose_method(chain, structure, names)
+
+
 def choose_free(
-    chain: Chain, named: tuple[int, ...] | None, names: tuple[str, ...]
+    chain: Chain,
+    named: tuple[int, ...] | None,
+    names: tuple[str, ...],
+    reserved: int | None = None,
 ) -> tuple[IkPlan | None, str]:
     """For an arm of more than 6 joints: the first method that solves the remainder of one
     of the free-joint choices (the spec's, else end joints; every closed form on every choice
-    before the general method), lifted to the arm; or None and why none does."""
+    before the general method; never the reserved joint: a task's virtual one), lifted to the
+    arm; or None and why none does."""
     reasons: list[str] = []
     usable = []
-    for choice in free.candidates(chain, named):
+    choices = free.candidates(chain, named)
+    if reserved is not None:
+        if named is not None and reserved in named:
+            return None, f"[ik] free names q{reserved}, which the task needs"
+        choices = tuple(c for c in choices if reserved not in c)
+        if not choices:
+            return None, (
+                f"the end joints that could be free leave joint {reserved} (the task's) "
+                "in the middle"
+            )
+    for choice in choices:
         label = "free " + ", ".join(f"q{i}" for i in choice)
         why = free.refusal(chain, choice)
         if why:

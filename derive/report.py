@@ -548,7 +548,7 @@ def walk(plan: Plan, pose: np.ndarray, q: tuple[float, ...]) -> list[tuple[str, 
         args = [float(a.xreplace(env)) for a in step.args]
         shown = ", ".join(number(x) for x in args)
         t = joint_symbol(step)
-        value = values[t] if t in values else virtual_value(plan, values, env)
+        value = values[t] if t in values else virtual_value(plan, q, env)
         env[t] = value
         if step.kind != "polyd":
             env[sym.c(step.joint)], env[sym.s(step.joint)] = math.cos(value), math.sin(value)
@@ -563,19 +563,18 @@ def walk(plan: Plan, pose: np.ndarray, q: tuple[float, ...]) -> list[tuple[str, 
     return lines
 
 
-def virtual_value(plan: Plan, values: dict[sp.Symbol, float], env: dict[sp.Symbol, float]) -> float:
-    """A task's virtual joint's value on the branch (derive/tasks.py), from the world pose
-    and the solution's joints."""
+def virtual_value(plan: Plan, q: tuple[float, ...], env: dict[sp.Symbol, float]) -> float:
+    """A task's virtual joint's value on the branch of solution q (derive/tasks.py), from the
+    world pose and the arm's joints (their c_i, s_i or d_i by the plan's joint definitions:
+    the steps may number a reversed chain's joints otherwise)."""
     assert plan.ik is not None and plan.ik.virtual
-    known = dict(env)
-    for var, value in values.items():
-        name = str(var)
-        if name.startswith("theta"):
-            known[sym.c(int(name[5:]))], known[sym.s(int(name[5:]))] = (
-                math.cos(value),
-                math.sin(value),
-            )
-        known[var] = value
+    known = {k: v for k, v in env.items() if k in set(sym.world_pose())}
+    for target, expr in plan.joint_defs:
+        value = float(expr.xreplace({sym.q(k + 1): q[k] for k in range(len(q))}))
+        known[target] = value
+        if str(target).startswith("theta"):
+            k = int(str(target)[5:])
+            known[sym.c(k)], known[sym.s(k)] = math.cos(value), math.sin(value)
     numbers = [float(e.xreplace(known)) for e in plan.ik.virtual]
     return math.atan2(numbers[1], numbers[0]) if len(numbers) == 2 else numbers[0]
 

@@ -106,6 +106,8 @@ IK_METHODS = ("pieper", "three-parallel", "planar", "position", "general")
 # what [ik] task and tool_axis may be (derive/tasks.py)
 IK_TASKS = ("pose", "position", "direction", "lookat")
 TOOL_AXES = ("x", "y", "z")
+# the joints each task needs: an arm with more has free joints ([ik] free)
+TASK_JOINTS = {"pose": 6, "position": 3, "direction": 5, "lookat": 2}
 # what [ik] structure_tol may be: beyond 0.1 rad or 0.1 of the arm's size it changes the arm
 STRUCTURE_TOL_RANGE = (0.0, 0.1)
 SOURCE_KEYS = ("urdf", "sha256", "base", "tip", "joints", "snaps", "deviation", "format")
@@ -448,7 +450,8 @@ def _structure_tol(table: object, where: str) -> float | None:
 
 
 def _free(table: object, where: str, joints: tuple[Joint, ...]) -> tuple[int, ...] | None:
-    """The optional [ik] table: `free`, the joints an arm of more than 6 joints leaves free."""
+    """The optional [ik] table: `free`, the joints an arm of more joints than its task needs
+    leaves free (a pose needs 6)."""
     if table is None:
         return None
     if not isinstance(table, dict):
@@ -458,14 +461,17 @@ def _free(table: object, where: str, joints: tuple[Joint, ...]) -> tuple[int, ..
         return None
     value = table["free"]
     n = len(joints)
-    allowed = f"allowed: a list of {n - 6} distinct joint numbers 1 to {n}"
-    if n <= 6:
+    task = table.get("task", "pose")
+    needs = TASK_JOINTS.get(task, 6) if isinstance(task, str) else 6
+    allowed = f"allowed: a list of {n - needs} distinct joint numbers 1 to {n}"
+    if n <= needs:
         raise SpecError(
-            f"{where}: ik.free: the arm has {n} joints; only an arm of more than 6 has free joints"
+            f"{where}: ik.free: the arm has {n} joints; only an arm of more than {needs} "
+            f"has free joints (the {task} task needs {needs})"
         )
     if (
         not isinstance(value, list)
-        or len(value) != n - 6
+        or len(value) != n - needs
         or not all(type(v) is int and 1 <= v <= n for v in value)
         or len(set(value)) != len(value)
     ):

@@ -33,7 +33,16 @@ import sympy as sp
 from derive import symbols as sym
 from derive.methods.common import NotApplicable
 from derive.plan import Assign, IkPlan, Solve, Step
-from derive.transforms import Chain, JointZ, Twist, product, trans, world_transform, x_factor
+from derive.transforms import (
+    Chain,
+    JointZ,
+    Twist,
+    arm_factors,
+    product,
+    trans,
+    world_transform,
+    x_factor,
+)
 
 TASKS = ("pose", "position", "direction", "lookat")
 # the tasks' numbers in the C solver (dk_match, DK_REFINE_TASK)
@@ -133,15 +142,14 @@ def extend_snapped(chain: Chain, task: Task, tol: float = 0.0) -> tuple[Chain, f
     size = arm_size(chain)
     across = math.sqrt(float(u[0] ** 2 + u[1] ** 2))
     snap = 0.0
+    if spins(chain, task.axis, tol):
+        raise NotApplicable(
+            f"the tool {task.axis_name} axis is joint {n}'s axis: joint {n} moves neither "
+            "the tool point nor that axis (choose another tool axis)"
+        )
     if across <= math.sin(tol):  # L parallel to joint n's axis (within tol)
         snap = max(snap, math.asin(min(across, 1.0)))
-        r2 = sp.simplify(o[0] ** 2 + o[1] ** 2)
-        if math.sqrt(float(r2)) <= tol * size:
-            raise NotApplicable(
-                f"the tool {task.axis_name} axis is joint {n}'s axis: joint {n} moves neither "
-                "the tool point nor that axis (choose another tool axis)"
-            )
-        a = sp.sqrt(r2)
+        a = sp.sqrt(sp.simplify(o[0] ** 2 + o[1] ** 2))
         cphi, sphi = sp.simplify(o[0] / a), sp.simplify(o[1] / a)
         ca = sp.Integer(1) if float(u[2]) > 0 else sp.Integer(-1)
         sa, delta = sp.Integer(0), sp.Integer(0)
@@ -192,17 +200,29 @@ def tool_line(chain: Chain, axis: int) -> tuple[list[sp.Expr], list[sp.Expr]]:
     ]
 
 
+def spins(chain: Chain, axis: int, tol: float = 0.0) -> bool:
+    """Whether the tool axis's line is joint n's axis (within tol: the angle, and the tool
+    point's distance over the arm's size): joint n then turns the tool about that line and
+    moves neither the tool point nor the axis's direction."""
+    o, u = tool_line(chain, axis)
+    across = math.sqrt(float(u[0] ** 2 + u[1] ** 2))
+    off = math.sqrt(float(o[0] ** 2 + o[1] ** 2))
+    return across <= math.sin(tol) and off <= tol * arm_size(chain)
+
+
 def axis_order(chain: Chain, tol: float) -> tuple[int, ...]:
     """The tool axes a task tries where the spec names none: z, x, y, those parallel to
-    joint n's axis (within tol) last. Joint n turns such an axis about a parallel line, so it
-    points the same way for every q_n and joint n serves the tool point only through the
-    lever between the lines (8 mm on an SO-101's gripper frame: the task is ill-conditioned
-    everywhere and lost solutions)."""
-    across = {}
+    joint n's axis (within tol) but beside it last. Joint n turns such an axis about a
+    parallel line, so it points the same way for every q_n and joint n serves the tool point
+    only through the lever between the lines (8 mm on an SO-101's gripper frame: the task is
+    ill-conditioned everywhere and lost solutions). (Joint n's own axis fails a five-joint
+    arm's task and frees joint n of a longer arm: spins.)"""
+    beside = {}
     for axis in (2, 0, 1):
         u = tool_line(chain, axis)[1]
-        across[axis] = math.sqrt(float(u[0] ** 2 + u[1] ** 2))
-    return tuple(sorted(across, key=lambda axis: across[axis] <= math.sin(tol)))
+        parallel = math.sqrt(float(u[0] ** 2 + u[1] ** 2)) <= math.sin(tol)
+        beside[axis] = parallel and not spins(chain, axis, tol)
+    return tuple(sorted(beside, key=lambda axis: beside[axis]))
 
 
 def arm_size(chain: Chain) -> float:
@@ -220,10 +240,14 @@ def lower(ik: IkPlan, chain: Chain, extended: Chain, task: Task, snap: float = 0
     n = chain.dof
     zero = {sym.q_ref(n + 1): sp.Integer(0)}
     steps = tuple(_substitute(step, zero) for step in ik.steps)
+    free_text = ik.free_text
+    if ik.free:  # (an arm of more joints than the task needs: derive/free.py)
+        free_text += f" (joint {n + 1} is the task's virtual joint)"
     return dataclasses.replace(
         ik,
         steps=steps,
         outputs=ik.outputs[:n],
+        free_text=free_text,
         details=tuple(sorted({**dict(ik.details), **link_details(chain, extended)}.items())),
         solves_for=SOLVES_FOR[task.kind].format(axis=task.axis_name),
         certify=task.kind,
@@ -236,6 +260,41 @@ def lower(ik: IkPlan, chain: Chain, extended: Chain, task: Task, snap: float = 0
         virtual=virtual_value(extended, task),
         task_snap=snap,
     )
+
+
+def lower_spun(ik: IkPlan, chain: Chain, task: Task) -> IkPlan:
+    """The plan of the arm's own pose as its direction task's, where joint n turns about the
+    tool axis through the tool point (spins): joint n plays the virtual joint, so the steps
+    solve the pose of origin p whose tool axis is d (any such pose) and joint n's value is
+    the caller's, a free joint (it moves neither p nor d)."""
+    n = chain.dof
+    why = (
+        f"q{n} (its axis is the tool {task.axis_name} axis through the tool point: it moves "
+        "neither the point nor the axis, so the task leaves it free)"
+    )
+    return dataclasses.replace(
+        ik,
+        outputs=(*ik.outputs[: n - 1], sym.q_ref(n)),
+        free=tuple(sorted((*ik.free, n))),
+        free_text="; ".join(t for t in (ik.free_text, why) if t),
+        solves_for=SOLVES_FOR[task.kind].format(axis=task.axis_name),
+        certify=task.kind,
+        case=f"{task.describe()} as the arm's pose, joint {n} turning about the tool "
+        f"{task.axis_name} axis: {ik.case}",
+        tool_axis=task.axis,
+        details=tuple(sorted({**dict(ik.details), "task_spun_joint": sp.Integer(n)}.items())),
+        virtual=spun_value(chain),
+    )
+
+
+def spun_value(chain: Chain) -> tuple[sp.Expr, ...]:
+    """The steps' theta_n where joint n plays the virtual joint (lower_spun), for the report's
+    worked example: with P = B X_0 Z_1 ... X_{n-1} and S = X_n E, the target's rotation is
+    R_P Rz(theta_n) R_S, so (cos, sin) are entries (1,1), (2,1) of R_P^T R_W R_S^T."""
+    rest = product([chain.base, *arm_factors(chain)[:-2]], expand=False)
+    after = product([x_factor(chain.twists[-1]), chain.tool])
+    m = rest[:3, :3].T * sym.world_pose()[:3, :3] * after[:3, :3].T
+    return (m[0, 0], m[1, 0])
 
 
 def virtual_value(extended: Chain, task: Task) -> tuple[sp.Expr, ...]:

@@ -1515,14 +1515,14 @@ static int dk_task_pose(const double p[3], const double *d, double T[16])
     return 1;
 }
 
-int locobot_head_ik_lookat(const double p[3], const double *q_ref, double tol,
-                            double q[DK_MAX][DK_DOF])
+int locobot_head_ik_lookat(const double p[3], const double *free, const double *q_ref,
+                            double tol, double q[DK_MAX][DK_DOF])
 {
     double T[16];
     if (!dk_task_pose(p, NULL, T)) {
         return LOCOBOT_HEAD_INVALID_ARGUMENT;
     }
-    return locobot_head_ik_ref(T, NULL, q_ref, tol, q);
+    return locobot_head_ik_ref(T, free, q_ref, tol, q);
 }
 
 int locobot_head_within_limits(double q[][DK_DOF], int n, const double *q_ref)

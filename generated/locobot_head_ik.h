@@ -52,10 +52,11 @@ int locobot_head_ik_ref(const double T[16], const double *free, const double *q_
 /* The task (derive/tasks.py): the arm has 2 joints and is solved for a look-at: its
    tool axis LOCOBOT_HEAD_TOOL_AXIS (0 x, 1 y, 2 z), from the tool point forward, through a
    point; ik reads only T's position (the point). ik_lookat: every solution looking at p;
-   ik_ref's codes, LOCOBOT_HEAD_INVALID_ARGUMENT also where p is not finite. */
+   free, q_ref and the codes as ik_ref's, LOCOBOT_HEAD_INVALID_ARGUMENT also where p is not
+   finite. */
 #define LOCOBOT_HEAD_TOOL_AXIS 2
-int locobot_head_ik_lookat(const double p[3], const double *q_ref, double tol,
-                            double q[4][2]);
+int locobot_head_ik_lookat(const double p[3], const double *free, const double *q_ref,
+                            double tol, double q[4][2]);
 
 /* The rows of q[0..n) inside the limits, in place, each revolute joint at its variant
    q + 2 pi k nearest q_ref's (NULL: zeros); their number. */

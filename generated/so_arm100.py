@@ -35,7 +35,8 @@ API:
         -> (Q (N, M, DOF), valid (N, M))
     nearest(T, q_ref, *, within_limits=True, weights=None, metric="l2", backend=None)
         -> (DOF,) ndarray or None
-    ik_direction(p, d, *, within_limits=False, q_ref=None, tol=CERTIFY_TOL, backend=None)
+    ik_direction(p, d, *, within_limits=False, q_ref=None, tol=CERTIFY_TOL,
+                 backend=None)
         -> (n, DOF) ndarray, all solutions with the tool point at p and the tool axis
         TOOL_AXIS (z) along the direction d (IKFast's TranslationDirection5D)
     ik_approximate(T, *, q_ref=None, tol=CERTIFY_TOL, backend=None)
@@ -1056,6 +1057,7 @@ def ik_direction(
     p: ArrayLike,
     d: ArrayLike,
     *,
+    free: ArrayLike | None = None,
     within_limits: bool = False,
     q_ref: ArrayLike | None = None,
     tol: float = CERTIFY_TOL,
@@ -1067,13 +1069,15 @@ def ik_direction(
     Args:
         p: the tool point in the world, 3 numbers.
         d: the tool axis's direction in the world, 3 numbers (not all 0; normalised here).
-        within_limits, q_ref, tol, backend: as ik's. Every row reproduces p within
-            tol * REACH and the unit d within tol per entry.
+        free, within_limits, q_ref, tol, backend: as ik's (free: an arm with more joints
+            than the task needs, FREE). Every row reproduces p within tol * REACH and the
+            unit d within tol per entry.
 
     Raises:
-        ValueError: p or d is not 3 finite numbers, or d is 0.
+        ValueError: p or d is not 3 finite numbers, or d is 0; free as ik says.
     """
-    return ik(_task_pose(p, d), within_limits=within_limits, q_ref=q_ref, tol=tol, backend=backend)
+    T = _task_pose(p, d)
+    return ik(T, free=free, within_limits=within_limits, q_ref=q_ref, tol=tol, backend=backend)
 
 
 def _task_pose(p: ArrayLike, d: ArrayLike | None) -> np.ndarray:

@@ -1525,14 +1525,14 @@ static int dk_task_pose(const double p[3], const double *d, double T[16])
     return 1;
 }
 
-int so_arm100_ik_direction(const double p[3], const double d[3], const double *q_ref,
-                            double tol, double q[DK_MAX][DK_DOF])
+int so_arm100_ik_direction(const double p[3], const double d[3], const double *free,
+                            const double *q_ref, double tol, double q[DK_MAX][DK_DOF])
 {
     double T[16];
     if (!dk_task_pose(p, d, T)) {
         return SO_ARM100_INVALID_ARGUMENT;
     }
-    return so_arm100_ik_ref(T, NULL, q_ref, tol, q);
+    return so_arm100_ik_ref(T, free, q_ref, tol, q);
 }
 
 int so_arm100_within_limits(double q[][DK_DOF], int n, const double *q_ref)

@@ -52,11 +52,12 @@ int youbot_ik_ref(const double T[16], const double *free, const double *q_ref, d
 /* The task (derive/tasks.py): the arm has 5 joints and is solved for the tool point
    and the direction of its tool axis YOUBOT_TOOL_AXIS (0 x, 1 y, 2 z): ik reads only T's
    position and that column, and certifies every row on them. ik_direction: every solution
-   with the tool point at p and that axis along d (not 0; normalised here); ik_ref's codes,
-   YOUBOT_INVALID_ARGUMENT also where p or d is not finite or d is 0. */
+   with the tool point at p and that axis along d (not 0; normalised here); free, q_ref
+   and the codes as ik_ref's, YOUBOT_INVALID_ARGUMENT also where p or d is not finite
+   or d is 0. */
 #define YOUBOT_TOOL_AXIS 0
-int youbot_ik_direction(const double p[3], const double d[3], const double *q_ref,
-                         double tol, double q[8][5]);
+int youbot_ik_direction(const double p[3], const double d[3], const double *free,
+                         const double *q_ref, double tol, double q[8][5]);
 
 /* The rows of q[0..n) inside the limits, in place, each revolute joint at its variant
    q + 2 pi k nearest q_ref's (NULL: zeros); their number. */

@@ -73,20 +73,26 @@ def task_sigma(module, q: np.ndarray, T: np.ndarray, step: float = 1e-6) -> floa
         u = E[:3, x]
         return (v - (v @ u) * u) / module.REACH
 
-    J = np.zeros((6 if module.IK_COMPONENTS == "direction" else 3, module.DOF))
-    for i in range(module.DOF):
+    moving = [i for i in range(module.DOF) if i + 1 not in module.FREE]
+    J = np.zeros((6 if module.IK_COMPONENTS == "direction" else 3, len(moving)))
+    for k, i in enumerate(moving):
         dq = np.zeros(module.DOF)
         dq[i] = step
-        J[:, i] = (residual(q + dq) - residual(q - dq)) / (2 * step)
+        J[:, k] = (residual(q + dq) - residual(q - dq)) / (2 * step)
     return float(np.linalg.svd(J, compute_uv=False)[-1])
 
 
 def round_trips(module, n: int, seed: int, backend: str) -> dict[str, float]:
     """Regular samples, the regular ones whose joint vector is missing from the rows, samples
-    answered with nothing, and the worst row's task error, over n samples (ik_batch)."""
+    answered with nothing, and the worst row's task error, over n samples (ik_batch; the
+    free joints of an arm with more joints than its task needs at the sample's values)."""
     Q = sample_joints(module, n, seed)
     T = task_targets(module, Q, seed)
-    rows, valid = module.ik_batch(T, backend=backend)
+    free = Q[:, [j - 1 for j in module.FREE]] if module.FREE else None
+    rows, valid = module.ik_batch(T, free=free, backend=backend)
+    if module.FREE:
+        assert np.allclose(rows[:, :, [j - 1 for j in module.FREE]][valid], np.repeat(
+            free, valid.sum(axis=1), axis=0), atol=1e-12)  # fmt: skip
     worst = 0.0
     regular = missed = 0
     for k in range(n):
@@ -230,6 +236,78 @@ def test_a_five_joint_arm_chooses_the_first_tool_axis_that_works():
     assert plan.ik is not None and plan.ik.certify == "direction" and plan.ik.tool_axis == 0
     assert any("position + direction of the tool x axis" in fact for fact in plan.structure)
     assert any("the first that works of the tool z, x, y axes" in f for f in plan.structure)
+
+
+def six_joint_text(name: str, ik: str) -> str:
+    """The bundled PUMA 560's spec renamed, with an [ik] table."""
+    text = resolve_spec("puma560").source
+    text = Path(text).read_text().replace('name = "puma560"', f'name = "{name}"')
+    return text + f"\n[ik]\n{ik}\n"
+
+
+def test_a_six_joint_arm_s_direction_frees_the_joint_that_turns_about_the_tool_axis(tmp_path):
+    """The PUMA asked for the position and direction of its tool z axis, which is joint 6's
+    own axis through the tool point: joint 6 moves neither, so it is the task's free joint,
+    the PUMA's own Pieper steps solve the pose of origin p whose z axis is d, and every row
+    has the caller's q6 (Python and C, 1,000 samples each)."""
+    module = build_module(six_joint_text("puma_direction", 'task = "direction"'), tmp_path)
+    assert module.FREE == (6,) and module.METHOD == "pieper" and module.TOOL_AXIS == 2
+    assert "its axis is the tool z axis through the tool point" in " ".join(module.__doc__.split())
+    for backend in ("python", "c"):
+        found = round_trips(module, 1000 if backend == "c" else 300, 7, backend)
+        assert found["regular"] >= 250 and found["missed"] == 0, found
+        assert found["empty"] == 0 and found["worst"] <= 1e-10, found
+    q = np.radians([20.0, -30.0, 40.0, 50.0, 60.0, 70.0])
+    T = module.fk(q)
+    rows = module.ik_direction(T[:3, 3], T[:3, 2], free=[1.2])
+    assert len(rows) == 8 and np.allclose(rows[:, 5], 1.2)
+    assert np.abs(rows[:, :5] - q[:5]).max(axis=1).min() < 1e-9
+
+
+def test_a_tool_axis_off_the_last_joint_frees_the_first_joint(tmp_path):
+    """A UR5 (tests/data/urdf) asked for its tool x axis: the virtual joint about it makes a
+    seven-joint arm, whose first joint is left free (never the virtual one); the remainder is
+    a three-parallel arm. A seven-joint iiwa asked for its tool z axis frees q7 (its axis)
+    and q1."""
+    from derive import cli
+
+    spec_file = tmp_path / "ur5x.toml"
+    urdf = str(DATA / "urdf" / "ur5.urdf")
+    chain = ["--base", "base_link", "--tip", "tool0", "--name", "ur5x"]
+    options = ["--task", "direction", "--tool-axis", "x", "-o", str(spec_file)]
+    assert cli.main(["import-urdf", urdf, *chain, *options]) == 0
+    module = build_module(spec_file.read_text(), tmp_path)
+    assert module.FREE == (1,) and module.METHOD == "three-parallel" and module.TOOL_AXIS == 0
+    assert "joint 7 is the task's virtual joint" in " ".join(module.__doc__.split())
+    found = round_trips(module, 300, 8, "python")
+    assert found["missed"] == 0 and found["empty"] == 0 and found["worst"] <= 1e-10, found
+    iiwa = Path(resolve_spec("iiwa14").source).read_text().replace("free = [7]", "")
+    iiwa = iiwa.replace('name = "iiwa14"', 'name = "iiwa_direction"')
+    module = build_module(iiwa.replace("[ik]", '[ik]\ntask = "direction"'), tmp_path)
+    assert module.FREE == (1, 7) and module.METHOD == "pieper"
+    found = round_trips(module, 300, 9, "python")
+    assert found["missed"] == 0 and found["empty"] == 0 and found["worst"] <= 1e-10, found
+
+
+@pytest.mark.parametrize(
+    ("ik", "message"),
+    [
+        (
+            'task = "direction"\nfree = [1, 6]',
+            "ik.free: [1, 6] is not allowed; allowed: a list of 1",
+        ),
+        ('task = "direction"\nfree = [2]', "tool z axis: it is joint 6's axis, so q6 is free, and"),
+        ('task = "lookat"', '"lookat" needs 2 revolute joints, the arm has RRRRRR'),
+    ],
+)
+def test_free_joints_that_do_not_fit_the_task_are_refused(ik, message):
+    text = six_joint_text("puma_direction", ik)
+    try:
+        plan = build_plan(parse_spec(text, "puma_direction.toml"))
+    except SpecError as exc:
+        assert message in str(exc) and "\n" not in str(exc)
+        return
+    assert plan.ik is None and message in plan.refusal
 
 
 def test_a_tool_axis_parallel_to_the_last_joint_s_is_tried_last(tmp_path):
@@ -399,21 +477,22 @@ def test_the_c_task_entry_points_give_the_module_s_rows(generated, name):
         if module.IK_COMPONENTS == "direction":
             d = np.ascontiguousarray(T[:3, module.TOOL_AXIS] * 2.0)
             call = lib[f"{name}_ik_direction"]
-            n = call(p.ctypes.data_as(double_p), d.ctypes.data_as(double_p), None,
+            n = call(p.ctypes.data_as(double_p), d.ctypes.data_as(double_p), None, None,
                      ctypes.c_double(module.CERTIFY_TOL), out)  # fmt: skip
             expected = module.ik_direction(p, d, backend="python")
         else:
             call = lib[f"{name}_ik_lookat"]
-            n = call(p.ctypes.data_as(double_p), None, ctypes.c_double(module.CERTIFY_TOL), out)
+            tol = ctypes.c_double(module.CERTIFY_TOL)
+            n = call(p.ctypes.data_as(double_p), None, None, tol, out)
             expected = module.ik_lookat(p, backend="python")
         assert n == len(expected) and np.allclose(rows[:n], expected, atol=1e-9)
     bad = np.array([0.1, np.nan, 0.2])
     if module.IK_COMPONENTS == "direction":
         zero = np.zeros(3)
         args = (p.ctypes.data_as(double_p), zero.ctypes.data_as(double_p))
-        assert lib[f"{name}_ik_direction"](*args, None, ctypes.c_double(1e-10), out) == -3
+        assert lib[f"{name}_ik_direction"](*args, None, None, ctypes.c_double(1e-10), out) == -3
     else:
-        assert lib[f"{name}_ik_lookat"](bad.ctypes.data_as(double_p), None,
+        assert lib[f"{name}_ik_lookat"](bad.ctypes.data_as(double_p), None, None,
                                          ctypes.c_double(1e-10), out) == -3  # fmt: skip
 
 

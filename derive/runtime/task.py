@@ -19,6 +19,7 @@ def ik_direction(
     p: ArrayLike,
     d: ArrayLike,
     *,
+    free: ArrayLike | None = None,
     within_limits: bool = False,
     q_ref: ArrayLike | None = None,
     tol: float = CERTIFY_TOL,
@@ -30,13 +31,15 @@ def ik_direction(
     Args:
         p: the tool point in the world, 3 numbers.
         d: the tool axis's direction in the world, 3 numbers (not all 0; normalised here).
-        within_limits, q_ref, tol, backend: as ik's. Every row reproduces p within
-            tol * REACH and the unit d within tol per entry.
+        free, within_limits, q_ref, tol, backend: as ik's (free: an arm with more joints
+            than the task needs, FREE). Every row reproduces p within tol * REACH and the
+            unit d within tol per entry.
 
     Raises:
-        ValueError: p or d is not 3 finite numbers, or d is 0.
+        ValueError: p or d is not 3 finite numbers, or d is 0; free as ik says.
     """
-    return ik(_task_pose(p, d), within_limits=within_limits, q_ref=q_ref, tol=tol, backend=backend)
+    T = _task_pose(p, d)
+    return ik(T, free=free, within_limits=within_limits, q_ref=q_ref, tol=tol, backend=backend)
 
 
 def ik_lookat(
