@@ -54,7 +54,11 @@ IK_ROOTS = (
 # the public names a module with free joints adds
 FREE_ROOTS = ("ik_sweep",)
 # the public names a module solved for a task adds (derive/tasks.py)
-TASK_ROOTS = {"direction": ("ik_direction",), "lookat": ("ik_lookat",)}
+TASK_ROOTS = {
+    "direction": ("ik_direction",),
+    "lookat": ("ik_lookat",),
+    "pointing": ("ik_pointing",),
+}
 
 
 @dataclass(frozen=True)

@@ -298,16 +298,23 @@ def solve_arguments(
 
     q = None
     task = getattr(module, "IK_COMPONENTS", "pose")
-    if args.direction is not None and task != "direction":
+    if args.pose is None and args.q is None and args.point is None and args.direction is None:
+        raise UsageError(
+            "give --pose, --q or --point (or --direction alone for an arm solved for a "
+            "direction only)"
+        )
+    if args.direction is not None and task not in ("direction", "pointing"):
         raise UsageError(
             f"--direction: {spec.name} is solved for "
             + {"lookat": "a look-at: give the point only (--point)"}.get(
                 task, f"the {task}; --direction is for an arm solved for a point and a direction"
             )
         )
-    if args.direction is not None and args.point is None:
+    if args.direction is not None and args.point is None and task == "direction":
         raise UsageError("--direction: give the tool point too (--point x y z)")
-    if args.point is not None:
+    if args.direction is not None and (args.pose is not None or args.q is not None):
+        raise UsageError("--direction: give it with --point (or alone), not with --pose or --q")
+    if args.point is not None or args.direction is not None:
         pose = task_pose(spec, module, args)
     elif args.q is not None:
         q = joint_vector(spec, parse_numbers(args.q, "--q"), args.rad)
@@ -333,6 +340,7 @@ TASK_READS = {
     "position": "its position",
     "direction": "its position and its {axis} column",
     "lookat": "its position, the point looked at",
+    "pointing": "its {axis} column only",
 }
 
 
@@ -344,6 +352,14 @@ def task_pose(spec: ArmSpec, module: ModuleType, args: argparse.Namespace) -> An
     task = getattr(module, "IK_COMPONENTS", "pose")
     if task == "pose":
         raise UsageError(f"--point: {spec.name} is solved for the full pose; give --pose or --q")
+    if task == "pointing":
+        if args.point is not None:
+            raise UsageError(
+                f"--point: {spec.name} is solved for a direction only: give --direction alone"
+            )
+        return module._task_pose((0.0, 0.0, 0.0), direction_numbers(args.direction))
+    if args.point is None:
+        raise UsageError(f"--direction: {spec.name} is solved for a point: give --point x y z")
     point = parse_numbers(args.point, "--point")
     if len(point) != 3:
         raise UsageError(f"--point: give 3 numbers, x y z (got {len(point)})")
@@ -357,10 +373,16 @@ def task_pose(spec: ArmSpec, module: ModuleType, args: argparse.Namespace) -> An
             raise UsageError(
                 f"--point: {spec.name} is solved for a point and a direction: give --direction"
             )
-        direction = parse_numbers(args.direction, "--direction")
-        if len(direction) != 3 or not any(direction):
-            raise UsageError("--direction: give 3 numbers, dx dy dz, not all 0")
+        direction = direction_numbers(args.direction)
     return module._task_pose(point, direction)
+
+
+def direction_numbers(text: list[str]) -> list[float]:
+    """--direction's 3 numbers, not all 0."""
+    direction = parse_numbers(text, "--direction")
+    if len(direction) != 3 or not any(direction):
+        raise UsageError("--direction: give 3 numbers, dx dy dz, not all 0")
+    return direction
 
 
 def task_residual(module: ModuleType, q: Any, pose: Any) -> float:
@@ -397,6 +419,11 @@ def cmd_workspace(args: argparse.Namespace) -> int:
     from derive.workspace import workspace
 
     spec, module = ik_module(args)
+    if getattr(module, "IK_COMPONENTS", "pose") == "pointing":
+        raise UsageError(
+            f"{spec.name}: its solver points a tool axis, wherever the tool point is: it has "
+            "no workspace of positions (derive solve --direction answers one direction)"
+        )
     if not 3 <= args.resolution <= 2001 or args.resolution % 2 == 0:
         raise UsageError("--resolution: an odd number from 3 to 2001 (the grid holds the centre)")
     output, fmt = figure_output(args, f"{spec.name}_workspace.svg")
@@ -429,6 +456,11 @@ def cmd_reach(args: argparse.Namespace) -> int:
         raise UsageError(
             f"{spec.name}: its solver looks at a point; reach maps sample orientations "
             "(use derive workspace)"
+        )
+    if plan.ik.certify == "pointing":
+        raise UsageError(
+            f"{spec.name}: its solver points a tool axis, wherever the tool point is; reach "
+            "maps sample positions (derive solve --direction answers one direction)"
         )
     if plan.ik.certify == "position":
         raise UsageError(
@@ -901,7 +933,9 @@ def parser() -> argparse.ArgumentParser:
 def add_pose_arguments(command: argparse.ArgumentParser) -> None:
     """The arm and the pose of solve and plot: --pose or --q, --rad, --free."""
     command.add_argument("arm", help="spec file or bundled arm name")
-    group = command.add_mutually_exclusive_group(required=True)
+    # (one of them, or --direction alone for an arm solved for a direction only: checked in
+    # solve_arguments)
+    group = command.add_mutually_exclusive_group()
     group.add_argument("--pose", help="'r11 r12 r13 px r21 ... pz' (12 or 16 numbers)")
     group.add_argument("--q", nargs="+", help="solve the pose of these joint values")
     group.add_argument(
@@ -911,7 +945,10 @@ def add_pose_arguments(command: argparse.ArgumentParser) -> None:
         "looked at (lookat), 'x y z'",
     )
     command.add_argument(
-        "--direction", nargs="+", help="with --point: the tool axis's direction, 'dx dy dz'"
+        "--direction",
+        nargs="+",
+        help="with --point: the tool axis's direction, 'dx dy dz' (alone for an arm solved for "
+        "a direction only: pointing)",
     )
     command.add_argument("--rad", action="store_true", help="--q and --free values are in radians")
     command.add_argument(

@@ -212,11 +212,13 @@ def task_text(plan: Plan) -> str:
     """The module docstring's paragraph on a task of fewer components than a pose
     (derive/tasks.py), "" for the methods' own problems."""
     ik = plan.ik
-    if ik is None or ik.certify not in ("direction", "lookat"):
+    if ik is None or ik.certify not in ("direction", "lookat", "pointing"):
         return ""
-    reads = "position and its column TOOL_AXIS" if ik.certify == "direction" else "position"
-    if ik.certify == "lookat":
-        reads += " (the point looked at)"
+    reads = {
+        "direction": "position and its column TOOL_AXIS",
+        "lookat": "position (the point looked at)",
+        "pointing": "column TOOL_AXIS (the direction)",
+    }[ik.certify]
     details = dict(ik.details)
     if "task_spun_joint" in details:
         n = int(details["task_spun_joint"])
@@ -224,6 +226,12 @@ def task_text(plan: Plan) -> str:
             f"from the arm's own pose: joint {n} turns about the tool axis through the tool point "
             f"(it moves neither), so it plays the part of a virtual joint and its value is the "
             "caller's (FREE)"
+        )
+    elif ik.certify == "pointing":
+        how = (
+            "as a look-at of the arm with every length 0 (its orientations, its tool point the "
+            "origin) at the point d, with one more, virtual, joint sliding along the tool axis "
+            "(derive/tasks.py), whose value is dropped"
         )
     else:
         how = (

@@ -183,7 +183,7 @@ def print_c(plan: Plan) -> PrintedC:
         seed_tol=repr(plan.correction.seed_tol) if plan.correction else "0.0",
         chain=tuple(", ".join(map(repr, f)) for f in plan.frames) if plan.correction else (),
         solved=plan.solved if plan.correction else (),
-        refine_rows=3 if ik.certify in ("position", "lookat") else 6,
+        refine_rows=3 if ik.certify in ("position", "lookat") else 6,  # (pointing: 3 zero)
         task_code=TASK_CODES[ik.certify],
         tool_axis=ik.tool_axis,
     )

@@ -164,13 +164,13 @@ def task_of(spec: ArmSpec, chain: Chain) -> tasks.Task | None:
         task = tasks.Task("direction", 2, NAMED)
     else:
         if kinds != "RR":
-            raise SpecError(f'{where}: "lookat" needs 2 revolute joints, the arm has {kinds}')
-        task = tasks.Task("lookat", 2, NAMED)
+            raise SpecError(f'{where}: "{spec.task}" needs 2 revolute joints, the arm has {kinds}')
+        task = tasks.Task(spec.task, 2, NAMED)
     if spec.tool_axis is not None:
         if task is None:
             raise SpecError(
-                f'{spec.source}: ik.tool_axis: only the "direction" and "lookat" tasks '
-                "have a tool axis"
+                f'{spec.source}: ik.tool_axis: only the "direction", "lookat" and "pointing" '
+                "tasks have a tool axis"
             )
         task = dataclasses.replace(task, axis=tasks.AXES.index(spec.tool_axis), fixed=True)
     return task
@@ -210,8 +210,11 @@ def choose(
                     return tasks.lower_spun(ik, chain, aimed), ""
                 reasons.append(f"tool {tasks.AXES[axis]} axis: {why}")
                 continue
+            # (a pointing task: a look-at of the arm with every length 0, at the point d)
+            arm = tasks.unmoved(chain) if task.kind == "pointing" else chain
+            looks = dataclasses.replace(aimed, kind="lookat") if arm is not chain else aimed
             try:
-                extended, snap = tasks.extend_snapped(chain, aimed, tol)
+                extended, snap = tasks.extend_snapped(arm, looks, tol)
             except NotApplicable as exc:
                 reasons.append(f"tool {tasks.AXES[axis]} axis: {exc}")
                 continue
@@ -220,12 +223,12 @@ def choose(
                 # the exact virtual link where its case is the snapped one's (no refinement:
                 # a look-at camera 9e-6 m off its axis); the snapped one where snapping gives
                 # a special case (a5 = 0: the exact a5 = 6e-7 left a degenerate quartic)
-                exact = tasks.extend(chain, aimed)
+                exact = tasks.extend(arm, looks)
                 exact_ik, _ = choose_pose(exact, classify(exact), named, names, n + 1)
                 if exact_ik is not None and (ik is None or exact_ik.case == ik.case):
                     ik, extended, snap = exact_ik, exact, 0.0
             if ik is not None:
-                return tasks.lower(ik, chain, extended, aimed, snap), ""
+                return tasks.lower(ik, arm, extended, aimed, snap), ""
             reasons.append(f"tool {tasks.AXES[axis]} axis: {why}")
         return None, "; ".join(reasons)
     if chain.dof > free.REMAINDER_DOF:

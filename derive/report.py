@@ -279,6 +279,18 @@ def task_blocks(plan: Plan, details: dict[str, sp.Expr]) -> list[Block]:
             f"value of joint {v} absorbs the rest). The steps below solve that arm's pose and "
             f"drop the value of joint {v}."
         )
+    elif plan.ik.certify == "pointing":
+        what = (
+            f"The arm has {n} joints; the task fixes only the direction $d$ of the tool {axis} "
+            "axis, two numbers. Lengths do not turn frames: the arm with every length 0 (every "
+            "$a_i$, $d_i$ and the base's and tool's translations) turns as the arm does, and its "
+            f"tool point is the origin for every $q$. Its tool {axis} axis points along $d$ "
+            f"exactly where its ray from the origin passes through the point $d$: a look-at of "
+            f"that arm. A virtual prismatic joint {v} slides a point along the axis from the "
+            f"origin; the steps below solve that arm's position at the point $d$ (they read "
+            f"the target's {axis} column where a look-at reads its position) and drop "
+            f"$d_{{{v}}}$ (it is 1); a row pointing the opposite way fails the certification."
+        )
     else:
         what = (
             f"The arm has {n} joints; the task asks that the tool {axis} axis, from the tool "

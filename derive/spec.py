@@ -34,7 +34,8 @@ Spec format (all keys other than those listed are errors)::
     task = "direction"          # what ik solves for: "pose" (6 joints), "position" (3),
                                 # "direction" (5: the tool point and the direction of a
                                 # tool axis), "lookat" (2: the tool axis's ray through a
-                                # point); default: the joints choose (derive/tasks.py)
+                                # point), "pointing" (2: the tool axis's direction only);
+                                # default: the joints choose (derive/tasks.py)
     tool_axis = "z"             # the tool axis of "direction" and "lookat" (x, y or z;
                                 # default z, or the first that works)
     method = "general"          # this method only (pieper, three-parallel, planar, position,
@@ -104,10 +105,10 @@ IK_KEYS = ("free", "structure_tol", "task", "tool_axis", "method")
 # applies; "general" gives a calibrated arm its complete solution set)
 IK_METHODS = ("pieper", "three-parallel", "planar", "position", "general")
 # what [ik] task and tool_axis may be (derive/tasks.py)
-IK_TASKS = ("pose", "position", "direction", "lookat")
+IK_TASKS = ("pose", "position", "direction", "lookat", "pointing")
 TOOL_AXES = ("x", "y", "z")
 # the joints each task needs: an arm with more has free joints ([ik] free)
-TASK_JOINTS = {"pose": 6, "position": 3, "direction": 5, "lookat": 2}
+TASK_JOINTS = {"pose": 6, "position": 3, "direction": 5, "lookat": 2, "pointing": 2}
 # what [ik] structure_tol may be: beyond 0.1 rad or 0.1 of the arm's size it changes the arm
 STRUCTURE_TOL_RANGE = (0.0, 0.1)
 SOURCE_KEYS = ("urdf", "sha256", "base", "tip", "joints", "snaps", "deviation", "format")

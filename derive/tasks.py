@@ -14,6 +14,12 @@ pose and position problems the methods already solve by one virtual joint.
   the two-joint arm looks at p where the three-joint arm's point reaches p with the virtual
   joint's value (the distance) >= 0: a position problem.
 
+* "pointing" (Direction3D): the tool axis u along a direction d, wherever the tool point is.
+  Lengths do not turn frames, so the arm with every length 0 (unmoved) has the arm's
+  orientations and its tool point at the origin: its tool axis points along d exactly where
+  its ray from the origin passes through the point d, a look-at of the unmoved arm whose
+  target point is d (the steps read T's column u where a look-at reads its position).
+
 The virtual joint is the line L through the tool point o along u, written as one more DH link
 after joint n (the frame of joint n after Z_n has its axis as z): the common normal of z and L
 gives the twist (alpha, a), its direction phi about z and its foot delta along z (absorbed by
@@ -44,15 +50,16 @@ from derive.transforms import (
     x_factor,
 )
 
-TASKS = ("pose", "position", "direction", "lookat")
+TASKS = ("pose", "position", "direction", "lookat", "pointing")
 # the tasks' numbers in the C solver (dk_match, DK_REFINE_TASK)
-TASK_CODES = {"pose": 0, "position": 1, "direction": 2, "lookat": 3}
+TASK_CODES = {"pose": 0, "position": 1, "direction": 2, "lookat": 3, "pointing": 4}
 AXES = ("x", "y", "z")
 
 # what each task's solver is defined on, in words (the module docstring and the report)
 SOLVES_FOR = {
     "direction": "the tool point's position and the direction of the tool {axis} axis",
     "lookat": "the tool {axis} axis's ray, from the tool point, through a point",
+    "pointing": "the direction of the tool {axis} axis",
 }
 # IKFast's names of the tasks
 IKFAST_NAMES = {
@@ -60,6 +67,7 @@ IKFAST_NAMES = {
     "position": "Translation3D",
     "direction": "TranslationDirection5D",
     "lookat": "Lookat3D",
+    "pointing": "Direction3D",
 }
 
 
@@ -87,7 +95,7 @@ class Task:
     @property
     def virtual(self) -> bool:
         """Whether the task is solved through a virtual joint."""
-        return self.kind in ("direction", "lookat")
+        return self.kind in ("direction", "lookat", "pointing")
 
     def describe(self) -> str:
         """The task in words, with IKFast's name."""
@@ -96,6 +104,7 @@ class Task:
             "position": "the tool point's position",
             "direction": f"position + direction of the tool {self.axis_name} axis",
             "lookat": f"look-at: the tool {self.axis_name} axis through a point",
+            "pointing": f"the direction of the tool {self.axis_name} axis only",
         }[self.kind]
         return f"{words} ({IKFAST_NAMES[self.kind]})"
 
@@ -225,6 +234,29 @@ def axis_order(chain: Chain, tol: float) -> tuple[int, ...]:
     return tuple(sorted(beside, key=lambda axis: beside[axis]))
 
 
+def unmoved(chain: Chain) -> Chain:
+    """The chain's rotations only: every a_i and d_i, and the base's and the tool's
+    translations, 0. Its frames turn as the arm's do, and its tool point is the origin for
+    every q (a pointing task's arm; only revolute joints turn frames)."""
+    zero = sp.Integer(0)
+    base, tool = sp.Matrix(chain.base), sp.Matrix(chain.tool)
+    base[:3, 3] = tool[:3, 3] = sp.zeros(3, 1)
+    return Chain(
+        tuple(Twist(t.ca, t.sa, zero) for t in chain.twists),
+        tuple(dataclasses.replace(j, d=zero) for j in chain.joints),
+        base,
+        tool,
+        chain.convention,
+    )
+
+
+def pointed(step: Step, axis: int) -> Step:
+    """A look-at step of the unmoved arm as the pointing task's: the target's position
+    entries (the point looked at) read from its column axis (the direction)."""
+    world = sym.world_pose()
+    return _substitute(step, {world[r, 3]: world[r, axis] for r in range(3)})
+
+
 def arm_size(chain: Chain) -> float:
     """The arm's size for the snapping of lengths: its |a| and |d| and its tool's offset."""
     size = sum(abs(float(t.a)) for t in chain.twists)
@@ -240,6 +272,13 @@ def lower(ik: IkPlan, chain: Chain, extended: Chain, task: Task, snap: float = 0
     n = chain.dof
     zero = {sym.q_ref(n + 1): sp.Integer(0)}
     steps = tuple(_substitute(step, zero) for step in ik.steps)
+    virtual = virtual_value(extended, task)
+    if task.kind == "pointing":
+        steps = tuple(pointed(step, task.axis) for step in steps)
+        world = sym.world_pose()
+        virtual = tuple(
+            e.xreplace({world[r, 3]: world[r, task.axis] for r in range(3)}) for e in virtual
+        )
     free_text = ik.free_text
     if ik.free:  # (an arm of more joints than the task needs: derive/free.py)
         free_text += f" (joint {n + 1} is the task's virtual joint)"
@@ -251,13 +290,18 @@ def lower(ik: IkPlan, chain: Chain, extended: Chain, task: Task, snap: float = 0
         details=tuple(sorted({**dict(ik.details), **link_details(chain, extended)}.items())),
         solves_for=SOLVES_FOR[task.kind].format(axis=task.axis_name),
         certify=task.kind,
-        case=f"{task.describe()} as the pose of the arm with a virtual joint {n + 1}: {ik.case}"
-        if task.kind == "direction"
-        else f"{task.describe()} as the position of the arm with a virtual joint {n + 1} "
-        f"sliding along the axis: {ik.case}",
+        case={
+            "direction": f"{task.describe()} as the pose of the arm with a virtual joint "
+            f"{n + 1}: {ik.case}",
+            "lookat": f"{task.describe()} as the position of the arm with a virtual joint "
+            f"{n + 1} sliding along the axis: {ik.case}",
+            "pointing": f"{task.describe()} as a look-at of the arm with every length 0 "
+            f"(its tool point the origin) at the point d, a virtual joint {n + 1} sliding "
+            f"along the axis: {ik.case}",
+        }[task.kind],
         tool_axis=task.axis,
         relabel=relabel(chain, extended),
-        virtual=virtual_value(extended, task),
+        virtual=virtual,
         task_snap=snap,
     )
 
@@ -305,7 +349,7 @@ def virtual_value(extended: Chain, task: Task) -> tuple[sp.Expr, ...]:
     n1 = extended.dof
     world = world_transform(extended, expand=False)
     target = sym.world_pose()
-    if task.kind == "direction":
+    if task.kind == "direction":  # (a look-at's and a pointing's: a slide)
         rest = world.xreplace({sym.c(n1): sp.Integer(1), sym.s(n1): sp.Integer(0)})
         align = _ALIGN[task.axis][:3, :3]
         m = align.T * rest[:3, :3].T * target[:3, :3] * align

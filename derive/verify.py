@@ -105,7 +105,8 @@ def pose_error(module: ModuleType, q: np.ndarray, T: np.ndarray) -> tuple[float,
     """(rotation error in rad, position error / REACH) of fk(q) against T, on the components
     the solver's task reads (derive/tasks.py): all of them; the position only (rotation error
     0); the position and the tool axis TOOL_AXIS ("direction"); the distance of T's point from
-    the ray of the tool axis, infinite behind the tool ("lookat", rotation error 0).
+    the ray of the tool axis, infinite behind the tool ("lookat", rotation error 0); the tool
+    axis only ("pointing", position error 0).
     """
     P = module.fk(q)
     task = module.IK_COMPONENTS
@@ -118,8 +119,10 @@ def pose_error(module: ModuleType, q: np.ndarray, T: np.ndarray) -> tuple[float,
     rot = float(np.abs(P[:3, :3] - T[:3, :3]).max())
     if task == "position":
         rot = 0.0
-    elif task == "direction":
+    elif task in ("direction", "pointing"):
         rot = float(np.abs(P[:3, axis] - T[:3, axis]).max())
+    if task == "pointing":
+        return rot, 0.0
     pos = float(np.abs(P[:3, 3] - T[:3, 3]).max()) / module.REACH
     return rot, pos
 
@@ -135,7 +138,8 @@ def targets(module: ModuleType, Q: np.ndarray) -> np.ndarray:
 
 def task_components(module: ModuleType, q: np.ndarray) -> np.ndarray:
     """What the solver's task reads of fk(q), as one vector (positions / REACH): the pose's
-    top rows, the position, the position and the tool axis, or for a look-at the point one
+    top rows, the position, the position and the tool axis, the tool axis, or for a look-at
+    the point one
     REACH ahead on the tool axis (the ray, through a point at a typical distance)."""
     P = module.fk(q)
     task = module.IK_COMPONENTS
@@ -145,6 +149,8 @@ def task_components(module: ModuleType, q: np.ndarray) -> np.ndarray:
         return position
     if task == "direction":
         return np.concatenate([position, P[:3, axis]])
+    if task == "pointing":
+        return P[:3, axis].copy()
     if task == "lookat":
         return position + P[:3, axis]
     top = P[:3, :].copy()

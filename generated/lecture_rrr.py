@@ -100,9 +100,10 @@ _OFFSETS = (0.0, 0.0, 0.0)
 _REVOLUTE = (True, True, True)
 # what every solution reproduces (the task, derive/tasks.py): "pose" the whole pose;
 # "position" the tool point; "direction" the tool point and the direction of the tool axis
-# TOOL_AXIS; "lookat" the ray of the tool axis TOOL_AXIS, from the tool point, through a point
+# TOOL_AXIS; "lookat" the ray of the tool axis TOOL_AXIS, from the tool point, through a point;
+# "pointing" the direction of the tool axis TOOL_AXIS only
 IK_COMPONENTS = "pose"
-# the tool axis of the "direction" and "lookat" tasks: 0 x, 1 y, 2 z
+# the tool axis of the "direction", "lookat" and "pointing" tasks: 0 x, 1 y, 2 z
 TOOL_AXIS = 2
 # the solution method (derive/methods/)
 METHOD = "planar"
@@ -1150,10 +1151,11 @@ def _pose_error(q, t, exact):
     rotation rows are the error's own derivative, 1/2 sum_k t_k x (z x r_k); else the
     geometric Jacobian's z, which they equal where the error vanishes (Newton's steps).
     The tasks (derive/tasks.py): "direction" has the rotation rows u x t_u (u the tool axis
-    TOOL_AXIS, t_u the target's), derivative t_u x (z x u); "lookat" has, as its three rows,
-    minus the target point's offset from the ray, v - (v.u) u with v = p - o, / REACH."""
+    TOOL_AXIS, t_u the target's), derivative t_u x (z x u); "pointing" has those and no
+    position error (its rows 0); "lookat" has, as its three rows, minus the target point's
+    offset from the ray, v - (v.u) u with v = p - o, / REACH."""
     task, x = IK_COMPONENTS, TOOL_AXIS
-    rows = 6 if task in ("pose", "direction") else 3
+    rows = 6 if task in ("pose", "direction", "pointing") else 3
     pose, axes, origins = _chain_pose(q)
     error = [(t[4 * r + 3] - pose[4 * r + 3]) / REACH for r in range(3)]
     size = max(map(abs, error))
@@ -1168,7 +1170,9 @@ def _pose_error(q, t, exact):
             )
             size = max(size, abs(t[4 * r] - pose[4 * r]), abs(t[4 * r + 1] - pose[4 * r + 1]),
                        abs(t[4 * r + 2] - pose[4 * r + 2]))  # fmt: skip
-    elif task == "direction":
+    elif task in ("direction", "pointing"):
+        if task == "pointing":
+            error, size = [0.0, 0.0, 0.0], 0.0
         for r in range(3):
             a, b = 4 * ((r + 1) % 3) + x, 4 * ((r + 2) % 3) + x
             error.append(pose[a] * t[b] - pose[b] * t[a])
@@ -1197,10 +1201,12 @@ def _pose_error(q, t, exact):
         else:
             column = [z[0] / REACH, z[1] / REACH, z[2] / REACH, 0.0, 0.0, 0.0]
             du = (0.0, 0.0, 0.0)
-        if task == "direction":
+        if task in ("direction", "pointing"):
             tu = (t[x], t[4 + x], t[8 + x])
             column[3:] = [tu[1] * du[2] - tu[2] * du[1], tu[2] * du[0] - tu[0] * du[2],
                           tu[0] * du[1] - tu[1] * du[0]]  # fmt: skip
+            if task == "pointing":
+                column[:3] = [0.0, 0.0, 0.0]
         elif task == "lookat":
             dv = [-column[r] * REACH for r in range(3)]
             dalong = sum(dv[r] * u[r] + v[r] * du[r] for r in range(3))

@@ -688,6 +688,10 @@ static int dk_match(const double e[12], const double t[12], double tol, double p
     if (task == 3) {
         return dk_ray_gap(e, t, axis) <= ptol;
     }
+    if (task == 4) {
+        return (fabs(e[axis] - t[axis]) <= tol) & (fabs(e[4 + axis] - t[4 + axis]) <= tol) &
+               (fabs(e[8 + axis] - t[8 + axis]) <= tol);
+    }
     if (task == 2) {
         return position & (fabs(e[axis] - t[axis]) <= tol) &
                (fabs(e[4 + axis] - t[4 + axis]) <= tol) &

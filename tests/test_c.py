@@ -369,6 +369,44 @@ def test_ikfast_shim_of_a_task_arm(generated, tmp_path, name, kind):
     assert at == len(out)
 
 
+def test_ikfast_shim_of_a_pointing_arm(tmp_path):
+    """IKP_Direction3D (eerot[0..2] the direction of the tool axis, eetrans unused): the
+    module's ik_pointing rows (a pan-tilt with offsets: tests/test_tasks.py's POINTING)."""
+    from test_tasks import POINTING
+
+    compiler = shutil.which("g++") or shutil.which("c++")
+    if compiler is None:
+        pytest.skip("no C++ compiler")
+    plan = build_plan(parse_spec(POINTING, "<pointer>"))
+    for file, text in {**render_c(plan), **render_ikfast(plan)}.items():
+        (tmp_path / file).write_text(text)
+    driver = tmp_path / "driver"
+    flags = ["-std=c++11", "-Wall", "-Wextra", "-Werror", "-O2"]
+    build = [compiler, *flags, f"-I{ROOT / 'tests' / 'ikfast'}", f"-I{tmp_path}"]
+    build += ['-DSHIM="pointer_ikfast_solver.cpp"', str(ROOT / "tests" / "ikfast" / "driver.cpp")]
+    subprocess.run([*build, "-o", str(driver)], check=True, capture_output=True)
+    info = subprocess.run([driver, "info"], check=True, capture_output=True, text=True).stdout
+    m = build_module(POINTING, tmp_path)
+    assert info.split()[:4] == ["2", "0", "8", "0x23000004"]
+    Q = np.random.default_rng(13).uniform(-1.5, 1.0, (100, 2))
+    T = m.fk_batch(Q)
+    data = np.zeros((len(T), 12))
+    data[:, :3] = T[:, :3, 2]
+    data[:, 9:] = 7.0  # (eetrans is not read)
+    out = subprocess.run([driver], input=data.tobytes(), check=True, capture_output=True).stdout
+    at = 0
+    for i in range(len(T)):
+        (count,) = np.frombuffer(out[at : at + 4], dtype=np.int32)
+        at += 4
+        rows = np.frombuffer(out[at : at + 8 * count * (m.DOF + 12)], dtype=np.float64)
+        at += 8 * count * (m.DOF + 12)
+        rows = rows.reshape(count, m.DOF + 12)
+        expected = m.ik_pointing(T[i, :3, 2], backend="python")
+        assert count == len(expected) > 0, i
+        np.testing.assert_allclose(rows[:, : m.DOF], expected, atol=1e-9)
+    assert at == len(out)
+
+
 def test_arms_the_shim_cannot_serve_are_refused_by_name(tmp_path):
     from derive.emit import GenerationError
 

@@ -1340,6 +1340,10 @@ static int dk_match(const double e[12], const double t[12], double tol, double p
     if (task == 3) {
         return dk_ray_gap(e, t, axis) <= ptol;
     }
+    if (task == 4) {
+        return (fabs(e[axis] - t[axis]) <= tol) & (fabs(e[4 + axis] - t[4 + axis]) <= tol) &
+               (fabs(e[8 + axis] - t[8 + axis]) <= tol);
+    }
     if (task == 2) {
         return position & (fabs(e[axis] - t[axis]) <= tol) &
                (fabs(e[4 + axis] - t[4 + axis]) <= tol) &
@@ -1456,11 +1460,11 @@ static int dk_seen(const double (*found)[DK_REFINE_N], int n, const int revolute
     return 0;
 }
 
-/* a task's Jacobian column k (the "direction" and "lookat" tasks, DK_REFINE_TASK 2 and 3):
-   given the column of the pose's position rows (J[0..2][k], set), the derivative of the
-   direction error u x t_u (rows 3..5: t_u x (z x u)), or of the ray offset v - (v.u) u, v the
-   target point minus the origin (rows 0..2), for a revolute joint's axis z (NULL: a prismatic
-   joint, which moves the origin only) */
+/* a task's Jacobian column k (the "direction", "lookat" and "pointing" tasks, DK_REFINE_TASK
+   2, 3 and 4): given the column of the pose's position rows (J[0..2][k], set), the derivative
+   of the direction error u x t_u (rows 3..5: t_u x (z x u); a pointing's position rows 0), or
+   of the ray offset v - (v.u) u, v the target point minus the origin (rows 0..2), for a
+   revolute joint's axis z (NULL: a prismatic joint, which moves the origin only) */
 static void dk_task_column(const double pose[12], const double t[12], double J[6][DK_REFINE_M],
                            int k, const double *z, double reach)
 {
@@ -1473,11 +1477,14 @@ static void dk_task_column(const double pose[12], const double t[12], double J[6
         du[1] = z[2] * u[0] - z[0] * u[2];
         du[2] = z[0] * u[1] - z[1] * u[0];
     }
-    if (DK_REFINE_TASK == 2) {
+    if (DK_REFINE_TASK == 2 || DK_REFINE_TASK == 4) {
         const double tu[3] = {t[x], t[4 + x], t[8 + x]};
         J[3][k] = tu[1] * du[2] - tu[2] * du[1];
         J[4][k] = tu[2] * du[0] - tu[0] * du[2];
         J[5][k] = tu[0] * du[1] - tu[1] * du[0];
+        if (DK_REFINE_TASK == 4) {
+            J[0][k] = J[1][k] = J[2][k] = 0.0;
+        }
         return;
     }
     for (r = 0; r < 3; r++) {
@@ -1542,7 +1549,7 @@ static double dk_refine(const double chain[DK_REFINE_N + 1][12], const int revol
         for (r = 0; r < 3; r++) {
             int a = (r + 1) % 3, b = (r + 2) % 3;
             double total = 0.0;
-            error[r] = (t[4 * r + 3] - pose[4 * r + 3]) / reach;
+            error[r] = DK_REFINE_TASK == 4 ? 0.0 : (t[4 * r + 3] - pose[4 * r + 3]) / reach;
             size = fabs(error[r]) > size ? fabs(error[r]) : size;
             for (k = 0; k < 3; k++) {
                 total += pose[4 * a + k] * t[4 * b + k] - pose[4 * b + k] * t[4 * a + k];
@@ -1552,7 +1559,7 @@ static double dk_refine(const double chain[DK_REFINE_N + 1][12], const int revol
                 }
             }
             error[3 + r] = 0.5 * total;
-            if (DK_REFINE_TASK == 2) { /* u x t_u: u the tool axis, t_u the target's */
+            if (DK_REFINE_TASK == 2 || DK_REFINE_TASK == 4) { /* u x t_u: u the tool axis */
                 const int x = DK_REFINE_AXIS;
                 const double gap = fabs(t[4 * r + x] - pose[4 * r + x]);
                 error[3 + r] = pose[4 * a + x] * t[4 * b + x] - pose[4 * b + x] * t[4 * a + x];

@@ -49,9 +49,9 @@ def derive(chain: Chain, structure: Structure) -> IkPlan | str:
         sum(abs(float(j.d)) for j in chain.joints if j.kind == "R") + abs(float(px)) + float(d4)
     )
     try:
-        position = position_equations(
-            numbers, max(length, 1e-300), joint_refs(chain), kinds[2] == "P"
-        )
+        # (an arm with every length 0, a pointing task's, moves its point on the unit sphere:
+        # derive/tasks.py; 1 is its size)
+        position = position_equations(numbers, length or 1.0, joint_refs(chain), kinds[2] == "P")
     except NotApplicable as exc:
         return str(exc).replace("Pieper", "position", 1).replace("wrist centre", "tool point")
     head = [chain.base, x_factor(chain.twists[0])]

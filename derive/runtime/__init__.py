@@ -18,7 +18,7 @@ Modules, in copy order:
 ``common``     argument checks and joint-value helpers the others share
 ``redundant``  ik_sweep and the searching nearest of arms with free joints (copied only
                into their modules, whose nearest it replaces)
-``task``       ik_direction and ik_lookat of arms solved for a task (derive/tasks.py;
+``task``       ik_direction, ik_lookat and ik_pointing of arms solved for a task (tasks.py;
                copied only into their modules)
 ``closed``     closed forms of the Python solver (quadratic, quartic, atan2, Newton
                steps, the free-joint reach searches)

@@ -23,9 +23,10 @@ REACH = 1.0
 MAX_SOLUTIONS = 2
 # the joints (1-based) whose values the caller gives (an arm of more than 6 joints)
 FREE: tuple[int, ...] = ()
-# "pose", "position", "direction" or "lookat": what certification compares (derive/tasks.py)
+# "pose", "position", "direction", "lookat" or "pointing": what certification compares
+# (derive/tasks.py)
 IK_COMPONENTS = "pose"
-# the tool axis of the "direction" and "lookat" tasks: 0 x, 1 y, 2 z
+# the tool axis of the "direction", "lookat" and "pointing" tasks: 0 x, 1 y, 2 z
 TOOL_AXIS = 2
 _REVOLUTE = (True, False)
 # how far the solver's equations may miss and still seed a refinement onto the exact chain

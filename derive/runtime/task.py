@@ -1,6 +1,7 @@
 """The task functions of an arm solved for fewer components than a pose (derive/tasks.py):
-ik_direction(p, d) and ik_lookat(p) build a pose whose components the task reads and call
-ik, which certifies every row on those components (IK_COMPONENTS, TOOL_AXIS)."""
+ik_direction(p, d), ik_lookat(p) and ik_pointing(d) build a pose whose components the task
+reads and call ik, which certifies every row on those components (IK_COMPONENTS,
+TOOL_AXIS)."""
 
 from __future__ import annotations
 
@@ -65,6 +66,30 @@ def ik_lookat(
     return ik(
         _task_pose(p, None), within_limits=within_limits, q_ref=q_ref, tol=tol, backend=backend
     )
+
+
+def ik_pointing(
+    d: ArrayLike,
+    *,
+    free: ArrayLike | None = None,
+    within_limits: bool = False,
+    q_ref: ArrayLike | None = None,
+    tol: float = CERTIFY_TOL,
+    backend: str | None = None,
+) -> np.ndarray:
+    """All solutions that point the tool axis TOOL_AXIS along d, wherever the tool point is
+    (IKFast's Direction3D), as an (n, DOF) array; empty if no configuration points that way.
+
+    Args:
+        d: the direction in the world, 3 numbers (not all 0; normalised here).
+        free, within_limits, q_ref, tol, backend: as ik's. Every row reproduces the unit d
+            within tol per entry.
+
+    Raises:
+        ValueError: d is not 3 finite numbers, or is 0; free as ik says.
+    """
+    T = _task_pose((0.0, 0.0, 0.0), d)
+    return ik(T, free=free, within_limits=within_limits, q_ref=q_ref, tol=tol, backend=backend)
 
 
 def _task_pose(p: ArrayLike, d: ArrayLike | None) -> np.ndarray:
