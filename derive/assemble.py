@@ -47,7 +47,7 @@ IMPORTS = (
     ("from numpy.typing import ArrayLike", "ArrayLike"),
 )
 # the public names of a module with forward kinematics only, and with inverse kinematics
-FK_ROOTS = ("fk", "fk_batch")
+FK_ROOTS = ("fk", "fk_batch", "jacobian", "manipulability", "ik_velocity")
 IK_ROOTS = (
     *FK_ROOTS, "ik", "ik_batch", "ik_approximate", "nearest", "warmup", "CERTIFY_TOL", "BACKEND",
 )  # fmt: skip

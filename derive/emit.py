@@ -93,6 +93,29 @@ def fk_pose_lines(plan: Plan) -> tuple[tuple[str, ...], tuple[str, ...]]:
     return tuple(lines), tuple(str(t) for t in targets)
 
 
+def jacobian_lines(plan: Plan) -> tuple[tuple[str, ...], tuple[str, ...]]:
+    """Body of _jacobian_from_cs: the CSE'd Jacobian entries (derive/jacobian.py) in c_i, s_i
+    (and d_i), and the 6 n names holding them, row-major."""
+    names = sp.numbered_symbols("x")
+    J = plan.jacobian
+    n = J.shape[1]
+    entries = [J[i, j] for i in range(6) for j in range(n)]
+    targets = tuple(sym.named(f"j{i}_{j}") for i in range(6) for j in range(n))
+    printer = CodePrinter()
+    head = []
+    for k, (target, expr) in enumerate(plan.joint_defs):
+        turns = str(target).startswith("theta")
+        if not ({sym.c(k + 1), sym.s(k + 1)} if turns else {target}) & J.free_symbols:
+            continue  # (the last joint's angle does not move the tool point or the axes)
+        head.append(
+            f"{target} = {printer.doprint(expr.xreplace({sym.q(k + 1): sp.Symbol(f'q[{k}]')}))}"
+        )
+        if turns:
+            head += [f"c{k + 1} = cos({target})", f"s{k + 1} = sin({target})"]
+    lines = [ln.text for ln in assign_lines(targets, tuple(entries), names, printer, 0)]
+    return (*head, *lines), tuple(str(t) for t in targets)
+
+
 def fk_joint_lines(plan: Plan, printer: CodePrinter, columns: bool) -> tuple[str, ...]:
     """theta_i = q_i + offset with c_i, s_i (or d_i = q_i + offset) from q or from Q's columns."""
     lines = []
@@ -126,6 +149,8 @@ class PrintedModule:
     tool_const: str
     reach: str
     fk_pose_body: tuple[str, ...]
+    jacobian_body: tuple[str, ...]
+    jacobian_outputs: tuple[str, ...]
     fk_joints: tuple[str, ...]
     fk_batch_joints: tuple[str, ...]
     fk_outputs: tuple[str, ...]
@@ -162,6 +187,7 @@ def print_plan(plan: Plan) -> PrintedModule:
     arm = plan.arm
     python, numpy = CodePrinter(), CodePrinter("np.")
     fk_pose_body, outputs = fk_pose_lines(plan)
+    jacobian_body, jacobian_outputs = jacobian_lines(plan)
     ik = plan.ik
     offsets = tuple(float(e.subs(sym.q(k + 1), 0)) for k, (_, e) in enumerate(plan.joint_defs))
     return PrintedModule(
@@ -181,6 +207,8 @@ def print_plan(plan: Plan) -> PrintedModule:
         tool_const=_tuple_of_tuples(tuple(arm.tool[4 * i : 4 * i + 4] for i in range(4))),
         reach=float_literal(arm.reach),
         fk_pose_body=fk_pose_body,
+        jacobian_body=jacobian_body,
+        jacobian_outputs=jacobian_outputs,
         fk_joints=fk_joint_lines(plan, python, columns=False),
         fk_batch_joints=fk_joint_lines(plan, numpy, columns=True),
         fk_outputs=outputs,

@@ -45,6 +45,7 @@ class PrintedC:
     limits: tuple[tuple[str, str], ...]
     fk_pose: tuple[str, ...]
     fk_joints: tuple[str, ...]
+    jacobian: tuple[str, ...]
     fk_params: str
     solve: tuple[tuple[int, str], ...]
     # dk_solve brings every revolute output to ik's range (c.seamed_outputs): dk_finish copies
@@ -154,6 +155,7 @@ def print_c(plan: Plan) -> PrintedC:
         raise GenerationError(f"{arm.name}: no IK method, so no C solver: {plan.refusal}")
     solve = c.solve_lines(plan)
     fk_pose, fk_joints, fk_params = c.fk_lines(plan)
+    jacobian = c.jacobian_lines(plan)
     upper = arm.name.upper()
     text = ik.free_text
     return PrintedC(
@@ -177,6 +179,7 @@ def print_c(plan: Plan) -> PrintedC:
         limits=tuple((c.c_double(lo), c.c_double(hi)) for lo, hi in arm.limits),
         fk_pose=fk_pose,
         fk_joints=fk_joints,
+        jacobian=jacobian,
         fk_params=fk_params,
         solve=solve,
         seamed=bool(c.seamed_outputs(plan)),

@@ -114,7 +114,15 @@ def frames_pose(frames: tuple[tuple[float, ...], ...], chain: Chain) -> sp.Matri
     theta_i = q_i + offset, or d_i = q_i + offset): F_0 Z_1 G_1 ... Z_n G_n with Z_i the joint's
     Rz(theta_i) or Tz(d_i) and G_i = Rz(-offset_i) F_i or Tz(-offset_i) F_i (unexpanded: CSE
     prints it in fewer operations)."""
-    out = _exact_matrix(_square(frames[0]))
+    out = sp.eye(4)
+    for factor in frames_factors(frames, chain):
+        out = out * factor
+    return out
+
+
+def frames_factors(frames: tuple[tuple[float, ...], ...], chain: Chain) -> list[sp.Matrix]:
+    """frames_pose's factors F_0, Z_1, G_1, ..., Z_n, G_n."""
+    out = [_exact_matrix(_square(frames[0]))]
     for j, frame in zip(chain.joints, frames[1:]):
         offset = float(j.offset)
         if j.kind == "R":
@@ -125,7 +133,7 @@ def frames_pose(frames: tuple[tuple[float, ...], ...], chain: Chain) -> sp.Matri
             undo = np.eye(4)
             undo[2, 3] = -offset
             move = trans(0, 0, sym.d(j.index))
-        out = out * move * _exact_matrix(undo @ _square(frame))
+        out += [move, _exact_matrix(undo @ _square(frame))]
     return out
 
 

@@ -7,7 +7,7 @@ import math
 
 import sympy as sp
 
-from derive import free, tasks
+from derive import free, jacobian, tasks
 from derive import symbols as sym
 from derive.classify import Structure, classify
 from derive.methods import general, parallel, pieper, planar, position
@@ -17,12 +17,20 @@ from derive.nominal import (
     Nominal,
     chain_frames,
     deviation,
+    frames_factors,
     frames_pose,
     nominal,
 )
 from derive.plan import ArmInfo, Correction, IkPlan, Plan
 from derive.spec import ArmSpec, SpecError
-from derive.transforms import Chain, chain_from_spec, frame_matrix, link_transform, world_transform
+from derive.transforms import (
+    Chain,
+    arm_factors,
+    chain_from_spec,
+    frame_matrix,
+    link_transform,
+    world_transform,
+)
 
 # Tried in order; each returns a plan, or a one-line reason why it does not apply.
 METHODS = {
@@ -117,15 +125,23 @@ def build_plan(spec: ArmSpec, method: str | None = None) -> Plan:
             )
         facts = (*facts, f"task: {shown.describe()}: {why}")
     pose = world_transform(chain, expand=False)
+    # (the pose's factors, and where its joints' are: the Jacobian's, derive/jacobian.py)
+    factors = [chain.base, *arm_factors(chain), chain.tool]
+    joints = [2 + 2 * k for k in range(chain.dof)]
     if spec.exact is not None:
         pose = frames_pose(spec.exact, chain)
+        factors = frames_factors(spec.exact, chain)
+        joints = [1 + 2 * k for k in range(chain.dof)]
+    velocity = jacobian.geometric(factors, joints, spec.joint_types)
     joint_defs = joint_definitions(chain)
     if ik is not None and ik.relabel != 0:
         pose, joint_defs = relabelled(pose, joint_defs, chain, ik.relabel)
+        velocity = in_steps_variable(velocity, chain, ik.relabel)
     return Plan(
         arm=arm_info(spec, chain),
         structure=facts,
         fk_pose=pose,
+        jacobian=velocity,
         links=tuple(link_transform(chain, i) for i in range(1, chain.dof + 1)),
         joint_defs=joint_defs,
         ik=ik,
@@ -379,18 +395,22 @@ def relabelled(
     theta_n = q_n + offset + shift, and the pose's c_n, s_n those of theta_n - shift (d_n
     - shift for a prismatic joint)."""
     n = chain.dof
-    last = chain.joints[-1]
-    if last.kind == "R":
+    target, expr = joint_defs[-1]
+    moved = sym.q(n) + sp.Float(float(expr.subs(sym.q(n), 0) + shift), 17)
+    return in_steps_variable(pose, chain, shift), (*joint_defs[:-1], (target, moved))
+
+
+def in_steps_variable(matrix: sp.Matrix, chain: Chain, shift: sp.Expr) -> sp.Matrix:
+    """A matrix in the arm's joint n symbols rewritten in the steps' (relabelled's): c_n, s_n
+    of theta_n - shift (d_n - shift for a prismatic joint)."""
+    n = chain.dof
+    if chain.joints[-1].kind == "R":
         cs, ss = sp.cos(shift), sp.sin(shift)
         if not (cs.is_Rational and ss.is_Rational):
             cs, ss = sp.Float(float(cs), 17), sp.Float(float(ss), 17)
         c, s = sym.c(n), sym.s(n)
-        pose = pose.xreplace({c: c * cs + s * ss, s: s * cs - c * ss})
-    else:
-        pose = pose.xreplace({sym.d(n): sym.d(n) - shift})
-    target, expr = joint_defs[-1]
-    moved = sym.q(n) + sp.Float(float(expr.subs(sym.q(n), 0) + shift), 17)
-    return pose, (*joint_defs[:-1], (target, moved))
+        return matrix.xreplace({c: c * cs + s * ss, s: s * cs - c * ss})
+    return matrix.xreplace({sym.d(n): sym.d(n) - shift})
 
 
 def joint_definitions(chain: Chain) -> tuple[tuple[sp.Symbol, sp.Expr], ...]:

@@ -30,6 +30,11 @@ homogeneous transforms of the tool frame in the world (base and tool frames incl
 API:
     fk(q) -> (4, 4) ndarray
     fk_batch(Q: (N, DOF)) -> (N, 4, 4) ndarray
+    jacobian(q, frame="base") -> (6, DOF) ndarray, the geometric Jacobian at the tool point
+        (linear over angular velocity; frame "base" the world's, "tool" the tool's)
+    manipulability(q) -> (smallest singular value, Yoshikawa's w) of the Jacobian
+    ik_velocity(q, twist, *, frame="base", damping=VELOCITY_DAMPING, band=VELOCITY_BAND,
+                preferred=None, gain=1.0) -> (DOF,) ndarray, joint velocities for a tool twist
     ik(T, *, free=None, within_limits=False, q_ref=None, tol=CERTIFY_TOL, backend=None,
        all_turns=False) -> (n, DOF) ndarray, all solutions for the free joints' values
     ik_batch(T: (N, 4, 4), *, free=None, q_ref=None, tol=CERTIFY_TOL, chunk=4096,
@@ -1250,6 +1255,116 @@ def _free_rows(free, refs, n):
     return rows
 
 
+def jacobian(q: ArrayLike, frame: str = "base") -> np.ndarray:
+    """The geometric Jacobian at q, (6, DOF): rows 0-2 the tool point's linear velocity, rows
+    3-5 the tool's angular velocity, per unit of each joint's velocity ([v; w] = J dq; length
+    units and radians, as fk's).
+
+    Args:
+        q: DOF joint values.
+        frame: "base": v and w in the world (fk's frame); "tool": both in the tool frame
+            (rotated by fk(q)'s R^T; the point is still the tool point).
+
+    Raises:
+        ValueError: q is not DOF finite numbers, or frame is neither "base" nor "tool".
+    """
+    values = _joint_values(q)
+    if frame not in ("base", "tool"):
+        raise ValueError(f'frame must be "base" or "tool", got {frame!r}')
+    J = np.array(_jacobian_q(values)).reshape(6, DOF)
+    if frame == "tool":
+        e = _fk_q(values)
+        R = np.array([e[0:3], e[4:7], e[8:11]])
+        J = np.vstack([R.T @ J[:3], R.T @ J[3:]])
+    return J
+
+
+# ik_velocity's damping: none while the Jacobian's smallest singular value is at least
+# VELOCITY_BAND; below it, lambda^2 = VELOCITY_DAMPING^2 (1 - (sigma / VELOCITY_BAND)^2), which
+# bounds every joint rate by |twist| / (2 VELOCITY_DAMPING) at a singular configuration
+VELOCITY_BAND = 0.05
+
+
+VELOCITY_DAMPING = 0.05
+
+
+def ik_velocity(
+    q: ArrayLike,
+    twist: ArrayLike,
+    *,
+    frame: str = "base",
+    damping: float = VELOCITY_DAMPING,
+    band: float = VELOCITY_BAND,
+    preferred: ArrayLike | None = None,
+    gain: float = 1.0,
+) -> np.ndarray:
+    """Joint velocities dq that move the tool with the twist [v; w] at q: damped least
+    squares on jacobian(q, frame), dq = sum_k sigma_k / (sigma_k^2 + lambda^2) v_k u_k^T twist.
+
+    Away from singular configurations (every singular value at least band) lambda is 0 and
+    J dq reproduces the twist (to rounding) where the arm can move that way; within band of one
+    the damping grows to damping^2 as the smallest singular value goes to 0, which bounds the
+    joint rates (by |twist| / (2 damping)) at the price of the twist's component along the lost
+    direction. An arm of fewer than 6 joints gets the least-squares dq.
+
+    Args:
+        q: DOF joint values; twist: 6 numbers, v (length units per second) then w (rad/s).
+        frame: the twist's frame, as jacobian's.
+        damping, band: the damping's size and where it starts (singular values, J's units).
+        preferred: joint values to drift toward in the Jacobian's null space (an arm with
+            more joints than the twist needs, FREE: its self-motion), gain * (preferred - q)
+            projected so that the tool does not move; None: no drift.
+        gain: the drift's rate (per second).
+
+    Raises:
+        ValueError: q or preferred is not DOF finite numbers, twist not 6, frame unknown,
+            damping or band negative, gain not finite.
+    """
+    J = jacobian(q, frame)
+    target = _real(twist, "twist")
+    if target.shape != (6,) or not np.isfinite(target).all():
+        raise ValueError(f"twist must be 6 finite numbers, got {target}")
+    if not (damping >= 0.0 and band >= 0.0 and math.isfinite(damping + band + gain)):
+        raise ValueError("damping and band must be finite numbers >= 0, gain finite")
+    U, sigma, Vt = np.linalg.svd(J, full_matrices=False)
+    least = float(sigma[-1]) if len(sigma) == 6 else math.inf
+    lam2 = 0.0
+    if least < band:
+        lam2 = damping * damping * (1.0 - (least / band) ** 2)
+    weights = np.divide(sigma, sigma * sigma + lam2, out=np.zeros_like(sigma), where=sigma > 0)
+    dq = Vt.T @ (weights * (U.T @ target))
+    if preferred is not None:
+        drift = gain * (np.array(_joint_values(preferred)) - np.array(_joint_values(q)))
+        rank = int(np.sum(sigma > 1e-12 * max(1.0, float(sigma[0]))))
+        rows = Vt[:rank]
+        dq = dq + drift - rows.T @ (rows @ drift)  # (the null space's share of the drift)
+    return dq
+
+
+def manipulability(q: ArrayLike) -> tuple[float, float]:
+    """How far q is from a singular configuration: (the smallest singular value of
+    jacobian(q), Yoshikawa's measure w, the product of its singular values: sqrt(det(J J^T))
+    for an arm of 6 joints or more, sqrt(det(J^T J)) for fewer). Both are 0 at a singular
+    configuration; J mixes length units and radians, so compare values of one arm.
+
+    Raises:
+        ValueError: q is not DOF finite numbers.
+    """
+    sigma = np.linalg.svd(jacobian(q), compute_uv=False)
+    return float(sigma[-1]) if len(sigma) == min(6, DOF) else 0.0, float(np.prod(sigma))
+
+
+def _joint_values(q: ArrayLike) -> list[float]:
+    """q as DOF finite floats."""
+    values = _real(q, "q")
+    if values.shape != (DOF,):
+        raise ValueError(f"q must have shape ({DOF},), got {values.shape}")
+    joints = values.tolist()
+    if not all(map(math.isfinite, joints)):
+        raise ValueError(f"q must be {DOF} finite numbers")
+    return joints
+
+
 def _kquadratic(b, c):
     """Both roots of x^2 + b x + c (complex b, c allowed), without cancellation."""
     t = cmath.sqrt(b * b - 4.0 * c)
@@ -1795,6 +1910,124 @@ def _fk_q(q):
     c7 = cos(theta7)
     s7 = sin(theta7)
     return _fk_from_cs(c1, s1, c2, s2, c3, s3, c4, s4, c5, s5, c6, s6, c7, s7)
+
+
+def _jacobian_q(q):
+    """The geometric Jacobian at the tool point in the world (linear velocity over angular
+    velocity), 6 * DOF entries row-major, for one joint vector (derive/jacobian.py)."""
+    theta1 = q[0]
+    c1 = cos(theta1)
+    s1 = sin(theta1)
+    theta2 = q[1]
+    c2 = cos(theta2)
+    s2 = sin(theta2)
+    theta3 = q[2]
+    c3 = cos(theta3)
+    s3 = sin(theta3)
+    theta4 = q[3]
+    c4 = cos(theta4)
+    s4 = sin(theta4)
+    theta5 = q[4]
+    c5 = cos(theta5)
+    s5 = sin(theta5)
+    theta6 = q[5]
+    c6 = cos(theta6)
+    s6 = sin(theta6)
+    x0 = s1*s2
+    x1 = c4*x0
+    x2 = c1*s3
+    x3 = c3*s1
+    x4 = c2*x3 + x2
+    x5 = -s4*x4 + x1
+    x6 = -c6*x5
+    x7 = 0.126*x6
+    x8 = c1*c3
+    x9 = s1*s3
+    x10 = -c2*x9 + x8
+    x11 = c4*x4 + s4*x0
+    x12 = c5*x11 + s5*x10
+    x13 = 0.126*s6*x12
+    x14 = -0.4*s4*x4 + 0.4*x1 + x13 - x7
+    x15 = 0.42*x0 + x14
+    x16 = c2*c4
+    x17 = c3*s2
+    x18 = s4*x17
+    x19 = x16 + x18
+    x20 = -c6*x19
+    x21 = 0.126*x20
+    x22 = s2*s3
+    x23 = c2*s4 - c4*x17
+    x24 = c5*x23 + s5*x22
+    x25 = 0.126*s6*x24 + 0.4*x16 + 0.4*x18 - x21
+    x26 = 0.42*c2 + x25
+    x27 = c1*x26
+    x28 = -x10
+    x29 = c5*x10 - s5*x11
+    x30 = 0.126*s6*x24 - x21
+    x31 = c5*x22 - s5*x23
+    x32 = x13 - x7
+    x33 = s6*x24 - x20
+    x34 = s6*x12 - x6
+    x35 = c1*s2
+    x36 = c4*x35
+    x37 = c2*x8 - x9
+    x38 = -s4*x37 + x36
+    x39 = -c6*x38
+    x40 = 0.126*x39
+    x41 = c2*x2 + x3
+    x42 = -x41
+    x43 = c4*x37 + s4*x35
+    x44 = c5*x43 + s5*x42
+    x45 = -0.4*s4*x37 + 0.126*s6*x44 + 0.4*x36 - x40
+    x46 = 0.42*x35 + x45
+    x47 = c5*x42 - s5*x43
+    x48 = 0.126*s6*x44 - x40
+    x49 = s6*x44 - x39
+    j0_0 = -x15
+    j0_1 = x27
+    j0_2 = -c2*x15 + s1*s2*x26
+    j0_3 = x14*x22 + x25*x28
+    j0_4 = -x14*x19 + x25*x5
+    j0_5 = x29*x30 - x31*x32
+    j0_6 = x30*x34 - x32*x33
+    j1_0 = x46
+    j1_1 = s1*x26
+    j1_2 = c2*x46 - s2*x27
+    j1_3 = -x22*x45 - x25*x41
+    j1_4 = x19*x45 - x25*x38
+    j1_5 = -x30*x47 + x31*x48
+    j1_6 = -x30*x49 + x33*x48
+    j2_0 = 0.0
+    j2_1 = -c1*x46 - s1*x15
+    j2_2 = -x0*x46 + x15*x35
+    j2_3 = x14*x41 - x28*x45
+    j2_4 = x14*x38 - x45*x5
+    j2_5 = -x29*x48 + x32*x47
+    j2_6 = x32*x49 - x34*x48
+    j3_0 = 0.0
+    j3_1 = -s1
+    j3_2 = x35
+    j3_3 = x41
+    j3_4 = x38
+    j3_5 = x47
+    j3_6 = x49
+    j4_0 = 0.0
+    j4_1 = c1
+    j4_2 = x0
+    j4_3 = x28
+    j4_4 = x5
+    j4_5 = x29
+    j4_6 = x34
+    j5_0 = 1.0
+    j5_1 = 0.0
+    j5_2 = c2
+    j5_3 = -x22
+    j5_4 = x19
+    j5_5 = x31
+    j5_6 = x33
+    return (j0_0, j0_1, j0_2, j0_3, j0_4, j0_5, j0_6, j1_0, j1_1, j1_2, j1_3, j1_4, j1_5, j1_6,
+        j2_0, j2_1, j2_2, j2_3, j2_4, j2_5, j2_6, j3_0, j3_1, j3_2, j3_3, j3_4, j3_5, j3_6, j4_0,
+        j4_1, j4_2, j4_3, j4_4, j4_5, j4_6, j5_0, j5_1, j5_2, j5_3, j5_4, j5_5, j5_6)
 
 
 def _cs_columns(Q):

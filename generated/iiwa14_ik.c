@@ -1664,6 +1664,178 @@ static int dk_finish(double found[DK_MAX][DK_DOF], int count, int repeats,
     return m;
 }
 
+void iiwa14_jacobian(const double q[DK_DOF], int frame, double J[6][DK_DOF])
+{
+    {
+        const double theta1 = q[0];
+        const double c1 = cos(theta1);
+        const double s1 = sin(theta1);
+        const double theta2 = q[1];
+        const double c2 = cos(theta2);
+        const double s2 = sin(theta2);
+        const double theta3 = q[2];
+        const double c3 = cos(theta3);
+        const double s3 = sin(theta3);
+        const double theta4 = q[3];
+        const double c4 = cos(theta4);
+        const double s4 = sin(theta4);
+        const double theta5 = q[4];
+        const double c5 = cos(theta5);
+        const double s5 = sin(theta5);
+        const double theta6 = q[5];
+        const double c6 = cos(theta6);
+        const double s6 = sin(theta6);
+        double x0 = s1*s2;
+        double x1 = c4*x0;
+        double x2 = c1*s3;
+        double x3 = c3*s1;
+        double x4 = c2*x3 + x2;
+        double x5 = -s4*x4 + x1;
+        double x6 = -c6*x5;
+        double x7 = 0.126*x6;
+        double x8 = c1*c3;
+        double x9 = s1*s3;
+        double x10 = -c2*x9 + x8;
+        double x11 = c4*x4 + s4*x0;
+        double x12 = c5*x11 + s5*x10;
+        double x13 = 0.126*s6*x12;
+        double x14 = -0.4*s4*x4 + 0.4*x1 + x13 - x7;
+        double x15 = 0.42*x0 + x14;
+        double x16 = c2*c4;
+        double x17 = c3*s2;
+        double x18 = s4*x17;
+        double x19 = x16 + x18;
+        double x20 = -c6*x19;
+        double x21 = 0.126*x20;
+        double x22 = s2*s3;
+        double x23 = c2*s4 - c4*x17;
+        double x24 = c5*x23 + s5*x22;
+        double x25 = 0.126*s6*x24 + 0.4*x16 + 0.4*x18 - x21;
+        double x26 = 0.42*c2 + x25;
+        double x27 = c1*x26;
+        double x28 = -x10;
+        double x29 = c5*x10 - s5*x11;
+        double x30 = 0.126*s6*x24 - x21;
+        double x31 = c5*x22 - s5*x23;
+        double x32 = x13 - x7;
+        double x33 = s6*x24 - x20;
+        double x34 = s6*x12 - x6;
+        double x35 = c1*s2;
+        double x36 = c4*x35;
+        double x37 = c2*x8 - x9;
+        double x38 = -s4*x37 + x36;
+        double x39 = -c6*x38;
+        double x40 = 0.126*x39;
+        double x41 = c2*x2 + x3;
+        double x42 = -x41;
+        double x43 = c4*x37 + s4*x35;
+        double x44 = c5*x43 + s5*x42;
+        double x45 = -0.4*s4*x37 + 0.126*s6*x44 + 0.4*x36 - x40;
+        double x46 = 0.42*x35 + x45;
+        double x47 = c5*x42 - s5*x43;
+        double x48 = 0.126*s6*x44 - x40;
+        double x49 = s6*x44 - x39;
+        double j0_0 = -x15;
+        double j0_1 = x27;
+        double j0_2 = -c2*x15 + s1*s2*x26;
+        double j0_3 = x14*x22 + x25*x28;
+        double j0_4 = -x14*x19 + x25*x5;
+        double j0_5 = x29*x30 - x31*x32;
+        double j0_6 = x30*x34 - x32*x33;
+        double j1_0 = x46;
+        double j1_1 = s1*x26;
+        double j1_2 = c2*x46 - s2*x27;
+        double j1_3 = -x22*x45 - x25*x41;
+        double j1_4 = x19*x45 - x25*x38;
+        double j1_5 = -x30*x47 + x31*x48;
+        double j1_6 = -x30*x49 + x33*x48;
+        double j2_0 = 0.0;
+        double j2_1 = -c1*x46 - s1*x15;
+        double j2_2 = -x0*x46 + x15*x35;
+        double j2_3 = x14*x41 - x28*x45;
+        double j2_4 = x14*x38 - x45*x5;
+        double j2_5 = -x29*x48 + x32*x47;
+        double j2_6 = x32*x49 - x34*x48;
+        double j3_0 = 0.0;
+        double j3_1 = -s1;
+        double j3_2 = x35;
+        double j3_3 = x41;
+        double j3_4 = x38;
+        double j3_5 = x47;
+        double j3_6 = x49;
+        double j4_0 = 0.0;
+        double j4_1 = c1;
+        double j4_2 = x0;
+        double j4_3 = x28;
+        double j4_4 = x5;
+        double j4_5 = x29;
+        double j4_6 = x34;
+        double j5_0 = 1.0;
+        double j5_1 = 0.0;
+        double j5_2 = c2;
+        double j5_3 = -x22;
+        double j5_4 = x19;
+        double j5_5 = x31;
+        double j5_6 = x33;
+        J[0][0] = j0_0;
+        J[0][1] = j0_1;
+        J[0][2] = j0_2;
+        J[0][3] = j0_3;
+        J[0][4] = j0_4;
+        J[0][5] = j0_5;
+        J[0][6] = j0_6;
+        J[1][0] = j1_0;
+        J[1][1] = j1_1;
+        J[1][2] = j1_2;
+        J[1][3] = j1_3;
+        J[1][4] = j1_4;
+        J[1][5] = j1_5;
+        J[1][6] = j1_6;
+        J[2][0] = j2_0;
+        J[2][1] = j2_1;
+        J[2][2] = j2_2;
+        J[2][3] = j2_3;
+        J[2][4] = j2_4;
+        J[2][5] = j2_5;
+        J[2][6] = j2_6;
+        J[3][0] = j3_0;
+        J[3][1] = j3_1;
+        J[3][2] = j3_2;
+        J[3][3] = j3_3;
+        J[3][4] = j3_4;
+        J[3][5] = j3_5;
+        J[3][6] = j3_6;
+        J[4][0] = j4_0;
+        J[4][1] = j4_1;
+        J[4][2] = j4_2;
+        J[4][3] = j4_3;
+        J[4][4] = j4_4;
+        J[4][5] = j4_5;
+        J[4][6] = j4_6;
+        J[5][0] = j5_0;
+        J[5][1] = j5_1;
+        J[5][2] = j5_2;
+        J[5][3] = j5_3;
+        J[5][4] = j5_4;
+        J[5][5] = j5_5;
+        J[5][6] = j5_6;
+    }
+    if (frame) { /* (the tool frame: v and w rotated by R^T) */
+        double e[12], column[6];
+        int j, r;
+        dk_fk_q(q, e);
+        for (j = 0; j < DK_DOF; j++) {
+            for (r = 0; r < 3; r++) {
+                column[r] = e[r] * J[0][j] + e[4 + r] * J[1][j] + e[8 + r] * J[2][j];
+                column[3 + r] = e[r] * J[3][j] + e[4 + r] * J[4][j] + e[8 + r] * J[5][j];
+            }
+            for (r = 0; r < 6; r++) {
+                J[r][j] = column[r];
+            }
+        }
+    }
+}
+
 void iiwa14_fk(const double q[DK_DOF], double T[16])
 {
     double e[12];

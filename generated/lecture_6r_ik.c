@@ -1696,6 +1696,162 @@ static int dk_finish(double found[DK_MAX][DK_DOF], int count, int repeats,
     return m;
 }
 
+void lecture_6r_jacobian(const double q[DK_DOF], int frame, double J[6][DK_DOF])
+{
+    {
+        const double theta1 = q[0];
+        const double c1 = cos(theta1);
+        const double s1 = sin(theta1);
+        const double theta2 = q[1];
+        const double c2 = cos(theta2);
+        const double s2 = sin(theta2);
+        const double theta3 = q[2];
+        const double c3 = cos(theta3);
+        const double s3 = sin(theta3);
+        const double theta4 = q[3];
+        const double c4 = cos(theta4);
+        const double s4 = sin(theta4);
+        const double theta5 = q[4];
+        const double c5 = cos(theta5);
+        const double s5 = sin(theta5);
+        double x0 = s2*s3;
+        double x1 = s1*x0;
+        double x2 = c2*c3;
+        double x3 = s1*x2;
+        double x4 = c2*s3;
+        double x5 = s1*x4;
+        double x6 = c3*s2;
+        double x7 = s1*x6;
+        double x8 = -x5 - x7;
+        double x9 = c5*x8;
+        double x10 = 206.0*x9;
+        double x11 = -x1 + x3;
+        double x12 = s5*(-c1*s4 + c4*x11);
+        double x13 = 206.0*x12;
+        double x14 = -x10 + x13 + 338.0*x5 + 338.0*x7;
+        double x15 = -40.0*x1 + x14 + 40.0*x3;
+        double x16 = -340.0*c2*s1 + x15;
+        double x17 = 338.0*x2;
+        double x18 = s2*s3 - x2;
+        double x19 = -x4 - x6;
+        double x20 = c4*s5*x19;
+        double x21 = 206.0*x20;
+        double x22 = 206.0*c5*x18 + 338.0*x0 - x17 - x21 + 40.0*x4 + 40.0*x6;
+        double x23 = -340.0*s2 + x22;
+        double x24 = -206.0*c5*x18 + x21;
+        double x25 = 338.0*s2*s3 - x17 - x24;
+        double x26 = -x14;
+        double x27 = c1*c4 + s4*x11;
+        double x28 = -x24;
+        double x29 = x10 - x13;
+        double x30 = s4*x19;
+        double x31 = -x12 + x9;
+        double x32 = c5*x18 - x20;
+        double x33 = c1*x2;
+        double x34 = c1*x4;
+        double x35 = c1*x6;
+        double x36 = -x34 - x35;
+        double x37 = -c1*x0 + x33;
+        double x38 = s5*(c4*x37 + s1*s4);
+        double x39 = 206.0*x38;
+        double x40 = -206.0*c5*x36 + 338.0*x34 + 338.0*x35 + x39;
+        double x41 = -40.0*c1*s2*s3 + 40.0*x33 + x40;
+        double x42 = -340.0*c1*c2 + x41;
+        double x43 = -x40;
+        double x44 = -c4*s1 + s4*x37;
+        double x45 = c5*x36;
+        double x46 = -x39 + 206.0*x45;
+        double x47 = -x38 + x45;
+        double x48 = -s1;
+        double j0_0 = 30.0*s1 + x16;
+        double j0_1 = c1*x23;
+        double j0_2 = c1*x22;
+        double j0_3 = -x18*x26 + x25*x8;
+        double j0_4 = x27*x28 - x29*x30;
+        double j0_5 = x28*x31 - x29*x32;
+        double j1_0 = -30.0*c1 - x42;
+        double j1_1 = s1*x23;
+        double j1_2 = s1*x22;
+        double j1_3 = x18*x43 - x25*x36;
+        double j1_4 = -x28*x44 + x30*x46;
+        double j1_5 = -x28*x47 + x32*x46;
+        double j2_0 = 0.0;
+        double j2_1 = c1*x42 + s1*x16;
+        double j2_2 = c1*x41 + s1*x15;
+        double j2_3 = x26*x36 - x43*x8;
+        double j2_4 = -x27*x46 + x29*x44;
+        double j2_5 = x29*x47 - x31*x46;
+        double j3_0 = 0.0;
+        double j3_1 = x48;
+        double j3_2 = x48;
+        double j3_3 = x36;
+        double j3_4 = x44;
+        double j3_5 = x47;
+        double j4_0 = 0.0;
+        double j4_1 = c1;
+        double j4_2 = c1;
+        double j4_3 = x8;
+        double j4_4 = x27;
+        double j4_5 = x31;
+        double j5_0 = 1.0;
+        double j5_1 = 0.0;
+        double j5_2 = 0.0;
+        double j5_3 = x18;
+        double j5_4 = x30;
+        double j5_5 = x32;
+        J[0][0] = j0_0;
+        J[0][1] = j0_1;
+        J[0][2] = j0_2;
+        J[0][3] = j0_3;
+        J[0][4] = j0_4;
+        J[0][5] = j0_5;
+        J[1][0] = j1_0;
+        J[1][1] = j1_1;
+        J[1][2] = j1_2;
+        J[1][3] = j1_3;
+        J[1][4] = j1_4;
+        J[1][5] = j1_5;
+        J[2][0] = j2_0;
+        J[2][1] = j2_1;
+        J[2][2] = j2_2;
+        J[2][3] = j2_3;
+        J[2][4] = j2_4;
+        J[2][5] = j2_5;
+        J[3][0] = j3_0;
+        J[3][1] = j3_1;
+        J[3][2] = j3_2;
+        J[3][3] = j3_3;
+        J[3][4] = j3_4;
+        J[3][5] = j3_5;
+        J[4][0] = j4_0;
+        J[4][1] = j4_1;
+        J[4][2] = j4_2;
+        J[4][3] = j4_3;
+        J[4][4] = j4_4;
+        J[4][5] = j4_5;
+        J[5][0] = j5_0;
+        J[5][1] = j5_1;
+        J[5][2] = j5_2;
+        J[5][3] = j5_3;
+        J[5][4] = j5_4;
+        J[5][5] = j5_5;
+    }
+    if (frame) { /* (the tool frame: v and w rotated by R^T) */
+        double e[12], column[6];
+        int j, r;
+        dk_fk_q(q, e);
+        for (j = 0; j < DK_DOF; j++) {
+            for (r = 0; r < 3; r++) {
+                column[r] = e[r] * J[0][j] + e[4 + r] * J[1][j] + e[8 + r] * J[2][j];
+                column[3 + r] = e[r] * J[3][j] + e[4 + r] * J[4][j] + e[8 + r] * J[5][j];
+            }
+            for (r = 0; r < 6; r++) {
+                J[r][j] = column[r];
+            }
+        }
+    }
+}
+
 void lecture_6r_fk(const double q[DK_DOF], double T[16])
 {
     double e[12];

@@ -1417,6 +1417,60 @@ static int dk_finish(double found[DK_MAX][DK_DOF], int count, int repeats,
     return m;
 }
 
+void locobot_head_jacobian(const double q[DK_DOF], int frame, double J[6][DK_DOF])
+{
+    {
+        const double theta1 = q[0];
+        const double c1 = cos(theta1);
+        const double s1 = sin(theta1);
+        const double theta2 = q[1] + 1.5707963267948966;
+        const double c2 = cos(theta2);
+        const double s2 = sin(theta2);
+        double x0 = 8.99999999998125e-06*c2;
+        double x1 = 0.0175*c1 + 0.05318*s1*s2 - s1*x0;
+        double x2 = 0.05318*c2 + 8.99999999998125e-06*s2;
+        double x3 = -0.05318*c1*s2 + c1*x0 + 0.0175*s1;
+        double j0_0 = -0.025034*s1 - x1;
+        double j0_1 = c1*x2;
+        double j1_0 = 0.025034*c1 - x3;
+        double j1_1 = s1*x2;
+        double j2_0 = 0.0;
+        double j2_1 = c1*x3 - s1*x1;
+        double j3_0 = 0.0;
+        double j3_1 = -s1;
+        double j4_0 = 0.0;
+        double j4_1 = c1;
+        double j5_0 = 1.0;
+        double j5_1 = 0.0;
+        J[0][0] = j0_0;
+        J[0][1] = j0_1;
+        J[1][0] = j1_0;
+        J[1][1] = j1_1;
+        J[2][0] = j2_0;
+        J[2][1] = j2_1;
+        J[3][0] = j3_0;
+        J[3][1] = j3_1;
+        J[4][0] = j4_0;
+        J[4][1] = j4_1;
+        J[5][0] = j5_0;
+        J[5][1] = j5_1;
+    }
+    if (frame) { /* (the tool frame: v and w rotated by R^T) */
+        double e[12], column[6];
+        int j, r;
+        dk_fk_q(q, e);
+        for (j = 0; j < DK_DOF; j++) {
+            for (r = 0; r < 3; r++) {
+                column[r] = e[r] * J[0][j] + e[4 + r] * J[1][j] + e[8 + r] * J[2][j];
+                column[3 + r] = e[r] * J[3][j] + e[4 + r] * J[4][j] + e[8 + r] * J[5][j];
+            }
+            for (r = 0; r < 6; r++) {
+                J[r][j] = column[r];
+            }
+        }
+    }
+}
+
 void locobot_head_fk(const double q[DK_DOF], double T[16])
 {
     double e[12];

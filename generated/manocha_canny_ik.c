@@ -2633,6 +2633,163 @@ static int dk_finish(double found[DK_MAX][DK_DOF], int count, int repeats,
     return m;
 }
 
+void manocha_canny_jacobian(const double q[DK_DOF], int frame, double J[6][DK_DOF])
+{
+    {
+        const double theta1 = q[0];
+        const double c1 = cos(theta1);
+        const double s1 = sin(theta1);
+        const double theta2 = q[1];
+        const double c2 = cos(theta2);
+        const double s2 = sin(theta2);
+        const double theta3 = q[2];
+        const double c3 = cos(theta3);
+        const double s3 = sin(theta3);
+        const double theta4 = q[3];
+        const double c4 = cos(theta4);
+        const double s4 = sin(theta4);
+        const double theta5 = q[4];
+        const double c5 = cos(theta5);
+        const double s5 = sin(theta5);
+        double x0 = c2*s1;
+        double x1 = 0.0034904812874567022*s2;
+        double x2 = 0.9998476951563913*c1;
+        double x3 = 0.01745240643728351*s1*s2 - x2;
+        double x4 = s4*x3;
+        double x5 = 0.01745240643728351*c1;
+        double x6 = 0.9998476951563913*s1;
+        double x7 = -s2*x6 - x5;
+        double x8 = c3*x0 + s3*x7;
+        double x9 = c4*x8;
+        double x10 = 1.5*x4 + 1.5*x9;
+        double x11 = -0.19996953903127826*c1 + s1*x1 + x10;
+        double x12 = x0 + x11;
+        double x13 = 0.9998476951563913*c2;
+        double x14 = c3*s2 + s3*x13;
+        double x15 = 0.026178609655925267*c2*s4 - 1.5*c4*x14;
+        double x16 = 0.0034904812874567022*c2 + x15;
+        double x17 = s2 - x16;
+        double x18 = -x16;
+        double x19 = 0.01745240643728351*c2;
+        double x20 = -x15;
+        double x21 = s3*x0;
+        double x22 = c3*x7;
+        double x23 = x21 - x22;
+        double x24 = -c3*x13 + s2*s3;
+        double x25 = c1*c2;
+        double x26 = s2*x5 + x6;
+        double x27 = s4*x26;
+        double x28 = 0.01745240643728351*s1 - s2*x2;
+        double x29 = c3*x25 + s3*x28;
+        double x30 = c4*x29;
+        double x31 = 1.5*x27 + 1.5*x30;
+        double x32 = c1*x1 + 0.19996953903127826*s1 + x31;
+        double x33 = x25 + x32;
+        double x34 = c3*x28;
+        double x35 = s3*x25 - x34;
+        double x36 = c2*s3;
+        double x37 = c4*x26;
+        double x38 = s4*x29;
+        double x39 = c4*x3;
+        double x40 = s4*x8;
+        double x41 = c2*c3;
+        double x42 = c2*c4;
+        double x43 = s4*x14;
+        double j0_0 = -0.3*s1 - x12;
+        double j0_1 = -c1*x17;
+        double j0_2 = x11*x19 + x18*x3;
+        double j0_3 = -x10*x24 + x20*x23;
+        double j0_4 = 0.0;
+        double j0_5 = 0.0;
+        double j1_0 = 0.3*c1 + x33;
+        double j1_1 = -s1*x17;
+        double j1_2 = -x18*x26 - x19*x32;
+        double j1_3 = -x20*x35 + x24*x31;
+        double j1_4 = 0.0;
+        double j1_5 = 0.0;
+        double j2_0 = 0.0;
+        double j2_1 = c1*x33 + s1*x12;
+        double j2_2 = x11*x26 - x3*x32;
+        double j2_3 = x10*x35 - x23*x31;
+        double j2_4 = 0.0;
+        double j2_5 = 0.0;
+        double j3_0 = 0.0;
+        double j3_1 = s1;
+        double j3_2 = x26;
+        double j3_3 = x35;
+        double j3_4 = x2*x36 - 0.9998476951563913*x34 - 0.01745240643728351*x37 +
+                0.01745240643728351*x38;
+        double j3_5 = -c5*(-0.01745240643728351*x34 + x36*x5 + 0.9998476951563913*x37 -
+                0.9998476951563913*x38) + s5*(x27 + x30);
+        double j4_0 = 0.0;
+        double j4_1 = -c1;
+        double j4_2 = x3;
+        double j4_3 = x23;
+        double j4_4 = 0.9998476951563913*x21 - 0.9998476951563913*x22 - 0.01745240643728351*x39 +
+                0.01745240643728351*x40;
+        double j4_5 = -c5*(0.01745240643728351*x21 - 0.01745240643728351*x22 +
+                0.9998476951563913*x39 - 0.9998476951563913*x40) + s5*(x4 + x9);
+        double j5_0 = 1.0;
+        double j5_1 = 0.0;
+        double j5_2 = -x19;
+        double j5_3 = x24;
+        double j5_4 = 0.9998476951563913*s2*s3 - 0.9996954135095479*x41 + 0.00030458649045213493*x42
+                + 0.01745240643728351*x43;
+        double j5_5 = -c5*(0.01745240643728351*s2*s3 - 0.017449748351250485*x41 -
+                0.017449748351250485*x42 - 0.9998476951563913*x43) + s5*(c4*x14 - s4*x19);
+        J[0][0] = j0_0;
+        J[0][1] = j0_1;
+        J[0][2] = j0_2;
+        J[0][3] = j0_3;
+        J[0][4] = j0_4;
+        J[0][5] = j0_5;
+        J[1][0] = j1_0;
+        J[1][1] = j1_1;
+        J[1][2] = j1_2;
+        J[1][3] = j1_3;
+        J[1][4] = j1_4;
+        J[1][5] = j1_5;
+        J[2][0] = j2_0;
+        J[2][1] = j2_1;
+        J[2][2] = j2_2;
+        J[2][3] = j2_3;
+        J[2][4] = j2_4;
+        J[2][5] = j2_5;
+        J[3][0] = j3_0;
+        J[3][1] = j3_1;
+        J[3][2] = j3_2;
+        J[3][3] = j3_3;
+        J[3][4] = j3_4;
+        J[3][5] = j3_5;
+        J[4][0] = j4_0;
+        J[4][1] = j4_1;
+        J[4][2] = j4_2;
+        J[4][3] = j4_3;
+        J[4][4] = j4_4;
+        J[4][5] = j4_5;
+        J[5][0] = j5_0;
+        J[5][1] = j5_1;
+        J[5][2] = j5_2;
+        J[5][3] = j5_3;
+        J[5][4] = j5_4;
+        J[5][5] = j5_5;
+    }
+    if (frame) { /* (the tool frame: v and w rotated by R^T) */
+        double e[12], column[6];
+        int j, r;
+        dk_fk_q(q, e);
+        for (j = 0; j < DK_DOF; j++) {
+            for (r = 0; r < 3; r++) {
+                column[r] = e[r] * J[0][j] + e[4 + r] * J[1][j] + e[8 + r] * J[2][j];
+                column[3 + r] = e[r] * J[3][j] + e[4 + r] * J[4][j] + e[8 + r] * J[5][j];
+            }
+            for (r = 0; r < 6; r++) {
+                J[r][j] = column[r];
+            }
+        }
+    }
+}
+
 void manocha_canny_fk(const double q[DK_DOF], double T[16])
 {
     double e[12];

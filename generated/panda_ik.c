@@ -1687,6 +1687,196 @@ static int dk_finish(double found[DK_MAX][DK_DOF], int count, int repeats,
     return m;
 }
 
+void panda_jacobian(const double q[DK_DOF], int frame, double J[6][DK_DOF])
+{
+    {
+        const double theta1 = q[0];
+        const double c1 = cos(theta1);
+        const double s1 = sin(theta1);
+        const double theta2 = q[1];
+        const double c2 = cos(theta2);
+        const double s2 = sin(theta2);
+        const double theta3 = q[2];
+        const double c3 = cos(theta3);
+        const double s3 = sin(theta3);
+        const double theta4 = q[3];
+        const double c4 = cos(theta4);
+        const double s4 = sin(theta4);
+        const double theta5 = q[4];
+        const double c5 = cos(theta5);
+        const double s5 = sin(theta5);
+        const double theta6 = q[5];
+        const double c6 = cos(theta6);
+        const double s6 = sin(theta6);
+        double x0 = c1*s3;
+        double x1 = s1*s2;
+        double x2 = c3*s1;
+        double x3 = c2*x2;
+        double x4 = x0 + x3;
+        double x5 = c4*x4;
+        double x6 = s4*x1;
+        double x7 = s4*x4;
+        double x8 = c4*x1;
+        double x9 = -x7 + x8;
+        double x10 = c6*x9;
+        double x11 = 0.107*x10;
+        double x12 = 0.088*s6;
+        double x13 = c1*c3;
+        double x14 = s1*s3;
+        double x15 = -c2*x14 + x13;
+        double x16 = x5 + x6;
+        double x17 = c5*x16 + s5*x15;
+        double x18 = 0.088*c6;
+        double x19 = 0.107*s6*x17;
+        double x20 = -x11 + x12*x9 + x17*x18 + x19;
+        double x21 = x20 - 0.384*x7 + 0.384*x8;
+        double x22 = x21 - 0.0825*x5 - 0.0825*x6;
+        double x23 = 0.0825*x0 + 0.316*x1 + x22 + 0.0825*x3;
+        double x24 = c3*s2;
+        double x25 = 0.0825*x24;
+        double x26 = c2*s4;
+        double x27 = c2*c4;
+        double x28 = s4*x24;
+        double x29 = x27 + x28;
+        double x30 = c6*x29;
+        double x31 = 0.107*x30;
+        double x32 = s2*s3;
+        double x33 = -c4*x24 + x26;
+        double x34 = c5*x33 + s5*x32;
+        double x35 = 0.107*s6*x34 + x12*x29 + x18*x34 - x31;
+        double x36 = 0.384*x27 + 0.384*x28 + x35;
+        double x37 = c4*x25 - 0.0825*x26 + x36;
+        double x38 = 0.316*c2 - x25 + x37;
+        double x39 = c1*x38;
+        double x40 = -x15;
+        double x41 = -c5*x15 + s5*x16;
+        double x42 = -c5*x32 + s5*x33;
+        double x43 = s6*x34 - x30;
+        double x44 = -x11 + x19;
+        double x45 = 0.107*s6*x34 - x31;
+        double x46 = s6*x17 - x10;
+        double x47 = c1*s2;
+        double x48 = c2*x13;
+        double x49 = -x14 + x48;
+        double x50 = c4*x49;
+        double x51 = s4*x47;
+        double x52 = s4*x49;
+        double x53 = c4*x47;
+        double x54 = -x52 + x53;
+        double x55 = c6*x54;
+        double x56 = 0.107*x55;
+        double x57 = c2*x0 + x2;
+        double x58 = -x57;
+        double x59 = x50 + x51;
+        double x60 = c5*x59 + s5*x58;
+        double x61 = 0.107*s6*x60 + x12*x54 + x18*x60 - x56;
+        double x62 = -0.384*x52 + 0.384*x53 + x61;
+        double x63 = -0.0825*x50 - 0.0825*x51 + x62;
+        double x64 = -0.0825*x14 + 0.316*x47 + 0.0825*x48 + x63;
+        double x65 = -c5*x58 + s5*x59;
+        double x66 = 0.107*s6*x60 - x56;
+        double x67 = s6*x60 - x55;
+        double j0_0 = -x23;
+        double j0_1 = x39;
+        double j0_2 = -c2*x23 + s1*s2*x38;
+        double j0_3 = x22*x32 + x37*x40;
+        double j0_4 = -x21*x29 + x36*x9;
+        double j0_5 = -x20*x42 + x35*x41;
+        double j0_6 = -x43*x44 + x45*x46;
+        double j1_0 = x64;
+        double j1_1 = s1*x38;
+        double j1_2 = c2*x64 - s2*x39;
+        double j1_3 = -x32*x63 - x37*x57;
+        double j1_4 = x29*x62 - x36*x54;
+        double j1_5 = -x35*x65 + x42*x61;
+        double j1_6 = x43*x66 - x45*x67;
+        double j2_0 = 0.0;
+        double j2_1 = -c1*x64 - s1*x23;
+        double j2_2 = -x1*x64 + x23*x47;
+        double j2_3 = x22*x57 - x40*x63;
+        double j2_4 = x21*x54 - x62*x9;
+        double j2_5 = x20*x65 - x41*x61;
+        double j2_6 = x44*x67 - x46*x66;
+        double j3_0 = 0.0;
+        double j3_1 = -s1;
+        double j3_2 = x47;
+        double j3_3 = x57;
+        double j3_4 = x54;
+        double j3_5 = x65;
+        double j3_6 = x67;
+        double j4_0 = 0.0;
+        double j4_1 = c1;
+        double j4_2 = x1;
+        double j4_3 = x40;
+        double j4_4 = x9;
+        double j4_5 = x41;
+        double j4_6 = x46;
+        double j5_0 = 1.0;
+        double j5_1 = 0.0;
+        double j5_2 = c2;
+        double j5_3 = -x32;
+        double j5_4 = x29;
+        double j5_5 = x42;
+        double j5_6 = x43;
+        J[0][0] = j0_0;
+        J[0][1] = j0_1;
+        J[0][2] = j0_2;
+        J[0][3] = j0_3;
+        J[0][4] = j0_4;
+        J[0][5] = j0_5;
+        J[0][6] = j0_6;
+        J[1][0] = j1_0;
+        J[1][1] = j1_1;
+        J[1][2] = j1_2;
+        J[1][3] = j1_3;
+        J[1][4] = j1_4;
+        J[1][5] = j1_5;
+        J[1][6] = j1_6;
+        J[2][0] = j2_0;
+        J[2][1] = j2_1;
+        J[2][2] = j2_2;
+        J[2][3] = j2_3;
+        J[2][4] = j2_4;
+        J[2][5] = j2_5;
+        J[2][6] = j2_6;
+        J[3][0] = j3_0;
+        J[3][1] = j3_1;
+        J[3][2] = j3_2;
+        J[3][3] = j3_3;
+        J[3][4] = j3_4;
+        J[3][5] = j3_5;
+        J[3][6] = j3_6;
+        J[4][0] = j4_0;
+        J[4][1] = j4_1;
+        J[4][2] = j4_2;
+        J[4][3] = j4_3;
+        J[4][4] = j4_4;
+        J[4][5] = j4_5;
+        J[4][6] = j4_6;
+        J[5][0] = j5_0;
+        J[5][1] = j5_1;
+        J[5][2] = j5_2;
+        J[5][3] = j5_3;
+        J[5][4] = j5_4;
+        J[5][5] = j5_5;
+        J[5][6] = j5_6;
+    }
+    if (frame) { /* (the tool frame: v and w rotated by R^T) */
+        double e[12], column[6];
+        int j, r;
+        dk_fk_q(q, e);
+        for (j = 0; j < DK_DOF; j++) {
+            for (r = 0; r < 3; r++) {
+                column[r] = e[r] * J[0][j] + e[4 + r] * J[1][j] + e[8 + r] * J[2][j];
+                column[3 + r] = e[r] * J[3][j] + e[4 + r] * J[4][j] + e[8 + r] * J[5][j];
+            }
+            for (r = 0; r < 6; r++) {
+                J[r][j] = column[r];
+            }
+        }
+    }
+}
+
 void panda_fk(const double q[DK_DOF], double T[16])
 {
     double e[12];

@@ -35,6 +35,11 @@ extern const int panda_free_joints[1];
 /* T = fk(q): the tool pose in the world */
 void panda_fk(const double q[7], double T[16]);
 
+/* J = the geometric Jacobian at q (derive/jacobian.py): rows 0-2 the tool point's linear
+   velocity, rows 3-5 the angular velocity, per unit of each joint's velocity; frame 0: in the
+   world (fk's frame), 1: in the tool frame (rotated by fk's R^T) */
+void panda_jacobian(const double q[7], int frame, double J[6][7]);
+
 /* Every solution of the pose T, each certified by forward kinematics (rotation within tol,
    position within tol * reach), revolute values in (-pi, pi], in the Python solver's order.
    free: the free joints' values (PANDA_FREE_COUNT of them; may be NULL: q_ref's, or 0),

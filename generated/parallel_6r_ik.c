@@ -1166,6 +1166,157 @@ static int dk_finish(double found[DK_MAX][DK_DOF], int count, int repeats,
     return m;
 }
 
+void parallel_6r_jacobian(const double q[DK_DOF], int frame, double J[6][DK_DOF])
+{
+    {
+        const double theta1 = q[0];
+        const double c1 = cos(theta1);
+        const double s1 = sin(theta1);
+        const double theta2 = q[1] - 1.5707963267948966;
+        const double c2 = cos(theta2);
+        const double s2 = sin(theta2);
+        const double theta3 = q[2];
+        const double c3 = cos(theta3);
+        const double s3 = sin(theta3);
+        const double theta4 = q[3] + 1.5707963267948966;
+        const double c4 = cos(theta4);
+        const double s4 = sin(theta4);
+        const double theta5 = q[4];
+        const double c5 = cos(theta5);
+        const double s5 = sin(theta5);
+        double x0 = s2*s3;
+        double x1 = s1*x0;
+        double x2 = c2*c3;
+        double x3 = s1*x2;
+        double x4 = c2*s3;
+        double x5 = c3*s2;
+        double x6 = -s1*x4 - s1*x5;
+        double x7 = c4*x6;
+        double x8 = -x1 + x3;
+        double x9 = c1*c5;
+        double x10 = s5*(c4*x8 + s4*x6);
+        double x11 = -42.0*x10 + 42.0*x9;
+        double x12 = 79.2*s4*x8 + x11 - 79.2*x7;
+        double x13 = -173.0*x1 + x12 + 173.0*x3;
+        double x14 = 116.5*c1 + 203.5*c2*s1 + x13;
+        double x15 = s2*s3 - x2;
+        double x16 = c4*x15;
+        double x17 = -x4 - x5;
+        double x18 = c4*x17 + s4*x15;
+        double x19 = s5*x18;
+        double x20 = 42.0*x19;
+        double x21 = -79.2*s4*x17 + 79.2*x16 + x20;
+        double x22 = x21 + 173.0*x4 + 173.0*x5;
+        double x23 = -203.5*s2 - x22;
+        double x24 = -x22;
+        double x25 = -x21;
+        double x26 = s4*x8 - x7;
+        double x27 = s4*x17 - x16;
+        double x28 = -x10 + x9;
+        double x29 = c1*x0;
+        double x30 = c1*x2 - x29;
+        double x31 = -c1*x4 - c1*x5;
+        double x32 = c4*x31;
+        double x33 = c5*s1;
+        double x34 = s5*(c4*x30 + s4*x31);
+        double x35 = 42.0*x33 + 42.0*x34;
+        double x36 = -79.2*s4*x30 + 79.2*x32 + x35;
+        double x37 = -173.0*c1*c2*c3 + 173.0*x29 + x36;
+        double x38 = 203.5*c1*c2 - 116.5*s1 - x37;
+        double x39 = s4*x30 - x32;
+        double x40 = -x36;
+        double x41 = -x35;
+        double x42 = -x33 - x34;
+        double x43 = -s1;
+        double j0_0 = -x14;
+        double j0_1 = c1*x23;
+        double j0_2 = c1*x24;
+        double j0_3 = c1*x25;
+        double j0_4 = -x12*x27 + x25*x26;
+        double j0_5 = s5*x11*x18 - x20*x28;
+        double j1_0 = x38;
+        double j1_1 = s1*x23;
+        double j1_2 = s1*x24;
+        double j1_3 = s1*x25;
+        double j1_4 = -x25*x39 + x27*x40;
+        double j1_5 = 42.0*s5*x18*x42 - x19*x41;
+        double j2_0 = 0.0;
+        double j2_1 = -c1*x38 - s1*x14;
+        double j2_2 = c1*x37 - s1*x13;
+        double j2_3 = -c1*x40 - s1*x12;
+        double j2_4 = x12*x39 - x26*x40;
+        double j2_5 = x11*x42 - x28*x41;
+        double j3_0 = 0.0;
+        double j3_1 = x43;
+        double j3_2 = x43;
+        double j3_3 = x43;
+        double j3_4 = x39;
+        double j3_5 = x42;
+        double j4_0 = 0.0;
+        double j4_1 = c1;
+        double j4_2 = c1;
+        double j4_3 = c1;
+        double j4_4 = x26;
+        double j4_5 = x28;
+        double j5_0 = 1.0;
+        double j5_1 = 0.0;
+        double j5_2 = 0.0;
+        double j5_3 = 0.0;
+        double j5_4 = x27;
+        double j5_5 = -x19;
+        J[0][0] = j0_0;
+        J[0][1] = j0_1;
+        J[0][2] = j0_2;
+        J[0][3] = j0_3;
+        J[0][4] = j0_4;
+        J[0][5] = j0_5;
+        J[1][0] = j1_0;
+        J[1][1] = j1_1;
+        J[1][2] = j1_2;
+        J[1][3] = j1_3;
+        J[1][4] = j1_4;
+        J[1][5] = j1_5;
+        J[2][0] = j2_0;
+        J[2][1] = j2_1;
+        J[2][2] = j2_2;
+        J[2][3] = j2_3;
+        J[2][4] = j2_4;
+        J[2][5] = j2_5;
+        J[3][0] = j3_0;
+        J[3][1] = j3_1;
+        J[3][2] = j3_2;
+        J[3][3] = j3_3;
+        J[3][4] = j3_4;
+        J[3][5] = j3_5;
+        J[4][0] = j4_0;
+        J[4][1] = j4_1;
+        J[4][2] = j4_2;
+        J[4][3] = j4_3;
+        J[4][4] = j4_4;
+        J[4][5] = j4_5;
+        J[5][0] = j5_0;
+        J[5][1] = j5_1;
+        J[5][2] = j5_2;
+        J[5][3] = j5_3;
+        J[5][4] = j5_4;
+        J[5][5] = j5_5;
+    }
+    if (frame) { /* (the tool frame: v and w rotated by R^T) */
+        double e[12], column[6];
+        int j, r;
+        dk_fk_q(q, e);
+        for (j = 0; j < DK_DOF; j++) {
+            for (r = 0; r < 3; r++) {
+                column[r] = e[r] * J[0][j] + e[4 + r] * J[1][j] + e[8 + r] * J[2][j];
+                column[3 + r] = e[r] * J[3][j] + e[4 + r] * J[4][j] + e[8 + r] * J[5][j];
+            }
+            for (r = 0; r < 6; r++) {
+                J[r][j] = column[r];
+            }
+        }
+    }
+}
+
 void parallel_6r_fk(const double q[DK_DOF], double T[16])
 {
     double e[12];

@@ -33,6 +33,11 @@ extern const int planar_2r_free_joints[1];
 /* T = fk(q): the tool pose in the world */
 void planar_2r_fk(const double q[2], double T[16]);
 
+/* J = the geometric Jacobian at q (derive/jacobian.py): rows 0-2 the tool point's linear
+   velocity, rows 3-5 the angular velocity, per unit of each joint's velocity; frame 0: in the
+   world (fk's frame), 1: in the tool frame (rotated by fk's R^T) */
+void planar_2r_jacobian(const double q[2], int frame, double J[6][2]);
+
 /* Every solution of the pose T, each certified by forward kinematics (rotation within tol,
    position within tol * reach), revolute values in (-pi, pi], in the Python solver's order.
    free: the free joints' values (PLANAR_2R_FREE_COUNT of them; may be NULL: q_ref's, or 0),

@@ -1686,6 +1686,142 @@ static int dk_finish(double found[DK_MAX][DK_DOF], int count, int repeats,
     return m;
 }
 
+void puma560_jacobian(const double q[DK_DOF], int frame, double J[6][DK_DOF])
+{
+    {
+        const double theta1 = q[0];
+        const double c1 = cos(theta1);
+        const double s1 = sin(theta1);
+        const double theta2 = q[1];
+        const double c2 = cos(theta2);
+        const double s2 = sin(theta2);
+        const double theta3 = q[2];
+        const double c3 = cos(theta3);
+        const double s3 = sin(theta3);
+        const double theta4 = q[3];
+        const double c4 = cos(theta4);
+        const double s4 = sin(theta4);
+        const double theta5 = q[4];
+        const double c5 = cos(theta5);
+        const double s5 = sin(theta5);
+        double x0 = 0.432*c2;
+        double x1 = c2*c3;
+        double x2 = s1*x1;
+        double x3 = s2*s3;
+        double x4 = s1*x3;
+        double x5 = c2*s3;
+        double x6 = s1*x5;
+        double x7 = c3*s2;
+        double x8 = s1*x7;
+        double x9 = 0.433*x6 + 0.433*x8;
+        double x10 = 0.149*c1 - 0.02*x2 + 0.02*x4 + x9;
+        double x11 = s1*x0 + x10;
+        double x12 = 0.433*x1 - 0.433*x3;
+        double x13 = x12 + 0.02*x5 + 0.02*x7;
+        double x14 = -0.432*s2 + x13;
+        double x15 = x6 + x8;
+        double x16 = x1 - x3;
+        double x17 = c1*x1;
+        double x18 = c1*x3;
+        double x19 = c1*x5;
+        double x20 = c1*x7;
+        double x21 = 0.433*x19 + 0.433*x20;
+        double x22 = -0.149*s1 - 0.02*x17 + 0.02*x18 + x21;
+        double x23 = c1*x0 + x22;
+        double x24 = x19 + x20;
+        double x25 = -s1;
+        double x26 = x17 - x18;
+        double x27 = x2 - x4;
+        double x28 = -x5 - x7;
+        double j0_0 = -x11;
+        double j0_1 = c1*x14;
+        double j0_2 = c1*x13;
+        double j0_3 = x12*x15 - x16*x9;
+        double j0_4 = 0.0;
+        double j0_5 = 0.0;
+        double j1_0 = x23;
+        double j1_1 = s1*x14;
+        double j1_2 = s1*x13;
+        double j1_3 = -x12*x24 + x16*x21;
+        double j1_4 = 0.0;
+        double j1_5 = 0.0;
+        double j2_0 = 0.0;
+        double j2_1 = -c1*x23 - s1*x11;
+        double j2_2 = -c1*x22 - s1*x10;
+        double j2_3 = -x15*x21 + x24*x9;
+        double j2_4 = 0.0;
+        double j2_5 = 0.0;
+        double j3_0 = 0.0;
+        double j3_1 = x25;
+        double j3_2 = x25;
+        double j3_3 = x24;
+        double j3_4 = -c4*s1 - s4*x26;
+        double j3_5 = c5*x24 + s5*(c4*x26 - s1*s4);
+        double j4_0 = 0.0;
+        double j4_1 = c1;
+        double j4_2 = c1;
+        double j4_3 = x15;
+        double j4_4 = c1*c4 - s4*x27;
+        double j4_5 = c5*x15 + s5*(c1*s4 + c4*x27);
+        double j5_0 = 1.0;
+        double j5_1 = 0.0;
+        double j5_2 = 0.0;
+        double j5_3 = x16;
+        double j5_4 = -s4*x28;
+        double j5_5 = c4*s5*x28 + c5*x16;
+        J[0][0] = j0_0;
+        J[0][1] = j0_1;
+        J[0][2] = j0_2;
+        J[0][3] = j0_3;
+        J[0][4] = j0_4;
+        J[0][5] = j0_5;
+        J[1][0] = j1_0;
+        J[1][1] = j1_1;
+        J[1][2] = j1_2;
+        J[1][3] = j1_3;
+        J[1][4] = j1_4;
+        J[1][5] = j1_5;
+        J[2][0] = j2_0;
+        J[2][1] = j2_1;
+        J[2][2] = j2_2;
+        J[2][3] = j2_3;
+        J[2][4] = j2_4;
+        J[2][5] = j2_5;
+        J[3][0] = j3_0;
+        J[3][1] = j3_1;
+        J[3][2] = j3_2;
+        J[3][3] = j3_3;
+        J[3][4] = j3_4;
+        J[3][5] = j3_5;
+        J[4][0] = j4_0;
+        J[4][1] = j4_1;
+        J[4][2] = j4_2;
+        J[4][3] = j4_3;
+        J[4][4] = j4_4;
+        J[4][5] = j4_5;
+        J[5][0] = j5_0;
+        J[5][1] = j5_1;
+        J[5][2] = j5_2;
+        J[5][3] = j5_3;
+        J[5][4] = j5_4;
+        J[5][5] = j5_5;
+    }
+    if (frame) { /* (the tool frame: v and w rotated by R^T) */
+        double e[12], column[6];
+        int j, r;
+        dk_fk_q(q, e);
+        for (j = 0; j < DK_DOF; j++) {
+            for (r = 0; r < 3; r++) {
+                column[r] = e[r] * J[0][j] + e[4 + r] * J[1][j] + e[8 + r] * J[2][j];
+                column[3 + r] = e[r] * J[3][j] + e[4 + r] * J[4][j] + e[8 + r] * J[5][j];
+            }
+            for (r = 0; r < 6; r++) {
+                J[r][j] = column[r];
+            }
+        }
+    }
+}
+
 void puma560_fk(const double q[DK_DOF], double T[16])
 {
     double e[12];

@@ -29,6 +29,11 @@ homogeneous transforms of the tool frame in the world (base and tool frames incl
 API:
     fk(q) -> (4, 4) ndarray
     fk_batch(Q: (N, DOF)) -> (N, 4, 4) ndarray
+    jacobian(q, frame="base") -> (6, DOF) ndarray, the geometric Jacobian at the tool point
+        (linear over angular velocity; frame "base" the world's, "tool" the tool's)
+    manipulability(q) -> (smallest singular value, Yoshikawa's w) of the Jacobian
+    ik_velocity(q, twist, *, frame="base", damping=VELOCITY_DAMPING, band=VELOCITY_BAND,
+                preferred=None, gain=1.0) -> (DOF,) ndarray, joint velocities for a tool twist
     ik(T, *, within_limits=False, q_ref=None, tol=CERTIFY_TOL, backend=None, all_turns=False)
         -> (n, DOF) ndarray, all solutions
     ik_batch(T: (N, 4, 4), *, q_ref=None, tol=CERTIFY_TOL, chunk=4096, backend=None)
@@ -1108,6 +1113,116 @@ def _task_pose(p: ArrayLike, d: ArrayLike | None) -> np.ndarray:
     return T
 
 
+def jacobian(q: ArrayLike, frame: str = "base") -> np.ndarray:
+    """The geometric Jacobian at q, (6, DOF): rows 0-2 the tool point's linear velocity, rows
+    3-5 the tool's angular velocity, per unit of each joint's velocity ([v; w] = J dq; length
+    units and radians, as fk's).
+
+    Args:
+        q: DOF joint values.
+        frame: "base": v and w in the world (fk's frame); "tool": both in the tool frame
+            (rotated by fk(q)'s R^T; the point is still the tool point).
+
+    Raises:
+        ValueError: q is not DOF finite numbers, or frame is neither "base" nor "tool".
+    """
+    values = _joint_values(q)
+    if frame not in ("base", "tool"):
+        raise ValueError(f'frame must be "base" or "tool", got {frame!r}')
+    J = np.array(_jacobian_q(values)).reshape(6, DOF)
+    if frame == "tool":
+        e = _fk_q(values)
+        R = np.array([e[0:3], e[4:7], e[8:11]])
+        J = np.vstack([R.T @ J[:3], R.T @ J[3:]])
+    return J
+
+
+# ik_velocity's damping: none while the Jacobian's smallest singular value is at least
+# VELOCITY_BAND; below it, lambda^2 = VELOCITY_DAMPING^2 (1 - (sigma / VELOCITY_BAND)^2), which
+# bounds every joint rate by |twist| / (2 VELOCITY_DAMPING) at a singular configuration
+VELOCITY_BAND = 0.05
+
+
+VELOCITY_DAMPING = 0.05
+
+
+def ik_velocity(
+    q: ArrayLike,
+    twist: ArrayLike,
+    *,
+    frame: str = "base",
+    damping: float = VELOCITY_DAMPING,
+    band: float = VELOCITY_BAND,
+    preferred: ArrayLike | None = None,
+    gain: float = 1.0,
+) -> np.ndarray:
+    """Joint velocities dq that move the tool with the twist [v; w] at q: damped least
+    squares on jacobian(q, frame), dq = sum_k sigma_k / (sigma_k^2 + lambda^2) v_k u_k^T twist.
+
+    Away from singular configurations (every singular value at least band) lambda is 0 and
+    J dq reproduces the twist (to rounding) where the arm can move that way; within band of one
+    the damping grows to damping^2 as the smallest singular value goes to 0, which bounds the
+    joint rates (by |twist| / (2 damping)) at the price of the twist's component along the lost
+    direction. An arm of fewer than 6 joints gets the least-squares dq.
+
+    Args:
+        q: DOF joint values; twist: 6 numbers, v (length units per second) then w (rad/s).
+        frame: the twist's frame, as jacobian's.
+        damping, band: the damping's size and where it starts (singular values, J's units).
+        preferred: joint values to drift toward in the Jacobian's null space (an arm with
+            more joints than the twist needs, FREE: its self-motion), gain * (preferred - q)
+            projected so that the tool does not move; None: no drift.
+        gain: the drift's rate (per second).
+
+    Raises:
+        ValueError: q or preferred is not DOF finite numbers, twist not 6, frame unknown,
+            damping or band negative, gain not finite.
+    """
+    J = jacobian(q, frame)
+    target = _real(twist, "twist")
+    if target.shape != (6,) or not np.isfinite(target).all():
+        raise ValueError(f"twist must be 6 finite numbers, got {target}")
+    if not (damping >= 0.0 and band >= 0.0 and math.isfinite(damping + band + gain)):
+        raise ValueError("damping and band must be finite numbers >= 0, gain finite")
+    U, sigma, Vt = np.linalg.svd(J, full_matrices=False)
+    least = float(sigma[-1]) if len(sigma) == 6 else math.inf
+    lam2 = 0.0
+    if least < band:
+        lam2 = damping * damping * (1.0 - (least / band) ** 2)
+    weights = np.divide(sigma, sigma * sigma + lam2, out=np.zeros_like(sigma), where=sigma > 0)
+    dq = Vt.T @ (weights * (U.T @ target))
+    if preferred is not None:
+        drift = gain * (np.array(_joint_values(preferred)) - np.array(_joint_values(q)))
+        rank = int(np.sum(sigma > 1e-12 * max(1.0, float(sigma[0]))))
+        rows = Vt[:rank]
+        dq = dq + drift - rows.T @ (rows @ drift)  # (the null space's share of the drift)
+    return dq
+
+
+def manipulability(q: ArrayLike) -> tuple[float, float]:
+    """How far q is from a singular configuration: (the smallest singular value of
+    jacobian(q), Yoshikawa's measure w, the product of its singular values: sqrt(det(J J^T))
+    for an arm of 6 joints or more, sqrt(det(J^T J)) for fewer). Both are 0 at a singular
+    configuration; J mixes length units and radians, so compare values of one arm.
+
+    Raises:
+        ValueError: q is not DOF finite numbers.
+    """
+    sigma = np.linalg.svd(jacobian(q), compute_uv=False)
+    return float(sigma[-1]) if len(sigma) == min(6, DOF) else 0.0, float(np.prod(sigma))
+
+
+def _joint_values(q: ArrayLike) -> list[float]:
+    """q as DOF finite floats."""
+    values = _real(q, "q")
+    if values.shape != (DOF,):
+        raise ValueError(f"q must have shape ({DOF},), got {values.shape}")
+    joints = values.tolist()
+    if not all(map(math.isfinite, joints)):
+        raise ValueError(f"q must be {DOF} finite numbers")
+    return joints
+
+
 def _reach_first2(A, B, C, lo, hi, ref):
     """The first value of a free t: ref if it keeps A + B cos t + C sin t in [lo, hi], else
     the nearer to ref of the two t at which it is mid-range."""
@@ -1635,6 +1750,158 @@ def _fk_q(q):
     c5 = cos(theta5)
     s5 = sin(theta5)
     return _fk_from_cs(c1, s1, c2, s2, c3, s3, c4, s4, c5, s5)
+
+
+def _jacobian_q(q):
+    """The geometric Jacobian at the tool point in the world (linear velocity over angular
+    velocity), 6 * DOF entries row-major, for one joint vector (derive/jacobian.py)."""
+    theta1 = q[0]
+    c1 = cos(theta1)
+    s1 = sin(theta1)
+    theta2 = q[1] + 0.24378056638519918
+    c2 = cos(theta2)
+    s2 = sin(theta2)
+    theta3 = q[2] - 0.28230856322733766
+    c3 = cos(theta3)
+    s3 = sin(theta3)
+    theta4 = q[3] - 1.5322620031578618
+    c4 = cos(theta4)
+    s4 = sin(theta4)
+    x0 = 6.326794896481483e-06 - 4.242642374223136e-06*c1
+    x1 = c2*x0
+    x2 = -0.9999999999709862*c1 - 2.6842328121609817e-11
+    x3 = c2*x2
+    x4 = 2.6842328121609817e-11*c1 + 0.9999999999709862
+    x5 = c2*x4
+    x6 = 6.326794896481483e-06*c1 - 4.242642374223136e-06
+    x7 = c2*x6
+    x8 = s2*x0
+    x9 = s2*x2
+    x10 = s2*x4
+    x11 = s2*x6
+    x12 = (0.9704339120281953*s2*x4 - 0.9704339120281953*x1 - 0.2413669869424017*x5 -
+        0.2413669869424017*x8)
+    x13 = c3*x12
+    x14 = (-0.2413669869424017*x1 + 0.2413669869424017*x10 + 0.9704339120281952*x5 +
+        0.9704339120281952*x8)
+    x15 = c3*x14
+    x16 = (0.9704339120281953*s2*x6 - 0.9704339120281953*x3 - 0.2413669869424017*x7 -
+        0.2413669869424017*x9)
+    x17 = c3*x16
+    x18 = (0.2413669869424017*x11 - 0.2413669869424017*x3 + 0.9704339120281952*x7 +
+        0.9704339120281952*x9)
+    x19 = c3*x18
+    x20 = s3*x12
+    x21 = s3*x14
+    x22 = s3*x16
+    x23 = s3*x18
+    x24 = (0.27857964376675615*x13 - 0.9604131309383415*x15 + 0.9604131309383415*x20 +
+        0.27857964376675615*x21)
+    x25 = c4*x24
+    x26 = 0.27857964376675615*s3
+    x27 = -x12*x26 + 0.9604131309383415*x13 + 0.27857964376675615*x15 + 0.9604131309383415*x21
+    x28 = c4*x27
+    x29 = (0.27857964376675615*x17 - 0.9604131309383415*x19 + 0.9604131309383415*x22 +
+        0.27857964376675615*x23)
+    x30 = c4*x29
+    x31 = -x16*x26 + 0.9604131309383415*x17 + 0.27857964376675615*x19 + 0.9604131309383415*x23
+    x32 = c4*x31
+    x33 = s4*x24
+    x34 = s4*x27
+    x35 = s4*x29
+    x36 = s4*x31
+    x37 = 0.0023153397455835125*x28
+    x38 = (-0.06005538445354022*c4*x24 - 0.03258541679967204*s3*x12 - 0.0023153397455835125*s4*x24 -
+        0.06005538445354022*s4*x27 + 0.13100855167504008*x13 + 0.03258541679967204*x15 +
+        0.13100855167504008*x21 + x37)
+    x39 = (0.11600002111836609*c2*x0 - 0.11600002111836609*x10 - x38 - 7.339083417139803e-07*x5 -
+        7.339083417139803e-07*x8)
+    x40 = 0.9999999999910001*s1
+    x41 = 0.0023153397455835125*x32
+    x42 = (-0.06005538445354022*c4*x29 - 0.03258541679967204*s3*x16 - 0.0023153397455835125*s4*x29 -
+        0.06005538445354022*s4*x31 + 0.13100855167504008*x17 + 0.03258541679967204*x19 +
+        0.13100855167504008*x23 + x41)
+    x43 = (0.11600002111836609*c2*x2 - 0.11600002111836609*x11 - x42 - 7.339083417139803e-07*x7 -
+        7.339083417139803e-07*x9)
+    x44 = 4.242642374308048e-06*s1
+    x45 = -x38
+    x46 = -x42
+    x47 = 0.06005538445354022*x25 + 0.0023153397455835125*x33 + 0.06005538445354022*x34 - x37
+    x48 = 0.06005538445354022*x30 + 0.0023153397455835125*x35 + 0.06005538445354022*x36 - x41
+    x49 = c2*s1
+    x50 = s1*s2
+    x51 = -0.9704323849293519*x49 - 0.24137312667389305*x50
+    x52 = c3*x51
+    x53 = 0.9704323849293518*s1*s2 - 0.24137312667389305*x49
+    x54 = c3*x53
+    x55 = s3*x51
+    x56 = s3*x53
+    x57 = 0.9604131309383415*x53
+    x58 = -c3*x57 + x26*x53 + 0.27857964376675615*x52 + 0.9604131309383415*x55
+    x59 = c4*x58
+    x60 = s3*x57 - x26*x51 + 0.9604131309383415*x52 + 0.27857964376675615*x54
+    x61 = c4*x60
+    x62 = s4*x58
+    x63 = s4*x60
+    x64 = 0.03258541679967204*x54
+    x65 = 0.13100855167504008*x52
+    x66 = 0.13100855167504008*x56
+    x67 = 0.0023153397455835125*x61
+    x68 = 0.06005538445354022*x59 + 0.0023153397455835125*x62 + 0.06005538445354022*x63 - x67
+    x69 = (0.11600002112068776*x49 - 8.926404519542792e-17*x50 + 0.03258541679967204*x55 - x64 - x65
+        - x66 + x68)
+    x70 = (0.06005538445354022*c4*x58 + 0.03258541679967204*s3*x51 + 0.0023153397455835125*s4*x58 +
+        0.06005538445354022*s4*x60 - x64 - x65 - x66 - x67)
+    j0_0 = (0.030600000000000006*c1 - 4.921466050174084e-07*x1 + 4.921466050174084e-07*x10 +
+        0.1160000211173221*x11 + 5.558224327332506e-07*x13 + 1.3824827009877795e-07*x15 +
+        0.13100855167386102*x17 + 0.03258541679937878*x19 - 1.3824827009877795e-07*x20 +
+        5.558224327332506e-07*x21 - 0.03258541679937878*x22 + 0.13100855167386102*x23 -
+        2.547935188879505e-07*x25 + 9.823158515532224e-09*x28 - 0.1160000211173221*x3 -
+        0.06005538445299973*x30 + 0.0023153397455626746*x32 - 9.823158515532224e-09*x33 -
+        2.547935188879505e-07*x34 - 0.0023153397455626746*x35 - 0.06005538445299973*x36 +
+        3.1137106294138834e-12*x5 + 7.339083417073752e-07*x7 + 3.1137106294138834e-12*x8 +
+        7.339083417073752e-07*x9 - 2.3826937544589962e-20)
+    j0_1 = x39*x40 - x43*x44
+    j0_2 = x40*x45 - x44*x46
+    j0_3 = x40*x47 - x44*x48
+    j0_4 = 0.0
+    j1_0 = (0.0305999999997246*s1 + 0.11600002111964378*x49 - 8.926404519462455e-17*x50 -
+        0.13100855167386102*x52 - 0.03258541679937878*x54 + 0.03258541679937878*x55 -
+        0.13100855167386102*x56 + 0.06005538445299973*x59 - 0.0023153397455626746*x61 +
+        0.0023153397455626746*x62 + 0.06005538445299973*x63)
+    j1_1 = -c1*x39 + 4.242642374308048e-06*s1*x69
+    j1_2 = -c1*x45 + 4.242642374308048e-06*s1*x70
+    j1_3 = -c1*x47 + 4.242642374308048e-06*s1*x68
+    j1_4 = 0.0
+    j2_0 = (1.2982485665382626e-07*s1 + 4.921466050272585e-07*x49 - 3.787154206482712e-22*x50 -
+        5.558224327332506e-07*x52 - 1.3824827009877795e-07*x54 + 1.3824827009877795e-07*x55 -
+        5.558224327332506e-07*x56 + 2.547935188879505e-07*x59 - 9.823158515532224e-09*x61 +
+        9.823158515532224e-09*x62 + 2.547935188879505e-07*x63)
+    j2_1 = c1*x43 - x40*x69
+    j2_2 = c1*x46 - x40*x70
+    j2_3 = c1*x48 - x40*x68
+    j2_4 = 0.0
+    j3_0 = 0.0
+    j3_1 = c1
+    j3_2 = c1
+    j3_3 = c1
+    j3_4 = (0.03852478778009172*c4*x60 - 0.999257644817641*x59 - 0.03852478778009172*x62 -
+        0.999257644817641*x63)
+    j4_0 = -4.242642374308048e-06
+    j4_1 = x40
+    j4_2 = x40
+    j4_3 = x40
+    j4_4 = (0.03852478778009172*c4*x31 - 0.999257644817641*x30 - 0.03852478778009172*x35 -
+        0.999257644817641*x36)
+    j5_0 = 0.9999999999910001
+    j5_1 = x44
+    j5_2 = x44
+    j5_3 = x44
+    j5_4 = (0.03852478778009172*c4*x27 - 0.999257644817641*x25 - 0.03852478778009172*x33 -
+        0.999257644817641*x34)
+    return (j0_0, j0_1, j0_2, j0_3, j0_4, j1_0, j1_1, j1_2, j1_3, j1_4, j2_0, j2_1, j2_2, j2_3,
+        j2_4, j3_0, j3_1, j3_2, j3_3, j3_4, j4_0, j4_1, j4_2, j4_3, j4_4, j5_0, j5_1, j5_2, j5_3,
+        j5_4)
 
 
 def _cs_columns(Q):

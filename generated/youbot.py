@@ -30,6 +30,11 @@ homogeneous transforms of the tool frame in the world (base and tool frames incl
 API:
     fk(q) -> (4, 4) ndarray
     fk_batch(Q: (N, DOF)) -> (N, 4, 4) ndarray
+    jacobian(q, frame="base") -> (6, DOF) ndarray, the geometric Jacobian at the tool point
+        (linear over angular velocity; frame "base" the world's, "tool" the tool's)
+    manipulability(q) -> (smallest singular value, Yoshikawa's w) of the Jacobian
+    ik_velocity(q, twist, *, frame="base", damping=VELOCITY_DAMPING, band=VELOCITY_BAND,
+                preferred=None, gain=1.0) -> (DOF,) ndarray, joint velocities for a tool twist
     ik(T, *, within_limits=False, q_ref=None, tol=CERTIFY_TOL, backend=None, all_turns=False)
         -> (n, DOF) ndarray, all solutions
     ik_batch(T: (N, 4, 4), *, q_ref=None, tol=CERTIFY_TOL, chunk=4096, backend=None)
@@ -1087,6 +1092,116 @@ def _task_pose(p: ArrayLike, d: ArrayLike | None) -> np.ndarray:
     return T
 
 
+def jacobian(q: ArrayLike, frame: str = "base") -> np.ndarray:
+    """The geometric Jacobian at q, (6, DOF): rows 0-2 the tool point's linear velocity, rows
+    3-5 the tool's angular velocity, per unit of each joint's velocity ([v; w] = J dq; length
+    units and radians, as fk's).
+
+    Args:
+        q: DOF joint values.
+        frame: "base": v and w in the world (fk's frame); "tool": both in the tool frame
+            (rotated by fk(q)'s R^T; the point is still the tool point).
+
+    Raises:
+        ValueError: q is not DOF finite numbers, or frame is neither "base" nor "tool".
+    """
+    values = _joint_values(q)
+    if frame not in ("base", "tool"):
+        raise ValueError(f'frame must be "base" or "tool", got {frame!r}')
+    J = np.array(_jacobian_q(values)).reshape(6, DOF)
+    if frame == "tool":
+        e = _fk_q(values)
+        R = np.array([e[0:3], e[4:7], e[8:11]])
+        J = np.vstack([R.T @ J[:3], R.T @ J[3:]])
+    return J
+
+
+# ik_velocity's damping: none while the Jacobian's smallest singular value is at least
+# VELOCITY_BAND; below it, lambda^2 = VELOCITY_DAMPING^2 (1 - (sigma / VELOCITY_BAND)^2), which
+# bounds every joint rate by |twist| / (2 VELOCITY_DAMPING) at a singular configuration
+VELOCITY_BAND = 0.05
+
+
+VELOCITY_DAMPING = 0.05
+
+
+def ik_velocity(
+    q: ArrayLike,
+    twist: ArrayLike,
+    *,
+    frame: str = "base",
+    damping: float = VELOCITY_DAMPING,
+    band: float = VELOCITY_BAND,
+    preferred: ArrayLike | None = None,
+    gain: float = 1.0,
+) -> np.ndarray:
+    """Joint velocities dq that move the tool with the twist [v; w] at q: damped least
+    squares on jacobian(q, frame), dq = sum_k sigma_k / (sigma_k^2 + lambda^2) v_k u_k^T twist.
+
+    Away from singular configurations (every singular value at least band) lambda is 0 and
+    J dq reproduces the twist (to rounding) where the arm can move that way; within band of one
+    the damping grows to damping^2 as the smallest singular value goes to 0, which bounds the
+    joint rates (by |twist| / (2 damping)) at the price of the twist's component along the lost
+    direction. An arm of fewer than 6 joints gets the least-squares dq.
+
+    Args:
+        q: DOF joint values; twist: 6 numbers, v (length units per second) then w (rad/s).
+        frame: the twist's frame, as jacobian's.
+        damping, band: the damping's size and where it starts (singular values, J's units).
+        preferred: joint values to drift toward in the Jacobian's null space (an arm with
+            more joints than the twist needs, FREE: its self-motion), gain * (preferred - q)
+            projected so that the tool does not move; None: no drift.
+        gain: the drift's rate (per second).
+
+    Raises:
+        ValueError: q or preferred is not DOF finite numbers, twist not 6, frame unknown,
+            damping or band negative, gain not finite.
+    """
+    J = jacobian(q, frame)
+    target = _real(twist, "twist")
+    if target.shape != (6,) or not np.isfinite(target).all():
+        raise ValueError(f"twist must be 6 finite numbers, got {target}")
+    if not (damping >= 0.0 and band >= 0.0 and math.isfinite(damping + band + gain)):
+        raise ValueError("damping and band must be finite numbers >= 0, gain finite")
+    U, sigma, Vt = np.linalg.svd(J, full_matrices=False)
+    least = float(sigma[-1]) if len(sigma) == 6 else math.inf
+    lam2 = 0.0
+    if least < band:
+        lam2 = damping * damping * (1.0 - (least / band) ** 2)
+    weights = np.divide(sigma, sigma * sigma + lam2, out=np.zeros_like(sigma), where=sigma > 0)
+    dq = Vt.T @ (weights * (U.T @ target))
+    if preferred is not None:
+        drift = gain * (np.array(_joint_values(preferred)) - np.array(_joint_values(q)))
+        rank = int(np.sum(sigma > 1e-12 * max(1.0, float(sigma[0]))))
+        rows = Vt[:rank]
+        dq = dq + drift - rows.T @ (rows @ drift)  # (the null space's share of the drift)
+    return dq
+
+
+def manipulability(q: ArrayLike) -> tuple[float, float]:
+    """How far q is from a singular configuration: (the smallest singular value of
+    jacobian(q), Yoshikawa's measure w, the product of its singular values: sqrt(det(J J^T))
+    for an arm of 6 joints or more, sqrt(det(J^T J)) for fewer). Both are 0 at a singular
+    configuration; J mixes length units and radians, so compare values of one arm.
+
+    Raises:
+        ValueError: q is not DOF finite numbers.
+    """
+    sigma = np.linalg.svd(jacobian(q), compute_uv=False)
+    return float(sigma[-1]) if len(sigma) == min(6, DOF) else 0.0, float(np.prod(sigma))
+
+
+def _joint_values(q: ArrayLike) -> list[float]:
+    """q as DOF finite floats."""
+    values = _real(q, "q")
+    if values.shape != (DOF,):
+        raise ValueError(f"q must have shape ({DOF},), got {values.shape}")
+    joints = values.tolist()
+    if not all(map(math.isfinite, joints)):
+        raise ValueError(f"q must be {DOF} finite numbers")
+    return joints
+
+
 def _reach_first2(A, B, C, lo, hi, ref):
     """The first value of a free t: ref if it keeps A + B cos t + C sin t in [lo, hi], else
     the nearer to ref of the two t at which it is mid-range."""
@@ -1499,6 +1614,88 @@ def _fk_q(q):
     c5 = cos(theta5)
     s5 = sin(theta5)
     return _fk_from_cs(c1, s1, c2, s2, c3, s3, c4, s4, c5, s5)
+
+
+def _jacobian_q(q):
+    """The geometric Jacobian at the tool point in the world (linear velocity over angular
+    velocity), 6 * DOF entries row-major, for one joint vector (derive/jacobian.py)."""
+    theta1 = q[0]
+    c1 = cos(theta1)
+    s1 = sin(theta1)
+    theta2 = q[1] + 1.5707963267948966
+    c2 = cos(theta2)
+    s2 = sin(theta2)
+    theta3 = q[2]
+    c3 = cos(theta3)
+    s3 = sin(theta3)
+    theta4 = q[3] + 1.5707963267948966
+    c4 = cos(theta4)
+    s4 = sin(theta4)
+    x0 = 0.155*c2
+    x1 = c2*c3
+    x2 = s1*x1
+    x3 = s2*s3
+    x4 = s1*x3
+    x5 = x2 - x4
+    x6 = 0.2175*s4*x5
+    x7 = c2*s3
+    x8 = c3*s2
+    x9 = c4*(-s1*x7 - s1*x8)
+    x10 = 0.2175*x9
+    x11 = -x10 + 0.135*x2 - 0.135*x4 + x6
+    x12 = s1*x0 + x11
+    x13 = x7 + x8
+    x14 = c4*(x1 - x3)
+    x15 = 0.2175*x14
+    x16 = 0.2175*s4*x13 - x15 + 0.135*x7 + 0.135*x8
+    x17 = 0.155*s2 + x16
+    x18 = 0.2175*s4*x13 - x15
+    x19 = s4*x13 - x14
+    x20 = -x10 + x6
+    x21 = s4*x5 - x9
+    x22 = c1*x1
+    x23 = c1*x3
+    x24 = x22 - x23
+    x25 = c4*(-c1*x7 - c1*x8)
+    x26 = 0.2175*x25
+    x27 = 0.2175*s4*x24 + 0.135*x22 - 0.135*x23 - x26
+    x28 = c1*x0 + x27
+    x29 = 0.2175*s4*x24 - x26
+    x30 = s4*x24 - x25
+    x31 = -c1
+    j0_0 = -0.033*s1 - x12
+    j0_1 = -c1*x17
+    j0_2 = -c1*x16
+    j0_3 = -c1*x18
+    j0_4 = x18*x21 - x19*x20
+    j1_0 = 0.033*c1 + x28
+    j1_1 = -s1*x17
+    j1_2 = -s1*x16
+    j1_3 = -s1*x18
+    j1_4 = -x18*x30 + x19*x29
+    j2_0 = 0.0
+    j2_1 = c1*x28 + s1*x12
+    j2_2 = c1*x27 + s1*x11
+    j2_3 = c1*x29 + s1*x20
+    j2_4 = x20*x30 - x21*x29
+    j3_0 = 0.0
+    j3_1 = s1
+    j3_2 = s1
+    j3_3 = s1
+    j3_4 = x30
+    j4_0 = 0.0
+    j4_1 = x31
+    j4_2 = x31
+    j4_3 = x31
+    j4_4 = x21
+    j5_0 = 1.0
+    j5_1 = 0.0
+    j5_2 = 0.0
+    j5_3 = 0.0
+    j5_4 = x19
+    return (j0_0, j0_1, j0_2, j0_3, j0_4, j1_0, j1_1, j1_2, j1_3, j1_4, j2_0, j2_1, j2_2, j2_3,
+        j2_4, j3_0, j3_1, j3_2, j3_3, j3_4, j4_0, j4_1, j4_2, j4_3, j4_4, j5_0, j5_1, j5_2, j5_3,
+        j5_4)
 
 
 def _cs_columns(Q):

@@ -1143,6 +1143,130 @@ static int dk_finish(double found[DK_MAX][DK_DOF], int count, int repeats,
     return m;
 }
 
+void youbot_jacobian(const double q[DK_DOF], int frame, double J[6][DK_DOF])
+{
+    {
+        const double theta1 = q[0];
+        const double c1 = cos(theta1);
+        const double s1 = sin(theta1);
+        const double theta2 = q[1] + 1.5707963267948966;
+        const double c2 = cos(theta2);
+        const double s2 = sin(theta2);
+        const double theta3 = q[2];
+        const double c3 = cos(theta3);
+        const double s3 = sin(theta3);
+        const double theta4 = q[3] + 1.5707963267948966;
+        const double c4 = cos(theta4);
+        const double s4 = sin(theta4);
+        double x0 = 0.155*c2;
+        double x1 = c2*c3;
+        double x2 = s1*x1;
+        double x3 = s2*s3;
+        double x4 = s1*x3;
+        double x5 = x2 - x4;
+        double x6 = 0.2175*s4*x5;
+        double x7 = c2*s3;
+        double x8 = c3*s2;
+        double x9 = c4*(-s1*x7 - s1*x8);
+        double x10 = 0.2175*x9;
+        double x11 = -x10 + 0.135*x2 - 0.135*x4 + x6;
+        double x12 = s1*x0 + x11;
+        double x13 = x7 + x8;
+        double x14 = c4*(x1 - x3);
+        double x15 = 0.2175*x14;
+        double x16 = 0.2175*s4*x13 - x15 + 0.135*x7 + 0.135*x8;
+        double x17 = 0.155*s2 + x16;
+        double x18 = 0.2175*s4*x13 - x15;
+        double x19 = s4*x13 - x14;
+        double x20 = -x10 + x6;
+        double x21 = s4*x5 - x9;
+        double x22 = c1*x1;
+        double x23 = c1*x3;
+        double x24 = x22 - x23;
+        double x25 = c4*(-c1*x7 - c1*x8);
+        double x26 = 0.2175*x25;
+        double x27 = 0.2175*s4*x24 + 0.135*x22 - 0.135*x23 - x26;
+        double x28 = c1*x0 + x27;
+        double x29 = 0.2175*s4*x24 - x26;
+        double x30 = s4*x24 - x25;
+        double x31 = -c1;
+        double j0_0 = -0.033*s1 - x12;
+        double j0_1 = -c1*x17;
+        double j0_2 = -c1*x16;
+        double j0_3 = -c1*x18;
+        double j0_4 = x18*x21 - x19*x20;
+        double j1_0 = 0.033*c1 + x28;
+        double j1_1 = -s1*x17;
+        double j1_2 = -s1*x16;
+        double j1_3 = -s1*x18;
+        double j1_4 = -x18*x30 + x19*x29;
+        double j2_0 = 0.0;
+        double j2_1 = c1*x28 + s1*x12;
+        double j2_2 = c1*x27 + s1*x11;
+        double j2_3 = c1*x29 + s1*x20;
+        double j2_4 = x20*x30 - x21*x29;
+        double j3_0 = 0.0;
+        double j3_1 = s1;
+        double j3_2 = s1;
+        double j3_3 = s1;
+        double j3_4 = x30;
+        double j4_0 = 0.0;
+        double j4_1 = x31;
+        double j4_2 = x31;
+        double j4_3 = x31;
+        double j4_4 = x21;
+        double j5_0 = 1.0;
+        double j5_1 = 0.0;
+        double j5_2 = 0.0;
+        double j5_3 = 0.0;
+        double j5_4 = x19;
+        J[0][0] = j0_0;
+        J[0][1] = j0_1;
+        J[0][2] = j0_2;
+        J[0][3] = j0_3;
+        J[0][4] = j0_4;
+        J[1][0] = j1_0;
+        J[1][1] = j1_1;
+        J[1][2] = j1_2;
+        J[1][3] = j1_3;
+        J[1][4] = j1_4;
+        J[2][0] = j2_0;
+        J[2][1] = j2_1;
+        J[2][2] = j2_2;
+        J[2][3] = j2_3;
+        J[2][4] = j2_4;
+        J[3][0] = j3_0;
+        J[3][1] = j3_1;
+        J[3][2] = j3_2;
+        J[3][3] = j3_3;
+        J[3][4] = j3_4;
+        J[4][0] = j4_0;
+        J[4][1] = j4_1;
+        J[4][2] = j4_2;
+        J[4][3] = j4_3;
+        J[4][4] = j4_4;
+        J[5][0] = j5_0;
+        J[5][1] = j5_1;
+        J[5][2] = j5_2;
+        J[5][3] = j5_3;
+        J[5][4] = j5_4;
+    }
+    if (frame) { /* (the tool frame: v and w rotated by R^T) */
+        double e[12], column[6];
+        int j, r;
+        dk_fk_q(q, e);
+        for (j = 0; j < DK_DOF; j++) {
+            for (r = 0; r < 3; r++) {
+                column[r] = e[r] * J[0][j] + e[4 + r] * J[1][j] + e[8 + r] * J[2][j];
+                column[3 + r] = e[r] * J[3][j] + e[4 + r] * J[4][j] + e[8 + r] * J[5][j];
+            }
+            for (r = 0; r < 6; r++) {
+                J[r][j] = column[r];
+            }
+        }
+    }
+}
+
 void youbot_fk(const double q[DK_DOF], double T[16])
 {
     double e[12];

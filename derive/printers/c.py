@@ -584,6 +584,33 @@ def fk_lines(plan: Plan) -> tuple[tuple[str, ...], tuple[str, ...], str]:
     return pose_body, tuple(joints), params
 
 
+def jacobian_lines(plan: Plan) -> tuple[str, ...]:
+    """The body of NAME_jacobian's world-frame part: theta_i (c_i, s_i) from q, then the
+    CSE'd Jacobian entries (derive/jacobian.py) into J[6][DK_DOF]."""
+    printer = CPrinter()
+    J = plan.jacobian
+    n = J.shape[1]
+    entries = tuple(J[i, j] for i in range(6) for j in range(n))
+    targets = tuple(sym.named(f"j{i}_{j}") for i in range(6) for j in range(n))
+    lines, _ = _cse_lines(
+        targets, entries, sp.numbered_symbols("x"), printer, 0, Scope([set()]), None
+    )
+    body = []
+    used = J.free_symbols
+    for k, (target, expr) in enumerate(plan.joint_defs):
+        turns = str(target).startswith("theta")
+        if not ({sym.c(k + 1), sym.s(k + 1)} if turns else {target}) & used:
+            continue  # (the last joint's angle does not move the tool point or the axes)
+        value = printer.doprint(expr.xreplace({sym.q(k + 1): sp.Symbol(f"q[{k}]")}))
+        body.append(f"const double {target} = {value};")
+        if turns:
+            body.append(f"const double c{k + 1} = cos({target});")
+            body.append(f"const double s{k + 1} = sin({target});")
+    body += [ln.text for ln in lines]
+    body += [f"J[{i}][{j}] = j{i}_{j};" for i in range(6) for j in range(n)]
+    return tuple(body)
+
+
 def c_double(value: float) -> str:
     """A double as a C literal (HUGE_VAL for infinities)."""
     if math.isinf(value):

@@ -20,6 +20,7 @@ Modules, in copy order:
                into their modules, whose nearest it replaces)
 ``task``       ik_direction, ik_lookat and ik_pointing of arms solved for a task (tasks.py;
                copied only into their modules)
+``motion``     jacobian and manipulability (the Jacobian derive/jacobian.py derives)
 ``closed``     closed forms of the Python solver (quadratic, quartic, atan2, Newton
                steps, the free-joint reach searches)
 ``general``    the general 6R method in the Python solver (numpy's eigensolver)
@@ -33,6 +34,6 @@ arm (DOF, LIMITS, the forward kinematics, the solver bodies), so that this packa
 """
 
 MODULES = (
-    "constants", "native", "api", "common", "redundant", "task", "closed", "general", "scalar",
-    "refine",
+    "constants", "native", "api", "common", "redundant", "task", "motion", "closed", "general",
+    "scalar", "refine",
 )  # fmt: skip
