@@ -49,7 +49,8 @@ IMPORTS = (
 # the public names of a module with forward kinematics only, and with inverse kinematics
 FK_ROOTS = ("fk", "fk_batch", "jacobian", "manipulability", "ik_velocity")
 IK_ROOTS = (
-    *FK_ROOTS, "ik", "ik_batch", "ik_approximate", "nearest", "warmup", "CERTIFY_TOL", "BACKEND",
+    *FK_ROOTS, "ik", "ik_batch", "ik_approximate", "nearest", "ik_path", "straight_line",
+    "warmup", "CERTIFY_TOL", "BACKEND",
 )  # fmt: skip
 # the public names a module with free joints adds
 FREE_ROOTS = ("ik_sweep",)

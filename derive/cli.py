@@ -271,6 +271,53 @@ def cmd_solve(args: argparse.Namespace) -> int:
     return 0
 
 
+def cmd_path(args: argparse.Namespace) -> int:
+    """Follow a straight line (position on a line, rotation by slerp) from the pose of --from
+    to that of --to in --steps poses, keeping the branch of --from (the module's ik_path);
+    print the joint values per pose with the breaks, and draw the joint curves with -o."""
+    import numpy as np
+
+    spec, module = ik_module(args)
+    if getattr(module, "IK_COMPONENTS", "pose") != "pose":
+        raise UsageError(f"{spec.name}: its solver is for a task, not a pose; paths are of poses")
+    if not 2 <= args.steps <= 100_000:
+        raise UsageError(f"--steps: an integer from 2 to 100000, got {args.steps}")
+    start = np.array(joint_vector(spec, parse_numbers(args.start, "--from"), args.rad))
+    end = np.array(joint_vector(spec, parse_numbers(args.end, "--to"), args.rad))
+    output = figure_output(args, f"{spec.name}_path.svg") if args.output else None
+    poses = module.straight_line(module.fk(start), module.fk(end), args.steps)
+    Q, breaks = module.ik_path(poses, start, within_limits=args.within_limits,
+                               on_break="flag" if args.flag else "stop")  # fmt: skip
+    notes = dict(breaks)
+    units = ["deg" if t == "R" else spec.length_unit for t in spec.joint_types]
+    print(
+        "step  "
+        + "  ".join(f"{f'q{i + 1} / {u}':>11}" for i, u in enumerate(units))
+        + "  sigma_min"
+    )
+    for k, q in enumerate(Q):
+        if np.isnan(q).any():
+            break
+        shown = [math.degrees(v) if t == "R" else v for v, t in zip(q, spec.joint_types)]
+        least = module.manipulability(q)[0]
+        flag = f"  BREAK: {notes[k]}" if k in notes else ""
+        print(f"{k:4d}  " + "  ".join(f"{v:11.4f}" for v in shown) + f"  {least:9.3g}{flag}")
+    stopped = [k for k, _ in breaks]
+    if stopped and not args.flag:
+        print(f"stopped at pose {stopped[0]} of {args.steps}: {notes[stopped[0]]}")
+    print(f"{spec.name}: {args.steps} poses, {len(breaks)} break(s)")
+    if output is not None:
+        from derive.plot import PlotUnavailable, figure_bytes, path_figure
+
+        try:
+            data = figure_bytes(path_figure(Q, breaks, spec.joint_types, spec.name), output[1])
+        except PlotUnavailable as exc:
+            raise UsageError(str(exc)) from None
+        write_atomic(output[0], data)
+        print(f"{output[0]}: written")
+    return 0 if not breaks else 1
+
+
 def ik_module(args: argparse.Namespace) -> tuple[ArmSpec, ModuleType]:
     """The arm of args.arm and its generated module, which must have an IK solver."""
     spec = resolve_spec(args.arm, urdf_options(args))
@@ -358,11 +405,15 @@ def task_pose(spec: ArmSpec, module: ModuleType, args: argparse.Namespace) -> An
                 f"--point: {spec.name} is solved for a direction only: give --direction alone"
             )
         return module._task_pose((0.0, 0.0, 0.0), direction_numbers(args.direction))
+    # (a point beyond any reach: refused here, not solved in overflowing arithmetic)
+    far = getattr(module, "FAR_REACH", 1e6) * module.REACH
     if args.point is None:
         raise UsageError(f"--direction: {spec.name} is solved for a point: give --point x y z")
     point = parse_numbers(args.point, "--point")
     if len(point) != 3:
         raise UsageError(f"--point: give 3 numbers, x y z (got {len(point)})")
+    if max(map(abs, point)) > far:
+        raise UsageError(f"--point: beyond {far:g} (a million times the reach): out of reach")
     if task == "position":
         pose = np.eye(4)
         pose[:3, 3] = point
@@ -797,6 +848,22 @@ def parser() -> argparse.ArgumentParser:
     solve = sub.add_parser("solve", help="print every IK solution of a pose")
     add_pose_arguments(solve)
     solve.set_defaults(run=cmd_solve)
+    path = sub.add_parser(
+        "path", help="follow a straight line of poses keeping the branch (ik_path), with breaks"
+    )
+    path.add_argument("arm", help="spec file or bundled arm name")
+    path.add_argument(
+        "--from", dest="start", nargs="+", required=True, help="the start's joint values"
+    )
+    path.add_argument(
+        "--to", dest="end", nargs="+", required=True, help="joint values whose pose ends the line"
+    )
+    path.add_argument("--steps", type=int, default=50, help="poses on the line (default 50)")
+    path.add_argument("--rad", action="store_true", help="joint values are in radians")
+    path.add_argument("--within-limits", action="store_true", help="stay inside the limits")
+    path.add_argument("--flag", action="store_true", help="go on after a break (flagged)")
+    path.add_argument("-o", "--output", help="draw the joint curves: FILE.svg or FILE.png")
+    path.set_defaults(run=cmd_path)
     plot = sub.add_parser("plot", help="draw every IK solution of a pose (needs matplotlib)")
     add_pose_arguments(plot)
     plot.add_argument("-o", "--output", help="FILE.svg or FILE.png (default: NAME_solutions.svg)")
@@ -925,7 +992,7 @@ def parser() -> argparse.ArgumentParser:
     )
     imj.add_argument("-o", "--output", help=f"write the spec to this file ({TEXT_OUTPUT})")
     imj.set_defaults(run=cmd_import_mjcf)
-    for command in (gen, chk, fk, solve, plot, space, reach, report, bench, build, imp, imj):
+    for command in (gen, chk, fk, solve, plot, path, space, reach, report, bench, build, imp, imj):
         add_urdf_arguments(command, required=command in (imp, imj))
     return top
 
@@ -960,7 +1027,7 @@ def add_urdf_arguments(command: argparse.ArgumentParser, required: bool) -> None
     """The options of a URDF's conversion (used where an arm is a .urdf file)."""
     group = command.add_argument_group("URDF or MJCF input (ARM.urdf, ARM.xml)")
     group.add_argument(
-        "--base", required=required, help="the URDF link (MJCF body or site) the chain starts from"
+        "--base", required=required, help="the URDF link (MJCF body) the chain starts from"
     )
     group.add_argument(
         "--tip", required=required, help="the URDF link (MJCF body or site) the chain ends at"

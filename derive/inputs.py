@@ -87,7 +87,7 @@ def resolve_spec(text: str, options: urdf.Options | None = None) -> ArmSpec:
     if given := conversion_options(options):
         raise SpecError(
             f"{text}: {', '.join(given)}: options of a URDF or MJCF file's conversion, and "
-            "this arm is a spec (in a spec, [ik] task and tool_axis name the task)"
+            "this arm is a spec (in a spec, [ik] task, tool_axis and method say these)"
         )
     if reader is not None:
         return reader(path, urdf.Options())

@@ -241,6 +241,11 @@ def import_mjcf(path: Path, options: urdf.Options) -> tuple[str, urdf.Conversion
                 f"{where}: {what} {urdf._shown(name)}: no such body or site; bodies: "
                 f"{urdf._listing(bodies)}" + (f"; sites: {urdf._listing(sites)}" if sites else "")
             )
+    if places[options.base][0] == "site":
+        raise UrdfError(
+            f"{where}: --base {urdf._shown(options.base)}: a site; the chain starts from a body "
+            "(a site, a frame fixed to a body, can be the --tip)"
+        )
     chain = urdf.chain_between(robot, options.base, options.tip, where)
     ids = [places[options.base], places[options.tip]]
     check_against_mujoco(model, chain, index, ids, where)

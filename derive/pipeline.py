@@ -121,7 +121,7 @@ def build_plan(spec: ArmSpec, method: str | None = None) -> Plan:
         if ik is not None and ik.tool_axis != 2 and not task.fixed:
             why += (
                 f" (the first that works of the tool z, x, y axes, those parallel to joint "
-                f"{chain.dof}'s axis last: {shown.axis_name})"
+                f"{chain.dof}'s axis but beside it last: {shown.axis_name})"
             )
         facts = (*facts, f"task: {shown.describe()}: {why}")
     pose = world_transform(chain, expand=False)

@@ -218,3 +218,22 @@ def workspace_figure(wmap: Any, title: str) -> Any:
     if 0 < len(dots) <= 20:  # a few dexterous cells: marked, or they would not show
         axes[1].plot(wmap.u[dots[:, 1]], wmap.v[dots[:, 0]], "r.", markersize=6)
     return fig
+
+
+def path_figure(Q: np.ndarray, breaks: list[tuple[int, str]], kinds: str, title: str) -> Any:
+    """The joint curves of a path (ik_path's rows), one line per joint (revolute in degrees),
+    the breaks marked by vertical lines."""
+    plt = pyplot()
+    fig, ax = plt.subplots(figsize=(8.0, 4.2), layout="constrained")
+    steps = np.arange(len(Q))
+    for j, kind in enumerate(kinds):
+        values = np.degrees(Q[:, j]) if kind == "R" else Q[:, j]
+        ax.plot(steps, values, label=f"q{j + 1}" + (" (deg)" if kind == "R" else ""))
+    for k, _ in breaks:
+        ax.axvline(k, color="red", linestyle="--", linewidth=1.0)
+    ax.set_xlabel("pose on the line", fontsize=8)
+    ax.set_title(f"{title}: joint values along the path" + (
+        f" ({len(breaks)} break(s), red)" if breaks else ""), fontsize=9)  # fmt: skip
+    ax.legend(fontsize=7, ncol=min(len(kinds), 7))
+    ax.tick_params(labelsize=7)
+    return fig

@@ -548,14 +548,14 @@ def walk(plan: Plan, pose: np.ndarray, q: tuple[float, ...]) -> list[tuple[str, 
             continue
         if isinstance(step, Eigen):
             for k, kind in zip(step.indices, step.kinds):  # the solution's, from the eigen-solve
+                # (a task's virtual joint, or the arm's joint playing it, is not among q's
+                # values: read from the target, derive/tasks.py)
+                t = sym.d(k) if kind == "P" else sym.theta(k)
+                env[t] = values[t] if t in values else virtual_value(plan, q, env)
                 if kind == "P":
-                    t = sym.d(k)
-                    env[t] = values[t]
-                    lines.append((tex(t), number(values[t])))
-                    continue
-                t = sym.theta(k)
-                env[t] = values[t]
-                lines.append((f"{tex(t)} / ^\\circ", number(math.degrees(values[t]))))
+                    lines.append((tex(t), number(env[t])))
+                else:
+                    lines.append((f"{tex(t)} / ^\\circ", number(math.degrees(env[t]))))
             continue
         args = [float(a.xreplace(env)) for a in step.args]
         shown = ", ".join(number(x) for x in args)

@@ -41,6 +41,9 @@ API:
     ik_approximate(T, *, q_ref=None, tol=CERTIFY_TOL, backend=None)
         -> (Q (n, DOF), residual (n,), exact (n,)): ik's rows, or where T is out of reach the
         nearest configuration of each branch
+    ik_path(Ts: (N, 4, 4), q0, *, within_limits=False, on_break="stop", backend=None)
+        -> (Q (N, DOF), breaks [(k, why)]): a path's rows continuing q0's branch
+    straight_line(A, B, n) -> (n, 4, 4) ndarray, poses on a line (rotation by slerp)
     warmup() -> bool: compile the C solver (or load it from the cache) now
 
 Every solution `ik` returns has been checked by forward kinematics against T (tolerance
@@ -1106,7 +1109,9 @@ def ik_velocity(
     J dq reproduces the twist (to rounding) where the arm can move that way; within band of one
     the damping grows to damping^2 as the smallest singular value goes to 0, which bounds the
     joint rates (by |twist| / (2 damping)) at the price of the twist's component along the lost
-    direction. An arm of fewer than 6 joints gets the least-squares dq.
+    direction. An arm of fewer than 6 joints gets the least-squares dq of the whole twist (a
+    direction arm cannot follow a roll about its tool axis, a position arm any rotation: give
+    a twist its task can follow, and read J dq for what it does).
 
     Args:
         q: DOF joint values; twist: 6 numbers, v (length units per second) then w (rad/s).
@@ -1128,7 +1133,7 @@ def ik_velocity(
     if not (damping >= 0.0 and band >= 0.0 and math.isfinite(damping + band + gain)):
         raise ValueError("damping and band must be finite numbers >= 0, gain finite")
     U, sigma, Vt = np.linalg.svd(J, full_matrices=False)
-    least = float(sigma[-1]) if len(sigma) == 6 else math.inf
+    least = float(sigma[-1])
     lam2 = 0.0
     if least < band:
         lam2 = damping * damping * (1.0 - (least / band) ** 2)
@@ -1164,6 +1169,174 @@ def _joint_values(q: ArrayLike) -> list[float]:
     if not all(map(math.isfinite, joints)):
         raise ValueError(f"q must be {DOF} finite numbers")
     return joints
+
+
+# ik_path: the continuation of a path from q to the next pose is Newton's iteration from q
+# (at most PATH_NEWTON steps of q += J^+ dX, until the pose error is within PATH_CONVERGED);
+# the solution nearest it continues the path if they agree within PATH_SLACK (radians, or
+# PATH_SLACK * REACH for a sliding joint) and its step is within PATH_GAIN times |dX| /
+# sigma_min (the pose step over the Jacobian's smallest singular value at q)
+PATH_NEWTON = 12
+
+
+PATH_CONVERGED = 1e-10
+
+
+PATH_GAIN = 3.0
+
+
+PATH_SLACK = 1e-6
+
+
+def ik_path(
+    Ts: ArrayLike,
+    q0: ArrayLike,
+    *,
+    within_limits: bool = False,
+    on_break: str = "stop",
+    backend: str | None = None,
+) -> tuple[np.ndarray, list[tuple[int, str]]]:
+    """One joint vector per pose of a path, each continuing the previous one: the closed-form
+    solution of pose k that Newton's iteration from q_{k-1} reaches (q += J^+ dX, dX the pose
+    error as a twist), accepted only within PATH_GAIN |dX| / sigma_min + PATH_SLACK of q_{k-1}
+    (the joint step a continuous branch can take; sigma_min the Jacobian's smallest singular
+    value). The free joints of an arm with free joints (FREE) follow Newton's iteration.
+
+    Where no solution continues the path (a singular crossing where the branch ends, a joint
+    limit with within_limits, a pose out of reach), the break is reported: (k, why) in the
+    returned list, and the path stops there (rows k.. NaN) or, with on_break="flag", goes on
+    from the nearest solution.
+
+    Args:
+        Ts: the poses, (N, 4, 4); Ts[0] is q0's pose (q0 is its row, as given).
+        q0: the starting joint vector.
+        within_limits: only solutions inside LIMITS continue the path.
+        on_break: "stop" or "flag".
+        backend: as ik's.
+
+    Returns:
+        (Q (N, DOF), breaks): the path's joint vectors and its breaks, in order.
+
+    Raises:
+        ValueError: Ts is not (N, 4, 4) with N >= 1, q0 not DOF finite numbers, on_break
+            unknown; ik's errors for a pose.
+    """
+    poses = np.asarray(Ts, dtype=float)
+    if poses.ndim != 3 or poses.shape[1:] != (4, 4) or len(poses) == 0:
+        raise ValueError(f"Ts must have shape (N, 4, 4), N >= 1, got {poses.shape}")
+    if on_break not in ("stop", "flag"):
+        raise ValueError(f'on_break must be "stop" or "flag", got {on_break!r}')
+    q = np.array(_joint_values(q0))
+    out = np.full((len(poses), DOF), np.nan)
+    out[0] = q
+    breaks: list[tuple[int, str]] = []
+    for k in range(1, len(poses)):
+        twist = _pose_step(poses[k - 1], poses[k])
+        least = manipulability(q)[0] if DOF >= 6 else 1.0
+        bound = PATH_GAIN * float(np.linalg.norm(twist)) / max(least, 1e-300)
+        row, why = _continuation(poses[k], q, bound, within_limits, backend)
+        if why:
+            breaks.append((k, f"pose {k}: {why}; sigma_min {least:.3g}"))
+            if on_break == "stop":
+                return out, breaks
+            if row is None:  # (no solution: the path goes on from the last row)
+                continue
+        out[k] = row
+        q = row
+    return out, breaks
+
+
+def _continuation(T, q, bound, within_limits, backend):
+    """ik_path's step from q to the pose T: the solution of T nearest Newton's iteration from
+    q (its revolute joints' turn nearest it), and "" if it continues the path, else why not
+    (the row None where T has no solution)."""
+    revolute = np.array(_REVOLUTE)
+    units = np.where(revolute, 1.0, REACH)
+    guess = np.array(q, dtype=float)
+    error, size = _pose_error_to(guess, T)
+    for _ in range(PATH_NEWTON):
+        if size <= PATH_CONVERGED:
+            break
+        step = np.linalg.pinv(jacobian(guess), rcond=1e-9) @ error
+        for _ in range(8):  # (halved until the error shrinks: a full step can overshoot)
+            trial = guess + step
+            trial_error, trial_size = _pose_error_to(trial, T)
+            if trial_size < size:
+                break
+            step = step / 2.0
+        else:
+            break
+        guess, error, size = trial, trial_error, trial_size
+    converged = size <= PATH_CONVERGED
+    free = [guess[j - 1] for j in FREE] if FREE else None
+    rows = ik(T, free=free, q_ref=guess, backend=backend)
+    if len(rows) == 0:
+        return None, "out of reach"
+    gaps = rows - guess
+    gaps[:, revolute] = np.remainder(gaps[:, revolute] + math.pi, 2 * math.pi) - math.pi
+    misses = np.abs(gaps / units).max(axis=1)
+    best = int(np.argmin(misses))
+    row = guess + gaps[best]
+    step = np.abs(row - q) / units
+    j = int(np.argmax(step))
+    if not converged or misses[best] > PATH_SLACK or step.max() > bound + PATH_SLACK:
+        return row, (
+            "no solution continues the path ("
+            + ("Newton's iteration from the last row does not converge"
+               if not converged else f"the nearest moves q{j + 1} by {step[j]:.3g}")
+            + ": a singular crossing where the branch ends, or another branch)"
+        )  # fmt: skip
+    if within_limits:
+        lo, hi = np.array(LIMITS).T
+        outside = [f"q{i + 1}" for i in range(DOF) if not lo[i] <= row[i] <= hi[i]]
+        if outside:
+            return row, f"the continuing solution leaves the limits ({', '.join(outside)})"
+    return row, ""
+
+
+def _pose_error_to(q: np.ndarray, T: np.ndarray) -> tuple[np.ndarray, float]:
+    """The twist from fk(q) to T (_pose_step) and its size: the largest position entry over
+    REACH or rotation entry."""
+    e = _fk_q(q.tolist())
+    error = _pose_step(np.array([e[0:4], e[4:8], e[8:12], (0.0, 0.0, 0.0, 1.0)]), T)
+    return error, max(float(np.abs(error[:3]).max()) / REACH, float(np.abs(error[3:]).max()))
+
+
+def _pose_step(A: np.ndarray, B: np.ndarray) -> np.ndarray:
+    """The twist that moves pose A to pose B in one unit of time, to first order: the
+    position difference over the rotation vector of B_R A_R^T (in the world)."""
+    R = B[:3, :3] @ A[:3, :3].T
+    w = np.array([R[2, 1] - R[1, 2], R[0, 2] - R[2, 0], R[1, 0] - R[0, 1]]) / 2.0
+    s = float(np.linalg.norm(w))
+    angle = math.atan2(s, (float(np.trace(R)) - 1.0) / 2.0)
+    axis = w / s if s > 0.0 else w
+    return np.concatenate([B[:3, 3] - A[:3, 3], axis * angle])
+
+
+def straight_line(A: ArrayLike, B: ArrayLike, n: int) -> np.ndarray:
+    """n poses from A to B (both included): the position along the straight line, the
+    rotation turning about one fixed axis at a constant rate (slerp), (n, 4, 4).
+
+    Raises:
+        ValueError: A or B is not a 4x4 rigid transform, or n < 2.
+    """
+    if type(n) is bool or not isinstance(n, (int, np.integer)) or n < 2:
+        raise ValueError(f"n must be an integer >= 2, got {n!r}")
+    ends = [np.asarray(A, dtype=float), np.asarray(B, dtype=float)]
+    for T in ends:
+        if T.shape != (4, 4) or not np.isfinite(T).all():
+            raise ValueError("A and B must be 4x4 transforms of finite numbers")
+    twist = _pose_step(ends[0], ends[1])
+    angle = float(np.linalg.norm(twist[3:]))
+    axis = twist[3:] / angle if angle > 0.0 else np.zeros(3)
+    K = np.array([[0.0, -axis[2], axis[1]], [axis[2], 0.0, -axis[0]], [-axis[1], axis[0], 0.0]])
+    out = np.zeros((n, 4, 4))
+    for k, t in enumerate(np.linspace(0.0, 1.0, n)):
+        turn = np.eye(3) + math.sin(t * angle) * K + (1.0 - math.cos(t * angle)) * (K @ K)
+        out[k, :3, :3] = turn @ ends[0][:3, :3]
+        out[k, :3, 3] = ends[0][:3, 3] + t * twist[:3]
+        out[k, 3, 3] = 1.0
+    return out
 
 
 def _kquadratic(b, c):

@@ -1699,13 +1699,17 @@ static int dk_task_pose(const double p[3], const double *d, double T[16])
         T[4 * r + 3] = p[r];
     }
     if (d != NULL) {
-        double u[3], a[3], b[3], size = sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]), dot;
+        double u[3], a[3], b[3], size = fmax(fabs(d[0]), fmax(fabs(d[1]), fabs(d[2]))), dot;
         int least = 0;
         if (!(size > 0.0 && size < HUGE_VAL)) {
             return 0;
         }
-        for (r = 0; r < 3; r++) {
+        for (r = 0; r < 3; r++) { /* (over the largest entry first: 1e-300 does not vanish) */
             u[r] = d[r] / size;
+        }
+        size = sqrt(u[0] * u[0] + u[1] * u[1] + u[2] * u[2]);
+        for (r = 0; r < 3; r++) {
+            u[r] /= size;
             least = fabs(u[r]) < fabs(u[least]) ? r : least;
         }
         dot = u[least];

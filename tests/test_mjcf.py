@@ -121,6 +121,14 @@ def test_a_site_is_a_tip(tmp_path):
         assert np.max(np.abs(module.fk(q) - np.linalg.inv(base) @ site)) <= 1e-12
 
 
+def test_a_site_as_the_base_is_refused_in_one_line(capsys):
+    path = DATA / "jaco_arm.xml"
+    assert cli.main(["import-mjcf", str(path), "--base", "wristsite", "--tip", "b_6"]) == 2
+    err = capsys.readouterr().err
+    assert "--base 'wristsite': a site; the chain starts from a body" in err
+    assert err.count("\n") == 1
+
+
 def test_task_tool_axis_and_method_options_reach_the_spec(tmp_path, capsys):
     """--task, --tool-axis and --method of a conversion are the spec's [ik] keys."""
     chain = ["--base", "so_arm100_right", "--tip", "so_arm100_right/Fixed_Jaw"]

@@ -125,3 +125,99 @@ def test_velocity_ik_moves_free_joints_without_moving_the_tool(generated):
         twist = rng.normal(size=6)
         dq = module.ik_velocity(q, twist, preferred=preferred)
         assert np.abs(module.jacobian(q) @ dq - twist).max() <= 1e-9
+
+
+def joint_line(module, rng, joint: int, cross: float, n: int) -> np.ndarray:
+    """n joint vectors on a straight line in joint space on which joint `joint` (0-based)
+    crosses `cross` (from cross + 0.3 to cross - 0.3), the others moving up to 0.5 rad."""
+    qa = rng.uniform(-np.pi, np.pi, module.DOF)
+    qb = qa + rng.uniform(-0.5, 0.5, module.DOF)
+    qa[joint], qb[joint] = cross + 0.3, cross - 0.3
+    return qa + np.linspace(0.0, 1.0, n)[:, None] * (qb - qa)
+
+
+def test_a_path_through_the_wrist_flip_region_keeps_its_branch(generated):
+    """ik_path on 100 continuous joint paths of the PUMA whose theta5 crosses 0 (the wrist
+    flip: the partner (theta4 + pi, -theta5, theta6 + pi) is one branch away), 20 poses each:
+    wherever the path stays regular (smallest singular value >= 1e-3 at every pose), it is
+    followed to 1e-6 with no break and every joint step within the first-order bound; the
+    pose-by-pose nearest is counted beside it (it stays too here: its steps are small)."""
+    module = generated("puma560")
+    rng = np.random.default_rng(44)
+    followed = nearest_kept = 0
+    for _ in range(100):
+        Qt = joint_line(module, rng, 4, 0.0, 20)
+        if min(module.manipulability(q)[0] for q in Qt) < 1e-3:
+            continue
+        Ts = module.fk_batch(Qt)
+        Q, breaks = module.ik_path(Ts, Qt[0])
+        assert breaks == []
+        gaps = np.abs(np.remainder(Q - Qt + np.pi, 2 * np.pi) - np.pi)
+        assert gaps.max() <= 1e-6
+        for k in range(1, len(Ts)):
+            twist = np.linalg.norm(module._pose_step(Ts[k - 1], Ts[k]))
+            bound = module.PATH_GAIN * twist / module.manipulability(Q[k - 1])[0]
+            assert np.abs(Q[k] - Q[k - 1]).max() <= bound + module.PATH_SLACK
+        followed += 1
+        q, kept = Qt[0], True
+        for T, target in zip(Ts[1:], Qt[1:]):
+            q = module.nearest(T, q, within_limits=False)
+            kept &= bool(np.abs(np.remainder(q - target + np.pi, 2 * np.pi) - np.pi).max() < 1e-6)
+        nearest_kept += kept
+    assert followed >= 70, followed  # (76 of the 100 stay regular)
+    assert nearest_kept <= followed
+
+
+def test_a_path_out_of_reach_or_limits_breaks_where_and_why(generated):
+    """A line that leaves the PUMA's workspace stops at its first unreachable pose (rows
+    after it NaN), or with on_break="flag" goes on; a path whose joint 2 leaves its limits
+    breaks there with within_limits."""
+    module = generated("puma560")
+    start = np.radians([10.0, 20.0, 30.0, 40.0, 30.0, 50.0])
+    A = module.fk(start)
+    B = A.copy()
+    B[:3, 3] *= 4.0  # (far beyond the reach)
+    Q, breaks = module.ik_path(module.straight_line(A, B, 30), start)
+    (k, why), *_ = breaks
+    assert 0 < k < 30 and "out of reach" in why and len(breaks) == 1
+    assert np.isnan(Q[k:]).all() and not np.isnan(Q[:k]).any()
+    _, flagged = module.ik_path(module.straight_line(A, B, 30), start, on_break="flag")
+    assert len(flagged) == 30 - k
+    end = start.copy()
+    end[1] = module.LIMITS[1][1] + 0.3  # (joint 2 beyond its upper limit)
+    Ts = module.fk_batch(start + np.linspace(0.0, 1.0, 20)[:, None] * (end - start))
+    Q, breaks = module.ik_path(Ts, start, within_limits=True)
+    (k, why), *_ = breaks
+    assert "the continuing solution leaves the limits (q2)" in why
+    assert (Q[:k, 1] <= module.LIMITS[1][1]).all()
+
+
+def test_a_path_of_an_arm_with_free_joints_moves_them_smoothly(generated):
+    """The iiwa14 (q7 free) on 20 continuous joint paths: every row reproduces its pose, the
+    free joint follows Newton's iteration (steps of at most 0.2 rad), no break
+    where the path stays regular."""
+    module = generated("iiwa14")
+    rng = np.random.default_rng(45)
+    for _ in range(20):
+        Qt = joint_line(module, rng, 3, 0.0, 20)
+        if min(module.manipulability(q)[0] for q in Qt) < 1e-2:
+            continue
+        Ts = module.fk_batch(Qt)
+        Q, breaks = module.ik_path(Ts, Qt[0])
+        assert breaks == []
+        assert np.abs(module.fk_batch(Q) - Ts).max() <= 1e-9
+        assert np.abs(np.diff(Q[:, 6])).max() <= 0.2
+
+
+def test_derive_path_prints_the_joints_and_draws_them(tmp_path, capsys):
+    pytest.importorskip("matplotlib", reason="pictures need matplotlib (the test extra has it)")
+    from derive.cli import main
+
+    out = tmp_path / "path.svg"
+    argv = ["path", "puma560", "--from", "10 20 30 40 30 50", "--to", "40 -10 60 -20 -30 80"]
+    assert main([*argv, "--steps", "12", "-o", str(out)]) == 0
+    text = capsys.readouterr().out
+    assert "puma560: 12 poses, 0 break(s)" in text and text.count("\n") == 15
+    assert out.read_text().startswith("<?xml")
+    assert main(["path", "youbot", "--from", "0 0 0 0 0", "--to", "1 1 1 1 1"]) == 2
+    assert "paths are of poses" in capsys.readouterr().err

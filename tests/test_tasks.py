@@ -592,3 +592,36 @@ def test_a_virtual_link_within_the_structure_tolerance_is_snapped_and_refined(tm
     module = build_module(five_r_text("direction", "x", tool), tmp_path)
     found = round_trips(module, 300, 9, "python")
     assert found["missed"] == 0 and found["empty"] == 0 and found["worst"] <= 1e-10, found
+
+
+def test_a_direction_task_by_the_general_method_generates_its_report(tmp_path):
+    """The report's worked example reads the virtual joint (or the last joint playing it)
+    from the target where the general method's eigen-solve lists it (it raised KeyError
+    theta6 for the youBot and the PUMA with [ik] method = "general")."""
+    from derive import cli
+
+    youbot = Path(resolve_spec("youbot").source).read_text()
+    for name, text in (
+        ("youbot_general", youbot.replace('name = "youbot"', 'name = "youbot_general"')
+         + '\n[ik]\nmethod = "general"\n'),
+        ("puma_general", six_joint_text("puma_general", 'task = "direction"\nmethod = "general"')),
+    ):  # fmt: skip
+        spec = tmp_path / f"{name}.toml"
+        spec.write_text(text)
+        assert cli.main(["generate", str(spec), "--out", str(tmp_path / "out")]) == 0
+        report = (tmp_path / "out" / f"{name}.md").read_text()
+        assert "general" in report and "Worked example" in report
+
+
+@pytest.mark.parametrize("d", [(1e-300, 0.0, 0.0), (1e300, 0.0, 1e300), (0.0, -1e-200, 0.0)])
+def test_tiny_and_huge_directions_are_directions(generated, d):
+    """ik_direction's d is normalised over its largest entry first: 1e-300 neither underflows
+    to "not all 0" nor 1e300 overflows (a traceback in derive solve before)."""
+    from derive.cli import main
+
+    module = generated("youbot")
+    T = module._task_pose((0.1, 0.0, 0.2), d)
+    u = np.array(d) / np.abs(d).max()
+    assert np.allclose(T[:3, module.TOOL_AXIS], u / np.linalg.norm(u), atol=1e-15)
+    args = ["solve", "youbot", "--point", "0.1 0 0.2", "--direction", " ".join(map(str, d))]
+    assert main(args) == 0

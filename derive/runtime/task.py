@@ -105,10 +105,11 @@ def _task_pose(p: ArrayLike, d: ArrayLike | None) -> np.ndarray:
     axis = _real(d, "d")
     if axis.shape != (3,) or not np.isfinite(axis).all():
         raise ValueError(f"d must be 3 finite numbers, got {axis}")
-    size = math.sqrt(float(axis @ axis))
-    if not size > 0.0:
+    largest = float(np.abs(axis).max())
+    if not largest > 0.0:
         raise ValueError("d must be a direction: not all 0")
-    u = axis / size
+    u = axis / largest  # (first: 1e-300 and 1e300 neither underflow nor overflow)
+    u = u / math.sqrt(float(u @ u))
     helper = np.zeros(3)
     helper[int(np.argmin(np.abs(u)))] = 1.0
     a = helper - (helper @ u) * u
