@@ -224,7 +224,8 @@ def choose(
                 ik, why = choose_pose(chain, structure, rest or None, names, n)
                 if ik is not None:
                     return tasks.lower_spun(ik, chain, aimed), ""
-                reasons.append(f"tool {tasks.AXES[axis]} axis: {why}")
+                if why:
+                    reasons.append(f"tool {tasks.AXES[axis]} axis: {why}")
                 continue
             # (a pointing task: a look-at of the arm with every length 0, at the point d)
             arm = tasks.unmoved(chain) if task.kind == "pointing" else chain
@@ -245,7 +246,8 @@ def choose(
                     ik, extended, snap = exact_ik, exact, 0.0
             if ik is not None:
                 return tasks.lower(ik, arm, extended, aimed, snap), ""
-            reasons.append(f"tool {tasks.AXES[axis]} axis: {why}")
+            if why:  # (the methods count the task's virtual joint among the arm's)
+                reasons.append(f"tool {tasks.AXES[axis]} axis, with virtual joint {n + 1}: {why}")
         return None, "; ".join(reasons)
     if chain.dof > free.REMAINDER_DOF:
         return choose_free(chain, named, names)

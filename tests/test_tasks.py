@@ -625,3 +625,16 @@ def test_tiny_and_huge_directions_are_directions(generated, d):
     assert np.allclose(T[:3, module.TOOL_AXIS], u / np.linalg.norm(u), atol=1e-15)
     args = ["solve", "youbot", "--point", "0.1 0 0.2", "--direction", " ".join(map(str, d))]
     assert main(args) == 0
+
+
+def test_a_task_no_method_solves_says_why_for_each_axis_without_empty_reasons():
+    """A pan-tilt asked for the general method only: one reason per tool axis, each saying
+    that the methods counted the task's virtual joint (the arm itself has 2), none empty
+    (they were "tool z axis: ;" where no closed form was asked for)."""
+    rows = [(0, 0, 0.1, 0), (-90, 0.02, 0, 0)]
+    tool = "\n[tool]\ntranslation = [0.05, 0.0, 0.0]\nrpy = [0.0, 90.0, 0.0]\n"
+    tool += '[ik]\nmethod = "general"\n'
+    plan = build_plan(parse_spec(spec_text("head", "modified", rows, extra=tool), "<t>"))
+    assert plan.ik is None
+    assert "tool z axis, with virtual joint 3: general: needs 6 joints" in plan.refusal
+    assert ": ;" not in plan.refusal and not plan.refusal.endswith(": ")
