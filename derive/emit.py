@@ -28,6 +28,7 @@ from derive.printers.common import (
     cs_arguments,
     float_literal,
     match_expression,
+    used_joints,
 )
 from derive.printers.general import general_code
 
@@ -94,8 +95,8 @@ def fk_pose_lines(plan: Plan) -> tuple[tuple[str, ...], tuple[str, ...]]:
 
 
 def jacobian_lines(plan: Plan) -> tuple[tuple[str, ...], tuple[str, ...]]:
-    """Body of _jacobian_from_cs: the CSE'd Jacobian entries (derive/jacobian.py) in c_i, s_i
-    (and d_i), and the 6 n names holding them, row-major."""
+    """Body of _jacobian_q: theta_i (c_i, s_i) from q, then the CSE'd Jacobian entries
+    (derive/jacobian.py), and the 6 n names holding them, row-major."""
     names = sp.numbered_symbols("x")
     J = plan.jacobian
     n = J.shape[1]
@@ -103,10 +104,7 @@ def jacobian_lines(plan: Plan) -> tuple[tuple[str, ...], tuple[str, ...]]:
     targets = tuple(sym.named(f"j{i}_{j}") for i in range(6) for j in range(n))
     printer = CodePrinter()
     head = []
-    for k, (target, expr) in enumerate(plan.joint_defs):
-        turns = str(target).startswith("theta")
-        if not ({sym.c(k + 1), sym.s(k + 1)} if turns else {target}) & J.free_symbols:
-            continue  # (the last joint's angle does not move the tool point or the axes)
+    for k, target, expr, turns in used_joints(plan, J.free_symbols):
         head.append(
             f"{target} = {printer.doprint(expr.xreplace({sym.q(k + 1): sp.Symbol(f'q[{k}]')}))}"
         )

@@ -482,13 +482,7 @@ def _batch_threads(call: Any, n: int) -> None:
 
 def fk(q: ArrayLike) -> np.ndarray:
     """World pose of the tool frame (base and tool included) for joint vector q."""
-    values = _real(q, "q")
-    if values.shape != (DOF,):
-        raise ValueError(f"q must have shape ({DOF},), got {values.shape}")
-    joints = values.tolist()
-    if not all(map(math.isfinite, joints)):
-        raise ValueError(f"q must be {DOF} finite numbers")
-    e = _fk_q(joints)
+    e = _fk_q(_joint_values(q))
     return np.array([e[0:4], e[4:8], e[8:12], (0.0, 0.0, 0.0, 1.0)])
 
 
@@ -958,6 +952,21 @@ def warmup() -> bool:
 _PERIODS = tuple(2.0 * math.pi if r else math.inf for r in _REVOLUTE)
 
 
+def _joint_values(q: object) -> list[float]:
+    """q as DOF finite floats (fk's and jacobian's argument).
+
+    Raises:
+        ValueError: q is not DOF finite numbers.
+    """
+    values = _real(q, "q")
+    if values.shape != (DOF,):
+        raise ValueError(f"q must have shape ({DOF},), got {values.shape}")
+    joints = values.tolist()
+    if not all(map(math.isfinite, joints)):
+        raise ValueError(f"q must be {DOF} finite numbers")
+    return joints
+
+
 def _real(x: object, name: str) -> np.ndarray:
     """x as a float64 array; ValueError for anything but real numbers (ints and floats:
     not complex numbers, booleans, strings or None)."""
@@ -1134,17 +1143,6 @@ def manipulability(q: ArrayLike) -> tuple[float, float]:
     """
     sigma = np.linalg.svd(jacobian(q), compute_uv=False)
     return float(sigma[-1]) if len(sigma) == min(6, DOF) else 0.0, float(np.prod(sigma))
-
-
-def _joint_values(q: ArrayLike) -> list[float]:
-    """q as DOF finite floats."""
-    values = _real(q, "q")
-    if values.shape != (DOF,):
-        raise ValueError(f"q must have shape ({DOF},), got {values.shape}")
-    joints = values.tolist()
-    if not all(map(math.isfinite, joints)):
-        raise ValueError(f"q must be {DOF} finite numbers")
-    return joints
 
 
 # ik_path: the continuation of a path from q to the next pose is Newton's iteration from q

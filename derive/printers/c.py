@@ -40,6 +40,7 @@ from derive.printers.common import (
     live_steps,
     read_pairs,
     same_joints,
+    used_joints,
     world_names,
 )
 from derive.printers.general import eigen_step, fill_entries
@@ -596,11 +597,7 @@ def jacobian_lines(plan: Plan) -> tuple[str, ...]:
         targets, entries, sp.numbered_symbols("x"), printer, 0, Scope([set()]), None
     )
     body = []
-    used = J.free_symbols
-    for k, (target, expr) in enumerate(plan.joint_defs):
-        turns = str(target).startswith("theta")
-        if not ({sym.c(k + 1), sym.s(k + 1)} if turns else {target}) & used:
-            continue  # (the last joint's angle does not move the tool point or the axes)
+    for k, target, expr, turns in used_joints(plan, J.free_symbols):
         value = printer.doprint(expr.xreplace({sym.q(k + 1): sp.Symbol(f"q[{k}]")}))
         body.append(f"const double {target} = {value};")
         if turns:

@@ -125,6 +125,18 @@ def read_pairs(
     return kept[::-1]
 
 
+def used_joints(plan: Plan, used: set[sp.Basic]) -> list[tuple[int, sp.Symbol, sp.Expr, bool]]:
+    """The joint definitions (k, target, expression in q_{k+1}, revolute) whose symbols (c_k,
+    s_k, or d_k) appear in used: a Jacobian needs no sine and cosine of a last joint that
+    moves neither the tool point nor the axes."""
+    out = []
+    for k, (target, expr) in enumerate(plan.joint_defs):
+        turns = str(target).startswith("theta")
+        if ({sym.c(k + 1), sym.s(k + 1)} if turns else {target}) & used:
+            out.append((k, target, expr, turns))
+    return out
+
+
 def cs_arguments(plan: Plan) -> str:
     """The arguments of _fk_from_cs: c1, s1, ... for R joints, d_i for P joints, in order."""
     out = []

@@ -29,6 +29,7 @@ from derive.runtime.common import (
     _REV,
     _UPPER,
     _ZEROS,
+    _joint_values,
     _real,
     _reference,
     _seam,
@@ -56,13 +57,7 @@ from derive.runtime.scalar import _LOOSE
 
 def fk(q: ArrayLike) -> np.ndarray:
     """World pose of the tool frame (base and tool included) for joint vector q."""
-    values = _real(q, "q")
-    if values.shape != (DOF,):
-        raise ValueError(f"q must have shape ({DOF},), got {values.shape}")
-    joints = values.tolist()
-    if not all(map(math.isfinite, joints)):
-        raise ValueError(f"q must be {DOF} finite numbers")
-    e = _fk_q(joints)
+    e = _fk_q(_joint_values(q))
     return np.array([e[0:4], e[4:8], e[8:12], (0.0, 0.0, 0.0, 1.0)])
 
 

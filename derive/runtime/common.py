@@ -12,6 +12,21 @@ from derive.runtime.constants import _SEAM_SNAP, _TWO_PI, FAR_REACH
 _PERIODS = tuple(2.0 * math.pi if r else math.inf for r in _REVOLUTE)
 
 
+def _joint_values(q: object) -> list[float]:
+    """q as DOF finite floats (fk's and jacobian's argument).
+
+    Raises:
+        ValueError: q is not DOF finite numbers.
+    """
+    values = _real(q, "q")
+    if values.shape != (DOF,):
+        raise ValueError(f"q must have shape ({DOF},), got {values.shape}")
+    joints = values.tolist()
+    if not all(map(math.isfinite, joints)):
+        raise ValueError(f"q must be {DOF} finite numbers")
+    return joints
+
+
 def _real(x: object, name: str) -> np.ndarray:
     """x as a float64 array; ValueError for anything but real numbers (ints and floats:
     not complex numbers, booleans, strings or None)."""

@@ -11,7 +11,7 @@ from numpy.typing import ArrayLike
 
 from derive.runtime.api import ik
 from derive.runtime.arm import _REVOLUTE, DOF, FREE, LIMITS, REACH, _fk_q, _jacobian_q
-from derive.runtime.common import _real
+from derive.runtime.common import _joint_values, _real
 
 
 def jacobian(q: ArrayLike, frame: str = "base") -> np.ndarray:
@@ -111,17 +111,6 @@ def manipulability(q: ArrayLike) -> tuple[float, float]:
     """
     sigma = np.linalg.svd(jacobian(q), compute_uv=False)
     return float(sigma[-1]) if len(sigma) == min(6, DOF) else 0.0, float(np.prod(sigma))
-
-
-def _joint_values(q: ArrayLike) -> list[float]:
-    """q as DOF finite floats."""
-    values = _real(q, "q")
-    if values.shape != (DOF,):
-        raise ValueError(f"q must have shape ({DOF},), got {values.shape}")
-    joints = values.tolist()
-    if not all(map(math.isfinite, joints)):
-        raise ValueError(f"q must be {DOF} finite numbers")
-    return joints
 
 
 # ik_path: the continuation of a path from q to the next pose is Newton's iteration from q
