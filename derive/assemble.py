@@ -47,7 +47,7 @@ IMPORTS = (
     ("from numpy.typing import ArrayLike", "ArrayLike"),
 )
 # the public names of a module with forward kinematics only, and with inverse kinematics
-FK_ROOTS = ("fk", "fk_batch", "jacobian", "manipulability", "ik_velocity")
+FK_ROOTS = ("fk", "fk_batch", "link_transform", "jacobian", "manipulability", "ik_velocity")
 IK_ROOTS = (
     *FK_ROOTS, "ik", "ik_batch", "ik_approximate", "nearest", "ik_path", "straight_line",
     "warmup", "CERTIFY_TOL", "BACKEND",

@@ -275,9 +275,14 @@ def task_text(plan: Plan) -> str:
 def correction_constants(plan: Plan) -> str:
     """The exact chain and the joints its Newton steps move (ik_approximate's, and the
     refinement of a closed form that solves a nominal table: derive/nominal.py), with the
-    nominal table where there is one; "" without IK."""
+    nominal table where there is one; the chain only without IK (link_transform's)."""
+    chain = (
+        "# the exact chain: T(q) = F_0 J_1(q_1) F_1 ... J_n(q_n) F_n, J_i = Rz(q_i) (R) or\n"
+        "# Tz(q_i) (P); each F_i's top three rows, row-major\n"
+        f"_CHAIN = {_frames_literal(plan.frames)}\n"
+    )
     if plan.ik is None:
-        return ""
+        return chain
     fix = plan.correction
     nominal = ""
     if fix is not None:
@@ -289,12 +294,13 @@ def correction_constants(plan: Plan) -> str:
             "# positions / REACH)\n"
             f"NOMINAL_DEVIATION = {fix.deviation:.3g}\n"
         )
-    return nominal + (
-        "# the exact chain: T(q) = F_0 J_1(q_1) F_1 ... J_n(q_n) F_n, J_i = Rz(q_i) (R) or\n"
-        "# Tz(q_i) (P); each F_i's top three rows, row-major\n"
-        f"_CHAIN = {_frames_literal(plan.frames)}\n"
-        "# the joints (0-based) Newton's steps on it move (free joints keep the caller's values)\n"
-        f"_SOLVED = {plan.solved!r}\n"
+    return (
+        nominal
+        + chain
+        + (
+            "# the joints (0-based) Newton's steps on it move (free joints keep the caller's values)\n"
+            f"_SOLVED = {plan.solved!r}\n"
+        )
     )
 
 

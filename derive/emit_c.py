@@ -17,7 +17,7 @@ from derive.layout import wrap_c
 from derive.plan import Eigen, Plan, Poly, PolyD
 from derive.printers import c
 from derive.printers.general import eigen_step, pad, spurious_counts
-from derive.runtime import constants
+from derive.runtime import constants, motion
 from derive.tasks import TASK_CODES
 
 
@@ -52,9 +52,15 @@ class PrintedC:
     seamed: bool
     # how far the solver's equations may miss and still seed a refinement (0.0: exact arms)
     seed_tol: str = "0.0"
-    # the exact chain's frames (each a line of 12 numbers) and the joints (0-based) its
-    # refinement moves, where the closed form solves a nominal table; () elsewhere
-    chain: tuple[str, ...] = ()
+    # the exact chain's frames (each three lines of 4 numbers, link_transform's and the
+    # refinement's) and the base's (3 lines); the joints (0-based) the refinement moves, where
+    # the closed form solves a nominal table (refined), else ()
+    chain: tuple[tuple[str, ...], ...] = ()
+    base: tuple[str, ...] = ()
+    refined: bool = False
+    # ik_velocity's defaults (derive/runtime/motion.py)
+    velocity_damping: str = repr(motion.VELOCITY_DAMPING)
+    velocity_band: str = repr(motion.VELOCITY_BAND)
     solved: tuple[int, ...] = ()
     refine_rows: int = 6
     # the task's code (derive/tasks.py TASK_CODES) and its tool axis
@@ -184,12 +190,19 @@ def print_c(plan: Plan) -> PrintedC:
         solve=solve,
         seamed=bool(c.seamed_outputs(plan)),
         seed_tol=repr(plan.correction.seed_tol) if plan.correction else "0.0",
-        chain=tuple(", ".join(map(repr, f)) for f in plan.frames) if plan.correction else (),
+        chain=tuple(_frame_rows(f) for f in plan.frames),
+        base=_frame_rows(arm.base[:12]),
+        refined=plan.correction is not None,
         solved=plan.solved if plan.correction else (),
         refine_rows=3 if ik.certify in ("position", "lookat") else 6,  # (pointing: 3 zero)
         task_code=TASK_CODES[ik.certify],
         tool_axis=ik.tool_axis,
     )
+
+
+def _frame_rows(frame: tuple[float, ...]) -> tuple[str, ...]:
+    """A frame's 12 numbers (top three rows) as three lines of C initialiser, one row each."""
+    return tuple(", ".join(map(repr, map(float, frame[4 * r : 4 * r + 4]))) for r in range(3))
 
 
 def poly_max(plan: Plan) -> int:

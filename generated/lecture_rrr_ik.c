@@ -739,6 +739,177 @@ static int dk_pose_ok(const double T[16])
     return ok && det > 0.0;
 }
 
+/* The pose of frame k of a chain of n joints and fixed frames (12 entries each: T(q) = F_0
+   J_1(q_1) F_1 ... J_n(q_n) F_n, J_i = Rz(q_i) or Tz(q_i)), top three rows into out: k = 1..n
+   the frame of joint k, F_0 J_1 F_1 ... F_{k-1} J_k (its z the joint's axis, its origin on
+   it); k = n + 1 the whole product, the tool's */
+static void dk_chain_frame(const double (*chain)[12], const int *revolute, int n,
+                           const double *q, int k, double out[12])
+{
+    int i, r, c;
+    for (i = 0; i < 12; i++) {
+        out[i] = chain[0][i];
+    }
+    for (i = 0; i < k && i < n; i++) {
+        if (revolute[i]) { /* out := out Rz(q_i) */
+            const double cq = cos(q[i]), sq = sin(q[i]);
+            for (r = 0; r < 3; r++) {
+                const double x = out[4 * r], y = out[4 * r + 1];
+                out[4 * r] = cq * x + sq * y;
+                out[4 * r + 1] = cq * y - sq * x;
+            }
+        } else { /* out := out Tz(q_i) */
+            for (r = 0; r < 3; r++) {
+                out[4 * r + 3] += q[i] * out[4 * r + 2];
+            }
+        }
+        if (i + 1 < k) { /* out := out F_{i+1} */
+            const double *f = chain[i + 1];
+            for (r = 0; r < 3; r++) {
+                const double p0 = out[4 * r], p1 = out[4 * r + 1], p2 = out[4 * r + 2];
+                for (c = 0; c < 4; c++) {
+                    out[4 * r + c] = p0 * f[c] + p1 * f[4 + c] + p2 * f[8 + c] +
+                                     (c == 3 ? out[4 * r + 3] : 0.0);
+                }
+            }
+        }
+    }
+}
+
+/* the most joints an arm has (derive/spec.py, MAX_JOINTS): the size of dk_sym_eigen's arrays */
+#define DK_JOINTS_MAX 12
+
+/* Jacobi's sweeps stop when the off-diagonal entries' squares sum to this fraction of the
+   diagonal's (or after DK_EIGEN_SWEEPS sweeps) */
+#define DK_EIGEN_DONE (1e-30)
+
+#define DK_EIGEN_SWEEPS 30
+
+/* The eigenvalues of the symmetric n x n matrix A (row-major; destroyed), by Jacobi's
+   rotations, into w in decreasing order, with unit eigenvectors as the columns of V
+   (row-major, n x n) in the same order; n <= DK_JOINTS_MAX */
+static void dk_sym_eigen(double *A, int n, double *w, double *V)
+{
+    int sweep, p, r, i, j;
+    for (i = 0; i < n; i++) {
+        for (j = 0; j < n; j++) {
+            V[n * i + j] = i == j ? 1.0 : 0.0;
+        }
+    }
+    for (sweep = 0; sweep < DK_EIGEN_SWEEPS; sweep++) {
+        double off = 0.0, diagonal = 0.0;
+        for (i = 0; i < n; i++) {
+            diagonal += A[n * i + i] * A[n * i + i];
+            for (j = i + 1; j < n; j++) {
+                off += A[n * i + j] * A[n * i + j];
+            }
+        }
+        if (off <= DK_EIGEN_DONE * diagonal) {
+            break;
+        }
+        for (p = 0; p < n; p++) {
+            for (r = p + 1; r < n; r++) { /* the rotation that zeroes A[p][r] */
+                const double apr = A[n * p + r];
+                double theta, t, c, s;
+                if (apr == 0.0) {
+                    continue;
+                }
+                theta = (A[n * r + r] - A[n * p + p]) / (2.0 * apr);
+                t = (theta >= 0.0 ? 1.0 : -1.0) / (fabs(theta) + sqrt(theta * theta + 1.0));
+                c = 1.0 / sqrt(t * t + 1.0);
+                s = t * c;
+                for (i = 0; i < n; i++) { /* A := A G (columns p and r) */
+                    const double x = A[n * i + p], y = A[n * i + r];
+                    A[n * i + p] = c * x - s * y;
+                    A[n * i + r] = s * x + c * y;
+                }
+                for (i = 0; i < n; i++) { /* A := G^T A (rows p and r) */
+                    const double x = A[n * p + i], y = A[n * r + i];
+                    A[n * p + i] = c * x - s * y;
+                    A[n * r + i] = s * x + c * y;
+                }
+                for (i = 0; i < n; i++) { /* V := V G */
+                    const double x = V[n * i + p], y = V[n * i + r];
+                    V[n * i + p] = c * x - s * y;
+                    V[n * i + r] = s * x + c * y;
+                }
+            }
+        }
+    }
+    for (i = 0; i < n; i++) {
+        w[i] = A[n * i + i];
+    }
+    for (i = 0; i < n; i++) { /* (selection sort, decreasing, columns of V along) */
+        int best = i;
+        for (j = i + 1; j < n; j++) {
+            best = w[j] > w[best] ? j : best;
+        }
+        if (best != i) {
+            const double x = w[i];
+            w[i] = w[best];
+            w[best] = x;
+            for (j = 0; j < n; j++) {
+                const double y = V[n * j + i];
+                V[n * j + i] = V[n * j + best];
+                V[n * j + best] = y;
+            }
+        }
+    }
+}
+
+/* Damped least squares (derive/runtime/motion.py, ik_velocity) with the 6 x n Jacobian J
+   (row-major): the eigenpairs (s_k^2, v_k) of J^T J, the m = min(6, n) largest (J's singular
+   values and right singular vectors), give dq = sum_k v_k (v_k . J^T t) / (s_k^2 + lambda^2),
+   lambda^2 = damping^2 (1 - (s_m / band)^2) where s_m < band, else 0; with drift (not NULL),
+   plus drift's part outside the v_k with s_k > DK_RANK_TOL max(1, s_1) (the null space's:
+   the tool does not move). The normal matrix's eigenvalues carry about 1e-16 s_1^2 of
+   rounding, so the rank's threshold is the square root of that, not numpy's 1e-12. */
+#define DK_RANK_TOL (1e-7)
+
+static void dk_dls(const double *J, int n, const double t[6], double damping, double band,
+                   const double *drift, double *dq)
+{
+    double A[DK_JOINTS_MAX * DK_JOINTS_MAX], V[DK_JOINTS_MAX * DK_JOINTS_MAX];
+    double w[DK_JOINTS_MAX], jt[DK_JOINTS_MAX], least, lam2 = 0.0, top;
+    const int m = n < 6 ? n : 6;
+    int i, j, k, r;
+    for (i = 0; i < n; i++) {
+        jt[i] = 0.0;
+        for (r = 0; r < 6; r++) {
+            jt[i] += J[n * r + i] * t[r];
+        }
+        for (j = 0; j <= i; j++) {
+            double v = 0.0;
+            for (r = 0; r < 6; r++) {
+                v += J[n * r + i] * J[n * r + j];
+            }
+            A[n * i + j] = A[n * j + i] = v;
+        }
+    }
+    dk_sym_eigen(A, n, w, V);
+    least = sqrt(fmax(w[m - 1], 0.0));
+    if (least < band) {
+        lam2 = damping * damping * (1.0 - (least / band) * (least / band));
+    }
+    for (i = 0; i < n; i++) {
+        dq[i] = drift ? drift[i] : 0.0;
+    }
+    top = DK_RANK_TOL * fmax(1.0, sqrt(fmax(w[0], 0.0)));
+    for (k = 0; k < m; k++) {
+        double along = 0.0, share = 0.0;
+        const double s2 = fmax(w[k], 0.0);
+        for (i = 0; i < n; i++) {
+            along += V[n * i + k] * jt[i];
+            share += drift ? V[n * i + k] * drift[i] : 0.0;
+        }
+        along = s2 + lam2 > 0.0 ? along / (s2 + lam2) : 0.0;
+        share = s2 > top * top ? share : 0.0;
+        for (i = 0; i < n; i++) {
+            dq[i] += V[n * i + k] * (along - share);
+        }
+    }
+}
+
 /* --- the arm's own code, printed from its plan ------------------------------------------- */
 
 #define DK_DOF 3
@@ -750,6 +921,28 @@ static const int DK_REVOLUTE[DK_DOF] = {1, 1, 1};
    joint's value lies within DK_FREE_LIMIT radians (times DK_REACH for a length) */
 static const double DK_FAR = 1400000.0;
 static const double DK_FREE_LIMIT = 1000000.0;
+
+/* the exact chain: T(q) = F_0 J_1(q_1) F_1 ... J_n(q_n) F_n, J_i = Rz(q_i) (R) or Tz(q_i) (P),
+   each F_i's top three rows (link_transform's), and the base frame */
+static const double DK_CHAIN[DK_DOF + 1][12] = {
+    {1.0, 0.0, 0.0, 0.0,
+     0.0, 1.0, 0.0, 0.0,
+     0.0, 0.0, 1.0, 0.0},
+    {1.0, 0.0, 0.0, 1.0,
+     0.0, 1.0, 0.0, 0.0,
+     0.0, 0.0, 1.0, 0.0},
+    {1.0, 0.0, 0.0, 0.4,
+     0.0, 1.0, 0.0, 0.0,
+     0.0, 0.0, 1.0, 0.0},
+    {1.0, 0.0, 0.0, 0.0,
+     0.0, 1.0, 0.0, 0.0,
+     0.0, 0.0, 1.0, 0.0},
+};
+static const double DK_BASE[12] = {
+    1.0, 0.0, 0.0, 0.0,
+    0.0, 1.0, 0.0, 0.0,
+    0.0, 0.0, 1.0, 0.0
+};
 
 const double lecture_rrr_limits[DK_DOF][2] = {
     {-HUGE_VAL, HUGE_VAL},
@@ -1029,6 +1222,63 @@ void lecture_rrr_fk(const double q[DK_DOF], double T[16])
     T[15] = 1.0;
 }
 
+int lecture_rrr_link_transform(const double q[DK_DOF], int k, double T[16])
+{
+    int i;
+    if (k < 0 || k > DK_DOF + 1) {
+        return LECTURE_RRR_INVALID_ARGUMENT;
+    }
+    if (k == 0) {
+        for (i = 0; i < 12; i++) {
+            T[i] = DK_BASE[i];
+        }
+    } else {
+        dk_chain_frame(DK_CHAIN, DK_REVOLUTE, DK_DOF, q, k, T);
+    }
+    T[12] = 0.0;
+    T[13] = 0.0;
+    T[14] = 0.0;
+    T[15] = 1.0;
+    return 0;
+}
+
+void lecture_rrr_twist(const double q[DK_DOF], const double dq[DK_DOF], int frame,
+                      double twist[6])
+{
+    double J[6][DK_DOF];
+    int r, j;
+    lecture_rrr_jacobian(q, frame, J);
+    for (r = 0; r < 6; r++) {
+        twist[r] = 0.0;
+        for (j = 0; j < DK_DOF; j++) {
+            twist[r] += J[r][j] * dq[j];
+        }
+    }
+}
+
+int lecture_rrr_ik_velocity(const double q[DK_DOF], const double twist[6], int frame,
+                           double damping, double band, const double *preferred, double gain,
+                           double dq[DK_DOF])
+{
+    double J[6][DK_DOF], drift[DK_DOF], sum = damping + band + gain;
+    int j;
+    for (j = 0; j < DK_DOF; j++) {
+        sum += q[j] + (preferred ? preferred[j] : 0.0);
+    }
+    for (j = 0; j < 6; j++) {
+        sum += twist[j];
+    }
+    if (!isfinite(sum) || !(damping >= 0.0 && band >= 0.0)) {
+        return LECTURE_RRR_INVALID_ARGUMENT;
+    }
+    lecture_rrr_jacobian(q, frame, J);
+    for (j = 0; j < DK_DOF; j++) {
+        drift[j] = preferred ? gain * (preferred[j] - q[j]) : 0.0;
+    }
+    dk_dls(&J[0][0], DK_DOF, twist, damping, band, preferred ? drift : NULL, dq);
+    return 0;
+}
+
 int lecture_rrr_ik_ref(const double T[16], const double *free, const double *q_ref, double tol,
                         double q[DK_MAX][DK_DOF])
 {
@@ -1099,6 +1349,13 @@ int lecture_rrr_within_limits(double q[][DK_DOF], int n, const double *q_ref)
         }
     }
     return count;
+}
+
+int lecture_rrr_ik_within_limits(const double T[16], const double *free, const double *q_ref,
+                                double tol, double q[DK_MAX][DK_DOF])
+{
+    const int n = lecture_rrr_ik_ref(T, free, q_ref, tol, q);
+    return n > 0 ? lecture_rrr_within_limits(q, n, q_ref) : n;
 }
 
 int lecture_rrr_nearest(const double T[16], const double *free, const double q_ref[DK_DOF],

@@ -7,6 +7,15 @@
    Inverse kinematics: position method, at most 4 solutions per pose.
    Poses are 4x4 homogeneous transforms, row-major (T[4 * row + column], as the Python
    solver's T.ravel()); joint values are radians (R) and lengths (P). 
+
+   A ros2_control kinematics plugin (kinematics_interface::KinematicsInterface) wraps:
+     calculate_link_transform                  locobot_head_link_transform (k: the link's joint)
+     calculate_jacobian                        locobot_head_jacobian (at the tool point)
+     convert_joint_deltas_to_cartesian_deltas  locobot_head_twist
+     convert_cartesian_deltas_to_joint_deltas  locobot_head_ik_velocity
+     IK: all solutions, those within the joint  locobot_head_ik_ref, locobot_head_ik_within_limits,
+     limits, the closest to a configuration    locobot_head_nearest
+   (twists and deltas are [v; w], linear then angular, in the world frame with frame 0).
 */
 #ifndef LOCOBOT_HEAD_IK_H
 #define LOCOBOT_HEAD_IK_H
@@ -38,6 +47,31 @@ void locobot_head_fk(const double q[2], double T[16]);
    world (fk's frame), 1: in the tool frame (rotated by fk's R^T) */
 void locobot_head_jacobian(const double q[2], int frame, double J[6][2]);
 
+/* T = the pose of frame k at q (the exact chain's: T(q) = F_0 J_1(q_1) F_1 ... J_n(q_n) F_n):
+   k = 0 the base frame, k = 1..2 the frame of joint k (F_0 J_1 F_1 ... F_{k-1} J_k: its z
+   axis the joint's axis, its origin on it; Craig's frame k for a table in modified DH), k = 3
+   the tool's (fk's). Returns 0, or LOCOBOT_HEAD_INVALID_ARGUMENT for another k. */
+int locobot_head_link_transform(const double q[2], int k, double T[16]);
+
+/* twist = J(q) dq: the tool's twist [v; w] for joint velocities (or deltas) dq; frame as
+   jacobian's */
+void locobot_head_twist(const double q[2], const double dq[2], int frame,
+                       double twist[6]);
+
+/* ik_velocity's damping (the Python module's VELOCITY_DAMPING and VELOCITY_BAND) */
+#define LOCOBOT_HEAD_VELOCITY_DAMPING 0.05
+#define LOCOBOT_HEAD_VELOCITY_BAND 0.05
+/* dq = joint velocities (or deltas) that move the tool with the twist [v; w] (frame as
+   jacobian's), by damped least squares as the Python ik_velocity: undamped while J's smallest
+   singular value is at least band, below it lambda^2 = damping^2 (1 - (sigma / band)^2), which
+   bounds every rate by |twist| / (2 damping); an arm of fewer than 6 joints gets the least-
+   squares dq. preferred (NULL: none): joint values the arm drifts toward at rate gain in the
+   Jacobian's null space (its self-motion). Returns 0, or LOCOBOT_HEAD_INVALID_ARGUMENT (a
+   number not finite, damping or band negative). */
+int locobot_head_ik_velocity(const double q[2], const double twist[6], int frame,
+                            double damping, double band, const double *preferred, double gain,
+                            double dq[2]);
+
 /* Every solution of the pose T, each certified by forward kinematics (rotation within tol,
    position within tol * reach), revolute values in (-pi, pi], in the Python solver's order.
    free: the free joints' values (LOCOBOT_HEAD_FREE_COUNT of them; may be NULL: q_ref's, or 0),
@@ -66,6 +100,11 @@ int locobot_head_ik_lookat(const double p[3], const double *free, const double *
 /* The rows of q[0..n) inside the limits, in place, each revolute joint at its variant
    q + 2 pi k nearest q_ref's (NULL: zeros); their number. */
 int locobot_head_within_limits(double q[][2], int n, const double *q_ref);
+
+/* ik_ref's solutions inside the limits (within_limits on them): their number, or ik's
+   negative code */
+int locobot_head_ik_within_limits(const double T[16], const double *free, const double *q_ref,
+                                 double tol, double q[4][2]);
 
 /* The solution inside the limits nearest q_ref in weighted squared distance (weights NULL:
    ones) into q: 1, or 0 where there is none, or ik's negative code. */

@@ -54,6 +54,118 @@ def test_the_jacobian_is_fk_s_derivative_in_python_and_in_c(generated, name):
             assert np.abs(out - expected).max() <= 1e-12 * scale
 
 
+def _doubles(values) -> tuple[np.ndarray, object]:
+    """A contiguous float64 copy of values and its ctypes pointer (which keeps the copy
+    alive)."""
+    array = np.ascontiguousarray(values, dtype=float)
+    return array, array.ctypes.data_as(ctypes.POINTER(ctypes.c_double))
+
+
+@pytest.mark.parametrize("name", BUNDLED)
+def test_link_transforms_are_the_joints_frames_in_python_and_in_c(generated, name):
+    """link_transform (issue 41, item 4), 10 random joint vectors: frame 0 is BASE and frame
+    DOF + 1 is fk's pose; frame k's z axis is joint k's axis and its origin lies on it, read
+    from the Jacobian (a revolute joint's angular column is its axis and its linear column the
+    axis crossed with the tool point's offset from the origin; a sliding joint's linear column
+    is its axis); the C function's frames equal the Python ones to 1e-13 (times the reach for
+    positions); a k outside 0..DOF + 1 is refused by both."""
+    module = generated(name)
+    lib, why = module._c_library()
+    assert lib is not None, why
+    call = lib[f"{name}_link_transform"]
+    n = module.DOF
+    rng = np.random.default_rng(411)
+    for q in rng.uniform(-np.pi, np.pi, (10, n)):
+        assert np.array_equal(module.link_transform(q, 0), module.BASE)
+        assert np.abs(module.link_transform(q, n + 1) - module.fk(q)).max() <= 1e-13 * max(
+            1.0, module.REACH
+        )
+        J = module.jacobian(q)
+        tool = module.fk(q)[:3, 3]
+        q_p = _doubles(q)[1]
+        for k in range(n + 2):
+            F = module.link_transform(q, k)
+            z, origin = F[:3, 2], F[:3, 3]
+            if 1 <= k <= n and module.JOINT_TYPES[k - 1] == "R":
+                assert np.abs(J[3:, k - 1] - z).max() <= 1e-12
+                assert np.abs(J[:3, k - 1] - np.cross(z, tool - origin)).max() <= 1e-12 * max(
+                    1.0, module.REACH
+                )
+            elif 1 <= k <= n:
+                assert np.abs(J[:3, k - 1] - z).max() <= 1e-12
+            out, out_p = _doubles(np.zeros((4, 4)))
+            assert call(q_p, k, out_p) == 0
+            scale = np.array([1.0, 1.0, 1.0, max(1.0, module.REACH)])
+            assert (np.abs(out - F) <= 1e-13 * scale).all(), k
+    for k in (-1, n + 2):
+        with pytest.raises(ValueError, match=f"k must be an integer from 0 to {n + 1}"):
+            module.link_transform(np.zeros(n), k)
+        assert call(_doubles(np.zeros(n))[1], k, _doubles(np.zeros(16))[1]) == -3
+
+
+# a joint (0-based) whose value 0 makes the arm singular: the PUMA's wrist (theta5), the
+# iiwa's and the youBot's elbow straight
+SINGULAR_JOINT = {"puma560": 4, "iiwa14": 3, "youbot": 2}
+
+
+@pytest.mark.parametrize("name", ["puma560", "iiwa14", "youbot", "locobot_head"])
+def test_c_delta_conversions_are_the_python_ones(generated, name):
+    """The ros2_control-shaped delta conversions in C (issue 41, item 4): NAME_twist is J dq,
+    and NAME_ik_velocity (damped least squares through the normal matrix's eigenvalues)
+    agrees with the Python ik_velocity (numpy's SVD) to 1e-9 relative at regular
+    configurations and 1e-7 near a singular one (damped), in the world and the tool frame, with
+    a preferred configuration for the redundant arm; bad numbers give -3."""
+    module = generated(name)
+    lib, why = module._c_library()
+    assert lib is not None, why
+    n = module.DOF
+    twist_c, velocity_c = lib[f"{name}_twist"], lib[f"{name}_ik_velocity"]
+    pointer, number = ctypes.c_void_p, ctypes.c_double
+    velocity_c.argtypes = [pointer, pointer, ctypes.c_int, number, number, pointer, number, pointer]
+    rng = np.random.default_rng(412)
+    configurations = list(rng.uniform(-np.pi, np.pi, (40, n)))
+    if name in SINGULAR_JOINT:  # (a joint 1e-6 from a singular configuration: damped)
+        q = rng.uniform(-np.pi, np.pi, n)
+        q[SINGULAR_JOINT[name]] = 1e-6
+        configurations.append(q)
+    checked = {"regular": 0, "damped": 0}
+    for q in configurations:
+        for frame, word in ((0, "base"), (1, "tool")):
+            twist = rng.normal(size=6)
+            dq = rng.normal(size=n)
+            q_p = _doubles(q)[1]
+            _, dq_p = _doubles(dq)
+            out, out_p = _doubles(np.zeros(6))
+            twist_c(q_p, dq_p, frame, out_p)
+            assert np.abs(out - module.jacobian(q, word) @ dq).max() <= 1e-12 * (
+                1.0 + np.abs(out).max()
+            )
+            preferred = rng.uniform(-1.0, 1.0, n) if n > 6 else None
+            expected = module.ik_velocity(q, twist, frame=word, preferred=preferred, gain=0.5)
+            got, got_p = _doubles(np.zeros(n))
+            pref_p = None if preferred is None else _doubles(preferred)[1]
+            _, t_p = _doubles(twist)
+            code = velocity_c(q_p, t_p, frame, module.VELOCITY_DAMPING, module.VELOCITY_BAND,
+                              pref_p, 0.5, got_p)  # fmt: skip
+            assert code == 0
+            least = module.manipulability(q)[0]
+            damped = least < module.VELOCITY_BAND
+            checked["damped" if damped else "regular"] += 1
+            # (damped: J^T J's eigenvectors of a singular value near 0, beside the null space
+            # of a redundant arm, are good to about 1e-8, the square root of rounding)
+            tol = 1e-7 if damped else 1e-9
+            assert np.abs(got - expected).max() <= tol * (1.0 + np.abs(expected).max()), q
+    assert checked["regular"] >= 10 and checked["damped"] >= (name in SINGULAR_JOINT)
+    q = np.zeros(n)
+    bad = np.full(6, np.nan)
+    code = velocity_c(_doubles(q)[1], _doubles(bad)[1], 0, 0.05, 0.05, None, 1.0,
+                      _doubles(np.zeros(n))[1])  # fmt: skip
+    assert code == -3
+    code = velocity_c(_doubles(q)[1], _doubles(np.ones(6))[1], 0, -1.0, 0.05, None, 1.0,
+                      _doubles(np.zeros(n))[1])  # fmt: skip
+    assert code == -3
+
+
 def test_manipulability_is_zero_where_the_wrist_is_singular(generated):
     """The PUMA's smallest singular value and Yoshikawa's measure: numpy's SVD of the
     Jacobian at a regular configuration; both 0 (to rounding) with theta5 = 0 (axes 4 and 6

@@ -10,7 +10,17 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from derive.runtime.api import ik
-from derive.runtime.arm import _REVOLUTE, DOF, FREE, LIMITS, REACH, _fk_q, _jacobian_q
+from derive.runtime.arm import (
+    _CHAIN,
+    _REVOLUTE,
+    BASE,
+    DOF,
+    FREE,
+    LIMITS,
+    REACH,
+    _fk_q,
+    _jacobian_q,
+)
 from derive.runtime.common import _joint_values, _real
 
 
@@ -38,11 +48,44 @@ def jacobian(q: ArrayLike, frame: str = "base") -> np.ndarray:
     return J
 
 
+def link_transform(q: ArrayLike, k: int) -> np.ndarray:
+    """The pose (4, 4) of frame k at q on the arm's exact chain, T(q) = F_0 J_1(q_1) F_1 ...
+    J_n(q_n) F_n (_CHAIN; J_i = Rz(q_i), or Tz(q_i) for a sliding joint): k = 0 the base frame
+    (BASE), k = 1..DOF the frame of joint k, F_0 J_1 F_1 ... F_{k-1} J_k (its z axis the joint's
+    axis, its origin on it: Craig's frame k for a table in modified DH), k = DOF + 1 the tool's
+    (fk(q)). A kinematics plugin's link transform (the C header's table).
+
+    Raises:
+        ValueError: q is not DOF finite numbers, or k is not an integer in 0..DOF + 1.
+    """
+    values = _joint_values(q)
+    if not isinstance(k, (int, np.integer)) or isinstance(k, bool) or not 0 <= k <= DOF + 1:
+        raise ValueError(f"k must be an integer from 0 to {DOF + 1}, got {k!r}")
+    if k == 0:
+        return np.array(BASE, dtype=float)
+    pose = np.vstack([np.array(_CHAIN[0]).reshape(3, 4), (0.0, 0.0, 0.0, 1.0)])
+    for i in range(min(k, DOF)):
+        joint = np.eye(4)
+        if _REVOLUTE[i]:
+            c, s = math.cos(values[i]), math.sin(values[i])
+            joint[:2, :2] = ((c, -s), (s, c))
+        else:
+            joint[2, 3] = values[i]
+        pose = pose @ joint
+        if i + 1 < k:
+            pose = pose @ np.vstack([np.array(_CHAIN[i + 1]).reshape(3, 4), (0, 0, 0, 1.0)])
+    return pose
+
+
 # ik_velocity's damping: none while the Jacobian's smallest singular value is at least
 # VELOCITY_BAND; below it, lambda^2 = VELOCITY_DAMPING^2 (1 - (sigma / VELOCITY_BAND)^2), which
 # bounds every joint rate by |twist| / (2 VELOCITY_DAMPING) at a singular configuration
 VELOCITY_BAND = 0.05
 VELOCITY_DAMPING = 0.05
+# the drift of ik_velocity stays off the directions whose singular values exceed _RANK_TOL
+# times the largest (at least 1): the C ik_velocity's singular values come from J^T J's
+# eigenvalues, which carry about 1e-16 of the largest's square, so this is their accuracy
+_RANK_TOL = 1e-7
 
 
 def ik_velocity(
@@ -94,7 +137,7 @@ def ik_velocity(
     dq = Vt.T @ (weights * (U.T @ target))
     if preferred is not None:
         drift = gain * (np.array(_joint_values(preferred)) - np.array(_joint_values(q)))
-        rank = int(np.sum(sigma > 1e-12 * max(1.0, float(sigma[0]))))
+        rank = int(np.sum(sigma > _RANK_TOL * max(1.0, float(sigma[0]))))
         rows = Vt[:rank]
         dq = dq + drift - rows.T @ (rows @ drift)  # (the null space's share of the drift)
     return dq
