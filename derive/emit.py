@@ -11,11 +11,13 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 from importlib import resources
+from typing import Any
 
 import jinja2
 import sympy as sp
 
 from derive import symbols as sym
+from derive import tasks
 from derive.assemble import assemble, import_block
 from derive.layout import wrap_code
 from derive.plan import Assign, Plan
@@ -173,6 +175,11 @@ class PrintedModule:
     correction_doc: str
     tool_axis: int = 2
     task_doc: str = ""
+    # a planar arm's plane task (derive/tasks.py, Plane): "xy_heading", "xy" or ""; its
+    # constants; whether the caller gives z
+    plane: str = ""
+    plane_constants: str = ""
+    plane_slide: bool = False
 
 
 def print_plan(plan: Plan) -> PrintedModule:
@@ -231,13 +238,62 @@ def print_plan(plan: Plan) -> PrintedModule:
         correction=correction_constants(plan),
         correction_doc=correction_text(plan),
         task_doc=task_text(plan),
+        **plane_fields(plan),
     )
+
+
+def plane_fields(plan: Plan) -> dict[str, Any]:
+    """The plane task's fields of PrintedModule (none where the arm has none)."""
+    ik = plan.ik
+    plane = None
+    if ik is not None:
+        plane = tasks.plane_of(plan.frames, plan.arm.joint_types, ik.method, ik.certify)
+    if plane is None:
+        return {}
+    return {
+        "plane": "xy_heading" if plane.heading else "xy",
+        "plane_slide": plane.slide,
+        "plane_constants": (
+            f"# the plane task ({plane.ikfast}, derive/tasks.py Plane): the tool's rotation at\n"
+            "# q = 0 (row-major), the tool axis whose angle about z is the heading (0 x, 1 y)\n"
+            "# and that angle at q = 0, the tool point's height at q = 0 (PLANE_Z: every\n"
+            "# height without a sliding joint), whether a sliding joint moves it along z\n"
+            f"_PLANE_ROTATION = {_tuple(plane.rotation)}\n"
+            f"HEADING_AXIS = {plane.axis}\n"
+            f"_HEADING_ZERO = {plane.zero!r}\n"
+            f"PLANE_Z = {plane.height!r}\n"
+            f"_PLANE_SLIDE = {plane.slide!r}\n"
+        ),
+    }
 
 
 def task_text(plan: Plan) -> str:
     """The module docstring's paragraph on a task of fewer components than a pose
     (derive/tasks.py), "" for the methods' own problems."""
     ik = plan.ik
+    plane = (
+        None
+        if ik is None
+        else tasks.plane_of(plan.frames, plan.arm.joint_types, ik.method, ik.certify)
+    )
+    if plane is not None:
+        call = "ik_xy_heading(x, y, heading" if plane.heading else "ik_xy(x, y"
+        return (
+            f"The task ({plane.ikfast}): every joint axis is along the world's z, so "
+            f"`{call}{', z' if plane.slide else ''})` builds the pose it names (the tool's "
+            "rotation at q = 0 turned about z"
+            + (
+                " to put the tool axis HEADING_AXIS at the heading from the world's x"
+                if plane.heading
+                else ""
+            )
+            + (
+                ", the tool point at height z: a sliding joint moves it"
+                if plane.slide
+                else ", the tool point in the plane z = PLANE_Z"
+            )
+            + ") and solves it with ik."
+        )
     if ik is None or ik.certify not in ("direction", "lookat", "pointing"):
         return ""
     reads = {
@@ -298,7 +354,8 @@ def correction_constants(plan: Plan) -> str:
         nominal
         + chain
         + (
-            "# the joints (0-based) Newton's steps on it move (free joints keep the caller's values)\n"
+            "# the joints (0-based) Newton's steps on it move (free joints keep the caller's\n"
+            "# values)\n"
             f"_SOLVED = {plan.solved!r}\n"
         )
     )
@@ -400,7 +457,10 @@ def render_module(plan: Plan) -> str:
     env = environment()
     arm_code = wrap_code(env.get_template("arm.py.j2").render(m=printed))
     parts = assemble(
-        arm_code, bool(printed.has_ik), bool(printed.free), printed.components or "pose"
+        arm_code,
+        bool(printed.has_ik),
+        bool(printed.free),
+        printed.plane or printed.components or "pose",
     )
     layout = env.get_template("module.py.j2")
 

@@ -11,6 +11,7 @@ from typing import Any
 
 import numpy as np
 
+from derive import tasks
 from derive.assemble import assemble_c
 from derive.emit import GENERATOR, GenerationError, check_printable, environment
 from derive.layout import wrap_c
@@ -58,6 +59,14 @@ class PrintedC:
     chain: tuple[tuple[str, ...], ...] = ()
     base: tuple[str, ...] = ()
     refined: bool = False
+    # a planar arm's plane task (derive/tasks.py, Plane): "xy_heading", "xy" or ""; the tool's
+    # rotation at q = 0 (9 numbers), the heading there, the plane's height, a sliding joint
+    plane: str = ""
+    plane_rotation: str = ""
+    plane_zero: str = "0.0"
+    plane_z: str = "0.0"
+    plane_slide: bool = False
+    heading_axis: int = 0
     # ik_velocity's defaults (derive/runtime/motion.py)
     velocity_damping: str = repr(motion.VELOCITY_DAMPING)
     velocity_band: str = repr(motion.VELOCITY_BAND)
@@ -197,7 +206,24 @@ def print_c(plan: Plan) -> PrintedC:
         refine_rows=3 if ik.certify in ("position", "lookat") else 6,  # (pointing: 3 zero)
         task_code=TASK_CODES[ik.certify],
         tool_axis=ik.tool_axis,
+        **plane_fields(plan),
     )
+
+
+def plane_fields(plan: Plan) -> dict[str, Any]:
+    """The plane task's fields of PrintedC (none where the arm has none)."""
+    assert plan.ik is not None
+    plane = tasks.plane_of(plan.frames, plan.arm.joint_types, plan.ik.method, plan.ik.certify)
+    if plane is None:
+        return {}
+    return {
+        "plane": "xy_heading" if plane.heading else "xy",
+        "plane_rotation": ", ".join(map(repr, plane.rotation)),
+        "plane_zero": repr(plane.zero),
+        "plane_z": repr(plane.height),
+        "plane_slide": plane.slide,
+        "heading_axis": plane.axis,
+    }
 
 
 def _frame_rows(frame: tuple[float, ...]) -> tuple[str, ...]:

@@ -391,3 +391,66 @@ def _substitute(step: Step, values: dict[sp.Symbol, sp.Integer]) -> Step:
         "ref": step.ref.xreplace(values),
     }
     return dataclasses.replace(step, **changes)  # type: ignore[arg-type]
+
+
+@dataclass(frozen=True)
+class Plane:
+    """A planar arm's task in the world (IKFast's TranslationXYOrientation3D for three
+    revolute joints, TranslationXY2D for two): every joint axis is along the world's z, so the
+    tool's rotation is Rz(psi) R0 and, without a sliding joint, its height is fixed.
+
+    Attributes:
+        heading: whether the task has a heading (three revolute joints).
+        rotation: R0, the tool's rotation at q = 0 (9 floats, row-major).
+        axis: the tool axis whose angle about z from the world's x is the heading: 0 x, or 1 y
+            where the tool y axis lies nearer the plane.
+        zero: that axis's heading at q = 0 (rad).
+        height: the tool point's z at q = 0 (every z without a sliding joint).
+        slide: whether a sliding joint moves the tool along z (the caller gives z).
+    """
+
+    heading: bool
+    rotation: tuple[float, ...]
+    axis: int
+    zero: float
+    height: float
+    slide: bool
+
+    @property
+    def ikfast(self) -> str:
+        """IKFast's name of the task."""
+        return "TranslationXYOrientation3D" if self.heading else "TranslationXY2D"
+
+
+# how far from the world's z a planar arm's axes may point for its plane task (the axes of a
+# spec's planar arm are exactly z, or a URDF's within its rounding)
+PLANE_AXIS_TOL = 1e-9
+
+
+def plane_of(
+    frames: tuple[tuple[float, ...], ...], joint_types: str, method: str, certify: str
+) -> Plane | None:
+    """The plane task of an arm the planar method solves (frames: its exact chain, F_0 .. F_n),
+    or None: another method, or the axes not along the world's z."""
+    if method != "planar" or not frames:
+        return None
+    pose = [list(frames[0][4 * r : 4 * r + 4]) for r in range(3)]
+    axis_z = abs(pose[2][2])
+    if abs(axis_z - 1.0) > PLANE_AXIS_TOL:
+        return None
+    for f in frames[1:]:
+        F = [f[4 * r : 4 * r + 4] for r in range(3)]
+        pose = [
+            [sum(pose[r][k] * F[k][c] for k in range(3)) + (pose[r][3] if c == 3 else 0.0)
+             for c in range(4)]
+            for r in range(3)
+        ]  # fmt: skip
+    axis = 0 if math.hypot(pose[0][0], pose[1][0]) >= math.hypot(pose[0][1], pose[1][1]) else 1
+    return Plane(
+        heading=certify == "pose",
+        rotation=tuple(pose[r][c] for r in range(3) for c in range(3)),
+        axis=axis,
+        zero=math.atan2(pose[1][axis], pose[0][axis]),
+        height=pose[2][3],
+        slide="P" in joint_types,
+    )

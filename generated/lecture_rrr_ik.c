@@ -1323,6 +1323,33 @@ int lecture_rrr_ik(const double T[16], const double *free, double tol,
     return lecture_rrr_ik_ref(T, free, NULL, tol, q);
 }
 
+int lecture_rrr_ik_xy_heading(double x, double y, double heading,
+                              const double *q_ref, double tol, double q[DK_MAX][DK_DOF])
+{
+    /* the tool's rotation at q = 0, turned about z by the heading's change from there */
+    static const double R0[9] = {1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0};
+    const double turn = heading - (0.0);
+    const double c = cos(turn), s = sin(turn);
+    double T[16];
+    int k;
+    if (!isfinite(x) || !isfinite(y) || !isfinite(turn)) {
+        return LECTURE_RRR_INVALID_ARGUMENT;
+    }
+    for (k = 0; k < 3; k++) {
+        T[k] = c * R0[k] - s * R0[3 + k];
+        T[4 + k] = s * R0[k] + c * R0[3 + k];
+        T[8 + k] = R0[6 + k];
+    }
+    T[3] = x;
+    T[7] = y;
+    T[11] = 0.0;
+    T[12] = 0.0;
+    T[13] = 0.0;
+    T[14] = 0.0;
+    T[15] = 1.0;
+    return lecture_rrr_ik_ref(T, NULL, q_ref, tol, q);
+}
+
 int lecture_rrr_within_limits(double q[][DK_DOF], int n, const double *q_ref)
 {
     int count = 0, r, j;

@@ -88,6 +88,14 @@ int lecture_rrr_ik(const double T[16], const double *free, double tol,
 int lecture_rrr_ik_ref(const double T[16], const double *free, const double *q_ref, double tol,
                         double q[2][3]);
 
+/* The plane task (IKFast's TranslationXYOrientation3D): every joint axis is along the world's z.
+   ik_xy_heading: every solution with the tool point at (x, y) and the tool's x axis at the
+   angle heading (rad) about z from the world's x axis (the tool point's height is the
+   plane's, 0.0); q_ref and the codes as ik_ref's, INVALID_ARGUMENT also for a number
+   that is not finite. */
+int lecture_rrr_ik_xy_heading(double x, double y, double heading,
+                              const double *q_ref, double tol, double q[2][3]);
+
 /* The rows of q[0..n) inside the limits, in place, each revolute joint at its variant
    q + 2 pi k nearest q_ref's (NULL: zeros); their number. */
 int lecture_rrr_within_limits(double q[][3], int n, const double *q_ref);

@@ -170,7 +170,8 @@ _CHAIN = (
         0.0, 0.01745240643728351, 0.9998476951563913, 0.0,
     ),
 )
-# the joints (0-based) Newton's steps on it move (free joints keep the caller's values)
+# the joints (0-based) Newton's steps on it move (free joints keep the caller's
+# values)
 _SOLVED = (0, 1, 2, 3, 4, 5)
 
 # the arm's C solver, beside this file (with its .h; "": none): compiled on the first call

@@ -36,6 +36,9 @@ API:
         -> (Q (N, M, DOF), valid (N, M))
     nearest(T, q_ref, *, within_limits=True, weights=None, metric="l2", backend=None)
         -> (DOF,) ndarray or None
+    ik_xy(x, y, z=None, *, within_limits=False, q_ref=None, tol=CERTIFY_TOL, backend=None)
+        -> (n, DOF) ndarray, all solutions with the tool point at (x, y, PLANE_Z) (IKFast's
+        TranslationXY2D)
     ik_approximate(T, *, q_ref=None, tol=CERTIFY_TOL, backend=None)
         -> (Q (n, DOF), residual (n,), exact (n,)): ik's rows, or where T is out of reach the
         nearest configuration of each branch
@@ -43,6 +46,10 @@ API:
         -> (Q (N, DOF), breaks [(k, why)]): a path's rows continuing q0's branch
     straight_line(A, B, n) -> (n, 4, 4) ndarray, poses on a line (rotation by slerp)
     warmup() -> bool: compile the C solver (or load it from the cache) now
+
+The task (TranslationXY2D): every joint axis is along the world's z, so `ik_xy(x, y)` builds the
+pose it names (the tool's rotation at q = 0 turned about z, the tool point in the plane z =
+PLANE_Z) and solves it with ik.
 
 Every solution `ik` returns has been checked by forward kinematics against T (tolerance
 CERTIFY_TOL in rotation and CERTIFY_TOL * REACH in position). Revolute values are wrapped to
@@ -119,6 +126,15 @@ MAX_SOLUTIONS = 2
 FREE = ()
 # how far the solver's equations may miss and still seed a refinement (0: exact arms)
 _SEED_TOL = 0.0
+# the plane task (TranslationXY2D, derive/tasks.py Plane): the tool's rotation at
+# q = 0 (row-major), the tool axis whose angle about z is the heading (0 x, 1 y)
+# and that angle at q = 0, the tool point's height at q = 0 (PLANE_Z: every
+# height without a sliding joint), whether a sliding joint moves it along z
+_PLANE_ROTATION = (1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0)
+HEADING_AXIS = 0
+_HEADING_ZERO = 0.0
+PLANE_Z = 0.0
+_PLANE_SLIDE = False
 # the exact chain: T(q) = F_0 J_1(q_1) F_1 ... J_n(q_n) F_n, J_i = Rz(q_i) (R) or
 # Tz(q_i) (P); each F_i's top three rows, row-major
 _CHAIN = (
@@ -138,7 +154,8 @@ _CHAIN = (
         0.0, 0.0, 1.0, 0.0,
     ),
 )
-# the joints (0-based) Newton's steps on it move (free joints keep the caller's values)
+# the joints (0-based) Newton's steps on it move (free joints keep the caller's
+# values)
 _SOLVED = (0, 1)
 
 # the arm's C solver, beside this file (with its .h; "": none): compiled on the first call
@@ -1013,6 +1030,51 @@ _LOWER = np.array([lo - 1e-12 for lo, _ in LIMITS])
 
 
 _UPPER = np.array([hi + 1e-12 for _, hi in LIMITS])
+
+
+def ik_xy(
+    x: float,
+    y: float,
+    z: float | None = None,
+    *,
+    within_limits: bool = False,
+    q_ref: ArrayLike | None = None,
+    tol: float = CERTIFY_TOL,
+    backend: str | None = None,
+) -> np.ndarray:
+    """All solutions of a planar arm of two revolute joints (every axis along the world's z)
+    with the tool point at (x, y) (IKFast's TranslationXY2D), as an (n, DOF) array.
+
+    Args:
+        x, y: the tool point in the world's plane; z: as ik_xy_heading's.
+        within_limits, q_ref, tol, backend: as ik's.
+
+    Raises:
+        ValueError: as ik_xy_heading's.
+    """
+    T = _plane_pose(x, y, z, 0.0)
+    return ik(T, within_limits=within_limits, q_ref=q_ref, tol=tol, backend=backend)
+
+
+def _plane_pose(x: float, y: float, z: float | None, heading: float) -> np.ndarray:
+    """The pose at (x, y, z or PLANE_Z) whose tool axis HEADING_AXIS is at heading about z:
+    Rz(heading - _HEADING_ZERO) times the tool's rotation at q = 0, _PLANE_ROTATION."""
+    numbers = {"x": x, "y": y, "heading": heading, "z": 0.0 if z is None else z}
+    for name, value in numbers.items():
+        if type(value) is bool or not isinstance(value, (int, float, np.integer, np.floating)):
+            raise ValueError(f"{name} must be a number, got {value!r}")
+        if not math.isfinite(float(value)):
+            raise ValueError(f"{name} must be finite, got {value!r}")
+    if _PLANE_SLIDE and z is None:
+        raise ValueError("z is needed: a sliding joint moves the tool along z")
+    if not _PLANE_SLIDE and z is not None:
+        raise ValueError(f"z is the arm's plane's ({PLANE_Z!r}): give none")
+    R0 = np.array(_PLANE_ROTATION).reshape(3, 3)
+    c, s = math.cos(float(heading) - _HEADING_ZERO), math.sin(float(heading) - _HEADING_ZERO)
+    T = np.eye(4)
+    T[:3, :3] = np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]]) @ R0
+    T[:3, 3] = (float(x), float(y), PLANE_Z if z is None else float(z))
+    return T
 
 
 def jacobian(q: ArrayLike, frame: str = "base") -> np.ndarray:

@@ -88,6 +88,12 @@ int planar_2r_ik(const double T[16], const double *free, double tol,
 int planar_2r_ik_ref(const double T[16], const double *free, const double *q_ref, double tol,
                       double q[2][2]);
 
+/* The plane task (IKFast's TranslationXY2D): every joint axis is along the world's z. ik_xy:
+   every solution with the tool point at (x, y) (its height is the plane's, 0.0);
+   q_ref and the codes as ik_ref's, INVALID_ARGUMENT also for a number that is not finite. */
+int planar_2r_ik_xy(double x, double y,
+                    const double *q_ref, double tol, double q[2][2]);
+
 /* The rows of q[0..n) inside the limits, in place, each revolute joint at its variant
    q + 2 pi k nearest q_ref's (NULL: zeros); their number. */
 int planar_2r_within_limits(double q[][2], int n, const double *q_ref);

@@ -638,3 +638,84 @@ def test_a_task_no_method_solves_says_why_for_each_axis_without_empty_reasons():
     assert plan.ik is None
     assert "tool z axis, with virtual joint 3: general: needs 6 joints" in plan.refusal
     assert ": ;" not in plan.refusal and not plan.refusal.endswith(": ")
+
+
+def _plane_target(module, q: np.ndarray) -> tuple[float, ...]:
+    """(x, y, heading[, z]) of fk(q): the plane task's arguments (heading of HEADING_AXIS)."""
+    T = module.fk(q)
+    a = module.HEADING_AXIS
+    out = (T[0, 3], T[1, 3], math.atan2(T[1, a], T[0, a]))
+    return out + ((T[2, 3],) if module._PLANE_SLIDE else ())
+
+
+def _plane_rows_reproduce(module, rows: np.ndarray, target: tuple[float, ...], heading: bool):
+    """Every row's tool point at (x, y[, z]) and, with heading, its heading axis there."""
+    a = module.HEADING_AXIS
+    for row in rows:
+        T = module.fk(row)
+        assert abs(T[0, 3] - target[0]) <= 1e-9 * module.REACH
+        assert abs(T[1, 3] - target[1]) <= 1e-9 * module.REACH
+        z = target[3] if module._PLANE_SLIDE else module.PLANE_Z
+        assert abs(T[2, 3] - z) <= 1e-9 * module.REACH
+        if heading:
+            gap = math.atan2(T[1, a], T[0, a]) - target[2]
+            assert abs(math.remainder(gap, 2 * math.pi)) <= 1e-9
+
+
+@pytest.mark.parametrize("name", ["lecture_rrr", "planar_2r"])
+def test_planar_arms_take_their_plane_task(generated, name):
+    """The planar arms' plane task (issue 40: TranslationXYOrientation3D for the lecture's RRR,
+    TranslationXY2D for the 2R arm): 2,000 random joint vectors, every row of ik_xy_heading
+    (x, y, heading) / ik_xy(x, y) reproduces them (1e-9), the sampled vector is among the rows;
+    the C entry point gives the same rows; numbers that are not finite are refused."""
+    import ctypes
+
+    module = generated(name)
+    heading = name == "lecture_rrr"
+    solve = module.ik_xy_heading if heading else module.ik_xy
+    lib, why = module._c_library()
+    assert lib is not None, why
+    call = lib[f"{name}_ik_{'xy_heading' if heading else 'xy'}"]
+    rows = np.zeros((module.MAX_SOLUTIONS, module.DOF))
+    out = rows.ctypes.data_as(ctypes.POINTER(ctypes.c_double))
+    tol = ctypes.c_double(module.CERTIFY_TOL)
+    rng = np.random.default_rng(40)
+    for q in rng.uniform(-np.pi, np.pi, (2000, module.DOF)):
+        target = _plane_target(module, q)
+        args = target if heading else target[:2]
+        found = solve(*args)
+        _plane_rows_reproduce(module, found, target, heading)
+        gaps = np.abs(np.remainder(found - q + np.pi, 2 * np.pi) - np.pi).max(axis=1)
+        assert gaps.min() <= 1e-8
+        n = call(*(ctypes.c_double(v) for v in args), None, tol, out)
+        assert n == len(found) and np.allclose(rows[:n], found, atol=1e-9)
+    nan = (0.1, float("nan"), 0.2)[: len(args)]
+    with pytest.raises(ValueError, match="y must be finite"):
+        solve(*nan)
+    with pytest.raises(ValueError, match="give none"):
+        solve(*args, 0.0) if heading else solve(*args, 0.3)
+    assert call(*(ctypes.c_double(v) for v in nan), None, tol, out) == -3
+
+
+def test_a_scara_takes_its_height_and_a_tilted_planar_arm_has_no_plane_task(tmp_path):
+    """A SCARA-type arm (RRPR, the prismatic joint along z) takes z with its heading: 300
+    random joint vectors come back from ik_xy_heading(x, y, heading, z); without z it is
+    refused. The same arm on a base turned 90 deg about x (axes along the world's y) has no
+    plane task: only ik(T)."""
+    rows = [(0, 0.4, 0.3, 0), (0, 0.3, 0, 0), (0, 0, 0, 0), (0, 0, 0.1, 0)]
+    text = spec_text("scara", "standard", rows, kinds="RRPR")
+    text = text.replace('type = "P"\n', 'type = "P"\nlimits = [-0.5, 0.5]\n')
+    module = build_module(text, tmp_path)
+    assert module.IK_COMPONENTS == "pose" and module._PLANE_SLIDE
+    rng = np.random.default_rng(41)
+    for q in rng.uniform(-np.pi, np.pi, (300, 4)):
+        q[2] = rng.uniform(-0.5, 0.5)
+        target = _plane_target(module, q)
+        found = module.ik_xy_heading(*target)
+        _plane_rows_reproduce(module, found, target, True)
+        assert np.abs(np.remainder(found - q + np.pi, 2 * np.pi) - np.pi).max(axis=1).min() < 1e-8
+    with pytest.raises(ValueError, match="z is needed"):
+        module.ik_xy_heading(0.5, 0.1, 0.2)
+    base = "[base]\ntranslation = [0, 0, 0]\nrpy = [90.0, 0.0, 0.0]\n"
+    tilted = build_module(text + base, tmp_path)
+    assert tilted.METHOD == "planar" and not hasattr(tilted, "ik_xy_heading")

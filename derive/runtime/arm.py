@@ -29,6 +29,14 @@ IK_COMPONENTS = "pose"
 # the tool axis of the "direction", "lookat" and "pointing" tasks: 0 x, 1 y, 2 z
 TOOL_AXIS = 2
 _REVOLUTE = (True, False)
+# a planar arm's plane task (derive/tasks.py, Plane): the tool's rotation at q = 0, the tool
+# axis whose angle about z is the heading (0 x, 1 y) and that angle at q = 0, the plane's
+# height, whether a sliding joint moves the tool along z
+_PLANE_ROTATION: tuple[float, ...] = (1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0)
+HEADING_AXIS = 0
+_HEADING_ZERO = 0.0
+PLANE_Z = 0.0
+_PLANE_SLIDE = False
 # how far the solver's equations may miss and still seed a refinement onto the exact chain
 # (0.0: the closed form solves the arm's own table)
 _SEED_TOL = 0.0

@@ -1,5 +1,6 @@
 """The task functions of an arm solved for fewer components than a pose (derive/tasks.py):
-ik_direction(p, d), ik_lookat(p) and ik_pointing(d) build a pose whose components the task
+ik_direction(p, d), ik_lookat(p) and ik_pointing(d) (and a planar arm's ik_xy_heading and
+ik_xy, derive/tasks.py Plane) build a pose whose components the task
 reads and call ik, which certifies every row on those components (IK_COMPONENTS,
 TOOL_AXIS)."""
 
@@ -11,7 +12,13 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from derive.runtime.api import ik
-from derive.runtime.arm import TOOL_AXIS
+from derive.runtime.arm import (
+    _HEADING_ZERO,
+    _PLANE_ROTATION,
+    _PLANE_SLIDE,
+    PLANE_Z,
+    TOOL_AXIS,
+)
 from derive.runtime.common import _real
 from derive.runtime.constants import CERTIFY_TOL
 
@@ -90,6 +97,80 @@ def ik_pointing(
     """
     T = _task_pose((0.0, 0.0, 0.0), d)
     return ik(T, free=free, within_limits=within_limits, q_ref=q_ref, tol=tol, backend=backend)
+
+
+def ik_xy_heading(
+    x: float,
+    y: float,
+    heading: float,
+    z: float | None = None,
+    *,
+    within_limits: bool = False,
+    q_ref: ArrayLike | None = None,
+    tol: float = CERTIFY_TOL,
+    backend: str | None = None,
+) -> np.ndarray:
+    """All solutions of a planar arm (every axis along the world's z) with the tool point at
+    (x, y) and the tool axis HEADING_AXIS at the angle heading about z from the world's x axis
+    (IKFast's TranslationXYOrientation3D), as an (n, DOF) array; empty if unreachable.
+
+    Args:
+        x, y: the tool point in the world's plane; heading: radians.
+        z: the tool point's height, for an arm with a sliding joint; else None (the arm's
+            plane, PLANE_Z).
+        within_limits, q_ref, tol, backend: as ik's (the pose it solves: the tool's rotation
+            turned about z, its point at (x, y, z)).
+
+    Raises:
+        ValueError: a number is not finite, or z is missing (a sliding joint) or given (none).
+    """
+    T = _plane_pose(x, y, z, heading)
+    return ik(T, within_limits=within_limits, q_ref=q_ref, tol=tol, backend=backend)
+
+
+def ik_xy(
+    x: float,
+    y: float,
+    z: float | None = None,
+    *,
+    within_limits: bool = False,
+    q_ref: ArrayLike | None = None,
+    tol: float = CERTIFY_TOL,
+    backend: str | None = None,
+) -> np.ndarray:
+    """All solutions of a planar arm of two revolute joints (every axis along the world's z)
+    with the tool point at (x, y) (IKFast's TranslationXY2D), as an (n, DOF) array.
+
+    Args:
+        x, y: the tool point in the world's plane; z: as ik_xy_heading's.
+        within_limits, q_ref, tol, backend: as ik's.
+
+    Raises:
+        ValueError: as ik_xy_heading's.
+    """
+    T = _plane_pose(x, y, z, 0.0)
+    return ik(T, within_limits=within_limits, q_ref=q_ref, tol=tol, backend=backend)
+
+
+def _plane_pose(x: float, y: float, z: float | None, heading: float) -> np.ndarray:
+    """The pose at (x, y, z or PLANE_Z) whose tool axis HEADING_AXIS is at heading about z:
+    Rz(heading - _HEADING_ZERO) times the tool's rotation at q = 0, _PLANE_ROTATION."""
+    numbers = {"x": x, "y": y, "heading": heading, "z": 0.0 if z is None else z}
+    for name, value in numbers.items():
+        if type(value) is bool or not isinstance(value, (int, float, np.integer, np.floating)):
+            raise ValueError(f"{name} must be a number, got {value!r}")
+        if not math.isfinite(float(value)):
+            raise ValueError(f"{name} must be finite, got {value!r}")
+    if _PLANE_SLIDE and z is None:
+        raise ValueError("z is needed: a sliding joint moves the tool along z")
+    if not _PLANE_SLIDE and z is not None:
+        raise ValueError(f"z is the arm's plane's ({PLANE_Z!r}): give none")
+    R0 = np.array(_PLANE_ROTATION).reshape(3, 3)
+    c, s = math.cos(float(heading) - _HEADING_ZERO), math.sin(float(heading) - _HEADING_ZERO)
+    T = np.eye(4)
+    T[:3, :3] = np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]]) @ R0
+    T[:3, 3] = (float(x), float(y), PLANE_Z if z is None else float(z))
+    return T
 
 
 def _task_pose(p: ArrayLike, d: ArrayLike | None) -> np.ndarray:
