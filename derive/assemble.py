@@ -59,6 +59,7 @@ TASK_ROOTS = {
     "direction": ("ik_direction",),
     "lookat": ("ik_lookat",),
     "pointing": ("ik_pointing",),
+    "axisangle": ("ik_axis_angle",),
     "xy_heading": ("ik_xy_heading",),  # (a planar arm's plane task: tasks.Plane)
     "xy": ("ik_xy",),
 }

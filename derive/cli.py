@@ -69,6 +69,7 @@ def urdf_options(args: argparse.Namespace) -> urdf.Options:
         task=args.task,
         tool_axis=args.tool_axis,
         method=args.method,
+        base_axis=args.base_axis,
     )
 
 
@@ -348,19 +349,26 @@ def solve_arguments(
     if args.pose is None and args.q is None and args.point is None and args.direction is None:
         raise UsageError(
             "give --pose, --q or --point (or --direction alone for an arm solved for a "
-            "direction only)"
+            "direction only; --angle goes with --point)"
         )
     if args.direction is not None and task not in ("direction", "pointing"):
         raise UsageError(
             f"--direction: {spec.name} is solved for "
-            + {"lookat": "a look-at: give the point only (--point)"}.get(
-                task, f"the {task}; --direction is for an arm solved for a point and a direction"
-            )
+            + {
+                "lookat": "a look-at: give the point only (--point)",
+                "axisangle": "a point and the tool axis's angle to a base axis: give --point "
+                "and --angle",
+            }.get(task, f"the {task}; --direction is for an arm solved for a point and a direction")
         )
     if args.direction is not None and args.point is None and task == "direction":
         raise UsageError("--direction: give the tool point too (--point x y z)")
     if args.direction is not None and (args.pose is not None or args.q is not None):
         raise UsageError("--direction: give it with --point (or alone), not with --pose or --q")
+    if getattr(args, "angle", None) is not None and (task != "axisangle" or args.point is None):
+        raise UsageError(
+            "--angle: with --point, for an arm solved for a point and the tool axis's angle to "
+            f"a base axis (axisangle); {spec.name} is solved for the {task}"
+        )
     if args.point is not None or args.direction is not None:
         pose = task_pose(spec, module, args)
     elif args.q is not None:
@@ -388,6 +396,7 @@ TASK_READS = {
     "direction": "its position and its {axis} column",
     "lookat": "its position, the point looked at",
     "pointing": "its {axis} column only",
+    "axisangle": "its position and its {axis} column's entry along the base axis",
 }
 
 
@@ -419,6 +428,23 @@ def task_pose(spec: ArmSpec, module: ModuleType, args: argparse.Namespace) -> An
         pose[:3, 3] = point
         return pose
     direction = None
+    if task == "axisangle":
+        if args.direction is not None or args.angle is None:
+            raise UsageError(
+                f"--point: {spec.name} is solved for a point and the tool axis's angle to the "
+                "base axis: give --angle (not --direction)"
+            )
+        top = math.pi if args.rad else 180.0
+        if not 0.0 <= args.angle <= top:  # (NaN fails too)
+            raise UsageError(
+                f"--angle: from 0 to {top:g} ({'radians' if args.rad else 'degrees'}), the "
+                f"angle between the tool axis and the base axis; got {args.angle:g}"
+            )
+        angle = args.angle if args.rad else math.radians(args.angle)
+        direction = [0.0, 0.0, 0.0]  # (at that angle: ik reads the base-axis entry only)
+        direction[module.CONE_AXIS] = math.cos(angle)
+        direction[(module.CONE_AXIS + 1) % 3] = math.sin(angle)
+        return module._task_pose(point, direction)
     if task == "direction":
         if args.direction is None:
             raise UsageError(
@@ -517,6 +543,12 @@ def cmd_reach(args: argparse.Namespace) -> int:
         raise UsageError(
             f"{spec.name}: its solver places the tool point only; reach maps sample "
             "orientations (use derive workspace)"
+        )
+    if plan.ik.certify == "axisangle":
+        raise UsageError(
+            f"{spec.name}: its solver places the tool point and tilts the tool axis; reach "
+            "maps sample whole orientations (use derive workspace, or derive solve --point "
+            "--angle)"
         )
     if not (math.isfinite(args.resolution) and args.resolution > 0):
         raise UsageError(f"--resolution: a positive length, got {args.resolution:g}")
@@ -1017,7 +1049,15 @@ def add_pose_arguments(command: argparse.ArgumentParser) -> None:
         help="with --point: the tool axis's direction, 'dx dy dz' (alone for an arm solved for "
         "a direction only: pointing)",
     )
-    command.add_argument("--rad", action="store_true", help="--q and --free values are in radians")
+    command.add_argument(
+        "--angle",
+        type=float,
+        help="with --point (axisangle): the tool axis's angle to the base axis, degrees (--rad: "
+        "radians)",
+    )
+    command.add_argument(
+        "--rad", action="store_true", help="--q, --free and --angle values are in radians"
+    )
     command.add_argument(
         "--free", nargs="+", help="an arm with free joints: their values (default: --q's, or 0)"
     )
@@ -1054,8 +1094,13 @@ def add_urdf_arguments(command: argparse.ArgumentParser, required: bool) -> None
     group.add_argument(
         "--tool-axis",
         choices=TOOL_AXES,
-        help='the tool axis of the "direction" and "lookat" tasks (default: z, else the first '
-        "of x, y that works)",
+        help='the tool axis of the "direction", "lookat", "pointing" and "axisangle" tasks '
+        "(default: z, else the first of x, y that works)",
+    )
+    group.add_argument(
+        "--base-axis",
+        choices=TOOL_AXES,
+        help='the base axis of the "axisangle" task (the tool axis\'s angle to it; default z)',
     )
     group.add_argument(
         "--method",

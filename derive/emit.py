@@ -174,6 +174,7 @@ class PrintedModule:
     correction: str
     correction_doc: str
     tool_axis: int = 2
+    cone_axis: int = 2
     task_doc: str = ""
     # a planar arm's plane task (derive/tasks.py, Plane): "xy_heading", "xy" or ""; its
     # constants; whether the caller gives z
@@ -226,8 +227,9 @@ def print_plan(plan: Plan) -> PrintedModule:
         refusal=plan.refusal,
         ik_body=scalar.ik_lines(plan) if ik else (),
         qref_names=", ".join(f"qr{i}" for i in range(1, arm.dof + 1)),
-        match=match_expression(ik.certify, ik.tool_axis) if ik else "",
+        match=match_expression(ik.certify, ik.tool_axis, ik.cone) if ik else "",
         tool_axis=ik.tool_axis if ik else 2,
+        cone_axis=ik.cone if ik else 2,
         components=ik.certify if ik else "",
         general=general_code(plan),
         c_source=repr(f"{arm.name}_ik.c" if ik else ""),
@@ -293,6 +295,16 @@ def task_text(plan: Plan) -> str:
                 else ", the tool point in the plane z = PLANE_Z"
             )
             + ") and solves it with ik."
+        )
+    if ik is not None and ik.certify == "axisangle":
+        return (
+            f"The task: the arm has {plan.arm.dof} joints; its solver is derived for "
+            f"{ik.solves_for} (IK_COMPONENTS, TOOL_AXIS, CONE_AXIS): joint 1 turns about "
+            "that base axis, so the tool axis's component along it depends on joints 2-4 "
+            "only, which turn about parallel axes by one angle phi (derive/methods/cone.py)"
+            + (", and the wrist roll's value is the caller's (FREE)" if ik.free else "")
+            + ". `ik(T)` reads only T's position and the entry of its column TOOL_AXIS along "
+            "CONE_AXIS (the angle's cosine); every row reproduces them."
         )
     if ik is None or ik.certify not in ("direction", "lookat", "pointing"):
         return ""

@@ -75,6 +75,7 @@ class PrintedC:
     # the task's code (derive/tasks.py TASK_CODES) and its tool axis
     task_code: int = 0
     tool_axis: int = 2
+    cone_axis: int = 2
 
 
 def general_constants(plan: Plan) -> dict[str, object]:
@@ -203,9 +204,11 @@ def print_c(plan: Plan) -> PrintedC:
         base=_frame_rows(arm.base[:12]),
         refined=plan.correction is not None,
         solved=plan.solved if plan.correction else (),
-        refine_rows=3 if ik.certify in ("position", "lookat") else 6,  # (pointing: 3 zero)
+        refine_rows={"position": 3, "lookat": 3, "axisangle": 4}.get(ik.certify, 6),  # (pointing:
+        # 3 zero)
         task_code=TASK_CODES[ik.certify],
         tool_axis=ik.tool_axis,
+        cone_axis=ik.cone,
         **plane_fields(plan),
     )
 

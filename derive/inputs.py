@@ -64,7 +64,8 @@ def conversion_options(options: urdf.Options | None) -> list[str]:
     flags = {"base": "--base", "tip": "--tip", "name": "--name", "exact": "--exact",
              "task": "--task", "tool_axis": "--tool-axis", "angle_tol": "--angle-tol",
              "length_tol": "--length-tol", "max_deviation": "--max-deviation",
-             "convention": "--convention", "method": "--method"}  # fmt: skip
+             "convention": "--convention", "method": "--method",
+             "base_axis": "--base-axis"}  # fmt: skip
     return [flag for key, flag in flags.items() if getattr(options, key) != getattr(default, key)]
 
 
@@ -87,7 +88,7 @@ def resolve_spec(text: str, options: urdf.Options | None = None) -> ArmSpec:
     if given := conversion_options(options):
         raise SpecError(
             f"{text}: {', '.join(given)}: options of a URDF or MJCF file's conversion, and "
-            "this arm is a spec (in a spec, [ik] task, tool_axis and method say these)"
+            "this arm is a spec (in a spec, [ik] task, tool_axis, base_axis and method say these)"
         )
     if reader is not None:
         return reader(path, urdf.Options())

@@ -10,7 +10,7 @@ import sympy as sp
 from derive import free, jacobian, tasks
 from derive import symbols as sym
 from derive.classify import Structure, classify
-from derive.methods import general, parallel, pieper, planar, position
+from derive.methods import cone, general, parallel, pieper, planar, position
 from derive.methods.common import NotApplicable
 from derive.nominal import (
     STRUCTURE_TOL,
@@ -178,6 +178,13 @@ def task_of(spec: ArmSpec, chain: Chain) -> tasks.Task | None:
         if n < 5:
             raise SpecError(f'{where}: "direction" needs at least 5 joints, the arm has {n}')
         task = tasks.Task("direction", 2, NAMED)
+    elif spec.task == "axisangle":
+        if n not in (4, 5):
+            raise SpecError(
+                f'{where}: "axisangle" needs 4 joints (or 5, the last a wrist roll about the '
+                f"tool axis), the arm has {n}"
+            )
+        task = tasks.Task("axisangle", 2, NAMED)
     else:
         if kinds != "RR":
             raise SpecError(f'{where}: "{spec.task}" needs 2 revolute joints, the arm has {kinds}')
@@ -185,10 +192,14 @@ def task_of(spec: ArmSpec, chain: Chain) -> tasks.Task | None:
     if spec.tool_axis is not None:
         if task is None:
             raise SpecError(
-                f'{spec.source}: ik.tool_axis: only the "direction", "lookat" and "pointing" '
-                "tasks have a tool axis"
+                f'{spec.source}: ik.tool_axis: only the "direction", "lookat", "pointing" and '
+                '"axisangle" tasks have a tool axis'
             )
         task = dataclasses.replace(task, axis=tasks.AXES.index(spec.tool_axis), fixed=True)
+    if spec.base_axis is not None:
+        if task is None or task.kind != "axisangle":
+            raise SpecError(f'{spec.source}: ik.base_axis: only the "axisangle" task has one')
+        task = dataclasses.replace(task, cone=tasks.AXES.index(spec.base_axis))
     return task
 
 
@@ -203,6 +214,8 @@ def choose(
     """The first of the named methods that solves the chain (an arm of more than 6 joints:
     with free joints; a task's arm: extended by its virtual joint, about the task's tool axis,
     else about the first of z, x, y that works), or None and why none does."""
+    if task is not None and task.kind == "axisangle":
+        return choose_cone(chain, structure, named, names, task, tol)
     if task is not None and task.virtual:
         reasons = []
         if task.why != NAMED:  # (the joints chose it: a method of the arm's own comes first)
@@ -252,6 +265,30 @@ def choose(
     if chain.dof > free.REMAINDER_DOF:
         return choose_free(chain, named, names)
     return choose_method(chain, structure, names)
+
+
+def choose_cone(
+    chain: Chain,
+    structure: Structure,
+    named: tuple[int, ...] | None,
+    names: tuple[str, ...],
+    task: tasks.Task,
+    tol: float,
+) -> tuple[IkPlan | None, str]:
+    """The "axisangle" task's plan (derive/methods/cone.py) for the task's tool axis, else
+    the first of z, x, y that works; where the joints chose the task, a method of the arm's
+    own first."""
+    if task.why != NAMED:
+        ik, why = choose(chain, structure, named, names)
+        if ik is not None:
+            return ik, why
+    reasons = []
+    for axis in (task.axis,) if task.fixed else tasks.axis_order(chain, tol):
+        try:
+            return cone.derive(chain, axis, task.cone, tol), ""
+        except NotApplicable as exc:
+            reasons.append(f"tool {tasks.AXES[axis]} axis: {exc}")
+    return None, "; ".join(reasons)
 
 
 # how far the nominal solver's equations may miss, relative, and still seed a refinement, in

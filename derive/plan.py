@@ -289,7 +289,8 @@ class IkPlan:
         certify: the task's components every solution reproduces (derive/tasks.py): "pose"
             (the whole pose), "position" (the tool point only: arms that do not control the
             orientation), "direction" (the tool point and the tool axis's direction) or
-            "lookat" (the tool axis's ray through the target point).
+            "lookat" (the tool axis's ray through the target point) or "axisangle" (the tool
+            point and the tool axis's component along the base axis `cone`).
         free: the joints (1-based) the caller gives values for (an arm of more than 6
             joints); their values are the reference values qr_i.
         free_text: which joints are free and why, in words (derive/free.py), "" without
@@ -302,6 +303,8 @@ class IkPlan:
         virtual: a task's virtual joint's value on a solution's branch, for the report:
             (cos, sin) of its angle, or (its length,), in the world pose's entries and the
             arm's joints' c_i, s_i (d_i); () without one.
+        cone: the base axis (0 x, 1 y, 2 z) the "axisangle" task measures the tool axis's
+            angle from (derive/methods/cone.py).
         task_snap: how far snapping moved the virtual link (derive/tasks.py, extend_snapped:
             radians, or a length over the arm's size); its rows are then refined onto the
             arm's exact chain.
@@ -321,6 +324,7 @@ class IkPlan:
     relabel: sp.Expr = sp.S.Zero
     virtual: tuple[sp.Expr, ...] = ()
     task_snap: float = 0.0
+    cone: int = 2
 
 
 @dataclass(frozen=True)

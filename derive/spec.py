@@ -34,10 +34,13 @@ Spec format (all keys other than those listed are errors)::
     task = "direction"          # what ik solves for: "pose" (6 joints), "position" (3),
                                 # "direction" (5: the tool point and the direction of a
                                 # tool axis), "lookat" (2: the tool axis's ray through a
-                                # point), "pointing" (2: the tool axis's direction only);
-                                # default: the joints choose (derive/tasks.py)
-    tool_axis = "z"             # the tool axis of "direction" and "lookat" (x, y or z;
-                                # default z, or the first that works)
+                                # point), "pointing" (2: the tool axis's direction only),
+                                # "axisangle" (4: the tool point and the angle of a tool
+                                # axis to a base axis); default: the joints choose
+                                # (derive/tasks.py)
+    tool_axis = "z"             # the tool axis of "direction", "lookat", "pointing" and
+                                # "axisangle" (x, y or z; default z, or the first that works)
+    base_axis = "z"             # the base axis of "axisangle" (x, y or z; default z)
     method = "general"          # this method only (pieper, three-parallel, planar, position,
                                 # general); default: the first that applies. "general"
                                 # gives an arm near a special one its complete solutions
@@ -100,15 +103,15 @@ TOP_KEYS = (
     "exact",
     "ik",
 )  # fmt: skip
-IK_KEYS = ("free", "structure_tol", "task", "tool_axis", "method")
+IK_KEYS = ("free", "structure_tol", "task", "tool_axis", "base_axis", "method")
 # what [ik] method may be (derive/pipeline.py's METHODS: one method only, not the first that
 # applies; "general" gives a calibrated arm its complete solution set)
 IK_METHODS = ("pieper", "three-parallel", "planar", "position", "general")
 # what [ik] task and tool_axis may be (derive/tasks.py)
-IK_TASKS = ("pose", "position", "direction", "lookat", "pointing")
+IK_TASKS = ("pose", "position", "direction", "lookat", "pointing", "axisangle")
 TOOL_AXES = ("x", "y", "z")
 # the joints each task needs: an arm with more has free joints ([ik] free)
-TASK_JOINTS = {"pose": 6, "position": 3, "direction": 5, "lookat": 2, "pointing": 2}
+TASK_JOINTS = {"pose": 6, "position": 3, "direction": 5, "lookat": 2, "pointing": 2, "axisangle": 4}
 # what [ik] structure_tol may be: beyond 0.1 rad or 0.1 of the arm's size it changes the arm
 STRUCTURE_TOL_RANGE = (0.0, 0.1)
 SOURCE_KEYS = ("urdf", "sha256", "base", "tip", "joints", "snaps", "deviation", "format")
@@ -206,6 +209,7 @@ class ArmSpec:
         structure_tol: [ik] structure_tol, or None (derive.nominal.STRUCTURE_TOL).
         task: [ik] task, or None (the joints choose: derive/tasks.py).
         tool_axis: [ik] tool_axis, or None (z, or the first that works).
+        base_axis: [ik] base_axis, or None (z): the "axisangle" task's.
         method: [ik] method, or None (the first method that applies).
         exact: [exact] frames (n + 1 tuples of 12 floats), or None (the table is exact).
     """
@@ -227,6 +231,7 @@ class ArmSpec:
     task: str | None = None
     tool_axis: str | None = None
     method: str | None = None
+    base_axis: str | None = None
 
     @property
     def dof(self) -> int:
@@ -279,6 +284,8 @@ class ArmSpec:
             ik["tool_axis"] = self.tool_axis
         if self.method is not None:  # (likewise)
             ik["method"] = self.method
+        if self.base_axis is not None:  # (likewise)
+            ik["base_axis"] = self.base_axis
         if ik:
             data["ik"] = ik
         if self.exact is not None:  # (likewise)
@@ -391,6 +398,7 @@ def _validate(data: dict, where: str) -> ArmSpec:
         _choice(data.get("ik"), where, "task", IK_TASKS),
         _choice(data.get("ik"), where, "tool_axis", TOOL_AXES),
         _choice(data.get("ik"), where, "method", IK_METHODS),
+        _choice(data.get("ik"), where, "base_axis", TOOL_AXES),
     )
 
 

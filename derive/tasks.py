@@ -50,9 +50,9 @@ from derive.transforms import (
     x_factor,
 )
 
-TASKS = ("pose", "position", "direction", "lookat", "pointing")
+TASKS = ("pose", "position", "direction", "lookat", "pointing", "axisangle")
 # the tasks' numbers in the C solver (dk_match, DK_REFINE_TASK)
-TASK_CODES = {"pose": 0, "position": 1, "direction": 2, "lookat": 3, "pointing": 4}
+TASK_CODES = {"pose": 0, "position": 1, "direction": 2, "lookat": 3, "pointing": 4, "axisangle": 5}
 AXES = ("x", "y", "z")
 
 # what each task's solver is defined on, in words (the module docstring and the report)
@@ -60,6 +60,8 @@ SOLVES_FOR = {
     "direction": "the tool point's position and the direction of the tool {axis} axis",
     "lookat": "the tool {axis} axis's ray, from the tool point, through a point",
     "pointing": "the direction of the tool {axis} axis",
+    "axisangle": "the tool point's position and the angle of the tool {axis} axis to the base "
+    "{cone} axis",
 }
 # IKFast's names of the tasks
 IKFAST_NAMES = {
@@ -68,6 +70,7 @@ IKFAST_NAMES = {
     "direction": "TranslationDirection5D",
     "lookat": "Lookat3D",
     "pointing": "Direction3D",
+    "axisangle": "Translation{CONE}AxisAngle4D",
 }
 
 
@@ -80,12 +83,14 @@ class Task:
         axis: the tool axis (0 x, 1 y, 2 z) of "direction" and "lookat".
         why: how it was chosen, in words (the summary line and the report).
         fixed: the spec names the axis (else z, or the first of x, y that works).
+        cone: the base axis (0 x, 1 y, 2 z) of "axisangle" (the angle of the tool axis to it).
     """
 
     kind: str
     axis: int = 2
     why: str = ""
     fixed: bool = False
+    cone: int = 2
 
     @property
     def axis_name(self) -> str:
@@ -105,8 +110,11 @@ class Task:
             "direction": f"position + direction of the tool {self.axis_name} axis",
             "lookat": f"look-at: the tool {self.axis_name} axis through a point",
             "pointing": f"the direction of the tool {self.axis_name} axis only",
+            "axisangle": f"position + angle of the tool {self.axis_name} axis to the base "
+            f"{AXES[self.cone]} axis",
         }[self.kind]
-        return f"{words} ({IKFAST_NAMES[self.kind]})"
+        name = IKFAST_NAMES[self.kind].format(CONE=AXES[self.cone].upper())
+        return f"{words} ({name})"
 
 
 def default_task(chain: Chain) -> Task | None:
@@ -115,6 +123,12 @@ def default_task(chain: Chain) -> Task | None:
     kinds = "".join(j.kind for j in chain.joints)
     if chain.dof == 5:
         return Task("direction", 2, "five joints: position + direction of a tool axis")
+    if kinds == "RRRR":
+        return Task(
+            "axisangle",
+            2,
+            "four revolute joints: position + the angle of a tool axis to the base z axis",
+        )
     if kinds == "RR" and chain.twists[1].sa != 0:
         return Task("lookat", 2, "two revolute joints, not parallel: a pan-tilt's look-at")
     return None

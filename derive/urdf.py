@@ -834,7 +834,8 @@ def spec_text(
         'length_unit = "m"',
     ]
     if ik:
-        lines += ["", "# from the command line (--task, --tool-axis, --method)", "[ik]"]
+        lines += ["", "# from the command line (--task, --tool-axis, --method, --base-axis)"]
+        lines += ["[ik]"]
         lines += [f'{key} = "{value}"' for key, value in ik]
     rows = conversion.rows
     if convention == "standard":
@@ -914,6 +915,7 @@ class Options:
     task: str | None = None
     tool_axis: str | None = None
     method: str | None = None
+    base_axis: str | None = None
 
     def __post_init__(self) -> None:
         """Refuse tolerances that mean nothing: negative, NaN, or so large that snapping
@@ -922,6 +924,7 @@ class Options:
             ("--task", self.task, IK_TASKS),
             ("--tool-axis", self.tool_axis, TOOL_AXES),
             ("--method", self.method, IK_METHODS),
+            ("--base-axis", self.base_axis, TOOL_AXES),
         ):
             if choice is not None and choice not in allowed:
                 raise UrdfError(f"{option} {choice!r}: allowed: {', '.join(allowed)}")
@@ -970,7 +973,12 @@ def import_chain(
     assert options.base is not None and options.tip is not None
     conversion = convert(chain, where, options.angle_tol, options.length_tol, options.exact)
     name = options.name or spec_name(robot.name or path.stem)
-    given = (("task", options.task), ("tool_axis", options.tool_axis), ("method", options.method))
+    given = (
+        ("task", options.task),
+        ("tool_axis", options.tool_axis),
+        ("method", options.method),
+        ("base_axis", options.base_axis),
+    )
     ik = tuple((key, value) for key, value in given if value)
     args = (conversion, robot, path.name, options.base, options.tip, name, options.convention,
             source, part, ik)  # fmt: skip

@@ -106,11 +106,16 @@ def pose_error(module: ModuleType, q: np.ndarray, T: np.ndarray) -> tuple[float,
     the solver's task reads (derive/tasks.py): all of them; the position only (rotation error
     0); the position and the tool axis TOOL_AXIS ("direction"); the distance of T's point from
     the ray of the tool axis, infinite behind the tool ("lookat", rotation error 0); the tool
-    axis only ("pointing", position error 0).
+    axis only ("pointing", position error 0); the position and the tool axis's component along
+    the base axis CONE_AXIS ("axisangle").
     """
     P = module.fk(q)
     task = module.IK_COMPONENTS
     axis = getattr(module, "TOOL_AXIS", 2)
+    if task == "axisangle":
+        cone = module.CONE_AXIS
+        rot = abs(float(P[cone, axis] - T[cone, axis]))
+        return rot, float(np.abs(P[:3, 3] - T[:3, 3]).max()) / module.REACH
     if task == "lookat":
         v = T[:3, 3] - P[:3, 3]
         along = float(v @ P[:3, axis])
@@ -138,9 +143,9 @@ def targets(module: ModuleType, Q: np.ndarray) -> np.ndarray:
 
 def task_components(module: ModuleType, q: np.ndarray) -> np.ndarray:
     """What the solver's task reads of fk(q), as one vector (positions / REACH): the pose's
-    top rows, the position, the position and the tool axis, the tool axis, or for a look-at
-    the point one
-    REACH ahead on the tool axis (the ray, through a point at a typical distance)."""
+    top rows, the position, the position and the tool axis (or its component along the base
+    axis), the tool axis, or for a look-at the point one REACH ahead on the tool axis (the
+    ray, through a point at a typical distance)."""
     P = module.fk(q)
     task = module.IK_COMPONENTS
     axis = getattr(module, "TOOL_AXIS", 2)
@@ -149,6 +154,8 @@ def task_components(module: ModuleType, q: np.ndarray) -> np.ndarray:
         return position
     if task == "direction":
         return np.concatenate([position, P[:3, axis]])
+    if task == "axisangle":
+        return np.concatenate([position, [P[module.CONE_AXIS, axis]]])
     if task == "pointing":
         return P[:3, axis].copy()
     if task == "lookat":

@@ -1246,8 +1246,9 @@ static double dk_ray_gap(const double e[12], const double t[12], int axis)
 
 /* whether e (a pose's 12 top entries) matches t in the task's components (0 the pose, 1 the
    position, 2 the position and tool axis `axis`'s direction, 3 the ray of that axis through
-   t's position): rotation entries within tol, positions within ptol (no early exit: the
-   comparisons are cheaper than the branches) */
+   t's position, 4 that axis's direction, 5 the position and entry `axis` (the tool axis's
+   component along a base axis)): rotation entries within tol, positions within ptol (no early
+   exit: the comparisons are cheaper than the branches) */
 static int dk_match(const double e[12], const double t[12], double tol, double ptol, int task,
                     int axis)
 {
@@ -1255,6 +1256,9 @@ static int dk_match(const double e[12], const double t[12], double tol, double p
                          (fabs(e[11] - t[11]) <= ptol);
     if (task == 3) {
         return dk_ray_gap(e, t, axis) <= ptol;
+    }
+    if (task == 5) {
+        return position & (fabs(e[axis] - t[axis]) <= tol);
     }
     if (task == 4) {
         return (fabs(e[axis] - t[axis]) <= tol) & (fabs(e[4 + axis] - t[4 + axis]) <= tol) &

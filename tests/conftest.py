@@ -27,6 +27,7 @@ BUNDLED = (
     "lecture_rrr",
     "locobot_head",
     "manocha_canny",
+    "open_manipulator_x",
     "panda",
     "parallel_6r",
     "planar_2r",

@@ -4,6 +4,7 @@ and gives them through ComputeIk; the files are byte-deterministic."""
 
 from __future__ import annotations
 
+import math
 import os
 import re
 import shutil
@@ -322,12 +323,18 @@ def test_ikfast_shim_compiles_and_answers(generated, tmp_path, name):
 
 
 @pytest.mark.parametrize(
-    ("name", "kind"), [("youbot", "0x56000007"), ("locobot_head", "0x23000006")]
+    ("name", "kind"),
+    [
+        ("youbot", "0x56000007"),
+        ("locobot_head", "0x23000006"),
+        ("open_manipulator_x", "0x4400000d"),
+    ],
 )
 def test_ikfast_shim_of_a_task_arm(generated, tmp_path, name, kind):
     """IKP_TranslationDirection5D (eetrans the point, eerot[0..2] the direction of the tool
-    axis) and IKP_Lookat3D (eetrans the point looked at): the module's task rows, and
-    ComputeFk gives the point and the axis back."""
+    axis), IKP_Lookat3D (eetrans the point looked at) and IKP_TranslationZAxisAngle4D
+    (eetrans the point, eerot[0] the tool axis's angle to the base z axis): the module's task
+    rows, and ComputeFk gives the point and the axis (its angle) back."""
     compiler = shutil.which("g++") or shutil.which("c++")
     if compiler is None:
         pytest.skip("no C++ compiler")
@@ -348,6 +355,9 @@ def test_ikfast_shim_of_a_task_arm(generated, tmp_path, name, kind):
     data[:, 9:] = T[:, :3, 3]
     if m.IK_COMPONENTS == "direction":
         data[:, :3] = T[:, :3, x]
+    angles = np.arccos(np.clip(T[:, 2, x], -1.0, 1.0))
+    if m.IK_COMPONENTS == "axisangle":
+        data[:, 0] = angles
     out = subprocess.run([driver], input=data.tobytes(), check=True, capture_output=True).stdout
     at = 0
     for i in range(len(T)):
@@ -358,13 +368,18 @@ def test_ikfast_shim_of_a_task_arm(generated, tmp_path, name, kind):
         rows = rows.reshape(count, m.DOF + 12)
         if m.IK_COMPONENTS == "direction":
             expected = m.ik_direction(T[i, :3, 3], T[i, :3, x], backend="python")
+        elif m.IK_COMPONENTS == "axisangle":
+            expected = m.ik_axis_angle(T[i, :3, 3], angles[i], backend="python")
         else:
             expected = m.ik_lookat(T[i, :3, 3], backend="python")
         assert count == len(expected), i
         np.testing.assert_allclose(rows[:, : m.DOF], expected, atol=1e-6)
-        for row in rows:  # ComputeFk: the tool point, and the axis in eerot[0..2]
+        for row in rows:  # ComputeFk: the tool point, and the axis (its angle) in eerot
             E = m.fk(row[: m.DOF])
-            np.testing.assert_allclose(row[m.DOF : m.DOF + 3], E[:3, x], atol=1e-12)
+            if m.IK_COMPONENTS == "axisangle":
+                assert abs(row[m.DOF] - math.acos(min(1.0, max(-1.0, E[2, x])))) <= 1e-12
+            else:
+                np.testing.assert_allclose(row[m.DOF : m.DOF + 3], E[:3, x], atol=1e-12)
             np.testing.assert_allclose(row[m.DOF + 9 :], E[:3, 3], atol=1e-12)
     assert at == len(out)
 

@@ -105,7 +105,11 @@ def tally(m, backends: tuple[str, ...]) -> dict[str, dict[str, int]]:
 # other. so_arm100 (refined onto its exact frames; 2,000 poses): 2 poses differ by rounding
 # (each backend's Newton steps stop within 1e-10 of the pose; on 10,000 poses: 8, and 1 by
 # more than 1e-6 at a singular configuration, a curve of solutions). locobot_head: none.
+# open_manipulator_x (the axis-angle task): 2 of 10,000 poses differ by rounding (9.5e-12 and
+# 1.3e-11), each with two rows 5e-4 apart in theta3 (the two tilts phi give wrists almost the
+# same distance from the shoulder: near-double roots of the law of cosines).
 ALLOWED = {
+    "open_manipulator_x": {"rounding": 3},
     "youbot": {"count": 1, "rounding": 5, "seam": 2},
     "so_arm100": {"rounding": 5},
     "iiwa14": {"rounding": 30, "seam": 10, "turn": 2},

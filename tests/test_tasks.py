@@ -23,7 +23,17 @@ from conftest import build_module, needs_cc, spec_text
 
 DATA = Path(__file__).parent / "data"
 # the bundled task arms and their tasks
-TASK_ARMS = {"youbot": "direction", "so_arm100": "direction", "locobot_head": "lookat"}
+TASK_ARMS = {
+    "youbot": "direction",
+    "so_arm100": "direction",
+    "locobot_head": "lookat",
+    "open_manipulator_x": "axisangle",
+}
+
+
+# OpenManipulator-X's upper arm leans 79.38 deg ahead of its DH x axis: at q3 = -that, the
+# elbow is stretched
+OMX_BEND = math.radians(79.380345)
 
 
 def sample_joints(module, n: int, seed: int) -> np.ndarray:
@@ -55,6 +65,10 @@ def task_error(module, rows: np.ndarray, T: np.ndarray) -> np.ndarray:
     if module.IK_COMPONENTS == "direction":
         position = np.abs(E[:, :3, 3] - T[:, :3, 3]).max(axis=1) / module.REACH
         return np.maximum(position, np.abs(E[:, :3, x] - T[:, :3, x]).max(axis=1))
+    if module.IK_COMPONENTS == "axisangle":  # (the axis's component along the base axis)
+        c = module.CONE_AXIS
+        position = np.abs(E[:, :3, 3] - T[:, :3, 3]).max(axis=1) / module.REACH
+        return np.maximum(position, np.abs(E[:, c, x] - T[:, c, x]))
     v = T[:, :3, 3] - E[:, :3, 3]
     u = E[:, :3, x]
     along = np.einsum("ij,ij->i", v, u)
@@ -73,12 +87,15 @@ def task_sigma(module, q: np.ndarray, T: np.ndarray, step: float = 1e-6) -> floa
             return E[:3, x]
         if module.IK_COMPONENTS == "direction":
             return np.concatenate([E[:3, 3] / module.REACH, E[:3, x]])
+        if module.IK_COMPONENTS == "axisangle":
+            return np.concatenate([E[:3, 3] / module.REACH, [E[module.CONE_AXIS, x]]])
         v = T[:3, 3] - E[:3, 3]
         u = E[:3, x]
         return (v - (v @ u) * u) / module.REACH
 
     moving = [i for i in range(module.DOF) if i + 1 not in module.FREE]
-    J = np.zeros((6 if module.IK_COMPONENTS == "direction" else 3, len(moving)))
+    rows = {"direction": 6, "axisangle": 4}.get(module.IK_COMPONENTS, 3)
+    J = np.zeros((rows, len(moving)))
     for k, i in enumerate(moving):
         dq = np.zeros(module.DOF)
         dq[i] = step
@@ -115,7 +132,9 @@ def round_trips(module, n: int, seed: int, backend: str) -> dict[str, float]:
 def test_bundled_task_arms_are_solved_for_their_task(generated, name):
     module = generated(name)
     assert TASK_ARMS[name] == module.IK_COMPONENTS
-    function = {"direction": "ik_direction", "lookat": "ik_lookat"}[module.IK_COMPONENTS]
+    function = {"direction": "ik_direction", "lookat": "ik_lookat", "axisangle": "ik_axis_angle"}[
+        module.IK_COMPONENTS
+    ]
     assert callable(getattr(module, function)) and f"    {function}(p" in module.__doc__
     assert "The task: the arm has" in module.__doc__
 
@@ -210,6 +229,12 @@ def test_ik_lookat_sees_the_point_and_never_looks_away(generated):
         ("so_arm100", (0.5, -1.0, 1.2, 0.0, math.pi)),
         ("locobot_head", (0.4, -math.pi / 2)),  # looking straight up the pan axis
         ("locobot_head", (0.0, 0.0)),
+        ("open_manipulator_x", (0.0, 0.0, 0.0, 0.0)),  # the home pose
+        ("open_manipulator_x", (0.3, 0.2, -OMX_BEND, 0.4)),  # elbow stretched (theta3 = 0)
+        ("open_manipulator_x", (0.3, 0.2, 0.5, -math.pi / 2 - 0.2 - 0.5)),  # gripper down
+        ("open_manipulator_x", (-1.0, -0.3, 0.9, math.pi / 2 + 0.3 - 0.9)),  # gripper up
+        ("open_manipulator_x", (0.7, -0.2, -0.2, math.pi)),  # gripper folded back
+        ("open_manipulator_x", (1.2, math.pi, -OMX_BEND, 0.0)),  # stretched back down
     ],
 )
 def test_singular_configurations_are_answered(generated, name, q):
@@ -481,7 +506,7 @@ def test_a_tool_axis_without_a_task_of_one_is_refused():
     text = spec_text(
         "six_r", "modified", [*FIVE_R_ROWS, (0, 0, 0.1, 0)], extra='\n[ik]\ntool_axis = "x"\n'
     )
-    with pytest.raises(SpecError, match='only the "direction", "lookat" and "pointing" tasks'):
+    with pytest.raises(SpecError, match='only the "direction", "lookat", "pointing" and "axis'):
         build_plan(parse_spec(text, "<t>"))
 
 
@@ -557,7 +582,13 @@ def test_the_c_task_entry_points_give_the_module_s_rows(generated, name):
     Q = sample_joints(module, 50, 43)
     for T in task_targets(module, Q, 43):
         p = np.ascontiguousarray(T[:3, 3])
-        if module.IK_COMPONENTS == "direction":
+        if module.IK_COMPONENTS == "axisangle":
+            angle = math.acos(min(1.0, max(-1.0, T[module.CONE_AXIS, module.TOOL_AXIS])))
+            call = lib[f"{name}_ik_axis_angle"]
+            n = call(p.ctypes.data_as(double_p), ctypes.c_double(angle), None, None,
+                     ctypes.c_double(module.CERTIFY_TOL), out)  # fmt: skip
+            expected = module.ik_axis_angle(p, angle, backend="python")
+        elif module.IK_COMPONENTS == "direction":
             d = np.ascontiguousarray(T[:3, module.TOOL_AXIS] * 2.0)
             call = lib[f"{name}_ik_direction"]
             n = call(p.ctypes.data_as(double_p), d.ctypes.data_as(double_p), None, None,
@@ -570,7 +601,13 @@ def test_the_c_task_entry_points_give_the_module_s_rows(generated, name):
             expected = module.ik_lookat(p, backend="python")
         assert n == len(expected) and np.allclose(rows[:n], expected, atol=1e-9)
     bad = np.array([0.1, np.nan, 0.2])
-    if module.IK_COMPONENTS == "direction":
+    if module.IK_COMPONENTS == "axisangle":
+        call, tol = lib[f"{name}_ik_axis_angle"], ctypes.c_double(1e-10)
+        assert call(bad.ctypes.data_as(double_p), ctypes.c_double(0.5), None, None, tol, out) == -3
+        for angle in (math.nan, -0.1, 3.2):
+            assert call(p.ctypes.data_as(double_p), ctypes.c_double(angle), None, None, tol,
+                        out) == -3  # fmt: skip
+    elif module.IK_COMPONENTS == "direction":
         zero = np.zeros(3)
         args = (p.ctypes.data_as(double_p), zero.ctypes.data_as(double_p))
         assert lib[f"{name}_ik_direction"](*args, None, None, ctypes.c_double(1e-10), out) == -3
@@ -719,3 +756,215 @@ def test_a_scara_takes_its_height_and_a_tilted_planar_arm_has_no_plane_task(tmp_
     base = "[base]\ntranslation = [0, 0, 0]\nrpy = [90.0, 0.0, 0.0]\n"
     tilted = build_module(text + base, tmp_path)
     assert tilted.METHOD == "planar" and not hasattr(tilted, "ik_xy_heading")
+
+
+# --- position + the tool axis's angle to a base axis (axisangle: derive/methods/cone.py) -----
+
+OMX = (DATA.parent.parent / "derive" / "arms" / "open_manipulator_x.toml").read_text()
+
+
+def _omx(name: str, ik: str = "", replace: tuple[tuple[str, str], ...] = ()) -> str:
+    """The bundled OpenManipulator-X's spec renamed, with text replaced and an [ik] table."""
+    text = OMX.replace('name = "open_manipulator_x"', f'name = "{name}"')
+    for old, new in replace:
+        assert old in text, old
+        text = text.replace(old, new, 1)
+    return text + (f"\n[ik]\n{ik}\n" if ik else "")
+
+
+def test_a_four_joint_arm_takes_the_axis_angle_task_and_says_why(generated):
+    module = generated("open_manipulator_x")
+    assert (module.IK_COMPONENTS, module.TOOL_AXIS, module.CONE_AXIS) == ("axisangle", 0, 2)
+    assert module.METHOD == "cone" and module.MAX_SOLUTIONS == 8
+    assert "four revolute joints: position + the angle of a tool axis to the base z axis" in (
+        " ".join(module.__doc__.split())
+    )
+    assert "(IKFast's TranslationZAxisAngle4D)" in module.__doc__
+
+
+def test_ik_axis_angle_reaches_the_point_at_the_angle_asked(generated):
+    """Every row puts the tool point at p with the gripper's x axis at the angle asked to
+    the vertical, and all four configurations (shoulder facing or turned away, elbow up or
+    down) come back where the arm reaches all of them."""
+    module = generated("open_manipulator_x")
+    p = np.array([0.2, 0.05, 0.1])
+    for angle in (0.3, math.pi / 2, 2.0, math.pi):
+        rows = module.ik_axis_angle(p, angle, backend="python")
+        assert len(rows) >= 2
+        for row in rows:
+            E = module.fk(row)
+            assert np.abs(E[:3, 3] - p).max() <= 1e-12
+            assert abs(math.acos(min(1.0, max(-1.0, E[2, 0]))) - angle) <= 1e-6
+        assert np.allclose(module.ik_axis_angle(p, angle, backend="c"), rows, atol=1e-9)
+    assert len(module.ik_axis_angle(p, 2.0)) == 4
+    assert len(module.ik_axis_angle((0.5, 0.0, 0.1), 1.0)) == 0  # (beyond the reach)
+
+
+@pytest.mark.parametrize(
+    ("args", "message"),
+    [
+        (((0, 0), 0.5), "p must be 3 finite numbers"),
+        (((0.2, 0, math.nan), 0.5), "p must be 3 finite numbers"),
+        (((0.2, 0, 0.1), math.inf), "angle must be from 0 to pi"),
+        (((0.2, 0, 0.1), math.nan), "angle must be from 0 to pi"),
+        (((0.2, 0, 0.1), -0.1), "angle must be from 0 to pi"),
+        (((0.2, 0, 0.1), 3.2), "angle must be from 0 to pi"),
+        (((0.2, 0, 0.1), "up"), "angle must be a number"),
+        (((0.2, 0, 0.1), True), "angle must be a number"),
+    ],
+)
+def test_axis_angle_arguments_are_checked(generated, args, message):
+    module = generated("open_manipulator_x")
+    with pytest.raises(ValueError, match=message):
+        module.ik_axis_angle(*args)
+
+
+def test_an_angle_may_be_a_numpy_scalar_or_a_0_d_array(generated):
+    module = generated("open_manipulator_x")
+    rows = module.ik_axis_angle((0.2, 0.05, 0.1), 2.0, backend="python")
+    for angle in (np.float64(2.0), np.array(2.0), np.float32(2.0)):
+        got = module.ik_axis_angle((0.2, 0.05, 0.1), angle, backend="python")
+        assert got.shape == rows.shape and np.allclose(got, rows, atol=1e-6)
+
+
+@needs_cc
+def test_a_wrist_roll_about_the_tool_axis_is_free_in_the_axis_angle_task(tmp_path):
+    """The youBot asked for the angle of its tool z axis (joint 5's, through the tool point)
+    to the vertical: joints 1-4 by the cone method, q5 the caller's."""
+    text = (DATA.parent.parent / "derive" / "arms" / "youbot.toml").read_text()
+    text = text.replace('name = "youbot"', 'name = "youbot_cone"') + '\n[ik]\ntask = "axisangle"\n'
+    module = build_module(text, tmp_path)
+    assert (module.IK_COMPONENTS, module.TOOL_AXIS, module.FREE) == ("axisangle", 2, (5,))
+    found = round_trips(module, 300, 44, "python")
+    assert found["regular"] >= 250, found
+    assert found["missed"] == 0 and found["empty"] == 0 and found["worst"] <= 1e-10, found
+    found = round_trips(module, 2000, 45, "c")
+    assert found["missed"] == 0 and found["empty"] == 0 and found["worst"] <= 1e-10, found
+
+
+def test_a_wrist_roll_a_little_off_the_tool_axis_is_free_and_refined(tmp_path):
+    """A URDF's decimals put the SO-101's roll axis 3.7e-6 rad off its tool z: joint 5 is
+    taken as turning about the tool axis within the structure tolerance, q5 stays the
+    caller's, and the rows are refined onto the arm's own chain (q5 at its value)."""
+    text = (DATA.parent.parent / "derive" / "arms" / "youbot.toml").read_text()
+    text = text.replace('name = "youbot"', 'name = "youbot_tilted_roll"')
+    text += "\n[tool]\ntranslation = [0.0, 0.0, 0.0]\nrpy = [0.0002, -0.0001, 0.0]\n"
+    text += '\n[ik]\ntask = "axisangle"\n'
+    module = build_module(text, tmp_path)
+    assert (module.IK_COMPONENTS, module.TOOL_AXIS, module.FREE) == ("axisangle", 2, (5,))
+    assert module._SEED_TOL > 0.0  # (refined onto the arm)
+    found = round_trips(module, 200, 48, "python")
+    assert found["missed"] == 0 and found["empty"] == 0 and found["worst"] <= 1e-10, found
+    with pytest.raises(SpecError, match="joint 5 does not turn about the tool z axis through"):
+        tilted = text.replace("rpy = [0.0002, -0.0001, 0.0]", "rpy = [5.0, 0.0, 0.0]")
+        plan = build_plan(parse_spec(tilted.replace("[ik]", '[ik]\ntool_axis = "z"'), "<t>"))
+        raise SpecError(plan.refusal)
+
+
+@needs_cc
+def test_a_calibrated_four_joint_arm_is_exact_for_its_own_table(tmp_path):
+    """Every twist and length a little off (a calibration): the cone method solves the
+    nominal table and its rows are refined onto the arm's own, to 1e-10, in Python and C."""
+    text = _omx(
+        "omx_calibrated",
+        replace=(
+            ("alpha = -90.0", "alpha = -90.013"),
+            ("alpha = 0.0\na = 0.130231", "alpha = -0.02\na = 0.130231"),
+            ("alpha = 0.0\na = 0.124", "alpha = 0.011\na = 0.1241"),
+            ("theta = -79.380345", "theta = -79.3712"),
+        ),
+    )
+    module = build_module(text, tmp_path, c=True)
+    assert module.IK_COMPONENTS == "axisangle" and module._SEED_TOL > 0.0
+    for backend, n in (("python", 200), ("c", 2000)):
+        found = round_trips(module, n, 46, backend)
+        assert found["missed"] == 0 and found["empty"] == 0 and found["worst"] <= 1e-10, found
+
+
+def test_the_base_axis_can_be_x(tmp_path):
+    """The arm on a wall, joint 1 along the world's x: the angle of the gripper to x."""
+    text = _omx("omx_wall", 'base_axis = "x"', (("translation = [0.012, 0.0, 0.017]",
+                "translation = [0.012, 0.0, 0.017]\nrpy = [0.0, 90.0, 0.0]"),))  # fmt: skip
+    module = build_module(text, tmp_path)
+    assert (module.IK_COMPONENTS, module.CONE_AXIS) == ("axisangle", 0)
+    assert "TranslationXAxisAngle4D" in module.__doc__
+    found = round_trips(module, 300, 47, "python")
+    assert found["missed"] == 0 and found["empty"] == 0 and found["worst"] <= 1e-10, found
+
+
+def test_a_base_axis_without_its_task_is_refused():
+    youbot = (DATA.parent.parent / "derive" / "arms" / "youbot.toml").read_text()
+    with pytest.raises(SpecError, match=r'ik\.base_axis: only the "axisangle" task has one'):
+        build_plan(parse_spec(youbot + '\n[ik]\nbase_axis = "y"\n', "<youbot>"))
+    with pytest.raises(SpecError, match=r"ik\.base_axis"):
+        parse_spec(_omx("omx_bad", 'task = "axisangle"\nbase_axis = "w"'), "<omx>")
+
+
+def test_axis_angle_needs_four_or_five_joints():
+    with pytest.raises(SpecError, match='"axisangle" needs 4 joints'):
+        build_plan(parse_spec(spec_text("six_r", "standard", [(90, 0, 0.3, 0)] * 6,
+                                        extra='[ik]\ntask = "axisangle"\n'), "<six>"))  # fmt: skip
+
+
+def test_an_arm_whose_joint_1_is_not_along_the_base_axis_gets_the_reason():
+    plan = build_plan(parse_spec(_omx("omx_tilted", 'task = "axisangle"\nbase_axis = "x"'), "<t>"))
+    assert plan.ik is None
+    assert "joint 1's axis is not along the base x axis" in plan.refusal
+
+
+def test_derive_solve_takes_a_point_and_an_angle(capsys):
+    from derive.cli import main
+
+    assert main(["solve", "open_manipulator_x", "--point", "0.2 0.05 0.1", "--angle", "120"]) == 0
+    out = capsys.readouterr().out
+    assert "the axisangle task reads its position and its x column's entry along the base" in out
+    assert "4 solution(s)" in out
+    assert main(["solve", "open_manipulator_x", "--point", "0.2 0.05 0.1", "--angle", "2.0944",
+                 "--rad"]) == 0  # fmt: skip
+    assert "4 solution(s)" in capsys.readouterr().out
+    assert main(["solve", "open_manipulator_x", "--point", "0.2 0.05 0.1"]) == 2
+    assert "give --angle" in capsys.readouterr().err
+    assert main(["solve", "puma560", "--q", "0 0 0 0 0 0", "--angle", "10"]) == 2
+    assert "--angle: with --point" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("name", sorted(TASK_ARMS))
+def test_ik_path_follows_a_task_arm_s_straight_lines(generated, name):
+    """ik_path on a task arm takes Newton's steps on the task's components (a slerp between
+    two poses of a five-joint arm is not a path of reachable poses): 20 lines between two
+    joint vectors up to 0.3 rad apart, 20 poses each. Every row reproduces its pose's task; a
+    line that does not break keeps its branch: its rows are those of the same line sampled
+    four times finer (a jump to another branch would show there), except on lines that pass a
+    singular configuration between the coarse line's poses, where Newton's steps can land on
+    the sibling branch (measured: 1 line each of open_manipulator_x and so_arm100, the fine
+    line's task sigma_min 0.0020 and 0.00096); a break is reported where the task Jacobian is
+    near singular (measured: 20, 18, 19 and 20 of 20 unbroken for open_manipulator_x,
+    locobot_head, youbot and so_arm100; the breaks at sigma_min 0.023..0.034 and 0.0012).
+    (Such a line need not end on the second joint vector: near a fold it continues onto its
+    sibling.)"""
+    import re
+
+    module = generated(name)
+    rng = np.random.default_rng(5)
+    unbroken = jumped = 0
+    for q0 in sample_joints(module, 20, 60):
+        q1 = q0 + rng.uniform(-0.3, 0.3, module.DOF)
+        A, B = task_targets(module, np.array([q0, q1]), 1)
+        Ts = module.straight_line(A, B, 20)
+        Q, breaks = module.ik_path(Ts, q0, backend="python")
+        done = ~np.isnan(Q).any(axis=1)
+        assert task_error(module, Q[done], Ts[done]).max() <= 1e-9
+        if breaks:
+            sigma = float(re.search(r"sigma_min ([0-9.e+-]+)", breaks[0][1]).group(1))
+            assert sigma < 0.05, breaks
+            continue
+        unbroken += 1
+        Tf = module.straight_line(A, B, 77)
+        fine, fine_breaks = module.ik_path(Tf, q0, backend="python")
+        if fine_breaks or np.abs(fine[::4] - Q).max() > 1e-8:  # (then it passes a singular
+            # configuration between the coarse line's poses: Newton's steps from one to the next
+            # can land on the sibling branch there)
+            done = ~np.isnan(fine).any(axis=1)
+            assert min(task_sigma(module, q, T) for q, T in zip(fine[done], Tf[done])) < 0.005
+            jumped += 1
+    assert unbroken >= 18 and jumped <= 1

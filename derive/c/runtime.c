@@ -1330,8 +1330,9 @@ static double dk_ray_gap(const double e[12], const double t[12], int axis)
 
 /* whether e (a pose's 12 top entries) matches t in the task's components (0 the pose, 1 the
    position, 2 the position and tool axis `axis`'s direction, 3 the ray of that axis through
-   t's position): rotation entries within tol, positions within ptol (no early exit: the
-   comparisons are cheaper than the branches) */
+   t's position, 4 that axis's direction, 5 the position and entry `axis` (the tool axis's
+   component along a base axis)): rotation entries within tol, positions within ptol (no early
+   exit: the comparisons are cheaper than the branches) */
 static int dk_match(const double e[12], const double t[12], double tol, double ptol, int task,
                     int axis)
 {
@@ -1339,6 +1340,9 @@ static int dk_match(const double e[12], const double t[12], double tol, double p
                          (fabs(e[11] - t[11]) <= ptol);
     if (task == 3) {
         return dk_ray_gap(e, t, axis) <= ptol;
+    }
+    if (task == 5) {
+        return position & (fabs(e[axis] - t[axis]) <= tol);
     }
     if (task == 4) {
         return (fabs(e[axis] - t[axis]) <= tol) & (fabs(e[4 + axis] - t[4 + axis]) <= tol) &
@@ -1460,9 +1464,10 @@ static int dk_seen(const double (*found)[DK_REFINE_N], int n, const int revolute
     return 0;
 }
 
-/* a task's Jacobian column k (the "direction", "lookat" and "pointing" tasks, DK_REFINE_TASK
-   2, 3 and 4): given the column of the pose's position rows (J[0..2][k], set), the derivative
-   of the direction error u x t_u (rows 3..5: t_u x (z x u); a pointing's position rows 0), or
+/* a task's Jacobian column k (the "direction", "lookat", "pointing" and "axisangle" tasks,
+   DK_REFINE_TASK 2 to 5): given the column of the pose's position rows (J[0..2][k], set), the
+   derivative of the direction error u x t_u (rows 3..5: t_u x (z x u); a pointing's position
+   rows 0), of the tool axis's component along the base axis DK_REFINE_CONE (row 3), or
    of the ray offset v - (v.u) u, v the target point minus the origin (rows 0..2), for a
    revolute joint's axis z (NULL: a prismatic joint, which moves the origin only) */
 static void dk_task_column(const double pose[12], const double t[12], double J[6][DK_REFINE_M],
@@ -1476,6 +1481,10 @@ static void dk_task_column(const double pose[12], const double t[12], double J[6
         du[0] = z[1] * u[2] - z[2] * u[1];
         du[1] = z[2] * u[0] - z[0] * u[2];
         du[2] = z[0] * u[1] - z[1] * u[0];
+    }
+    if (DK_REFINE_TASK == 5) {
+        J[3][k] = du[DK_REFINE_CONE];
+        return;
     }
     if (DK_REFINE_TASK == 2 || DK_REFINE_TASK == 4) {
         const double tu[3] = {t[x], t[4 + x], t[8 + x]};
@@ -1565,6 +1574,11 @@ static double dk_refine(const double chain[DK_REFINE_N + 1][12], const int revol
                 error[3 + r] = pose[4 * a + x] * t[4 * b + x] - pose[4 * b + x] * t[4 * a + x];
                 size = gap > size ? gap : size;
             }
+        }
+        if (DK_REFINE_TASK == 5) { /* the tool axis's component along the base axis */
+            const int e = 4 * DK_REFINE_CONE + DK_REFINE_AXIS;
+            error[3] = t[e] - pose[e];
+            size = fabs(error[3]) > size ? fabs(error[3]) : size;
         }
         if (DK_REFINE_TASK == 3) { /* minus the target point's offset from the ray, / reach */
             const int x = DK_REFINE_AXIS;

@@ -13,6 +13,7 @@
 #define DK_REFINE_ROWS 6
 #define DK_REFINE_TASK 0
 #define DK_REFINE_AXIS 2
+#define DK_REFINE_CONE 2
 
 #define DK_RR_SPLIT_COUNT 1
 #define DK_RR_LENGTH (1.0)

@@ -390,6 +390,8 @@ def solve_lines(plan: Plan) -> tuple[tuple[int, str], ...]:
     if not fix:
         task = TASK_CODES[plan.ik.certify]
         axis = plan.ik.tool_axis
+        if plan.ik.certify == "axisangle":  # (the entry compared: the axis's base-axis one)
+            axis += 4 * plan.ik.cone
         body.append(Line(depth, f"if (n < DK_MAX && dk_match(e, t, tol, ptol, {task}, {axis})) {{"))
         body += [Line(depth + 1, f"found[n][{k}] = {v};") for k, v in enumerate(outputs)]
         body.append(Line(depth + 1, "n++;"))

@@ -155,7 +155,7 @@ def same_joints(plan: Plan) -> bool:
     return True
 
 
-def match_expression(certify: str, axis: int = 2) -> str:
+def match_expression(certify: str, axis: int = 2, cone: int = 2) -> str:
     """The certification test of entries e against target t in the task's components
     (derive/tasks.py), unrolled: rotation entries within tol, positions within ptol."""
     if certify == "lookat":
@@ -164,6 +164,7 @@ def match_expression(certify: str, axis: int = 2) -> str:
         "pose": (0, 1, 2, 4, 5, 6, 8, 9, 10),
         "direction": (axis, 4 + axis, 8 + axis),
         "pointing": (axis, 4 + axis, 8 + axis),
+        "axisangle": (4 * cone + axis,),  # (the tool axis's component along the base axis)
     }.get(certify, ())
     tests = [f"abs(e[{k}] - t[{k}]) <= tol" for k in rotation]
     if certify != "pointing":  # (a pointing reads no position)

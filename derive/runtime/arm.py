@@ -23,11 +23,13 @@ REACH = 1.0
 MAX_SOLUTIONS = 2
 # the joints (1-based) whose values the caller gives (an arm of more than 6 joints)
 FREE: tuple[int, ...] = ()
-# "pose", "position", "direction", "lookat" or "pointing": what certification compares
-# (derive/tasks.py)
+# "pose", "position", "direction", "lookat", "pointing" or "axisangle": what certification
+# compares (derive/tasks.py)
 IK_COMPONENTS = "pose"
-# the tool axis of the "direction", "lookat" and "pointing" tasks: 0 x, 1 y, 2 z
+# the tool axis of the "direction", "lookat", "pointing" and "axisangle" tasks: 0 x, 1 y, 2 z
 TOOL_AXIS = 2
+# the base axis of the "axisangle" task: 0 x, 1 y, 2 z
+CONE_AXIS = 2
 _REVOLUTE = (True, False)
 # a planar arm's plane task (derive/tasks.py, Plane): the tool's rotation at q = 0, the tool
 # axis whose angle about z is the heading (0 x, 1 y) and that angle at q = 0, the plane's

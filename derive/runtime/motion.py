@@ -16,12 +16,14 @@ from derive.runtime.arm import (
     BASE,
     DOF,
     FREE,
+    IK_COMPONENTS,
     LIMITS,
     REACH,
     _fk_q,
     _jacobian_q,
 )
 from derive.runtime.common import _joint_values, _real
+from derive.runtime.refine import _pose_error, _refine
 
 
 def jacobian(q: ArrayLike, frame: str = "base") -> np.ndarray:
@@ -179,7 +181,9 @@ def ik_path(
     solution of pose k that Newton's iteration from q_{k-1} reaches (q += J^+ dX, dX the pose
     error as a twist), accepted only within PATH_GAIN |dX| / sigma_min + PATH_SLACK of q_{k-1}
     (the joint step a continuous branch can take; sigma_min the Jacobian's smallest singular
-    value). The free joints of an arm with free joints (FREE) follow Newton's iteration.
+    value). The free joints of an arm with free joints (FREE) follow Newton's iteration. An
+    arm solved for a task (IK_COMPONENTS) takes Newton's steps on the task's components only
+    (the poses' other components need not be reachable), its free joints kept.
 
     Where no solution continues the path (a singular crossing where the branch ends, a joint
     limit with within_limits, a pose out of reach), the break is reported: (k, why) in the
@@ -210,9 +214,14 @@ def ik_path(
     out[0] = q
     breaks: list[tuple[int, str]] = []
     for k in range(1, len(poses)):
-        twist = _pose_step(poses[k - 1], poses[k])
-        least = manipulability(q)[0] if DOF >= 6 else 1.0
-        bound = PATH_GAIN * float(np.linalg.norm(twist)) / max(least, 1e-300)
+        if IK_COMPONENTS == "pose":
+            change = float(np.linalg.norm(_pose_step(poses[k - 1], poses[k])))
+            least = manipulability(q)[0] if DOF >= 6 else 1.0
+        else:  # (the task's components and their Jacobian: what the task's rows follow)
+            error, columns, _ = _pose_error(q.tolist(), poses[k][:3].ravel().tolist(), False)
+            change = float(np.linalg.norm(error))
+            least = float(np.linalg.svd(np.array(columns).T, compute_uv=False)[-1])
+        bound = PATH_GAIN * change / max(least, 1e-300)
         row, why = _continuation(poses[k], q, bound, within_limits, backend)
         if why:
             breaks.append((k, f"pose {k}: {why}; sigma_min {least:.3g}"))
@@ -232,20 +241,11 @@ def _continuation(T, q, bound, within_limits, backend):
     revolute = np.array(_REVOLUTE)
     units = np.where(revolute, 1.0, REACH)
     guess = np.array(q, dtype=float)
-    error, size = _pose_error_to(guess, T)
-    for _ in range(PATH_NEWTON):
-        if size <= PATH_CONVERGED:
-            break
-        step = np.linalg.pinv(jacobian(guess), rcond=1e-9) @ error
-        for _ in range(8):  # (halved until the error shrinks: a full step can overshoot)
-            trial = guess + step
-            trial_error, trial_size = _pose_error_to(trial, T)
-            if trial_size < size:
-                break
-            step = step / 2.0
-        else:
-            break
-        guess, error, size = trial, trial_error, trial_size
+    if IK_COMPONENTS == "pose":
+        guess, size = _newton_to(guess, T)
+    else:  # (a task arm: Newton's steps on the task's components, the free joints kept)
+        moved, size = _refine(guess.tolist(), T[:3].ravel().tolist())
+        guess = np.array(moved)
     converged = size <= PATH_CONVERGED
     free = [guess[j - 1] for j in FREE] if FREE else None
     rows = ik(T, free=free, q_ref=guess, backend=backend)
@@ -271,6 +271,26 @@ def _continuation(T, q, bound, within_limits, backend):
         if outside:
             return row, f"the continuing solution leaves the limits ({', '.join(outside)})"
     return row, ""
+
+
+def _newton_to(guess: np.ndarray, T: np.ndarray) -> tuple[np.ndarray, float]:
+    """At most PATH_NEWTON steps of q += J^+ dX from guess towards the pose T (each halved
+    until the error shrinks: a full step can overshoot), and the pose error reached."""
+    error, size = _pose_error_to(guess, T)
+    for _ in range(PATH_NEWTON):
+        if size <= PATH_CONVERGED:
+            break
+        step = np.linalg.pinv(jacobian(guess), rcond=1e-9) @ error
+        for _ in range(8):
+            trial = guess + step
+            trial_error, trial_size = _pose_error_to(trial, T)
+            if trial_size < size:
+                break
+            step = step / 2.0
+        else:
+            break
+        guess, error, size = trial, trial_error, trial_size
+    return guess, size
 
 
 def _pose_error_to(q: np.ndarray, T: np.ndarray) -> tuple[np.ndarray, float]:

@@ -17,7 +17,15 @@ from __future__ import annotations
 
 import math
 
-from derive.runtime.arm import _CHAIN, _REVOLUTE, _SOLVED, IK_COMPONENTS, REACH, TOOL_AXIS
+from derive.runtime.arm import (
+    _CHAIN,
+    _REVOLUTE,
+    _SOLVED,
+    CONE_AXIS,
+    IK_COMPONENTS,
+    REACH,
+    TOOL_AXIS,
+)
 from derive.runtime.scalar import _LOOSE, _ray_gap
 
 # at most this many steps per candidate (a seed on a singular configuration converges
@@ -133,9 +141,11 @@ def _pose_error(q, t, exact):
     The tasks (derive/tasks.py): "direction" has the rotation rows u x t_u (u the tool axis
     TOOL_AXIS, t_u the target's), derivative t_u x (z x u); "pointing" has those and no
     position error (its rows 0); "lookat" has, as its three rows, minus the target point's
-    offset from the ray, v - (v.u) u with v = p - o, / REACH."""
+    offset from the ray, v - (v.u) u with v = p - o, / REACH; "axisangle" has, as its fourth
+    row, the tool axis's component along the base axis CONE_AXIS, t_c - u_c, derivative
+    (z x u)_c."""
     task, x = IK_COMPONENTS, TOOL_AXIS
-    rows = 6 if task in ("pose", "direction", "pointing") else 3
+    rows = 6 if task in ("pose", "direction", "pointing") else 4 if task == "axisangle" else 3
     pose, axes, origins = _chain_pose(q)
     error = [(t[4 * r + 3] - pose[4 * r + 3]) / REACH for r in range(3)]
     size = max(map(abs, error))
@@ -160,6 +170,10 @@ def _pose_error(q, t, exact):
     elif task == "lookat":
         error = [-(v[r] - along * u[r]) / REACH for r in range(3)]
         size = _ray_gap(pose, t, x) / REACH
+    elif task == "axisangle":
+        k = 4 * CONE_AXIS + x
+        error.append(t[k] - pose[k])
+        size = max(size, abs(t[k] - pose[k]))
     columns = []
     for i in _SOLVED:
         z, o = axes[i], origins[i]
@@ -187,6 +201,8 @@ def _pose_error(q, t, exact):
                           tu[0] * du[1] - tu[1] * du[0]]  # fmt: skip
             if task == "pointing":
                 column[:3] = [0.0, 0.0, 0.0]
+        elif task == "axisangle":
+            column[3] = du[CONE_AXIS]
         elif task == "lookat":
             dv = [-column[r] * REACH for r in range(3)]
             dalong = sum(dv[r] * u[r] + v[r] * du[r] for r in range(3))

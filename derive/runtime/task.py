@@ -1,8 +1,8 @@
 """The task functions of an arm solved for fewer components than a pose (derive/tasks.py):
-ik_direction(p, d), ik_lookat(p) and ik_pointing(d) (and a planar arm's ik_xy_heading and
-ik_xy, derive/tasks.py Plane) build a pose whose components the task
+ik_direction(p, d), ik_lookat(p), ik_pointing(d) and ik_axis_angle(p, angle) (and a planar
+arm's ik_xy_heading and ik_xy, derive/tasks.py Plane) build a pose whose components the task
 reads and call ik, which certifies every row on those components (IK_COMPONENTS,
-TOOL_AXIS)."""
+TOOL_AXIS, CONE_AXIS)."""
 
 from __future__ import annotations
 
@@ -16,6 +16,7 @@ from derive.runtime.arm import (
     _HEADING_ZERO,
     _PLANE_ROTATION,
     _PLANE_SLIDE,
+    CONE_AXIS,
     PLANE_Z,
     TOOL_AXIS,
 )
@@ -99,6 +100,46 @@ def ik_pointing(
     return ik(T, free=free, within_limits=within_limits, q_ref=q_ref, tol=tol, backend=backend)
 
 
+def ik_axis_angle(
+    p: ArrayLike,
+    angle: float,
+    *,
+    free: ArrayLike | None = None,
+    within_limits: bool = False,
+    q_ref: ArrayLike | None = None,
+    tol: float = CERTIFY_TOL,
+    backend: str | None = None,
+) -> np.ndarray:
+    """All solutions that put the tool point at p with the tool axis TOOL_AXIS at the angle
+    `angle` to the base axis CONE_AXIS (IKFast's Translation{X,Y,Z}AxisAngle4D), as an
+    (n, DOF) array; empty if unreachable. The task does not fix the direction about the base
+    axis: the arm's joints choose it.
+
+    Args:
+        p: the tool point in the world, 3 numbers.
+        angle: radians, 0 (the tool axis along the base axis) to pi (against it); the task
+            reads its cosine.
+        free, within_limits, q_ref, tol, backend: as ik's (free: a five-joint arm's wrist
+            roll, FREE). Every row reproduces p within tol * REACH and the tool axis's
+            component along the base axis, cos(angle), within tol.
+
+    Raises:
+        ValueError: p is not 3 finite numbers, or angle is not a number from 0 to pi; free
+            as ik says.
+    """
+    if isinstance(angle, np.ndarray) and angle.shape == ():  # (a 0-d array: its number)
+        angle = angle.item()
+    if type(angle) is bool or not isinstance(angle, (int, float, np.integer, np.floating)):
+        raise ValueError(f"angle must be a number, got {angle!r}")
+    if not 0.0 <= float(angle) <= math.pi:  # (NaN fails too)
+        raise ValueError(f"angle must be from 0 to pi (radians), got {angle!r}")
+    d = np.zeros(3)  # (a direction at that angle: the task reads only its CONE_AXIS entry)
+    d[CONE_AXIS] = math.cos(float(angle))
+    d[(CONE_AXIS + 1) % 3] = math.sin(float(angle))
+    T = _task_pose(p, d)
+    return ik(T, free=free, within_limits=within_limits, q_ref=q_ref, tol=tol, backend=backend)
+
+
 def ik_xy_heading(
     x: float,
     y: float,
@@ -175,7 +216,8 @@ def _plane_pose(x: float, y: float, z: float | None, heading: float) -> np.ndarr
 
 def _task_pose(p: ArrayLike, d: ArrayLike | None) -> np.ndarray:
     """A pose with origin p and, where d is given, column TOOL_AXIS along d (the other two
-    columns complete it to a right-handed frame: the task does not read them)."""
+    columns complete it to a right-handed frame: the task does not read them). Plain floats:
+    numpy's small-array calls cost more than the arithmetic."""
     point = _real(p, "p")
     if point.shape != (3,) or not np.isfinite(point).all():
         raise ValueError(f"p must be 3 finite numbers, got {point}")
@@ -186,16 +228,19 @@ def _task_pose(p: ArrayLike, d: ArrayLike | None) -> np.ndarray:
     axis = _real(d, "d")
     if axis.shape != (3,) or not np.isfinite(axis).all():
         raise ValueError(f"d must be 3 finite numbers, got {axis}")
-    largest = float(np.abs(axis).max())
+    d0, d1, d2 = (float(v) for v in axis)
+    largest = max(abs(d0), abs(d1), abs(d2))
     if not largest > 0.0:
         raise ValueError("d must be a direction: not all 0")
-    u = axis / largest  # (first: 1e-300 and 1e300 neither underflow nor overflow)
-    u = u / math.sqrt(float(u @ u))
-    helper = np.zeros(3)
-    helper[int(np.argmin(np.abs(u)))] = 1.0
-    a = helper - (helper @ u) * u
-    a /= math.sqrt(float(a @ a))
-    b = np.cross(u, a)
+    u = [d0 / largest, d1 / largest, d2 / largest]  # (first: 1e-300 and 1e300 neither
+    # underflow nor overflow)
+    size = math.sqrt(u[0] * u[0] + u[1] * u[1] + u[2] * u[2])
+    u = [v / size for v in u]
+    least = min(range(3), key=lambda k: abs(u[k]))
+    a = [(1.0 if k == least else 0.0) - u[least] * u[k] for k in range(3)]
+    size = math.sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2])
+    a = [v / size for v in a]
+    b = [u[1] * a[2] - u[2] * a[1], u[2] * a[0] - u[0] * a[2], u[0] * a[1] - u[1] * a[0]]
     for k, column in enumerate((u, a, b)):  # (a cyclic order keeps the frame right-handed)
         T[:3, (TOOL_AXIS + k) % 3] = column
     return T
