@@ -85,34 +85,34 @@ def test_require_ik_exits_3_for_fk_only_arm(tmp_path):
 
 def test_check_detects_edited_removed_and_extra_files(tmp_path, capsys):
     # the committed output (test_regeneration checks it is today's), copied: one whole
-    # generation fewer)
+    # generation fewer); a two-joint arm's check regenerates in a third of a PUMA's time)
     out = tmp_path / "gen"
     shutil.copytree(GENERATED, out, ignore=shutil.ignore_patterns("__pycache__"))
-    assert main(["check", "puma560", "--out", str(out)]) == 0
-    target = out / "puma560.py"
+    assert main(["check", "planar_2r", "--out", str(out)]) == 0
+    target = out / "planar_2r.py"
     original = target.read_text()
-    target.write_text(original.replace("DOF = 6", "DOF = 7"))
+    target.write_text(original.replace("DOF = 2", "DOF = 3"))
     before = target.read_bytes()
     capsys.readouterr()
-    assert main(["check", "puma560", "--out", str(out)]) == 1
+    assert main(["check", "planar_2r", "--out", str(out)]) == 1
     report = capsys.readouterr().out
     assert (
         f"{target}: differs" in report
-        and "-DOF = 7" in report
+        and "-DOF = 3" in report
         and "to update: derive generate" in report
     )
     assert target.read_bytes() == before
     target.unlink()
-    assert main(["check", "puma560", "--out", str(out)]) == 1
-    assert "puma560.py: missing" in capsys.readouterr().out
+    assert main(["check", "planar_2r", "--out", str(out)]) == 1
+    assert "planar_2r.py: missing" in capsys.readouterr().out
     target.write_text(original)
     # the C files the module runs are checked with it
-    c_file = out / "puma560_ik.c"
+    c_file = out / "planar_2r_ik.c"
     c_text = c_file.read_text()
-    c_file.write_text(c_text.replace("#define DK_MAX 8", "#define DK_MAX 9"))
-    assert main(["check", "puma560", "--out", str(out)]) == 1
+    c_file.write_text(c_text.replace("#define DK_MAX 2", "#define DK_MAX 3"))
+    assert main(["check", "planar_2r", "--out", str(out)]) == 1
     report = capsys.readouterr().out
-    assert f"{c_file}: differs" in report and "to update: derive generate puma560" in report
+    assert f"{c_file}: differs" in report and "to update: derive generate planar_2r" in report
     c_file.write_text(c_text)
     (out / "old_arm.py").write_text("")
     (out / "old_arm_ik.c").write_text("")
