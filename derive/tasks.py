@@ -19,6 +19,10 @@ pose and position problems the methods already solve by one virtual joint.
   orientations and its tool point at the origin: its tool axis points along d exactly where
   its ray from the origin passes through the point d, a look-at of the unmoved arm whose
   target point is d (the steps read T's column u where a look-at reads its position).
+* "axisangle" (Translation{X,Y,Z}AxisAngle4D): the tool point and the angle of the tool axis
+  u to a base axis; no virtual joint gives it (u's direction about the base axis is a turn of
+  the target about a world line, not a joint), so it has a method of its own
+  (derive/methods/cone.py).
 
 The virtual joint is the line L through the tool point o along u, written as one more DH link
 after joint n (the frame of joint n after Z_n has its axis as z): the common normal of z and L
