@@ -1082,9 +1082,7 @@ def _plane_pose(x: float, y: float, z: float | None, heading: float) -> np.ndarr
     Rz(heading - _HEADING_ZERO) times the tool's rotation at q = 0, _PLANE_ROTATION."""
     numbers = {"x": x, "y": y, "heading": heading, "z": 0.0 if z is None else z}
     for name, value in numbers.items():
-        if type(value) is bool or not isinstance(value, (int, float, np.integer, np.floating)):
-            raise ValueError(f"{name} must be a number, got {value!r}")
-        if not math.isfinite(float(value)):
+        if not math.isfinite(_number(value, name)):
             raise ValueError(f"{name} must be finite, got {value!r}")
     if _PLANE_SLIDE and z is None:
         raise ValueError("z is needed: a sliding joint moves the tool along z")
@@ -1096,6 +1094,17 @@ def _plane_pose(x: float, y: float, z: float | None, heading: float) -> np.ndarr
     T[:3, :3] = np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]]) @ R0
     T[:3, 3] = (float(x), float(y), PLANE_Z if z is None else float(z))
     return T
+
+
+def _number(value: object, name: str) -> float:
+    """value as a float: an int or a float (numpy's too), not a bool.
+
+    Raises:
+        ValueError: it is not one.
+    """
+    if type(value) is bool or not isinstance(value, (int, float, np.integer, np.floating)):
+        raise ValueError(f"{name} must be a number, got {value!r}")
+    return float(value)
 
 
 def jacobian(q: ArrayLike, frame: str = "base") -> np.ndarray:

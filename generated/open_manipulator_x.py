@@ -1083,15 +1083,24 @@ def ik_axis_angle(
     """
     if isinstance(angle, np.ndarray) and angle.shape == ():  # (a 0-d array: its number)
         angle = angle.item()
-    if type(angle) is bool or not isinstance(angle, (int, float, np.integer, np.floating)):
-        raise ValueError(f"angle must be a number, got {angle!r}")
-    if not 0.0 <= float(angle) <= math.pi:  # (NaN fails too)
+    if not 0.0 <= _number(angle, "angle") <= math.pi:  # (NaN fails too)
         raise ValueError(f"angle must be from 0 to pi (radians), got {angle!r}")
     d = np.zeros(3)  # (a direction at that angle: the task reads only its CONE_AXIS entry)
     d[CONE_AXIS] = math.cos(float(angle))
     d[(CONE_AXIS + 1) % 3] = math.sin(float(angle))
     T = _task_pose(p, d)
     return ik(T, free=free, within_limits=within_limits, q_ref=q_ref, tol=tol, backend=backend)
+
+
+def _number(value: object, name: str) -> float:
+    """value as a float: an int or a float (numpy's too), not a bool.
+
+    Raises:
+        ValueError: it is not one.
+    """
+    if type(value) is bool or not isinstance(value, (int, float, np.integer, np.floating)):
+        raise ValueError(f"{name} must be a number, got {value!r}")
+    return float(value)
 
 
 def _task_pose(p: ArrayLike, d: ArrayLike | None) -> np.ndarray:

@@ -35,11 +35,10 @@ from derive.halfangle import linear_coeffs
 from derive.methods.common import NotApplicable, joint_outputs, joint_refs
 from derive.methods.planar import arm_length, heading_step, planar_steps
 from derive.plan import Assign, Cs1, IkPlan, Step
-from derive.tasks import arm_size, spins, tool_line
-from derive.transforms import Chain, inverse, product, rot_z, trans, x_factor, z_factor
+from derive.tasks import AXES, arm_size, spins, tool_line
+from derive.transforms import Chain, JointZ, inverse, product, rot_z, trans, x_factor, z_factor
 
 NAME = "cone"
-AXES = ("x", "y", "z")
 
 
 def derive(chain: Chain, axis: int, cone: int, tol: float = 0.0) -> IkPlan:
@@ -53,23 +52,23 @@ def derive(chain: Chain, axis: int, cone: int, tol: float = 0.0) -> IkPlan:
     """
     n = chain.dof
     kinds = "".join(j.kind for j in chain.joints)
+    snap = 0.0
     if kinds == "RRRRR":
+        across, beside = _spin_gap(chain, axis)
         if not spins(chain, axis, tol):
-            o, u = tool_line(chain, axis)
-            across = math.degrees(math.asin(min(1.0, math.sqrt(float(u[0] ** 2 + u[1] ** 2)))))
-            beside = math.sqrt(float(o[0] ** 2 + o[1] ** 2))
             raise NotApplicable(
                 f"joint 5 does not turn about the tool {AXES[axis]} axis through the tool "
-                f"point (the axis {across:.3g} deg off joint 5's, the point {beside:.3g} "
-                "beside it), so it moves the point or the axis: one joint too many"
+                f"point (the axis {math.degrees(across):.3g} deg off joint 5's, the point "
+                f"{beside:.3g} beside it), so it moves the point or the axis: one joint too "
+                "many"
             )
+        snap = max(across, beside / arm_size(chain))
     elif kinds != "RRRR":
         raise NotApplicable(
             f"needs 4 revolute joints (or 5 with joint 5 turning about the tool axis), "
             f"the arm has {kinds}"
         )
     spun = n == 5
-    snap = _spin_gap(chain, axis) if spun else 0.0
     arm = _first_four(chain) if spun else chain
     aux = n + 1  # (the auxiliary angle phi: the steps' joint n + 1, dropped from the outputs)
     refs = joint_refs(arm)
@@ -98,7 +97,6 @@ def derive(chain: Chain, axis: int, cone: int, tol: float = 0.0) -> IkPlan:
             f"the tool {AXES[axis]} axis is along joints 2-4's axes: its angle to the base "
             f"{AXES[cone]} axis does not change"
         )
-    turns = _check_turn(arm, phi_signs, flip)
     # the tool point in frame 1' (after X1) as M's: wrist W(theta2, theta3) + Rz(phi) F t4
     wrist = product(
         [
@@ -108,6 +106,7 @@ def derive(chain: Chain, axis: int, cone: int, tol: float = 0.0) -> IkPlan:
             x_factor(arm.twists[3]),
         ]
     )
+    turns = _check_turn(wrist, arm.joints[3], phi_signs, flip)
     t4 = product([trans(0, 0, arm.joints[3].d), after])[:3, 3]
     lateral = sp.expand(wrist[2, 3] + (flip * t4)[2])
     if lateral.free_symbols:
@@ -197,12 +196,12 @@ def _signed(sign: int) -> str:
     return "+" if sign > 0 else "-"
 
 
-def _check_turn(arm: Chain, signs: tuple[int, ...], flip: sp.Matrix) -> sp.Matrix:
-    """Z2 X2 Z3 X3 Z4's rotation, in c2..s4: Rz(theta2 + s3 theta3 + s4 theta4) F, checked at
-    three sets of angles (a guard on the reading of the twists above)."""
-    factors = [z_factor(arm.joints[1]), x_factor(arm.twists[2]), z_factor(arm.joints[2])]
-    factors += [x_factor(arm.twists[3]), z_factor(arm.joints[3])]
-    turns = product(factors)[:3, :3]
+def _check_turn(
+    wrist: sp.Matrix, fourth: JointZ, signs: tuple[int, ...], flip: sp.Matrix
+) -> sp.Matrix:
+    """Z2 X2 Z3 X3 Z4's rotation (wrist = Z2 X2 Z3 X3), in c2..s4: Rz(theta2 + s3 theta3 +
+    s4 theta4) F, checked at three sets of angles (a guard on the reading of the twists)."""
+    turns = product([wrist, z_factor(fourth)])[:3, :3]
     for angles in ((0.3, -1.1, 2.0), (2.5, 0.7, -0.4), (-1.9, 3.0, 1.3)):
         subs = {}
         for k, t in zip((2, 3, 4), angles):
@@ -230,9 +229,10 @@ def _in_phi(ca: sp.Expr, sa: sp.Expr, cc: sp.Expr) -> str:
     return sp.sstr(ca * cos_phi + sa * sin_phi + cc)
 
 
-def _spin_gap(chain: Chain, axis: int) -> float:
-    """How far joint 5 is from turning about the tool axis through the tool point (radians,
-    and the point's distance from its axis over the arm's size): 0 where it does exactly."""
+def _spin_gap(chain: Chain, axis: int) -> tuple[float, float]:
+    """How far joint 5 is from turning about the tool axis through the tool point: the
+    angle between the axes (radians) and the point's distance from joint 5's axis (0, 0
+    where it does exactly)."""
     o, u = tool_line(chain, axis)
     across = math.asin(min(1.0, math.sqrt(float(u[0] ** 2 + u[1] ** 2))))
-    return max(across, math.sqrt(float(o[0] ** 2 + o[1] ** 2)) / arm_size(chain))
+    return across, math.sqrt(float(o[0] ** 2 + o[1] ** 2))

@@ -129,9 +129,7 @@ def ik_axis_angle(
     """
     if isinstance(angle, np.ndarray) and angle.shape == ():  # (a 0-d array: its number)
         angle = angle.item()
-    if type(angle) is bool or not isinstance(angle, (int, float, np.integer, np.floating)):
-        raise ValueError(f"angle must be a number, got {angle!r}")
-    if not 0.0 <= float(angle) <= math.pi:  # (NaN fails too)
+    if not 0.0 <= _number(angle, "angle") <= math.pi:  # (NaN fails too)
         raise ValueError(f"angle must be from 0 to pi (radians), got {angle!r}")
     d = np.zeros(3)  # (a direction at that angle: the task reads only its CONE_AXIS entry)
     d[CONE_AXIS] = math.cos(float(angle))
@@ -198,9 +196,7 @@ def _plane_pose(x: float, y: float, z: float | None, heading: float) -> np.ndarr
     Rz(heading - _HEADING_ZERO) times the tool's rotation at q = 0, _PLANE_ROTATION."""
     numbers = {"x": x, "y": y, "heading": heading, "z": 0.0 if z is None else z}
     for name, value in numbers.items():
-        if type(value) is bool or not isinstance(value, (int, float, np.integer, np.floating)):
-            raise ValueError(f"{name} must be a number, got {value!r}")
-        if not math.isfinite(float(value)):
+        if not math.isfinite(_number(value, name)):
             raise ValueError(f"{name} must be finite, got {value!r}")
     if _PLANE_SLIDE and z is None:
         raise ValueError("z is needed: a sliding joint moves the tool along z")
@@ -212,6 +208,17 @@ def _plane_pose(x: float, y: float, z: float | None, heading: float) -> np.ndarr
     T[:3, :3] = np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]]) @ R0
     T[:3, 3] = (float(x), float(y), PLANE_Z if z is None else float(z))
     return T
+
+
+def _number(value: object, name: str) -> float:
+    """value as a float: an int or a float (numpy's too), not a bool.
+
+    Raises:
+        ValueError: it is not one.
+    """
+    if type(value) is bool or not isinstance(value, (int, float, np.integer, np.floating)):
+        raise ValueError(f"{name} must be a number, got {value!r}")
+    return float(value)
 
 
 def _task_pose(p: ArrayLike, d: ArrayLike | None) -> np.ndarray:
