@@ -50,7 +50,7 @@ IMPORTS = (
 FK_ROOTS = ("fk", "fk_batch", "link_transform", "jacobian", "manipulability", "ik_velocity")
 IK_ROOTS = (
     *FK_ROOTS, "ik", "ik_batch", "ik_approximate", "nearest", "ik_path", "straight_line",
-    "warmup", "CERTIFY_TOL", "BACKEND",
+    "branch", "warmup", "CERTIFY_TOL", "BACKEND",
 )  # fmt: skip
 # the public names a module with free joints adds
 FREE_ROOTS = ("ik_sweep",)

@@ -162,6 +162,9 @@ class PrintedModule:
     solves_for: str
     refusal: str
     ik_body: tuple[tuple[int, str], ...]
+    # _branch_signs's body and BRANCHES (printers/scalar.py, branch_lines)
+    branch_body: tuple[tuple[int, str], ...]
+    branches_const: str
     qref_names: str
     match: str
     components: str
@@ -226,6 +229,8 @@ def print_plan(plan: Plan) -> PrintedModule:
         solves_for=ik.solves_for if ik else "",
         refusal=plan.refusal,
         ik_body=scalar.ik_lines(plan) if ik else (),
+        branch_body=scalar.branch_lines(plan) if ik else (),
+        branches_const=repr(scalar.branch_names(plan)) if ik else "()",
         qref_names=", ".join(f"qr{i}" for i in range(1, arm.dof + 1)),
         match=match_expression(ik.certify, ik.tool_axis, ik.cone) if ik else "",
         tool_axis=ik.tool_axis if ik else 2,

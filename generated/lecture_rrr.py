@@ -47,6 +47,8 @@ API:
     ik_approximate(T, *, q_ref=None, tol=CERTIFY_TOL, backend=None)
         -> (Q (n, DOF), residual (n,), exact (n,)): ik's rows, or where T is out of reach the
         nearest configuration of each branch
+    branch(q) -> tuple of +1, -1 or 0 per BRANCHES step: the configuration q is on (0 at a
+        fold, where two meet)
     ik_path(Ts: (N, 4, 4), q0, *, within_limits=False, on_break="stop", backend=None)
         -> (Q (N, DOF), breaks [(k, why)]): a path's rows continuing q0's branch
     straight_line(A, B, n) -> (n, 4, 4) ndarray, poses on a line (rotation by slerp)
@@ -135,6 +137,9 @@ METHOD = "planar"
 MAX_SOLUTIONS = 2
 # the joints (1-based) whose values the caller gives: ik(T, free=...)
 FREE = ()
+# the joint values whose steps choose a branch (branch(q): the sign of each step's equation's
+# derivative), in the order they are solved
+BRANCHES = ('q2',)
 # how far the solver's equations may miss and still seed a refinement (0: exact arms)
 _SEED_TOL = 0.0
 # the plane task (TranslationXYOrientation3D, derive/tasks.py Plane): the tool's rotation at
@@ -203,6 +208,12 @@ _CLAMP_TOL = 1e-7
 # below _FOLD_TOL sqrt(a^2 + b^2), and every backend gives the same value (acos near +-1 turns
 # one rounding of its argument into 1e-8 of angle)
 _FOLD_TOL = 1e-14
+
+
+# a step's branch (branch(T, q)) is the sign of its equation's derivative in the joint's value
+# at the solution; 0 (a fold: two branches meet, a singular configuration) where the
+# derivative is below _BRANCH_FOLD of the equation's scale
+_BRANCH_FOLD = 1e-9
 
 
 _FREE_TOL = 1e-14  # squared sizes: a joint is free below 1e-7 of its equation's scale
@@ -1243,6 +1254,27 @@ def manipulability(q: ArrayLike) -> tuple[float, float]:
     return float(sigma[-1]) if len(sigma) == min(6, DOF) else 0.0, float(np.prod(sigma))
 
 
+def branch(q: ArrayLike) -> tuple[int, ...]:
+    """The branch of the solution q of its own pose: one sign per step of the closed form that
+    gives several values (BRANCHES names their joints, in the order they are solved), +1 or
+    -1, 0 where that step's values meet (a fold: a singular configuration, as the elbow
+    stretched or the wrist straight). Each is the sign of the derivative of the step's
+    equation in its joint's value (a cos t + b sin t = e: +1 for the + acos value); it changes
+    only where a path of solutions crosses a fold, so it names the configuration (shoulder,
+    elbow, wrist) whatever the distances between solutions. () where the derivation has no
+    such steps, or its steps solve values that are not joints (the general method, a task's
+    virtual joint).
+
+    Raises:
+        ValueError: q is not DOF finite numbers.
+    """
+    q = _joint_values(q)
+    if not BRANCHES:
+        return ()
+    e = _fk_q(q)
+    return tuple(_branch_signs(tuple(e), q))
+
+
 # ik_path: the continuation of a path from q to the next pose is Newton's iteration from q
 # (at most PATH_NEWTON steps of q += J^+ dX, until the pose error is within PATH_CONVERGED);
 # the solution nearest it continues the path if they agree within PATH_SLACK (radians, or
@@ -1313,7 +1345,7 @@ def ik_path(
             change = float(np.linalg.norm(error))
             least = float(np.linalg.svd(np.array(columns).T, compute_uv=False)[-1])
         bound = PATH_GAIN * change / max(least, 1e-300)
-        row, why = _continuation(poses[k], q, bound, within_limits, backend)
+        row, why = _continuation(poses[k], q, branch(q), bound, within_limits, backend)
         if why:
             breaks.append((k, f"pose {k}: {why}; sigma_min {least:.3g}"))
             if on_break == "stop":
@@ -1325,10 +1357,13 @@ def ik_path(
     return out, breaks
 
 
-def _continuation(T, q, bound, within_limits, backend):
-    """ik_path's step from q to the pose T: the solution of T nearest Newton's iteration from
-    q (its revolute joints' turn nearest it), and "" if it continues the path, else why not
-    (the row None where T has no solution)."""
+def _continuation(T, q, label, bound, within_limits, backend):
+    """ik_path's step from q (on the branch label) to the pose T: the solution of T nearest
+    Newton's iteration from q (its revolute joints' turn nearest it), and "" if it continues
+    the path, else why not (the row None where T has no solution). Where that solution is on
+    another branch and one on q's own is within the bound and no farther from q, that one
+    continues the path: near a fold (the elbow nearly stretched) both branches lie within one
+    step, and Newton's iteration may cross to the other."""
     revolute = np.array(_REVOLUTE)
     units = np.where(revolute, 1.0, REACH)
     guess = np.array(q, dtype=float)
@@ -1346,6 +1381,18 @@ def _continuation(T, q, bound, within_limits, backend):
     gaps[:, revolute] = np.remainder(gaps[:, revolute] + math.pi, 2 * math.pi) - math.pi
     misses = np.abs(gaps / units).max(axis=1)
     best = int(np.argmin(misses))
+    if label:  # (the row of q's branch nearest q continues it if its step is within the
+        # bound and PATH_GAIN times the nearest row's: else the path crosses a fold, as the
+        # wrist turning through straight, where the row of q's branch turns joints 4 and 6
+        # by half a turn)
+        moves = rows - q
+        moves[:, revolute] = np.remainder(moves[:, revolute] + math.pi, 2 * math.pi) - math.pi
+        sizes = np.abs(moves / units).max(axis=1)
+        same = [i for i, r in enumerate(rows) if _same_branch(branch(r), label)]
+        if same:
+            kept = min(same, key=lambda i: sizes[i])
+            if sizes[kept] <= min(bound, PATH_GAIN * sizes.min()) + PATH_SLACK:
+                return _within(q + moves[kept], within_limits)
     row = guess + gaps[best]
     step = np.abs(row - q) / units
     j = int(np.argmax(step))
@@ -1356,12 +1403,22 @@ def _continuation(T, q, bound, within_limits, backend):
                if not converged else f"the nearest moves q{j + 1} by {step[j]:.3g}")
             + ": a singular crossing where the branch ends, or another branch)"
         )  # fmt: skip
+    return _within(row, within_limits)
+
+
+def _within(row, within_limits):
+    """The continuing row, and why it does not continue a path kept within the limits."""
     if within_limits:
         lo, hi = np.array(LIMITS).T
         outside = [f"q{i + 1}" for i in range(DOF) if not lo[i] <= row[i] <= hi[i]]
         if outside:
             return row, f"the continuing solution leaves the limits ({', '.join(outside)})"
     return row, ""
+
+
+def _same_branch(a: tuple[int, ...], b: tuple[int, ...]) -> bool:
+    """Whether two branches agree on every step where neither is at a fold (0)."""
+    return all(x == y or not x or not y for x, y in zip(a, b))
 
 
 def _newton_to(guess: np.ndarray, T: np.ndarray) -> tuple[np.ndarray, float]:
@@ -1522,6 +1579,15 @@ def _atan2(y: float, x: float, ref: float) -> tuple[float, ...]:
     if abs(y) + abs(x) <= 1e-12:
         return _free(ref)
     return (atan2(y, x),)
+
+
+def _cs1_branch(a: float, b: float, t: float) -> int:
+    """The branch of t among the values of a cos t + b sin t = e: +1 for atan2(b, a) + acos,
+    -1 for - acos (the sign of -f'(t) = a sin t - b cos t), 0 at the fold, where they meet."""
+    slope = a * sin(t) - b * cos(t)
+    if abs(slope) <= _BRANCH_FOLD * sqrt(a * a + b * b):
+        return 0
+    return 1 if slope > 0.0 else -1
 
 
 # at most this many steps per candidate (a seed on a singular configuration converges
@@ -1898,3 +1964,13 @@ def _ik_scalar(target, qr1, qr2, qr3, tol):
         if _v2.__class__ is _Free and len(found) > _n2:
             break
     return found
+
+
+def _branch_signs(target, q):
+    """The branch of the solution q of target (branch(q)): the solver's steps in a straight
+    line, each joint's value read from q, and the sign of each BRANCHES step's derivative."""
+    (_, _, _, _, _, _, _, _, _, _, _, _) = target
+    (_, qr2, _,) = q
+    theta2 = qr2
+    _b0 = _cs1_branch(0.8, 0.0, theta2)
+    return (_b0,)

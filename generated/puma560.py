@@ -43,6 +43,8 @@ API:
     ik_approximate(T, *, q_ref=None, tol=CERTIFY_TOL, backend=None)
         -> (Q (n, DOF), residual (n,), exact (n,)): ik's rows, or where T is out of reach the
         nearest configuration of each branch
+    branch(q) -> tuple of +1, -1 or 0 per BRANCHES step: the configuration q is on (0 at a
+        fold, where two meet)
     ik_path(Ts: (N, 4, 4), q0, *, within_limits=False, on_break="stop", backend=None)
         -> (Q (N, DOF), breaks [(k, why)]): a path's rows continuing q0's branch
     straight_line(A, B, n) -> (n, 4, 4) ndarray, poses on a line (rotation by slerp)
@@ -133,6 +135,9 @@ METHOD = "pieper"
 MAX_SOLUTIONS = 8
 # the joints (1-based) whose values the caller gives: ik(T, free=...)
 FREE = ()
+# the joint values whose steps choose a branch (branch(q): the sign of each step's equation's
+# derivative), in the order they are solved
+BRANCHES = ('q3', 'q2', 'q5')
 # how far the solver's equations may miss and still seed a refinement (0: exact arms)
 _SEED_TOL = 0.0
 # the exact chain: T(q) = F_0 J_1(q_1) F_1 ... J_n(q_n) F_n, J_i = Rz(q_i) (R) or
@@ -222,6 +227,12 @@ _FOLD_TOL = 1e-14
 
 
 _LEAD_TOL = 1e-10
+
+
+# a step's branch (branch(T, q)) is the sign of its equation's derivative in the joint's value
+# at the solution; 0 (a fold: two branches meet, a singular configuration) where the
+# derivative is below _BRANCH_FOLD of the equation's scale
+_BRANCH_FOLD = 1e-9
 
 
 _OMEGA = (1.0, complex(-0.5, math.sqrt(3.0) / 2.0), complex(-0.5, -math.sqrt(3.0) / 2.0))
@@ -1211,6 +1222,27 @@ def manipulability(q: ArrayLike) -> tuple[float, float]:
     return float(sigma[-1]) if len(sigma) == min(6, DOF) else 0.0, float(np.prod(sigma))
 
 
+def branch(q: ArrayLike) -> tuple[int, ...]:
+    """The branch of the solution q of its own pose: one sign per step of the closed form that
+    gives several values (BRANCHES names their joints, in the order they are solved), +1 or
+    -1, 0 where that step's values meet (a fold: a singular configuration, as the elbow
+    stretched or the wrist straight). Each is the sign of the derivative of the step's
+    equation in its joint's value (a cos t + b sin t = e: +1 for the + acos value); it changes
+    only where a path of solutions crosses a fold, so it names the configuration (shoulder,
+    elbow, wrist) whatever the distances between solutions. () where the derivation has no
+    such steps, or its steps solve values that are not joints (the general method, a task's
+    virtual joint).
+
+    Raises:
+        ValueError: q is not DOF finite numbers.
+    """
+    q = _joint_values(q)
+    if not BRANCHES:
+        return ()
+    e = _fk_q(q)
+    return tuple(_branch_signs(tuple(e), q))
+
+
 # ik_path: the continuation of a path from q to the next pose is Newton's iteration from q
 # (at most PATH_NEWTON steps of q += J^+ dX, until the pose error is within PATH_CONVERGED);
 # the solution nearest it continues the path if they agree within PATH_SLACK (radians, or
@@ -1281,7 +1313,7 @@ def ik_path(
             change = float(np.linalg.norm(error))
             least = float(np.linalg.svd(np.array(columns).T, compute_uv=False)[-1])
         bound = PATH_GAIN * change / max(least, 1e-300)
-        row, why = _continuation(poses[k], q, bound, within_limits, backend)
+        row, why = _continuation(poses[k], q, branch(q), bound, within_limits, backend)
         if why:
             breaks.append((k, f"pose {k}: {why}; sigma_min {least:.3g}"))
             if on_break == "stop":
@@ -1293,10 +1325,13 @@ def ik_path(
     return out, breaks
 
 
-def _continuation(T, q, bound, within_limits, backend):
-    """ik_path's step from q to the pose T: the solution of T nearest Newton's iteration from
-    q (its revolute joints' turn nearest it), and "" if it continues the path, else why not
-    (the row None where T has no solution)."""
+def _continuation(T, q, label, bound, within_limits, backend):
+    """ik_path's step from q (on the branch label) to the pose T: the solution of T nearest
+    Newton's iteration from q (its revolute joints' turn nearest it), and "" if it continues
+    the path, else why not (the row None where T has no solution). Where that solution is on
+    another branch and one on q's own is within the bound and no farther from q, that one
+    continues the path: near a fold (the elbow nearly stretched) both branches lie within one
+    step, and Newton's iteration may cross to the other."""
     revolute = np.array(_REVOLUTE)
     units = np.where(revolute, 1.0, REACH)
     guess = np.array(q, dtype=float)
@@ -1314,6 +1349,18 @@ def _continuation(T, q, bound, within_limits, backend):
     gaps[:, revolute] = np.remainder(gaps[:, revolute] + math.pi, 2 * math.pi) - math.pi
     misses = np.abs(gaps / units).max(axis=1)
     best = int(np.argmin(misses))
+    if label:  # (the row of q's branch nearest q continues it if its step is within the
+        # bound and PATH_GAIN times the nearest row's: else the path crosses a fold, as the
+        # wrist turning through straight, where the row of q's branch turns joints 4 and 6
+        # by half a turn)
+        moves = rows - q
+        moves[:, revolute] = np.remainder(moves[:, revolute] + math.pi, 2 * math.pi) - math.pi
+        sizes = np.abs(moves / units).max(axis=1)
+        same = [i for i, r in enumerate(rows) if _same_branch(branch(r), label)]
+        if same:
+            kept = min(same, key=lambda i: sizes[i])
+            if sizes[kept] <= min(bound, PATH_GAIN * sizes.min()) + PATH_SLACK:
+                return _within(q + moves[kept], within_limits)
     row = guess + gaps[best]
     step = np.abs(row - q) / units
     j = int(np.argmax(step))
@@ -1324,12 +1371,22 @@ def _continuation(T, q, bound, within_limits, backend):
                if not converged else f"the nearest moves q{j + 1} by {step[j]:.3g}")
             + ": a singular crossing where the branch ends, or another branch)"
         )  # fmt: skip
+    return _within(row, within_limits)
+
+
+def _within(row, within_limits):
+    """The continuing row, and why it does not continue a path kept within the limits."""
     if within_limits:
         lo, hi = np.array(LIMITS).T
         outside = [f"q{i + 1}" for i in range(DOF) if not lo[i] <= row[i] <= hi[i]]
         if outside:
             return row, f"the continuing solution leaves the limits ({', '.join(outside)})"
     return row, ""
+
+
+def _same_branch(a: tuple[int, ...], b: tuple[int, ...]) -> bool:
+    """Whether two branches agree on every step where neither is at a fold (0)."""
+    return all(x == y or not x or not y for x, y in zip(a, b))
 
 
 def _newton_to(guess: np.ndarray, T: np.ndarray) -> tuple[np.ndarray, float]:
@@ -1702,6 +1759,35 @@ def _clusters(zs: list[complex]) -> list[tuple[complex, bool]]:
         else:
             out.append((z, True))
     return out
+
+
+def _cs1_branch(a: float, b: float, t: float) -> int:
+    """The branch of t among the values of a cos t + b sin t = e: +1 for atan2(b, a) + acos,
+    -1 for - acos (the sign of -f'(t) = a sin t - b cos t), 0 at the fold, where they meet."""
+    slope = a * sin(t) - b * cos(t)
+    if abs(slope) <= _BRANCH_FOLD * sqrt(a * a + b * b):
+        return 0
+    return 1 if slope > 0.0 else -1
+
+
+def _poly_branch(coeffs: tuple[float, ...], t: float) -> int:
+    """The branch of the root t of a polynomial in u = tan(t/2) (coefficients highest degree
+    first): the sign of dH/dt, H(t) = cos(t/2)^n p(tan(t/2)) (smooth through t = pi, where u
+    is infinite), 0 at a fold (a double root). t is wrapped first: H changes sign by a turn
+    of t where n is odd."""
+    n = len(coeffs) - 1
+    t = _wrap(t)
+    c, s = cos(t / 2.0), sin(t / 2.0)
+    slope = 0.0
+    for k, a in enumerate(coeffs):  # (a u^m, m = n - k: a s^m c^(n - m) in H)
+        m = n - k
+        if m:
+            slope += a * m * s ** (m - 1) * c ** (n - m + 1)
+        if n - m:
+            slope -= a * (n - m) * s ** (m + 1) * c ** (n - m - 1)
+    if abs(slope) <= _BRANCH_FOLD * n * sum(abs(a) for a in coeffs):
+        return 0
+    return 1 if slope > 0.0 else -1
 
 
 # at most this many steps per candidate (a seed on a singular configuration converges
@@ -2219,3 +2305,23 @@ def _ik_scalar(target, qr1, qr2, qr3, qr4, qr5, qr6, tol):
         if _v3.__class__ is _Free and len(found) > _n3:
             break
     return found
+
+
+def _branch_signs(target, q):
+    """The branch of the solution q of target (branch(q)): the solver's steps in a straight
+    line, each joint's value read from q, and the sign of each BRANCHES step's derivative."""
+    (_, _, _, wx, _, _, _, wy, _, _, _, wz) = target
+    (_, qr2, qr3, _, qr5, _,) = q
+    px = wx
+    py = wy
+    pz = wz
+    r = px*px + py*py + pz*pz
+    theta3 = qr3
+    _b0 = _poly_branch((0.413994 - r, 0.748224, 0.379434 - r,), theta3)
+    c3 = cos(theta3)
+    s3 = sin(theta3)
+    theta2 = qr2
+    _b1 = _cs1_branch(0.433*c3 + 0.02*s3, 0.02*c3 - 0.433*s3 - 0.432, theta2)
+    theta5 = qr5
+    _b2 = _cs1_branch(1.0, 0.0, theta5)
+    return (_b0, _b1, _b2,)

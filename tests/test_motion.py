@@ -280,10 +280,98 @@ def test_a_path_through_the_wrist_flip_region_keeps_its_branch(generated):
     assert nearest_kept <= followed
 
 
+def test_a_path_near_the_elbow_s_fold_keeps_its_branch_where_nearest_flips(generated):
+    """60 straight joint paths of the PUMA, 10 poses each, whose elbow stays 0.0005-0.01 rad
+    from stretched on one side (one branch at 400 points along each), the other joints moving
+    up to 0.8 rad: both elbow branches lie within one step, so the pose-by-pose nearest takes
+    the other one on some; ik_path, choosing by the closed form's branch, follows every path
+    to 1e-6 with no break."""
+    module = generated("puma560")
+    rng = np.random.default_rng(7)
+    stretched = _label_changes(module, np.zeros(6), 2)[0]  # (the elbow's fold at q = 0)
+    followed = nearest_kept = paths = 0
+    while paths < 60:
+        qa = rng.uniform(-2.5, 2.5, 6)
+        qb = qa + rng.uniform(-0.8, 0.8, 6)
+        side = rng.choice([-1.0, 1.0])
+        qa[2], qb[2] = stretched + side * rng.uniform(0.0005, 0.01, 2)
+        if len({module.branch(q) for q in qa + np.linspace(0, 1, 400)[:, None] * (qb - qa)}) > 1:
+            continue  # (the line crosses another fold: the wrist's, or the shoulder's)
+        paths += 1
+        Qt = qa + np.linspace(0.0, 1.0, 10)[:, None] * (qb - qa)
+        Ts = module.fk_batch(Qt)
+        Q, breaks = module.ik_path(Ts, Qt[0])
+        gaps = np.abs(np.remainder(Q - Qt + np.pi, 2 * np.pi) - np.pi)
+        followed += breaks == [] and gaps.max() <= 1e-6
+        q, kept = Qt[0], True
+        for T, target in zip(Ts[1:], Qt[1:]):
+            q = module.nearest(T, q, within_limits=False)
+            kept &= bool(np.abs(np.remainder(q - target + np.pi, 2 * np.pi) - np.pi).max() < 1e-6)
+        nearest_kept += kept
+    assert followed == paths
+    assert nearest_kept < paths, "no path where nearest flips: the test no longer tests it"
+
+
+def _label_changes(module, q: np.ndarray, joint: int) -> np.ndarray:
+    """The values of joint `joint` (0-based) where branch(q)'s label of that joint's step
+    changes, the others as in q (20001 samples over a turn)."""
+    where = module.BRANCHES.index(f"q{joint + 1}")
+    values = np.linspace(-np.pi, np.pi, 20001)
+    labels = []
+    for value in values:
+        q = q.copy()
+        q[joint] = value
+        labels.append(module.branch(q)[where])
+    changed = np.flatnonzero(np.diff(labels))
+    return values[changed + 1]
+
+
+@pytest.mark.parametrize(
+    ("name", "names"),
+    [
+        ("puma560", ("q3", "q2", "q5")),
+        ("parallel_6r", ("q1", "q5", "q3")),
+        ("iiwa14", ("q4", "q5", "q2")),  # (solved as a reversed chain: theta_k is q_{7 - k})
+        ("youbot", ("q1", "q5", "q3")),  # (a direction task: the virtual joint 6 solved)
+        ("lecture_rrr", ("q2",)),
+    ],
+)
+def test_branches_tell_every_solution_apart(generated, name, names):
+    """Where every branching step is a choice of two (a cos + b sin = e, a quadratic), the
+    signs of branch() tell the rows of 100 random poses apart and none is at a fold."""
+    module = generated(name)
+    assert names == module.BRANCHES
+    rng = np.random.default_rng(3)
+    lo, hi = np.clip(np.array(module.LIMITS).T, -np.pi, np.pi)
+    for _ in range(100):
+        q = rng.uniform(lo, hi)
+        rows = module.ik(module.fk(q), q_ref=q) if module.FREE else module.ik(module.fk(q))
+        labels = [module.branch(row) for row in rows]
+        assert len(set(labels)) == len(labels) and module.branch(q) in labels
+        assert all(0 not in label for label in labels)
+
+
+def test_branches_change_only_at_folds(generated):
+    """The PUMA's elbow label changes, over a turn of q3, exactly where the Jacobian is
+    singular (the elbow stretched); its wrist label is 0 at q5 = 0, the wrist's fold."""
+    module = generated("puma560")
+    q = np.radians([10.0, 20.0, 30.0, 40.0, 30.0, 50.0])
+    changes = _label_changes(module, q, 2)
+    assert len(changes) == 2
+    for value in changes:
+        q[2] = value
+        assert module.manipulability(q)[0] < 1e-3
+    q[4] = 0.0
+    assert module.branch(q)[2] == 0
+    assert module.BRANCHES and generated("manocha_canny").BRANCHES == ()  # (the general method)
+
+
 def test_a_path_out_of_reach_or_limits_breaks_where_and_why(generated):
     """A line that leaves the PUMA's workspace stops at its first unreachable pose (rows
-    after it NaN), or with on_break="flag" goes on; a path whose joint 2 leaves its limits
-    breaks there with within_limits."""
+    after it NaN), or with on_break="flag" goes on; a path on one branch whose joint 5 leaves
+    its limits breaks there with within_limits. (A path of joint 2 alone beyond its limit
+    crosses the shoulder's fold first, the wrist centre passing the cylinder of axis 1: there
+    the path keeps its branch and turns back, inside the limits.)"""
     module = generated("puma560")
     start = np.radians([10.0, 20.0, 30.0, 40.0, 30.0, 50.0])
     A = module.fk(start)
@@ -296,12 +384,13 @@ def test_a_path_out_of_reach_or_limits_breaks_where_and_why(generated):
     _, flagged = module.ik_path(module.straight_line(A, B, 30), start, on_break="flag")
     assert len(flagged) == 30 - k
     end = start.copy()
-    end[1] = module.LIMITS[1][1] + 0.3  # (joint 2 beyond its upper limit)
-    Ts = module.fk_batch(start + np.linspace(0.0, 1.0, 20)[:, None] * (end - start))
-    Q, breaks = module.ik_path(Ts, start, within_limits=True)
+    end[4] = module.LIMITS[4][1] + 0.3  # (joint 5 beyond its upper limit)
+    Qt = start + np.linspace(0.0, 1.0, 20)[:, None] * (end - start)
+    assert {module.branch(q) for q in Qt} == {(1, 1, 1)}
+    Q, breaks = module.ik_path(module.fk_batch(Qt), start, within_limits=True)
     (k, why), *_ = breaks
-    assert "the continuing solution leaves the limits (q2)" in why
-    assert (Q[:k, 1] <= module.LIMITS[1][1]).all()
+    assert "the continuing solution leaves the limits (q5)" in why
+    assert (Q[:k, 4] <= module.LIMITS[4][1]).all()
 
 
 def test_a_path_of_an_arm_with_free_joints_moves_them_smoothly(generated):

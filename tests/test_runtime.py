@@ -118,3 +118,27 @@ def test_quartic_closed_form_agrees_with_the_companion_matrix():
             # each root near one of the other's (conjugate pairs come in either order)
             distance = np.abs(np.subtract.outer(np.array(roots), np.array(reference)))
             assert distance.min(axis=0).max() <= 1e-8 and distance.min(axis=1).max() <= 1e-8
+
+
+def test_branch_signs_are_constant_along_each_branch_and_opposite_across():
+    """a cos t + b sin t = e, swept so that its - acos value passes through t = pi: the
+    branch of each value is the same all along, as the equation (_cs1_branch) and as its
+    half-angle quadratic (c + a) u^2 - 2 b u + (c - a) (_poly_branch, smooth where u is
+    infinite), and the two values have opposite signs; at the fold (e = rho) both are 0."""
+    a, b = 0.3, -0.4
+    rho = math.hypot(a, b)
+    seen: dict[int, set[int]] = {1: set(), -1: set()}
+    for e in np.linspace(-0.49, 0.49, 301):
+        base, delta = math.atan2(b, a), math.acos(e / rho)
+        quadratic = (e + a, -2.0 * b, e - a)
+        for sign in (1, -1):
+            t = base + sign * delta
+            assert scalar._cs1_branch(a, b, t) == sign
+            seen[sign].add(scalar._poly_branch(quadratic, t))
+            seen[sign].add(scalar._poly_branch(quadratic, t + 2.0 * math.pi))
+    (plus,), (minus,) = seen[1], seen[-1]
+    assert plus == -minus != 0
+    assert scalar._cs1_branch(a, b, math.atan2(b, a)) == 0
+    assert scalar._poly_branch((1.0, -2.0, 1.0), math.pi / 2.0) == 0  # ((u - 1)^2 at u = 1)
+    assert scalar._polyd_branch((1.0, 0.0, -4.0), 2.0) == 1  # (d^2 - 4 rising at d = 2)
+    assert scalar._polyd_branch((1.0, 0.0, -4.0), -2.0) == -1

@@ -7,6 +7,7 @@ value that gave a solution are the same for every kind.
 
 from __future__ import annotations
 
+import re
 from collections.abc import Callable
 
 import sympy as sp
@@ -123,3 +124,135 @@ def solve_lines(
         if step.angle and name in after:
             lines.append(Line(depth + 1, f"{name} = {function}({step.variable})"))
     return lines
+
+
+# Solve kind -> the call giving the branch of the step's value (derive/runtime/scalar.py): the
+# sign of its equation's derivative in the joint's value; kinds that give one value have none
+BRANCHES: dict[type[Solve], Callable[[Solve, list[str]], str]] = {
+    Cs1: lambda step, values: f"_cs1_branch({values[0]}, {values[1]}, {step.variable})",
+    Cs1Reach: lambda step, values: f"_cs1_branch({values[0]}, {values[1]}, {step.variable})",
+    Poly: lambda step, values: f"_poly_branch(({', '.join(values)},), {step.variable})",
+    PolyD: lambda step, values: f"_polyd_branch(({', '.join(values)},), {step.variable})",
+}
+
+
+def branch_steps(plan: Plan) -> tuple[Solve, ...] | None:
+    """The steps that choose a branch (a Solve of more than one value, of a kind in BRANCHES),
+    or None where a joint vector alone cannot say which branch it is on: a step before one of
+    them gives several values of something that is not one of the arm's joints (the
+    axis-angle task's auxiliary angle, a look-at's distance), or one step solves all joints
+    at once (the general method). A step giving one value of a task's virtual joint is
+    solved as the solver does (branch_lines)."""
+    assert plan.ik is not None
+    out = []
+    unknown = False  # (a value not a joint's solved before: later steps may read it)
+    for step in plan.ik.steps:
+        if isinstance(step, Assign):
+            continue
+        if isinstance(step, Eigen):
+            return None
+        branching = type(step) in BRANCHES and step.fanout > 1
+        if _from_joints(plan, step) is not None:
+            if branching and unknown:
+                return None
+            if branching:
+                out.append(step)
+        elif branching:  # (a value not a joint's: which of its values, q cannot say)
+            unknown = True
+    return tuple(out)
+
+
+def _from_joints(plan: Plan, step: Solve) -> sp.Expr | None:
+    """The step's value as an expression in the joint values q_i: the inverse of the one
+    output q_i = +-value + constant that reads it, or None where no output is such."""
+    assert plan.ik is not None
+    value = sp.Symbol(step.variable, real=True)
+    for i, out in enumerate(plan.ik.outputs, start=1):
+        if out.free_symbols != {value}:
+            continue
+        k = out.coeff(value)
+        rest = sp.expand(out - k * value)
+        if k in (1, -1) and not rest.free_symbols:
+            return (sp.Symbol(f"qr{i}", real=True) - rest) / k
+    return None
+
+
+def branch_lines(plan: Plan) -> tuple[tuple[int, str], ...]:
+    """Body of _branch_signs(target, q): the solver's steps in a straight line, each joint's
+    value read from q instead of solved, and the branch of each step of branch_steps; a body
+    returning () where branch_steps is None."""
+    chosen = branch_steps(plan)
+    if not chosen:
+        return ((0, "return ()"),)
+    printer = CodePrinter()
+    names = sp.numbered_symbols("x")
+    steps, _ = live_steps(plan)
+    lines: list[Line] = []
+    out: list[str] = []
+    for live in steps:
+        step = live.step
+        if len(out) == len(chosen):
+            break  # (nothing after the last branching step is read)
+        if isinstance(step, Assign):
+            lines += assign_lines(step.targets, step.exprs, names, printer, 0, live.after)
+            continue
+        assert isinstance(step, Solve)
+        value = _from_joints(plan, step)
+        if value is None:  # (a task's virtual joint: its one value, solved)
+            more, values = step_arguments(step, names, printer, 0)
+            call = SOLVES[type(step)](
+                step, ", ".join(values), printer.doprint(step.ref), repr(1e-10 * step.scale)
+            )
+            lines += more[1:]
+            lines.append(Line(0, f"{step.variable} = {call}[0]"))
+        else:
+            lines.append(Line(0, f"{step.variable} = {printer.doprint(value)}"))
+        if any(step is c for c in chosen):
+            more, values = step_arguments(step, names, printer, 0)
+            lines += more[1:]  # (the step's note is the solver's)
+            lines.append(Line(0, f"_b{len(out)} = {BRANCHES[type(step)](step, values)}"))
+            out.append(f"_b{len(out)}")
+        for name, function in ((f"c{step.joint}", "cos"), (f"s{step.joint}", "sin")):
+            if step.angle and name in live.after:
+                lines.append(Line(0, f"{name} = {function}({step.variable})"))
+    lines = _read_lines(lines, set(out))
+    read = {name for ln in lines for name in _NAME.findall(ln.text.split(" = ", 1)[1])}
+    world = ", ".join(name if name in read else "_" for name in WORLD)
+    joints = ", ".join(
+        name if name in read else "_" for name in _qr_names(plan).split(", ")
+    )  # fmt: skip
+    head = [Line(0, f"({world}) = target"), Line(0, f"({joints},) = q")]
+    return tuple(
+        (ln.depth, ln.text) for ln in [*head, *lines, Line(0, f"return ({', '.join(out)},)")]
+    )
+
+
+_NAME = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")
+
+
+def _read_lines(lines: list[Line], needed: set[str]) -> list[Line]:
+    """The assignment lines (name = expression) whose name is needed, directly or through
+    later lines, in their order."""
+    kept = []
+    for line in reversed(lines):
+        target, expr = line.text.split(" = ", 1)
+        if target in needed:
+            kept.append(line)
+            needed |= set(_NAME.findall(expr))
+    return kept[::-1]
+
+
+def branch_names(plan: Plan) -> tuple[str, ...]:
+    """The arm's joints whose steps choose a branch (BRANCHES in the module: "q3", ...), in
+    the order they are solved (a reversed chain's theta_k is another joint of the arm)."""
+    out = []
+    for step in branch_steps(plan) or ():
+        value = _from_joints(plan, step)
+        assert value is not None
+        (joint,) = value.free_symbols
+        out.append(f"q{str(joint)[2:]}")
+    return tuple(out)
+
+
+def _qr_names(plan: Plan) -> str:
+    return ", ".join(f"qr{i}" for i in range(1, plan.arm.dof + 1))

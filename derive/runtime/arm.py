@@ -59,6 +59,9 @@ def _missing(*args: Any) -> Any:
 
 
 _fk_from_cs = _fk_q = _jacobian_q = _cs_columns = _keep = _ik_scalar = _rr_fill = _missing
+_branch_signs = _missing
+# the joint values whose steps choose a branch (branch(q)), in the order they are solved
+BRANCHES: tuple[str, ...] = ()
 BASE = TOOL = np.eye(4)
 # the general method's splits: (reversed, rows the matrices were filled from, the arm's rows,
 # (1.0, theta3) where joint 3 slides else (0.0, 0.0)), rows (d, a, cos alpha, sin alpha) of

@@ -21,6 +21,10 @@ _CLAMP_TOL = 1e-7
 # one rounding of its argument into 1e-8 of angle)
 _FOLD_TOL = 1e-14
 _LEAD_TOL = 1e-10
+# a step's branch (branch(T, q)) is the sign of its equation's derivative in the joint's value
+# at the solution; 0 (a fold: two branches meet, a singular configuration) where the
+# derivative is below _BRANCH_FOLD of the equation's scale
+_BRANCH_FOLD = 1e-9
 _OMEGA = (1.0, complex(-0.5, math.sqrt(3.0) / 2.0), complex(-0.5, -math.sqrt(3.0) / 2.0))
 _FREE_TOL = 1e-14  # squared sizes: a joint is free below 1e-7 of its equation's scale
 # the values a free joint tries, as offsets from its preferred value: 0, +5, -5, +10, ... deg

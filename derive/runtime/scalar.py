@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import math
 import threading
-from math import acos, atan2, sqrt
+from math import acos, atan2, cos, sin, sqrt
 
 import numpy as np
 
@@ -20,6 +20,7 @@ from derive.runtime.closed import (
 )
 from derive.runtime.common import _wrap
 from derive.runtime.constants import (
+    _BRANCH_FOLD,
     _CLAMP_TOL,
     _CLUSTER_TOL,
     _FOLD_TOL,
@@ -343,3 +344,50 @@ def _clusters(zs: list[complex]) -> list[tuple[complex, bool]]:
         else:
             out.append((z, True))
     return out
+
+
+# Branches. A step that gives several values of its joint gives them as the roots of one
+# equation f(t) = 0; the sign of f'(t) at a root labels it, and it changes only where two
+# roots meet (f' = 0: a fold, a singular configuration). So a solution's signs, one per such
+# step, stay the same along a path that crosses no fold: they name its branch (shoulder,
+# elbow, wrist configuration) whatever the distances (branch(T, q) in motion.py).
+
+
+def _cs1_branch(a: float, b: float, t: float) -> int:
+    """The branch of t among the values of a cos t + b sin t = e: +1 for atan2(b, a) + acos,
+    -1 for - acos (the sign of -f'(t) = a sin t - b cos t), 0 at the fold, where they meet."""
+    slope = a * sin(t) - b * cos(t)
+    if abs(slope) <= _BRANCH_FOLD * sqrt(a * a + b * b):
+        return 0
+    return 1 if slope > 0.0 else -1
+
+
+def _poly_branch(coeffs: tuple[float, ...], t: float) -> int:
+    """The branch of the root t of a polynomial in u = tan(t/2) (coefficients highest degree
+    first): the sign of dH/dt, H(t) = cos(t/2)^n p(tan(t/2)) (smooth through t = pi, where u
+    is infinite), 0 at a fold (a double root). t is wrapped first: H changes sign by a turn
+    of t where n is odd."""
+    n = len(coeffs) - 1
+    t = _wrap(t)
+    c, s = cos(t / 2.0), sin(t / 2.0)
+    slope = 0.0
+    for k, a in enumerate(coeffs):  # (a u^m, m = n - k: a s^m c^(n - m) in H)
+        m = n - k
+        if m:
+            slope += a * m * s ** (m - 1) * c ** (n - m + 1)
+        if n - m:
+            slope -= a * (n - m) * s ** (m + 1) * c ** (n - m - 1)
+    if abs(slope) <= _BRANCH_FOLD * n * sum(abs(a) for a in coeffs):
+        return 0
+    return 1 if slope > 0.0 else -1
+
+
+def _polyd_branch(coeffs: tuple[float, ...], d: float) -> int:
+    """The branch of the root d of a polynomial in d (coefficients highest degree first): the
+    sign of p'(d), 0 at a fold (a double root)."""
+    n = len(coeffs) - 1
+    terms = [a * (n - k) * d ** (n - k - 1) for k, a in enumerate(coeffs[:-1])]
+    slope = sum(terms)
+    if abs(slope) <= _BRANCH_FOLD * sum(abs(x) for x in terms):
+        return 0
+    return 1 if slope > 0.0 else -1
