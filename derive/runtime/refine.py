@@ -10,7 +10,10 @@ it is singular), bring it there. The error is the position difference divided by
 the rotation error 1/2 sum_k r_k x t_k (r_k, t_k the columns of the rotations), whose
 Jacobian at the solution is the geometric one: J_i = (z_i x (p - o_i) / REACH, z_i) for a
 revolute joint, (z_i / REACH, 0) for a prismatic one; only the joints in _SOLVED move (free
-joints keep the caller's values).
+joints keep the caller's values). The C solver's dk_refine takes the same steps, but turns
+the joints' cos and sin by their series after a small step and takes the last step (from an
+error within _REFINE_LAST) with the step before's Jacobian and factor: the two agree to
+~1e-13.
 """
 
 from __future__ import annotations
