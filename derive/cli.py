@@ -254,6 +254,9 @@ def cmd_solve(args: argparse.Namespace) -> int:
         ]
         print(f"free joints: {', '.join(given)} (degrees for R joints)")
     print(f"{len(sols)} solution(s) (degrees for R joints):")
+    branches = getattr(module, "BRANCHES", ())
+    if branches and len(sols):
+        print(f"(branch: the signs of the steps of {', '.join(branches)}; 0 at a fold)")
     for k, q in enumerate(sols, start=1):
         shown = [math.degrees(v) if t == "R" else v for v, t in zip(q, spec.joint_types)]
         # (the components the solver reproduces: its task's)
@@ -264,10 +267,13 @@ def cmd_solve(args: argparse.Namespace) -> int:
             if not lo <= v <= hi
         ]
         flag = f"  out of limits: {', '.join(outside)}" if outside else ""
+        signs = "".join("0+-"[s] for s in module.branch(q)) if branches else ""
         print(
             f"{k:2d}: "
             + " ".join(f"{round(v, 4) + 0.0:10.4f}" for v in shown)  # (+ 0.0: no -0.0000)
-            + f"  residual {residual:.1e}{flag}"
+            + f"  residual {residual:.1e}"
+            + (f"  branch {signs}" if signs else "")
+            + flag
         )
     return 0
 

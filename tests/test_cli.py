@@ -138,6 +138,11 @@ def test_solve_command_lists_eight_solutions_with_limits():
     assert len(rows) == 8
     assert any("out of limits" in r for r in rows)
     assert all(float(r.split("residual")[1].split()[0]) < 1e-9 for r in rows)
+    # (each row's branch: the signs of the q3, q2 and q5 steps, the 8 configurations)
+    assert "(branch: the signs of the steps of q3, q2, q5; 0 at a fold)" in result.stdout
+    assert {r.split("branch ")[1].split()[0] for r in rows} == {
+        a + b + c for a in "+-" for b in "+-" for c in "+-"
+    }
 
 
 def test_solve_rejects_non_rigid_pose():
