@@ -139,7 +139,7 @@ MAX_SOLUTIONS = 4
 FREE = ()
 # the joint values whose steps choose a branch (branch(q): the sign of each step's equation's
 # derivative), in the order they are solved
-BRANCHES = ()
+BRANCHES = ('virtual',)
 # how far the solver's equations may miss and still seed a refinement (0: exact arms)
 _SEED_TOL = 0.0
 # the exact chain: T(q) = F_0 J_1(q_1) F_1 ... J_n(q_n) F_n, J_i = Rz(q_i) (R) or
@@ -197,6 +197,12 @@ _CLUSTER_TOL = 1e-3
 
 
 _LEAD_TOL = 1e-10
+
+
+# a step's branch (branch(T, q)) is the sign of its equation's derivative in the joint's value
+# at the solution; 0 (a fold: two branches meet, a singular configuration) where the
+# derivative is below _BRANCH_FOLD of the equation's scale
+_BRANCH_FOLD = 1e-9
 
 
 _OMEGA = (1.0, complex(-0.5, math.sqrt(3.0) / 2.0), complex(-0.5, -math.sqrt(3.0) / 2.0))
@@ -1228,9 +1234,9 @@ def branch(q: ArrayLike) -> tuple[int, ...]:
     stretched or the wrist straight). Each is the sign of the derivative of the step's
     equation in its joint's value (a cos t + b sin t = e: +1 for the + acos value); it changes
     only where a path of solutions crosses a fold, so it names the configuration (shoulder,
-    elbow, wrist) whatever the distances between solutions. () where the derivation has no
-    such steps, or its steps solve values that are not joints (the general method, a task's
-    virtual joint).
+    elbow, wrist) whatever the distances between solutions; "virtual" in BRANCHES is the
+    task's own value (the axis-angle task's tilt, a look-at's distance along the ray). ()
+    where the derivation has no such steps (the general method).
 
     Raises:
         ValueError: q is not DOF finite numbers.
@@ -1704,6 +1710,17 @@ def _clusters(zs: list[complex]) -> list[tuple[complex, bool]]:
     return out
 
 
+def _polyd_branch(coeffs: tuple[float, ...], d: float) -> int:
+    """The branch of the root d of a polynomial in d (coefficients highest degree first): the
+    sign of p'(d), 0 at a fold (a double root)."""
+    n = len(coeffs) - 1
+    terms = [a * (n - k) * d ** (n - k - 1) for k, a in enumerate(coeffs[:-1])]
+    slope = sum(terms)
+    if abs(slope) <= _BRANCH_FOLD * sum(abs(x) for x in terms):
+        return 0
+    return 1 if slope > 0.0 else -1
+
+
 # at most this many steps per candidate (a seed on a singular configuration converges
 # linearly); a step longer than _REFINE_STRIDE (radians, or
 # REACH of length) is shortened to it, so that a far seed does not jump branches
@@ -2064,4 +2081,20 @@ def _ik_scalar(target, qr1, qr2, tol):
 def _branch_signs(target, q):
     """The branch of the solution q of target (branch(q)): the solver's steps in a straight
     line, each joint's value read from q, and the sign of each BRANCHES step's derivative."""
-    return ()
+    (_, _, _, wx, _, _, _, wy, _, _, _, wz) = target
+    (qr1, qr2,) = q
+    px = wx - 0.061228
+    py = wy
+    pz = wz - 0.421
+    z = pz
+    r = px*px + py*py + pz*pz
+    c1 = cos(qr1)
+    s1 = sin(qr1)
+    c2 = cos(qr2 + 1.5707963267948966)
+    s2 = sin(qr2 + 1.5707963267948966)
+    d3 = (c1*s2*(8.99999999998125e-06*c1*c2 - 0.05318*c1*s2 - 0.025034*c1 + 0.0175*s1 + wx -
+        0.061228) + c2*(-0.05318*c2 - 8.99999999998125e-06*s2 + wz - 0.421) + s1*s2*(-0.0175*c1 +
+        8.99999999998125e-06*c2*s1 - 0.05318*s1*s2 - 0.025034*s1 + wy))
+    _b0 = (_polyd_branch((1.0, 0.21272, 0.01632777225 - 2.0*r, 0.000533429717054 - 0.21272*r, r*r -
+        0.007522127274*r + 0.002506804624*z*z + 7.056074237000755e-06,), d3))
+    return (_b0,)

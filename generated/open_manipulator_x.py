@@ -149,7 +149,7 @@ MAX_SOLUTIONS = 8
 FREE = ()
 # the joint values whose steps choose a branch (branch(q): the sign of each step's equation's
 # derivative), in the order they are solved
-BRANCHES = ()
+BRANCHES = ('q1', 'virtual', 'q3')
 # how far the solver's equations may miss and still seed a refinement (0: exact arms)
 _SEED_TOL = 0.0
 # the exact chain: T(q) = F_0 J_1(q_1) F_1 ... J_n(q_n) F_n, J_i = Rz(q_i) (R) or
@@ -214,6 +214,12 @@ _CLAMP_TOL = 1e-7
 # below _FOLD_TOL sqrt(a^2 + b^2), and every backend gives the same value (acos near +-1 turns
 # one rounding of its argument into 1e-8 of angle)
 _FOLD_TOL = 1e-14
+
+
+# a step's branch (branch(T, q)) is the sign of its equation's derivative in the joint's value
+# at the solution; 0 (a fold: two branches meet, a singular configuration) where the
+# derivative is below _BRANCH_FOLD of the equation's scale
+_BRANCH_FOLD = 1e-9
 
 
 _FREE_TOL = 1e-14  # squared sizes: a joint is free below 1e-7 of its equation's scale
@@ -1283,9 +1289,9 @@ def branch(q: ArrayLike) -> tuple[int, ...]:
     stretched or the wrist straight). Each is the sign of the derivative of the step's
     equation in its joint's value (a cos t + b sin t = e: +1 for the + acos value); it changes
     only where a path of solutions crosses a fold, so it names the configuration (shoulder,
-    elbow, wrist) whatever the distances between solutions. () where the derivation has no
-    such steps, or its steps solve values that are not joints (the general method, a task's
-    virtual joint).
+    elbow, wrist) whatever the distances between solutions; "virtual" in BRANCHES is the
+    task's own value (the axis-angle task's tilt, a look-at's distance along the ray). ()
+    where the derivation has no such steps (the general method).
 
     Raises:
         ValueError: q is not DOF finite numbers.
@@ -1601,6 +1607,15 @@ def _atan2(y: float, x: float, ref: float) -> tuple[float, ...]:
     if abs(y) + abs(x) <= 1e-12:
         return _free(ref)
     return (atan2(y, x),)
+
+
+def _cs1_branch(a: float, b: float, t: float) -> int:
+    """The branch of t among the values of a cos t + b sin t = e: +1 for atan2(b, a) + acos,
+    -1 for - acos (the sign of -f'(t) = a sin t - b cos t), 0 at the fold, where they meet."""
+    slope = a * sin(t) - b * cos(t)
+    if abs(slope) <= _BRANCH_FOLD * sqrt(a * a + b * b):
+        return 0
+    return 1 if slope > 0.0 else -1
 
 
 # at most this many steps per candidate (a seed on a singular configuration converges
@@ -2048,4 +2063,21 @@ def _ik_scalar(target, qr1, qr2, qr3, qr4, tol):
 def _branch_signs(target, q):
     """The branch of the solution q of target (branch(q)): the solver's steps in a straight
     line, each joint's value read from q, and the sign of each BRANCHES step's derivative."""
-    return ()
+    (_, _, _, wx, _, _, _, wy, _, _, _, _) = target
+    (qr1, qr2, qr3, qr4,) = q
+    px = wx - 0.012
+    py = wy
+    theta1 = qr1
+    _b0 = _cs1_branch(py, -px, theta1)
+    c2 = cos(qr2 - 1.3854483816190182)
+    s2 = sin(qr2 - 1.3854483816190182)
+    c3 = cos(qr3 + 1.3854483816190182)
+    s3 = sin(qr3 + 1.3854483816190182)
+    c4 = cos(qr4)
+    s4 = sin(qr4)
+    theta5 = (atan2(c2*c3*s4 + c2*c4*s3 + c3*c4*s2 - s2*s3*s4, c2*c3*c4 - c2*s3*s4 - c3*s2*s4 -
+        c4*s2*s3))
+    _b1 = _cs1_branch(0.0, -1.0, theta5)
+    theta3 = qr3 + 1.3854483816190182
+    _b2 = _cs1_branch(0.032297288, 0.0, theta3)
+    return (_b0, _b1, _b2,)

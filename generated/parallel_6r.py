@@ -1206,9 +1206,9 @@ def branch(q: ArrayLike) -> tuple[int, ...]:
     stretched or the wrist straight). Each is the sign of the derivative of the step's
     equation in its joint's value (a cos t + b sin t = e: +1 for the + acos value); it changes
     only where a path of solutions crosses a fold, so it names the configuration (shoulder,
-    elbow, wrist) whatever the distances between solutions. () where the derivation has no
-    such steps, or its steps solve values that are not joints (the general method, a task's
-    virtual joint).
+    elbow, wrist) whatever the distances between solutions; "virtual" in BRANCHES is the
+    task's own value (the axis-angle task's tilt, a look-at's distance along the ray). ()
+    where the derivation has no such steps (the general method).
 
     Raises:
         ValueError: q is not DOF finite numbers.

@@ -334,6 +334,9 @@ def _label_changes(module, q: np.ndarray, joint: int) -> np.ndarray:
         ("iiwa14", ("q4", "q5", "q2")),  # (solved as a reversed chain: theta_k is q_{7 - k})
         ("youbot", ("q1", "q5", "q3")),  # (a direction task: the virtual joint 6 solved)
         ("lecture_rrr", ("q2",)),
+        # (the axis-angle task's tilt phi and a look-at's distance: the plan's virtual value)
+        ("open_manipulator_x", ("q1", "virtual", "q3")),
+        ("locobot_head", ("virtual",)),
     ],
 )
 def test_branches_tell_every_solution_apart(generated, name, names):

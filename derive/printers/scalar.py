@@ -12,6 +12,7 @@ from collections.abc import Callable
 
 import sympy as sp
 
+from derive import symbols as sym
 from derive.plan import (
     Assign,
     Atan2,
@@ -139,10 +140,10 @@ BRANCHES: dict[type[Solve], Callable[[Solve, list[str]], str]] = {
 def branch_steps(plan: Plan) -> tuple[Solve, ...] | None:
     """The steps that choose a branch (a Solve of more than one value, of a kind in BRANCHES),
     or None where a joint vector alone cannot say which branch it is on: a step before one of
-    them gives several values of something that is not one of the arm's joints (the
-    axis-angle task's auxiliary angle, a look-at's distance), or one step solves all joints
-    at once (the general method). A step giving one value of a task's virtual joint is
-    solved as the solver does (branch_lines)."""
+    them gives several values of something that is neither one of the arm's joints nor the
+    task's virtual value (IkPlan.virtual: the axis-angle task's tilt, a look-at's distance),
+    or one step solves all joints at once (the general method). A step giving one value of a
+    task's virtual joint is solved as the solver does (branch_lines)."""
     assert plan.ik is not None
     out = []
     unknown = False  # (a value not a joint's solved before: later steps may read it)
@@ -152,7 +153,7 @@ def branch_steps(plan: Plan) -> tuple[Solve, ...] | None:
         if isinstance(step, Eigen):
             return None
         branching = type(step) in BRANCHES and step.fanout > 1
-        if _from_joints(plan, step) is not None:
+        if _from_joints(plan, step) is not None or _virtual(plan, step) is not None:
             if branching and unknown:
                 return None
             if branching:
@@ -160,6 +161,35 @@ def branch_steps(plan: Plan) -> tuple[Solve, ...] | None:
         elif branching:  # (a value not a joint's: which of its values, q cannot say)
             unknown = True
     return tuple(out)
+
+
+def _virtual(plan: Plan, step: Solve) -> str | None:
+    """A branching step's value that is not a joint's but the task's virtual or auxiliary
+    one (IkPlan.virtual: its cos and sin, or its length, on a solution's branch, in the world
+    pose's entries and the joints' c_i, s_i, d_i), printed; None where the plan has none or
+    numbers the steps' joints otherwise than the arm's (a reversed chain)."""
+    assert plan.ik is not None
+    if not plan.ik.virtual or step.joint <= plan.arm.dof or not same_joints(plan):
+        return None
+    printer = CodePrinter()
+    parts = [printer.doprint(e) for e in plan.ik.virtual]
+    return f"atan2({parts[1]}, {parts[0]})" if len(parts) == 2 else parts[0]
+
+
+def _joint_lines(plan: Plan) -> list[Line]:
+    """Every joint's theta_i (c_i, s_i) or d_i from q (the plan's joint definitions), for a
+    virtual value's expression: the straight line's later lines keep only those it reads."""
+    printer = CodePrinter()
+    out = []
+    for k, (target, expr) in enumerate(plan.joint_defs, start=1):
+        value = printer.doprint(
+            expr.xreplace({sym.q(i + 1): sp.Symbol(f"qr{i + 1}") for i in range(plan.arm.dof)})
+        )
+        if str(target).startswith("theta"):
+            out += [Line(0, f"c{k} = cos({value})"), Line(0, f"s{k} = sin({value})")]
+        else:
+            out.append(Line(0, f"{target} = {value}"))
+    return out
 
 
 def _from_joints(plan: Plan, step: Solve) -> sp.Expr | None:
@@ -198,7 +228,11 @@ def branch_lines(plan: Plan) -> tuple[tuple[int, str], ...]:
             continue
         assert isinstance(step, Solve)
         value = _from_joints(plan, step)
-        if value is None:  # (a task's virtual joint: its one value, solved)
+        virtual = _virtual(plan, step) if value is None else None
+        if virtual is not None and any(step is c for c in chosen):  # (its value on q's branch)
+            lines += _joint_lines(plan)
+            lines.append(Line(0, f"{step.variable} = {virtual}"))
+        elif value is None:  # (a task's virtual joint: its one value, solved)
             more, values = step_arguments(step, names, printer, 0)
             call = SOLVES[type(step)](
                 step, ", ".join(values), printer.doprint(step.ref), repr(1e-10 * step.scale)
@@ -248,7 +282,9 @@ def branch_names(plan: Plan) -> tuple[str, ...]:
     out = []
     for step in branch_steps(plan) or ():
         value = _from_joints(plan, step)
-        assert value is not None
+        if value is None:  # (the task's virtual or auxiliary value: IkPlan.virtual)
+            out.append("virtual")
+            continue
         (joint,) = value.free_symbols
         out.append(f"q{str(joint)[2:]}")
     return tuple(out)
