@@ -1311,12 +1311,15 @@ def ik_path(
     backend: str | None = None,
 ) -> tuple[np.ndarray, list[tuple[int, str]]]:
     """One joint vector per pose of a path, each continuing the previous one: the closed-form
-    solution of pose k that Newton's iteration from q_{k-1} reaches (q += J^+ dX, dX the pose
-    error as a twist), accepted only within PATH_GAIN |dX| / sigma_min + PATH_SLACK of q_{k-1}
-    (the joint step a continuous branch can take; sigma_min the Jacobian's smallest singular
-    value). The free joints of an arm with free joints (FREE) follow Newton's iteration. An
-    arm solved for a task (IK_COMPONENTS) takes Newton's steps on the task's components only
-    (the poses' other components need not be reachable), its free joints kept.
+    solution of pose k on q_{k-1}'s branch (branch) nearest q_{k-1}, where its step is within
+    PATH_GAIN times the nearest solution's; else the one that Newton's iteration from q_{k-1}
+    reaches (q += J^+ dX, dX the pose error as a twist: a path crossing a fold, the wrist
+    turning through straight). Either is accepted only within PATH_GAIN |dX| / sigma_min +
+    PATH_SLACK of q_{k-1} (the joint step a continuous branch can take; sigma_min the
+    Jacobian's smallest singular value). The free joints of an arm with free joints (FREE)
+    follow Newton's iteration. An arm solved for a task (IK_COMPONENTS) takes Newton's steps
+    on the task's components only (the poses' other components need not be reachable), its
+    free joints kept.
 
     Where no solution continues the path (a singular crossing where the branch ends, a joint
     limit with within_limits, a pose out of reach), the break is reported: (k, why) in the
