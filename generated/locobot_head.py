@@ -139,7 +139,7 @@ MAX_SOLUTIONS = 4
 FREE = ()
 # the joint values whose steps choose a branch (branch(q): the sign of each step's equation's
 # derivative), in the order they are solved
-BRANCHES = ('virtual',)
+BRANCHES = ()
 # how far the solver's equations may miss and still seed a refinement (0: exact arms)
 _SEED_TOL = 0.0
 # the exact chain: T(q) = F_0 J_1(q_1) F_1 ... J_n(q_n) F_n, J_i = Rz(q_i) (R) or
@@ -197,12 +197,6 @@ _CLUSTER_TOL = 1e-3
 
 
 _LEAD_TOL = 1e-10
-
-
-# a step's branch (branch(T, q)) is the sign of its equation's derivative in the joint's value
-# at the solution; 0 (a fold: two branches meet, a singular configuration) where the
-# derivative is below _BRANCH_FOLD of the equation's scale
-_BRANCH_FOLD = 1e-9
 
 
 _OMEGA = (1.0, complex(-0.5, math.sqrt(3.0) / 2.0), complex(-0.5, -math.sqrt(3.0) / 2.0))
@@ -970,7 +964,7 @@ def _real(x: object, name: str) -> np.ndarray:
         ):
             raise TypeError
         return a.astype(float)
-    except (TypeError, ValueError):
+    except (TypeError, ValueError, OverflowError):  # (OverflowError: an int beyond a float)
         raise ValueError(f"{name} must be an array of real numbers (ints or floats)") from None
 
 
@@ -1265,6 +1259,19 @@ PATH_GAIN = 3.0
 PATH_SLACK = 1e-6
 
 
+# ... and q0 must reach Ts[0] within this (its pose error, as ik's certification measures it);
+# a step of more than PATH_JUMP (radians, or REACH) where sigma_min is below PATH_SINGULAR is
+# a break: the first-order bound allows any step there, and which way the path goes depends
+# on how finely it is sampled
+PATH_START_TOL = 1e-6
+
+
+PATH_SINGULAR = 1e-3
+
+
+PATH_JUMP = 0.5
+
+
 def ik_path(
     Ts: ArrayLike,
     q0: ArrayLike,
@@ -1300,8 +1307,8 @@ def ik_path(
         (Q (N, DOF), breaks): the path's joint vectors and its breaks, in order.
 
     Raises:
-        ValueError: Ts is not (N, 4, 4) with N >= 1, q0 not DOF finite numbers, on_break
-            unknown; ik's errors for a pose.
+        ValueError: Ts is not (N, 4, 4) with N >= 1, q0 not DOF finite numbers or not
+            reaching Ts[0] within PATH_START_TOL, on_break unknown; ik's errors for a pose.
     """
     poses = np.asarray(Ts, dtype=float)
     if poses.ndim != 3 or poses.shape[1:] != (4, 4) or len(poses) == 0:
@@ -1309,6 +1316,15 @@ def ik_path(
     if on_break not in ("stop", "flag"):
         raise ValueError(f'on_break must be "stop" or "flag", got {on_break!r}')
     q = np.array(_joint_values(q0))
+    if IK_COMPONENTS == "pose":
+        size = _pose_error_to(q, poses[0])[1]
+    else:
+        size = _pose_error(q.tolist(), poses[0][:3].ravel().tolist(), False)[2]
+    if not size <= PATH_START_TOL:
+        raise ValueError(
+            f"q0 does not reach Ts[0] (pose error {size:.3g}, rotation entries and position "
+            f"/ REACH; at most {PATH_START_TOL:g})"
+        )
     out = np.full((len(poses), DOF), np.nan)
     out[0] = q
     breaks: list[tuple[int, str]] = []
@@ -1322,6 +1338,14 @@ def ik_path(
             least = float(np.linalg.svd(np.array(columns).T, compute_uv=False)[-1])
         bound = PATH_GAIN * change / max(least, 1e-300)
         row, why = _continuation(poses[k], q, branch(q), bound, within_limits, backend)
+        if not why and least < PATH_SINGULAR:
+            jump = np.abs(row - q) / np.where(np.array(_REVOLUTE), 1.0, REACH)
+            if jump.max() > PATH_JUMP:
+                j = int(np.argmax(jump))
+                why = (
+                    f"q{j + 1} jumps by {jump[j]:.3g} at a singular configuration (the path "
+                    "passes one; where it goes from there the poses do not say)"
+                )
         if why:
             breaks.append((k, f"pose {k}: {why}; sigma_min {least:.3g}"))
             if on_break == "stop":
@@ -1370,7 +1394,10 @@ def _continuation(T, q, label, bound, within_limits, backend):
             if sizes[kept] <= min(bound, PATH_GAIN * sizes.min()) + PATH_SLACK:
                 return _within(q + moves[kept], within_limits)
     row = guess + gaps[best]
-    step = np.abs(row - q) / units
+    move = row - q  # (Newton's iteration may have wandered whole turns: the row's nearest q)
+    move[revolute] = np.remainder(move[revolute] + math.pi, 2 * math.pi) - math.pi
+    row = q + move
+    step = np.abs(move) / units
     j = int(np.argmax(step))
     if not converged or misses[best] > PATH_SLACK or step.max() > bound + PATH_SLACK:
         return row, (
@@ -1431,8 +1458,16 @@ def _pose_step(A: np.ndarray, B: np.ndarray) -> np.ndarray:
     R = B[:3, :3] @ A[:3, :3].T
     w = np.array([R[2, 1] - R[1, 2], R[0, 2] - R[2, 0], R[1, 0] - R[0, 1]]) / 2.0
     s = float(np.linalg.norm(w))
-    angle = math.atan2(s, (float(np.trace(R)) - 1.0) / 2.0)
+    c = (float(np.trace(R)) - 1.0) / 2.0
+    angle = math.atan2(s, c)
     axis = w / s if s > 0.0 else w
+    if s < 1e-6 and c < 0.0:  # (near a half turn w vanishes: the axis from R's symmetric
+        # part, (R + R^T) / 2 = cos I + (1 - cos) a a^T, its sign w's)
+        outer = ((R + R.T) / 2.0 - c * np.eye(3)) / (1.0 - c)
+        column = outer[:, int(np.argmax(np.diag(outer)))]
+        axis = column / float(np.linalg.norm(column))
+        if float(axis @ w) < 0.0:
+            axis = -axis
     return np.concatenate([B[:3, 3] - A[:3, 3], axis * angle])
 
 
@@ -1445,10 +1480,13 @@ def straight_line(A: ArrayLike, B: ArrayLike, n: int) -> np.ndarray:
     """
     if type(n) is bool or not isinstance(n, (int, np.integer)) or n < 2:
         raise ValueError(f"n must be an integer >= 2, got {n!r}")
-    ends = [np.asarray(A, dtype=float), np.asarray(B, dtype=float)]
-    for T in ends:
-        if T.shape != (4, 4) or not np.isfinite(T).all():
-            raise ValueError("A and B must be 4x4 transforms of finite numbers")
+    ends = []
+    for T in (A, B):
+        try:
+            _pose(T)
+        except ValueError as error:
+            raise ValueError(f"A and B must be rigid 4x4 transforms: {error}") from None
+        ends.append(np.asarray(T, dtype=float))
     twist = _pose_step(ends[0], ends[1])
     angle = float(np.linalg.norm(twist[3:]))
     axis = twist[3:] / angle if angle > 0.0 else np.zeros(3)
@@ -1711,17 +1749,6 @@ def _clusters(zs: list[complex]) -> list[tuple[complex, bool]]:
         else:
             out.append((z, True))
     return out
-
-
-def _polyd_branch(coeffs: tuple[float, ...], d: float) -> int:
-    """The branch of the root d of a polynomial in d (coefficients highest degree first): the
-    sign of p'(d), 0 at a fold (a double root)."""
-    n = len(coeffs) - 1
-    terms = [a * (n - k) * d ** (n - k - 1) for k, a in enumerate(coeffs[:-1])]
-    slope = sum(terms)
-    if abs(slope) <= _BRANCH_FOLD * sum(abs(x) for x in terms):
-        return 0
-    return 1 if slope > 0.0 else -1
 
 
 # at most this many steps per candidate (a seed on a singular configuration converges
@@ -2084,20 +2111,4 @@ def _ik_scalar(target, qr1, qr2, tol):
 def _branch_signs(target, q):
     """The branch of the solution q of target (branch(q)): the solver's steps in a straight
     line, each joint's value read from q, and the sign of each BRANCHES step's derivative."""
-    (_, _, _, wx, _, _, _, wy, _, _, _, wz) = target
-    (qr1, qr2,) = q
-    px = wx - 0.061228
-    py = wy
-    pz = wz - 0.421
-    z = pz
-    r = px*px + py*py + pz*pz
-    c1 = cos(qr1)
-    s1 = sin(qr1)
-    c2 = cos(qr2 + 1.5707963267948966)
-    s2 = sin(qr2 + 1.5707963267948966)
-    d3 = (c1*s2*(8.99999999998125e-06*c1*c2 - 0.05318*c1*s2 - 0.025034*c1 + 0.0175*s1 + wx -
-        0.061228) + c2*(-0.05318*c2 - 8.99999999998125e-06*s2 + wz - 0.421) + s1*s2*(-0.0175*c1 +
-        8.99999999998125e-06*c2*s1 - 0.05318*s1*s2 - 0.025034*s1 + wy))
-    _b0 = (_polyd_branch((1.0, 0.21272, 0.01632777225 - 2.0*r, 0.000533429717054 - 0.21272*r, r*r -
-        0.007522127274*r + 0.002506804624*z*z + 7.056074237000755e-06,), d3))
-    return (_b0,)
+    return ()

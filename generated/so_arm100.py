@@ -1026,7 +1026,7 @@ def _real(x: object, name: str) -> np.ndarray:
         ):
             raise TypeError
         return a.astype(float)
-    except (TypeError, ValueError):
+    except (TypeError, ValueError, OverflowError):  # (OverflowError: an int beyond a float)
         raise ValueError(f"{name} must be an array of real numbers (ints or floats)") from None
 
 
@@ -1323,6 +1323,19 @@ PATH_GAIN = 3.0
 PATH_SLACK = 1e-6
 
 
+# ... and q0 must reach Ts[0] within this (its pose error, as ik's certification measures it);
+# a step of more than PATH_JUMP (radians, or REACH) where sigma_min is below PATH_SINGULAR is
+# a break: the first-order bound allows any step there, and which way the path goes depends
+# on how finely it is sampled
+PATH_START_TOL = 1e-6
+
+
+PATH_SINGULAR = 1e-3
+
+
+PATH_JUMP = 0.5
+
+
 def ik_path(
     Ts: ArrayLike,
     q0: ArrayLike,
@@ -1358,8 +1371,8 @@ def ik_path(
         (Q (N, DOF), breaks): the path's joint vectors and its breaks, in order.
 
     Raises:
-        ValueError: Ts is not (N, 4, 4) with N >= 1, q0 not DOF finite numbers, on_break
-            unknown; ik's errors for a pose.
+        ValueError: Ts is not (N, 4, 4) with N >= 1, q0 not DOF finite numbers or not
+            reaching Ts[0] within PATH_START_TOL, on_break unknown; ik's errors for a pose.
     """
     poses = np.asarray(Ts, dtype=float)
     if poses.ndim != 3 or poses.shape[1:] != (4, 4) or len(poses) == 0:
@@ -1367,6 +1380,15 @@ def ik_path(
     if on_break not in ("stop", "flag"):
         raise ValueError(f'on_break must be "stop" or "flag", got {on_break!r}')
     q = np.array(_joint_values(q0))
+    if IK_COMPONENTS == "pose":
+        size = _pose_error_to(q, poses[0])[1]
+    else:
+        size = _pose_error(q.tolist(), poses[0][:3].ravel().tolist(), False)[2]
+    if not size <= PATH_START_TOL:
+        raise ValueError(
+            f"q0 does not reach Ts[0] (pose error {size:.3g}, rotation entries and position "
+            f"/ REACH; at most {PATH_START_TOL:g})"
+        )
     out = np.full((len(poses), DOF), np.nan)
     out[0] = q
     breaks: list[tuple[int, str]] = []
@@ -1380,6 +1402,14 @@ def ik_path(
             least = float(np.linalg.svd(np.array(columns).T, compute_uv=False)[-1])
         bound = PATH_GAIN * change / max(least, 1e-300)
         row, why = _continuation(poses[k], q, branch(q), bound, within_limits, backend)
+        if not why and least < PATH_SINGULAR:
+            jump = np.abs(row - q) / np.where(np.array(_REVOLUTE), 1.0, REACH)
+            if jump.max() > PATH_JUMP:
+                j = int(np.argmax(jump))
+                why = (
+                    f"q{j + 1} jumps by {jump[j]:.3g} at a singular configuration (the path "
+                    "passes one; where it goes from there the poses do not say)"
+                )
         if why:
             breaks.append((k, f"pose {k}: {why}; sigma_min {least:.3g}"))
             if on_break == "stop":
@@ -1428,7 +1458,10 @@ def _continuation(T, q, label, bound, within_limits, backend):
             if sizes[kept] <= min(bound, PATH_GAIN * sizes.min()) + PATH_SLACK:
                 return _within(q + moves[kept], within_limits)
     row = guess + gaps[best]
-    step = np.abs(row - q) / units
+    move = row - q  # (Newton's iteration may have wandered whole turns: the row's nearest q)
+    move[revolute] = np.remainder(move[revolute] + math.pi, 2 * math.pi) - math.pi
+    row = q + move
+    step = np.abs(move) / units
     j = int(np.argmax(step))
     if not converged or misses[best] > PATH_SLACK or step.max() > bound + PATH_SLACK:
         return row, (
@@ -1489,8 +1522,16 @@ def _pose_step(A: np.ndarray, B: np.ndarray) -> np.ndarray:
     R = B[:3, :3] @ A[:3, :3].T
     w = np.array([R[2, 1] - R[1, 2], R[0, 2] - R[2, 0], R[1, 0] - R[0, 1]]) / 2.0
     s = float(np.linalg.norm(w))
-    angle = math.atan2(s, (float(np.trace(R)) - 1.0) / 2.0)
+    c = (float(np.trace(R)) - 1.0) / 2.0
+    angle = math.atan2(s, c)
     axis = w / s if s > 0.0 else w
+    if s < 1e-6 and c < 0.0:  # (near a half turn w vanishes: the axis from R's symmetric
+        # part, (R + R^T) / 2 = cos I + (1 - cos) a a^T, its sign w's)
+        outer = ((R + R.T) / 2.0 - c * np.eye(3)) / (1.0 - c)
+        column = outer[:, int(np.argmax(np.diag(outer)))]
+        axis = column / float(np.linalg.norm(column))
+        if float(axis @ w) < 0.0:
+            axis = -axis
     return np.concatenate([B[:3, 3] - A[:3, 3], axis * angle])
 
 
@@ -1503,10 +1544,13 @@ def straight_line(A: ArrayLike, B: ArrayLike, n: int) -> np.ndarray:
     """
     if type(n) is bool or not isinstance(n, (int, np.integer)) or n < 2:
         raise ValueError(f"n must be an integer >= 2, got {n!r}")
-    ends = [np.asarray(A, dtype=float), np.asarray(B, dtype=float)]
-    for T in ends:
-        if T.shape != (4, 4) or not np.isfinite(T).all():
-            raise ValueError("A and B must be 4x4 transforms of finite numbers")
+    ends = []
+    for T in (A, B):
+        try:
+            _pose(T)
+        except ValueError as error:
+            raise ValueError(f"A and B must be rigid 4x4 transforms: {error}") from None
+        ends.append(np.asarray(T, dtype=float))
     twist = _pose_step(ends[0], ends[1])
     angle = float(np.linalg.norm(twist[3:]))
     axis = twist[3:] / angle if angle > 0.0 else np.zeros(3)

@@ -334,9 +334,7 @@ def _label_changes(module, q: np.ndarray, joint: int) -> np.ndarray:
         ("iiwa14", ("q4", "q5", "q2")),  # (solved as a reversed chain: theta_k is q_{7 - k})
         ("youbot", ("q1", "q5", "q3")),  # (a direction task: the virtual joint 6 solved)
         ("lecture_rrr", ("q2",)),
-        # (the axis-angle task's tilt phi and a look-at's distance: the plan's virtual value)
-        ("open_manipulator_x", ("q1", "virtual", "q3")),
-        ("locobot_head", ("virtual",)),
+        ("open_manipulator_x", ("q1", "virtual", "q3")),  # (virtual: the tilt phi)
     ],
 )
 def test_branches_tell_every_solution_apart(generated, name, names):
@@ -367,6 +365,23 @@ def test_branches_change_only_at_folds(generated):
     q[4] = 0.0
     assert module.branch(q)[2] == 0
     assert module.BRANCHES and generated("manocha_canny").BRANCHES == ()  # (the general method)
+    # (a look-at's distance along the ray is the point's, not q's: no branch from q alone)
+    assert generated("locobot_head").BRANCHES == ()
+
+
+def test_straight_line_turns_half_a_turn_and_refuses_what_is_not_rigid(generated):
+    """A half turn between A and B (where the rotation vector's sine part vanishes) is
+    followed to B; a scaled pose is refused; ik_path refuses a q0 that does not reach Ts[0]."""
+    module = generated("puma560")
+    A = module.fk(np.full(6, 0.1))
+    B = A @ np.diag([-1.0, -1.0, 1.0, 1.0])
+    line = module.straight_line(A, B, 5)
+    assert np.abs(line[-1] - B).max() < 1e-12
+    assert np.abs(line[2, :3, :3] - A[:3, :3]).max() > 0.5  # (it turns on the way)
+    with pytest.raises(ValueError, match="rigid"):
+        module.straight_line(A, 3.0 * A, 3)
+    with pytest.raises(ValueError, match="q0 does not reach Ts"):
+        module.ik_path(line, np.zeros(6))
 
 
 def test_a_path_out_of_reach_or_limits_breaks_where_and_why(generated):

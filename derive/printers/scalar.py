@@ -141,8 +141,9 @@ def branch_steps(plan: Plan) -> tuple[Solve, ...] | None:
     """The steps that choose a branch (a Solve of more than one value, of a kind in BRANCHES),
     or None where a joint vector alone cannot say which branch it is on: a step before one of
     them gives several values of something that is neither one of the arm's joints nor the
-    task's virtual value (IkPlan.virtual: the axis-angle task's tilt, a look-at's distance),
-    or one step solves all joints at once (the general method). A step giving one value of a
+    task's virtual value on q's pose (IkPlan.virtual: the axis-angle task's tilt; not a
+    look-at's distance, which is the point's, not q's), or one step solves all joints at
+    once (the general method). A step giving one value of a
     task's virtual joint is solved as the solver does (branch_lines)."""
     assert plan.ik is not None
     out = []
@@ -170,6 +171,8 @@ def _virtual(plan: Plan, step: Solve) -> str | None:
     numbers the steps' joints otherwise than the arm's (a reversed chain)."""
     assert plan.ik is not None
     if not plan.ik.virtual or step.joint <= plan.arm.dof or not same_joints(plan):
+        return None
+    if plan.ik.certify == "lookat":  # (the distance to the point looked at: not in q's pose)
         return None
     printer = CodePrinter()
     parts = [printer.doprint(e) for e in plan.ik.virtual]

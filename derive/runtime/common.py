@@ -40,7 +40,7 @@ def _real(x: object, name: str) -> np.ndarray:
         ):
             raise TypeError
         return a.astype(float)
-    except (TypeError, ValueError):
+    except (TypeError, ValueError, OverflowError):  # (OverflowError: an int beyond a float)
         raise ValueError(f"{name} must be an array of real numbers (ints or floats)") from None
 
 
