@@ -297,21 +297,29 @@ def cmd_path(args: argparse.Namespace) -> int:
                                on_break="flag" if args.flag else "stop")  # fmt: skip
     notes = dict(breaks)
     units = ["deg" if t == "R" else spec.length_unit for t in spec.joint_types]
+    branches = getattr(module, "BRANCHES", ())
     print(
         "step  "
         + "  ".join(f"{f'q{i + 1} / {u}':>11}" for i, u in enumerate(units))
         + "  sigma_min"
+        + (f"  branch ({' '.join(branches)})" if branches else "")
     )
     for k, q in enumerate(Q):
         if np.isnan(q).any():
             break
         shown = [math.degrees(v) if t == "R" else v for v, t in zip(q, spec.joint_types)]
         least = module.manipulability(q)[0]
+        signs = "  " + "".join("0+-"[s] for s in module.branch(q)) if branches else ""
         flag = f"  BREAK: {notes[k]}" if k in notes else ""
-        print(f"{k:4d}  " + "  ".join(f"{v:11.4f}" for v in shown) + f"  {least:9.3g}{flag}")
+        print(f"{k:4d}  " + "  ".join(f"{v:11.4f}" for v in shown) + f"  {least:9.3g}{signs}{flag}")
     stopped = [k for k, _ in breaks]
     if stopped and not args.flag:
         print(f"stopped at pose {stopped[0]} of {args.steps}: {notes[stopped[0]]}")
+    elif branches and module.branch(Q[-1]) != module.branch(end):
+        print(
+            "the path ends on another branch than --to's: the same pose in another "
+            "configuration (the path keeps --from's branch unless it crosses a fold)"
+        )
     print(f"{spec.name}: {args.steps} poses, {len(breaks)} break(s)")
     if output is not None:
         from derive.plot import PlotUnavailable, figure_bytes, path_figure

@@ -436,7 +436,9 @@ def test_derive_path_prints_the_joints_and_draws_them(tmp_path, capsys):
     argv = ["path", "puma560", "--from", "10 20 30 40 30 50", "--to", "40 -10 60 -20 -30 80"]
     assert main([*argv, "--steps", "12", "-o", str(out)]) == 0
     text = capsys.readouterr().out
-    assert "puma560: 12 poses, 0 break(s)" in text and text.count("\n") == 15
+    assert "puma560: 12 poses, 0 break(s)" in text and text.count("\n") == 16
+    # (--to's wrist is flipped against --from's: the path keeps --from's branch, and says so)
+    assert "branch (q3 q2 q5)" in text and "ends on another branch than --to's" in text
     assert out.read_text().startswith("<?xml")
     assert main(["path", "youbot", "--from", "0 0 0 0 0", "--to", "1 1 1 1 1"]) == 2
     assert "paths are of poses" in capsys.readouterr().err
