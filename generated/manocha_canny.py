@@ -1301,6 +1301,12 @@ PATH_SINGULAR = 1e-3
 PATH_JUMP = 0.5
 
 
+# the row on the last row's branch continues the path where its step is within PATH_NEAR
+# (radians, or REACH) or PATH_GAIN times the nearest row's (near a fold, the other branch's
+# row can be the nearer one by more than PATH_GAIN: measured on open_manipulator_x)
+PATH_NEAR = 0.25
+
+
 def ik_path(
     Ts: ArrayLike,
     q0: ArrayLike,
@@ -1311,14 +1317,14 @@ def ik_path(
 ) -> tuple[np.ndarray, list[tuple[int, str]]]:
     """One joint vector per pose of a path, each continuing the previous one: the closed-form
     solution of pose k on q_{k-1}'s branch (branch) nearest q_{k-1}, where its step is within
-    PATH_GAIN times the nearest solution's; else the one that Newton's iteration from q_{k-1}
-    reaches (q += J^+ dX, dX the pose error as a twist: a path crossing a fold, the wrist
-    turning through straight). Either is accepted only within PATH_GAIN |dX| / sigma_min +
-    PATH_SLACK of q_{k-1} (the joint step a continuous branch can take; sigma_min the
-    Jacobian's smallest singular value). The free joints of an arm with free joints (FREE)
-    follow Newton's iteration. An arm solved for a task (IK_COMPONENTS) takes Newton's steps
-    on the task's components only (the poses' other components need not be reachable), its
-    free joints kept.
+    PATH_NEAR or PATH_GAIN times the nearest solution's; else the one that Newton's iteration
+    from q_{k-1} reaches (q += J^+ dX, dX the pose error as a twist: a path crossing a fold,
+    the wrist turning through straight). Either is accepted only within PATH_GAIN |dX| /
+    sigma_min + PATH_SLACK of q_{k-1} (the joint step a continuous branch can take;
+    sigma_min the Jacobian's smallest singular value). The free joints of an arm with free
+    joints (FREE) follow Newton's iteration. An arm solved for a task (IK_COMPONENTS) takes
+    Newton's steps on the task's components only (the poses' other components need not be
+    reachable), its free joints kept.
 
     Where no solution continues the path (a singular crossing where the branch ends, a joint
     limit with within_limits, a pose out of reach), the break is reported: (k, why) in the
@@ -1411,16 +1417,17 @@ def _continuation(T, q, label, bound, within_limits, backend):
     misses = np.abs(gaps / units).max(axis=1)
     best = int(np.argmin(misses))
     if label:  # (the row of q's branch nearest q continues it if its step is within the
-        # bound and PATH_GAIN times the nearest row's: else the path crosses a fold, as the
-        # wrist turning through straight, where the row of q's branch turns joints 4 and 6
-        # by half a turn)
+        # bound and within PATH_NEAR or PATH_GAIN times the nearest row's: else the path
+        # crosses a fold, as the wrist turning through straight, where the row of q's branch
+        # turns joints 4 and 6 by half a turn)
         moves = rows - q
         moves[:, revolute] = np.remainder(moves[:, revolute] + math.pi, 2 * math.pi) - math.pi
         sizes = np.abs(moves / units).max(axis=1)
         same = [i for i, r in enumerate(rows) if _same_branch(branch(r), label)]
         if same:
             kept = min(same, key=lambda i: sizes[i])
-            if sizes[kept] <= min(bound, PATH_GAIN * sizes.min()) + PATH_SLACK:
+            reach = max(PATH_GAIN * sizes.min(), PATH_NEAR)  # (how far q's branch may be)
+            if sizes[kept] <= min(bound, reach) + PATH_SLACK:
                 return _within(q + moves[kept], within_limits)
     row = guess + gaps[best]
     move = row - q  # (Newton's iteration may have wandered whole turns: the row's nearest q)
