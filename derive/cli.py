@@ -267,7 +267,7 @@ def cmd_solve(args: argparse.Namespace) -> int:
             if not lo <= v <= hi
         ]
         flag = f"  out of limits: {', '.join(outside)}" if outside else ""
-        signs = "".join("0+-"[s] for s in module.branch(q)) if branches else ""
+        signs = branch_signs(module, q) if branches else ""
         print(
             f"{k:2d}: "
             + " ".join(f"{round(v, 4) + 0.0:10.4f}" for v in shown)  # (+ 0.0: no -0.0000)
@@ -276,6 +276,11 @@ def cmd_solve(args: argparse.Namespace) -> int:
             + flag
         )
     return 0
+
+
+def branch_signs(module: ModuleType, q: Any) -> str:
+    """A solution's branch(q) as signs: "+-0" for (1, -1, 0)."""
+    return "".join("0+-"[sign] for sign in module.branch(q))
 
 
 def cmd_path(args: argparse.Namespace) -> int:
@@ -309,7 +314,7 @@ def cmd_path(args: argparse.Namespace) -> int:
             break
         shown = [math.degrees(v) if t == "R" else v for v, t in zip(q, spec.joint_types)]
         least = module.manipulability(q)[0]
-        signs = "  " + "".join("0+-"[s] for s in module.branch(q)) if branches else ""
+        signs = "  " + branch_signs(module, q) if branches else ""
         flag = f"  BREAK: {notes[k]}" if k in notes else ""
         print(f"{k:4d}  " + "  ".join(f"{v:11.4f}" for v in shown) + f"  {least:9.3g}{signs}{flag}")
     stopped = [k for k, _ in breaks]

@@ -1230,8 +1230,8 @@ def branch(q: ArrayLike) -> tuple[int, ...]:
     equation in its joint's value (a cos t + b sin t = e: +1 for the + acos value); it changes
     only where a path of solutions crosses a fold, so it names the configuration (shoulder,
     elbow, wrist) whatever the distances between solutions; "virtual" in BRANCHES is the
-    task's own value (the axis-angle task's tilt, a look-at's distance along the ray). ()
-    where the derivation has no such steps (the general method).
+    task's own value (the axis-angle task's tilt). () where the derivation has no such steps
+    (the general method, a look-at: its distance along the ray is the point's, not q's).
 
     Raises:
         ValueError: q is not DOF finite numbers.
@@ -1367,10 +1367,11 @@ def ik_path(
 def _continuation(T, q, label, bound, within_limits, backend):
     """ik_path's step from q (on the branch label) to the pose T: the solution of T nearest
     Newton's iteration from q (its revolute joints' turn nearest it), and "" if it continues
-    the path, else why not (the row None where T has no solution). Where that solution is on
-    another branch and one on q's own is within the bound and no farther from q, that one
-    continues the path: near a fold (the elbow nearly stretched) both branches lie within one
-    step, and Newton's iteration may cross to the other."""
+    the path, else why not (the row None where T has no solution). Before it, the solution
+    on q's own branch nearest q continues the path if its step is within the bound and
+    within PATH_NEAR or PATH_GAIN times the nearest solution's: near a fold (the elbow nearly
+    stretched) both branches lie within one step, and Newton's iteration may cross to the
+    other."""
     revolute = np.array(_REVOLUTE)
     units = np.where(revolute, 1.0, REACH)
     guess = np.array(q, dtype=float)
@@ -1384,16 +1385,14 @@ def _continuation(T, q, label, bound, within_limits, backend):
     rows = ik(T, free=free, q_ref=guess, backend=backend)
     if len(rows) == 0:
         return None, "out of reach"
-    gaps = rows - guess
-    gaps[:, revolute] = np.remainder(gaps[:, revolute] + math.pi, 2 * math.pi) - math.pi
+    gaps = _turned(rows - guess, revolute)
     misses = np.abs(gaps / units).max(axis=1)
     best = int(np.argmin(misses))
     if label:  # (the row of q's branch nearest q continues it if its step is within the
         # bound and within PATH_NEAR or PATH_GAIN times the nearest row's: else the path
         # crosses a fold, as the wrist turning through straight, where the row of q's branch
         # turns joints 4 and 6 by half a turn)
-        moves = rows - q
-        moves[:, revolute] = np.remainder(moves[:, revolute] + math.pi, 2 * math.pi) - math.pi
+        moves = _turned(rows - q, revolute)
         sizes = np.abs(moves / units).max(axis=1)
         same = [i for i, r in enumerate(rows) if _same_branch(branch(r), label)]
         if same:
@@ -1402,8 +1401,7 @@ def _continuation(T, q, label, bound, within_limits, backend):
             if sizes[kept] <= min(bound, reach) + PATH_SLACK:
                 return _within(q + moves[kept], within_limits)
     row = guess + gaps[best]
-    move = row - q  # (Newton's iteration may have wandered whole turns: the row's nearest q)
-    move[revolute] = np.remainder(move[revolute] + math.pi, 2 * math.pi) - math.pi
+    move = _turned(row - q, revolute)  # (Newton's iteration may have wandered whole turns)
     row = q + move
     step = np.abs(move) / units
     j = int(np.argmax(step))
@@ -1415,6 +1413,13 @@ def _continuation(T, q, label, bound, within_limits, backend):
             + ": a singular crossing where the branch ends, or another branch)"
         )  # fmt: skip
     return _within(row, within_limits)
+
+
+def _turned(d: np.ndarray, revolute: np.ndarray) -> np.ndarray:
+    """Joint differences d (..., DOF), the revolute ones by the turn nearest 0 (in [-pi, pi))."""
+    d = d.copy()
+    d[..., revolute] = np.remainder(d[..., revolute] + math.pi, 2 * math.pi) - math.pi
+    return d
 
 
 def _within(row, within_limits):

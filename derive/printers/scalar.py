@@ -143,8 +143,8 @@ def branch_steps(plan: Plan) -> tuple[Solve, ...] | None:
     them gives several values of something that is neither one of the arm's joints nor the
     task's virtual value on q's pose (IkPlan.virtual: the axis-angle task's tilt; not a
     look-at's distance, which is the point's, not q's), or one step solves all joints at
-    once (the general method). A step giving one value of a
-    task's virtual joint is solved as the solver does (branch_lines)."""
+    once (the general method). A step giving one value of a task's virtual joint is solved
+    as the solver does (branch_lines)."""
     assert plan.ik is not None
     out = []
     unknown = False  # (a value not a joint's solved before: later steps may read it)
