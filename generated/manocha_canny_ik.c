@@ -963,6 +963,25 @@ static void dk_dls(const double *J, int n, const double t[6], double damping, do
 
 #define DK_RR_PATH_COUNT 3
 
+#define DK_RR_PATH_STEPS 1
+
+/* a Newton step within this (radians) turns the joints' cos and sin by the angle-sum formulas
+   and a few terms of the step's series (error d^6 / 720 ~ 1e-21), not by calling sincos */
+#define DK_RR_SMALL (1e-3)
+
+#define DK_RR_SAME (0.01)
+
+/* an answer in doubt: the fallback split is tried (clusters on a perturbed table), and the
+   rescue too (clusters on the arm's own table, a candidate Newton does not settle there, or
+   no usable pencil) */
+#define DK_RR_FALLBACK 2
+
+#define DK_RR_RESCUE 1
+
+/* where a perturbed table answered and a row found is within this of a singular configuration
+   (Hadamard's ratio of its Jacobian), the rescue is tried too */
+#define DK_RR_NEAR_SINGULAR (0.001)
+
 #define DK_RR_SEARCH_COUNT 64
 
 static const double DK_RR_MOEBIUS[3][4] = {{1.0, 0.3, -0.4, 1.0}, {1.0, -0.7, 0.5, 1.0}, {0.6, 1.0,
@@ -1481,24 +1500,87 @@ static double dk_rr_ratio_angle(const double v[12], int step)
     return 2.0 * atan2(high, across) + shift;
 }
 
+/* out := M A_i (standard DH row i: d, a, cos alpha, sin alpha) at the joint's cos ct and sin
+   st (a sliding joint 3: ct, st of its fixed angle, d its value t); out may be M */
+static void dk_rr_link_cs(double ct, double st, double t, const double rows[7][4], int i,
+                          const double M[4][4], double out[4][4])
+{
+    const double d = i == 2 && rows[6][0] != 0.0 ? t : rows[i][0];
+    const double a = rows[i][1], ca = rows[i][2], sa = rows[i][3];
+    int r;
+    for (r = 0; r < 4; r++) {
+        const double m0 = M[r][0], m1 = M[r][1], m2 = M[r][2], m3 = M[r][3];
+        const double x = m0 * ct + m1 * st, y = -m0 * st + m1 * ct;
+        out[r][0] = x;
+        out[r][1] = y * ca + m2 * sa;
+        out[r][2] = -y * sa + m2 * ca;
+        out[r][3] = m3 + x * a + m2 * d;
+    }
+}
+
 /* M := M A_i(t) (standard DH row i: d, a, cos alpha, sin alpha) */
 static void dk_rr_link(double t, const double rows[7][4], int i, double M[4][4])
 {
-    double d = rows[i][0], a = rows[i][1], ca = rows[i][2], sa = rows[i][3], ct, st;
-    if (i == 2 && rows[6][0] != 0.0) { /* a sliding joint 3: Rz(theta3) Tz(t) X3 */
-        d = t;
-        t = rows[6][1];
+    const double angle = i == 2 && rows[6][0] != 0.0 ? rows[6][1] : t; /* (a sliding joint 3:
+                                                                          Rz(theta3) Tz(t) X3) */
+    dk_rr_link_cs(cos(angle), sin(angle), t, rows, i, (const double(*)[4])M, M);
+}
+
+/* x := A^-1 x for a 6 x 6 A by Gaussian elimination with partial pivoting (dk_solve_into's
+   steps, its size fixed), |det A| into *size where size is not NULL; 0 where A is singular */
+static int dk_solve6(const double M[6][6], double x[6], double *size)
+{
+    double A[6][6], det = 1.0;
+    int k, i, j, p;
+    for (i = 0; i < 6; i++) {
+        for (j = 0; j < 6; j++) {
+            A[i][j] = M[i][j];
+        }
     }
-    ct = cos(t);
-    st = sin(t);
-    int r;
-    for (r = 0; r < 4; r++) {
-        double m0 = M[r][0], m1 = M[r][1], m2 = M[r][2];
-        M[r][0] = m0 * ct + m1 * st;
-        M[r][1] = (-m0 * st + m1 * ct) * ca + m2 * sa;
-        M[r][2] = -(-m0 * st + m1 * ct) * sa + m2 * ca;
-        M[r][3] += (m0 * ct + m1 * st) * a + m2 * d;
+    for (k = 0; k < 6; k++) {
+        p = k;
+        for (i = k + 1; i < 6; i++) {
+            if (fabs(A[i][k]) > fabs(A[p][k])) {
+                p = i;
+            }
+        }
+        if (A[p][k] == 0.0) {
+            if (size != NULL) {
+                *size = 0.0;
+            }
+            return 0;
+        }
+        det *= fabs(A[p][k]);
+        if (p != k) {
+            double t;
+            for (j = 0; j < 6; j++) {
+                t = A[k][j];
+                A[k][j] = A[p][j];
+                A[p][j] = t;
+            }
+            t = x[k];
+            x[k] = x[p];
+            x[p] = t;
+        }
+        for (i = k + 1; i < 6; i++) {
+            const double f = A[i][k] / A[k][k];
+            for (j = k + 1; j < 6; j++) {
+                A[i][j] -= f * A[k][j];
+            }
+            x[i] -= f * x[k];
+        }
     }
+    for (k = 5; k >= 0; k--) {
+        double total = x[k];
+        for (i = k + 1; i < 6; i++) {
+            total -= A[k][i] * x[i];
+        }
+        x[k] = total / A[k][k];
+    }
+    if (size != NULL) {
+        *size = det;
+    }
+    return 1;
 }
 
 static void dk_eye4(double M[4][4])
@@ -1640,28 +1722,31 @@ static void dk_rr_between(const double fill[7][4], const double truth[7][4], dou
     }
 }
 
-/* `steps` steps on the forward kinematics of rows towards F from q (in place: the best point
-   met; each stops where it is exact, its error beyond `reach` or its system singular):
-   Newton's, or Levenberg-Marquardt's (damping |error|^2) where damped is set; the pose error
-   there */
+/* Steps on the forward kinematics of rows towards F from q (in place: the best point met; they
+   stop where it is exact, its error beyond `reach` or its system singular): Newton's, or
+   Levenberg-Marquardt's (damping |error|^2) where damped is set, `steps` + 1 of them (the
+   last measured only where it is Newton's last, _RR_NEWTON_DONE); where track is set,
+   `steps` Newton steps and q where they end (a continuation's corrector: not measured). The
+   pose error at q (track: before the last step). */
 static double dk_rr_walk(const double rows[7][4], const double F[4][4], double q[6], int damped,
-                         int steps, double reach)
+                         int steps, double reach, int track)
 {
-    double cur[6], frames[7][4][4], J[6][6], normal[6][6], rhs[6], step[6], best = HUGE_VAL;
+    double cur[6], cs[6][2], frames[7][4][4], J[6][6], normal[6][6], rhs[6], step[6];
+    double best = HUGE_VAL;
+    const int slider = rows[6][0] != 0.0 ? 2 : -1;
     int it, i, r, c, k;
     for (i = 0; i < 6; i++) {
+        const double angle = i == slider ? rows[6][1] : q[i];
         cur[i] = q[i];
+        cs[i][0] = cos(angle);
+        cs[i][1] = sin(angle);
     }
-    for (it = 0; it < steps + 1; it++) {
+    dk_eye4(frames[0]);
+    for (it = 0; it < steps + !track; it++) {
         double size = 0.0, longest = 0.0, mu = 0.0, scale;
-        dk_eye4(frames[0]);
         for (i = 0; i < 6; i++) {
-            for (r = 0; r < 4; r++) {
-                for (c = 0; c < 4; c++) {
-                    frames[i + 1][r][c] = frames[i][r][c];
-                }
-            }
-            dk_rr_link(cur[i], rows, i, frames[i + 1]);
+            dk_rr_link_cs(cs[i][0], cs[i][1], cur[i], rows, i, (const double(*)[4])frames[i],
+                          frames[i + 1]);
         }
         for (r = 0; r < 3; r++) {
             for (c = 0; c < 4; c++) {
@@ -1725,7 +1810,8 @@ static double dk_rr_walk(const double rows[7][4], const double F[4][4], double q
                 step[r] = rhs[r];
             }
         }
-        if (!dk_solve_into(damped ? &normal[0][0] : &J[0][0], 6, step, 1)) {
+        if (!dk_solve6(damped ? (const double(*)[6])normal : (const double(*)[6])J, step,
+                       NULL)) {
             break;
         }
         for (i = 0; i < 6; i++) {
@@ -1733,7 +1819,21 @@ static double dk_rr_walk(const double rows[7][4], const double F[4][4], double q
         }
         scale = longest <= 0.5 ? 1.0 : 0.5 / longest;
         for (i = 0; i < 6; i++) {
-            cur[i] += scale * step[i];
+            const double d = scale * step[i];
+            cur[i] += d;
+            if (i == slider) {
+                continue;
+            }
+            if (fabs(d) <= DK_RR_SMALL) { /* (cos, sin) turned by d: its series to d^5 */
+                const double d2 = d * d, cd = 1.0 - d2 / 2.0 * (1.0 - d2 / 12.0);
+                const double sd = d * (1.0 - d2 / 6.0 * (1.0 - d2 / 20.0));
+                const double c0 = cs[i][0], s0 = cs[i][1];
+                cs[i][0] = c0 * cd - s0 * sd;
+                cs[i][1] = s0 * cd + c0 * sd;
+            } else {
+                cs[i][0] = cos(cur[i]);
+                cs[i][1] = sin(cur[i]);
+            }
         }
         if (!damped && size <= DK_RR_NEWTON_DONE && longest <= DK_RR_NEWTON_DONE_STEP) {
             /* the last step, not measured (the Python solver's _RR_NEWTON_DONE) */
@@ -1744,6 +1844,9 @@ static double dk_rr_walk(const double rows[7][4], const double F[4][4], double q
             break;
         }
     }
+    for (i = 0; i < 6 && track; i++) {
+        q[i] = cur[i];
+    }
     return best;
 }
 
@@ -1751,7 +1854,7 @@ static double dk_rr_walk(const double rows[7][4], const double F[4][4], double q
 static double dk_rr_steps(const double rows[7][4], const double F[4][4], double q[6],
                           int damped)
 {
-    return dk_rr_walk(rows, F, q, damped, DK_RR_NEWTON_STEPS, DK_RR_NEWTON_REACH);
+    return dk_rr_walk(rows, F, q, damped, DK_RR_NEWTON_STEPS, DK_RR_NEWTON_REACH, 0);
 }
 
 /* Newton steps, then, where they do not reach DK_RR_GOOD, Levenberg-Marquardt steps from the
@@ -1762,6 +1865,9 @@ static double dk_rr_newton(const double rows[7][4], const double F[4][4], double
 {
     double damped[6], error = dk_rr_steps(rows, F, q, 0), damped_error;
     int i;
+    if (DK_RR_NEWTON_DONE < error && error <= DK_RR_GOOD) { /* (slowly: near a double root) */
+        error = fmin(error, dk_rr_steps(rows, F, q, 0));
+    }
     *used = error > DK_RR_GOOD && !extra; /* (an extra gets Newton's steps only) */
     if (!*used) {
         return error;
@@ -2015,9 +2121,20 @@ static int dk_rr_within_reach(const double rows[7][4], const double *moebius, do
            fabs(moebius[0] * y + moebius[1]) <= reach * fabs(moebius[2] * y + moebius[3]);
 }
 
-/* the candidate joint vectors of one split: their count written to out, extra[c] set for
-   those from nearly real pairs; *doubt: whether the answer is in doubt (clusters, or no
-   usable pencil) */
+/* whether split k solves a perturbed table (the arm's own pencils are singular) */
+static int dk_rr_perturbed(int k)
+{
+    int i, j;
+    for (i = 0; i < 6; i++) {
+        for (j = 0; j < 4; j++) {
+            if (DK_RR_FILL[k][i][j] != DK_RR_TRUE[k][i][j]) {
+                return 1;
+            }
+        }
+    }
+    return 0;
+}
+
 /* split k's companion matrix K without its known eigenvalues (_rr_deflated in
    derive/runtime/general.py): K[o, o] - G K[p', o], p' the rows DK_RR_PIVOTS[k] and 12 more,
    o the others, G = [Re W[o] - (yr / yi) Im W[o], Im W[o] / yi] for W = [v; y+ v] (v the
@@ -2074,6 +2191,9 @@ static int dk_rr_deflate(double K[24][24], int k, const double *moebius)
     return n;
 }
 
+/* the candidate joint vectors of one split: their count written to out, extra[c] set for
+   those from nearly real pairs; *doubt: whether the answer is in doubt (clusters on the
+   arm's own table, or no usable pencil) */
 static int dk_rr_candidates(const double values[490], const double F[4][4],
                             const double rows[7][4], double out[DK_RR_CANDS][6], int extra[],
                             int *doubt, double imag_tol, int split)
@@ -2089,7 +2209,7 @@ static int dk_rr_candidates(const double values[490], const double F[4][4],
     const double(*Ps)[9] = (const double(*)[9])(values + 126);
     const double(*Pc)[9] = (const double(*)[9])(values + 252);
     const double(*Q)[8] = (const double(*)[8])(values + 378);
-    *doubt = 1;
+    *doubt = DK_RR_RESCUE;
     for (i = 0; i < 6; i++) {
         reach += fabs(rows[i][0]) + fabs(rows[i][1]);
     }
@@ -2215,7 +2335,12 @@ static int dk_rr_candidates(const double values[490], const double F[4][4],
         }
         nv = dk_null_right(S, V, &plane);
         if (clustered || plane) {
-            *doubt |= !is_extra;
+            /* (a perturbed table's clusters are the arm's pairs sharing the eigen-joint's
+               value, which its special geometry makes common: both come from the plane, and
+               the partners and the search find one lost; they ask for the fallback only) */
+            if (!is_extra) {
+                *doubt |= dk_rr_perturbed(split) ? DK_RR_FALLBACK : DK_RR_RESCUE;
+            }
             if (nv == 2) {
                 nv = 1 + dk_rr_unmix(V);
             }
@@ -2227,7 +2352,7 @@ static int dk_rr_candidates(const double values[490], const double F[4][4],
             for (p = 0; p < pairs; p++) {
                 double q5[5];
                 if (count == DK_RR_CANDS) {
-                    *doubt |= !is_extra;
+                    *doubt |= is_extra ? 0 : DK_RR_RESCUE;
                     return count;
                 }
                 extra[count] = is_extra;
@@ -2244,24 +2369,38 @@ static int dk_rr_candidates(const double values[490], const double F[4][4],
     return count;
 }
 
-/* split k's joint values q as the arm's (a sliding joint 3 in the arm's lengths; the reversed
-   chain's joint j is -q_{7-j}) added to out[0..count) unless there already (angles modulo
-   2 pi, within 1e-7): the new count */
-static int dk_rr_add(int k, const double q[6], double out[DK_RR_ROWS][6], int count)
+/* split k's joint values q as the arm's, into arm (a sliding joint 3 in the arm's lengths;
+   the reversed chain's joint j is -q_{7-j}) */
+static void dk_rr_arm(int k, const double q[6], double arm[6])
 {
-    double arm[6];
-    int j, r;
+    int j;
     for (j = 0; j < 6; j++) {
         const double v = DK_RR_REVERSED[k] ? -q[5 - j] : q[j];
         arm[j] = j == (DK_RR_REVERSED[k] ? 3 : 2) && DK_RR_TRUE[k][6][0] != 0.0
                      ? v * DK_RR_LENGTH : v;
     }
+}
+
+/* the largest difference of two rows' joints, modulo 2 pi */
+static double dk_rr_gap(const double a[6], const double b[6])
+{
+    double gap = 0.0;
+    int j;
+    for (j = 0; j < 6; j++) {
+        gap = fmax(gap, fabs(dk_pymod(a[j] - b[j] + DK_PI, DK_TWO_PI) - DK_PI));
+    }
+    return gap;
+}
+
+/* split k's joint values q (as the arm's) added to out[0..count) unless there already (within
+   1e-7): the new count */
+static int dk_rr_add(int k, const double q[6], double out[DK_RR_ROWS][6], int count)
+{
+    double arm[6];
+    int j, r;
+    dk_rr_arm(k, q, arm);
     for (r = 0; r < count; r++) {
-        double gap = 0.0;
-        for (j = 0; j < 6; j++) {
-            gap = fmax(gap, fabs(dk_pymod(arm[j] - out[r][j] + DK_PI, DK_TWO_PI) - DK_PI));
-        }
-        if (gap <= 1e-7) {
+        if (dk_rr_gap(arm, out[r]) <= 1e-7) {
             return count;
         }
     }
@@ -2271,27 +2410,15 @@ static int dk_rr_add(int k, const double q[6], double out[DK_RR_ROWS][6], int co
     return count + 1;
 }
 
-/* whether split k solves a perturbed table (the arm's own pencils are singular) */
-static int dk_rr_perturbed(int k)
-{
-    int i, j;
-    for (i = 0; i < 6; i++) {
-        for (j = 0; j < 4; j++) {
-            if (DK_RR_FILL[k][i][j] != DK_RR_TRUE[k][i][j]) {
-                return 1;
-            }
-        }
-    }
-    return 0;
-}
-
 /* split k's polished candidates for the target F (found from the pose `moved`) added to
-   out[count..] where new, until DK_RR_ROWS; the new count; *doubt as dk_rr_candidates' */
+   out[count..] where new, until DK_RR_ROWS (a candidate within DK_RR_SAME of a row out had
+   before is not polished: that row again); the new count; *doubt as dk_rr_candidates' */
 static int dk_rr_split(int k, const double F[4][4], const double moved[4][4],
                        double out[DK_RR_ROWS][6], int count, int *doubt, double imag_tol)
 {
     double values[490], cands[DK_RR_CANDS][6], between[7][4];
-    int extra[DK_RR_CANDS], perturbed = dk_rr_perturbed(k), damped = 0, n, c, i, j;
+    const int known = count;
+    int extra[DK_RR_CANDS], perturbed = dk_rr_perturbed(k), damped = 0, n, c, i, j, r;
     for (i = 0; i < 490; i++) {
         values[i] = 0.0;
     }
@@ -2299,23 +2426,32 @@ static int dk_rr_split(int k, const double F[4][4], const double moved[4][4],
                values);
     n = dk_rr_candidates(values, moved, DK_RR_FILL[k], cands, extra, doubt, imag_tol, k);
     for (c = 0; c < n; c++) {
-        double q[6], error;
+        double q[6], arm[6], error;
+        int seen = 0;
+        dk_rr_arm(k, cands[c], arm);
+        for (r = 0; r < known && !seen; r++) {
+            seen = dk_rr_gap(arm, out[r]) <= DK_RR_SAME;
+        }
+        if (seen) {
+            continue;
+        }
         for (j = 0; j < 6; j++) {
             q[j] = cands[c][j];
         }
         if (perturbed) {
             for (i = 0; i < (int)(sizeof DK_RR_PATH / sizeof DK_RR_PATH[0]); i++) {
                 dk_rr_between(DK_RR_FILL[k], DK_RR_TRUE[k], DK_RR_PATH[i], between);
-                dk_rr_steps(between, F, q, 0); /* Newton only on the way */
+                /* (Newton only on the way) */
+                dk_rr_walk(between, F, q, 0, DK_RR_PATH_STEPS, DK_RR_NEWTON_REACH, 1);
             }
         }
         error = dk_rr_newton(DK_RR_TRUE[k], F, q, &damped, extra[c]);
         if (damped && !perturbed && !extra[c]) { /* Newton alone did not settle it */
-            *doubt = 1;
+            *doubt = DK_RR_RESCUE;
         }
         if (error > DK_RR_GOOD) {
             if (!perturbed && !extra[c]) {
-                *doubt = 1;
+                *doubt = DK_RR_RESCUE;
             }
             continue;
         }
@@ -2325,6 +2461,60 @@ static int dk_rr_split(int k, const double F[4][4], const double moved[4][4],
         }
     }
     return count;
+}
+
+/* whether a row (the arm's values) is within DK_RR_NEAR_SINGULAR of a singular configuration:
+   |det J| over the product of J's column norms (Hadamard's ratio: 1 where the columns are
+   orthogonal, 0 where J is singular), J the geometric Jacobian of split 0's chain (lengths in
+   units of DK_RR_LENGTH) */
+static int dk_rr_near_singular(const double row[6])
+{
+    double q[6], frames[7][4][4], J[6][6], x[6] = {0.0}, ratio = 0.0;
+    const int slider = DK_RR_TRUE[0][6][0] != 0.0 ? 2 : -1;
+    int i, r;
+    for (i = 0; i < 6; i++) { /* the arm's values as split 0's */
+        q[i] = DK_RR_REVERSED[0] ? -row[5 - i] : row[i];
+    }
+    if (slider >= 0) {
+        q[2] /= DK_RR_LENGTH;
+    }
+    dk_eye4(frames[0]);
+    for (i = 0; i < 6; i++) {
+        const double angle = i == slider ? DK_RR_TRUE[0][6][1] : q[i];
+        dk_rr_link_cs(cos(angle), sin(angle), q[i], DK_RR_TRUE[0],
+                      i, (const double(*)[4])frames[i], frames[i + 1]);
+    }
+    for (i = 0; i < 6; i++) {
+        const double *z[3] = {&frames[i][0][2], &frames[i][1][2], &frames[i][2][2]};
+        const double dx = frames[6][0][3] - frames[i][0][3];
+        const double dy = frames[6][1][3] - frames[i][1][3];
+        const double dz = frames[6][2][3] - frames[i][2][3];
+        double norm = 0.0;
+        if (i == slider) {
+            J[0][i] = *z[0];
+            J[1][i] = *z[1];
+            J[2][i] = *z[2];
+            J[3][i] = J[4][i] = J[5][i] = 0.0;
+        } else {
+            J[0][i] = *z[1] * dz - *z[2] * dy;
+            J[1][i] = *z[2] * dx - *z[0] * dz;
+            J[2][i] = *z[0] * dy - *z[1] * dx;
+            J[3][i] = *z[0];
+            J[4][i] = *z[1];
+            J[5][i] = *z[2];
+        }
+        for (r = 0; r < 6; r++) {
+            norm += J[r][i] * J[r][i];
+        }
+        if (!(norm > 0.0)) {
+            return 1;
+        }
+        for (r = 0; r < 6; r++) {
+            J[r][i] /= sqrt(norm);
+        }
+    }
+    dk_solve6((const double(*)[6])J, x, &ratio); /* (|det J|, the columns of unit length) */
+    return ratio <= DK_RR_NEAR_SINGULAR;
 }
 
 /* The wrist-flip partners of out[0..count) (the Python solver's _rr_partners): each row with
@@ -2385,14 +2575,14 @@ static int dk_rr_search(const double F[4][4], double out[DK_RR_ROWS][6], int cou
             Q[r][2] = r < count ? Q[r][2] / DK_RR_LENGTH
                                 : Q[r][2] * (DK_RR_SEARCH_SLIDE / DK_PI);
         }
-        least = fmin(least, dk_rr_walk(DK_RR_TRUE[0], F, Q[r], 1, first, HUGE_VAL));
+        least = fmin(least, dk_rr_walk(DK_RR_TRUE[0], F, Q[r], 1, first, HUGE_VAL, 0));
     }
     if (!(least <= DK_RR_SEARCH_BAIL)) {
         return count;
     }
     for (r = 0; r < n && count < DK_RR_ROWS; r++) {
         const double error = dk_rr_walk(DK_RR_TRUE[0], F, Q[r], 1, DK_RR_SEARCH_STEPS - first,
-                                        HUGE_VAL);
+                                        HUGE_VAL, 0);
         if (error <= DK_RR_SEARCH_FROM && dk_rr_steps(DK_RR_TRUE[0], F, Q[r], 0) <= DK_RR_GOOD) {
             count = dk_rr_add(0, Q[r], out, count);
         }
@@ -2406,7 +2596,7 @@ static int dk_rr_search(const double F[4][4], double out[DK_RR_ROWS][6], int cou
 static int dk_general(const double flanges[DK_RR_SPLIT_COUNT][12], double out[DK_RR_ROWS][6])
 {
     double targets[DK_RR_SPLIT_COUNT][4][4], moved[4][4];
-    int count = 0, doubt = 1, perturbed = 0, k, r, c, m, i;
+    int count = 0, doubt = DK_RR_RESCUE, perturbed = 0, grew = 0, k, r, c, m, i;
     for (k = 0; k < DK_RR_SPLIT_COUNT; k++) {
         for (r = 0; r < 4; r++) {
             for (c = 0; c < 4; c++) {
@@ -2418,8 +2608,10 @@ static int dk_general(const double flanges[DK_RR_SPLIT_COUNT][12], double out[DK
         }
     }
     for (k = 0; k < DK_RR_SPLIT_COUNT; k++) {
+        const int before = count;
         count = dk_rr_split(k, targets[k], targets[k], out, count, &doubt, DK_RR_IMAG_TOL);
         perturbed |= dk_rr_perturbed(k); /* (a perturbed table walked: the partners below) */
+        grew |= k > 0 && count > before; /* (the fallback found what the first split missed) */
         if (count == DK_RR_ROWS) {
             return count;
         }
@@ -2427,7 +2619,10 @@ static int dk_general(const double flanges[DK_RR_SPLIT_COUNT][12], double out[DK
             break;
         }
     }
-    if (doubt || count == 0 || count % 2) {
+    for (r = 0; r < count && perturbed && !(doubt & DK_RR_RESCUE); r++) {
+        doubt |= dk_rr_near_singular(out[r]) ? DK_RR_RESCUE : 0; /* (solutions meet there) */
+    }
+    if ((doubt & DK_RR_RESCUE) || grew || count == 0 || count % 2) {
         for (m = 0; m < DK_RR_MOTION_COUNT; m++) {
             for (k = 0; k < DK_RR_SPLIT_COUNT; k++) {
                 int ignored;

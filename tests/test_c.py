@@ -193,7 +193,10 @@ def test_general_method_in_c_finds_the_wrist_flip_partners_of_the_puma(tmp_path)
     """The PUMA by the general method (a perturbed table) in C: the closed form's solution
     sets on 400 random poses, and the Python general solver's rows to 1e-9 (as sets) on 80 of
     them and on poses 46 and 346, which had 7 of their 8 solutions before the search on odd
-    counts (dk_rr_search). (The Python general solver on all 400 took 15 s of CI.)"""
+    counts (dk_rr_search). (The Python general solver on all 400 took 15 s of CI.) At a
+    singular sample (verify.SINGULAR_SIGMA) the rows are compared to 1e-6: there a pose
+    error of 1e-14 moves the joints by up to 1e-14 / sigma (pose 26, sigma 2.2e-7: a row
+    Newton's steps left at 1.3e-14 in C and 3e-16 in Python, 2.3e-9 apart)."""
     from derive.cli import resolve_spec
 
     spec = resolve_spec("puma560")
@@ -211,7 +214,8 @@ def test_general_method_in_c_finds_the_wrist_flip_partners_of_the_puma(tmp_path)
             continue
         python = general.ik(T[i], backend="python")
         gaps = np.abs((rows[:, None] - python[None] + np.pi) % (2 * np.pi) - np.pi)
-        assert gaps.max(axis=2).min(axis=1).max(initial=0.0) <= 1e-9, i
+        singular = verify.jacobian_nullity(closed, Q[i])[0] < verify.SINGULAR_SIGMA
+        assert gaps.max(axis=2).min(axis=1).max(initial=0.0) <= (1e-6 if singular else 1e-9), i
 
 
 def test_invalid_poses_give_the_error_code(harnesses):

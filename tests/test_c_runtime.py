@@ -76,7 +76,14 @@ def test_the_c_runtime_holds_the_python_runtimes_constants():
         assert float(found[f"DK_RR_{name}"]) == getattr(constants, f"_RR_{name}"), name
     for name in ("NULL2_TOL", "NEWTON_STEPS", "NEWTON_REACH", "PAIR_TOL", "SEARCH_FROM"):
         assert float(found[f"DK_RR_{name}"]) == getattr(constants, f"_RR_{name}"), name
-    for name in ("SEARCH_BAIL", "SEARCH_STEPS", "SEARCH_SLIDE"):
+    for name in (
+        "SEARCH_BAIL",
+        "SEARCH_STEPS",
+        "SEARCH_SLIDE",
+        "PATH_STEPS",
+        "SAME",
+        "NEAR_SINGULAR",
+    ):
         assert float(found[f"DK_RR_{name}"]) == getattr(constants, f"_RR_{name}"), name
     assert (float(found["DK_RR_NEWTON_DONE"]), float(found["DK_RR_NEWTON_DONE_STEP"])) == (
         constants._RR_NEWTON_DONE

@@ -104,10 +104,25 @@ _RR_NEWTON_STEPS = 10
 _RR_NEWTON_REACH = 0.5
 # a Newton step from a pose error within _RR_NEWTON_DONE[0], no joint moving more than
 # _RR_NEWTON_DONE[1], is the last (its result is not measured: the error after it is at most
-# the step squared times the arm's curvature; near a singular Jacobian the step is long)
+# the step squared times the arm's curvature; near a singular Jacobian the step is long); a
+# candidate they leave between _RR_NEWTON_DONE[0] and _RR_GOOD (converging slowly, near a
+# double root) gets as many again
 _RR_NEWTON_DONE = (1e-11, 1e-8)
-# a perturbed table's candidates are polished on tables these shares of the way back first
+# a perturbed table's candidates are polished on tables these shares of the way back first,
+# _RR_PATH_STEPS Newton steps on each (a continuation's corrector: it follows the solution,
+# the true table's steps settle it)
 _RR_PATH = (0.3, 0.1, 0.03)
+_RR_PATH_STEPS = 1
+# a candidate of a later split or pass within _RR_SAME (radians, each joint) of a row found
+# before is that row again, and is not polished (on two cobots' perturbed tables: 96% of the
+# fallback split's candidates polished onto a row found; a new row was at least 0.02 from
+# every earlier one)
+_RR_SAME = 1e-2
+# where a perturbed table answered and a row found is within _RR_NEAR_SINGULAR of a singular
+# configuration (Hadamard's ratio of its Jacobian: |det J| over the product of its column
+# norms), the rescue is tried too: there solutions meet, and the perturbed table's
+# continuation may take two onto one
+_RR_NEAR_SINGULAR = 1e-3
 _RR_RESCUE = ((1e-4, 1e-4), (-2e-4, 1.5e-4))
 # where nothing polishes and a pencil on the arm's own table is singular at the pose (or at a
 # moved one), or a candidate's polishing stopped within _RR_SEARCH_FROM of it (a curve of

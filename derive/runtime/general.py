@@ -50,14 +50,17 @@ from derive.runtime.constants import (
     _RR_IMAG_TOL,
     _RR_MOEBIUS,
     _RR_NEAR,
+    _RR_NEAR_SINGULAR,
     _RR_NEWTON_DONE,
     _RR_NEWTON_REACH,
     _RR_NEWTON_STEPS,
     _RR_NULL2_TOL,
     _RR_PAIR_TOL,
     _RR_PATH,
+    _RR_PATH_STEPS,
     _RR_RANK_TOL,
     _RR_RESCUE,
+    _RR_SAME,
     _RR_SEARCH_BAIL,
     _RR_SEARCH_FROM,
     _RR_SEARCH_SLIDE,
@@ -115,20 +118,25 @@ def _general(flanges, tol):
     near: list[np.ndarray] = []
     leads = _RRLeads()
     targets = [_rr_target(f) for f in flanges]
-    doubt = True
+    doubt = _RESCUE
     walked = False  # whether a perturbed table's solutions were walked back to the arm's
+    grew = False  # whether the fallback split found what the first missed
     for k, F in enumerate(targets):
-        candidates, close, doubt = _rr_split(k, F, F, leads)
+        candidates, close, doubt = _rr_split(k, F, F, leads, found)
         walked |= _RR_SPLITS[k][1] != _RR_SPLITS[k][2]
+        before = len(found)
         _rr_merge(found, [_rr_to_arm(k, q) for q in candidates])
+        grew |= k > 0 and len(found) > before
         _rr_merge(near, [_rr_to_arm(k, q) for q in close])
         if not doubt and len(found) % 2 == 0:
             break
-    if doubt or not found or len(found) % 2:
+    if walked and doubt != _RESCUE and found and _rr_near_singular(found):
+        doubt = _RESCUE  # (a perturbed table's continuation near where solutions meet)
+    if doubt == _RESCUE or grew or not found or len(found) % 2:
         # the rescue: solve slightly moved poses, polish back onto the true one
         for motion in _RR_MOTIONS:
             for k, F in enumerate(targets):
-                candidates, close, _ = _rr_split(k, F, F @ motion, leads)
+                candidates, close, _ = _rr_split(k, F, F @ motion, leads, found)
                 walked |= _RR_SPLITS[k][1] != _RR_SPLITS[k][2]
                 _rr_merge(found, [_rr_to_arm(k, q) for q in candidates])
                 _rr_merge(near, [_rr_to_arm(k, q) for q in close])
@@ -149,7 +157,7 @@ def _general(flanges, tol):
         # the last resort: a pose whose pencil is singular (a curve of solutions) scatters
         # the eigenvalues off the real line; those within _RR_IMAG_LOOSE of it, polished
         for k, F in enumerate(targets):
-            candidates, close, _ = _rr_split(k, F, F @ motion, leads, _RR_IMAG_LOOSE)
+            candidates, close, _ = _rr_split(k, F, F @ motion, leads, found, _RR_IMAG_LOOSE)
             _rr_merge(found, [_rr_to_arm(k, q) for q in candidates])
             _rr_merge(near, [_rr_to_arm(k, q) for q in close])
     if not found and not near and (leads.singular or leads.rows):
@@ -161,6 +169,31 @@ def _general(flanges, tol):
         found = near
     # a self-motion (a singular pose) has a curve of solutions: at most MAX_SOLUTIONS of them
     return [tuple(float(t) for t in q) for q in found[:MAX_SOLUTIONS]]
+
+
+def _rr_near_singular(rows):
+    """Whether a row (the arm's values) is within _RR_NEAR_SINGULAR of a singular
+    configuration: |det J| over the product of J's column norms (Hadamard's ratio: 1 where
+    the columns are orthogonal, 0 where J is singular), J the geometric Jacobian of split 0's
+    chain (lengths in units of _RR_LENGTH)."""
+    _, _, true_rows, slide = _RR_SPLITS[0]
+    Q = np.array([_rr_from_arm(0, q) for q in rows])
+    links = _rr_chain(Q, true_rows, slide)
+    frames = np.empty((len(Q), 7, 4, 4))
+    frames[:, 0] = _RR_EYE4
+    for i in range(6):
+        frames[:, i + 1] = frames[:, i] @ links[:, i]
+    z = frames[:, :6, :3, 2]
+    r = frames[:, 6, None, :3, 3] - frames[:, :6, :3, 3]
+    columns = np.concatenate(
+        (z[..., _RR_NEXT] * r[..., _RR_LAST] - z[..., _RR_LAST] * r[..., _RR_NEXT], z), axis=2
+    )
+    if slide[0]:  # a sliding joint 3 moves the flange along its axis
+        columns[:, 2, :3] = z[:, 2]
+        columns[:, 2, 3:] = 0.0
+    norms = np.linalg.norm(columns, axis=2).prod(axis=1)
+    ratios = np.abs(np.linalg.det(columns)) / np.where(norms > 0.0, norms, 1.0)
+    return bool(((ratios <= _RR_NEAR_SINGULAR) | (norms <= 0.0)).any())
 
 
 class _RRLeads:
@@ -278,12 +311,20 @@ def _rr_merge(found, candidates):
             found.append(candidates[i - start])
 
 
-def _rr_split(k, F, moved, leads, imag_tol=_RR_IMAG_TOL):
+# an answer in doubt (_rr_split): the fallback split is tried (_FALLBACK: clusters on a
+# perturbed table), and the rescue too (_RESCUE: clusters on the arm's own table, a candidate
+# Newton does not settle there, or no usable pencil)
+_FALLBACK = 2
+_RESCUE = 1
+
+
+def _rr_split(k, F, moved, leads, known=(), imag_tol=_RR_IMAG_TOL):
     """The polished candidates of split k for the target F, found from the pose `moved` (F
-    itself, or F slightly moved in a rescue; eigenvalues real within imag_tol); those that came
-    within _RR_NEAR only; and whether the answer is in doubt. Noted in leads (_RRLeads): a
-    singular pencil on the arm's own table, and the candidates that stopped within
-    _RR_SEARCH_FROM of F."""
+    itself, or F slightly moved in a rescue; eigenvalues real within imag_tol), but those
+    within _RR_SAME of a row in known (the arm's values); those that came within _RR_NEAR
+    only; and whether the answer is in doubt (0, _FALLBACK or _RESCUE). Noted in leads
+    (_RRLeads): a singular pencil on the arm's own table, and the candidates that stopped
+    within _RR_SEARCH_FROM of F."""
     _, fill_rows, true_rows, slide = _RR_SPLITS[k]
     values = np.zeros(490)
     _rr_fill(k, *moved[:3, 2], *moved[:3, 3], values)
@@ -305,18 +346,35 @@ def _rr_split(k, F, moved, leads, imag_tol=_RR_IMAG_TOL):
     close: list[np.ndarray] = []
     if candidates is None:  # (a singular pencil)
         leads.singular = leads.singular or fill_rows == true_rows
-        return out, close, doubt
+        return out, close, _RESCUE
+    # a perturbed table's clusters are the arm's pairs sharing the eigen-joint's value, which
+    # its special geometry makes common: both come from the plane, and the partners and the
+    # search find one lost; they ask for the fallback split only (on 2,000 poses of two
+    # cobots, the rescue they started added nothing)
+    doubt = (_FALLBACK if fill_rows != true_rows else _RESCUE) if doubt else 0
+    if known and candidates:  # (one within _RR_SAME of a known row is that row again)
+        rows = np.array(known)
+        kept = [
+            c
+            for c, q in enumerate(candidates)
+            if (
+                np.abs((rows - _rr_to_arm(k, q) + math.pi) % _TWO_PI - math.pi).max(axis=1)
+                > _RR_SAME
+            ).all()
+        ]
+        candidates = [candidates[c] for c in kept]
+        extras = [extras[c] for c in kept]
     if not candidates:
         return out, close, doubt
     # every candidate at once (numpy's stacked products and solves: the Python solver's time
     # went to calling numpy on 4 x 4 matrices one candidate at a time)
     Q = np.array(candidates)
     for rows in path:  # (Newton's steps only: damped ones may change branch on the way)
-        Q, _ = _rr_steps_many(rows, F, Q, slide, False)
+        Q, _ = _rr_steps_many(rows, F, Q, slide, False, steps=_RR_PATH_STEPS, track=True)
     Q, residuals, damped = _rr_newton_many(true_rows, F, Q, slide, np.array(extras))
     for q, residual, was_damped, extra in zip(Q, residuals, damped, extras):
         if was_damped and fill_rows == true_rows and not extra:  # Newton did not settle it
-            doubt = True
+            doubt = _RESCUE
         if residual <= _RR_GOOD:
             out.append(q)
             continue
@@ -327,7 +385,7 @@ def _rr_split(k, F, moved, leads, imag_tol=_RR_IMAG_TOL):
         if residual <= _RR_NEAR:
             close.append(q)
         if fill_rows == true_rows:  # (a perturbed table has solutions the arm has not)
-            doubt = True
+            doubt = _RESCUE
     return out, close, doubt
 
 
@@ -693,6 +751,10 @@ def _rr_newton_many(rows, F, Q, slide, extras):
     reach slowly is settled exactly, not left a rounding's width from the same solution found
     otherwise. Rows marked in extras get Newton's steps only."""
     Q, errors = _rr_steps_many(rows, F, Q, slide, False)
+    slow = np.flatnonzero((errors > _RR_NEWTON_DONE[0]) & (errors <= _RR_GOOD))
+    if slow.size:  # (Newton converges slowly near a double root: as many steps again)
+        A, again_errors = _rr_steps_many(rows, F, Q[slow], slide, False)
+        Q[slow], errors[slow] = A, np.minimum(errors[slow], again_errors)
     damped = (errors > _RR_GOOD) & ~extras  # (an extra Newton does not settle is dropped)
     if damped.any():
         tried = np.flatnonzero(damped)
@@ -759,17 +821,21 @@ _RR_NEXT = np.array([1, 2, 0])
 _RR_LAST = np.array([2, 0, 1])
 
 
-def _rr_steps_many(rows, F, Q, slide, damped, reach=_RR_NEWTON_REACH, steps=_RR_NEWTON_STEPS):
-    """`steps` steps from each row of Q (all at once; each stops on its own, where it is
-    exact, its pose error beyond `reach` or its system is singular): Newton's (J step = error),
-    or damped ones (J^T J + mu) step = J^T error with mu = |error|^2 (Levenberg-Marquardt as
-    Yamashita and Fukushima: still quadratic onto a curve of solutions, where J is singular
-    and Newton's steps jump; slow in a direction J nearly loses, which is why Newton goes
-    first). The best point met by each, and its error."""
+def _rr_steps_many(
+    rows, F, Q, slide, damped, reach=_RR_NEWTON_REACH, steps=_RR_NEWTON_STEPS, track=False
+):
+    """`steps` + 1 steps from each row of Q, all at once (the last measured only where it is
+    Newton's last, _RR_NEWTON_DONE); each stops on its own, where it is exact, its pose error
+    beyond `reach` or its system is singular: Newton's (J step = error), or damped ones
+    (J^T J + mu) step = J^T error with mu = |error|^2 (Levenberg-Marquardt as Yamashita and
+    Fukushima: still quadratic onto a curve of solutions, where J is singular and Newton's
+    steps jump; slow in a direction J nearly loses, which is why Newton goes first). The best
+    point met by each, and its error; where track is set, `steps` Newton steps and the points
+    where they end, not measured (a continuation's corrector), and the errors before."""
     q = np.array(Q, dtype=float)
     best_q, best = q.copy(), np.full(len(q), math.inf)
     live = np.arange(len(q))
-    for _ in range(steps + 1):
+    for _ in range(steps if track else steps + 1):
         x = q[live]
         links = _rr_chain(x, rows, slide)
         frames = np.empty((len(live), 7, 4, 4))
@@ -800,10 +866,10 @@ def _rr_steps_many(rows, F, Q, slide, damped, reach=_RR_NEWTON_REACH, steps=_RR_
             columns[:, 2, :3] = z[:, 2]
             columns[:, 2, 3:] = 0.0
         J = columns.transpose(0, 2, 1)
-        steps, solved = _rr_solve_many(J, error, damped)
-        live, x, steps = live[solved], x[solved], steps[solved]  # (a singular J: it stops)
-        longest = np.abs(steps).max(axis=1, initial=0.0)
-        q[live] = x + steps * (0.5 / np.maximum(longest, 0.5))[:, None]  # (at most 0.5 a joint)
+        moves, solved = _rr_solve_many(J, error, damped)
+        live, x, moves = live[solved], x[solved], moves[solved]  # (a singular J: it stops)
+        longest = np.abs(moves).max(axis=1, initial=0.0)
+        q[live] = x + moves * (0.5 / np.maximum(longest, 0.5))[:, None]  # (at most 0.5 a joint)
         if not damped:
             # Newton's step of at most _RR_NEWTON_DONE[1] from within _RR_NEWTON_DONE[0] lands
             # a rounding's width from the solution (the error after it is at most the step
@@ -815,7 +881,7 @@ def _rr_steps_many(rows, F, Q, slide, damped, reach=_RR_NEWTON_REACH, steps=_RR_
             live = live[~done]
             if not live.size:
                 break
-    return best_q, best
+    return (q if track else best_q), best
 
 
 def _rr_solve_many(J, error, damped):
