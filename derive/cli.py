@@ -383,10 +383,14 @@ def solve_arguments(
         raise UsageError("--direction: give the tool point too (--point x y z)")
     if args.direction is not None and (args.pose is not None or args.q is not None):
         raise UsageError("--direction: give it with --point (or alone), not with --pose or --q")
-    if getattr(args, "angle", None) is not None and (task != "axisangle" or args.point is None):
+    heading = hasattr(module, "_plane_pose") and task == "pose"  # (a planar arm's heading)
+    if getattr(args, "angle", None) is not None and (
+        (task != "axisangle" and not heading) or args.point is None
+    ):
         raise UsageError(
             "--angle: with --point, for an arm solved for a point and the tool axis's angle to "
-            f"a base axis (axisangle); {spec.name} is solved for the {task}"
+            "a base axis (axisangle) or a planar arm solved for the pose (the heading); "
+            f"{spec.name} is solved for the {task}"
         )
     if args.point is not None or args.direction is not None:
         pose = task_pose(spec, module, args)
@@ -425,6 +429,10 @@ def task_pose(spec: ArmSpec, module: ModuleType, args: argparse.Namespace) -> An
     import numpy as np
 
     task = getattr(module, "IK_COMPONENTS", "pose")
+    # (a point beyond any reach: refused here, not solved in overflowing arithmetic)
+    far = getattr(module, "FAR_REACH", 1e6) * module.REACH
+    if hasattr(module, "_plane_pose") and args.point is not None:  # (ik_xy(_heading)'s)
+        return plane_pose(spec, module, args, far)
     if task == "pose":
         raise UsageError(f"--point: {spec.name} is solved for the full pose; give --pose or --q")
     if task == "pointing":
@@ -433,8 +441,6 @@ def task_pose(spec: ArmSpec, module: ModuleType, args: argparse.Namespace) -> An
                 f"--point: {spec.name} is solved for a direction only: give --direction alone"
             )
         return module._task_pose((0.0, 0.0, 0.0), direction_numbers(args.direction))
-    # (a point beyond any reach: refused here, not solved in overflowing arithmetic)
-    far = getattr(module, "FAR_REACH", 1e6) * module.REACH
     if args.point is None:
         raise UsageError(f"--direction: {spec.name} is solved for a point: give --point x y z")
     point = parse_numbers(args.point, "--point")
@@ -471,6 +477,33 @@ def task_pose(spec: ArmSpec, module: ModuleType, args: argparse.Namespace) -> An
             )
         direction = direction_numbers(args.direction)
     return module._task_pose(point, direction)
+
+
+def plane_pose(spec: ArmSpec, module: ModuleType, args: argparse.Namespace, far: float) -> Any:
+    """A planar arm's pose for --point 'x y' (or 'x y z' where a sliding joint lifts the tool)
+    and, for an arm solved for the pose, --angle's heading (the module's _plane_pose)."""
+    slides = module._PLANE_SLIDE
+    point = parse_numbers(args.point, "--point")
+    if len(point) != (3 if slides else 2):
+        raise UsageError(
+            f"--point: {spec.name} is planar: give "
+            + ("x y z (a sliding joint lifts the tool)" if slides else "x y, in its plane")
+            + f" (got {len(point)} numbers)"
+        )
+    if max(map(abs, point)) > far:
+        raise UsageError(f"--point: beyond {far:g} (a million times the reach): out of reach")
+    heading = 0.0
+    if module.IK_COMPONENTS == "pose":
+        if args.angle is None:
+            raise UsageError(
+                f"--point: {spec.name} is solved for a point and a heading: give --angle (the "
+                f"tool's {'xy'[module.HEADING_AXIS]} axis's angle about z)"
+            )
+        heading = args.angle if args.rad else math.radians(args.angle)
+    try:
+        return module._plane_pose(*point[:2], point[2] if slides else None, heading)
+    except ValueError as exc:
+        raise UsageError(f"--point: {exc}") from None
 
 
 def direction_numbers(text: list[str]) -> list[float]:
@@ -1060,7 +1093,8 @@ def add_pose_arguments(command: argparse.ArgumentParser) -> None:
         "--point",
         nargs="+",
         help="an arm solved for a task: the tool point (position, direction) or the point "
-        "looked at (lookat), 'x y z'",
+        "looked at (lookat), 'x y z'; a planar arm: 'x y' in its plane ('x y z' where a "
+        "sliding joint lifts it), with --angle the heading",
     )
     command.add_argument(
         "--direction",
@@ -1071,8 +1105,8 @@ def add_pose_arguments(command: argparse.ArgumentParser) -> None:
     command.add_argument(
         "--angle",
         type=float,
-        help="with --point (axisangle): the tool axis's angle to the base axis, degrees (--rad: "
-        "radians)",
+        help="with --point (axisangle): the tool axis's angle to the base axis; a planar arm "
+        "solved for the pose: the heading about z; degrees (--rad: radians)",
     )
     command.add_argument(
         "--rad", action="store_true", help="--q, --free and --angle values are in radians"

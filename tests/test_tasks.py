@@ -546,9 +546,27 @@ def test_derive_solve_takes_a_task_s_point_and_direction(capsys):
     assert "2 solution(s)" in capsys.readouterr().out
 
 
+def test_derive_solve_takes_a_planar_arm_s_point_and_heading(capsys):
+    """The plane task from the command line: --point x y and, for an arm solved for the pose,
+    --angle (the heading about z); the rows are ik_xy_heading's / ik_xy's."""
+    from derive.cli import main
+
+    point = "1.3312179145 0.3736481777"  # (fk at 10, 20, 30 deg: heading 60 deg)
+    assert main(["solve", "lecture_rrr", "--point", point, "--angle", "60"]) == 0
+    out = capsys.readouterr().out
+    assert "2 solution(s)" in out and "10.0000    20.0000    30.0000" in out
+    assert main(["solve", "planar_2r", "--point", "0.6", "0.9"]) == 0
+    out = capsys.readouterr().out
+    assert "the position task reads its position" in out and "2 solution(s)" in out
+
+
 @pytest.mark.parametrize(
     ("args", "message"),
     [
+        (["lecture_rrr", "--point", "1 0"], "give --angle (the tool's x axis's angle about z)"),
+        (["lecture_rrr", "--point", "1 0 0", "--angle", "3"], "planar: give x y, in its plane"),
+        (["planar_2r", "--point", "1 0", "--angle", "3"], "planar_2r is solved for the position"),
+        (["lecture_rrr", "--point", "1 nan", "--angle", "3"], "--point: numbers must be finite"),
         (["youbot", "--point", "0.2", "0.1", "0.3"], "give --direction"),
         (["youbot", "--point", "0.2", "0.1"], "--point: give 3 numbers"),
         (["youbot", "--point", "0.2 0.1 0.3", "--direction", "0 0 0"], "not all 0"),
