@@ -302,11 +302,12 @@ _RR_NEWTON_DONE = (1e-11, 1e-8)
 
 # a perturbed table's candidates are polished on tables these shares of the way back first,
 # _RR_PATH_STEPS Newton steps on each (a continuation's corrector: it follows the solution,
-# the true table's steps settle it)
+# the true table's steps settle it; with one, ABB's GoFa 12 lost the pair of a near fold at
+# regular poses that two find)
 _RR_PATH = (0.3, 0.1, 0.03)
 
 
-_RR_PATH_STEPS = 1
+_RR_PATH_STEPS = 2
 
 
 # a candidate of a later split or pass within _RR_SAME (radians, each joint) of a row found

@@ -963,7 +963,7 @@ static void dk_dls(const double *J, int n, const double t[6], double damping, do
 
 #define DK_RR_PATH_COUNT 3
 
-#define DK_RR_PATH_STEPS 1
+#define DK_RR_PATH_STEPS 2
 
 /* a Newton step within this (radians) turns the joints' cos and sin by the angle-sum formulas
    and a few terms of the step's series (error d^6 / 720 ~ 1e-21), not by calling sincos */

@@ -31,7 +31,7 @@
 #define DK_RR_SEARCH_SLIDE (1.5)
 #define DK_RR_MOTION_COUNT 2
 #define DK_RR_PATH_COUNT 3
-#define DK_RR_PATH_STEPS 1
+#define DK_RR_PATH_STEPS 2
 /* a Newton step within this (radians) turns the joints' cos and sin by the angle-sum formulas
    and a few terms of the step's series (error d^6 / 720 ~ 1e-21), not by calling sincos */
 #define DK_RR_SMALL (1e-3)
