@@ -1686,20 +1686,8 @@ def _rr_near_singular(rows):
     the columns are orthogonal, 0 where J is singular), J the geometric Jacobian of split 0's
     chain (lengths in units of _RR_LENGTH)."""
     _, _, true_rows, slide = _RR_SPLITS[0]
-    Q = np.array([_rr_from_arm(0, q) for q in rows])
-    links = _rr_chain(Q, true_rows, slide)
-    frames = np.empty((len(Q), 7, 4, 4))
-    frames[:, 0] = _RR_EYE4
-    for i in range(6):
-        frames[:, i + 1] = frames[:, i] @ links[:, i]
-    z = frames[:, :6, :3, 2]
-    r = frames[:, 6, None, :3, 3] - frames[:, :6, :3, 3]
-    columns = np.concatenate(
-        (z[..., _RR_NEXT] * r[..., _RR_LAST] - z[..., _RR_LAST] * r[..., _RR_NEXT], z), axis=2
-    )
-    if slide[0]:  # a sliding joint 3 moves the flange along its axis
-        columns[:, 2, :3] = z[:, 2]
-        columns[:, 2, 3:] = 0.0
+    frames = _rr_frames(np.array([_rr_from_arm(0, q) for q in rows]), true_rows, slide)
+    columns = _rr_columns(frames, slide)
     norms = np.linalg.norm(columns, axis=2).prod(axis=1)
     ratios = np.abs(np.linalg.det(columns)) / np.where(norms > 0.0, norms, 1.0)
     return bool(((ratios <= _RR_NEAR_SINGULAR) | (norms <= 0.0)).any())
@@ -1860,8 +1848,9 @@ def _rr_split(k, F, moved, leads, known=(), imag_tol=_RR_IMAG_TOL):
         return out, close, _RESCUE
     # a perturbed table's clusters are the arm's pairs sharing the eigen-joint's value, which
     # its special geometry makes common: both come from the plane, and the partners and the
-    # search find one lost; they ask for the fallback split only (on 2,000 poses of two
-    # cobots, the rescue they started added nothing)
+    # search find one lost; they ask for the fallback split only (on 2,000 poses of each of
+    # two cobots, the rescue they started added rows at 14 poses, 13 of them with an odd
+    # count, which starts it anyway)
     doubt = (_FALLBACK if fill_rows != true_rows else _RESCUE) if doubt else 0
     if known and candidates:  # (one within _RR_SAME of a known row is that row again)
         rows = np.array(known)
@@ -2334,11 +2323,7 @@ def _rr_steps_many(
     live = np.arange(len(q))
     for _ in range(steps if track else steps + 1):
         x = q[live]
-        links = _rr_chain(x, rows, slide)
-        frames = np.empty((len(live), 7, 4, 4))
-        frames[:, 0] = _RR_EYE4
-        for i in range(6):
-            frames[:, i + 1] = frames[:, i] @ links[:, i]
+        frames = _rr_frames(x, rows, slide)
         size = np.abs(F[:3] - frames[:, 6, :3]).max(axis=(1, 2))
         better = size < best[live]
         best_q[live[better]], best[live[better]] = x[better], size[better]
@@ -2353,16 +2338,7 @@ def _rr_steps_many(
         error[:, :3] = F[:3, 3] - E[:, :3, 3]
         P = E[:, :3, :3] @ F[:3, :3].T
         error[:, 3:] = 0.5 * (P[:, _RR_NEXT, _RR_LAST] - P[:, _RR_LAST, _RR_NEXT])
-        # J's columns: z_i x (p - o_i) over z_i (a sliding joint 3: z_3 over 0)
-        z = frames[:, :6, :3, 2]
-        r = E[:, None, :3, 3] - frames[:, :6, :3, 3]
-        columns = np.concatenate(
-            (z[..., _RR_NEXT] * r[..., _RR_LAST] - z[..., _RR_LAST] * r[..., _RR_NEXT], z), axis=2
-        )
-        if slide[0]:  # a sliding joint 3 moves the flange along its axis
-            columns[:, 2, :3] = z[:, 2]
-            columns[:, 2, 3:] = 0.0
-        J = columns.transpose(0, 2, 1)
+        J = _rr_columns(frames, slide).transpose(0, 2, 1)
         moves, solved = _rr_solve_many(J, error, damped)
         live, x, moves = live[solved], x[solved], moves[solved]  # (a singular J: it stops)
         longest = np.abs(moves).max(axis=1, initial=0.0)
@@ -2379,6 +2355,31 @@ def _rr_steps_many(
             if not live.size:
                 break
     return (q if track else best_q), best
+
+
+def _rr_frames(X, rows, slide):
+    """The frames F_0 = I, F_1, ..., F_6 of the split's chain at the joint values in the rows
+    of X: shape (n, 7, 4, 4)."""
+    links = _rr_chain(X, rows, slide)
+    frames = np.empty((len(X), 7, 4, 4))
+    frames[:, 0] = _RR_EYE4
+    for i in range(6):
+        frames[:, i + 1] = frames[:, i] @ links[:, i]
+    return frames
+
+
+def _rr_columns(frames, slide):
+    """The geometric Jacobian's columns at those frames, shape (n, 6, 6) (column i last but
+    one): z_i x (p - o_i) over z_i (a sliding joint 3: z_3 over 0)."""
+    z = frames[:, :6, :3, 2]
+    r = frames[:, 6, None, :3, 3] - frames[:, :6, :3, 3]
+    columns = np.concatenate(
+        (z[..., _RR_NEXT] * r[..., _RR_LAST] - z[..., _RR_LAST] * r[..., _RR_NEXT], z), axis=2
+    )
+    if slide[0]:  # a sliding joint 3 moves the flange along its axis
+        columns[:, 2, :3] = z[:, 2]
+        columns[:, 2, 3:] = 0.0
+    return columns
 
 
 def _rr_solve_many(J, error, damped):

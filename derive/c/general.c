@@ -775,6 +775,31 @@ static void dk_rr_between(const double fill[7][4], const double truth[7][4], dou
     }
 }
 
+/* J := the geometric Jacobian of rows' chain at the frames F_0 .. F_6 of its joints (column i:
+   z_i x (p - o_i) over z_i; a sliding joint 3: z_3 over 0) */
+static void dk_rr_columns(const double rows[7][4], const double frames[7][4][4], double J[6][6])
+{
+    int i;
+    for (i = 0; i < 6; i++) {
+        const double z0 = frames[i][0][2], z1 = frames[i][1][2], z2 = frames[i][2][2];
+        const double dx = frames[6][0][3] - frames[i][0][3];
+        const double dy = frames[6][1][3] - frames[i][1][3];
+        const double dz = frames[6][2][3] - frames[i][2][3];
+        J[0][i] = z1 * dz - z2 * dy;
+        J[1][i] = z2 * dx - z0 * dz;
+        J[2][i] = z0 * dy - z1 * dx;
+        J[3][i] = z0;
+        J[4][i] = z1;
+        J[5][i] = z2;
+        if (i == 2 && rows[6][0] != 0.0) { /* a sliding joint 3 */
+            J[0][i] = z0;
+            J[1][i] = z1;
+            J[2][i] = z2;
+            J[3][i] = J[4][i] = J[5][i] = 0.0;
+        }
+    }
+}
+
 /* Steps on the forward kinematics of rows towards F from q (in place: the best point met; they
    stop where it is exact, its error beyond `reach` or its system singular): Newton's, or
    Levenberg-Marquardt's (damping |error|^2) where damped is set, `steps` + 1 of them (the
@@ -824,24 +849,7 @@ static double dk_rr_walk(const double rows[7][4], const double F[4][4], double q
             }
             step[3 + r] = 0.5 * total;
         }
-        for (i = 0; i < 6; i++) {
-            const double z0 = frames[i][0][2], z1 = frames[i][1][2], z2 = frames[i][2][2];
-            const double dx = frames[6][0][3] - frames[i][0][3];
-            const double dy = frames[6][1][3] - frames[i][1][3];
-            const double dz = frames[6][2][3] - frames[i][2][3];
-            J[0][i] = z1 * dz - z2 * dy;
-            J[1][i] = z2 * dx - z0 * dz;
-            J[2][i] = z0 * dy - z1 * dx;
-            J[3][i] = z0;
-            J[4][i] = z1;
-            J[5][i] = z2;
-            if (i == 2 && rows[6][0] != 0.0) { /* a sliding joint 3 */
-                J[0][i] = z0;
-                J[1][i] = z1;
-                J[2][i] = z2;
-                J[3][i] = J[4][i] = J[5][i] = 0.0;
-            }
-        }
+        dk_rr_columns(rows, (const double(*)[4][4])frames, J);
         if (damped) { /* (J^T J + mu) step = J^T error, mu = |error|^2 */
             for (r = 0; r < 6; r++) {
                 mu += step[r] * step[r];
@@ -1537,25 +1545,9 @@ static int dk_rr_near_singular(const double row[6])
         dk_rr_link_cs(cos(angle), sin(angle), q[i], DK_RR_TRUE[0],
                       i, (const double(*)[4])frames[i], frames[i + 1]);
     }
+    dk_rr_columns(DK_RR_TRUE[0], (const double(*)[4][4])frames, J);
     for (i = 0; i < 6; i++) {
-        const double *z[3] = {&frames[i][0][2], &frames[i][1][2], &frames[i][2][2]};
-        const double dx = frames[6][0][3] - frames[i][0][3];
-        const double dy = frames[6][1][3] - frames[i][1][3];
-        const double dz = frames[6][2][3] - frames[i][2][3];
         double norm = 0.0;
-        if (i == slider) {
-            J[0][i] = *z[0];
-            J[1][i] = *z[1];
-            J[2][i] = *z[2];
-            J[3][i] = J[4][i] = J[5][i] = 0.0;
-        } else {
-            J[0][i] = *z[1] * dz - *z[2] * dy;
-            J[1][i] = *z[2] * dx - *z[0] * dz;
-            J[2][i] = *z[0] * dy - *z[1] * dx;
-            J[3][i] = *z[0];
-            J[4][i] = *z[1];
-            J[5][i] = *z[2];
-        }
         for (r = 0; r < 6; r++) {
             norm += J[r][i] * J[r][i];
         }
