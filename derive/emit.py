@@ -21,7 +21,7 @@ from derive import tasks
 from derive.assemble import assemble, import_block
 from derive.layout import wrap_code
 from derive.plan import Assign, Plan
-from derive.printers import scalar
+from derive.printers import branches, scalar
 from derive.printers.common import (
     SCALAR_FUNCTIONS,
     CodePrinter,
@@ -162,7 +162,7 @@ class PrintedModule:
     solves_for: str
     refusal: str
     ik_body: tuple[tuple[int, str], ...]
-    # _branch_signs's body and BRANCHES (printers/scalar.py, branch_lines)
+    # _branch_signs's body and BRANCHES (printers/branches.py, printed by printers/scalar.py)
     branch_body: tuple[tuple[int, str], ...]
     branches_const: str
     qref_names: str
@@ -230,7 +230,7 @@ def print_plan(plan: Plan) -> PrintedModule:
         refusal=plan.refusal,
         ik_body=scalar.ik_lines(plan) if ik else (),
         branch_body=scalar.branch_lines(plan) if ik else (),
-        branches_const=repr(scalar.branch_names(plan)) if ik else "()",
+        branches_const=repr(branches.branch_names(plan)) if ik else "()",
         qref_names=", ".join(f"qr{i}" for i in range(1, arm.dof + 1)),
         match=match_expression(ik.certify, ik.tool_axis, ik.cone) if ik else "",
         tool_axis=ik.tool_axis if ik else 2,

@@ -16,7 +16,7 @@ from derive.assemble import assemble_c
 from derive.emit import GENERATOR, GenerationError, check_printable, environment
 from derive.layout import wrap_c
 from derive.plan import Eigen, Plan, Poly, PolyD
-from derive.printers import c
+from derive.printers import branches, c
 from derive.printers.general import eigen_step, pad, spurious_counts
 from derive.runtime import constants, motion
 from derive.tasks import TASK_CODES
@@ -47,6 +47,9 @@ class PrintedC:
     fk_pose: tuple[str, ...]
     fk_joints: tuple[str, ...]
     jacobian: tuple[str, ...]
+    # <name>_branch's body and the joints its signs name (the Python module's BRANCHES)
+    branch: tuple[str, ...]
+    branch_names: tuple[str, ...]
     fk_params: str
     solve: tuple[tuple[int, str], ...]
     # dk_solve brings every revolute output to ik's range (c.seamed_outputs): dk_finish copies
@@ -196,6 +199,8 @@ def print_c(plan: Plan) -> PrintedC:
         fk_pose=fk_pose,
         fk_joints=fk_joints,
         jacobian=jacobian,
+        branch=c.branch_lines(plan),
+        branch_names=branches.branch_names(plan),
         fk_params=fk_params,
         solve=solve,
         seamed=bool(c.seamed_outputs(plan)),

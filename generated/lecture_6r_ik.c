@@ -43,6 +43,10 @@
 
 #define DK_SEAM_SNAP (1e-12)
 
+/* a branch's sign is 0 (a fold: two values meet) where the derivative of its step's
+   equation is below this of the equation's scale (derive/runtime/constants.py) */
+#define DK_BRANCH_FOLD (1e-09)
+
 #define DK_PI (3.141592653589793)
 
 #define DK_TWO_PI (6.283185307179586)
@@ -588,6 +592,40 @@ static double dk_unit_seam(double t)
 {
     t = t < -DK_SEAM ? t + DK_TWO_PI : t;
     return fabs(t - DK_PI) <= DK_SEAM_SNAP ? DK_PI : t;
+}
+
+/* the branch of t among the values of a cos t + b sin t = e: +1 for atan2(b, a) + acos, -1
+   for - acos (the sign of a sin t - b cos t) */
+static int dk_cs1_branch(double a, double b, double t)
+{
+    const double slope = a * sin(t) - b * cos(t);
+    if (fabs(slope) <= DK_BRANCH_FOLD * sqrt(a * a + b * b)) {
+        return 0;
+    }
+    return slope > 0.0 ? 1 : -1;
+}
+
+/* the branch of the root t of the polynomial p (degree n, highest first) in u = tan(t/2):
+   the sign of dH/dt, H(t) = cos(t/2)^n p(tan(t/2)) (smooth through t = pi), t wrapped */
+static int dk_poly_branch(const double *p, int n, double t)
+{
+    const double w = dk_wrap(t), c = cos(w / 2.0), s = sin(w / 2.0);
+    double slope = 0.0, size = 0.0;
+    int k;
+    for (k = 0; k <= n; k++) { /* (p[k] u^m, m = n - k: p[k] s^m c^(n - m) in H) */
+        const int m = n - k;
+        if (m) {
+            slope += p[k] * m * pow(s, m - 1) * pow(c, n - m + 1);
+        }
+        if (n - m) {
+            slope -= p[k] * (n - m) * pow(s, m + 1) * pow(c, n - m - 1);
+        }
+        size += fabs(p[k]);
+    }
+    if (fabs(slope) <= DK_BRANCH_FOLD * n * size) {
+        return 0;
+    }
+    return slope > 0.0 ? 1 : -1;
 }
 
 /* complex numbers, for the quartic's fallback (no complex.h: math.h only) */
@@ -2056,6 +2094,39 @@ void lecture_6r_jacobian(const double q[DK_DOF], int frame, double J[6][DK_DOF])
             }
         }
     }
+}
+
+int lecture_6r_branch(const double q[DK_DOF], int signs[2])
+{
+    double e[12];
+    dk_fk_q(q, e);
+    double w11 = e[0];
+    double wx = e[3];
+    double w21 = e[4];
+    double wy = e[7];
+    double w31 = e[8];
+    double wz = e[11];
+    double qr3 = q[2];
+    double qr5 = q[4];
+    double px = -206.0*w11 + wx;
+    double py = -206.0*w21 + wy;
+    double pz = -206.0*w31 + wz - 373.0;
+    double z = pz;
+    double r = (px*px) + (py*py) + (pz*pz);
+    double theta3 = qr3;
+    double x0 = (r*r);
+    double x1 = (z*z);
+    double x2 = x0 + 3600.0*x1;
+    double x3 = 919360.0*r;
+    const double dk_b0_p[] = {-519088.0*r + x2 + 66431969536.0, x3 - 236959523840.0, -929376.0*r +
+            2.0*x0 + 7200.0*x1 + 316127094272.0, x3 - 186946339840.0, -410288.0*r + x2 +
+            41348782336.0};
+    const int dk_b0 = dk_poly_branch(dk_b0_p, 4, theta3);
+    double theta5 = qr5;
+    const int dk_b1 = dk_cs1_branch(1.0, 0.0, theta5);
+    signs[0] = dk_b0;
+    signs[1] = dk_b1;
+    return 2;
 }
 
 void lecture_6r_fk(const double q[DK_DOF], double T[16])

@@ -33,6 +33,10 @@
 
 #define DK_SEAM_SNAP (1e-12)
 
+/* a branch's sign is 0 (a fold: two values meet) where the derivative of its step's
+   equation is below this of the equation's scale (derive/runtime/constants.py) */
+#define DK_BRANCH_FOLD (1e-09)
+
 #define DK_PI (3.141592653589793)
 
 #define DK_TWO_PI (6.283185307179586)
@@ -566,6 +570,17 @@ static double dk_unit_seam(double t)
 {
     t = t < -DK_SEAM ? t + DK_TWO_PI : t;
     return fabs(t - DK_PI) <= DK_SEAM_SNAP ? DK_PI : t;
+}
+
+/* the branch of t among the values of a cos t + b sin t = e: +1 for atan2(b, a) + acos, -1
+   for - acos (the sign of a sin t - b cos t) */
+static int dk_cs1_branch(double a, double b, double t)
+{
+    const double slope = a * sin(t) - b * cos(t);
+    if (fabs(slope) <= DK_BRANCH_FOLD * sqrt(a * a + b * b)) {
+        return 0;
+    }
+    return slope > 0.0 ? 1 : -1;
 }
 
 /* angles t with a cos t + b sin t = e (the half-angle method's two values); free when the
@@ -1210,6 +1225,17 @@ void lecture_rrr_jacobian(const double q[DK_DOF], int frame, double J[6][DK_DOF]
             }
         }
     }
+}
+
+int lecture_rrr_branch(const double q[DK_DOF], int signs[1])
+{
+    double e[12];
+    dk_fk_q(q, e);
+    double qr2 = q[1];
+    double theta2 = qr2;
+    const int dk_b0 = dk_cs1_branch(0.8, 0.0, theta2);
+    signs[0] = dk_b0;
+    return 1;
 }
 
 void lecture_rrr_fk(const double q[DK_DOF], double T[16])

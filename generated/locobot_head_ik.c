@@ -1665,6 +1665,13 @@ void locobot_head_jacobian(const double q[DK_DOF], int frame, double J[6][DK_DOF
     }
 }
 
+int locobot_head_branch(const double q[DK_DOF], int signs[1])
+{
+    (void)q;
+    (void)signs;
+    return 0;
+}
+
 void locobot_head_fk(const double q[DK_DOF], double T[16])
 {
     double e[12];

@@ -3183,6 +3183,13 @@ void manocha_canny_jacobian(const double q[DK_DOF], int frame, double J[6][DK_DO
     }
 }
 
+int manocha_canny_branch(const double q[DK_DOF], int signs[1])
+{
+    (void)q;
+    (void)signs;
+    return 0;
+}
+
 void manocha_canny_fk(const double q[DK_DOF], double T[16])
 {
     double e[12];

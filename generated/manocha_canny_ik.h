@@ -48,6 +48,19 @@ void manocha_canny_fk(const double q[6], double T[16]);
    world (fk's frame), 1: in the tool frame (rotated by fk's R^T) */
 void manocha_canny_jacobian(const double q[6], int frame, double J[6][6]);
 
+/* the branches of the closed form (0; the
+   Python module's BRANCHES and branch): one sign per step that gives several values, +1 or
+   -1 (the sign of the derivative of the step's equation at the value), 0 at a fold, where
+   the step's values meet (a singular configuration: the elbow stretched, the wrist straight);
+   the signs change only where a path crosses a fold, so they name a solution's configuration
+   (shoulder, elbow, wrist); this arm has none (its method solves
+   all joints at once, or q alone cannot tell its branch) */
+#define MANOCHA_CANNY_BRANCHES 0
+
+/* signs = the branch of the solution q of its own pose fk(q); returns MANOCHA_CANNY_BRANCHES, or
+   -1 where q solves no pose of the task's (a task's auxiliary step has no value there) */
+int manocha_canny_branch(const double q[6], int signs[1]);
+
 /* T = the pose of frame k at q (the exact chain's: T(q) = F_0 J_1(q_1) F_1 ... J_n(q_n) F_n):
    k = 0 the base frame, k = 1..6 the frame of joint k (F_0 J_1 F_1 ... F_{k-1} J_k: its z
    axis the joint's axis, its origin on it; Craig's frame k for a table in modified DH), k = 7

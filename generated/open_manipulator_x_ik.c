@@ -33,6 +33,10 @@
 
 #define DK_SEAM_SNAP (1e-12)
 
+/* a branch's sign is 0 (a fold: two values meet) where the derivative of its step's
+   equation is below this of the equation's scale (derive/runtime/constants.py) */
+#define DK_BRANCH_FOLD (1e-09)
+
 #define DK_PI (3.141592653589793)
 
 #define DK_TWO_PI (6.283185307179586)
@@ -548,6 +552,17 @@ static double dk_wrap(double t)
     }
     w = t - DK_TWO_PI * floor(t / DK_TWO_PI + 0.5);
     return w <= -DK_PI ? w + DK_TWO_PI : w;
+}
+
+/* the branch of t among the values of a cos t + b sin t = e: +1 for atan2(b, a) + acos, -1
+   for - acos (the sign of a sin t - b cos t) */
+static int dk_cs1_branch(double a, double b, double t)
+{
+    const double slope = a * sin(t) - b * cos(t);
+    if (fabs(slope) <= DK_BRANCH_FOLD * sqrt(a * a + b * b)) {
+        return 0;
+    }
+    return slope > 0.0 ? 1 : -1;
 }
 
 /* angles t with a cos t + b sin t = e (the half-angle method's two values); free when the
@@ -1302,6 +1317,37 @@ void open_manipulator_x_jacobian(const double q[DK_DOF], int frame, double J[6][
             }
         }
     }
+}
+
+int open_manipulator_x_branch(const double q[DK_DOF], int signs[3])
+{
+    double e[12];
+    dk_fk_q(q, e);
+    double wx = e[3];
+    double wy = e[7];
+    double qr1 = q[0];
+    double qr2 = q[1];
+    double qr3 = q[2];
+    double qr4 = q[3];
+    double px = wx - 0.012;
+    double py = wy;
+    double theta1 = qr1;
+    const int dk_b0 = dk_cs1_branch(py, -px, theta1);
+    double c2 = cos(qr2 - 1.3854483816190182);
+    double s2 = sin(qr2 - 1.3854483816190182);
+    double c3 = cos(qr3 + 1.3854483816190182);
+    double s3 = sin(qr3 + 1.3854483816190182);
+    double c4 = cos(qr4);
+    double s4 = sin(qr4);
+    double theta5 = atan2(c2*c3*s4 + c2*c4*s3 + c3*c4*s2 - s2*s3*s4, c2*c3*c4 - c2*s3*s4 - c3*s2*s4
+            - c4*s2*s3);
+    const int dk_b1 = dk_cs1_branch(0.0, -1.0, theta5);
+    double theta3 = qr3 + 1.3854483816190182;
+    const int dk_b2 = dk_cs1_branch(0.032297288, 0.0, theta3);
+    signs[0] = dk_b0;
+    signs[1] = dk_b1;
+    signs[2] = dk_b2;
+    return 3;
 }
 
 void open_manipulator_x_fk(const double q[DK_DOF], double T[16])

@@ -43,6 +43,10 @@
 
 #define DK_SEAM_SNAP (1e-12)
 
+/* a branch's sign is 0 (a fold: two values meet) where the derivative of its step's
+   equation is below this of the equation's scale (derive/runtime/constants.py) */
+#define DK_BRANCH_FOLD (1e-09)
+
 #define DK_PI (3.141592653589793)
 
 #define DK_TWO_PI (6.283185307179586)
@@ -570,6 +574,40 @@ static double dk_wrap(double t)
     }
     w = t - DK_TWO_PI * floor(t / DK_TWO_PI + 0.5);
     return w <= -DK_PI ? w + DK_TWO_PI : w;
+}
+
+/* the branch of t among the values of a cos t + b sin t = e: +1 for atan2(b, a) + acos, -1
+   for - acos (the sign of a sin t - b cos t) */
+static int dk_cs1_branch(double a, double b, double t)
+{
+    const double slope = a * sin(t) - b * cos(t);
+    if (fabs(slope) <= DK_BRANCH_FOLD * sqrt(a * a + b * b)) {
+        return 0;
+    }
+    return slope > 0.0 ? 1 : -1;
+}
+
+/* the branch of the root t of the polynomial p (degree n, highest first) in u = tan(t/2):
+   the sign of dH/dt, H(t) = cos(t/2)^n p(tan(t/2)) (smooth through t = pi), t wrapped */
+static int dk_poly_branch(const double *p, int n, double t)
+{
+    const double w = dk_wrap(t), c = cos(w / 2.0), s = sin(w / 2.0);
+    double slope = 0.0, size = 0.0;
+    int k;
+    for (k = 0; k <= n; k++) { /* (p[k] u^m, m = n - k: p[k] s^m c^(n - m) in H) */
+        const int m = n - k;
+        if (m) {
+            slope += p[k] * m * pow(s, m - 1) * pow(c, n - m + 1);
+        }
+        if (n - m) {
+            slope -= p[k] * (n - m) * pow(s, m + 1) * pow(c, n - m - 1);
+        }
+        size += fabs(p[k]);
+    }
+    if (fabs(slope) <= DK_BRANCH_FOLD * n * size) {
+        return 0;
+    }
+    return slope > 0.0 ? 1 : -1;
 }
 
 /* complex numbers, for the quartic's fallback (no complex.h: math.h only) */
@@ -2084,6 +2122,60 @@ void panda_jacobian(const double q[DK_DOF], int frame, double J[6][DK_DOF])
             }
         }
     }
+}
+
+int panda_branch(const double q[DK_DOF], int signs[3])
+{
+    double e[12];
+    dk_fk_q(q, e);
+    double w11 = e[0];
+    double w12 = e[1];
+    double w13 = e[2];
+    double wx = e[3];
+    double w21 = e[4];
+    double w22 = e[5];
+    double w23 = e[6];
+    double wy = e[7];
+    double w31 = e[8];
+    double w32 = e[9];
+    double w33 = e[10];
+    double wz = e[11];
+    double qr2 = q[1];
+    double qr4 = q[3];
+    double qr5 = q[4];
+    double qr7 = q[6];
+    double c7 = cos(qr7);
+    double s7 = sin(qr7);
+    double x0 = c7*w11;
+    double x1 = s7*w12;
+    double x2 = c7*w21;
+    double x3 = s7*w22;
+    double x4 = c7*w31;
+    double x5 = s7*w32;
+    double x6 = c7*w12;
+    double x7 = s7*w11;
+    double x8 = c7*w22;
+    double x9 = s7*w21;
+    double x10 = c7*w32;
+    double x11 = s7*w31;
+    double px = 0.088*(c7*c7) + 0.088*(s7*s7) - wx*x0 + wx*x1 - wy*x2 + wy*x3 - wz*x4 + wz*x5 +
+            0.333*x4 - 0.333*x5;
+    double py = w13*wx + w23*wy + w33*wz - 0.333*w33 - 0.107;
+    double pz = 0.333*c7*w32 + 0.333*s7*w31 - wx*x6 - wx*x7 - wy*x8 - wy*x9 - wz*x10 - wz*x11;
+    double r = (px*px) + (py*py) + (pz*pz);
+    double theta3 = -qr4;
+    const double dk_b0_p[] = {0.031849 - r, 0.231, 0.49 - r};
+    const int dk_b0 = dk_poly_branch(dk_b0_p, 2, theta3);
+    double c3 = cos(theta3);
+    double s3 = sin(theta3);
+    double theta2 = -qr5;
+    const int dk_b1 = dk_cs1_branch(0.0, 0.0825*c3 - 0.316*s3 - 0.0825, theta2);
+    double theta5 = -qr2;
+    const int dk_b2 = dk_cs1_branch(1.0, 0.0, theta5);
+    signs[0] = dk_b0;
+    signs[1] = dk_b1;
+    signs[2] = dk_b2;
+    return 3;
 }
 
 void panda_fk(const double q[DK_DOF], double T[16])

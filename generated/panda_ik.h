@@ -49,6 +49,18 @@ void panda_fk(const double q[7], double T[16]);
    world (fk's frame), 1: in the tool frame (rotated by fk's R^T) */
 void panda_jacobian(const double q[7], int frame, double J[6][7]);
 
+/* the branches of the closed form (3: the steps solving q4, q5, q2; the
+   Python module's BRANCHES and branch): one sign per step that gives several values, +1 or
+   -1 (the sign of the derivative of the step's equation at the value), 0 at a fold, where
+   the step's values meet (a singular configuration: the elbow stretched, the wrist straight);
+   the signs change only where a path crosses a fold, so they name a solution's configuration
+   (shoulder, elbow, wrist) */
+#define PANDA_BRANCHES 3
+
+/* signs = the branch of the solution q of its own pose fk(q); returns PANDA_BRANCHES, or
+   -1 where q solves no pose of the task's (a task's auxiliary step has no value there) */
+int panda_branch(const double q[7], int signs[3]);
+
 /* T = the pose of frame k at q (the exact chain's: T(q) = F_0 J_1(q_1) F_1 ... J_n(q_n) F_n):
    k = 0 the base frame, k = 1..7 the frame of joint k (F_0 J_1 F_1 ... F_{k-1} J_k: its z
    axis the joint's axis, its origin on it; Craig's frame k for a table in modified DH), k = 8

@@ -47,6 +47,18 @@ void planar_2r_fk(const double q[2], double T[16]);
    world (fk's frame), 1: in the tool frame (rotated by fk's R^T) */
 void planar_2r_jacobian(const double q[2], int frame, double J[6][2]);
 
+/* the branches of the closed form (1: the steps solving q2; the
+   Python module's BRANCHES and branch): one sign per step that gives several values, +1 or
+   -1 (the sign of the derivative of the step's equation at the value), 0 at a fold, where
+   the step's values meet (a singular configuration: the elbow stretched, the wrist straight);
+   the signs change only where a path crosses a fold, so they name a solution's configuration
+   (shoulder, elbow, wrist) */
+#define PLANAR_2R_BRANCHES 1
+
+/* signs = the branch of the solution q of its own pose fk(q); returns PLANAR_2R_BRANCHES, or
+   -1 where q solves no pose of the task's (a task's auxiliary step has no value there) */
+int planar_2r_branch(const double q[2], int signs[1]);
+
 /* T = the pose of frame k at q (the exact chain's: T(q) = F_0 J_1(q_1) F_1 ... J_n(q_n) F_n):
    k = 0 the base frame, k = 1..2 the frame of joint k (F_0 J_1 F_1 ... F_{k-1} J_k: its z
    axis the joint's axis, its origin on it; Craig's frame k for a table in modified DH), k = 3

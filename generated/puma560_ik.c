@@ -43,6 +43,10 @@
 
 #define DK_SEAM_SNAP (1e-12)
 
+/* a branch's sign is 0 (a fold: two values meet) where the derivative of its step's
+   equation is below this of the equation's scale (derive/runtime/constants.py) */
+#define DK_BRANCH_FOLD (1e-09)
+
 #define DK_PI (3.141592653589793)
 
 #define DK_TWO_PI (6.283185307179586)
@@ -588,6 +592,40 @@ static double dk_unit_seam(double t)
 {
     t = t < -DK_SEAM ? t + DK_TWO_PI : t;
     return fabs(t - DK_PI) <= DK_SEAM_SNAP ? DK_PI : t;
+}
+
+/* the branch of t among the values of a cos t + b sin t = e: +1 for atan2(b, a) + acos, -1
+   for - acos (the sign of a sin t - b cos t) */
+static int dk_cs1_branch(double a, double b, double t)
+{
+    const double slope = a * sin(t) - b * cos(t);
+    if (fabs(slope) <= DK_BRANCH_FOLD * sqrt(a * a + b * b)) {
+        return 0;
+    }
+    return slope > 0.0 ? 1 : -1;
+}
+
+/* the branch of the root t of the polynomial p (degree n, highest first) in u = tan(t/2):
+   the sign of dH/dt, H(t) = cos(t/2)^n p(tan(t/2)) (smooth through t = pi), t wrapped */
+static int dk_poly_branch(const double *p, int n, double t)
+{
+    const double w = dk_wrap(t), c = cos(w / 2.0), s = sin(w / 2.0);
+    double slope = 0.0, size = 0.0;
+    int k;
+    for (k = 0; k <= n; k++) { /* (p[k] u^m, m = n - k: p[k] s^m c^(n - m) in H) */
+        const int m = n - k;
+        if (m) {
+            slope += p[k] * m * pow(s, m - 1) * pow(c, n - m + 1);
+        }
+        if (n - m) {
+            slope -= p[k] * (n - m) * pow(s, m + 1) * pow(c, n - m - 1);
+        }
+        size += fabs(p[k]);
+    }
+    if (fabs(slope) <= DK_BRANCH_FOLD * n * size) {
+        return 0;
+    }
+    return slope > 0.0 ? 1 : -1;
 }
 
 /* complex numbers, for the quartic's fallback (no complex.h: math.h only) */
@@ -2026,6 +2064,35 @@ void puma560_jacobian(const double q[DK_DOF], int frame, double J[6][DK_DOF])
             }
         }
     }
+}
+
+int puma560_branch(const double q[DK_DOF], int signs[3])
+{
+    double e[12];
+    dk_fk_q(q, e);
+    double wx = e[3];
+    double wy = e[7];
+    double wz = e[11];
+    double qr2 = q[1];
+    double qr3 = q[2];
+    double qr5 = q[4];
+    double px = wx;
+    double py = wy;
+    double pz = wz;
+    double r = (px*px) + (py*py) + (pz*pz);
+    double theta3 = qr3;
+    const double dk_b0_p[] = {0.413994 - r, 0.748224, 0.379434 - r};
+    const int dk_b0 = dk_poly_branch(dk_b0_p, 2, theta3);
+    double c3 = cos(theta3);
+    double s3 = sin(theta3);
+    double theta2 = qr2;
+    const int dk_b1 = dk_cs1_branch(0.433*c3 + 0.02*s3, 0.02*c3 - 0.433*s3 - 0.432, theta2);
+    double theta5 = qr5;
+    const int dk_b2 = dk_cs1_branch(1.0, 0.0, theta5);
+    signs[0] = dk_b0;
+    signs[1] = dk_b1;
+    signs[2] = dk_b2;
+    return 3;
 }
 
 void puma560_fk(const double q[DK_DOF], double T[16])

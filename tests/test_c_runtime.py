@@ -58,7 +58,7 @@ def test_the_c_runtime_holds_the_python_runtimes_constants():
     found = defines(runtime)
     for name in ("FREE_TOL", "CLAMP_TOL", "FOLD_TOL", "LEAD_TOL", "ROOT_IMAG_TOL", "MERGE_TOL"):
         assert float(found[f"DK_{name}"]) == getattr(constants, f"_{name}"), name
-    for name in ("CLUSTER_TOL", "RESIDUAL_TOL", "SEAM", "SEAM_SNAP"):
+    for name in ("CLUSTER_TOL", "RESIDUAL_TOL", "SEAM", "SEAM_SNAP", "BRANCH_FOLD"):
         assert float(found[f"DK_{name}"]) == getattr(constants, f"_{name}"), name
     for name in ("SPREAD_WIDTH", "SPREAD_COUNT", "SEED_BAND"):
         assert float(found[f"DK_{name}"]) == getattr(constants, f"_{name}"), name

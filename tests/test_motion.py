@@ -9,7 +9,7 @@ import ctypes
 import numpy as np
 import pytest
 
-from conftest import BUNDLED
+from conftest import BUNDLED, GENERATED
 
 
 def differences(module, q: np.ndarray, step: float = 1e-6) -> np.ndarray:
@@ -350,6 +350,37 @@ def test_branches_tell_every_solution_apart(generated, name, names):
         labels = [module.branch(row) for row in rows]
         assert len(set(labels)) == len(labels) and module.branch(q) in labels
         assert all(0 not in label for label in labels)
+
+
+@pytest.mark.parametrize("name", BUNDLED)
+def test_the_c_branch_is_the_python_branch(generated, name):
+    """<name>_branch gives branch's signs (printed from one program, printers/branches.py):
+    300 joint vectors within the limits, a third of their joints at 0 or +-90 deg (folds
+    among them: the PUMA's wrist straight at q5 = 0), and returns as many as BRANCHES names,
+    the header's <NAME>_BRANCHES; none (0) where the arm has no branches."""
+    module = generated(name)
+    lib, why = module._c_library()
+    assert lib is not None, why
+    call = lib[f"{name}_branch"]
+    call.restype = ctypes.c_int
+    header = (GENERATED / f"{name}_ik.h").read_text()
+    assert f"#define {name.upper()}_BRANCHES {len(module.BRANCHES)}\n" in header
+    rng = np.random.default_rng(4)
+    lo, hi = np.clip(np.array(module.LIMITS).T, -np.pi, np.pi)
+    folds = 0
+    for _ in range(300):
+        q = rng.uniform(lo, hi)
+        snap = rng.random(module.DOF) < 1 / 3
+        special = np.clip(rng.choice([0.0, np.pi / 2, -np.pi / 2], module.DOF), lo, hi)
+        q[snap] = special[snap]
+        values = np.ascontiguousarray(q)
+        signs = (ctypes.c_int * max(1, len(module.BRANCHES)))()
+        count = call(values.ctypes.data_as(ctypes.POINTER(ctypes.c_double)), signs)
+        assert count == len(module.BRANCHES)
+        assert tuple(signs[:count]) == module.branch(q), q
+        folds += 0 in module.branch(q)
+    if name == "puma560":  # (the signs at a fold are 0 in both)
+        assert folds > 0
 
 
 def test_branches_change_only_at_folds(generated):

@@ -20,6 +20,9 @@
 #define DK_POSE_TOL (1e-06)
 #define DK_SEAM (3.141592652589793)
 #define DK_SEAM_SNAP (1e-12)
+/* a branch's sign is 0 (a fold: two values meet) where the derivative of its step's
+   equation is below this of the equation's scale (derive/runtime/constants.py) */
+#define DK_BRANCH_FOLD (1e-09)
 #define DK_PI (3.141592653589793)
 #define DK_TWO_PI (6.283185307179586)
 #define DK_SPREAD_WIDTH (0.2)
@@ -595,6 +598,60 @@ static double dk_unit_seam(double t)
 {
     t = t < -DK_SEAM ? t + DK_TWO_PI : t;
     return fabs(t - DK_PI) <= DK_SEAM_SNAP ? DK_PI : t;
+}
+
+/* Branches (derive/runtime/scalar.py's _cs1_branch, _poly_branch, _polyd_branch, which say
+   why): the sign of the derivative of a step's equation at one of its values, 0 at a fold. */
+
+/* the branch of t among the values of a cos t + b sin t = e: +1 for atan2(b, a) + acos, -1
+   for - acos (the sign of a sin t - b cos t) */
+static int dk_cs1_branch(double a, double b, double t)
+{
+    const double slope = a * sin(t) - b * cos(t);
+    if (fabs(slope) <= DK_BRANCH_FOLD * sqrt(a * a + b * b)) {
+        return 0;
+    }
+    return slope > 0.0 ? 1 : -1;
+}
+
+/* the branch of the root t of the polynomial p (degree n, highest first) in u = tan(t/2):
+   the sign of dH/dt, H(t) = cos(t/2)^n p(tan(t/2)) (smooth through t = pi), t wrapped */
+static int dk_poly_branch(const double *p, int n, double t)
+{
+    const double w = dk_wrap(t), c = cos(w / 2.0), s = sin(w / 2.0);
+    double slope = 0.0, size = 0.0;
+    int k;
+    for (k = 0; k <= n; k++) { /* (p[k] u^m, m = n - k: p[k] s^m c^(n - m) in H) */
+        const int m = n - k;
+        if (m) {
+            slope += p[k] * m * pow(s, m - 1) * pow(c, n - m + 1);
+        }
+        if (n - m) {
+            slope -= p[k] * (n - m) * pow(s, m + 1) * pow(c, n - m - 1);
+        }
+        size += fabs(p[k]);
+    }
+    if (fabs(slope) <= DK_BRANCH_FOLD * n * size) {
+        return 0;
+    }
+    return slope > 0.0 ? 1 : -1;
+}
+
+/* the branch of the root d of the polynomial p (degree n, highest first) in d: the sign of
+   p'(d) */
+static int dk_polyd_branch(const double *p, int n, double d)
+{
+    double slope = 0.0, size = 0.0;
+    int k;
+    for (k = 0; k < n; k++) {
+        const double term = p[k] * (n - k) * pow(d, n - k - 1);
+        slope += term;
+        size += fabs(term);
+    }
+    if (fabs(slope) <= DK_BRANCH_FOLD * size) {
+        return 0;
+    }
+    return slope > 0.0 ? 1 : -1;
 }
 
 /* complex numbers, for the quartic's fallback (no complex.h: math.h only) */

@@ -33,6 +33,7 @@ from derive.plan import (
     PolyD,
     Solve,
 )
+from derive.printers.branches import First, Sign, branch_program
 from derive.printers.common import (
     CodePrinter,
     Line,
@@ -407,6 +408,61 @@ def solve_lines(plan: Plan) -> tuple[tuple[int, str], ...]:
     body.append(Line(0, "*repeats = dk_close;"))
     body.append(Line(0, "return n;"))
     return tuple((ln.depth, ln.text) for ln in body)
+
+
+# Solve kind -> the C runtime's sign function of its branches (derive/c/runtime.c)
+SIGNS: dict[type[Solve], str] = {
+    Cs1: "dk_cs1_branch",
+    Cs1Reach: "dk_cs1_branch",
+    Poly: "dk_poly_branch",
+    PolyD: "dk_polyd_branch",
+}
+
+
+def branch_lines(plan: Plan) -> tuple[str, ...]:
+    """Body of <name>_branch(q, signs): the branch program (printers/branches.py) as C, the
+    signs stored in signs[0..] and their count returned (0 where the arm has none)."""
+    program = branch_program(plan)
+    if program is None:
+        return ("(void)q;", "(void)signs;", "return 0;")
+    printer = CPrinter()
+    scope = Scope([set()])
+    lines = ["double e[12];", "dk_fk_q(q, e);"]
+    lines += [_assign(w, f"e[{k}]", 0, scope).text for k, w in enumerate(program.world) if w]
+    lines += [_assign(j, f"q[{k}]", 0, scope).text for k, j in enumerate(program.joints) if j]
+    for target, value in program.lines:
+        if isinstance(value, Sign):
+            values = [printer.doprint(e) for e in value.args]
+            function = SIGNS[type(value.step)]
+            name = f"dk{target}"
+            if function == "dk_cs1_branch":
+                lines.append(
+                    f"const int {name} = {function}({', '.join(values)}, {value.variable});"
+                )
+                continue
+            lines.append(f"const double {name}_p[] = {{{', '.join(values)}}};")
+            degree = len(values) - 1
+            lines.append(f"const int {name} = {function}({name}_p, {degree}, {value.variable});")
+        elif isinstance(value, First):  # (its first value: dk_value's, as the solver reads it)
+            step, j = value.step, value.step.joint
+            values = [printer.doprint(e) for e in value.args]
+            call = CALLS[type(step)](step, values, printer.doprint(step.ref))
+            if call.before:
+                lines.append(call.before)
+            lines.append(f"dk_values dk_v{j};")
+            lines.append(f"double dk_c{j}, dk_s{j};")
+            lines.append(
+                f"if ({call.routine}(&dk_v{j}, {', '.join(call.args)}) < 0 || !dk_v{j}.n) {{"
+            )
+            lines.append("    return -1; /* (no value: q is not a solution of its own pose) */")
+            lines.append("}")
+            lines.append(_assign(target, "0.0", 0, scope).text)
+            lines.append(f"dk_value(&dk_v{j}, 0, &{target}, &dk_c{j}, &dk_s{j});")
+        else:
+            lines.append(_assign(target, printer.doprint(value), 0, scope).text)
+    for k, sign in enumerate(program.signs):
+        lines.append(f"signs[{k}] = dk{sign};")
+    return (*lines, f"return {len(program.signs)};")
 
 
 def branches_are_outputs(plan: Plan) -> bool:
