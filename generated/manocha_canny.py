@@ -327,6 +327,16 @@ _RR_NEAR_SINGULAR = 1e-3
 _RR_RESCUE = ((1e-4, 1e-4), (-2e-4, 1.5e-4))
 
 
+# on a nominal table (an arm whose exact chain is refined from it: _SEED_TOL > 0), a
+# candidate that Newton's and damped steps leave within _SEED_TOL of the pose is a pair of
+# the exact arm's solutions near a fold that the nominal table has as a complex pair (or a
+# real pair its rounding lost): it seeds the refinement, with the points _RR_FOLD_STEP
+# (radians, each way) along the direction the table's Jacobian nearly loses, where the two
+# solutions lie (measured on the xArm6 URDF: both found from +-1e-3 at pairs 1e-4 to 1e-2
+# apart)
+_RR_FOLD_STEP = 1e-3
+
+
 # where nothing polishes and a pencil on the arm's own table is singular at the pose (or at a
 # moved one), or a candidate's polishing stopped within _RR_SEARCH_FROM of it (a curve of
 # solutions the eigenvalues missed), _RR_SEARCH_STEPS damped steps from those candidates and
@@ -1672,6 +1682,10 @@ def _general(flanges, tol):
     if not found and not near and (leads.singular or leads.rows):
         # a curve of solutions that none of the above reached: a search (_rr_search)
         _rr_merge(found, _rr_search(targets, leads.rows))
+    if leads.seeds:
+        # a nominal table's near misses: seeds the caller refines onto the exact arm and
+        # certifies there (a pair of the exact arm near a fold, complex on the nominal table)
+        _rr_merge(found, leads.seeds)
     if not found:
         # a singular pose, where Newton converges slowly: what came within _RR_NEAR (the
         # caller's certification decides)
@@ -1693,6 +1707,26 @@ def _rr_near_singular(rows):
     return bool(((ratios <= _RR_NEAR_SINGULAR) | (norms <= 0.0)).any())
 
 
+def _rr_fold_seeds(k, q, rows, slide):
+    """Seeds for the refinement onto the exact arm from split k's values q, which damped steps
+    left near the pose on a nominal table (rows): q, and q +- _RR_FOLD_STEP along the
+    direction the table's Jacobian nearly loses there (two steps of inverse iteration on
+    J^T J from (1, ..., 1)), where the exact arm's two solutions lie when q is near a fold;
+    as the arm's values. The caller refines and certifies them."""
+    J = _rr_columns(_rr_frames(q[None], rows, slide), slide)[0].T
+    v = np.full(6, 1.0 / math.sqrt(6.0))
+    for _ in range(2):
+        try:
+            w = np.linalg.solve(J.T @ J, v)
+        except np.linalg.LinAlgError:
+            break  # (singular: v is as good a direction as any)
+        size = float(np.linalg.norm(w))
+        if not 0.0 < size < math.inf:
+            break
+        v = w / size
+    return [_rr_to_arm(k, q + h * v) for h in (0.0, _RR_FOLD_STEP, -_RR_FOLD_STEP)]
+
+
 class _RRLeads:
     """What the splits saw of a pose that may lie on a curve of solutions: whether a pencil
     on the arm's own table was singular at it or at a pose moved by the rescue, and the
@@ -1702,6 +1736,7 @@ class _RRLeads:
     def __init__(self):
         self.singular = False
         self.rows: list[np.ndarray] = []
+        self.seeds: list[np.ndarray] = []  # (a nominal table's near misses: _rr_fold_seeds)
 
 
 def _rr_partners(targets, rows):
@@ -1880,6 +1915,8 @@ def _rr_split(k, F, moved, leads, known=(), imag_tol=_RR_IMAG_TOL):
             continue
         if residual <= _RR_SEARCH_FROM:
             leads.rows.append(_rr_to_arm(k, q))
+        if residual <= _SEED_TOL:  # (a nominal table's near miss: _SEED_TOL is 0 elsewhere)
+            leads.seeds += _rr_fold_seeds(k, q, true_rows, slide)
         if extra:
             continue
         if residual <= _RR_NEAR:
@@ -2227,13 +2264,15 @@ def _rr_newton_many(rows, F, Q, slide, extras):
     damped steps (a candidate Newton does not settle puts the answer in doubt, as before they
     existed). Newton's steps again after the damped ones: a regular solution the damped steps
     reach slowly is settled exactly, not left a rounding's width from the same solution found
-    otherwise. Rows marked in extras get Newton's steps only."""
+    otherwise. Rows marked in extras get Newton's steps only (but on a nominal table)."""
     Q, errors = _rr_steps_many(rows, F, Q, slide, False)
     slow = np.flatnonzero((errors > _RR_NEWTON_DONE[0]) & (errors <= _RR_GOOD))
     if slow.size:  # (Newton converges slowly near a double root: as many steps again)
         A, again_errors = _rr_steps_many(rows, F, Q[slow], slide, False)
         Q[slow], errors[slow] = A, np.minimum(errors[slow], again_errors)
-    damped = (errors > _RR_GOOD) & ~extras  # (an extra Newton does not settle is dropped)
+    # (an extra Newton does not settle is dropped, but on a nominal table, where the damped
+    # steps may bring it near enough to seed the refinement: _rr_fold_seeds)
+    damped = (errors > _RR_GOOD) & (~extras | (_SEED_TOL > 0.0))
     if damped.any():
         tried = np.flatnonzero(damped)
         D, damped_errors = _rr_steps_many(rows, F, Q[tried], slide, True)

@@ -982,6 +982,11 @@ static void dk_dls(const double *J, int n, const double t[6], double damping, do
    (Hadamard's ratio of its Jacobian), the rescue is tried too */
 #define DK_RR_NEAR_SINGULAR (0.001)
 
+/* on a nominal table (DK_SEED_TOL > 0), a candidate the steps leave within DK_SEED_TOL of the
+   pose seeds the refinement, with the points this far each way along the direction the
+   table's Jacobian nearly loses (a pair of the exact arm near a fold: dk_rr_fold_seeds) */
+#define DK_RR_FOLD_STEP (0.001)
+
 #define DK_RR_SEARCH_COUNT 64
 
 static const double DK_RR_MOEBIUS[3][4] = {{1.0, 0.3, -0.4, 1.0}, {1.0, -0.7, 0.5, 1.0}, {0.6, 1.0,
@@ -1876,7 +1881,8 @@ static double dk_rr_newton(const double rows[7][4], const double F[4][4], double
     if (DK_RR_NEWTON_DONE < error && error <= DK_RR_GOOD) { /* (slowly: near a double root) */
         error = fmin(error, dk_rr_steps(rows, F, q, 0));
     }
-    *used = error > DK_RR_GOOD && !extra; /* (an extra gets Newton's steps only) */
+    /* (an extra gets Newton's steps only, but on a nominal table: dk_rr_fold_seeds) */
+    *used = error > DK_RR_GOOD && (!extra || DK_SEED_TOL > 0.0);
     if (!*used) {
         return error;
     }
@@ -2418,11 +2424,77 @@ static int dk_rr_add(int k, const double q[6], double out[DK_RR_ROWS][6], int co
     return count + 1;
 }
 
+/* J = the geometric Jacobian of split k's own table at its values q (lengths in units of
+   DK_RR_LENGTH) */
+static void dk_rr_jacobian(int k, const double q[6], double J[6][6])
+{
+    double frames[7][4][4];
+    const int slider = DK_RR_TRUE[k][6][0] != 0.0 ? 2 : -1;
+    int i;
+    dk_eye4(frames[0]);
+    for (i = 0; i < 6; i++) {
+        const double angle = i == slider ? DK_RR_TRUE[k][6][1] : q[i];
+        dk_rr_link_cs(cos(angle), sin(angle), q[i], DK_RR_TRUE[k], i,
+                      (const double(*)[4])frames[i], frames[i + 1]);
+    }
+    dk_rr_columns(DK_RR_TRUE[k], (const double(*)[4][4])frames, J);
+}
+
+/* The seeds of split k's values q, which the steps left near the pose on a nominal table (the
+   Python solver's _rr_fold_seeds): q, and q +- DK_RR_FOLD_STEP along the direction the
+   table's Jacobian nearly loses there (two steps of inverse iteration on J^T J from (1, ...,
+   1)), as the arm's values, added to seeds[0..n) where new and room is left: the new count */
+static int dk_rr_fold_seeds(int k, const double q[6], double seeds[DK_RR_ROWS][6], int n)
+{
+    double J[6][6], A[6][6], v[6], w[6], x[6], size;
+    int i, j, r, it, h;
+    dk_rr_jacobian(k, q, J);
+    for (i = 0; i < 6; i++) {
+        for (j = 0; j < 6; j++) {
+            A[i][j] = 0.0;
+            for (r = 0; r < 6; r++) {
+                A[i][j] += J[r][i] * J[r][j];
+            }
+        }
+        v[i] = 1.0 / sqrt(6.0);
+    }
+    for (it = 0; it < 2; it++) {
+        for (i = 0; i < 6; i++) {
+            w[i] = v[i];
+        }
+        if (!dk_solve6((const double(*)[6])A, w, NULL)) {
+            break; /* (singular: v is as good a direction as any) */
+        }
+        size = 0.0;
+        for (i = 0; i < 6; i++) {
+            size += w[i] * w[i];
+        }
+        size = sqrt(size);
+        if (!(0.0 < size && size < HUGE_VAL)) {
+            break;
+        }
+        for (i = 0; i < 6; i++) {
+            v[i] = w[i] / size;
+        }
+    }
+    for (h = 0; h < 3 && n < DK_RR_ROWS; h++) {
+        const double step = h == 0 ? 0.0 : (h == 1 ? DK_RR_FOLD_STEP : -DK_RR_FOLD_STEP);
+        for (i = 0; i < 6; i++) {
+            x[i] = q[i] + step * v[i];
+        }
+        n = dk_rr_add(k, x, seeds, n);
+    }
+    return n;
+}
+
 /* split k's polished candidates for the target F (found from the pose `moved`) added to
    out[count..] where new, until DK_RR_ROWS (a candidate within DK_RR_SAME of a row out had
-   before is not polished: that row again); the new count; *doubt as dk_rr_candidates' */
+   before is not polished: that row again); the new count; *doubt as dk_rr_candidates'; on a
+   nominal table, the seeds of candidates left within DK_SEED_TOL added to seeds[0..*n_seeds)
+   (dk_rr_fold_seeds) */
 static int dk_rr_split(int k, const double F[4][4], const double moved[4][4],
-                       double out[DK_RR_ROWS][6], int count, int *doubt, double imag_tol)
+                       double out[DK_RR_ROWS][6], int count, int *doubt, double imag_tol,
+                       double seeds[DK_RR_ROWS][6], int *n_seeds)
 {
     double values[490], cands[DK_RR_CANDS][6], between[7][4];
     const int known = count;
@@ -2458,6 +2530,9 @@ static int dk_rr_split(int k, const double F[4][4], const double moved[4][4],
             *doubt = DK_RR_RESCUE;
         }
         if (error > DK_RR_GOOD) {
+            if (error <= DK_SEED_TOL) { /* (a nominal table's near miss: 0 elsewhere) */
+                *n_seeds = dk_rr_fold_seeds(k, q, seeds, *n_seeds);
+            }
             if (!perturbed && !extra[c]) {
                 *doubt = DK_RR_RESCUE;
             }
@@ -2477,22 +2552,15 @@ static int dk_rr_split(int k, const double F[4][4], const double moved[4][4],
    units of DK_RR_LENGTH) */
 static int dk_rr_near_singular(const double row[6])
 {
-    double q[6], frames[7][4][4], J[6][6], x[6] = {0.0}, ratio = 0.0;
-    const int slider = DK_RR_TRUE[0][6][0] != 0.0 ? 2 : -1;
+    double q[6], J[6][6], x[6] = {0.0}, ratio = 0.0;
     int i, r;
     for (i = 0; i < 6; i++) { /* the arm's values as split 0's */
         q[i] = DK_RR_REVERSED[0] ? -row[5 - i] : row[i];
     }
-    if (slider >= 0) {
+    if (DK_RR_TRUE[0][6][0] != 0.0) {
         q[2] /= DK_RR_LENGTH;
     }
-    dk_eye4(frames[0]);
-    for (i = 0; i < 6; i++) {
-        const double angle = i == slider ? DK_RR_TRUE[0][6][1] : q[i];
-        dk_rr_link_cs(cos(angle), sin(angle), q[i], DK_RR_TRUE[0],
-                      i, (const double(*)[4])frames[i], frames[i + 1]);
-    }
-    dk_rr_columns(DK_RR_TRUE[0], (const double(*)[4][4])frames, J);
+    dk_rr_jacobian(0, q, J);
     for (i = 0; i < 6; i++) {
         double norm = 0.0;
         for (r = 0; r < 6; r++) {
@@ -2587,8 +2655,8 @@ static int dk_rr_search(const double F[4][4], double out[DK_RR_ROWS][6], int cou
    split, the 12 top entries of the target in the split's frame. */
 static int dk_general(const double flanges[DK_RR_SPLIT_COUNT][12], double out[DK_RR_ROWS][6])
 {
-    double targets[DK_RR_SPLIT_COUNT][4][4], moved[4][4];
-    int count = 0, doubt = DK_RR_RESCUE, perturbed = 0, grew = 0, k, r, c, m, i;
+    double targets[DK_RR_SPLIT_COUNT][4][4], moved[4][4], seeds[DK_RR_ROWS][6];
+    int count = 0, doubt = DK_RR_RESCUE, perturbed = 0, grew = 0, n_seeds = 0, k, r, c, m, i;
     for (k = 0; k < DK_RR_SPLIT_COUNT; k++) {
         for (r = 0; r < 4; r++) {
             for (c = 0; c < 4; c++) {
@@ -2601,7 +2669,8 @@ static int dk_general(const double flanges[DK_RR_SPLIT_COUNT][12], double out[DK
     }
     for (k = 0; k < DK_RR_SPLIT_COUNT; k++) {
         const int before = count;
-        count = dk_rr_split(k, targets[k], targets[k], out, count, &doubt, DK_RR_IMAG_TOL);
+        count = dk_rr_split(k, targets[k], targets[k], out, count, &doubt, DK_RR_IMAG_TOL,
+                            seeds, &n_seeds);
         perturbed |= dk_rr_perturbed(k); /* (a perturbed table walked: the partners below) */
         grew |= k > 0 && count > before; /* (the fallback found what the first split missed) */
         if (count == DK_RR_ROWS) {
@@ -2627,7 +2696,8 @@ static int dk_general(const double flanges[DK_RR_SPLIT_COUNT][12], double out[DK
                         moved[r][c] = total;
                     }
                 }
-                count = dk_rr_split(k, targets[k], moved, out, count, &ignored, DK_RR_IMAG_TOL);
+                count = dk_rr_split(k, targets[k], moved, out, count, &ignored,
+                                    DK_RR_IMAG_TOL, seeds, &n_seeds);
                 perturbed |= dk_rr_perturbed(k);
                 if (count == DK_RR_ROWS) {
                     return count;
@@ -2659,11 +2729,25 @@ static int dk_general(const double flanges[DK_RR_SPLIT_COUNT][12], double out[DK
                     moved[r][c] = total;
                 }
             }
-            count = dk_rr_split(k, targets[k], moved, out, count, &ignored, DK_RR_IMAG_LOOSE);
+            count = dk_rr_split(k, targets[k], moved, out, count, &ignored,
+                                DK_RR_IMAG_LOOSE, seeds, &n_seeds);
             if (count == DK_RR_ROWS) {
                 return count;
             }
         }
+    }
+    for (r = 0; r < n_seeds && count < DK_RR_ROWS; r++) {
+        /* a nominal table's near misses: seeds the caller refines onto the exact arm and
+           certifies there (a pair of the exact arm near a fold, complex on the nominal table) */
+        double split[6];
+        int j;
+        for (j = 0; j < 6; j++) { /* (the arm's values as split 0's, for dk_rr_add) */
+            split[j] = DK_RR_REVERSED[0] ? -seeds[r][5 - j] : seeds[r][j];
+        }
+        if (DK_RR_TRUE[0][6][0] != 0.0) {
+            split[2] /= DK_RR_LENGTH;
+        }
+        count = dk_rr_add(0, split, out, count);
     }
     return count > 0 ? count : -1;
 }

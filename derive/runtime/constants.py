@@ -125,6 +125,14 @@ _RR_SAME = 1e-2
 # continuation may take two onto one
 _RR_NEAR_SINGULAR = 1e-3
 _RR_RESCUE = ((1e-4, 1e-4), (-2e-4, 1.5e-4))
+# on a nominal table (an arm whose exact chain is refined from it: _SEED_TOL > 0), a
+# candidate that Newton's and damped steps leave within _SEED_TOL of the pose is a pair of
+# the exact arm's solutions near a fold that the nominal table has as a complex pair (or a
+# real pair its rounding lost): it seeds the refinement, with the points _RR_FOLD_STEP
+# (radians, each way) along the direction the table's Jacobian nearly loses, where the two
+# solutions lie (measured on the xArm6 URDF: both found from +-1e-3 at pairs 1e-4 to 1e-2
+# apart)
+_RR_FOLD_STEP = 1e-3
 # where nothing polishes and a pencil on the arm's own table is singular at the pose (or at a
 # moved one), or a candidate's polishing stopped within _RR_SEARCH_FROM of it (a curve of
 # solutions the eigenvalues missed), _RR_SEARCH_STEPS damped steps from those candidates and
