@@ -224,6 +224,73 @@ def check_against_mujoco(
         )
 
 
+def check_numbers(model: Any, chain: list[UrdfJoint], index: dict[str, int], where: str) -> None:
+    """Refuse the chain where a frame, axis or range MuJoCo compiled is not finite or exceeds
+    MAX_NUMBER in magnitude (the URDF reader's rule; MuJoCo takes nan and 1e300, and leaves
+    a joint whose range holds a nan without limits)."""
+    for joint in chain:
+        moving = joint.kind in urdf.MOVING
+        name = joint.name if moving else joint.name.split("#")[0]
+        what = "joint" if moving else "body"
+        parts = {
+            "frame (its body's pos and quat, its own pos)" if moving else "frame (pos and quat)": [
+                v for row in joint.origin[:3] for v in row
+            ],
+            "axis": list(joint.axis),
+            "range": [float(v) for v in model.jnt_range[index[name]]] if moving else [],
+        }
+        for part, values in parts.items():
+            if not all(abs(v) <= urdf.MAX_NUMBER for v in values):
+                shown = " ".join(f"{v:g}" for v in values)
+                raise UrdfError(
+                    f"{where}: {what} {urdf._shown(name)}: {part} {shown}; allowed: finite "
+                    f"numbers of magnitude at most {urdf.MAX_NUMBER:g}"
+                )
+
+
+def check_couplings(
+    model: Any, chain: list[UrdfJoint], index: dict[str, int], base: str, where: str
+) -> None:
+    """Refuse the chain where an <equality> couples one of its joints to another (a joint or
+    tendon equality: a URDF mimic joint's kind) or ties one of its bodies past the base to
+    something (a connect or weld: a closed loop): its joints would not move freely."""
+    mujoco = _mujoco(where)
+    joints = {index[j.name] for j in chain if j.kind in urdf.MOVING}
+    bodies = {
+        mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, j.child)
+        for j in chain
+        if j.kind == "fixed" and j.child != base
+    } - {-1}
+    eq = mujoco.mjtEq
+    for e in range(model.neq):
+        kind, ends = int(model.eq_type[e]), (int(model.eq_obj1id[e]), int(model.eq_obj2id[e]))
+        name = mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_EQUALITY, e)
+        label = urdf._shown(name) if name else f"number {e + 1} (unnamed)"
+        if kind == eq.mjEQ_JOINT:
+            coupled = any(j in joints for j in ends)
+        elif kind == eq.mjEQ_TENDON:
+            wraps = [
+                int(model.wrap_objid[w])
+                for t in ends
+                if t >= 0
+                for w in range(model.tendon_adr[t], model.tendon_adr[t] + model.tendon_num[t])
+                if int(model.wrap_type[w]) == mujoco.mjtWrap.mjWRAP_JOINT
+            ]
+            coupled = any(j in joints for j in wraps)
+        elif kind in (eq.mjEQ_CONNECT, eq.mjEQ_WELD):
+            if int(model.eq_objtype[e]) == mujoco.mjtObj.mjOBJ_SITE:
+                ends = tuple(int(model.site_bodyid[i]) if i >= 0 else -1 for i in ends)
+            coupled = any(b in bodies for b in ends)
+        else:
+            coupled = False
+        if coupled:
+            raise UrdfError(
+                f"{where}: equality {label}, a {eq(kind).name[5:].lower()} constraint, ties the "
+                "chain's joints or bodies between base and tip; not supported (the joints "
+                "must move freely, as a URDF mimic joint's does not)"
+            )
+
+
 def import_mjcf(path: Path, options: urdf.Options) -> tuple[str, urdf.Conversion]:
     """The spec text of the chain options.base .. options.tip (bodies) of an MJCF file, and
     the conversion's record (derive/urdf.py's import_chain)."""
@@ -247,6 +314,8 @@ def import_mjcf(path: Path, options: urdf.Options) -> tuple[str, urdf.Conversion
             "(a site, a frame fixed to a body, can be the --tip)"
         )
     chain = urdf.chain_between(robot, options.base, options.tip, where)
+    check_numbers(model, chain, index, where)
+    check_couplings(model, chain, index, options.base, where)
     ids = [places[options.base], places[options.tip]]
     check_against_mujoco(model, chain, index, ids, where)
     return urdf.import_chain(robot, chain, path, options, source="MJCF", part="body")

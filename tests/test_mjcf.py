@@ -165,6 +165,72 @@ def test_bad_mjcf_input_is_one_line_naming_the_file(xml, base, tip, message, tmp
     assert err.startswith(f"error: {path}: ") and message in err and err.count("\n") == 1
 
 
+THREE = (
+    '<mujoco model="m"><worldbody><body name="b0"><body name="b1" pos="0 0 0.1">'
+    '<joint name="j1" axis="0 0 1" RANGE/><geom size="0.01"/>'
+    '<body name="b2" pos="0 0 0.1"><joint name="j2" axis="AXIS"/><geom size="0.01"/>'
+    '<body name="b3" pos="POS"><joint name="j3" axis="0 1 0" REF/><geom size="0.01"/>'
+    '<body name="b4" pos="0.2 0 0"><geom size="0.01"/></body></body></body></body></body>'
+    "</worldbody>TAIL</mujoco>"
+)
+
+
+def three_joints(pos="0.3 0 0", axis="0 1 0", range_="", ref="", tail="") -> str:
+    """A three-joint MJCF (bodies b0 .. b4) with one field written as given."""
+    text = THREE.replace("POS", pos).replace("AXIS", axis).replace("TAIL", tail)
+    return text.replace("RANGE", range_).replace("REF", ref)
+
+
+@pytest.mark.parametrize(
+    ("xml", "message"),
+    [
+        (three_joints(pos="nan 0 0"), "joint 'j3': frame (its body's pos and quat, its own pos)"),
+        (three_joints(pos="inf 0 0"), "allowed: finite numbers of magnitude at most 1e+06"),
+        (three_joints(pos="1e300 0 0"), "1e+300 0 1 0 0 0 0 1 0; allowed: finite numbers"),
+        (three_joints(ref='ref="nan"'), "joint 'j3': frame"),
+        (three_joints(range_='range="nan 1"'), "joint 'j1': range nan 1; allowed: finite"),
+        (
+            three_joints(tail='<equality><joint joint1="j3" joint2="j2"/></equality>'),
+            "equality number 1 (unnamed), a joint constraint, ties the chain's joints",
+        ),
+        (
+            three_joints(
+                tail='<equality><connect name="loop" body1="b4" body2="b0" anchor="0 0 0"/>'
+                "</equality>"
+            ),
+            "equality 'loop', a connect constraint, ties",
+        ),
+        (
+            three_joints(tail='<equality><weld body1="b3" body2="b0"/></equality>'),
+            "a weld constraint, ties",
+        ),
+        (
+            three_joints(
+                tail='<tendon><fixed name="t"><joint joint="j2" coef="1"/>'
+                '<joint joint="j3" coef="-1"/></fixed></tendon>'
+                '<equality><tendon tendon1="t"/></equality>'
+            ),
+            "a tendon constraint, ties",
+        ),
+    ],
+)
+def test_mjcf_numbers_and_couplings_are_refused_as_a_urdf_s_are(xml, message, tmp_path, capsys):
+    """What MuJoCo compiles but the chain cannot be (a helper's attack: nan and inf gave a
+    traceback, 1e300 "a converter error", a nan range no limits, couplings nothing): one
+    line naming the file, and nothing written. A coupling of bodies outside the chain, or
+    of the base to the world, is not refused."""
+    path, out = tmp_path / "m.xml", tmp_path / "m.toml"
+    path.write_text(xml)
+    args = ["import-mjcf", str(path), "--base", "b0", "--tip", "b4", "-o", str(out)]
+    assert cli.main(args) == 2
+    err = capsys.readouterr().err
+    assert err.startswith(f"error: {path}: ") and message in err and err.count("\n") == 1
+    assert not out.exists()
+    free = three_joints(tail='<equality><weld body1="b0"/></equality>')
+    path.write_text(free)
+    assert cli.main(args) == 0 and out.exists()
+
+
 def test_without_mujoco_the_reader_says_which_extra_to_install(monkeypatch):
     monkeypatch.setitem(__import__("sys").modules, "mujoco", None)
     with pytest.raises(SpecError, match=r"MuJoCo's compiler: pip install 'mujoco==4\.0\.1'"):
