@@ -251,21 +251,30 @@ def check_numbers(model: Any, chain: list[UrdfJoint], index: dict[str, int], whe
 def check_couplings(
     model: Any, chain: list[UrdfJoint], index: dict[str, int], base: str, where: str
 ) -> None:
-    """Refuse the chain where an <equality> couples one of its joints to another (a joint or
-    tendon equality: a URDF mimic joint's kind) or ties one of its bodies past the base to
-    something (a connect or weld: a closed loop): its joints would not move freely."""
+    """Refuse the chain where an active <equality> couples one of its joints to another or
+    fixes it (a joint or tendon equality: a URDF mimic joint's kind), or ties one of its
+    bodies past the base to the chain or to something fixed in the world (a connect or weld:
+    a closed loop); its joints would not move freely. A weld to a mocap body (a controller's
+    handle) or to a body that moves freely (a grasped object), or one that starts inactive,
+    is not a loop."""
     mujoco = _mujoco(where)
     joints = {index[j.name] for j in chain if j.kind in urdf.MOVING}
-    bodies = {
-        mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, j.child)
-        for j in chain
-        if j.kind == "fixed" and j.child != base
-    } - {-1}
+    body = mujoco.mjtObj.mjOBJ_BODY
+    bodies = {mujoco.mj_name2id(model, body, j.child) for j in chain if j.kind == "fixed"} - {
+        -1,
+        mujoco.mj_name2id(model, body, base),
+    }
+    fixed = {
+        b
+        for b in range(model.nbody)
+        if int(model.body_weldid[b]) == 0 and int(model.body_mocapid[b]) < 0
+    }
+    held = bodies | fixed | {mujoco.mj_name2id(model, body, base)}
     eq = mujoco.mjtEq
     for e in range(model.neq):
+        if not model.eq_active0[e]:
+            continue
         kind, ends = int(model.eq_type[e]), (int(model.eq_obj1id[e]), int(model.eq_obj2id[e]))
-        name = mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_EQUALITY, e)
-        label = urdf._shown(name) if name else f"number {e + 1} (unnamed)"
         if kind == eq.mjEQ_JOINT:
             coupled = any(j in joints for j in ends)
         elif kind == eq.mjEQ_TENDON:
@@ -280,10 +289,13 @@ def check_couplings(
         elif kind in (eq.mjEQ_CONNECT, eq.mjEQ_WELD):
             if int(model.eq_objtype[e]) == mujoco.mjtObj.mjOBJ_SITE:
                 ends = tuple(int(model.site_bodyid[i]) if i >= 0 else -1 for i in ends)
-            coupled = any(b in bodies for b in ends)
+            ends = tuple(0 if b < 0 else b for b in ends)  # (no second body: the world)
+            coupled = any(b in bodies for b in ends) and all(b in held for b in ends)
         else:
             coupled = False
         if coupled:
+            name = mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_EQUALITY, e)
+            label = urdf._shown(name) if name else f"number {e + 1} (unnamed)"
             raise UrdfError(
                 f"{where}: equality {label}, a {eq(kind).name[5:].lower()} constraint, ties the "
                 "chain's joints or bodies between base and tip; not supported (the joints "

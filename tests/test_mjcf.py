@@ -217,8 +217,8 @@ def three_joints(pos="0.3 0 0", axis="0 1 0", range_="", ref="", tail="") -> str
 def test_mjcf_numbers_and_couplings_are_refused_as_a_urdf_s_are(xml, message, tmp_path, capsys):
     """What MuJoCo compiles but the chain cannot be (a helper's attack: nan and inf gave a
     traceback, 1e300 "a converter error", a nan range no limits, couplings nothing): one
-    line naming the file, and nothing written. A coupling of bodies outside the chain, or
-    of the base to the world, is not refused."""
+    line naming the file, and nothing written. The base welded to the world, an inactive
+    weld and a weld to a mocap body are not loops, and are not refused."""
     path, out = tmp_path / "m.xml", tmp_path / "m.toml"
     path.write_text(xml)
     args = ["import-mjcf", str(path), "--base", "b0", "--tip", "b4", "-o", str(out)]
@@ -226,8 +226,20 @@ def test_mjcf_numbers_and_couplings_are_refused_as_a_urdf_s_are(xml, message, tm
     err = capsys.readouterr().err
     assert err.startswith(f"error: {path}: ") and message in err and err.count("\n") == 1
     assert not out.exists()
-    free = three_joints(tail='<equality><weld body1="b0"/></equality>')
-    path.write_text(free)
+    for free in (
+        '<equality><weld body1="b0"/></equality>',  # (the base to the world)
+        '<equality><weld body1="b4" body2="b0" active="false"/></equality>',  # (inactive)
+    ):
+        path.write_text(three_joints(tail=free))
+        assert cli.main(args) == 0 and out.exists()
+        out.unlink()
+    # a mocap body welded to the tip (a controller's handle, as gym-xarm's): not a loop
+    mocap = three_joints().replace("</worldbody>", '<body name="handle" mocap="true"/></worldbody>')
+    path.write_text(
+        mocap.replace(
+            "</mujoco>", '<equality><weld body1="handle" body2="b4"/></equality></mujoco>'
+        )
+    )
     assert cli.main(args) == 0 and out.exists()
 
 

@@ -652,8 +652,12 @@ def test_a_virtual_link_within_the_structure_tolerance_is_snapped_and_refined(tm
 def test_a_direction_task_by_the_general_method_generates_its_report(tmp_path):
     """The report's worked example reads the virtual joint (or the last joint playing it)
     from the target where the general method's eigen-solve lists it (it raised KeyError
-    theta6 for the youBot and the PUMA with [ik] method = "general")."""
-    from derive import cli
+    theta6 for the youBot and the PUMA with [ik] method = "general"); the C compiles without
+    warnings (the youBot's theta6, which the direction does not read, was declared and unused:
+    -Werror failed, as on gym-xarm's xArm7 in a new user's attack)."""
+    import subprocess
+
+    from derive import cbuild, cli
 
     youbot = Path(resolve_spec("youbot").source).read_text()
     for name, text in (
@@ -666,6 +670,12 @@ def test_a_direction_task_by_the_general_method_generates_its_report(tmp_path):
         assert cli.main(["generate", str(spec), "--out", str(tmp_path / "out")]) == 0
         report = (tmp_path / "out" / f"{name}.md").read_text()
         assert "general" in report and "Worked example" in report
+        compiler = cbuild.c_compiler()
+        if compiler is not None:
+            source = tmp_path / "out" / f"{name}_ik.c"
+            command = [compiler, *cbuild.WARNINGS, "-c", str(source), "-o", str(tmp_path / "a.o")]
+            done = subprocess.run(command, capture_output=True, text=True, check=False)
+            assert done.returncode == 0, done.stderr
 
 
 @pytest.mark.parametrize("d", [(1e-300, 0.0, 0.0), (1e300, 0.0, 1e300), (0.0, -1e-200, 0.0)])

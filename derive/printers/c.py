@@ -577,6 +577,8 @@ def _eigen_lines(
     ]
     scope.levels.append(set())
     for place, (k, variable) in enumerate(zip(step.indices, step.variables)):
+        if not {variable, f"c{k}", f"s{k}"} & after:  # (a task's joint it does not move)
+            continue
         scope.declare(variable)
         lines.append(Line(depth + 1, f"const double {variable} = dk_rows{j}[dk_k{j}][{place}];"))
         for kind, function in (("c", "cos"), ("s", "sin")):
