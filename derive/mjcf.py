@@ -274,7 +274,8 @@ def check_couplings(
     for e in range(model.neq):
         if not model.eq_active0[e]:
             continue
-        kind, ends = int(model.eq_type[e]), (int(model.eq_obj1id[e]), int(model.eq_obj2id[e]))
+        kind = int(model.eq_type[e])
+        ends: tuple[int, ...] = (int(model.eq_obj1id[e]), int(model.eq_obj2id[e]))
         if kind == eq.mjEQ_JOINT:
             coupled = any(j in joints for j in ends)
         elif kind == eq.mjEQ_TENDON:
