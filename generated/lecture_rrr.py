@@ -236,6 +236,20 @@ _SPREAD_WIDTH = 0.2
 _SPREAD_COUNT = 8
 
 
+# ... and where its acos argument is beyond _FOLD_NEAR (cos 1e-3: its two values within 1e-3
+# of their fold, or one clamped value, where the exact arm's pair may lie up to acos(1 -
+# _SEED_MISS) apart), the fold's angle +- each of _FOLD_SEEDS seeds the refinement too: two
+# equal seeds refine onto one of the pair and lose the other (a new user's SO-101 MJCF lost
+# the elbow's second row 0.03-0.12 rad from its fold), and Newton's steps from either side of
+# a fold go to that side's solution; values farther apart already seed either side (with
+# cos 0.01 the seeds came at 13% of a calibrated UR5's poses, and cost 20% of its time; one
+# offset of 0.03 finds what 0.01 and 0.1 found on the SO-101, at half the cost)
+_FOLD_NEAR = 0.9999995
+
+
+_FOLD_SEEDS = (0.03,)
+
+
 # ... and its acos argument up to _SEED_BAND beyond 1 (or _SEED_TOL, if larger) still seeds
 # the refinement, at the boundary: a step before it near a singular configuration amplifies
 # the arm's difference (measured: the SO-ARM100 from its MJCF, deviation 4.2e-6, its virtual
@@ -1586,8 +1600,9 @@ def _cs1(a: float, b: float, e: float, scale: float = 0.0, ref: float = 0.0) -> 
     acos argument clamped when it exceeds 1 by at most _CLAMP_TOL (and _SEED_MISS: a nominal
     table's equation seeds the refinement onto the exact arm at its boundary; where
     sqrt(a^2 + b^2) itself is within _SPREAD_WIDTH _SEED_TOL sqrt(scale), as where two links
-    of nearly equal length fold back, _SPREAD_COUNT seeds all round), and taken as +-1 within
-    _FOLD_TOL below (the double root).
+    of nearly equal length fold back, _SPREAD_COUNT seeds all round; where the argument is
+    near +-1, seeds either side of the fold, _FOLD_SEEDS), and taken as +-1 within _FOLD_TOL
+    below (the double root).
 
     When a^2 + b^2 and e^2 are both at most _FREE_TOL * scale the equation holds for every
     t (the angle is free; e.g. the elbow folded onto axis 1): _free(ref).
@@ -1608,6 +1623,12 @@ def _cs1(a: float, b: float, e: float, scale: float = 0.0, ref: float = 0.0) -> 
         delta = 0.0 if ratio > 0.0 else math.pi
     else:
         delta = acos(ratio)
+    if _SEED_TOL and not _LOOSE.on and abs(ratio) > _FOLD_NEAR:
+        fold = base if ratio > 0.0 else base + math.pi  # (a nominal fold: seeds either side)
+        sides = tuple(fold + s * d for d in _FOLD_SEEDS for s in (1.0, -1.0))
+        if abs(ratio) >= 1.0 - _FOLD_TOL:  # (the double root once, not twice)
+            return (base + delta, *sides)
+        return (base + delta, base - delta, *sides)
     return (base + delta, base - delta)
 
 

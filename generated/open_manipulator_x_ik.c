@@ -47,6 +47,14 @@
 
 #define DK_SEED_BAND (0.05)
 
+/* beyond this acos argument (a nominal fold), the fold's angle +- each of these seeds the
+   refinement too (derive/runtime/constants.py, _FOLD_NEAR and _FOLD_SEEDS, say why) */
+#define DK_FOLD_NEAR (0.9999995)
+
+#define DK_FOLD_SEED_COUNT 1
+
+static const double DK_FOLD_SEEDS[DK_FOLD_SEED_COUNT] = {0.03};
+
 /* how far beyond 1 a nominal table's acos argument still seeds the refinement (0: exact arms;
    derive/runtime/constants.py, _SEED_BAND, says why) */
 #define DK_SEED_MISS (DK_SEED_TOL > 0.0 ? fmax(DK_SEED_TOL, DK_SEED_BAND) : 0.0)
@@ -612,6 +620,19 @@ static int dk_cs1(dk_values *v, double a, double b, double e, double scale, doub
     v->s[1] = sb * ratio - cb * sd;
     /* (b = 0: (c, s) and (c, -s) exactly, and dk_uangle is odd in s: no second call) */
     v->t[1] = sb == 0.0 && sd > 0.0 ? -v->t[0] : dk_uangle(v->s[1], v->c[1]);
+    if (DK_SEED_TOL > 0.0 && fabs(ratio) > DK_FOLD_NEAR) {
+        /* a nominal fold: seeds either side of it (the Python solver's order) */
+        const double fold = atan2(b, a) + (ratio > 0.0 ? 0.0 : DK_PI);
+        int k;
+        v->n = sd == 0.0 ? 1 : 2; /* (the double root once, not twice) */
+        for (k = 0; k < 2 * DK_FOLD_SEED_COUNT && v->n < DK_VALUES_MAX; k++) {
+            const double t = fold + (k % 2 ? -1.0 : 1.0) * DK_FOLD_SEEDS[k / 2];
+            v->t[v->n] = t;
+            v->c[v->n] = cos(t);
+            v->s[v->n] = sin(t);
+            v->n++;
+        }
+    }
     return 0;
 }
 

@@ -58,7 +58,7 @@ def test_the_c_runtime_holds_the_python_runtimes_constants():
     found = defines(runtime)
     for name in ("FREE_TOL", "CLAMP_TOL", "FOLD_TOL", "LEAD_TOL", "ROOT_IMAG_TOL", "MERGE_TOL"):
         assert float(found[f"DK_{name}"]) == getattr(constants, f"_{name}"), name
-    for name in ("CLUSTER_TOL", "RESIDUAL_TOL", "SEAM", "SEAM_SNAP", "BRANCH_FOLD"):
+    for name in ("CLUSTER_TOL", "RESIDUAL_TOL", "SEAM", "SEAM_SNAP", "BRANCH_FOLD", "FOLD_NEAR"):
         assert float(found[f"DK_{name}"]) == getattr(constants, f"_{name}"), name
     for name in ("SPREAD_WIDTH", "SPREAD_COUNT", "SEED_BAND"):
         assert float(found[f"DK_{name}"]) == getattr(constants, f"_{name}"), name
@@ -68,6 +68,7 @@ def test_the_c_runtime_holds_the_python_runtimes_constants():
         assert float(found[f"DK_REFINE_{name}"]) == getattr(refine, f"_REFINE_{name}"), name
     assert float(found["DK_PI"]) == np.pi and float(found["DK_TWO_PI"]) == 2 * np.pi
     assert table(runtime, "DK_FREE_STEPS").tolist() == list(constants._FREE_STEPS)
+    assert table(runtime, "DK_FOLD_SEEDS").tolist() == list(constants._FOLD_SEEDS)
     assert table(runtime, "DK_ANGLE_AT").tolist() == list(closed._ANGLE_AT)
     assert table(runtime, "DK_TAN_AT").tolist() == list(closed._TAN_AT)
     assert table(runtime, "DK_UA").tolist() == np.ravel(emit_c.unit_angle_table()).tolist()

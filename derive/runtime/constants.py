@@ -36,6 +36,16 @@ _TWO_PI = 2.0 * math.pi
 # all round the circle go to the refinement onto the exact arm
 _SPREAD_WIDTH = 0.2
 _SPREAD_COUNT = 8
+# ... and where its acos argument is beyond _FOLD_NEAR (cos 1e-3: its two values within 1e-3
+# of their fold, or one clamped value, where the exact arm's pair may lie up to acos(1 -
+# _SEED_MISS) apart), the fold's angle +- each of _FOLD_SEEDS seeds the refinement too: two
+# equal seeds refine onto one of the pair and lose the other (a new user's SO-101 MJCF lost
+# the elbow's second row 0.03-0.12 rad from its fold), and Newton's steps from either side of
+# a fold go to that side's solution; values farther apart already seed either side (with
+# cos 0.01 the seeds came at 13% of a calibrated UR5's poses, and cost 20% of its time; one
+# offset of 0.03 finds what 0.01 and 0.1 found on the SO-101, at half the cost)
+_FOLD_NEAR = 0.9999995
+_FOLD_SEEDS = (0.03,)
 # ... and its acos argument up to _SEED_BAND beyond 1 (or _SEED_TOL, if larger) still seeds
 # the refinement, at the boundary: a step before it near a singular configuration amplifies
 # the arm's difference (measured: the SO-ARM100 from its MJCF, deviation 4.2e-6, its virtual

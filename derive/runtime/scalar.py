@@ -23,6 +23,8 @@ from derive.runtime.constants import (
     _BRANCH_FOLD,
     _CLAMP_TOL,
     _CLUSTER_TOL,
+    _FOLD_NEAR,
+    _FOLD_SEEDS,
     _FOLD_TOL,
     _FREE_STEPS,
     _FREE_TOL,
@@ -77,8 +79,9 @@ def _cs1(a: float, b: float, e: float, scale: float = 0.0, ref: float = 0.0) -> 
     acos argument clamped when it exceeds 1 by at most _CLAMP_TOL (and _SEED_MISS: a nominal
     table's equation seeds the refinement onto the exact arm at its boundary; where
     sqrt(a^2 + b^2) itself is within _SPREAD_WIDTH _SEED_TOL sqrt(scale), as where two links
-    of nearly equal length fold back, _SPREAD_COUNT seeds all round), and taken as +-1 within
-    _FOLD_TOL below (the double root).
+    of nearly equal length fold back, _SPREAD_COUNT seeds all round; where the argument is
+    near +-1, seeds either side of the fold, _FOLD_SEEDS), and taken as +-1 within _FOLD_TOL
+    below (the double root).
 
     When a^2 + b^2 and e^2 are both at most _FREE_TOL * scale the equation holds for every
     t (the angle is free; e.g. the elbow folded onto axis 1): _free(ref).
@@ -99,6 +102,12 @@ def _cs1(a: float, b: float, e: float, scale: float = 0.0, ref: float = 0.0) -> 
         delta = 0.0 if ratio > 0.0 else math.pi
     else:
         delta = acos(ratio)
+    if _SEED_TOL and not _LOOSE.on and abs(ratio) > _FOLD_NEAR:
+        fold = base if ratio > 0.0 else base + math.pi  # (a nominal fold: seeds either side)
+        sides = tuple(fold + s * d for d in _FOLD_SEEDS for s in (1.0, -1.0))
+        if abs(ratio) >= 1.0 - _FOLD_TOL:  # (the double root once, not twice)
+            return (base + delta, *sides)
+        return (base + delta, base - delta, *sides)
     return (base + delta, base - delta)
 
 
