@@ -285,18 +285,29 @@ def branch_signs(module: ModuleType, q: Any) -> str:
 
 def cmd_path(args: argparse.Namespace) -> int:
     """Follow a straight line (position on a line, rotation by slerp) from the pose of --from
-    to that of --to in --steps poses, keeping the branch of --from (the module's ik_path);
-    print the joint values per pose with the breaks, and draw the joint curves with -o."""
+    to that of --to in --steps poses, keeping the branch of --from (the module's ik_path; an
+    arm solved for a task follows the task's components of those poses); print the joint
+    values per pose with the breaks, and draw the joint curves with -o."""
     import numpy as np
 
     spec, module = ik_module(args)
-    if getattr(module, "IK_COMPONENTS", "pose") != "pose":
-        raise UsageError(f"{spec.name}: its solver is for a task, not a pose; paths are of poses")
+    if getattr(module, "IK_COMPONENTS", "pose") == "lookat":
+        raise UsageError(
+            f"{spec.name}: a look-at arm's path is of points looked at, not of poses; use the "
+            "module's ik_path with poses whose position is the point (ik_lookat's)"
+        )
     if not 2 <= args.steps <= 100_000:
         raise UsageError(f"--steps: an integer from 2 to 100000, got {args.steps}")
     start = np.array(joint_vector(spec, parse_numbers(args.start, "--from"), args.rad))
     end = np.array(joint_vector(spec, parse_numbers(args.end, "--to"), args.rad))
     output = figure_output(args, f"{spec.name}_path.svg") if args.output else None
+    if output is not None:  # (matplotlib first: not after the whole path is printed)
+        from derive.plot import PlotUnavailable, pyplot
+
+        try:
+            pyplot()
+        except PlotUnavailable as exc:
+            raise UsageError(str(exc)) from None
     poses = module.straight_line(module.fk(start), module.fk(end), args.steps)
     Q, breaks = module.ik_path(poses, start, within_limits=args.within_limits,
                                on_break="flag" if args.flag else "stop")  # fmt: skip

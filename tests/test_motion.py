@@ -471,5 +471,24 @@ def test_derive_path_prints_the_joints_and_draws_them(tmp_path, capsys):
     # (--to's wrist is flipped against --from's: the path keeps --from's branch, and says so)
     assert "branch (q3 q2 q5)" in text and "ends on another branch than --to's" in text
     assert out.read_text().startswith("<?xml")
-    assert main(["path", "youbot", "--from", "0 0 0 0 0", "--to", "1 1 1 1 1"]) == 2
-    assert "paths are of poses" in capsys.readouterr().err
+    # a task arm follows its task's components (a new user found it refused); a look-at arm's
+    # path is of points, which joint vectors do not give: refused in one line
+    argv = ["path", "so_arm100", "--from", "10 20 30 40 10", "--to", "15 25 35 45 -10"]
+    assert main([*argv, "--steps", "6"]) == 0
+    text = capsys.readouterr().out
+    assert "so_arm100: 6 poses, 0 break(s)" in text and "branch (q1 q5 q3)" in text
+    last = [float(v) for v in text.splitlines()[-2].split()[1:6]]
+    assert np.allclose(last, [15, 25, 35, 45, -10], atol=1e-6)
+    assert main(["path", "locobot_head", "--from", "10 20", "--to", "30 -10"]) == 2
+    assert "a look-at arm's path is of points" in capsys.readouterr().err
+
+
+def test_derive_path_without_matplotlib_says_so_before_the_path(monkeypatch, capsys):
+    """-o without the plot extra: the one-line refusal comes first, not after the table."""
+    from derive.cli import main
+
+    monkeypatch.setitem(__import__("sys").modules, "matplotlib", None)
+    argv = ["path", "puma560", "--from", "10 20 30 40 30 50", "--to", "40 -10 60 -20 -30 80"]
+    assert main([*argv, "-o", "p.svg"]) == 2
+    captured = capsys.readouterr()
+    assert captured.out == "" and "pictures need matplotlib" in captured.err
