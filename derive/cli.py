@@ -1205,7 +1205,8 @@ def write_import(
         sys.stdout.write(text)
     snaps = f"{len(conversion.snaps)} snap(s)" if conversion.snaps else "no snapping"
     print(
-        f"{source}: {len(conversion.rows)} joints; {snaps}; FK deviation from the {kind} "
+        f"{source}: {len(conversion.rows)} joint{'s' if len(conversion.rows) != 1 else ''}; "
+        f"{snaps}; FK deviation from the {kind} "
         f"{conversion.deviation:.2g} (of the reach, {urdf.SAMPLES} random joint vectors)",
         file=sys.stderr,
     )

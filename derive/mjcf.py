@@ -139,7 +139,8 @@ def model_robot(
             kind, name = int(model.jnt_type[j]), names[j]
             anchor = _vector(model.jnt_pos[j])
             if kind in (FREE, BALL):  # (chain_between refuses it between base and tip)
-                joint = UrdfJoint(name, "floating", above, f"{body}#{name}", place,
+                joint = UrdfJoint(name, "floating" if kind == FREE else "ball", above,
+                                  f"{body}#{name}", place,
                                   (0.0, 0.0, 1.0), None, False)  # fmt: skip
                 place = _frame((0.0, 0.0, 0.0))
             else:
@@ -178,7 +179,8 @@ def model_robot(
                                 None, False))  # fmt: skip
         links.add(name)
         places[name] = ("site", i)
-    model_name = mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_MODEL, 0) or ""
+    # (the model's name is the first of model.names, which mj_id2name does not give)
+    model_name = bytes(model.names).split(b"\0", 1)[0].decode("utf-8", "replace")
     return Robot(model_name, frozenset(links), tuple(joints), digest), index, places
 
 
@@ -313,6 +315,11 @@ def import_mjcf(path: Path, options: urdf.Options) -> tuple[str, urdf.Conversion
     model = compile_model(path)
     digest = hashlib.sha256(path.read_bytes()).hexdigest()[:16]
     robot, index, places = model_robot(model, where, digest)
+    if model.nbody == 1:  # (only MuJoCo's world: no <worldbody> of the file's own)
+        raise UrdfError(
+            f"{where}: no bodies but MuJoCo's world (an included fragment without a "
+            "<worldbody>? give the model that includes it)"
+        )
     for name, what in ((options.base, "--base"), (options.tip, "--tip")):
         if name not in places:
             bodies = sorted(n for n, (kind, _) in places.items() if kind == "body")
@@ -331,7 +338,10 @@ def import_mjcf(path: Path, options: urdf.Options) -> tuple[str, urdf.Conversion
     check_couplings(model, chain, index, options.base, where)
     ids = [places[options.base], places[options.tip]]
     check_against_mujoco(model, chain, index, ids, where)
-    return urdf.import_chain(robot, chain, path, options, source="MJCF", part="body")
+    part = "body/site" if places[options.tip][0] == "site" else "body"
+    # (the spec is named after the file, as before the model's name was read)
+    named = dataclasses.replace(options, name=options.name or urdf.spec_name(path.stem))
+    return urdf.import_chain(robot, chain, path, named, source="MJCF", part=part)
 
 
 def load_mjcf(path: Path, options: urdf.Options) -> ArmSpec:

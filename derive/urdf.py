@@ -372,7 +372,7 @@ def chain_between(robot: Robot, base: str, tip: str, where: str) -> list[UrdfJoi
             f"allowed at most {MAX_CHAIN}"
         )
     for joint in path:
-        if joint.kind in ("floating", "planar"):
+        if joint.kind in ("floating", "planar", "ball"):
             raise UrdfError(
                 f"{where}: joint {_shown(joint.name)}: a {joint.kind} joint between base and tip; "
                 "allowed: revolute, continuous, prismatic, fixed"
@@ -817,7 +817,8 @@ def spec_text(
 
     lines = [
         f"# Converted by derive-ik from the {kind} {source!r} (sha256 {robot.digest}...),",
-        f"# robot {robot.name!r}, from {part} {base!r} to {part} {tip!r}. Joint values mean what",
+        f"# robot {robot.name!r}, from {part.split('/')[0]} {base!r} to {part.split('/')[-1]} "
+        f"{tip!r}. Joint values mean what",
         f"# they mean in the {kind} (same axis direction, same zero).",
     ]
     for snap in conversion.snaps:
@@ -968,7 +969,8 @@ def import_chain(
     part: str = "link",
 ) -> tuple[str, Conversion]:
     """import_urdf's conversion of a chain read from a file of the format source (whose
-    frames are parts: URDF links, MJCF bodies; derive/mjcf.py)."""
+    frames are parts: URDF links, MJCF bodies; derive/mjcf.py; "body/site": the base's kind,
+    then the tip's)."""
     where = str(path)
     assert options.base is not None and options.tip is not None
     conversion = convert(chain, where, options.angle_tol, options.length_tol, options.exact)

@@ -177,7 +177,7 @@ def test_task_tool_axis_and_method_options_reach_the_spec(tmp_path, capsys):
             "</worldbody></mujoco>",
             "world",
             "b",
-            "a floating joint between base and tip",
+            "a ball joint between base and tip",
         ),
     ],
 )
