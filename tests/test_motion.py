@@ -5,6 +5,7 @@ frame, and the manipulability measures."""
 from __future__ import annotations
 
 import ctypes
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -381,6 +382,36 @@ def test_the_c_branch_is_the_python_branch(generated, name):
         folds += 0 in module.branch(q)
     if name == "puma560":  # (the signs at a fold are 0 in both)
         assert folds > 0
+
+
+def test_an_axis_angle_arm_with_its_wrist_roll_free_has_branches(tmp_path):
+    """The youBot asked for the axis-angle task frees its wrist roll (q5: the caller's value);
+    the tilt's step is the task's virtual joint, computed from q as on OpenManipulator-X. It
+    had no branches (a free joint's output was taken for a reversed chain's); now its signs
+    tell the rows of 100 random poses apart, and the C signs are the Python ones."""
+    from derive.inputs import resolve_spec
+
+    from conftest import build_module
+
+    text = Path(resolve_spec("youbot").source).read_text().replace('"youbot"', '"youbot_aa"')
+    module = build_module(text + '\n[ik]\ntask = "axisangle"\n', tmp_path, c=True)
+    assert module.IK_COMPONENTS == "axisangle" and module.FREE == (5,)
+    assert module.BRANCHES == ("q1", "virtual", "q3")
+    lib, why = module._c_library()
+    assert lib is not None, why
+    call = lib["youbot_aa_branch"]
+    rng = np.random.default_rng(7)
+    lo, hi = np.clip(np.array(module.LIMITS).T, -np.pi, np.pi)
+    for _ in range(100):
+        q = rng.uniform(lo, hi)
+        rows = module.ik(module.fk(q), q_ref=q)
+        labels = [module.branch(row) for row in rows]
+        assert len(set(labels)) == len(labels) and module.branch(q) in labels
+        for row, label in zip(rows, labels):
+            signs = (ctypes.c_int * 3)()
+            values = np.ascontiguousarray(row)
+            assert call(values.ctypes.data_as(ctypes.POINTER(ctypes.c_double)), signs) == 3
+            assert tuple(signs) == label
 
 
 def test_branches_change_only_at_folds(generated):

@@ -89,12 +89,25 @@ def virtual_value(plan: Plan, step: Solve) -> sp.Expr | None:
     pose's entries and the joints' c_i, s_i, d_i); None where the plan has none or numbers
     the steps' joints otherwise than the arm's (a reversed chain)."""
     assert plan.ik is not None
-    if not plan.ik.virtual or step.joint <= plan.arm.dof or not same_joints(plan):
+    if not plan.ik.virtual or step.joint <= plan.arm.dof or not _arm_numbering(plan):
         return None
     if plan.ik.certify == "lookat":  # (the distance to the point looked at: not in q's pose)
         return None
     parts = plan.ik.virtual
     return sp.atan2(parts[1], parts[0], evaluate=False) if len(parts) == 2 else parts[0]
+
+
+def _arm_numbering(plan: Plan) -> bool:
+    """Whether the plan's theta_i / d_i are the arm's joint i (same_joints), a free joint's
+    output being the caller's value qr_i (its theta_i is still q_i's): not a reversed chain."""
+    assert plan.ik is not None
+    for i, ((target, _), out) in enumerate(zip(plan.joint_defs, plan.ik.outputs), start=1):
+        given = out.free_symbols == {sp.Symbol(f"qr{i}", real=True)} or out.free_symbols == {
+            sp.Symbol(f"qr{i}")
+        }
+        if not given and (out.free_symbols != {target} or out.coeff(target) != 1):
+            return False
+    return True
 
 
 def from_joints(plan: Plan, step: Solve) -> sp.Expr | None:
