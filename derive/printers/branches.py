@@ -18,7 +18,7 @@ import sympy as sp
 
 from derive import symbols as sym
 from derive.plan import Assign, Cs1, Cs1Reach, Eigen, Plan, Poly, PolyD, Solve
-from derive.printers.common import live_steps, read_pairs, same_joints, world_names
+from derive.printers.common import live_steps, read_pairs, world_names
 
 # the Solve kinds whose several values have a branch each (their sign functions: the
 # runtimes' _cs1_branch, _poly_branch, _polyd_branch and dk_..._branch)
