@@ -63,6 +63,19 @@ def compile_model(path: Path) -> Any:
         raise UrdfError(
             f"{where}: {status.st_size} bytes; an MJCF may have at most {urdf.MAX_BYTES}"
         )
+    # MuJoCo's warnings (a nan in the XML) go to stderr and to MUJOCO_LOG.TXT in the working
+    # folder unless a handler takes them: the checks below refuse what they warn of, in one line
+    previous = mujoco.get_mju_user_warning()
+    mujoco.set_mju_user_warning(lambda message: None)
+    try:
+        return _compile(mujoco, path)
+    finally:
+        mujoco.set_mju_user_warning(previous)
+
+
+def _compile(mujoco: Any, path: Path) -> Any:
+    """compile_model's compilation (meshes it names but cannot find left out)."""
+    where = str(path)
     try:
         return mujoco.MjModel.from_xml_path(str(path))
     except ValueError as first:

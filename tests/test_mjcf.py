@@ -239,18 +239,21 @@ def three_joints(pos="0.3 0 0", axis="0 1 0", range_="", ref="", tail="") -> str
         ),
     ],
 )
-def test_mjcf_numbers_and_couplings_are_refused_as_a_urdf_s_are(xml, message, tmp_path, capsys):
+def test_mjcf_numbers_and_couplings_are_refused_as_a_urdf_s_are(
+    xml, message, tmp_path, capfd, monkeypatch
+):
     """What MuJoCo compiles but the chain cannot be (a helper's attack: nan and inf gave a
     traceback, 1e300 "a converter error", a nan range no limits, couplings nothing): one
     line naming the file, and nothing written. The base welded to the world, an inactive
     weld and a weld to a mocap body are not loops, and are not refused."""
+    monkeypatch.chdir(tmp_path)  # (MuJoCo's warnings went to MUJOCO_LOG.TXT here, and stderr)
     path, out = tmp_path / "m.xml", tmp_path / "m.toml"
     path.write_text(xml)
     args = ["import-mjcf", str(path), "--base", "b0", "--tip", "b4", "-o", str(out)]
     assert cli.main(args) == 2
-    err = capsys.readouterr().err
+    err = capfd.readouterr().err
     assert err.startswith(f"error: {path}: ") and message in err and err.count("\n") == 1
-    assert not out.exists()
+    assert not out.exists() and not (tmp_path / "MUJOCO_LOG.TXT").exists()
     for free in (
         '<equality><weld body1="b0"/></equality>',  # (the base to the world)
         '<equality><weld body1="b4" body2="b0" active="false"/></equality>',  # (inactive)
