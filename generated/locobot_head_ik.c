@@ -43,6 +43,10 @@
 
 #define DK_TWO_PI (6.283185307179586)
 
+#define DK_FOLD_SEED_COUNT 1
+
+static const double DK_FOLD_SEEDS[DK_FOLD_SEED_COUNT] = {0.03};
+
 /* the values a free joint tries, as offsets from its first value: 0, +5, -5, +10, ... deg */
 #define DK_FREE_COUNT 72
 
@@ -880,7 +884,10 @@ static int dk_accept(const double *p, int d, const dk_cx *zs, int m, int check, 
         for (k = 0; k < m; k++) {
             const double size = 1.0 + dk_cx_abs(zs[k]);
             if (zs[k].im > DK_ROOT_IMAG_TOL * size && zs[k].im <= near * size) {
+                const double w = atan(zs[k].re); /* (and either side of the fold, _FOLD_SEEDS) */
                 out[count++] = zs[k].re;
+                out[count++] = tan(w + 0.5 * DK_FOLD_SEEDS[0]);
+                out[count++] = tan(w - 0.5 * DK_FOLD_SEEDS[0]);
             }
         }
     }
@@ -1079,7 +1086,7 @@ static int dk_poly(dk_values *v, const double *coeffs, int d, int angles, double
             c[j + 1] = ck;
             s[j + 1] = sk;
         }
-        for (k = 0; k < n; k++) {
+        for (k = 0; k < n && v->n < DK_VALUES_MAX; k++) {
             if (v->n == 0 || t[k] - v->t[v->n - 1] > 1e-12) {
                 v->t[v->n] = t[k];
                 v->c[v->n] = c[k];
@@ -1088,7 +1095,7 @@ static int dk_poly(dk_values *v, const double *coeffs, int d, int angles, double
             }
         }
     } else {
-        for (k = 0; k < n; k++) {
+        for (k = 0; k < n && v->n < DK_VALUES_MAX; k++) {
             if (v->n == 0 || fabs(x[k] - v->t[v->n - 1] / unit) > 1e-12 * (1.0 + fabs(x[k]))) {
                 v->t[v->n] = x[k] * unit;
                 v->c[v->n] = 1.0;

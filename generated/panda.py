@@ -2016,11 +2016,13 @@ def _accept(p: list[float], zs: list[complex], check: bool = True) -> list[float
     if _SEED_TOL or _LOOSE.on:  # a nominal table's near-double root, split by the arm's
         # difference (or any complex root, seeding ik_approximate)
         near = math.inf if _LOOSE.on else math.sqrt(_SEED_TOL)
-        out += [
-            z.real
-            for z in map(complex, zs)
-            if _ROOT_IMAG_TOL * (1.0 + abs(z)) < z.imag <= near * (1.0 + abs(z))
-        ]
+        for z in map(complex, zs):
+            if _ROOT_IMAG_TOL * (1.0 + abs(z)) < z.imag <= near * (1.0 + abs(z)):
+                out.append(z.real)
+                if not _LOOSE.on:  # (and either side of the fold, as _cs1's _FOLD_SEEDS: a
+                    # half-angle's u or 1/u, turned by +-_FOLD_SEEDS[0] / 2)
+                    w = math.atan(z.real)
+                    out += [math.tan(w + s * 0.5 * _FOLD_SEEDS[0]) for s in (1.0, -1.0)]
     return out
 
 
