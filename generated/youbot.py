@@ -251,7 +251,9 @@ _SPREAD_COUNT = 8
 # _SEED_MISS) apart), the fold's angle +- each of _FOLD_SEEDS seeds the refinement too: two
 # equal seeds refine onto one of the pair and lose the other (a new user's SO-101 MJCF lost
 # the elbow's second row 0.03-0.12 rad from its fold), and Newton's steps from either side of
-# a fold go to that side's solution; values farther apart already seed either side (with
+# a fold go to that side's solution; values farther apart already seed either side. A
+# polynomial's near-double root (a complex pair within sqrt(_SEED_TOL)) seeds its real part's
+# angle +- _FOLD_SEEDS[0] too (a calibrated PUMA's elbow near stretched) (with
 # cos 0.01 the seeds came at 13% of a calibrated UR5's poses, and cost 20% of its time; one
 # offset of 0.03 finds what 0.01 and 0.1 found on the SO-101, at half the cost)
 _FOLD_NEAR = 0.9999995
