@@ -945,6 +945,8 @@ static void dk_dls(const double *J, int n, const double t[6], double damping, do
 
 #define DK_RR_ROWS 16 /* the most rows one pose gives */
 
+#define DK_RR_OUT (2 * DK_RR_ROWS) /* the rows, then a nominal table's seeds */
+
 #define DK_RR_MAX 16  /* eigenvalues of one split */
 
 #define DK_RR_CANDS (8 * DK_RR_MAX) /* candidates of one split, the extras' too */
@@ -2651,9 +2653,10 @@ static int dk_rr_search(const double F[4][4], double out[DK_RR_ROWS][6], int cou
 }
 
 /* The general method's solutions of one pose into out (the first DK_RR_ROWS found where a
-   self-motion gives more): their count, or -1 where no solution polished. flanges: per
-   split, the 12 top entries of the target in the split's frame. */
-static int dk_general(const double flanges[DK_RR_SPLIT_COUNT][12], double out[DK_RR_ROWS][6])
+   self-motion gives more; then, on a nominal table, up to DK_RR_ROWS seeds of its near
+   misses, for the caller to refine and certify): their count, or -1 where none polished and
+   no seed came. flanges: per split, the 12 top entries of the target in the split's frame. */
+static int dk_general(const double flanges[DK_RR_SPLIT_COUNT][12], double out[DK_RR_OUT][6])
 {
     double targets[DK_RR_SPLIT_COUNT][4][4], moved[4][4], seeds[DK_RR_ROWS][6];
     int count = 0, doubt = DK_RR_RESCUE, perturbed = 0, grew = 0, n_seeds = 0, k, r, c, m, i;
@@ -2736,7 +2739,7 @@ static int dk_general(const double flanges[DK_RR_SPLIT_COUNT][12], double out[DK
             }
         }
     }
-    for (r = 0; r < n_seeds && count < DK_RR_ROWS; r++) {
+    for (r = 0; r < n_seeds && count < DK_RR_OUT; r++) { /* (a budget of their own) */
         /* a nominal table's near misses: seeds the caller refines onto the exact arm and
            certifies there (a pair of the exact arm near a fold, complex on the nominal table) */
         double split[6];
@@ -2963,7 +2966,7 @@ static int dk_solve(const double t[12], double tol, const double ref[DK_DOF],
     const double dk_fl3[DK_RR_SPLIT_COUNT][12] = {{F0_11, F0_12, F0_13, F0_14, F0_21, F0_22, F0_23,
             F0_24, F0_31, F0_32, F0_33, F0_34}, {F1_11, F1_12, F1_13, F1_14, F1_21, F1_22, F1_23,
             F1_24, F1_31, F1_32, F1_33, F1_34}};
-    double dk_rows3[DK_RR_ROWS][6];
+    double dk_rows3[DK_RR_OUT][6];
     const int dk_n3 = dk_general(dk_fl3, dk_rows3);
     if (dk_n3 < 0) {
         return DK_UNSETTLED;

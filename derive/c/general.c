@@ -22,6 +22,7 @@
 #define DK_RR_NEWTON_DONE (1e-11)
 #define DK_RR_NEWTON_DONE_STEP (1e-08)
 #define DK_RR_ROWS 16 /* the most rows one pose gives */
+#define DK_RR_OUT (2 * DK_RR_ROWS) /* the rows, then a nominal table's seeds */
 #define DK_RR_MAX 16  /* eigenvalues of one split */
 #define DK_RR_CANDS (8 * DK_RR_MAX) /* candidates of one split, the extras' too */
 #define DK_RR_PAIR_TOL (0.05)
@@ -1703,9 +1704,10 @@ static int dk_rr_search(const double F[4][4], double out[DK_RR_ROWS][6], int cou
 }
 
 /* The general method's solutions of one pose into out (the first DK_RR_ROWS found where a
-   self-motion gives more): their count, or -1 where no solution polished. flanges: per
-   split, the 12 top entries of the target in the split's frame. */
-static int dk_general(const double flanges[DK_RR_SPLIT_COUNT][12], double out[DK_RR_ROWS][6])
+   self-motion gives more; then, on a nominal table, up to DK_RR_ROWS seeds of its near
+   misses, for the caller to refine and certify): their count, or -1 where none polished and
+   no seed came. flanges: per split, the 12 top entries of the target in the split's frame. */
+static int dk_general(const double flanges[DK_RR_SPLIT_COUNT][12], double out[DK_RR_OUT][6])
 {
     double targets[DK_RR_SPLIT_COUNT][4][4], moved[4][4], seeds[DK_RR_ROWS][6];
     int count = 0, doubt = DK_RR_RESCUE, perturbed = 0, grew = 0, n_seeds = 0, k, r, c, m, i;
@@ -1788,7 +1790,7 @@ static int dk_general(const double flanges[DK_RR_SPLIT_COUNT][12], double out[DK
             }
         }
     }
-    for (r = 0; r < n_seeds && count < DK_RR_ROWS; r++) {
+    for (r = 0; r < n_seeds && count < DK_RR_OUT; r++) { /* (a budget of their own) */
         /* a nominal table's near misses: seeds the caller refines onto the exact arm and
            certifies there (a pair of the exact arm near a fold, complex on the nominal table) */
         double split[6];

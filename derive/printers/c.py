@@ -568,7 +568,7 @@ def _eigen_lines(
     j = step.joint
     lines = [
         Line(depth, f"const double dk_fl{j}[DK_RR_SPLIT_COUNT][12] = {{{flanges}}};"),
-        Line(depth, f"double dk_rows{j}[DK_RR_ROWS][6];"),
+        Line(depth, f"double dk_rows{j}[DK_RR_OUT][6];"),
         Line(depth, f"const int dk_n{j} = dk_general(dk_fl{j}, dk_rows{j});"),
         Line(depth, f"if (dk_n{j} < 0) {{"),
         Line(depth + 1, "return DK_UNSETTLED;"),

@@ -165,16 +165,17 @@ def _general(flanges, tol):
     if not found and not near and (leads.singular or leads.rows):
         # a curve of solutions that none of the above reached: a search (_rr_search)
         _rr_merge(found, _rr_search(targets, leads.rows))
-    if leads.seeds:
-        # a nominal table's near misses: seeds the caller refines onto the exact arm and
-        # certifies there (a pair of the exact arm near a fold, complex on the nominal table)
-        _rr_merge(found, leads.seeds)
-    if not found:
+    if not found and not leads.seeds:
         # a singular pose, where Newton converges slowly: what came within _RR_NEAR (the
         # caller's certification decides)
         found = near
     # a self-motion (a singular pose) has a curve of solutions: at most MAX_SOLUTIONS of them
-    return [tuple(float(t) for t in q) for q in found[:MAX_SOLUTIONS]]
+    found = found[:MAX_SOLUTIONS]
+    # a nominal table's near misses, after the rows (a budget of their own, as in C): seeds
+    # the caller refines onto the exact arm and certifies there (a pair of the exact arm near
+    # a fold, complex on the nominal table)
+    _rr_merge(found, leads.seeds)
+    return [tuple(float(t) for t in q) for q in found]
 
 
 def _rr_near_singular(rows):
@@ -397,7 +398,10 @@ def _rr_split(k, F, moved, leads, known=(), imag_tol=_RR_IMAG_TOL):
         if residual <= _RR_SEARCH_FROM:
             leads.rows.append(_rr_to_arm(k, q))
         if residual <= _SEED_TOL:  # (a nominal table's near miss: _SEED_TOL is 0 elsewhere)
-            leads.seeds += _rr_fold_seeds(k, q, true_rows, slide)
+            for seed in _rr_fold_seeds(k, q, true_rows, slide):  # (new ones, at most
+                # MAX_SOLUTIONS: the C solver's buffer)
+                if len(leads.seeds) < MAX_SOLUTIONS:
+                    _rr_merge(leads.seeds, [seed])
         if extra:
             continue
         if residual <= _RR_NEAR:
