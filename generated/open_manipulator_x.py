@@ -242,6 +242,17 @@ _SPREAD_WIDTH = 0.2
 _SPREAD_COUNT = 8
 
 
+# ... and a nominal two-equation step (a wrist's theta6 from s5's terms) whose determinant's
+# square root is within _WRIST_WIDTH _SEED_TOL of 0 (the wrist nearly straight: the arm's
+# difference over s5 moves the angle anywhere; _SEED_TOL is 100 times the nominal deviation)
+# seeds all round too (_SPREAD_COUNT): a calibrated UR5 got no row at q5 = 1.5e-4, and most
+# misses near folds of calibrated arms were there. 300 samples near folds (seed 7), vector
+# missed by the PUMA, UR5 and KR6: 21, 10, 20 without; 16, 2, 11 with 0.01; 10, 1, 5 with
+# 0.03; 5, 1, 3 with 0.2. The seeds that do not converge cost: KR6's C ik 9.6 us on uniform
+# poses, 12.7 with 0.01, 14.8 with 0.03, 33.7 with 0.2
+_WRIST_WIDTH = 0.03
+
+
 # ... and where its acos argument is beyond _FOLD_NEAR (cos 1e-3: its two values within 1e-3
 # of their fold, or one clamped value, where the exact arm's pair may lie up to acos(1 -
 # _SEED_MISS) apart), the fold's angle +- each of _FOLD_SEEDS seeds the refinement too: two
@@ -1681,7 +1692,18 @@ def _cs2(
     det = a1 * b2 - a2 * b1
     if abs(det) <= _FREE_TOL * det_scale or e1 * e1 + e2 * e2 <= _FREE_TOL * rhs_scale:
         return _free(ref)
-    return (atan2((a1 * e2 - a2 * e1) / det, (e1 * b2 - b1 * e2) / det),)
+    t = atan2((a1 * e2 - a2 * e1) / det, (e1 * b2 - b1 * e2) / det)
+    return _wrist_spread(t, det, det_scale)
+
+
+def _wrist_spread(t: float, det: float, det_scale: float) -> tuple[float, ...]:
+    """(t,), or on a nominal table where the system is nearly singular (sqrt(|det| /
+    det_scale) within _WRIST_WIDTH _SEED_TOL: the wrist nearly straight, where the arm's
+    difference moves t anywhere) t and _SPREAD_COUNT - 1 more seeds all round, as _cs1's
+    nominal fold (a calibrated UR5 at q5 = 1.5e-4 got t 0.77 rad off and no row)."""
+    if _SEED_TOL and not _LOOSE.on and abs(det) <= (_WRIST_WIDTH * _SEED_TOL) ** 2 * det_scale:
+        return tuple(t + _TWO_PI * k / _SPREAD_COUNT for k in range(_SPREAD_COUNT))
+    return (t,)
 
 
 def _atan2(y: float, x: float, ref: float) -> tuple[float, ...]:

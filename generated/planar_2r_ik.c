@@ -45,6 +45,8 @@
 
 #define DK_SPREAD_COUNT 8
 
+#define DK_WRIST_WIDTH (0.03)
+
 #define DK_SEED_BAND (0.05)
 
 /* beyond this acos argument (a nominal fold), the fold's angle +- each of these seeds the
@@ -689,6 +691,26 @@ static int dk_cs2_value(dk_values *v, double a1, double b1, double e1, double a2
     return dk_one(v, sign * (a1 * e2 - a2 * e1), sign * (e1 * b2 - b1 * e2));
 }
 
+/* v's one value, or on a nominal table where the system is nearly singular (sqrt(|det| /
+   det_scale) within DK_WRIST_WIDTH DK_SEED_TOL: the wrist nearly straight, where the arm's
+   difference moves it anywhere) it and DK_SPREAD_COUNT - 1 more all round (the Python
+   solver's _wrist_spread) */
+static void dk_wrist_spread(dk_values *v, double det, double det_scale)
+{
+    const double width = DK_WRIST_WIDTH * DK_SEED_TOL;
+    int k;
+    if (!(DK_SEED_TOL > 0.0 && fabs(det) <= width * width * det_scale)) {
+        return;
+    }
+    for (k = 1; k < DK_SPREAD_COUNT && v->n < DK_VALUES_MAX; k++) {
+        const double t = v->t[0] + DK_TWO_PI * k / DK_SPREAD_COUNT;
+        v->t[v->n] = t;
+        v->c[v->n] = cos(t);
+        v->s[v->n] = sin(t);
+        v->n++;
+    }
+}
+
 static int dk_cs2(dk_values *v, double a1, double b1, double e1, double a2, double b2,
                   double e2, double det_scale, double rhs_scale, double ref)
 {
@@ -696,7 +718,9 @@ static int dk_cs2(dk_values *v, double a1, double b1, double e1, double a2, doub
         dk_set_free(v, ref, 1);
         return 0;
     }
-    return dk_cs2_value(v, a1, b1, e1, a2, b2, e2);
+    dk_cs2_value(v, a1, b1, e1, a2, b2, e2);
+    dk_wrist_spread(v, a1 * b2 - a2 * b1, det_scale);
+    return 0;
 }
 
 /* the distance of the point t's position from the ray of e's tool axis (0 x, 1 y, 2 z) from

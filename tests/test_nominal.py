@@ -323,6 +323,23 @@ def test_a_calibrated_elbow_near_its_stretch_keeps_both_rows_of_each_pair(tmp_pa
             assert np.abs(module.fk(row) - T).max() <= 1e-10
 
 
+@needs_cc
+def test_a_calibrated_wrist_nearly_straight_is_answered(tmp_path):
+    """The calibrated UR5 at q5 = 1.5e-4: the nominal wrist's theta6 comes from s5's terms,
+    which the arm's difference swamps there (0.77 rad off), and the elbow after it had no
+    value: no row, in C and Python, though the pose is reached (a new user's attack). The
+    step's nearly singular system now seeds all round (_WRIST_WIDTH): the sampled vector."""
+    module = build_module(calibrated("ur5"), tmp_path, c=True)
+    q = np.array([-1.3307933409328216, -0.43360403156170796, 0.050175337314055296,
+                  -1.5354277480857816, -0.00015109384801703651, -1.9299661384598432])  # fmt: skip
+    T = module.fk(q)
+    for backend in ("c", "python"):
+        rows = module.ik(T, backend=backend)
+        assert len(rows), backend
+        gaps = np.abs(np.remainder(rows - q + math.pi, 2 * math.pi) - math.pi)
+        assert np.min(np.max(gaps, axis=1)) <= 1e-8, backend
+
+
 def _near_folds(module, count: int, seed: int) -> list[tuple[np.ndarray, float]]:
     """count joint vectors within 1e-4 to 3e-2 rad of a fold (where det J changes sign along
     a random line, found by bisection), each with its distance from the fold."""

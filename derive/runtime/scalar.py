@@ -35,6 +35,7 @@ from derive.runtime.constants import (
     _SPREAD_COUNT,
     _SPREAD_WIDTH,
     _TWO_PI,
+    _WRIST_WIDTH,
 )
 
 
@@ -156,7 +157,18 @@ def _cs2(
     det = a1 * b2 - a2 * b1
     if abs(det) <= _FREE_TOL * det_scale or e1 * e1 + e2 * e2 <= _FREE_TOL * rhs_scale:
         return _free(ref)
-    return (atan2((a1 * e2 - a2 * e1) / det, (e1 * b2 - b1 * e2) / det),)
+    t = atan2((a1 * e2 - a2 * e1) / det, (e1 * b2 - b1 * e2) / det)
+    return _wrist_spread(t, det, det_scale)
+
+
+def _wrist_spread(t: float, det: float, det_scale: float) -> tuple[float, ...]:
+    """(t,), or on a nominal table where the system is nearly singular (sqrt(|det| /
+    det_scale) within _WRIST_WIDTH _SEED_TOL: the wrist nearly straight, where the arm's
+    difference moves t anywhere) t and _SPREAD_COUNT - 1 more seeds all round, as _cs1's
+    nominal fold (a calibrated UR5 at q5 = 1.5e-4 got t 0.77 rad off and no row)."""
+    if _SEED_TOL and not _LOOSE.on and abs(det) <= (_WRIST_WIDTH * _SEED_TOL) ** 2 * det_scale:
+        return tuple(t + _TWO_PI * k / _SPREAD_COUNT for k in range(_SPREAD_COUNT))
+    return (t,)
 
 
 def _cs2_reach(
@@ -178,7 +190,8 @@ def _cs2_reach(
     """As _cs2; a free t starts at _reach_first2's value (reachability of later joints)."""
     det = a1 * b2 - a2 * b1
     if abs(det) > _FREE_TOL * det_scale and e1 * e1 + e2 * e2 > _FREE_TOL * rhs_scale:
-        return (atan2((a1 * e2 - a2 * e1) / det, (e1 * b2 - b1 * e2) / det),)
+        t = atan2((a1 * e2 - a2 * e1) / det, (e1 * b2 - b1 * e2) / det)
+        return _wrist_spread(t, det, det_scale)
     return _free(_reach_first2(A, B, C, lo, hi, ref))
 
 
