@@ -1195,6 +1195,21 @@ static int dk_poly(dk_values *v, const double *coeffs, int d, int angles, double
     return 0;
 }
 
+/* v's values after its first v->n: first + 2 pi k / DK_SPREAD_COUNT for k = v->n .. (at most
+   DK_VALUES_MAX in all): seeds all round a nominal table's angle that its equations fix only
+   roughly (the Python solver's _all_round) */
+static void dk_all_round(dk_values *v, double first)
+{
+    int k;
+    for (k = v->n; k < DK_SPREAD_COUNT && v->n < DK_VALUES_MAX; k++) {
+        const double t = first + DK_TWO_PI * k / DK_SPREAD_COUNT;
+        v->t[v->n] = t;
+        v->c[v->n] = cos(t);
+        v->s[v->n] = sin(t);
+        v->n++;
+    }
+}
+
 /* angles t with a cos t + b sin t = e (the half-angle method's two values); free when the
    equation vanishes identically */
 static int dk_cs1(dk_values *v, double a, double b, double e, double scale, double ref)
@@ -1213,14 +1228,7 @@ static int dk_cs1(dk_values *v, double a, double b, double e, double scale, doub
         return 0;
     }
     if (rho <= DK_SPREAD_WIDTH * DK_SEED_TOL * sqrt(scale)) { /* a nominal fold: seeds all round */
-        const double first = atan2(b, a);
-        int k;
-        v->n = DK_SPREAD_COUNT < DK_VALUES_MAX ? DK_SPREAD_COUNT : DK_VALUES_MAX;
-        for (k = 0; k < v->n; k++) {
-            v->t[k] = first + DK_TWO_PI * k / DK_SPREAD_COUNT;
-            v->c[k] = cos(v->t[k]);
-            v->s[k] = sin(v->t[k]);
-        }
+        dk_all_round(v, atan2(b, a));
         return 0;
     }
     inverse = 1.0 / rho;
@@ -1300,16 +1308,8 @@ static int dk_cs2_value(dk_values *v, double a1, double b1, double e1, double a2
 static void dk_wrist_spread(dk_values *v, double det, double det_scale)
 {
     const double width = DK_WRIST_WIDTH * DK_SEED_TOL;
-    int k;
-    if (!(DK_SEED_TOL > 0.0 && fabs(det) <= width * width * det_scale)) {
-        return;
-    }
-    for (k = 1; k < DK_SPREAD_COUNT && v->n < DK_VALUES_MAX; k++) {
-        const double t = v->t[0] + DK_TWO_PI * k / DK_SPREAD_COUNT;
-        v->t[v->n] = t;
-        v->c[v->n] = cos(t);
-        v->s[v->n] = sin(t);
-        v->n++;
+    if (DK_SEED_TOL > 0.0 && fabs(det) <= width * width * det_scale) {
+        dk_all_round(v, v->t[0]);
     }
 }
 

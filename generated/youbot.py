@@ -1711,8 +1711,7 @@ def _cs1(a: float, b: float, e: float, scale: float = 0.0, ref: float = 0.0) -> 
     if rho == 0.0:
         return (ref,) if _LOOSE.on else ()
     if rho <= _SPREAD_WIDTH * _SEED_TOL * sqrt(scale) and not _LOOSE.on:
-        first = atan2(b, a)  # (a nominal fold: seeds all round)
-        return tuple(first + _TWO_PI * k / _SPREAD_COUNT for k in range(_SPREAD_COUNT))
+        return _all_round(atan2(b, a))  # (a nominal fold)
     ratio = e / rho
     if abs(ratio) > 1.0 + _CLAMP_TOL + _SEED_MISS and not _LOOSE.on:
         return ()
@@ -1759,8 +1758,14 @@ def _wrist_spread(t: float, det: float, det_scale: float) -> tuple[float, ...]:
     difference moves t anywhere) t and _SPREAD_COUNT - 1 more seeds all round, as _cs1's
     nominal fold (a calibrated UR5 at q5 = 1.5e-4 got t 0.77 rad off and no row)."""
     if _SEED_TOL and not _LOOSE.on and abs(det) <= (_WRIST_WIDTH * _SEED_TOL) ** 2 * det_scale:
-        return tuple(t + _TWO_PI * k / _SPREAD_COUNT for k in range(_SPREAD_COUNT))
+        return _all_round(t)
     return (t,)
+
+
+def _all_round(first: float) -> tuple[float, ...]:
+    """_SPREAD_COUNT seeds all round from first: a nominal table's angle that its equations fix
+    only roughly."""
+    return tuple(first + _TWO_PI * k / _SPREAD_COUNT for k in range(_SPREAD_COUNT))
 
 
 def _cs2_reach(

@@ -435,7 +435,7 @@ def branch_lines(plan: Plan) -> tuple[str, ...]:
             values = [printer.doprint(e) for e in value.args]
             function = SIGNS[type(value.step)]
             name = f"dk{target}"
-            if function == "dk_cs1_branch":
+            if isinstance(value.step, (Cs1, Cs1Reach)):  # (a, b: no coefficient array)
                 lines.append(
                     f"const int {name} = {function}({', '.join(values)}, {value.variable});"
                 )
