@@ -56,6 +56,7 @@ IK_ROOTS = (
 FREE_ROOTS = ("ik_sweep",)
 # the public names a module solved for a task adds (derive/tasks.py)
 TASK_ROOTS = {
+    "position": ("ik_position",),  # (a three-joint arm's: a planar one has "xy" instead)
     "direction": ("ik_direction",),
     "lookat": ("ik_lookat",),
     "pointing": ("ik_pointing",),

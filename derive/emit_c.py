@@ -277,18 +277,21 @@ def render_ikfast(plan: Plan) -> dict[str, str]:
 
     Raises:
         GenerationError: the arm's solver is neither a 6-DOF pose solver (IKP_Transform6D)
-            nor a task's (IKP_TranslationDirection5D, IKP_Lookat3D).
+            nor a task's (IKP_Translation3D, IKP_TranslationDirection5D, IKP_Lookat3D,
+            IKP_Direction3D, IKP_Translation{X,Y,Z}AxisAngle4D): a planar arm's plane tasks
+            are not served.
     """
     printed = print_c(plan)
     assert plan.ik is not None
-    if plan.ik.certify == "position" or (
-        plan.ik.certify == "pose" and printed.dof - len(printed.free) != 6
-    ):
+    if printed.plane or (plan.ik.certify == "pose" and printed.dof - len(printed.free) != 6):
         raise GenerationError(
             f"{printed.name}: the IKFast shim serves arms solved for the whole pose with 6 "
-            "joints besides the free ones (IKP_Transform6D), or for a task's direction "
-            f"(IKP_TranslationDirection5D) or look-at (IKP_Lookat3D); this arm has {printed.dof} "
-            f"joints ({len(printed.free)} free), solved for {plan.ik.solves_for}"
+            "joints besides the free ones (IKP_Transform6D), or for a task: the tool point "
+            "(IKP_Translation3D), the point and a direction (IKP_TranslationDirection5D), a "
+            "look-at (IKP_Lookat3D), a direction (IKP_Direction3D) or the point and an axis's "
+            "angle (IKP_Translation{X,Y,Z}AxisAngle4D); this arm has "
+            f"{printed.dof} joints ({len(printed.free)} free), solved for {plan.ik.solves_for}"
+            + (" in a plane" if printed.plane else "")
         )
     text = environment().get_template("ikfast.cpp.j2").render(m=printed, generator=GENERATOR)
     return {f"{printed.name}_ikfast_solver.cpp": text}

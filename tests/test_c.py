@@ -426,6 +426,49 @@ def test_ikfast_shim_of_a_pointing_arm(tmp_path):
     assert at == len(out)
 
 
+def test_ikfast_shim_of_a_three_joint_position_arm(tmp_path):
+    """IKP_Translation3D (eetrans the tool point, eerot not read): the module's ik_position
+    rows, and ComputeFk gives the point and the tool's rotation back (tests/test_position.py's
+    offset3, whose case is the general quartic)."""
+    from test_position import arm_text
+
+    compiler = shutil.which("g++") or shutil.which("c++")
+    if compiler is None:
+        pytest.skip("no C++ compiler")
+    text = arm_text("offset3")
+    plan = build_plan(parse_spec(text, "<offset3>"))
+    for file, source in {**render_c(plan), **render_ikfast(plan)}.items():
+        (tmp_path / file).write_text(source)
+    driver = tmp_path / "driver"
+    flags = ["-std=c++11", "-Wall", "-Wextra", "-Werror", "-O2"]
+    build = [compiler, *flags, f"-I{ROOT / 'tests' / 'ikfast'}", f"-I{tmp_path}"]
+    build += ['-DSHIM="offset3_ikfast_solver.cpp"', str(ROOT / "tests" / "ikfast" / "driver.cpp")]
+    subprocess.run([*build, "-o", str(driver)], check=True, capture_output=True)
+    info = subprocess.run([driver, "info"], check=True, capture_output=True, text=True).stdout
+    m = build_module(text, tmp_path)
+    assert info.split()[:4] == ["3", "0", "8", "0x33000003"]
+    T = m.fk_batch(np.random.default_rng(14).uniform(-math.pi, math.pi, (100, 3)))
+    data = np.zeros((len(T), 12))
+    data[:, :9] = 7.0  # (eerot is not read)
+    data[:, 9:] = T[:, :3, 3]
+    out = subprocess.run([driver], input=data.tobytes(), check=True, capture_output=True).stdout
+    at = 0
+    for i in range(len(T)):
+        (count,) = np.frombuffer(out[at : at + 4], dtype=np.int32)
+        at += 4
+        rows = np.frombuffer(out[at : at + 8 * count * (m.DOF + 12)], dtype=np.float64)
+        at += 8 * count * (m.DOF + 12)
+        rows = rows.reshape(count, m.DOF + 12)
+        expected = m.ik_position(T[i, :3, 3], backend="python")
+        assert count == len(expected) > 0, i
+        np.testing.assert_allclose(rows[:, : m.DOF], expected, atol=1e-9)
+        for row in rows:
+            E = m.fk(row[: m.DOF])
+            np.testing.assert_allclose(row[m.DOF : m.DOF + 9], E[:3, :3].ravel(), atol=1e-12)
+            np.testing.assert_allclose(row[m.DOF + 9 :], T[i, :3, 3], atol=1e-9)
+    assert at == len(out)
+
+
 def test_arms_the_shim_cannot_serve_are_refused_by_name(tmp_path):
     from derive.emit import GenerationError
 

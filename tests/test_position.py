@@ -4,6 +4,7 @@ position part with the tool point as the wrist centre (derive/methods/position.p
 from __future__ import annotations
 
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -139,3 +140,46 @@ def test_the_report_shows_the_tool_point_as_the_wrist_centre():
     # the tool point (0.4, 0.02, 0) in frame 3: a3 = 0.4, d4 = 0.02, alpha3 = -90 deg
     assert maths["a_{3}"] == "0.4" and maths["d_{4}"] == "0.02"
     assert maths["\\sin\\alpha_{3}"] == "-1" and maths["\\cos\\alpha_{3}"] == "0"
+
+
+def test_ik_position_takes_the_point_and_ignores_any_rotation(tmp_path):
+    """ik_position(p) (Translation3D's own arguments) gives ik's rows for a pose at p, whatever
+    its rotation; a point that is not 3 finite numbers is refused."""
+    module = build_module(arm_text("offset3"), tmp_path)
+    rng = np.random.default_rng(5)
+    for q in rng.uniform(-math.pi, math.pi, (50, 3)):
+        T = module.fk(q)
+        rows = module.ik_position(T[:3, 3], backend="python")
+        assert len(rows) and np.allclose(rows, module.ik(T, backend="python"), atol=1e-12)
+        gaps = np.abs(np.remainder(rows - q + math.pi, 2 * math.pi) - math.pi)
+        assert np.min(np.max(gaps, axis=1)) <= 1e-8
+    for bad in ([0.1, 0.2], [0.1, np.nan, 0.2], "xyz"):
+        with pytest.raises(ValueError):
+            module.ik_position(bad)
+    assert "ik_position(p" in module.__doc__
+    # a planar arm's task is ik_xy's, not ik_position's
+    planar = (Path(__file__).parents[1] / "generated" / "planar_2r.py").read_text()
+    assert "def ik_xy(" in planar and "def ik_position(" not in planar
+
+
+@needs_cc
+def test_the_c_ik_position_gives_the_module_s_rows(tmp_path):
+    """NAME_ik_position of the generated C (arm.h) through ctypes: the Python module's rows,
+    and a point that is not finite refused (INVALID_ARGUMENT)."""
+    import ctypes
+
+    module = build_module(arm_text("offset3"), tmp_path, c=True)
+    lib, why = module._c_library()
+    assert lib is not None, why
+    double_p = ctypes.POINTER(ctypes.c_double)
+    call = lib["offset3_ik_position"]
+    rows = np.zeros((module.MAX_SOLUTIONS, module.DOF))
+    rng = np.random.default_rng(6)
+    tol = ctypes.c_double(module.CERTIFY_TOL)
+    for q in rng.uniform(-math.pi, math.pi, (100, 3)):
+        p = np.ascontiguousarray(module.fk(q)[:3, 3])
+        n = call(p.ctypes.data_as(double_p), None, tol, rows.ctypes.data_as(double_p))
+        expected = module.ik_position(p, backend="python")
+        assert n == len(expected) > 0 and np.allclose(rows[:n], expected, atol=1e-9)
+    bad = np.array([0.1, np.inf, 0.2])
+    assert call(bad.ctypes.data_as(double_p), None, tol, rows.ctypes.data_as(double_p)) == -3

@@ -18,8 +18,8 @@ Modules, in copy order:
 ``common``     argument checks and joint-value helpers the others share
 ``redundant``  ik_sweep and the searching nearest of arms with free joints (copied only
                into their modules, whose nearest it replaces)
-``task``       ik_direction, ik_lookat and ik_pointing of arms solved for a task (tasks.py;
-               copied only into their modules)
+``task``       ik_position, ik_direction, ik_lookat and ik_pointing of arms solved for a
+               task (tasks.py; copied only into their modules)
 ``motion``     jacobian and manipulability (the Jacobian derive/jacobian.py derives)
 ``closed``     closed forms of the Python solver (quadratic, quartic, atan2, Newton
                steps, the free-joint reach searches)

@@ -1,8 +1,8 @@
 """The task functions of an arm solved for fewer components than a pose (derive/tasks.py):
-ik_direction(p, d), ik_lookat(p), ik_pointing(d) and ik_axis_angle(p, angle) (and a planar
-arm's ik_xy_heading and ik_xy, derive/tasks.py Plane) build a pose whose components the task
-reads and call ik, which certifies every row on those components (IK_COMPONENTS,
-TOOL_AXIS, CONE_AXIS)."""
+ik_position(p), ik_direction(p, d), ik_lookat(p), ik_pointing(d) and ik_axis_angle(p, angle)
+(and a planar arm's ik_xy_heading and ik_xy, derive/tasks.py Plane) build a pose whose
+components the task reads and call ik, which certifies every row on those components
+(IK_COMPONENTS, TOOL_AXIS, CONE_AXIS)."""
 
 from __future__ import annotations
 
@@ -22,6 +22,30 @@ from derive.runtime.arm import (
 )
 from derive.runtime.common import _real
 from derive.runtime.constants import CERTIFY_TOL
+
+
+def ik_position(
+    p: ArrayLike,
+    *,
+    within_limits: bool = False,
+    q_ref: ArrayLike | None = None,
+    tol: float = CERTIFY_TOL,
+    backend: str | None = None,
+) -> np.ndarray:
+    """All solutions that put the tool point at p, whatever the tool's orientation (IKFast's
+    Translation3D: an arm of three joints), as an (n, DOF) array; empty if unreachable.
+
+    Args:
+        p: the tool point in the world, 3 numbers.
+        within_limits, q_ref, tol, backend: as ik's. Every row reproduces p within
+            tol * REACH.
+
+    Raises:
+        ValueError: p is not 3 finite numbers.
+    """
+    return ik(
+        _task_pose(p, None), within_limits=within_limits, q_ref=q_ref, tol=tol, backend=backend
+    )
 
 
 def ik_direction(
