@@ -286,44 +286,59 @@ def test_sanitized_round_trips(generated, harnesses):
         assert agree >= len(T) - (3 if name == "manocha_canny" else 2), (name, agree)
 
 
-@pytest.mark.parametrize("name", ["puma560", "iiwa14"])
-def test_ikfast_shim_compiles_and_answers(generated, tmp_path, name):
+def shim_driver(plan, tmp_path: Path) -> tuple[Path, list[str]]:
+    """tests/ikfast/driver.cpp built against the arm's IKFast shim (g++ -Werror), and its
+    `info` line's words (joints, free, real size, IK type, version, ...); skips without a
+    C++ compiler."""
     compiler = shutil.which("g++") or shutil.which("c++")
     if compiler is None:
         pytest.skip("no C++ compiler")
-    plan = plan_of(name)
     for file, text in {**render_c(plan), **render_ikfast(plan)}.items():
         (tmp_path / file).write_text(text)
     driver = tmp_path / "driver"
-    shim = f'"{name}_ikfast_solver.cpp"'
     flags = ["-std=c++11", "-Wall", "-Wextra", "-Werror", "-O2"]
     build = [compiler, *flags, f"-I{ROOT / 'tests' / 'ikfast'}", f"-I{tmp_path}"]
-    build += [f"-DSHIM={shim}", str(ROOT / "tests" / "ikfast" / "driver.cpp"), "-o", str(driver)]
+    shim = f'-DSHIM="{plan.arm.name}_ikfast_solver.cpp"'
+    build += [shim, str(ROOT / "tests" / "ikfast" / "driver.cpp"), "-o", str(driver)]
     subprocess.run(build, check=True, capture_output=True)
     info = subprocess.run([driver, "info"], check=True, capture_output=True, text=True).stdout
+    return driver, info.split()
+
+
+def shim_answers(driver: Path, data: np.ndarray, dof: int) -> list[np.ndarray]:
+    """The driver's ComputeIk for each row of data (eerot's 9 numbers, eetrans's 3, the free
+    values): per pose an (n, dof + 12) array, each solution then its ComputeFk (eerot,
+    eetrans)."""
+    out = subprocess.run([driver], input=data.tobytes(), check=True, capture_output=True).stdout
+    answers, at = [], 0
+    for _ in range(len(data)):
+        (count,) = np.frombuffer(out[at : at + 4], dtype=np.int32)
+        at += 4
+        rows = np.frombuffer(out[at : at + 8 * count * (dof + 12)], dtype=np.float64)
+        at += 8 * count * (dof + 12)
+        answers.append(rows.reshape(count, dof + 12))
+    assert at == len(out)
+    return answers
+
+
+@pytest.mark.parametrize("name", ["puma560", "iiwa14"])
+def test_ikfast_shim_compiles_and_answers(generated, tmp_path, name):
+    driver, info = shim_driver(plan_of(name), tmp_path)
     m = generated(name)
     free = len(m.FREE)
-    assert info.split()[:5] == [str(m.DOF), str(free), "8", "0x67000001", "0x1000003d"]
-    assert info.split()[8:] == [str(j - 1) for j in m.FREE]
+    assert info[:5] == [str(m.DOF), str(free), "8", "0x67000001", "0x1000003d"]
+    assert info[8:] == [str(j - 1) for j in m.FREE]
     _, T, refs = poses(m, 300, 11)
     data = np.concatenate([T[:, :3, :3].reshape(-1, 9), T[:, :3, 3]], axis=1)
     if free:
         data = np.concatenate([data, refs[:, [j - 1 for j in m.FREE]]], axis=1)
-    out = subprocess.run([driver], input=data.tobytes(), check=True, capture_output=True).stdout
     P = python_rows(m, T, refs)
-    at = 0
-    for i in range(len(T)):
-        (count,) = np.frombuffer(out[at : at + 4], dtype=np.int32)
-        at += 4
-        rows = np.frombuffer(out[at : at + 8 * count * (m.DOF + 12)], dtype=np.float64)
-        at += 8 * count * (m.DOF + 12)
-        rows = rows.reshape(count, m.DOF + 12)
-        assert count == len(P[i]), i
+    for i, rows in enumerate(shim_answers(driver, data, m.DOF)):
+        assert len(rows) == len(P[i]), i
         np.testing.assert_allclose(rows[:, : m.DOF], P[i], atol=1e-6)
         for row in rows:  # ComputeFk of each solution gives the pose back
             np.testing.assert_allclose(row[m.DOF : m.DOF + 9], T[i, :3, :3].ravel(), atol=1e-9)
             np.testing.assert_allclose(row[m.DOF + 9 :], T[i, :3, 3], atol=1e-9)
-    assert at == len(out)
 
 
 @pytest.mark.parametrize(
@@ -339,20 +354,9 @@ def test_ikfast_shim_of_a_task_arm(generated, tmp_path, name, kind):
     axis), IKP_Lookat3D (eetrans the point looked at) and IKP_TranslationZAxisAngle4D
     (eetrans the point, eerot[0] the tool axis's angle to the base z axis): the module's task
     rows, and ComputeFk gives the point and the axis (its angle) back."""
-    compiler = shutil.which("g++") or shutil.which("c++")
-    if compiler is None:
-        pytest.skip("no C++ compiler")
-    plan = plan_of(name)
-    for file, text in {**render_c(plan), **render_ikfast(plan)}.items():
-        (tmp_path / file).write_text(text)
-    driver = tmp_path / "driver"
-    flags = ["-std=c++11", "-Wall", "-Wextra", "-Werror", "-O2"]
-    build = [compiler, *flags, f"-I{ROOT / 'tests' / 'ikfast'}", f"-I{tmp_path}"]
-    build += [f'-DSHIM="{name}_ikfast_solver.cpp"', str(ROOT / "tests" / "ikfast" / "driver.cpp")]
-    subprocess.run([*build, "-o", str(driver)], check=True, capture_output=True)
-    info = subprocess.run([driver, "info"], check=True, capture_output=True, text=True).stdout
+    driver, info = shim_driver(plan_of(name), tmp_path)
     m = generated(name)
-    assert info.split()[:4] == [str(m.DOF), "0", "8", kind]
+    assert info[:4] == [str(m.DOF), "0", "8", kind]
     _, T, _ = poses(m, 200, 12)
     x = m.TOOL_AXIS
     data = np.zeros((len(T), 12))
@@ -362,21 +366,14 @@ def test_ikfast_shim_of_a_task_arm(generated, tmp_path, name, kind):
     angles = np.arccos(np.clip(T[:, 2, x], -1.0, 1.0))
     if m.IK_COMPONENTS == "axisangle":
         data[:, 0] = angles
-    out = subprocess.run([driver], input=data.tobytes(), check=True, capture_output=True).stdout
-    at = 0
-    for i in range(len(T)):
-        (count,) = np.frombuffer(out[at : at + 4], dtype=np.int32)
-        at += 4
-        rows = np.frombuffer(out[at : at + 8 * count * (m.DOF + 12)], dtype=np.float64)
-        at += 8 * count * (m.DOF + 12)
-        rows = rows.reshape(count, m.DOF + 12)
+    for i, rows in enumerate(shim_answers(driver, data, m.DOF)):
         if m.IK_COMPONENTS == "direction":
             expected = m.ik_direction(T[i, :3, 3], T[i, :3, x], backend="python")
         elif m.IK_COMPONENTS == "axisangle":
             expected = m.ik_axis_angle(T[i, :3, 3], angles[i], backend="python")
         else:
             expected = m.ik_lookat(T[i, :3, 3], backend="python")
-        assert count == len(expected), i
+        assert len(rows) == len(expected), i
         np.testing.assert_allclose(rows[:, : m.DOF], expected, atol=1e-6)
         for row in rows:  # ComputeFk: the tool point, and the axis (its angle) in eerot
             E = m.fk(row[: m.DOF])
@@ -385,7 +382,6 @@ def test_ikfast_shim_of_a_task_arm(generated, tmp_path, name, kind):
             else:
                 np.testing.assert_allclose(row[m.DOF : m.DOF + 3], E[:3, x], atol=1e-12)
             np.testing.assert_allclose(row[m.DOF + 9 :], E[:3, 3], atol=1e-12)
-    assert at == len(out)
 
 
 def test_ikfast_shim_of_a_pointing_arm(tmp_path):
@@ -393,37 +389,18 @@ def test_ikfast_shim_of_a_pointing_arm(tmp_path):
     module's ik_pointing rows (a pan-tilt with offsets: tests/test_tasks.py's POINTING)."""
     from test_tasks import POINTING
 
-    compiler = shutil.which("g++") or shutil.which("c++")
-    if compiler is None:
-        pytest.skip("no C++ compiler")
-    plan = build_plan(parse_spec(POINTING, "<pointer>"))
-    for file, text in {**render_c(plan), **render_ikfast(plan)}.items():
-        (tmp_path / file).write_text(text)
-    driver = tmp_path / "driver"
-    flags = ["-std=c++11", "-Wall", "-Wextra", "-Werror", "-O2"]
-    build = [compiler, *flags, f"-I{ROOT / 'tests' / 'ikfast'}", f"-I{tmp_path}"]
-    build += ['-DSHIM="pointer_ikfast_solver.cpp"', str(ROOT / "tests" / "ikfast" / "driver.cpp")]
-    subprocess.run([*build, "-o", str(driver)], check=True, capture_output=True)
-    info = subprocess.run([driver, "info"], check=True, capture_output=True, text=True).stdout
+    driver, info = shim_driver(build_plan(parse_spec(POINTING, "<pointer>")), tmp_path)
     m = build_module(POINTING, tmp_path)
-    assert info.split()[:4] == ["2", "0", "8", "0x23000004"]
+    assert info[:4] == ["2", "0", "8", "0x23000004"]
     Q = np.random.default_rng(13).uniform(-1.5, 1.0, (100, 2))
     T = m.fk_batch(Q)
     data = np.zeros((len(T), 12))
     data[:, :3] = T[:, :3, 2]
     data[:, 9:] = 7.0  # (eetrans is not read)
-    out = subprocess.run([driver], input=data.tobytes(), check=True, capture_output=True).stdout
-    at = 0
-    for i in range(len(T)):
-        (count,) = np.frombuffer(out[at : at + 4], dtype=np.int32)
-        at += 4
-        rows = np.frombuffer(out[at : at + 8 * count * (m.DOF + 12)], dtype=np.float64)
-        at += 8 * count * (m.DOF + 12)
-        rows = rows.reshape(count, m.DOF + 12)
+    for i, rows in enumerate(shim_answers(driver, data, m.DOF)):
         expected = m.ik_pointing(T[i, :3, 2], backend="python")
-        assert count == len(expected) > 0, i
+        assert len(rows) == len(expected) > 0, i
         np.testing.assert_allclose(rows[:, : m.DOF], expected, atol=1e-9)
-    assert at == len(out)
 
 
 def test_ikfast_shim_of_a_three_joint_position_arm(tmp_path):
@@ -432,41 +409,22 @@ def test_ikfast_shim_of_a_three_joint_position_arm(tmp_path):
     offset3, whose case is the general quartic)."""
     from test_position import arm_text
 
-    compiler = shutil.which("g++") or shutil.which("c++")
-    if compiler is None:
-        pytest.skip("no C++ compiler")
     text = arm_text("offset3")
-    plan = build_plan(parse_spec(text, "<offset3>"))
-    for file, source in {**render_c(plan), **render_ikfast(plan)}.items():
-        (tmp_path / file).write_text(source)
-    driver = tmp_path / "driver"
-    flags = ["-std=c++11", "-Wall", "-Wextra", "-Werror", "-O2"]
-    build = [compiler, *flags, f"-I{ROOT / 'tests' / 'ikfast'}", f"-I{tmp_path}"]
-    build += ['-DSHIM="offset3_ikfast_solver.cpp"', str(ROOT / "tests" / "ikfast" / "driver.cpp")]
-    subprocess.run([*build, "-o", str(driver)], check=True, capture_output=True)
-    info = subprocess.run([driver, "info"], check=True, capture_output=True, text=True).stdout
+    driver, info = shim_driver(build_plan(parse_spec(text, "<offset3>")), tmp_path)
     m = build_module(text, tmp_path)
-    assert info.split()[:4] == ["3", "0", "8", "0x33000003"]
+    assert info[:4] == ["3", "0", "8", "0x33000003"]
     T = m.fk_batch(np.random.default_rng(14).uniform(-math.pi, math.pi, (100, 3)))
     data = np.zeros((len(T), 12))
     data[:, :9] = 7.0  # (eerot is not read)
     data[:, 9:] = T[:, :3, 3]
-    out = subprocess.run([driver], input=data.tobytes(), check=True, capture_output=True).stdout
-    at = 0
-    for i in range(len(T)):
-        (count,) = np.frombuffer(out[at : at + 4], dtype=np.int32)
-        at += 4
-        rows = np.frombuffer(out[at : at + 8 * count * (m.DOF + 12)], dtype=np.float64)
-        at += 8 * count * (m.DOF + 12)
-        rows = rows.reshape(count, m.DOF + 12)
+    for i, rows in enumerate(shim_answers(driver, data, m.DOF)):
         expected = m.ik_position(T[i, :3, 3], backend="python")
-        assert count == len(expected) > 0, i
+        assert len(rows) == len(expected) > 0, i
         np.testing.assert_allclose(rows[:, : m.DOF], expected, atol=1e-9)
         for row in rows:
             E = m.fk(row[: m.DOF])
             np.testing.assert_allclose(row[m.DOF : m.DOF + 9], E[:3, :3].ravel(), atol=1e-12)
             np.testing.assert_allclose(row[m.DOF + 9 :], T[i, :3, 3], atol=1e-9)
-    assert at == len(out)
 
 
 def test_arms_the_shim_cannot_serve_are_refused_by_name(tmp_path):
