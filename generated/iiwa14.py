@@ -2134,10 +2134,11 @@ _LSQ_STEPS = 200
 _LSQ_FLAT = 1e-13
 
 
-def _refine(q, t):
+def _refine(q, t, held=()):
     """q after Newton's steps towards t on the exact chain, and its pose error there (the
-    largest rotation entry's difference, or position difference / REACH). Plain floats:
-    numpy's calls cost more than this size of arithmetic."""
+    largest rotation entry's difference, or position difference / REACH); the joints in held
+    (arm indices) keep their values. Plain floats: numpy's calls cost more than this size of
+    arithmetic."""
     m = len(_SOLVED)
     cur = [float(x) for x in q]
     best, best_size, worse = list(cur), math.inf, 0
@@ -2150,6 +2151,8 @@ def _refine(q, t):
         if size <= _REFINE_DONE or worse == _REFINE_PATIENCE:
             break
         last = size <= _REFINE_LAST and worse == 0
+        if held:  # (a held joint's column 0, its row of the normal equations the identity's)
+            columns = [[0.0] * len(c) if _SOLVED[k] in held else c for k, c in enumerate(columns)]
         mu = sum(e * e for e in error)
         step = [sum(c * e for c, e in zip(column, error)) for column in columns]
         normal = [
@@ -2157,6 +2160,9 @@ def _refine(q, t):
              for j in range(m)]
             for i in range(m)
         ]  # fmt: skip
+        for k in range(m):
+            if _SOLVED[k] in held:
+                normal[k][k] = 1.0
         if not _cholesky_solve(normal, step):
             break
         longest = max(map(abs, step))

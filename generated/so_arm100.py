@@ -1866,19 +1866,31 @@ _LSQ_STEPS = 200
 _LSQ_FLAT = 1e-13
 
 
-def _seed(found, t, q, tol):
+def _seed(found, t, q, tol, frees=()):
     """Append q refined onto the exact chain if its pose there reproduces the target t (the
     12 top entries) within tol and _REFINE_TOL (rotation entries; positions within that times
-    REACH)."""
+    REACH). frees: (values, arm joint index) of the steps whose joint can be free: a joint
+    whose step's values are _Free (the pose left it free on the nominal table: it took q_ref's
+    value, or a step from it) is first held there, and moves only where holding does not
+    reach the tolerance (on the exact arm, nearly singular there, Newton's steps along the
+    near-null direction would otherwise carry it anywhere, away from q_ref)."""
+    held = [i for values, i in frees if values.__class__ is _Free]
+    limit = min(tol, _REFINE_TOL)
+    if held:
+        moved, size = _refine(q, t, held)
+        if size <= limit:
+            found.append(moved)
+            return
     q, size = _refine(q, t)
-    if size <= min(tol, _REFINE_TOL) or _LOOSE.on:  # (ik_approximate keeps every seed)
+    if size <= limit or _LOOSE.on:  # (ik_approximate keeps every seed)
         found.append(q)
 
 
-def _refine(q, t):
+def _refine(q, t, held=()):
     """q after Newton's steps towards t on the exact chain, and its pose error there (the
-    largest rotation entry's difference, or position difference / REACH). Plain floats:
-    numpy's calls cost more than this size of arithmetic."""
+    largest rotation entry's difference, or position difference / REACH); the joints in held
+    (arm indices) keep their values. Plain floats: numpy's calls cost more than this size of
+    arithmetic."""
     m = len(_SOLVED)
     cur = [float(x) for x in q]
     best, best_size, worse = list(cur), math.inf, 0
@@ -1891,6 +1903,8 @@ def _refine(q, t):
         if size <= _REFINE_DONE or worse == _REFINE_PATIENCE:
             break
         last = size <= _REFINE_LAST and worse == 0
+        if held:  # (a held joint's column 0, its row of the normal equations the identity's)
+            columns = [[0.0] * len(c) if _SOLVED[k] in held else c for k, c in enumerate(columns)]
         mu = sum(e * e for e in error)
         step = [sum(c * e for c, e in zip(column, error)) for column in columns]
         normal = [
@@ -1898,6 +1912,9 @@ def _refine(q, t):
              for j in range(m)]
             for i in range(m)
         ]  # fmt: skip
+        for k in range(m):
+            if _SOLVED[k] in held:
+                normal[k][k] = 1.0
         if not _cholesky_solve(normal, step):
             break
         longest = max(map(abs, step))
@@ -2445,7 +2462,8 @@ def _ik_scalar(target, qr1, qr2, qr3, qr4, qr5, tol):
                             G11*c2*c3 - G11*x35 + G21*x33 + G21*x34, qr4 - 1.5322620031578618)):
                             _seed(found, target, (theta1, theta2 - 0.24378056638519918, theta3 +
                                 0.28230856322733766, theta4 + 1.5322620031578618, theta5 -
-                                1.5707963267948966,), tol)
+                                1.5707963267948966,), tol, ((_v1, 0), (_v2, 1), (_v3, 2), (_v4, 3),
+                                (_v5, 4), ))
                             if _v4.__class__ is _Free and len(found) > _n4:
                                 break
                         if _v2.__class__ is _Free and len(found) > _n2:

@@ -1632,10 +1632,12 @@ static void dk_task_column(const double pose[12], const double t[12], double J[6
    DK_REFINE_SMALL (a few terms of their series), and the last step (from an error within
    DK_REFINE_LAST) reuses the previous step's Jacobian and factor where that step was within
    DK_REFINE_SMALL: its error is that error times the Jacobian's change, ~1e-13 or less; the
-   two save two thirds of a seed's work (a nominal seed takes two steps) */
+   two save two thirds of a seed's work (a nominal seed takes two steps). The joints whose bit
+   is set in held (arm indices) keep their values: their columns are 0, their rows of the
+   normal equations the identity's. */
 static double dk_refine(const double chain[DK_REFINE_N + 1][12], const int revolute[DK_REFINE_N],
                         const int solved[DK_REFINE_M], double reach, const double t[12],
-                        double q[DK_REFINE_N])
+                        double q[DK_REFINE_N], unsigned held)
 {
     double cur[DK_REFINE_N], cs[DK_REFINE_N][2], best = HUGE_VAL, reused = HUGE_VAL;
     double J[6][DK_REFINE_M], normal[DK_REFINE_M][DK_REFINE_M];
@@ -1770,6 +1772,11 @@ static double dk_refine(const double chain[DK_REFINE_N + 1][12], const int revol
             if (DK_REFINE_TASK >= 2) {
                 dk_task_column(pose, t, J, k, revolute[j] ? z : NULL, reach);
             }
+            if (held >> j & 1u) {
+                for (r = 0; r < 6; r++) {
+                    J[r][k] = 0.0;
+                }
+            }
         }
         for (r = 0; r < DK_REFINE_ROWS; r++) {
             mu += error[r] * error[r];
@@ -1786,7 +1793,7 @@ static double dk_refine(const double chain[DK_REFINE_N + 1][12], const int revol
                 }
                 normal[i][c] = normal[c][i] = v;
             }
-            normal[i][i] += mu;
+            normal[i][i] = held >> solved[i] & 1u ? 1.0 : normal[i][i] + mu;
         }
         if (!dk_cholesky_solve(normal, step)) {
             break;
@@ -1823,6 +1830,33 @@ static double dk_refine(const double chain[DK_REFINE_N + 1][12], const int revol
         }
     }
     return best;
+}
+
+/* dk_refine of a nominal solution q, the joints in held (a bit per arm joint: those the pose
+   left free on the nominal table, at q_ref's value or a step from it) first held there, and
+   moved too only where holding does not reach limit (on the exact arm, nearly singular there,
+   Newton's steps along the near-null direction would otherwise carry them anywhere, away from
+   q_ref): the Python solver's _seed */
+static double dk_refine_held(const double chain[DK_REFINE_N + 1][12],
+                             const int revolute[DK_REFINE_N], const int solved[DK_REFINE_M],
+                             double reach, const double t[12], double q[DK_REFINE_N],
+                             unsigned held, double limit)
+{
+    double kept[DK_REFINE_N], size;
+    int i;
+    if (held) {
+        for (i = 0; i < DK_REFINE_N; i++) {
+            kept[i] = q[i];
+        }
+        size = dk_refine(chain, revolute, solved, reach, t, q, held);
+        if (size <= limit) {
+            return size;
+        }
+        for (i = 0; i < DK_REFINE_N; i++) {
+            q[i] = kept[i];
+        }
+    }
+    return dk_refine(chain, revolute, solved, reach, t, q, 0u);
 }
 
 /* The pose of frame k of a chain of n joints and fixed frames (12 entries each: T(q) = F_0

@@ -38,6 +38,7 @@ from derive.printers.common import (
     CodePrinter,
     Line,
     cs_arguments,
+    held_joints,
     live_steps,
     read_pairs,
     same_joints,
@@ -370,11 +371,15 @@ def solve_lines(plan: Plan) -> tuple[tuple[int, str], ...]:
     if fix:  # refined onto the exact chain, certified there
         body.append(Line(depth, "if (n < DK_MAX) {"))
         body.append(Line(depth + 1, f"double dk_q[DK_DOF] = {{{', '.join(outputs)}}};"))
+        # (the joints the pose left free, held first: derive/c/runtime.c dk_refine_held)
+        held = " | ".join(f"(dk_v{j}.free ? {1 << i}u : 0u)" for j, i in held_joints(plan))
+        body.append(Line(depth + 1, f"const unsigned dk_held = {held or '0u'};"))
+        body.append(Line(depth + 1, "const double dk_limit = fmin(tol, DK_REFINE_TOL);"))
         body.append(
             Line(
                 depth + 1,
-                "if (dk_refine(DK_CHAIN, DK_REVOLUTE, DK_SOLVED, DK_REACH, t, dk_q) <= "
-                "fmin(tol, DK_REFINE_TOL) && !dk_seen(found, n, DK_REVOLUTE, dk_q)) {",
+                "if (dk_refine_held(DK_CHAIN, DK_REVOLUTE, DK_SOLVED, DK_REACH, t, dk_q, dk_held, "
+                "dk_limit) <= dk_limit && !dk_seen(found, n, DK_REVOLUTE, dk_q)) {",
             )
         )
         body += [Line(depth + 2, f"found[n][{k}] = dk_q[{k}];") for k in range(len(outputs))]

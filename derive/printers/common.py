@@ -155,6 +155,25 @@ def same_joints(plan: Plan) -> bool:
     return True
 
 
+def held_joints(plan: Plan) -> tuple[tuple[int, int], ...]:
+    """(step joint j, arm joint index i) for each arm joint whose value is one step's variable
+    (q_i = +-theta_j + const): where that step's joint is free (it takes q_ref's value at a
+    singular configuration), the refinement onto the exact chain first holds joint i there
+    (derive/runtime/refine.py _refine)."""
+    assert plan.ik is not None
+    steps = {
+        s.variable: s.joint
+        for s in plan.ik.steps
+        if isinstance(s, Solve) and s.kind != "eigen"  # (the general method: no free joint)
+    }
+    pairs = []
+    for i, out in enumerate(plan.ik.outputs):
+        names = [str(x) for x in out.free_symbols]
+        if len(names) == 1 and names[0] in steps:
+            pairs.append((steps[names[0]], i))
+    return tuple(pairs)
+
+
 def match_expression(certify: str, axis: int = 2, cone: int = 2) -> str:
     """The certification test of entries e against target t in the task's components
     (derive/tasks.py), unrolled: rotation entries within tol, positions within ptol."""

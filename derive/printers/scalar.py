@@ -30,6 +30,7 @@ from derive.printers.common import (
     Line,
     assign_lines,
     cs_arguments,
+    held_joints,
     live_steps,
     same_joints,
     step_arguments,
@@ -74,7 +75,8 @@ def ik_lines(plan: Plan) -> tuple[tuple[int, str], ...]:
         depth += 1
     outputs = ", ".join(printer.doprint(e) for e in plan.ik.outputs)
     if plan.correction is not None:  # refined onto the exact chain, certified there
-        lines.append(Line(depth, f"_seed(found, target, ({outputs},), tol)"))
+        frees = "".join(f"(_v{j}, {i}), " for j, i in held_joints(plan))
+        lines.append(Line(depth, f"_seed(found, target, ({outputs},), tol, ({frees}))"))
     elif same_joints(plan):
         fk = f"_fk_from_cs({cs_arguments(plan)})"
         lines.append(Line(depth, f"_keep(found, target, ({outputs},), {fk}, tol)"))
