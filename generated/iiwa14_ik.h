@@ -93,7 +93,8 @@ int iiwa14_ik_velocity(const double q[7], const double twist[6], int frame,
    returned as, its value in (-pi, pi].
    q_ref (ik_ref; may be NULL: zeros): the value a joint the pose leaves free starts from.
    Returns the number of solutions written to q (0 for a pose a million times the reach away),
-   IIWA14_INVALID_POSE (T is no finite rigid transform, or tol is not positive),
+   IIWA14_INVALID_POSE (T is no finite rigid transform, or tol is not a finite positive
+   number),
    IIWA14_UNSETTLED (a root the closed forms cannot settle: ask the Python solver) or
    IIWA14_INVALID_ARGUMENT (q_ref not finite, a free value beyond its limit). The rows of
    q past the count (all of them on a negative code) hold no solution. */
@@ -111,8 +112,9 @@ int iiwa14_within_limits(double q[][7], int n, const double *q_ref);
 int iiwa14_ik_within_limits(const double T[16], const double *free, const double *q_ref,
                            double tol, double q[8][7]);
 
-/* The solution inside the limits nearest q_ref in weighted squared distance (weights NULL:
-   ones) into q: 1, or 0 where there is none, or ik's negative code. The free
+/* The solution inside the limits nearest q_ref (NULL: zeros) in weighted squared distance
+   (weights NULL: ones; else DOF finite numbers >= 0, or INVALID_ARGUMENT) into q: 1, or 0 where
+   there is none, or ik's negative code. The free
    joints take their values from free (NULL: q_ref's); the Python nearest also searches them. */
 int iiwa14_nearest(const double T[16], const double *free, const double q_ref[7],
                    const double *weights, double tol, double q[7]);

@@ -921,7 +921,9 @@ def _finish(found):
     (DEDUP_TOL, revolute differences modulo 2 pi) dropped.
 
     Repeats are found by comparing the last joint first, then all joints; the first of
-    equal candidates is kept.
+    equal candidates is kept. At most MAX_SOLUTIONS rows, the first ones, as the C solver's
+    buffer keeps: a pose on a curve of solutions (a singular configuration of a nominal table
+    whose exact arm keeps it, SO-ARM100's wrist roll at 90 deg) certifies every seed.
     """
     rows: list[tuple[float, ...]] = []
     for q in found:
@@ -938,7 +940,7 @@ def _finish(found):
                 break
         else:
             rows.append(q)
-    return rows
+    return rows[:MAX_SOLUTIONS]
 
 
 def _as_rows(rows):

@@ -91,7 +91,8 @@ int lecture_6r_ik_velocity(const double q[6], const double twist[6], int frame,
    returned as, its value in (-pi, pi].
    q_ref (ik_ref; may be NULL: zeros): the value a joint the pose leaves free starts from.
    Returns the number of solutions written to q (0 for a pose a million times the reach away),
-   LECTURE_6R_INVALID_POSE (T is no finite rigid transform, or tol is not positive),
+   LECTURE_6R_INVALID_POSE (T is no finite rigid transform, or tol is not a finite positive
+   number),
    LECTURE_6R_UNSETTLED (a root the closed forms cannot settle: ask the Python solver) or
    LECTURE_6R_INVALID_ARGUMENT (q_ref not finite, a free value beyond its limit). The rows of
    q past the count (all of them on a negative code) hold no solution. */
@@ -109,8 +110,9 @@ int lecture_6r_within_limits(double q[][6], int n, const double *q_ref);
 int lecture_6r_ik_within_limits(const double T[16], const double *free, const double *q_ref,
                                double tol, double q[8][6]);
 
-/* The solution inside the limits nearest q_ref in weighted squared distance (weights NULL:
-   ones) into q: 1, or 0 where there is none, or ik's negative code. */
+/* The solution inside the limits nearest q_ref (NULL: zeros) in weighted squared distance
+   (weights NULL: ones; else DOF finite numbers >= 0, or INVALID_ARGUMENT) into q: 1, or 0 where
+   there is none, or ik's negative code. */
 int lecture_6r_nearest(const double T[16], const double *free, const double q_ref[6],
                        const double *weights, double tol, double q[6]);
 

@@ -7,6 +7,13 @@
 #include <math.h>
 #include <stddef.h>
 
+/* The solver tests its inputs with isfinite and takes NaN's comparisons as false (a pose that
+   is not finite is refused, a NaN is never an index): -ffinite-math-only (in -ffast-math)
+   lets the compiler drop both. Add -fno-finite-math-only after -ffast-math. */
+#if defined(__FINITE_MATH_ONLY__) && __FINITE_MATH_ONLY__
+#error "compile without -ffinite-math-only (part of -ffast-math): see the comment above"
+#endif
+
 /* the size of the polynomial steps' arrays: the most roots one of this arm's polynomials has */
 #define DK_POLY_MAX 4
 /* the most values one joint's step gives (the polynomials' roots; a nominal fold's seeds) */
@@ -1683,7 +1690,7 @@ static int dk_rr_joints12(const double rows[7][4], const double F[4][4], double 
     system[3][1] = -a1 * gl[1];
     system[3][2] = (fl[0] * fp[0] + fl[1] * fp[1] + fl[2] * fp[2]) -
                    (gl[0] * gp[0] + gl[1] * gp[1] + gl[2] * gp[2]);
-    n = dk_unit_solutions(system, cs);
+    n = dk_unit_solutions((const double(*)[3])system, cs);
     for (k = 0; k < n; k++) {
         double c2 = cs[k][0], s2 = cs[k][1];
         double wl0 = c2 * gl[0] - s2 * gl[1], wl1 = s2 * gl[0] + c2 * gl[1], wl2 = gl[2];
@@ -2258,8 +2265,9 @@ static int dk_rr_candidates(const double values[490], const double F[4][4],
     }
     for (c = 0; c < 3; c++) {
         double ratio;
-        dk_rr_pencil(A6, B6, C6, DK_RR_MOEBIUS[c], pencil);
-        ratio = dk_pivot_ratio(pencil[0]);
+        dk_rr_pencil((const double(*)[9])A6, (const double(*)[9])B6, (const double(*)[9])C6,
+                     DK_RR_MOEBIUS[c], pencil);
+        ratio = dk_pivot_ratio((const double(*)[12])pencil[0]);
         if (ratio < best) {
             best = ratio;
             moebius = DK_RR_MOEBIUS[c];
@@ -2299,7 +2307,7 @@ static int dk_rr_candidates(const double values[490], const double F[4][4],
         }
     }
     n_eig = dk_rr_deflate(K, split, moebius);
-    if (!dk_eigenvalues(K, n_eig, wr, wi)) {
+    if (!dk_eigenvalues((const double(*)[24])K, n_eig, wr, wi)) {
         return 0;
     }
     for (i = 0; i < n_eig; i++) {
@@ -2349,7 +2357,7 @@ static int dk_rr_candidates(const double values[490], const double F[4][4],
                             best_pencil[2][i][col];
             }
         }
-        nv = dk_null_right(S, V, &plane);
+        nv = dk_null_right((const double(*)[12])S, V, &plane);
         if (clustered || plane) {
             /* (a perturbed table's clusters are the arm's pairs sharing the eigen-joint's
                value, which its special geometry makes common: both come from the plane, and
@@ -2524,7 +2532,8 @@ static int dk_rr_split(int k, const double F[4][4], const double moved[4][4],
             for (i = 0; i < (int)(sizeof DK_RR_PATH / sizeof DK_RR_PATH[0]); i++) {
                 dk_rr_between(DK_RR_FILL[k], DK_RR_TRUE[k], DK_RR_PATH[i], between);
                 /* (Newton only on the way) */
-                dk_rr_walk(between, F, q, 0, DK_RR_PATH_STEPS, DK_RR_NEWTON_REACH, 1);
+                dk_rr_walk((const double(*)[4])between, F, q, 0, DK_RR_PATH_STEPS,
+                           DK_RR_NEWTON_REACH, 1);
             }
         }
         error = dk_rr_newton(DK_RR_TRUE[k], F, q, &damped, extra[c]);
@@ -2672,8 +2681,8 @@ static int dk_general(const double flanges[DK_RR_SPLIT_COUNT][12], double out[DK
     }
     for (k = 0; k < DK_RR_SPLIT_COUNT; k++) {
         const int before = count;
-        count = dk_rr_split(k, targets[k], targets[k], out, count, &doubt, DK_RR_IMAG_TOL,
-                            seeds, &n_seeds);
+        count = dk_rr_split(k, (const double(*)[4])targets[k], (const double(*)[4])targets[k],
+                            out, count, &doubt, DK_RR_IMAG_TOL, seeds, &n_seeds);
         perturbed |= dk_rr_perturbed(k); /* (a perturbed table walked: the partners below) */
         grew |= k > 0 && count > before; /* (the fallback found what the first split missed) */
         if (count == DK_RR_ROWS) {
@@ -2699,8 +2708,8 @@ static int dk_general(const double flanges[DK_RR_SPLIT_COUNT][12], double out[DK
                         moved[r][c] = total;
                     }
                 }
-                count = dk_rr_split(k, targets[k], moved, out, count, &ignored,
-                                    DK_RR_IMAG_TOL, seeds, &n_seeds);
+                count = dk_rr_split(k, (const double(*)[4])targets[k], (const double(*)[4])moved,
+                                    out, count, &ignored, DK_RR_IMAG_TOL, seeds, &n_seeds);
                 perturbed |= dk_rr_perturbed(k);
                 if (count == DK_RR_ROWS) {
                     return count;
@@ -2712,10 +2721,10 @@ static int dk_general(const double flanges[DK_RR_SPLIT_COUNT][12], double out[DK
         /* a perturbed table walks two solutions that share the eigen-joint value (the PUMA's
            wrist flip) onto one now and then, whether the count stays even or not: where such
            a table answered */
-        count = dk_rr_partners(targets[0], out, count);
+        count = dk_rr_partners((const double(*)[4])targets[0], out, count);
     }
     if (count % 2) {
-        count = dk_rr_search(targets[0], out, count);
+        count = dk_rr_search((const double(*)[4])targets[0], out, count);
     }
     /* the last resort: a pose whose pencil is singular (a curve of solutions) scatters the
        eigenvalues off the real line; those within DK_RR_IMAG_LOOSE of it, polished */
@@ -2732,8 +2741,8 @@ static int dk_general(const double flanges[DK_RR_SPLIT_COUNT][12], double out[DK
                     moved[r][c] = total;
                 }
             }
-            count = dk_rr_split(k, targets[k], moved, out, count, &ignored,
-                                DK_RR_IMAG_LOOSE, seeds, &n_seeds);
+            count = dk_rr_split(k, (const double(*)[4])targets[k], (const double(*)[4])moved,
+                                out, count, &ignored, DK_RR_IMAG_LOOSE, seeds, &n_seeds);
             if (count == DK_RR_ROWS) {
                 return count;
             }
@@ -2759,6 +2768,8 @@ static int dk_general(const double flanges[DK_RR_SPLIT_COUNT][12], double out[DK
 
 #define DK_DOF 6
 #define DK_MAX 16
+/* a joint value within this of a limit is inside it (the Python module's _LOWER, _UPPER) */
+#define DK_LIMIT_SLACK (1e-12)
 #define DK_UNSETTLED (-2)
 static const double DK_REACH = 3.0;
 static const int DK_REVOLUTE[DK_DOF] = {1, 1, 1, 1, 1, 1};
@@ -3353,7 +3364,7 @@ int manocha_canny_ik_ref(const double T[16], const double *free, const double *q
 {
     double ref[DK_DOF], found[DK_MAX][DK_DOF];
     int j, count, repeats = 1;
-    if (!dk_pose_ok(T) || !(tol > 0.0)) {
+    if (!dk_pose_ok(T) || !(tol > 0.0 && tol < HUGE_VAL)) {
         return MANOCHA_CANNY_INVALID_POSE;
     }
     for (j = 0; j < DK_DOF; j++) {
@@ -3398,7 +3409,9 @@ int manocha_canny_within_limits(double q[][DK_DOF], int n, const double *q_ref)
         double row[DK_DOF];
         int inside = 1;
         for (j = 0; j < DK_DOF && inside; j++) {
-            double x = q[r][j], lo = manocha_canny_limits[j][0], hi = manocha_canny_limits[j][1];
+            /* (the limits with DK_LIMIT_SLACK: a row on a limit, a rounding past it, is inside) */
+            double x = q[r][j], lo = manocha_canny_limits[j][0] - DK_LIMIT_SLACK;
+            double hi = manocha_canny_limits[j][1] + DK_LIMIT_SLACK;
             double first = ceil((lo - x) / DK_TWO_PI), last = floor((hi - x) / DK_TWO_PI), k = 0.0;
             if (DK_REVOLUTE[j]) {
                 double ref = q_ref ? q_ref[j] : 0.0;
@@ -3430,7 +3443,13 @@ int manocha_canny_nearest(const double T[16], const double *free, const double q
                           const double *weights, double tol, double q[DK_DOF])
 {
     double rows[DK_MAX][DK_DOF], least = HUGE_VAL;
-    int n = manocha_canny_ik_ref(T, free, q_ref, tol, rows), best = -1, r, j;
+    int n, best = -1, r, j;
+    for (j = 0; weights && j < DK_DOF; j++) {
+        if (!(weights[j] >= 0.0 && weights[j] < HUGE_VAL)) { /* (NaN fails too) */
+            return MANOCHA_CANNY_INVALID_ARGUMENT;
+        }
+    }
+    n = manocha_canny_ik_ref(T, free, q_ref, tol, rows);
     if (n < 0) {
         return n;
     }
@@ -3438,7 +3457,7 @@ int manocha_canny_nearest(const double T[16], const double *free, const double q
     for (r = 0; r < n; r++) {
         double total = 0.0;
         for (j = 0; j < DK_DOF; j++) {
-            double d = rows[r][j] - q_ref[j];
+            double d = rows[r][j] - (q_ref ? q_ref[j] : 0.0);
             total += (weights ? weights[j] : 1.0) * d * d;
         }
         if (best < 0 || total < least) { /* (q_ref far out: every distance inf, the first) */

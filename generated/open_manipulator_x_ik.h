@@ -95,7 +95,8 @@ int open_manipulator_x_ik_velocity(const double q[4], const double twist[6], int
    returned as, its value in (-pi, pi].
    q_ref (ik_ref; may be NULL: zeros): the value a joint the pose leaves free starts from.
    Returns the number of solutions written to q (0 for a pose a million times the reach away),
-   OPEN_MANIPULATOR_X_INVALID_POSE (T is no finite rigid transform, or tol is not positive),
+   OPEN_MANIPULATOR_X_INVALID_POSE (T is no finite rigid transform, or tol is not a finite positive
+   number),
    OPEN_MANIPULATOR_X_UNSETTLED (a root the closed forms cannot settle: ask the Python solver) or
    OPEN_MANIPULATOR_X_INVALID_ARGUMENT (q_ref not finite, a free value beyond its limit). The rows
            of
@@ -127,8 +128,9 @@ int open_manipulator_x_within_limits(double q[][4], int n, const double *q_ref);
 int open_manipulator_x_ik_within_limits(const double T[16], const double *free, const double *q_ref,
                                        double tol, double q[8][4]);
 
-/* The solution inside the limits nearest q_ref in weighted squared distance (weights NULL:
-   ones) into q: 1, or 0 where there is none, or ik's negative code. */
+/* The solution inside the limits nearest q_ref (NULL: zeros) in weighted squared distance
+   (weights NULL: ones; else DOF finite numbers >= 0, or INVALID_ARGUMENT) into q: 1, or 0 where
+   there is none, or ik's negative code. */
 int open_manipulator_x_nearest(const double T[16], const double *free, const double q_ref[4],
                                const double *weights, double tol, double q[4]);
 

@@ -7,6 +7,13 @@
 #include <math.h>
 #include <stddef.h>
 
+/* The solver tests its inputs with isfinite and takes NaN's comparisons as false (a pose that
+   is not finite is refused, a NaN is never an index): -ffinite-math-only (in -ffast-math)
+   lets the compiler drop both. Add -fno-finite-math-only after -ffast-math. */
+#if defined(__FINITE_MATH_ONLY__) && __FINITE_MATH_ONLY__
+#error "compile without -ffinite-math-only (part of -ffast-math): see the comment above"
+#endif
+
 /* the size of the polynomial steps' arrays: the most roots one of this arm's polynomials has */
 #define DK_POLY_MAX 4
 /* the most values one joint's step gives (the polynomials' roots; a nominal fold's seeds) */
@@ -1562,6 +1569,8 @@ static void dk_dls(const double *J, int n, const double t[6], double damping, do
 
 #define DK_DOF 7
 #define DK_MAX 8
+/* a joint value within this of a limit is inside it (the Python module's _LOWER, _UPPER) */
+#define DK_LIMIT_SLACK (1e-12)
 #define DK_UNSETTLED (-2)
 static const double DK_REACH = 1.393;
 static const int DK_REVOLUTE[DK_DOF] = {1, 1, 1, 1, 1, 1, 1};
@@ -2302,7 +2311,7 @@ int panda_ik_ref(const double T[16], const double *free, const double *q_ref, do
 {
     double ref[DK_DOF], found[DK_MAX][DK_DOF];
     int j, count, repeats = 1;
-    if (!dk_pose_ok(T) || !(tol > 0.0)) {
+    if (!dk_pose_ok(T) || !(tol > 0.0 && tol < HUGE_VAL)) {
         return PANDA_INVALID_POSE;
     }
     for (j = 0; j < DK_DOF; j++) {
@@ -2347,7 +2356,9 @@ int panda_within_limits(double q[][DK_DOF], int n, const double *q_ref)
         double row[DK_DOF];
         int inside = 1;
         for (j = 0; j < DK_DOF && inside; j++) {
-            double x = q[r][j], lo = panda_limits[j][0], hi = panda_limits[j][1];
+            /* (the limits with DK_LIMIT_SLACK: a row on a limit, a rounding past it, is inside) */
+            double x = q[r][j], lo = panda_limits[j][0] - DK_LIMIT_SLACK;
+            double hi = panda_limits[j][1] + DK_LIMIT_SLACK;
             double first = ceil((lo - x) / DK_TWO_PI), last = floor((hi - x) / DK_TWO_PI), k = 0.0;
             if (DK_REVOLUTE[j]) {
                 double ref = q_ref ? q_ref[j] : 0.0;
@@ -2379,7 +2390,13 @@ int panda_nearest(const double T[16], const double *free, const double q_ref[DK_
                   const double *weights, double tol, double q[DK_DOF])
 {
     double rows[DK_MAX][DK_DOF], least = HUGE_VAL;
-    int n = panda_ik_ref(T, free, q_ref, tol, rows), best = -1, r, j;
+    int n, best = -1, r, j;
+    for (j = 0; weights && j < DK_DOF; j++) {
+        if (!(weights[j] >= 0.0 && weights[j] < HUGE_VAL)) { /* (NaN fails too) */
+            return PANDA_INVALID_ARGUMENT;
+        }
+    }
+    n = panda_ik_ref(T, free, q_ref, tol, rows);
     if (n < 0) {
         return n;
     }
@@ -2387,7 +2404,7 @@ int panda_nearest(const double T[16], const double *free, const double q_ref[DK_
     for (r = 0; r < n; r++) {
         double total = 0.0;
         for (j = 0; j < DK_DOF; j++) {
-            double d = rows[r][j] - q_ref[j];
+            double d = rows[r][j] - (q_ref ? q_ref[j] : 0.0);
             total += (weights ? weights[j] : 1.0) * d * d;
         }
         if (best < 0 || total < least) { /* (q_ref far out: every distance inf, the first) */

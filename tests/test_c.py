@@ -434,11 +434,13 @@ def test_arms_the_shim_cannot_serve_are_refused_by_name(tmp_path):
         render_ikfast(plan_of("planar_2r"))
 
 
-@pytest.mark.parametrize("opt", ["-O1", "-O3 -march=native", "-Os"])
+@pytest.mark.parametrize("opt", ["-O1", "-O3 -march=native", "-Os -pedantic"])
 def test_c_files_compile_without_warnings_at_other_optimisation_levels(tmp_path, opt):
     """The tests build with -O2; a user's build (and `derive bench --lang c`, -O3
     -march=native) may not: GCC's maybe-uninitialized analysis depends on the inlining, and
-    -Werror turns what it finds into a failed build (it did: lecture_6r at -O3)."""
+    -Werror turns what it finds into a failed build (it did: lecture_6r at -O3). -pedantic:
+    ISO C99, whose arrays of arrays do not turn const implicitly (manocha_canny and
+    so_arm100 failed under it: a new user's attack)."""
     from derive.cli import BENCH_CFLAGS
 
     assert "-O3" in BENCH_CFLAGS  # (the benchmark's flags are among those tried here)
@@ -450,6 +452,23 @@ def test_c_files_compile_without_warnings_at_other_optimisation_levels(tmp_path,
             [*command, str(tmp_path / "arm.o")], capture_output=True, text=True, check=False
         )
         assert done.returncode == 0, f"{path.name} {opt}:\n{done.stderr}"
+
+
+def test_fast_math_is_refused_by_name(tmp_path):
+    """-ffast-math's -ffinite-math-only lets the compiler drop the solver's isfinite tests
+    and NaN's comparisons (a NaN position crashed youbot's C in dk_uangle, a NaN row was
+    taken as a pose: a new user's attack): the C file refuses it with a message, and
+    -fno-finite-math-only after it is accepted."""
+    compiler = cbuild.c_compiler()
+    assert compiler is not None
+    path = GENERATED / "youbot_ik.c"
+    for flags, ok in ((["-ffast-math"], False), (["-ffast-math", "-fno-finite-math-only"], True)):
+        command = [compiler, *cbuild.WARNINGS, "-O2", *flags, "-c", str(path)]
+        done = subprocess.run(
+            [*command, "-o", str(tmp_path / "a.o")], capture_output=True, text=True, check=False
+        )
+        assert (done.returncode == 0) == ok, done.stderr
+        assert ok or "-ffinite-math-only" in done.stderr
 
 
 def test_the_wrist_flip_is_taken_where_both_wrist_twists_are_right_angles(tmp_path):
@@ -537,6 +556,68 @@ def test_within_limits_and_nearest_match_python(generated, tmp_path):
         assert best is not None
         np.testing.assert_allclose(best, m.nearest(T, ref), atol=1e-9)
         assert np.abs(best - q).max() <= 1e-6
+
+
+def test_a_row_on_a_joint_limit_is_inside_in_c_as_in_python(generated):
+    """A joint exactly at its limit (the PUMA's q1 at +160 deg, SO-ARM100's q2 at its upper
+    limit): the C row comes back a rounding past it (9e-15), and C's within_limits, with no
+    slack, dropped it where Python's (1e-12 of slack) kept it, so nearest said None in C (a
+    new user's attack: row counts differed at 106 of 400 such PUMA samples)."""
+    for name, k, side in (("puma560", 0, 1), ("so_arm100", 1, 1), ("puma560", 2, 0)):
+        m = generated(name)
+        rng = np.random.default_rng(5)
+        lo, hi = np.clip(np.array(m.LIMITS, dtype=float).T, -3.0, 3.0)
+        for q in rng.uniform(lo, hi, (40, m.DOF)):
+            q[k] = m.LIMITS[k][side]
+            T = m.fk(q)
+            ref = q + 0.01  # (q itself: a wrist flip's row is pi from it, a tie between turns)
+            rows = {b: m.ik(T, within_limits=True, q_ref=ref, backend=b) for b in ("c", "python")}
+            assert rows["c"].shape == rows["python"].shape, (name, q)
+            assert np.allclose(rows["c"], rows["python"], atol=1e-9)
+            for b in ("c", "python"):
+                best = m.nearest(T, ref, backend=b)
+                assert best is not None and np.abs(best - q).max() <= 1e-9, (name, b, q)
+
+
+def test_the_c_entry_points_refuse_what_python_refuses(generated):
+    """tol = inf (INVALID_POSE, as Python's ValueError), weights negative or NaN
+    (INVALID_ARGUMENT), and nearest's q_ref NULL taken as zeros (it crashed: a new user's
+    attack), through the module's own C library (codes: arm.h)."""
+    m = generated("puma560")
+    native = m._native_solver("c")
+    assert native is not None
+    q = np.array([0.2, -0.4, 0.3, 0.5, 0.6, -0.7])
+    T = np.ascontiguousarray(m.fk(q))
+    out = np.zeros((m.MAX_SOLUTIONS, m.DOF))
+    best = np.zeros(m.DOF)
+    at = T.ctypes.data
+    assert native.ik(at, None, None, math.inf, out.ctypes.data) == -1  # (INVALID_POSE)
+    assert native.ik(at, None, None, 1e-10, out.ctypes.data) == len(m.ik(T))
+    for bad in (-1.0, math.nan, math.inf):
+        w = np.ones(m.DOF)
+        w[3] = bad
+        assert native.nearest(at, None, q.ctypes.data, w.ctypes.data, 1e-10, best.ctypes.data) == -3
+    assert native.nearest(at, None, None, None, 1e-10, best.ctypes.data) == 1
+    expected = m.nearest(T, np.zeros(m.DOF), backend="python")
+    assert np.allclose(best, expected, atol=1e-9)
+
+
+def test_a_pose_on_a_curve_of_solutions_gets_at_most_max_solutions_rows_in_both(generated):
+    """SO-ARM100 with its wrist roll at 90 deg: the tool z axis parallel to the pitch axes, a
+    curve of solutions that the exact arm keeps, so every seed certifies: Python returned up to
+    42 rows, past MAX_SOLUTIONS = 8, where C's buffer keeps 8 (a new user's attack). Both now
+    give the first MAX_SOLUTIONS, the same rows."""
+    m = generated("so_arm100")
+    q = np.array([0.7387133845139449, -math.pi / 2, 2.908206401485271, 0.843344312546662,
+                  math.pi / 2])  # fmt: skip
+    T = m.fk(q)
+    rows = {b: m.ik(T, backend=b) for b in ("c", "python")}
+    assert len(rows["python"]) == len(rows["c"]) == m.MAX_SOLUTIONS
+    assert np.allclose(rows["c"], rows["python"], atol=1e-9)
+    for row in rows["python"]:  # (the task's components: the tool point and the z axis)
+        E = m.fk(row)
+        assert np.abs(E[:3, 3] - T[:3, 3]).max() <= 1e-10 * m.REACH
+        assert np.abs(E[:3, 2] - T[:3, 2]).max() <= 1e-10
 
 
 UANGLE_PROBE = r"""

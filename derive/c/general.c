@@ -734,7 +734,7 @@ static int dk_rr_joints12(const double rows[7][4], const double F[4][4], double 
     system[3][1] = -a1 * gl[1];
     system[3][2] = (fl[0] * fp[0] + fl[1] * fp[1] + fl[2] * fp[2]) -
                    (gl[0] * gp[0] + gl[1] * gp[1] + gl[2] * gp[2]);
-    n = dk_unit_solutions(system, cs);
+    n = dk_unit_solutions((const double(*)[3])system, cs);
     for (k = 0; k < n; k++) {
         double c2 = cs[k][0], s2 = cs[k][1];
         double wl0 = c2 * gl[0] - s2 * gl[1], wl1 = s2 * gl[0] + c2 * gl[1], wl2 = gl[2];
@@ -1309,8 +1309,9 @@ static int dk_rr_candidates(const double values[490], const double F[4][4],
     }
     for (c = 0; c < 3; c++) {
         double ratio;
-        dk_rr_pencil(A6, B6, C6, DK_RR_MOEBIUS[c], pencil);
-        ratio = dk_pivot_ratio(pencil[0]);
+        dk_rr_pencil((const double(*)[9])A6, (const double(*)[9])B6, (const double(*)[9])C6,
+                     DK_RR_MOEBIUS[c], pencil);
+        ratio = dk_pivot_ratio((const double(*)[12])pencil[0]);
         if (ratio < best) {
             best = ratio;
             moebius = DK_RR_MOEBIUS[c];
@@ -1350,7 +1351,7 @@ static int dk_rr_candidates(const double values[490], const double F[4][4],
         }
     }
     n_eig = dk_rr_deflate(K, split, moebius);
-    if (!dk_eigenvalues(K, n_eig, wr, wi)) {
+    if (!dk_eigenvalues((const double(*)[24])K, n_eig, wr, wi)) {
         return 0;
     }
     for (i = 0; i < n_eig; i++) {
@@ -1400,7 +1401,7 @@ static int dk_rr_candidates(const double values[490], const double F[4][4],
                             best_pencil[2][i][col];
             }
         }
-        nv = dk_null_right(S, V, &plane);
+        nv = dk_null_right((const double(*)[12])S, V, &plane);
         if (clustered || plane) {
             /* (a perturbed table's clusters are the arm's pairs sharing the eigen-joint's
                value, which its special geometry makes common: both come from the plane, and
@@ -1575,7 +1576,8 @@ static int dk_rr_split(int k, const double F[4][4], const double moved[4][4],
             for (i = 0; i < (int)(sizeof DK_RR_PATH / sizeof DK_RR_PATH[0]); i++) {
                 dk_rr_between(DK_RR_FILL[k], DK_RR_TRUE[k], DK_RR_PATH[i], between);
                 /* (Newton only on the way) */
-                dk_rr_walk(between, F, q, 0, DK_RR_PATH_STEPS, DK_RR_NEWTON_REACH, 1);
+                dk_rr_walk((const double(*)[4])between, F, q, 0, DK_RR_PATH_STEPS,
+                           DK_RR_NEWTON_REACH, 1);
             }
         }
         error = dk_rr_newton(DK_RR_TRUE[k], F, q, &damped, extra[c]);
@@ -1723,8 +1725,8 @@ static int dk_general(const double flanges[DK_RR_SPLIT_COUNT][12], double out[DK
     }
     for (k = 0; k < DK_RR_SPLIT_COUNT; k++) {
         const int before = count;
-        count = dk_rr_split(k, targets[k], targets[k], out, count, &doubt, DK_RR_IMAG_TOL,
-                            seeds, &n_seeds);
+        count = dk_rr_split(k, (const double(*)[4])targets[k], (const double(*)[4])targets[k],
+                            out, count, &doubt, DK_RR_IMAG_TOL, seeds, &n_seeds);
         perturbed |= dk_rr_perturbed(k); /* (a perturbed table walked: the partners below) */
         grew |= k > 0 && count > before; /* (the fallback found what the first split missed) */
         if (count == DK_RR_ROWS) {
@@ -1750,8 +1752,8 @@ static int dk_general(const double flanges[DK_RR_SPLIT_COUNT][12], double out[DK
                         moved[r][c] = total;
                     }
                 }
-                count = dk_rr_split(k, targets[k], moved, out, count, &ignored,
-                                    DK_RR_IMAG_TOL, seeds, &n_seeds);
+                count = dk_rr_split(k, (const double(*)[4])targets[k], (const double(*)[4])moved,
+                                    out, count, &ignored, DK_RR_IMAG_TOL, seeds, &n_seeds);
                 perturbed |= dk_rr_perturbed(k);
                 if (count == DK_RR_ROWS) {
                     return count;
@@ -1763,10 +1765,10 @@ static int dk_general(const double flanges[DK_RR_SPLIT_COUNT][12], double out[DK
         /* a perturbed table walks two solutions that share the eigen-joint value (the PUMA's
            wrist flip) onto one now and then, whether the count stays even or not: where such
            a table answered */
-        count = dk_rr_partners(targets[0], out, count);
+        count = dk_rr_partners((const double(*)[4])targets[0], out, count);
     }
     if (count % 2) {
-        count = dk_rr_search(targets[0], out, count);
+        count = dk_rr_search((const double(*)[4])targets[0], out, count);
     }
     /* the last resort: a pose whose pencil is singular (a curve of solutions) scatters the
        eigenvalues off the real line; those within DK_RR_IMAG_LOOSE of it, polished */
@@ -1783,8 +1785,8 @@ static int dk_general(const double flanges[DK_RR_SPLIT_COUNT][12], double out[DK
                     moved[r][c] = total;
                 }
             }
-            count = dk_rr_split(k, targets[k], moved, out, count, &ignored,
-                                DK_RR_IMAG_LOOSE, seeds, &n_seeds);
+            count = dk_rr_split(k, (const double(*)[4])targets[k], (const double(*)[4])moved,
+                                out, count, &ignored, DK_RR_IMAG_LOOSE, seeds, &n_seeds);
             if (count == DK_RR_ROWS) {
                 return count;
             }

@@ -1551,7 +1551,7 @@ static int dk_cholesky_solve(double A[DK_REFINE_M][DK_REFINE_M], double x[DK_REF
             A[i][j] = v * A[j][j];
         }
     }
-    dk_cholesky_again(A, x);
+    dk_cholesky_again((const double(*)[DK_REFINE_M])A, x);
     return 1;
 }
 

@@ -379,7 +379,8 @@ def solve_lines(plan: Plan) -> tuple[tuple[int, str], ...]:
             Line(
                 depth + 1,
                 "if (dk_refine_held(DK_CHAIN, DK_REVOLUTE, DK_SOLVED, DK_REACH, t, dk_q, dk_held, "
-                "dk_limit) <= dk_limit && !dk_seen(found, n, DK_REVOLUTE, dk_q)) {",
+                "dk_limit) <= dk_limit && !dk_seen((const double(*)[DK_DOF])found, n, DK_REVOLUTE, "
+                "dk_q)) {",
             )
         )
         body += [Line(depth + 2, f"found[n][{k}] = dk_q[{k}];") for k in range(len(outputs))]
