@@ -37,6 +37,8 @@ CHECK_SAMPLES = 20
 CHECK_TOL = 1e-9
 # MuJoCo's compiler message, cut to this many characters
 COMPILE_SHOWN = 300
+# the name MuJoCo gives a model whose <mujoco> has no model attribute
+MUJOCO_UNNAMED = "MuJoCo Model"
 
 
 def _mujoco(where: str) -> Any:
@@ -352,8 +354,12 @@ def import_mjcf(path: Path, options: urdf.Options) -> tuple[str, urdf.Conversion
     ids = [places[options.base], places[options.tip]]
     check_against_mujoco(model, chain, index, ids, where)
     part = "body/site" if places[options.tip][0] == "site" else "body"
-    # (the spec is named after the file, as before the model's name was read)
-    named = dataclasses.replace(options, name=options.name or urdf.spec_name(path.stem))
+    # (named after the model, <mujoco model="...">, as a URDF after its robot; after the file
+    # where the model has no name, which MuJoCo reports as MUJOCO_UNNAMED)
+    model_name = "" if robot.name == MUJOCO_UNNAMED else robot.name
+    named = dataclasses.replace(
+        options, name=options.name or urdf.spec_name(model_name or path.stem)
+    )
     return urdf.import_chain(robot, chain, path, named, source="MJCF", part=part)
 
 

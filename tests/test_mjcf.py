@@ -293,3 +293,16 @@ def test_a_urdf_named_xml_is_read_as_a_urdf(tmp_path):
     assert spec.origin is not None and spec.origin.format == "URDF"
     mj = resolve_spec(str(DATA / "jaco_arm.xml"), Options(base="b_base", tip="b_6"))
     assert mj.origin is not None and mj.origin.format == "MJCF"
+
+
+def test_the_spec_is_named_after_the_model_else_the_file(tmp_path):
+    """<mujoco model="ur5e"> names the arm as a URDF's <robot name> does (robosuite's arms are
+    all robot.xml: each generated robot.py over the last, a new user's attack); a model
+    without a name (MuJoCo's "MuJoCo Model") is named after its file."""
+    named = tmp_path / "robot.xml"
+    named.write_text(three_joints().replace('model="m"', 'model="UR5e arm"'))
+    unnamed = tmp_path / "left_arm.xml"
+    unnamed.write_text(three_joints().replace(' model="m"', ""))
+    for path, name in ((named, "ur5e_arm"), (unnamed, "left_arm")):
+        spec = mjcf.load_mjcf(path, Options(base="b0", tip="b4"))
+        assert spec.name == name
