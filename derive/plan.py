@@ -138,6 +138,17 @@ class Cs1(Solve):
 
 
 @dataclass(frozen=True)
+class Cs1Unit(Cs1):
+    """Cs1 whose a^2 + b^2 - e^2 is known as a sum of squares, rest, exact to roundings where
+    it is small (a spherical wrist's theta5: W33 = -+c5 of the unit column (W13, W23, W33), so
+    s5^2 = W13^2 + W23^2): the half-width of the two values is atan2(sqrt(rest), e), the
+    lecture's theta5 = atan2(+-sqrt(W13^2 + W23^2), W33), not acos(e / sqrt(a^2 + b^2)),
+    which loses half the digits near the fold (the wrist nearly straight)."""
+
+    ARGS: ClassVar[tuple[str, ...]] = ("a", "b", "e", "rest")
+
+
+@dataclass(frozen=True)
 class Cs1Reach(Solve):
     """Cs1 whose free value must leave the next joint t' a value keeping
     W = sum M_ij u_i(t') u_j(t) inside [lo, hi], u = (1, cos, sin): the first value in 5
@@ -268,7 +279,9 @@ class Eigen(Solve):
 
 
 # every kind of Solve step: each backend's printer has a function for each (a test checks it)
-SOLVE_KINDS: tuple[type[Solve], ...] = (Cs1, Cs1Reach, Cs2, Cs2Reach, Atan2, Poly, PolyD, Eigen)
+SOLVE_KINDS: tuple[type[Solve], ...] = (
+    Cs1, Cs1Unit, Cs1Reach, Cs2, Cs2Reach, Atan2, Poly, PolyD, Eigen,
+)  # fmt: skip
 
 
 Step = Assign | Solve

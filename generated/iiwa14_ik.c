@@ -28,6 +28,8 @@
    leading underscore. */
 #define DK_FREE_TOL (1e-14)
 
+#define DK_FREE_TOL_EXACT (1e-20)
+
 #define DK_CLAMP_TOL (1e-07)
 
 #define DK_FOLD_TOL (1e-14)
@@ -1200,8 +1202,11 @@ static void dk_all_round(dk_values *v, double first)
 }
 
 /* angles t with a cos t + b sin t = e (the half-angle method's two values); free when the
-   equation vanishes identically */
-static int dk_cs1(dk_values *v, double a, double b, double e, double scale, double ref)
+   equation vanishes identically; where rest >= 0 (a^2 + b^2 - e^2 as a sum of squares, exact
+   to roundings: a spherical wrist's W13^2 + W23^2), the half-width's sine is sqrt(rest) / rho,
+   not sqrt(1 - ratio^2), which loses half the digits at the fold (the Python _cs1x) */
+static int dk_cs1x(dk_values *v, double a, double b, double e, double rest, double scale,
+                   double ref)
 {
     double rho = sqrt(a * a + b * b), inverse, ratio, sd, cb, sb;
     v->n = 0;
@@ -1225,10 +1230,14 @@ static int dk_cs1(dk_values *v, double a, double b, double e, double scale, doub
     if (fabs(ratio) > 1.0 + DK_CLAMP_TOL + DK_SEED_MISS) {
         return 0;
     }
-    if (fabs(ratio) >= 1.0 - DK_FOLD_TOL) {
-        ratio = ratio > 0.0 ? 1.0 : -1.0;
+    if (rest >= 0.0) {
+        sd = sqrt(rest) * inverse;
+    } else {
+        if (fabs(ratio) >= 1.0 - DK_FOLD_TOL) {
+            ratio = ratio > 0.0 ? 1.0 : -1.0;
+        }
+        sd = sqrt((1.0 - ratio) * (1.0 + ratio));
     }
-    sd = sqrt((1.0 - ratio) * (1.0 + ratio));
     cb = a * inverse;
     sb = b * inverse;
     v->n = 2; /* base + delta and base - delta, base the angle of (a, b), cos delta = ratio */
@@ -1255,6 +1264,12 @@ static int dk_cs1(dk_values *v, double a, double b, double e, double scale, doub
     return 0;
 }
 
+/* dk_cs1x without a sum of squares for a^2 + b^2 - e^2 */
+static int dk_cs1(dk_values *v, double a, double b, double e, double scale, double ref)
+{
+    return dk_cs1x(v, a, b, e, -1.0, scale, ref);
+}
+
 static int dk_one(dk_values *v, double y, double x)
 {
     double h = sqrt(x * x + y * y);
@@ -1275,12 +1290,13 @@ static int dk_one(dk_values *v, double y, double x)
 }
 
 /* the angle t with a1 c + b1 s = e1 and a2 c + b2 s = e2; free where the system is singular
-   or its right-hand side vanishes */
+   or its right-hand side vanishes (on an exact table to roundings: DK_FREE_TOL_EXACT) */
 static int dk_cs2_free(double a1, double b1, double e1, double a2, double b2, double e2,
                        double det_scale, double rhs_scale)
 {
-    double det = a1 * b2 - a2 * b1;
-    return fabs(det) <= DK_FREE_TOL * det_scale || e1 * e1 + e2 * e2 <= DK_FREE_TOL * rhs_scale;
+    const double det = a1 * b2 - a2 * b1;
+    const double free = DK_SEED_TOL > 0.0 ? DK_FREE_TOL : DK_FREE_TOL_EXACT;
+    return fabs(det) <= free * det_scale || e1 * e1 + e2 * e2 <= free * rhs_scale;
 }
 
 static int dk_cs2_value(dk_values *v, double a1, double b1, double e1, double a2, double b2,
@@ -1826,9 +1842,10 @@ static int dk_solve(const double t[12], double tol, const double ref[DK_DOF],
                 double W23 = c2*r33 - r13*x16 - r23*x17;
                 double W31 = r11*x19 + r21*x20 - r31*x18;
                 double W33 = r13*x19 + r23*x20 - r33*x18;
-                /* theta5: W33 = e3^T Rx(alpha4) Rz(theta5) Rx(alpha5) e3 */
+                /* theta5: W33 = e3^T Rx(alpha4) Rz(theta5) Rx(alpha5) e3, its half-width
+                        atan2(sqrt(W13^2 + W23^2), W33) (the Z-Y-Z Euler angle's) */
                 dk_values dk_v5;
-                if (dk_cs1(&dk_v5, 1.0, 0.0, W33, 0.0, 0.0) < 0) {
+                if (dk_cs1x(&dk_v5, 1.0, 0.0, W33, (W13*W13) + (W23*W23), 0.0, 0.0) < 0) {
                     return DK_UNSETTLED;
                 }
                 /* the wrist flip: theta4, theta6 of the second value */

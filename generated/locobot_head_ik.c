@@ -28,6 +28,8 @@
    leading underscore. */
 #define DK_FREE_TOL (1e-14)
 
+#define DK_FREE_TOL_EXACT (1e-20)
+
 #define DK_LEAD_TOL (1e-10)
 
 #define DK_ROOT_IMAG_TOL (1e-06)
@@ -1153,12 +1155,13 @@ static int dk_one(dk_values *v, double y, double x)
 }
 
 /* the angle t with a1 c + b1 s = e1 and a2 c + b2 s = e2; free where the system is singular
-   or its right-hand side vanishes */
+   or its right-hand side vanishes (on an exact table to roundings: DK_FREE_TOL_EXACT) */
 static int dk_cs2_free(double a1, double b1, double e1, double a2, double b2, double e2,
                        double det_scale, double rhs_scale)
 {
-    double det = a1 * b2 - a2 * b1;
-    return fabs(det) <= DK_FREE_TOL * det_scale || e1 * e1 + e2 * e2 <= DK_FREE_TOL * rhs_scale;
+    const double det = a1 * b2 - a2 * b1;
+    const double free = DK_SEED_TOL > 0.0 ? DK_FREE_TOL : DK_FREE_TOL_EXACT;
+    return fabs(det) <= free * det_scale || e1 * e1 + e2 * e2 <= free * rhs_scale;
 }
 
 static int dk_cs2_value(dk_values *v, double a1, double b1, double e1, double a2, double b2,

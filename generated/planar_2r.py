@@ -207,6 +207,16 @@ _BRANCH_FOLD = 1e-9
 _FREE_TOL = 1e-14  # squared sizes: a joint is free below 1e-7 of its equation's scale
 
 
+# ... and a two-equation step's (a wrist's theta4 from (W13, W23) = s5 (c4, s4)) on an exact
+# table below 1e-10 of its scale (squared: 1e-20): its entries are exact to the arm joints'
+# roundings (1e-13 and less; 1e-13 of a singular wrist's s5 gave theta4 from noise, C and
+# Python 1e-3 apart), and so is s5 where theta5 comes from atan2(sqrt(W13^2 + W23^2), W33)
+# (Cs1Unit), so a wrist 1e-8 from straight has its own theta4 (below 1e-7 it was free, q_ref's:
+# a PUMA missed its sampled vector and answered with rows 1e-8 off); a nominal table keeps
+# _FREE_TOL (its arm's difference is larger)
+_FREE_TOL_EXACT = 1e-20
+
+
 # the values a free joint tries, as offsets from its preferred value: 0, +5, -5, +10, ... deg
 _FREE_STEPS = tuple(math.radians(5.0 * ((k + 1) // 2) * (1 if k % 2 else -1)) for k in range(72))
 
@@ -1593,7 +1603,9 @@ def _free(t: float) -> _Free:
     return _Free([t + step for step in _FREE_STEPS])
 
 
-def _cs1(a: float, b: float, e: float, scale: float = 0.0, ref: float = 0.0) -> tuple[float, ...]:
+def _cs1(
+    a: float, b: float, e: float, scale: float = 0.0, ref: float = 0.0, rest: float = -1.0
+) -> tuple[float, ...]:
     """Angles t with a cos t + b sin t = e: atan2(b, a) +- acos(e / sqrt(a^2 + b^2)), the
     acos argument clamped when it exceeds 1 by at most _CLAMP_TOL (and _SEED_MISS: a nominal
     table's equation seeds the refinement onto the exact arm at its boundary; where
@@ -1603,7 +1615,9 @@ def _cs1(a: float, b: float, e: float, scale: float = 0.0, ref: float = 0.0) -> 
     below (the double root).
 
     When a^2 + b^2 and e^2 are both at most _FREE_TOL * scale the equation holds for every
-    t (the angle is free; e.g. the elbow folded onto axis 1): _free(ref).
+    t (the angle is free; e.g. the elbow folded onto axis 1): _free(ref). Where rest >= 0
+    (a^2 + b^2 - e^2 as a sum of squares: _cs1x), the half-width is atan2(sqrt(rest), e),
+    exact to roundings at the fold, where acos's is not.
     """
     rho = sqrt(a * a + b * b)
     if rho * rho <= _FREE_TOL * scale:  # (seeding ik_approximate, any value is a seed)
@@ -1616,14 +1630,16 @@ def _cs1(a: float, b: float, e: float, scale: float = 0.0, ref: float = 0.0) -> 
     if abs(ratio) > 1.0 + _CLAMP_TOL + _SEED_MISS and not _LOOSE.on:
         return ()
     base = atan2(b, a)
-    if abs(ratio) >= 1.0 - _FOLD_TOL:
+    if rest >= 0.0:
+        delta = atan2(sqrt(rest), e)
+    elif abs(ratio) >= 1.0 - _FOLD_TOL:
         delta = 0.0 if ratio > 0.0 else math.pi
     else:
         delta = acos(ratio)
     if _SEED_TOL and not _LOOSE.on and abs(ratio) > _FOLD_NEAR:
         fold = base if ratio > 0.0 else base + math.pi  # (a nominal fold: seeds either side)
         sides = tuple(fold + s * d for d in _FOLD_SEEDS for s in (1.0, -1.0))
-        if abs(ratio) >= 1.0 - _FOLD_TOL:  # (the double root once, not twice)
+        if delta in (0.0, math.pi):  # (the double root once, not twice)
             return (base + delta, *sides)
         return (base + delta, base - delta, *sides)
     return (base + delta, base - delta)
@@ -1646,7 +1662,8 @@ def _cs2(
     side vanishes (then so does the determinant, up to the errors of earlier joints).
     """
     det = a1 * b2 - a2 * b1
-    if abs(det) <= _FREE_TOL * det_scale or e1 * e1 + e2 * e2 <= _FREE_TOL * rhs_scale:
+    free = _FREE_TOL if _SEED_TOL else _FREE_TOL_EXACT
+    if abs(det) <= free * det_scale or e1 * e1 + e2 * e2 <= free * rhs_scale:
         return _free(ref)
     t = atan2((a1 * e2 - a2 * e1) / det, (e1 * b2 - b1 * e2) / det)
     return _wrist_spread(t, det, det_scale)

@@ -59,3 +59,26 @@ def test_wrist_centre_on_axis_1_of_an_offset_free_puma(tmp_path):
     sols = solve_checked(m, T)
     assert len(sols) > 0
     assert contains(m, m.ik(T, q_ref=q), q)
+
+
+@pytest.mark.parametrize("backend", ["python", pytest.param("c", marks=needs_cc)])
+def test_a_wrist_nearly_straight_is_solved_to_roundings(generated, backend):
+    """The PUMA's wrist 1e-8 to 1e-6 rad from straight: theta5 from acos(W33) lost half the
+    digits (acos of 1 - 5e-15), and theta4 was free below 1e-7 (q_ref's, 0), so rows missed
+    the pose by up to 1e-7 and the sampled vector was never among them at |q5| <= 1e-7 (40 of
+    40; tol=1e-10 answered nothing). theta5 now comes from atan2(sqrt(W13^2 + W23^2), W33),
+    the lecture's Z-Y-Z formula, and theta4 is free only where s5 is a rounding
+    (_FREE_TOL_EXACT). theta4 and theta6 are then ill-conditioned, their sum is not: the
+    sampled vector is found to 1e-12 / |q5| (the arm joints' roundings over s5)."""
+    m = generated("puma560")
+    rng = np.random.default_rng(21)
+    for q5 in (1e-6, 3e-7, 1e-7, 3e-8, 1e-8):
+        for q in rng.uniform(-2.5, 2.5, (20, 6)):
+            q[4] = q5 * rng.choice([-1.0, 1.0])
+            T = m.fk(q)
+            rows = m.ik(T, tol=1e-10, backend=backend)
+            for row in rows:
+                gap = np.abs(m.fk(row) - T)[:3]
+                assert max(gap[:, :3].max(), gap[:, 3].max() / m.REACH) <= 1e-12, (q, row)
+            gaps = np.abs(np.remainder(rows - q + np.pi, 2 * np.pi) - np.pi).max(axis=1)
+            assert len(rows) and gaps.min() <= 1e-12 / q5 + 1e-9, (q5, q, gaps.min())

@@ -42,6 +42,7 @@ from derive.plan import (
     Atan2,
     Cs1,
     Cs1Reach,
+    Cs1Unit,
     Cs2,
     Cs2Reach,
     IkPlan,
@@ -326,7 +327,7 @@ def reach_guided(position: list[Step], wrist: list[Step]) -> list[Step]:
     """
     w_assign, theta5 = wrist[0], wrist[1]
     assert isinstance(w_assign, Assign) and isinstance(theta5, Solve)
-    a5, b5, e5 = theta5.args
+    a5, b5, e5 = theta5.args[:3]  # (a Cs1Unit's fourth, rest, is not read here)
     e5 = -(e5 - sym.named("W33"))
     rho = sp.sqrt(a5**2 + b5**2)
     lo, hi = float(e5 - rho), float(e5 + rho)
@@ -378,18 +379,29 @@ def wrist_equations(numbers: dict, refs: tuple[sp.Expr, ...]) -> list[Step]:
     a5, b5, e5 = linear_coeffs(v[2], c5, s5)
     m = (inner.T * rot_z(c4, s4)[:3, :3].T * w_names).applyfunc(sp.expand)
     v1, v2 = sym.named("v1"), sym.named("v2")
+    w13, w23, w33 = sym.named("W13"), sym.named("W23"), sym.named("W33")
+    if e5 == 0 and sp.simplify(a5**2 + b5**2 - 1) == 0:
+        # (twists of +-90 deg: W33 = a5 c5 + b5 s5 on a unit circle, and the column (W13, W23,
+        # W33) is a unit vector, so a5^2 + b5^2 - W33^2 = W13^2 + W23^2, exact to roundings
+        # where the wrist is nearly straight: the lecture's atan2(+-sqrt(W13^2 + W23^2), W33))
+        theta5: Solve = Cs1Unit(
+            5,
+            (a5, b5, w33, w13**2 + w23**2),
+            "theta5: W33 = e3^T Rx(alpha4) Rz(theta5) Rx(alpha5) e3, its half-width "
+            "atan2(sqrt(W13^2 + W23^2), W33) (the Z-Y-Z Euler angle's)",
+            2,
+        )
+    else:
+        theta5 = Cs1(
+            5, (a5, b5, w33 - e5), "theta5: W33 = e3^T Rx(alpha4) Rz(theta5) Rx(alpha5) e3", 2
+        )
     return [
         Assign(
             tuple(w_names),
             tuple(w_value),
             "wrist W = (0_3R Rx(alpha3))^T 0_6R = Rz(t4) Rx(alpha4) Rz(t5) Rx(alpha5) Rz(t6)",
         ),
-        Cs1(
-            5,
-            (a5, b5, sym.named("W33") - e5),
-            "theta5: W33 = e3^T Rx(alpha4) Rz(theta5) Rx(alpha5) e3",
-            2,
-        ),
+        theta5,
         Assign((v1, v2), (v[0], v[1]), "v = Rx(alpha4) Rz(theta5) Rx(alpha5) e3"),
         Cs2(
             4,

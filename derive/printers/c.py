@@ -25,6 +25,7 @@ from derive.plan import (
     Atan2,
     Cs1,
     Cs1Reach,
+    Cs1Unit,
     Cs2,
     Cs2Reach,
     Eigen,
@@ -128,7 +129,7 @@ def _poly(step: Solve, values: list[str], ref: str) -> Call:
 
 
 def _cs1(step: Solve, values: list[str], ref: str) -> Call:
-    routine = "dk_cs1r" if isinstance(step, Cs1Reach) else "dk_cs1"
+    routine = {Cs1Reach: "dk_cs1r", Cs1Unit: "dk_cs1x"}.get(type(step), "dk_cs1")
     return Call(routine, (*values, repr(step.scale), ref))
 
 
@@ -145,6 +146,7 @@ CALLS: dict[type[Solve], Callable[[Solve, list[str], str], Call]] = {
     Poly: _poly,
     PolyD: _poly,
     Cs1: _cs1,
+    Cs1Unit: _cs1,
     Cs1Reach: _cs1,
     Cs2: _cs2,
     Cs2Reach: _cs2,
@@ -175,7 +177,7 @@ def wrist_flip(plan: Plan) -> tuple[int, int, int] | None:
     for k in range(len(steps) - 3):
         five, v, four, six = steps[k : k + 4]
         if (
-            type(five) is Cs1
+            isinstance(five, Cs1)  # (Cs1Unit too)
             and isinstance(v, Assign)
             and type(four) is Cs2
             and type(six) is Atan2
@@ -419,6 +421,7 @@ def solve_lines(plan: Plan) -> tuple[tuple[int, str], ...]:
 # Solve kind -> the C runtime's sign function of its branches (derive/c/runtime.c)
 SIGNS: dict[type[Solve], str] = {
     Cs1: "dk_cs1_branch",
+    Cs1Unit: "dk_cs1_branch",
     Cs1Reach: "dk_cs1_branch",
     Poly: "dk_poly_branch",
     PolyD: "dk_polyd_branch",

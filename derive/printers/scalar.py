@@ -16,6 +16,7 @@ from derive.plan import (
     Atan2,
     Cs1,
     Cs1Reach,
+    Cs1Unit,
     Cs2,
     Cs2Reach,
     Eigen,
@@ -43,6 +44,7 @@ SOLVES: dict[type[Solve], SolvePrinter] = {
     Poly: lambda step, args, ref, free: f"_poly_angles(({args},), {ref}, {free})",
     PolyD: lambda step, args, ref, free: f"_poly_real(({args},), {ref}, {free}, {step.unit!r})",
     Cs1: lambda step, args, ref, free: f"_cs1({args}, {step.scale!r}, {ref})",
+    Cs1Unit: lambda step, args, ref, free: f"_cs1x({args}, {step.scale!r}, {ref})",
     Cs1Reach: lambda step, args, ref, free: f"_cs1_reach({args}, {step.scale!r}, {ref})",
     Cs2: lambda step, args, ref, free: f"_cs2({args}, {ref})",
     Cs2Reach: lambda step, args, ref, free: f"_cs2_reach({args}, {ref})",
@@ -132,6 +134,7 @@ def solve_lines(
 # sign of its equation's derivative in the joint's value; kinds that give one value have none
 BRANCHES: dict[type[Solve], Callable[[Solve, list[str]], str]] = {
     Cs1: lambda step, values: f"_cs1_branch({values[0]}, {values[1]}, {step.variable})",
+    Cs1Unit: lambda step, values: f"_cs1_branch({values[0]}, {values[1]}, {step.variable})",
     Cs1Reach: lambda step, values: f"_cs1_branch({values[0]}, {values[1]}, {step.variable})",
     Poly: lambda step, values: f"_poly_branch(({', '.join(values)},), {step.variable})",
     PolyD: lambda step, values: f"_polyd_branch(({', '.join(values)},), {step.variable})",

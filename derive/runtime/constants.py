@@ -27,6 +27,14 @@ _LEAD_TOL = 1e-10
 _BRANCH_FOLD = 1e-9
 _OMEGA = (1.0, complex(-0.5, math.sqrt(3.0) / 2.0), complex(-0.5, -math.sqrt(3.0) / 2.0))
 _FREE_TOL = 1e-14  # squared sizes: a joint is free below 1e-7 of its equation's scale
+# ... and a two-equation step's (a wrist's theta4 from (W13, W23) = s5 (c4, s4)) on an exact
+# table below 1e-10 of its scale (squared: 1e-20): its entries are exact to the arm joints'
+# roundings (1e-13 and less; 1e-13 of a singular wrist's s5 gave theta4 from noise, C and
+# Python 1e-3 apart), and so is s5 where theta5 comes from atan2(sqrt(W13^2 + W23^2), W33)
+# (Cs1Unit), so a wrist 1e-8 from straight has its own theta4 (below 1e-7 it was free, q_ref's:
+# a PUMA missed its sampled vector and answered with rows 1e-8 off); a nominal table keeps
+# _FREE_TOL (its arm's difference is larger)
+_FREE_TOL_EXACT = 1e-20
 # the values a free joint tries, as offsets from its preferred value: 0, +5, -5, +10, ... deg
 _FREE_STEPS = tuple(math.radians(5.0 * ((k + 1) // 2) * (1 if k % 2 else -1)) for k in range(72))
 _TWO_PI = 2.0 * math.pi
