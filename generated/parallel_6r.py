@@ -1640,6 +1640,12 @@ def _free(t: float) -> _Free:
     return _Free([t + step for step in _FREE_STEPS])
 
 
+def _cs1x(a: float, b: float, e: float, rest: float, scale: float, ref: float) -> tuple[float, ...]:
+    """_cs1 where rest = a^2 + b^2 - e^2 is given as a sum of squares, exact to roundings
+    (derive/plan.py Cs1Unit): the values atan2(b, a) +- atan2(sqrt(rest), e)."""
+    return _cs1(a, b, e, scale, ref, rest)
+
+
 def _cs1(
     a: float, b: float, e: float, scale: float = 0.0, ref: float = 0.0, rest: float = -1.0
 ) -> tuple[float, ...]:
@@ -2233,9 +2239,10 @@ def _ik_scalar(target, qr1, qr2, qr3, qr4, qr5, qr6, tol):
     for theta1 in (_v1 := _cs1(py, -px, 116.5, 327412.84, qr1)):
         c1 = cos(theta1)
         s1 = sin(theta1)
-        # theta5: entry (3,3) of the invariant equation
+        # theta5: entry (3,3) of the invariant equation, its half-width atan2(sqrt(rest), e)
         _n5 = len(found)
-        for theta5 in (_v5 := _cs1(-1.0, 0.0, -c1*r23 + r13*s1, 0.0, 0.0)):
+        for theta5 in (_v5 := _cs1x(-1.0, 0.0, -c1*r23 + r13*s1, (c1*r21 - r11*s1)**2.0 + (c1*r22 -
+            r12*s1)**2.0, 0.0, 0.0)):
             c5 = cos(theta5)
             s5 = sin(theta5)
             # squared radius of the planar target at theta6 = 0, 90, 180 deg

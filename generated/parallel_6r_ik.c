@@ -1243,9 +1243,10 @@ static int dk_solve(const double t[12], double tol, const double ref[DK_DOF],
     for (int dk_k1 = 0; dk_k1 < dk_v1.n; dk_k1++) {
         double theta1, c1, s1;
         dk_value(&dk_v1, dk_k1, &theta1, &c1, &s1);
-        /* theta5: entry (3,3) of the invariant equation */
+        /* theta5: entry (3,3) of the invariant equation, its half-width atan2(sqrt(rest), e) */
         dk_values dk_v5;
-        if (dk_cs1(&dk_v5, -1.0, 0.0, -c1*r23 + r13*s1, 0.0, 0.0) < 0) {
+        if (dk_cs1x(&dk_v5, -1.0, 0.0, -c1*r23 + r13*s1, ((c1*r21 - r11*s1)*(c1*r21 - r11*s1)) +
+                ((c1*r22 - r12*s1)*(c1*r22 - r12*s1)), 0.0, 0.0) < 0) {
             return DK_UNSETTLED;
         }
         const int dk_m5 = n;

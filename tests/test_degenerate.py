@@ -62,15 +62,18 @@ def test_wrist_centre_on_axis_1_of_an_offset_free_puma(tmp_path):
 
 
 @pytest.mark.parametrize("backend", ["python", pytest.param("c", marks=needs_cc)])
-def test_a_wrist_nearly_straight_is_solved_to_roundings(generated, backend):
+@pytest.mark.parametrize("name", ["puma560", "parallel_6r"])
+def test_a_wrist_nearly_straight_is_solved_to_roundings(generated, name, backend):
     """The PUMA's wrist 1e-8 to 1e-6 rad from straight: theta5 from acos(W33) lost half the
     digits (acos of 1 - 5e-15), and theta4 was free below 1e-7 (q_ref's, 0), so rows missed
     the pose by up to 1e-7 and the sampled vector was never among them at |q5| <= 1e-7 (40 of
     40; tol=1e-10 answered nothing). theta5 now comes from atan2(sqrt(W13^2 + W23^2), W33),
     the lecture's Z-Y-Z formula, and theta4 is free only where s5 is a rounding
     (_FREE_TOL_EXACT). theta4 and theta6 are then ill-conditioned, their sum is not: the
-    sampled vector is found to 1e-12 / |q5| (the arm joints' roundings over s5)."""
-    m = generated("puma560")
+    sampled vector is found to 1e-12 / |q5| (the arm joints' roundings over s5). parallel_6r
+    (three parallel axes, a UR's structure) likewise: theta5 from entry (3,3), its half-width
+    from entries (3,1), (3,2) of the target side."""
+    m = generated(name)
     rng = np.random.default_rng(21)
     for q5 in (1e-6, 3e-7, 1e-7, 3e-8, 1e-8):
         for q in rng.uniform(-2.5, 2.5, (20, 6)):

@@ -37,12 +37,13 @@ from derive.methods.common import (
     unreverse_outputs,
 )
 from derive.methods.planar import flange_factors, heading_step, planar_steps
-from derive.plan import Assign, Cs1, Cs2, Cs2Reach, IkPlan, Poly, PolyD, Solve, Step
+from derive.plan import Assign, Cs1, Cs1Unit, Cs2, Cs2Reach, IkPlan, Poly, PolyD, Solve, Step
 from derive.transforms import Chain, inverse, numbers_of, product, reverse_chain
 
 NAME = "three-parallel"
-# theta5 comes from acos of entry (3,3), accurate to ~1e-8 near 0 and pi: |h| below 1e-7
-# (h^2 below _FREE_TOL = 1e-14) is treated as the singular wrist, where theta6 is free.
+# theta6 is free where |h| = |s5| is below 1e-10 on an exact table (h^2 below _FREE_TOL_EXACT
+# = 1e-20; theta5 from entry (3,3) with its half-width atan2(sqrt(lhs_31^2 + lhs_32^2), ...),
+# exact to roundings, where the entries say so: Cs1Unit), 1e-7 on a nominal one (_FREE_TOL)
 SIN5_FREE = sp.Integer(1)
 
 
@@ -272,7 +273,7 @@ def derive_234(chain: Chain, target: sp.Matrix, refs: tuple[sp.Expr, ...], prefi
     position = planar_part[:2, 3].applyfunc(sp.expand)
     planar = planar_steps(position[0], position[1], 2, 3, g[0, 3], g[1, 3], refs, length)
     steps: list[Step] = [flange_target(chain, target)]
-    steps += theta1_theta5_steps(equations[3], equations[2], refs, length)
+    steps += theta1_theta5_steps(equations[3], equations[2], refs, length, lhs)
     note = "G = (Z1 X1)^-1 0_6T (X4 Z5 X5 Z6)^-1 = Z2 X2 Z3 X3 Z4 (planar)"
     steps += planar_tail(equations, g, g_value, planar, refs, note)
     before = product(mats[2:6])[:3, :3]
@@ -303,9 +304,14 @@ def planar_tail(
 
 
 def theta1_theta5_steps(
-    pos_eq: sp.Expr, z6_eq: sp.Expr, refs: tuple[sp.Expr, ...], length: float
+    pos_eq: sp.Expr,
+    z6_eq: sp.Expr,
+    refs: tuple[sp.Expr, ...],
+    length: float,
+    lhs: sp.Matrix | None = None,
 ) -> list[Step]:
-    """theta1 and theta5 from entries (3,4) and (3,3) of the invariant equation."""
+    """theta1 and theta5 from entries (3,4) and (3,3) of the invariant equation (lhs: its
+    target side, whose entries (3,1), (3,2), (3,3) are a unit vector)."""
     c1, s1, c5, s5, u = sym.c(1), sym.s(1), sym.c(5), sym.s(5), sym.named("u")
     if not pos_eq.has(c5, s5):
         a, b, c = linear_coeffs(pos_eq, c1, s1)
@@ -314,6 +320,17 @@ def theta1_theta5_steps(
         a5, b5, c5_ = linear_coeffs(z6_eq, c5, s5)
         if a5 == 0 and b5 == 0:
             raise NotApplicable("three-parallel: entry (3,3) does not involve theta5")
+        note = "theta5: entry (3,3) of the invariant equation"
+        theta5: Solve = Cs1(5, (a5, b5, -c5_), note, 2)
+        if lhs is not None and sp.expand(c5_ - lhs[2]) == 0 and sp.simplify(a5**2 + b5**2 - 1) == 0:
+            # (entry (3,3) is a5 c5 + b5 s5 on a unit circle and the target side's (3,1),
+            # (3,2), (3,3) a unit vector, so a5^2 + b5^2 - lhs_33^2 = lhs_31^2 + lhs_32^2,
+            # exact to roundings where the wrist is nearly straight, as a spherical wrist's
+            # W13^2 + W23^2: Cs1Unit)
+            rest = lhs[0] ** 2 + lhs[1] ** 2
+            theta5 = Cs1Unit(
+                5, (a5, b5, -c5_, rest), note + ", its half-width atan2(sqrt(rest), e)", 2
+            )
         return [
             Cs1(
                 1,
@@ -323,7 +340,7 @@ def theta1_theta5_steps(
                 refs[0],
                 length**2,
             ),
-            Cs1(5, (a5, b5, -c5_), "theta5: entry (3,3) of the invariant equation", 2),
+            theta5,
         ]
     pa, pb, pc = linear_coeffs(pos_eq, c5, s5)
     za, zb, zc = linear_coeffs(z6_eq, c5, s5)
