@@ -2166,6 +2166,12 @@ void lecture_6r_jacobian(const double q[DK_DOF], int frame, double J[6][DK_DOF])
 
 int lecture_6r_branch(const double q[DK_DOF], int signs[2])
 {
+    int k;
+    for (k = 0; k < DK_DOF; k++) {
+        if (!isfinite(q[k])) {
+            return LECTURE_6R_INVALID_ARGUMENT;
+        }
+    }
     double e[12];
     dk_fk_q(q, e);
     double w11 = e[0];
@@ -2257,7 +2263,7 @@ int lecture_6r_ik_velocity(const double q[DK_DOF], const double twist[6], int fr
     for (j = 0; j < 6; j++) {
         sum += twist[j];
     }
-    if (!isfinite(sum) || !(damping >= 0.0 && band >= 0.0)) {
+    if (!isfinite(sum) || !(damping >= 0.0 && band >= 0.0) || (frame != 0 && frame != 1)) {
         return LECTURE_6R_INVALID_ARGUMENT;
     }
     lecture_6r_jacobian(q, frame, J);

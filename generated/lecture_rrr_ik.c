@@ -1299,6 +1299,12 @@ void lecture_rrr_jacobian(const double q[DK_DOF], int frame, double J[6][DK_DOF]
 
 int lecture_rrr_branch(const double q[DK_DOF], int signs[1])
 {
+    int k;
+    for (k = 0; k < DK_DOF; k++) {
+        if (!isfinite(q[k])) {
+            return LECTURE_RRR_INVALID_ARGUMENT;
+        }
+    }
     double e[12];
     dk_fk_q(q, e);
     double qr2 = q[1];
@@ -1368,7 +1374,7 @@ int lecture_rrr_ik_velocity(const double q[DK_DOF], const double twist[6], int f
     for (j = 0; j < 6; j++) {
         sum += twist[j];
     }
-    if (!isfinite(sum) || !(damping >= 0.0 && band >= 0.0)) {
+    if (!isfinite(sum) || !(damping >= 0.0 && band >= 0.0) || (frame != 0 && frame != 1)) {
         return LECTURE_RRR_INVALID_ARGUMENT;
     }
     lecture_rrr_jacobian(q, frame, J);

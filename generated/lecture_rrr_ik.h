@@ -56,7 +56,8 @@ void lecture_rrr_jacobian(const double q[3], int frame, double J[6][3]);
 #define LECTURE_RRR_BRANCHES 1
 
 /* signs = the branch of the solution q of its own pose fk(q); returns LECTURE_RRR_BRANCHES, or
-   -1 where q solves no pose of the task's (a task's auxiliary step has no value there) */
+   -1 where q solves no pose of the task's (a task's auxiliary step has no value there), or
+   LECTURE_RRR_INVALID_ARGUMENT where q is not finite */
 int lecture_rrr_branch(const double q[3], int signs[1]);
 
 /* T = the pose of frame k at q (the exact chain's: T(q) = F_0 J_1(q_1) F_1 ... J_n(q_n) F_n):
@@ -79,7 +80,7 @@ void lecture_rrr_twist(const double q[3], const double dq[3], int frame,
    bounds every rate by |twist| / (2 damping); an arm of fewer than 6 joints gets the least-
    squares dq. preferred (NULL: none): joint values the arm drifts toward at rate gain in the
    Jacobian's null space (its self-motion). Returns 0, or LECTURE_RRR_INVALID_ARGUMENT (a
-   number not finite, damping or band negative). */
+   number not finite, damping or band negative, frame neither 0 nor 1). */
 int lecture_rrr_ik_velocity(const double q[3], const double twist[6], int frame,
                            double damping, double band, const double *preferred, double gain,
                            double dq[3]);

@@ -1719,6 +1719,12 @@ void locobot_head_jacobian(const double q[DK_DOF], int frame, double J[6][DK_DOF
 
 int locobot_head_branch(const double q[DK_DOF], int signs[1])
 {
+    int k;
+    for (k = 0; k < DK_DOF; k++) {
+        if (!isfinite(q[k])) {
+            return LOCOBOT_HEAD_INVALID_ARGUMENT;
+        }
+    }
     (void)q;
     (void)signs;
     return 0;
@@ -1784,7 +1790,7 @@ int locobot_head_ik_velocity(const double q[DK_DOF], const double twist[6], int 
     for (j = 0; j < 6; j++) {
         sum += twist[j];
     }
-    if (!isfinite(sum) || !(damping >= 0.0 && band >= 0.0)) {
+    if (!isfinite(sum) || !(damping >= 0.0 && band >= 0.0) || (frame != 0 && frame != 1)) {
         return LOCOBOT_HEAD_INVALID_ARGUMENT;
     }
     locobot_head_jacobian(q, frame, J);

@@ -3283,6 +3283,12 @@ void manocha_canny_jacobian(const double q[DK_DOF], int frame, double J[6][DK_DO
 
 int manocha_canny_branch(const double q[DK_DOF], int signs[1])
 {
+    int k;
+    for (k = 0; k < DK_DOF; k++) {
+        if (!isfinite(q[k])) {
+            return MANOCHA_CANNY_INVALID_ARGUMENT;
+        }
+    }
     (void)q;
     (void)signs;
     return 0;
@@ -3348,7 +3354,7 @@ int manocha_canny_ik_velocity(const double q[DK_DOF], const double twist[6], int
     for (j = 0; j < 6; j++) {
         sum += twist[j];
     }
-    if (!isfinite(sum) || !(damping >= 0.0 && band >= 0.0)) {
+    if (!isfinite(sum) || !(damping >= 0.0 && band >= 0.0) || (frame != 0 && frame != 1)) {
         return MANOCHA_CANNY_INVALID_ARGUMENT;
     }
     manocha_canny_jacobian(q, frame, J);

@@ -1391,6 +1391,12 @@ void open_manipulator_x_jacobian(const double q[DK_DOF], int frame, double J[6][
 
 int open_manipulator_x_branch(const double q[DK_DOF], int signs[3])
 {
+    int k;
+    for (k = 0; k < DK_DOF; k++) {
+        if (!isfinite(q[k])) {
+            return OPEN_MANIPULATOR_X_INVALID_ARGUMENT;
+        }
+    }
     double e[12];
     dk_fk_q(q, e);
     double wx = e[3];
@@ -1480,7 +1486,7 @@ int open_manipulator_x_ik_velocity(const double q[DK_DOF], const double twist[6]
     for (j = 0; j < 6; j++) {
         sum += twist[j];
     }
-    if (!isfinite(sum) || !(damping >= 0.0 && band >= 0.0)) {
+    if (!isfinite(sum) || !(damping >= 0.0 && band >= 0.0) || (frame != 0 && frame != 1)) {
         return OPEN_MANIPULATOR_X_INVALID_ARGUMENT;
     }
     open_manipulator_x_jacobian(q, frame, J);

@@ -59,7 +59,8 @@ void open_manipulator_x_jacobian(const double q[4], int frame, double J[6][4]);
 
 /* signs = the branch of the solution q of its own pose fk(q); returns OPEN_MANIPULATOR_X_BRANCHES,
         or
-   -1 where q solves no pose of the task's (a task's auxiliary step has no value there) */
+   -1 where q solves no pose of the task's (a task's auxiliary step has no value there), or
+   OPEN_MANIPULATOR_X_INVALID_ARGUMENT where q is not finite */
 int open_manipulator_x_branch(const double q[4], int signs[3]);
 
 /* T = the pose of frame k at q (the exact chain's: T(q) = F_0 J_1(q_1) F_1 ... J_n(q_n) F_n):
@@ -82,7 +83,7 @@ void open_manipulator_x_twist(const double q[4], const double dq[4], int frame,
    bounds every rate by |twist| / (2 damping); an arm of fewer than 6 joints gets the least-
    squares dq. preferred (NULL: none): joint values the arm drifts toward at rate gain in the
    Jacobian's null space (its self-motion). Returns 0, or OPEN_MANIPULATOR_X_INVALID_ARGUMENT (a
-   number not finite, damping or band negative). */
+   number not finite, damping or band negative, frame neither 0 nor 1). */
 int open_manipulator_x_ik_velocity(const double q[4], const double twist[6], int frame,
                                   double damping, double band, const double *preferred, double gain,
                                   double dq[4]);

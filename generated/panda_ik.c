@@ -2200,6 +2200,12 @@ void panda_jacobian(const double q[DK_DOF], int frame, double J[6][DK_DOF])
 
 int panda_branch(const double q[DK_DOF], int signs[3])
 {
+    int k;
+    for (k = 0; k < DK_DOF; k++) {
+        if (!isfinite(q[k])) {
+            return PANDA_INVALID_ARGUMENT;
+        }
+    }
     double e[12];
     dk_fk_q(q, e);
     double w11 = e[0];
@@ -2312,7 +2318,7 @@ int panda_ik_velocity(const double q[DK_DOF], const double twist[6], int frame,
     for (j = 0; j < 6; j++) {
         sum += twist[j];
     }
-    if (!isfinite(sum) || !(damping >= 0.0 && band >= 0.0)) {
+    if (!isfinite(sum) || !(damping >= 0.0 && band >= 0.0) || (frame != 0 && frame != 1)) {
         return PANDA_INVALID_ARGUMENT;
     }
     panda_jacobian(q, frame, J);

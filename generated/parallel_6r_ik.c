@@ -1613,6 +1613,12 @@ void parallel_6r_jacobian(const double q[DK_DOF], int frame, double J[6][DK_DOF]
 
 int parallel_6r_branch(const double q[DK_DOF], int signs[3])
 {
+    int k;
+    for (k = 0; k < DK_DOF; k++) {
+        if (!isfinite(q[k])) {
+            return PARALLEL_6R_INVALID_ARGUMENT;
+        }
+    }
     double e[12];
     dk_fk_q(q, e);
     double w13 = e[2];
@@ -1696,7 +1702,7 @@ int parallel_6r_ik_velocity(const double q[DK_DOF], const double twist[6], int f
     for (j = 0; j < 6; j++) {
         sum += twist[j];
     }
-    if (!isfinite(sum) || !(damping >= 0.0 && band >= 0.0)) {
+    if (!isfinite(sum) || !(damping >= 0.0 && band >= 0.0) || (frame != 0 && frame != 1)) {
         return PARALLEL_6R_INVALID_ARGUMENT;
     }
     parallel_6r_jacobian(q, frame, J);

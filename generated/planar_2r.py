@@ -1256,7 +1256,11 @@ def ik_velocity(
     weights = np.divide(sigma, sigma * sigma + lam2, out=np.zeros_like(sigma), where=sigma > 0)
     dq = Vt.T @ (weights * (U.T @ target))
     if preferred is not None:
-        drift = gain * (np.array(_joint_values(preferred)) - np.array(_joint_values(q)))
+        try:
+            wanted = _joint_values(preferred)
+        except ValueError as exc:  # (named as the argument it is)
+            raise ValueError(str(exc).replace("q must", "preferred must", 1)) from None
+        drift = gain * (np.array(wanted) - np.array(_joint_values(q)))
         rank = int(np.sum(sigma > _RANK_TOL * max(1.0, float(sigma[0]))))
         rows = Vt[:rank]
         dq = dq + drift - rows.T @ (rows @ drift)  # (the null space's share of the drift)
@@ -1376,6 +1380,8 @@ def ik_path(
         raise ValueError(f"Ts must have shape (N, 4, 4), N >= 1, got {poses.shape}")
     if on_break not in ("stop", "flag"):
         raise ValueError(f'on_break must be "stop" or "flag", got {on_break!r}')
+    if backend not in (None, "auto", "c", "python"):  # (a one-pose path calls no ik)
+        raise ValueError(f"backend must be 'auto', 'c' or 'python', got {backend!r}")
     q = np.array(_joint_values(q0))
     if IK_COMPONENTS == "pose":
         size = _pose_error_to(q, poses[0])[1]

@@ -1229,6 +1229,12 @@ void planar_2r_jacobian(const double q[DK_DOF], int frame, double J[6][DK_DOF])
 
 int planar_2r_branch(const double q[DK_DOF], int signs[1])
 {
+    int k;
+    for (k = 0; k < DK_DOF; k++) {
+        if (!isfinite(q[k])) {
+            return PLANAR_2R_INVALID_ARGUMENT;
+        }
+    }
     double e[12];
     dk_fk_q(q, e);
     double qr2 = q[1];
@@ -1298,7 +1304,7 @@ int planar_2r_ik_velocity(const double q[DK_DOF], const double twist[6], int fra
     for (j = 0; j < 6; j++) {
         sum += twist[j];
     }
-    if (!isfinite(sum) || !(damping >= 0.0 && band >= 0.0)) {
+    if (!isfinite(sum) || !(damping >= 0.0 && band >= 0.0) || (frame != 0 && frame != 1)) {
         return PLANAR_2R_INVALID_ARGUMENT;
     }
     planar_2r_jacobian(q, frame, J);

@@ -2142,6 +2142,12 @@ void puma560_jacobian(const double q[DK_DOF], int frame, double J[6][DK_DOF])
 
 int puma560_branch(const double q[DK_DOF], int signs[3])
 {
+    int k;
+    for (k = 0; k < DK_DOF; k++) {
+        if (!isfinite(q[k])) {
+            return PUMA560_INVALID_ARGUMENT;
+        }
+    }
     double e[12];
     dk_fk_q(q, e);
     double wx = e[3];
@@ -2229,7 +2235,7 @@ int puma560_ik_velocity(const double q[DK_DOF], const double twist[6], int frame
     for (j = 0; j < 6; j++) {
         sum += twist[j];
     }
-    if (!isfinite(sum) || !(damping >= 0.0 && band >= 0.0)) {
+    if (!isfinite(sum) || !(damping >= 0.0 && band >= 0.0) || (frame != 0 && frame != 1)) {
         return PUMA560_INVALID_ARGUMENT;
     }
     puma560_jacobian(q, frame, J);

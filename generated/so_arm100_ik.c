@@ -2006,6 +2006,12 @@ void so_arm100_jacobian(const double q[DK_DOF], int frame, double J[6][DK_DOF])
 
 int so_arm100_branch(const double q[DK_DOF], int signs[3])
 {
+    int k;
+    for (k = 0; k < DK_DOF; k++) {
+        if (!isfinite(q[k])) {
+            return SO_ARM100_INVALID_ARGUMENT;
+        }
+    }
     double e[12];
     dk_fk_q(q, e);
     double wx = e[3];
@@ -2087,7 +2093,7 @@ int so_arm100_ik_velocity(const double q[DK_DOF], const double twist[6], int fra
     for (j = 0; j < 6; j++) {
         sum += twist[j];
     }
-    if (!isfinite(sum) || !(damping >= 0.0 && band >= 0.0)) {
+    if (!isfinite(sum) || !(damping >= 0.0 && band >= 0.0) || (frame != 0 && frame != 1)) {
         return SO_ARM100_INVALID_ARGUMENT;
     }
     so_arm100_jacobian(q, frame, J);

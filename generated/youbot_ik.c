@@ -1560,6 +1560,12 @@ void youbot_jacobian(const double q[DK_DOF], int frame, double J[6][DK_DOF])
 
 int youbot_branch(const double q[DK_DOF], int signs[3])
 {
+    int k;
+    for (k = 0; k < DK_DOF; k++) {
+        if (!isfinite(q[k])) {
+            return YOUBOT_INVALID_ARGUMENT;
+        }
+    }
     double e[12];
     dk_fk_q(q, e);
     double wx = e[3];
@@ -1641,7 +1647,7 @@ int youbot_ik_velocity(const double q[DK_DOF], const double twist[6], int frame,
     for (j = 0; j < 6; j++) {
         sum += twist[j];
     }
-    if (!isfinite(sum) || !(damping >= 0.0 && band >= 0.0)) {
+    if (!isfinite(sum) || !(damping >= 0.0 && band >= 0.0) || (frame != 0 && frame != 1)) {
         return YOUBOT_INVALID_ARGUMENT;
     }
     youbot_jacobian(q, frame, J);

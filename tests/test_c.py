@@ -600,6 +600,24 @@ def test_the_c_entry_points_refuse_what_python_refuses(generated):
     assert native.nearest(at, None, None, None, 1e-10, best.ctypes.data) == 1
     expected = m.nearest(T, np.zeros(m.DOF), backend="python")
     assert np.allclose(best, expected, atol=1e-9)
+    # branch of a q that is not finite; ik_velocity with a frame neither 0 nor 1
+    import ctypes
+
+    lib, _ = m._c_library()
+    signs = np.zeros(8, dtype=np.intc)
+    bad = np.array([0.1, math.nan, 0.0, 0.0, 0.0, 0.0])
+    branch = lib.puma560_branch
+    branch.argtypes = (ctypes.c_void_p, ctypes.c_void_p)
+    assert branch(bad.ctypes.data, signs.ctypes.data) == -3
+    assert branch(q.ctypes.data, signs.ctypes.data) == len(m.BRANCHES)
+    velocity = lib.puma560_ik_velocity
+    d = ctypes.c_double
+    velocity.argtypes = (ctypes.c_void_p, ctypes.c_void_p, ctypes.c_int, d, d,
+                         ctypes.c_void_p, d, ctypes.c_void_p)  # fmt: skip
+    twist, dq = np.ones(6), np.zeros(6)
+    at_q, out = q.ctypes.data, dq.ctypes.data
+    for frame, code in ((0, 0), (1, 0), (2, -3), (-1, -3)):
+        assert velocity(at_q, twist.ctypes.data, frame, 0.05, 0.01, None, 1.0, out) == code
 
 
 def test_a_pose_on_a_curve_of_solutions_gets_at_most_max_solutions_rows_in_both(generated):

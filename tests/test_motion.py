@@ -523,3 +523,15 @@ def test_derive_path_without_matplotlib_says_so_before_the_path(monkeypatch, cap
     assert main([*argv, "-o", "p.svg"]) == 2
     captured = capsys.readouterr()
     assert captured.out == "" and "pictures need matplotlib" in captured.err
+
+
+def test_motion_arguments_are_named_in_their_errors(generated):
+    """ik_velocity's preferred of the wrong size is named as preferred (it said q), and
+    ik_path refuses an unknown backend also for a one-pose path, which solves nothing (a new
+    user's attack)."""
+    m = generated("puma560")
+    q = np.array([0.2, -0.4, 0.3, 0.5, 0.6, -0.7])
+    with pytest.raises(ValueError, match="preferred must have shape"):
+        m.ik_velocity(q, np.ones(6), preferred=[0.0])
+    with pytest.raises(ValueError, match="backend must be"):
+        m.ik_path(m.fk(q)[None], q, backend="bogus")
