@@ -1442,8 +1442,8 @@ static void dk_dls(const double *J, int n, const double t[6], double damping, do
 /* the tool axis of the task (0 x, 1 y, 2 z) */
 #define DK_TOOL_AXIS 2
 #define DK_MAX 4
-/* a joint value within this of a limit is inside it (the Python module's _LOWER, _UPPER) */
-#define DK_LIMIT_SLACK (1e-12)
+/* a joint value within this of a limit is inside it (the Python module's _LIMIT_SLACK) */
+#define DK_LIMIT_SLACK (1e-9)
 #define DK_UNSETTLED (-2)
 static const double DK_REACH = 0.577951;
 static const int DK_REVOLUTE[DK_DOF] = {1, 1};

@@ -202,6 +202,12 @@ POSE_TOL = 1e-6
 DEDUP_TOL = 1e-6
 
 
+# a joint value within this of a limit is inside it: a row on a limit comes back a rounding
+# past it (1e-15 from the closed forms, 3e-12 from a quartic's root: KR3's q2 at its limit
+# was dropped at 1e-12, a new user's attack); C's DK_LIMIT_SLACK
+_LIMIT_SLACK = 1e-9
+
+
 _TWO_PI = 2.0 * math.pi
 
 
@@ -1022,9 +1028,10 @@ def _every_turn(rows):
 
 
 def _turn_range(x, lo, hi):
-    """The k with lo <= x + 2 pi k <= hi (1e-12 slack): (first, last), empty if first > last."""
-    first = -math.inf if lo == -math.inf else math.ceil((lo - 1e-12 - x) / _TWO_PI)
-    last = math.inf if hi == math.inf else math.floor((hi + 1e-12 - x) / _TWO_PI)
+    """The k with lo <= x + 2 pi k <= hi (_LIMIT_SLACK of slack): (first, last), empty if first >
+    last."""
+    first = -math.inf if lo == -math.inf else math.ceil((lo - _LIMIT_SLACK - x) / _TWO_PI)
+    last = math.inf if hi == math.inf else math.floor((hi + _LIMIT_SLACK - x) / _TWO_PI)
     return first, last
 
 
@@ -1034,7 +1041,7 @@ def _turns(q):
     options = []
     for x, r, (lo, hi) in zip(q, _REVOLUTE, LIMITS):
         first, last = _turn_range(x, lo, hi) if r else (0, 0)
-        if (not r and not lo - 1e-12 <= x <= hi + 1e-12) or first > last:
+        if (not r and not lo - _LIMIT_SLACK <= x <= hi + _LIMIT_SLACK) or first > last:
             return []
         if math.isinf(first) or math.isinf(last):
             options.append([x])
@@ -1142,10 +1149,10 @@ def _seam(x: float) -> float:
 _REV = np.array([1.0 if r else 0.0 for r in _REVOLUTE])
 
 
-_LOWER = np.array([lo - 1e-12 for lo, _ in LIMITS])
+_LOWER = np.array([lo - _LIMIT_SLACK for lo, _ in LIMITS])
 
 
-_UPPER = np.array([hi + 1e-12 for _, hi in LIMITS])
+_UPPER = np.array([hi + _LIMIT_SLACK for _, hi in LIMITS])
 
 
 def jacobian(q: ArrayLike, frame: str = "base") -> np.ndarray:

@@ -2768,8 +2768,8 @@ static int dk_general(const double flanges[DK_RR_SPLIT_COUNT][12], double out[DK
 
 #define DK_DOF 6
 #define DK_MAX 16
-/* a joint value within this of a limit is inside it (the Python module's _LOWER, _UPPER) */
-#define DK_LIMIT_SLACK (1e-12)
+/* a joint value within this of a limit is inside it (the Python module's _LIMIT_SLACK) */
+#define DK_LIMIT_SLACK (1e-9)
 #define DK_UNSETTLED (-2)
 static const double DK_REACH = 3.0;
 static const int DK_REVOLUTE[DK_DOF] = {1, 1, 1, 1, 1, 1};

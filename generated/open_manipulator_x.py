@@ -235,6 +235,12 @@ _FREE_TOL = 1e-14  # squared sizes: a joint is free below 1e-7 of its equation's
 _FREE_TOL_EXACT = 1e-20
 
 
+# a joint value within this of a limit is inside it: a row on a limit comes back a rounding
+# past it (1e-15 from the closed forms, 3e-12 from a quartic's root: KR3's q2 at its limit
+# was dropped at 1e-12, a new user's attack); C's DK_LIMIT_SLACK
+_LIMIT_SLACK = 1e-9
+
+
 # the values a free joint tries, as offsets from its preferred value: 0, +5, -5, +10, ... deg
 _FREE_STEPS = tuple(math.radians(5.0 * ((k + 1) // 2) * (1 if k % 2 else -1)) for k in range(72))
 
@@ -978,9 +984,10 @@ def _every_turn(rows):
 
 
 def _turn_range(x, lo, hi):
-    """The k with lo <= x + 2 pi k <= hi (1e-12 slack): (first, last), empty if first > last."""
-    first = -math.inf if lo == -math.inf else math.ceil((lo - 1e-12 - x) / _TWO_PI)
-    last = math.inf if hi == math.inf else math.floor((hi + 1e-12 - x) / _TWO_PI)
+    """The k with lo <= x + 2 pi k <= hi (_LIMIT_SLACK of slack): (first, last), empty if first >
+    last."""
+    first = -math.inf if lo == -math.inf else math.ceil((lo - _LIMIT_SLACK - x) / _TWO_PI)
+    last = math.inf if hi == math.inf else math.floor((hi + _LIMIT_SLACK - x) / _TWO_PI)
     return first, last
 
 
@@ -990,7 +997,7 @@ def _turns(q):
     options = []
     for x, r, (lo, hi) in zip(q, _REVOLUTE, LIMITS):
         first, last = _turn_range(x, lo, hi) if r else (0, 0)
-        if (not r and not lo - 1e-12 <= x <= hi + 1e-12) or first > last:
+        if (not r and not lo - _LIMIT_SLACK <= x <= hi + _LIMIT_SLACK) or first > last:
             return []
         if math.isinf(first) or math.isinf(last):
             options.append([x])
@@ -1098,10 +1105,10 @@ def _seam(x: float) -> float:
 _REV = np.array([1.0 if r else 0.0 for r in _REVOLUTE])
 
 
-_LOWER = np.array([lo - 1e-12 for lo, _ in LIMITS])
+_LOWER = np.array([lo - _LIMIT_SLACK for lo, _ in LIMITS])
 
 
-_UPPER = np.array([hi + 1e-12 for _, hi in LIMITS])
+_UPPER = np.array([hi + _LIMIT_SLACK for _, hi in LIMITS])
 
 
 def ik_axis_angle(
@@ -1681,7 +1688,7 @@ def _cs1(
     if abs(ratio) > 1.0 + _CLAMP_TOL + _SEED_MISS and not _LOOSE.on:
         return ()
     base = atan2(b, a)
-    if rest >= 0.0:
+    if rest >= 0.0 and not _SEED_TOL:  # (a nominal table's fold keeps acos's: see _cs1x)
         delta = atan2(sqrt(rest), e)
     elif abs(ratio) >= 1.0 - _FOLD_TOL:
         delta = 0.0 if ratio > 0.0 else math.pi

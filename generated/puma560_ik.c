@@ -1248,7 +1248,7 @@ static int dk_cs1x(dk_values *v, double a, double b, double e, double rest, doub
     if (fabs(ratio) > 1.0 + DK_CLAMP_TOL + DK_SEED_MISS) {
         return 0;
     }
-    if (rest >= 0.0) {
+    if (rest >= 0.0 && DK_SEED_TOL == 0.0) { /* (a nominal table keeps acos's: see _cs1x) */
         sd = sqrt(rest) * inverse;
     } else {
         if (fabs(ratio) >= 1.0 - DK_FOLD_TOL) {
@@ -1603,8 +1603,8 @@ static void dk_dls(const double *J, int n, const double t[6], double damping, do
 
 #define DK_DOF 6
 #define DK_MAX 8
-/* a joint value within this of a limit is inside it (the Python module's _LOWER, _UPPER) */
-#define DK_LIMIT_SLACK (1e-12)
+/* a joint value within this of a limit is inside it (the Python module's _LIMIT_SLACK) */
+#define DK_LIMIT_SLACK (1e-9)
 #define DK_UNSETTLED (-2)
 static const double DK_REACH = 1.034;
 static const int DK_REVOLUTE[DK_DOF] = {1, 1, 1, 1, 1, 1};

@@ -562,7 +562,13 @@ def test_a_row_on_a_joint_limit_is_inside_in_c_as_in_python(generated):
     """A joint exactly at its limit (the PUMA's q1 at +160 deg, SO-ARM100's q2 at its upper
     limit): the C row comes back a rounding past it (9e-15), and C's within_limits, with no
     slack, dropped it where Python's (1e-12 of slack) kept it, so nearest said None in C (a
-    new user's attack: row counts differed at 106 of 400 such PUMA samples)."""
+    new user's attack: row counts differed at 106 of 400 such PUMA samples). Both now allow
+    _LIMIT_SLACK (1e-9: a quartic's row came back 3e-12 past, KR3's q2)."""
+    from derive.runtime import constants
+
+    text = (GENERATED / "puma560_ik.c").read_text()
+    slack = re.search(r"#define DK_LIMIT_SLACK \((.*)\)", text)
+    assert slack is not None and float(slack.group(1)) == constants._LIMIT_SLACK
     for name, k, side in (("puma560", 0, 1), ("so_arm100", 1, 1), ("puma560", 2, 0)):
         m = generated(name)
         rng = np.random.default_rng(5)

@@ -1259,7 +1259,7 @@ static int dk_cs1x(dk_values *v, double a, double b, double e, double rest, doub
     if (fabs(ratio) > 1.0 + DK_CLAMP_TOL + DK_SEED_MISS) {
         return 0;
     }
-    if (rest >= 0.0) {
+    if (rest >= 0.0 && DK_SEED_TOL == 0.0) { /* (a nominal table keeps acos's: see _cs1x) */
         sd = sqrt(rest) * inverse;
     } else {
         if (fabs(ratio) >= 1.0 - DK_FOLD_TOL) {

@@ -36,6 +36,7 @@ from derive.runtime.common import (
     _tolerance,
 )
 from derive.runtime.constants import (
+    _LIMIT_SLACK,
     _SEAM,
     _TWO_PI,
     BACKEND,
@@ -495,9 +496,10 @@ def _every_turn(rows):
 
 
 def _turn_range(x, lo, hi):
-    """The k with lo <= x + 2 pi k <= hi (1e-12 slack): (first, last), empty if first > last."""
-    first = -math.inf if lo == -math.inf else math.ceil((lo - 1e-12 - x) / _TWO_PI)
-    last = math.inf if hi == math.inf else math.floor((hi + 1e-12 - x) / _TWO_PI)
+    """The k with lo <= x + 2 pi k <= hi (_LIMIT_SLACK of slack): (first, last), empty if first >
+    last."""
+    first = -math.inf if lo == -math.inf else math.ceil((lo - _LIMIT_SLACK - x) / _TWO_PI)
+    last = math.inf if hi == math.inf else math.floor((hi + _LIMIT_SLACK - x) / _TWO_PI)
     return first, last
 
 
@@ -507,7 +509,7 @@ def _turns(q):
     options = []
     for x, r, (lo, hi) in zip(q, _REVOLUTE, LIMITS):
         first, last = _turn_range(x, lo, hi) if r else (0, 0)
-        if (not r and not lo - 1e-12 <= x <= hi + 1e-12) or first > last:
+        if (not r and not lo - _LIMIT_SLACK <= x <= hi + _LIMIT_SLACK) or first > last:
             return []
         if math.isinf(first) or math.isinf(last):
             options.append([x])

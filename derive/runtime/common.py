@@ -7,7 +7,7 @@ import math
 import numpy as np
 
 from derive.runtime.arm import _REVOLUTE, DOF, LIMITS, REACH
-from derive.runtime.constants import _SEAM_SNAP, _TWO_PI, FAR_REACH
+from derive.runtime.constants import _LIMIT_SLACK, _SEAM_SNAP, _TWO_PI, FAR_REACH
 
 _PERIODS = tuple(2.0 * math.pi if r else math.inf for r in _REVOLUTE)
 
@@ -103,7 +103,7 @@ def _seam(x: float) -> float:
 _REV = np.array([1.0 if r else 0.0 for r in _REVOLUTE])
 
 
-_LOWER = np.array([lo - 1e-12 for lo, _ in LIMITS])
+_LOWER = np.array([lo - _LIMIT_SLACK for lo, _ in LIMITS])
 
 
-_UPPER = np.array([hi + 1e-12 for _, hi in LIMITS])
+_UPPER = np.array([hi + _LIMIT_SLACK for _, hi in LIMITS])

@@ -35,6 +35,10 @@ _FREE_TOL = 1e-14  # squared sizes: a joint is free below 1e-7 of its equation's
 # a PUMA missed its sampled vector and answered with rows 1e-8 off); a nominal table keeps
 # _FREE_TOL (its arm's difference is larger)
 _FREE_TOL_EXACT = 1e-20
+# a joint value within this of a limit is inside it: a row on a limit comes back a rounding
+# past it (1e-15 from the closed forms, 3e-12 from a quartic's root: KR3's q2 at its limit
+# was dropped at 1e-12, a new user's attack); C's DK_LIMIT_SLACK
+_LIMIT_SLACK = 1e-9
 # the values a free joint tries, as offsets from its preferred value: 0, +5, -5, +10, ... deg
 _FREE_STEPS = tuple(math.radians(5.0 * ((k + 1) // 2) * (1 if k % 2 else -1)) for k in range(72))
 _TWO_PI = 2.0 * math.pi
