@@ -5,7 +5,7 @@ from __future__ import annotations
 import sympy as sp
 
 from derive import symbols as sym
-from derive.plan import Assign
+from derive.plan import Assign, Cs1, Cs1Unit, Solve
 from derive.transforms import Chain, inverse, product, trans, x_factor
 
 
@@ -84,3 +84,22 @@ def typical_magnitude(exprs: tuple[sp.Expr, ...], length: float) -> float:
         }
     )
     return max(abs(float(e.xreplace(subs))) for e in exprs)
+
+
+def unit_column_cs1(
+    joint: int,
+    a: sp.Expr,
+    b: sp.Expr,
+    e: sp.Expr,
+    others: tuple[sp.Expr, sp.Expr],
+    note: str,
+    half_width: str = "atan2(sqrt(rest), e)",
+) -> Solve:
+    """a c + b s = e for an angle whose e is one entry of a unit vector and the two others
+    entries too: where a^2 + b^2 = 1, a^2 + b^2 - e^2 is the others' squares, exact to roundings
+    near the fold (a wrist nearly straight): Cs1Unit, the half-width atan2(sqrt(rest), e) (the
+    lecture's Z-Y-Z theta5; half_width names it in the note); else the plain Cs1."""
+    if sp.simplify(a**2 + b**2 - 1) == 0:
+        rest = others[0] ** 2 + others[1] ** 2
+        return Cs1Unit(joint, (a, b, e, rest), f"{note}, its half-width {half_width}", 2)
+    return Cs1(joint, (a, b, e), note, 2)

@@ -34,10 +34,11 @@ from derive.methods.common import (
     joint_refs,
     reversed_refs,
     typical_magnitude,
+    unit_column_cs1,
     unreverse_outputs,
 )
 from derive.methods.planar import flange_factors, heading_step, planar_steps
-from derive.plan import Assign, Cs1, Cs1Unit, Cs2, Cs2Reach, IkPlan, Poly, PolyD, Solve, Step
+from derive.plan import Assign, Cs1, Cs2, Cs2Reach, IkPlan, Poly, PolyD, Solve, Step
 from derive.transforms import Chain, inverse, numbers_of, product, reverse_chain
 
 NAME = "three-parallel"
@@ -321,16 +322,13 @@ def theta1_theta5_steps(
         if a5 == 0 and b5 == 0:
             raise NotApplicable("three-parallel: entry (3,3) does not involve theta5")
         note = "theta5: entry (3,3) of the invariant equation"
-        theta5: Solve = Cs1(5, (a5, b5, -c5_), note, 2)
-        if lhs is not None and sp.expand(c5_ - lhs[2]) == 0 and sp.simplify(a5**2 + b5**2 - 1) == 0:
-            # (entry (3,3) is a5 c5 + b5 s5 on a unit circle and the target side's (3,1),
-            # (3,2), (3,3) a unit vector, so a5^2 + b5^2 - lhs_33^2 = lhs_31^2 + lhs_32^2,
-            # exact to roundings where the wrist is nearly straight, as a spherical wrist's
-            # W13^2 + W23^2: Cs1Unit)
-            rest = lhs[0] ** 2 + lhs[1] ** 2
-            theta5 = Cs1Unit(
-                5, (a5, b5, -c5_, rest), note + ", its half-width atan2(sqrt(rest), e)", 2
-            )
+        # (where (3,3) has no constant, its target side's (3,1), (3,2), (3,3) a unit vector:
+        # the half-width from (3,1), (3,2), as a spherical wrist's from W13, W23)
+        theta5 = (
+            unit_column_cs1(5, a5, b5, -c5_, (lhs[0], lhs[1]), note)
+            if lhs is not None and sp.expand(c5_ - lhs[2]) == 0
+            else Cs1(5, (a5, b5, -c5_), note, 2)
+        )
         return [
             Cs1(
                 1,

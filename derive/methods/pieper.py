@@ -35,6 +35,7 @@ from derive.methods.common import (
     joint_refs,
     reversed_refs,
     typical_magnitude,
+    unit_column_cs1,
     unreverse_outputs,
 )
 from derive.plan import (
@@ -42,7 +43,6 @@ from derive.plan import (
     Atan2,
     Cs1,
     Cs1Reach,
-    Cs1Unit,
     Cs2,
     Cs2Reach,
     IkPlan,
@@ -380,21 +380,22 @@ def wrist_equations(numbers: dict, refs: tuple[sp.Expr, ...]) -> list[Step]:
     m = (inner.T * rot_z(c4, s4)[:3, :3].T * w_names).applyfunc(sp.expand)
     v1, v2 = sym.named("v1"), sym.named("v2")
     w13, w23, w33 = sym.named("W13"), sym.named("W23"), sym.named("W33")
-    if e5 == 0 and sp.simplify(a5**2 + b5**2 - 1) == 0:
-        # (twists of +-90 deg: W33 = a5 c5 + b5 s5 on a unit circle, and the column (W13, W23,
-        # W33) is a unit vector, so a5^2 + b5^2 - W33^2 = W13^2 + W23^2, exact to roundings
-        # where the wrist is nearly straight: the lecture's atan2(+-sqrt(W13^2 + W23^2), W33))
-        theta5: Solve = Cs1Unit(
+    note = "theta5: W33 = e3^T Rx(alpha4) Rz(theta5) Rx(alpha5) e3"
+    # (twists of +-90 deg: W33 = a5 c5 + b5 s5 on a unit circle, of the unit column (W13, W23,
+    # W33): the lecture's atan2(+-sqrt(W13^2 + W23^2), W33))
+    theta5 = (
+        unit_column_cs1(
             5,
-            (a5, b5, w33, w13**2 + w23**2),
-            "theta5: W33 = e3^T Rx(alpha4) Rz(theta5) Rx(alpha5) e3, its half-width "
+            a5,
+            b5,
+            w33,
+            (w13, w23),
+            note,
             "atan2(sqrt(W13^2 + W23^2), W33) (the Z-Y-Z Euler angle's)",
-            2,
         )
-    else:
-        theta5 = Cs1(
-            5, (a5, b5, w33 - e5), "theta5: W33 = e3^T Rx(alpha4) Rz(theta5) Rx(alpha5) e3", 2
-        )
+        if e5 == 0
+        else Cs1(5, (a5, b5, w33 - e5), note, 2)
+    )
     return [
         Assign(
             tuple(w_names),
