@@ -484,6 +484,10 @@ def _angle(u: Vector, v: Vector, about: Vector) -> float:
 
 # rounding noise: what --exact still takes as parallel, meeting, 0 or 90 deg (and never reports)
 NOISE = 1e-12
+# a spec whose FK differs from its file's by more than this (its numbers rounded to 15 digits,
+# entries below 1e-9 written as 0: a tool written with pi as 3.14159265359) keeps the file's
+# frames as [exact], as a snapped one does
+ROUNDED = 1e-13
 
 
 def convert(
@@ -492,9 +496,12 @@ def convert(
     angle_tol: float = ANGLE_TOL,
     length_tol: float = LENGTH_TOL,
     exact: bool = False,
+    task: str | None = None,
 ) -> Conversion:
     """The chain as modified-DH rows, base and tool, snapping within the tolerances (exact:
-    rounding noise only); the deviation is measured by :func:`measure`."""
+    rounding noise only); the deviation is measured by :func:`measure`. The base's and the
+    tool's rotations are snapped only where the task's structure reads them (_frames_snapped):
+    a base written with euler 1.57079 would otherwise make the arm nominal for nothing."""
     if exact:
         angle_tol = length_tol = NOISE
     moving = [j for j in path if j.kind in MOVING]
@@ -594,8 +601,11 @@ def convert(
     for _kind, alpha, a, d, theta, _limits in rows:
         built = matmul(built, dh_modified(alpha, a, theta, d))
     tool = orthonormalise(matmul(inverse(built), tip_pose), where, "tool", snaps)
-    first = _snap_frame(first, angle_tol, ltol, snaps, "base")
-    tool = _snap_frame(tool, angle_tol, ltol, snaps, "tool")
+    snap_base, snap_tool = _frames_snapped(task, [j.kind for j in moving], bool(snaps))
+    if snap_base:
+        first = _snap_frame(first, angle_tol, ltol, snaps, "base")
+    if snap_tool:
+        tool = _snap_frame(tool, angle_tol, ltol, snaps, "tool")
     for matrix, what in ((first, "base"), (tool, "tool")):
         away = math.sqrt(sum(matrix[i][3] ** 2 for i in range(3)))
         if away > OFFSET_LIMIT * reach:
@@ -614,6 +624,22 @@ def convert(
         reach=reach,
         rounded=not exact,
         frames=exact_frames(path),
+    )
+
+
+def _frames_snapped(task: str | None, kinds: list[str], rows_snapped: bool) -> tuple[bool, bool]:
+    """Whether conversion snaps the base's and the tool's frames: where the rows are snapped
+    (the arm is nominal anyway, and a snapped tool can undo some of the rows' difference: an
+    xArm6's deviation 1.4e-5 with it, 2.2e-5 without), or where the frame shapes the structure
+    of the task (given, or the arm's joints' choice: six or more joints the pose, five a tool
+    axis's direction; derive/tasks.py default_task). A pose's closed forms solve B^-1 T E^-1
+    for any rigid B and E; a tool axis's task reads the tool's frame (the virtual joint's
+    line) and not the base's; the others (a planar arm's, an axis angle to a base axis, a
+    position) read both, or are left as they were."""
+    chosen = task or ("pose" if len(kinds) >= 6 else "direction" if len(kinds) == 5 else None)
+    return (
+        rows_snapped or chosen not in ("pose", "direction"),
+        rows_snapped or chosen != "pose",
     )
 
 
@@ -863,11 +889,12 @@ def spec_text(
     def strings(values: list[str]) -> str:
         return "[" + ", ".join(f'"{_label(v)}"' for v in values) + "]"
 
-    if conversion.snaps:
+    if conversion.snaps or conversion.deviation > ROUNDED:
         lines += [
             "",
             f"# the {kind}'s own geometry: the table above is snapped (its structure picks the",
-            "# closed form); fk, and every answer, are these frames' (derive/nominal.py)",
+            "# closed form) or rounded; fk, and every answer, are these frames'",
+            "# (derive/nominal.py)",
             "[exact]",
             "frames = [",
             *(f"    [{', '.join(_exact_number(v) for v in f)}]," for f in conversion.frames),
@@ -973,7 +1000,9 @@ def import_chain(
     then the tip's)."""
     where = str(path)
     assert options.base is not None and options.tip is not None
-    conversion = convert(chain, where, options.angle_tol, options.length_tol, options.exact)
+    conversion = convert(
+        chain, where, options.angle_tol, options.length_tol, options.exact, options.task
+    )
     name = options.name or spec_name(robot.name or path.stem)
     given = (
         ("task", options.task),

@@ -34,7 +34,7 @@ pytestmark = pytest.mark.skipif(
 C_ARMS = BUNDLED
 POSES = 10_000
 # the general method's Python solver takes about 2 ms a pose (the closed forms 50 us)
-POSES_FOR = {"manocha_canny": 2_000, "so_arm100": 3_000}
+POSES_FOR = {"manocha_canny": 2_000}
 # Rows that differ from the Python solver's by more than 1e-9 (but at most 1e-6), and poses
 # with another number of rows, measured on these poses (seed 5, 20% of the joints at 0,
 # +-90, 180 deg). Everywhere else the rows agree to 1e-9 (most to 1e-12). These are poses
@@ -51,19 +51,10 @@ POSES_FOR = {"manocha_canny": 2_000, "so_arm100": 3_000}
 # on 0.3%). Every regular sample's own q is among the C rows there too (checked below).
 BEYOND = {"lecture_6r": 10, "parallel_6r": 4, "iiwa14": 15, "panda": 15}
 BEYOND |= {"youbot": 3, "locobot_head": 1}
-# (so_arm100's rows are refined onto its exact chain: each backend's Newton steps stop within
-# 1e-10 of the pose, and near a singular configuration (its roll near 90 deg) that leaves the
-# joint values up to 1e-6 apart; measured 38 of its 3,000 poses (140 of 10,000), allowed 45.
-# Its Python solver refines every row: 3,000 poses, not 10,000, keep CI inside its time)
-BEYOND |= {"so_arm100": 45}
 # Below this smallest singular value a sample's own q may be missing from the rows: the
-# sample is singular. A nominal table refined onto the exact arm (so_arm100, from its MJCF)
-# misses one more: where the nominal arm is singular the exact one can have two solutions
-# close together, and the nominal seed refines onto one of them (measured on 10,000 poses: 841, the
-# roll 2.3 deg from 90 deg, sigma 1.1e-5; both solvers return the other solution, 0.01 rad
-# away, exact to 1e-16)
+# sample is singular.
 SINGULAR = verify.SINGULAR_SIGMA
-SINGULAR_FOR = {"so_arm100": 1e-4}
+SINGULAR_FOR: dict[str, float] = {}
 COUNT = {"parallel_6r": 1, "manocha_canny": 40}
 TURN = {"manocha_canny": 12}
 
@@ -626,12 +617,15 @@ def test_the_c_entry_points_refuse_what_python_refuses(generated):
         assert velocity(at_q, twist.ctypes.data, frame, 0.05, 0.01, None, 1.0, out) == code
 
 
-def test_a_pose_on_a_curve_of_solutions_gets_at_most_max_solutions_rows_in_both(generated):
-    """SO-ARM100 with its wrist roll at 90 deg: the tool z axis parallel to the pitch axes, a
-    curve of solutions that the exact arm keeps, so every seed certifies: Python returned up to
-    42 rows, past MAX_SOLUTIONS = 8, where C's buffer keeps 8 (a new user's attack). Both now
-    give the first MAX_SOLUTIONS, the same rows."""
-    m = generated("so_arm100")
+def test_a_pose_on_a_curve_of_solutions_gets_at_most_max_solutions_rows_in_both(tmp_path):
+    """SO-ARM100 on a nominal table (its base snapped, as the converter once wrote it:
+    tests/data/specs/so_arm100_nominal.toml) with its wrist roll at 90 deg: the tool z axis
+    parallel to the pitch axes, a curve of solutions that the exact arm keeps, so every seed
+    certifies: Python returned up to 42 rows, past MAX_SOLUTIONS = 8, where C's buffer keeps
+    8 (a new user's attack). Both now give the first MAX_SOLUTIONS, the same rows."""
+    text = (ROOT / "tests" / "data" / "specs" / "so_arm100_nominal.toml").read_text()
+    m = build_module(text, tmp_path, c=True)
+    assert m.NOMINAL_DEVIATION > 1e-6
     q = np.array([0.7387133845139449, -math.pi / 2, 2.908206401485271, 0.843344312546662,
                   math.pi / 2])  # fmt: skip
     T = m.fk(q)

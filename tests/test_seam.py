@@ -13,9 +13,7 @@ SEAM_SHARE = 0.2
 POSES = 10_000
 # The general method's Python solver takes about 2 ms a pose (the closed forms 50 us): its arm
 # gets fewer poses so that the suite stays inside CI's time.
-# So does a nominal table's refined onto its exact chain (so_arm100: about 1 ms a pose in
-# Python, 60 s for 10,000).
-POSES_FOR = {"manocha_canny": 2_000, "so_arm100": 2_000}
+POSES_FOR = {"manocha_canny": 2_000}
 
 
 def seam_poses(m, n: int, seed: int) -> np.ndarray:
@@ -109,16 +107,16 @@ def tally(m, backends: tuple[str, ...]) -> dict[str, dict[str, int]]:
 # 2.7e-7 from folded back, where the compiled solver merges two solutions 4e-6 apart and the
 # Python one keeps both (as parallel_6r's); 3 more poses near such a double root differ by
 # rounding (1e-12..1e-6), and at 1 a joint at the seam is pi in one and pi - 8e-12 in the
-# other. so_arm100 (refined onto its exact frames; 2,000 poses): 2 poses differ by rounding
-# (each backend's Newton steps stop within 1e-10 of the pose; on 10,000 poses: 8, and 1 by
-# more than 1e-6 at a singular configuration, a curve of solutions). locobot_head: none.
+# other. so_arm100: at 2 of 10,000 poses two rows lie 4e-3 and 3e-4 apart (near a double root
+# of the law of cosines), where the backends' rows differ by 1e-12..3e-12, and at one of them
+# a joint at the seam is pi in Python and pi + 1.2e-12 in C. locobot_head: none.
 # open_manipulator_x (the axis-angle task): 2 of 10,000 poses differ by rounding (9.5e-12 and
 # 1.3e-11), each with two rows 5e-4 apart in theta3 (the two tilts phi give wrists almost the
 # same distance from the shoulder: near-double roots of the law of cosines).
 ALLOWED = {
     "open_manipulator_x": {"rounding": 3},
     "youbot": {"count": 1, "rounding": 5, "seam": 2},
-    "so_arm100": {"rounding": 5},
+    "so_arm100": {"rounding": 1, "seam": 1},
     "iiwa14": {"rounding": 30, "seam": 10, "turn": 2},
     "panda": {"rounding": 5},
     "lecture_6r": {"rounding": 500, "seam": 50, "turn": 1, "count": 1},

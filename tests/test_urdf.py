@@ -90,6 +90,40 @@ def generated_module(path: Path, base: str, tip: str, tmp_path: Path):
     return module
 
 
+def test_a_mount_written_with_cad_decimals_keeps_the_table_exact(tmp_path):
+    """A KR210 (its URDF exact) on a mount turned by 1.5708 rad about z (CAD decimals), with
+    a tool turned by 3.1416: a pose's closed form solves B^-1 T E^-1 for any rigid B and E,
+    so the mount and the tool are not snapped. Before, they were taken as right-angle
+    rotations, the arm went nominal (deviation 7e-6) and every row was refined by Newton's
+    steps; now the table is the file's, with no [exact] frames. (A mount also tilted about x
+    gives products of its entries below 1e-9, which a spec writes as 0: that arm keeps
+    [exact] frames 1.7e-10 away and is refined.)"""
+    extra = (
+        '<link name="mount"/><link name="tcp"/>'
+        '<joint name="mount_joint" type="fixed"><parent link="mount"/><child link="base_link"/>'
+        '<origin xyz="0.1 0.2 0.3" rpy="0 0 1.5708"/></joint>'
+        '<joint name="tcp_joint" type="fixed"><parent link="tool0"/><child link="tcp"/>'
+        '<origin xyz="0 0.01 0.1" rpy="0 0 3.1416"/></joint></robot>'
+    )
+    text = (DATA / "kr210l150.urdf").read_text()
+    path = tmp_path / "kr210_mounted.urdf"
+    path.write_text(text.replace("</robot>", extra))
+    spec_text, conversion = urdf.import_urdf(path, options("mount", "tcp"))
+    assert not conversion.snaps and "[exact]" not in spec_text, conversion.snaps
+    assert conversion.deviation <= 1e-13
+    chain = urdf.chain_between(urdf.read_urdf(path), "mount", "tcp", str(path))
+    module = generated_module(path, "mount", "tcp", tmp_path)
+    rng = random.Random(3)
+    for _ in range(100):
+        q = random_joint_values(chain, rng)
+        T = np.array(urdf.urdf_fk(chain, q))
+        assert np.abs(module.fk(q) - T).max() <= 1e-12
+        rows = module.ik(T)
+        assert len(rows) and np.abs(rows - np.array(q)).max(axis=1).min() <= 1e-9
+        for row in rows:
+            assert np.abs(np.array(urdf.urdf_fk(chain, list(row))) - T).max() <= 1e-12
+
+
 @pytest.mark.parametrize(("name", "base", "tip"), [f[:3] for f in FIXTURES if f[3]])
 def test_the_solver_of_a_urdf_finds_the_urdf_joint_values(name, base, tip, tmp_path):
     """ik(FK_urdf(q)) contains q (to 1e-8) on 1,000 random q within the limits; where it does
