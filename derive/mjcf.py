@@ -357,9 +357,7 @@ def import_mjcf(path: Path, options: urdf.Options) -> tuple[str, urdf.Conversion
     # (named after the model, <mujoco model="...">, as a URDF after its robot; after the file
     # where the model has no name, which MuJoCo reports as MUJOCO_UNNAMED)
     model_name = "" if robot.name == MUJOCO_UNNAMED else robot.name
-    named = dataclasses.replace(
-        options, name=options.name or urdf.spec_name(model_name or path.stem)
-    )
+    named = dataclasses.replace(options, name=options.name or urdf.arm_name(model_name, path))
     return urdf.import_chain(robot, chain, path, named, source="MJCF", part=part)
 
 

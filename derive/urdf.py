@@ -814,6 +814,12 @@ def spec_name(text: str) -> str:
     return name[:60]
 
 
+def arm_name(given: str, path: Path) -> str:
+    """The spec name of the robot a file names given: given's, or the file's where given has
+    no letter or digit (<robot name="  "> was named "arm_")."""
+    return spec_name(given if re.search(r"[A-Za-z0-9]", given) else path.stem)
+
+
 def spec_text(
     conversion: Conversion,
     robot: Robot,
@@ -1003,7 +1009,7 @@ def import_chain(
     conversion = convert(
         chain, where, options.angle_tol, options.length_tol, options.exact, options.task
     )
-    name = options.name or spec_name(robot.name or path.stem)
+    name = options.name or arm_name(robot.name, path)
     given = (
         ("task", options.task),
         ("tool_axis", options.tool_axis),

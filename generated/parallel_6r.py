@@ -1044,9 +1044,18 @@ def _real(x: object, name: str) -> np.ndarray:
             and not any(v is None or isinstance(v, (bool, np.bool_, str, bytes)) for v in a.flat)
         ):
             raise TypeError
+        if type(x) is not np.ndarray and _holds_bool(x):  # ([True, 0.5, 0.2] is floats to numpy)
+            raise TypeError
         return a.astype(float)
     except (TypeError, ValueError, OverflowError):  # (OverflowError: an int beyond a float)
         raise ValueError(f"{name} must be an array of real numbers (ints or floats)") from None
+
+
+def _holds_bool(x: object) -> bool:
+    """Whether x is a boolean or a list or tuple holding one, at any depth."""
+    if isinstance(x, (list, tuple)):
+        return any(map(_holds_bool, x))
+    return isinstance(x, (bool, np.bool_))
 
 
 _ONES = np.ones(DOF)

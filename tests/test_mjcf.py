@@ -303,11 +303,14 @@ def test_a_urdf_named_xml_is_read_as_a_urdf(tmp_path):
 def test_the_spec_is_named_after_the_model_else_the_file(tmp_path):
     """<mujoco model="ur5e"> names the arm as a URDF's <robot name> does (robosuite's arms are
     all robot.xml: each generated robot.py over the last, a new user's attack); a model
-    without a name (MuJoCo's "MuJoCo Model") is named after its file."""
+    without a name (MuJoCo's "MuJoCo Model"), or one with no letter or digit (it was named
+    "arm_"), is named after its file."""
     named = tmp_path / "robot.xml"
     named.write_text(three_joints().replace('model="m"', 'model="UR5e arm"'))
     unnamed = tmp_path / "left_arm.xml"
     unnamed.write_text(three_joints().replace(' model="m"', ""))
-    for path, name in ((named, "ur5e_arm"), (unnamed, "left_arm")):
+    blank = tmp_path / "right_arm.xml"
+    blank.write_text(three_joints().replace('model="m"', 'model="  "'))
+    for path, name in ((named, "ur5e_arm"), (unnamed, "left_arm"), (blank, "right_arm")):
         spec = mjcf.load_mjcf(path, Options(base="b0", tip="b4"))
         assert spec.name == name

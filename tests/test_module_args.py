@@ -170,6 +170,22 @@ def test_strings_and_booleans_are_not_poses(ur5, T):
         ur5.fk(T[0, :4].tolist() + T[1, :2].tolist())
 
 
+def test_a_boolean_among_numbers_is_not_a_number(ur5):
+    """numpy reads [True, 0.5] as floats; ik, ik_batch and fk (and a position arm's
+    ik_position, through the same _real) took True as 1.0 (a new user's attack). A list or
+    tuple holding a boolean at any depth is refused."""
+    T = ur5.fk(np.full(6, 0.3)).tolist()
+    T[0][3] = True
+    with pytest.raises(ValueError, match="real numbers"):
+        ur5.ik(T)
+    with pytest.raises(ValueError, match="real numbers"):
+        ur5.ik_batch([T])
+    with pytest.raises(ValueError, match="real numbers"):
+        ur5.fk((0.1, np.True_, 0.2, 0.3, 0.4, 0.5))
+    T[0][3] = 1  # (ints are numbers)
+    assert ur5.ik(T).shape[1] == 6
+
+
 @pytest.mark.parametrize("free", ["0.5", [True], [[0.5]], np.array([[0.5]])])
 def test_free_values_must_be_numbers_one_per_free_joint(generated, free):
     m = generated("iiwa14")

@@ -431,3 +431,13 @@ def test_a_scara_urdf_with_a_prismatic_joint_gets_its_solver(tmp_path):
         d = sols - np.array(q)
         d[:, [0, 1, 3]] = np.remainder(d[:, [0, 1, 3]] + np.pi, 2 * np.pi) - np.pi
         assert len(sols) and np.abs(d).max(axis=1).min() <= 1e-9, (q, sols)
+
+
+def test_a_robot_named_with_no_letter_or_digit_is_named_after_its_file(tmp_path):
+    """<robot name="  "> gave the spec name "arm_" (a new user's attack); now the file's."""
+    text, base, tip = random_chain(random.Random(1))
+    path = tmp_path / "left_leg.urdf"
+    path.write_text(text.replace('<robot name="chain">', '<robot name="  ">'))
+    assert urdf.load_urdf(path, options(base, tip)).name == "left_leg"
+    path.write_text(text)
+    assert urdf.load_urdf(path, options(base, tip)).name == "chain"
