@@ -1227,10 +1227,14 @@ static int dk_cs1x(dk_values *v, double a, double b, double e, double rest, doub
                    double ref)
 {
     double rho = sqrt(a * a + b * b), inverse, ratio, sd, cb, sb;
+    /* free below DK_FREE_TOL_EXACT on an exact table, or where nearly so and unsolvable
+       (an earlier joint's snapped double root leaves e 3e-11 off): the Python _cs1 */
+    const int small = rho * rho <= DK_FREE_TOL * scale;
+    const int free = DK_SEED_TOL > 0.0 ? small : rho * rho <= DK_FREE_TOL_EXACT * scale;
     v->n = 0;
     v->free = 0;
     v->ref = 0.0; /* (unread unless free; set so that no compiler sees it unset) */
-    if (rho * rho <= DK_FREE_TOL * scale) {
+    if (free || (small && fabs(e) > rho * (1.0 + DK_CLAMP_TOL))) {
         if (e * e <= DK_FREE_TOL * scale) {
             dk_set_free(v, ref, 1);
         }

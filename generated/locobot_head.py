@@ -210,8 +210,10 @@ _FREE_TOL = 1e-14  # squared sizes: a joint is free below 1e-7 of its equation's
 # roundings (1e-13 and less; 1e-13 of a singular wrist's s5 gave theta4 from noise, C and
 # Python 1e-3 apart), and so is s5 where theta5 comes from atan2(sqrt(W13^2 + W23^2), W33)
 # (Cs1Unit), so a wrist 1e-8 from straight has its own theta4 (below 1e-7 it was free, q_ref's:
-# a PUMA missed its sampled vector and answered with rows 1e-8 off); a nominal table keeps
-# _FREE_TOL (its arm's difference is larger)
+# a PUMA missed its sampled vector and answered with rows 1e-8 off); likewise a one-equation
+# step's (theta1 where the wrist centre is 6e-8 of the reach from axis 1 took q_ref's value, its
+# rows 6e-8 off: a new user's attack); a nominal table keeps _FREE_TOL (its arm's difference
+# is larger)
 _FREE_TOL_EXACT = 1e-20
 
 

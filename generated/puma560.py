@@ -246,8 +246,10 @@ _FREE_TOL = 1e-14  # squared sizes: a joint is free below 1e-7 of its equation's
 # roundings (1e-13 and less; 1e-13 of a singular wrist's s5 gave theta4 from noise, C and
 # Python 1e-3 apart), and so is s5 where theta5 comes from atan2(sqrt(W13^2 + W23^2), W33)
 # (Cs1Unit), so a wrist 1e-8 from straight has its own theta4 (below 1e-7 it was free, q_ref's:
-# a PUMA missed its sampled vector and answered with rows 1e-8 off); a nominal table keeps
-# _FREE_TOL (its arm's difference is larger)
+# a PUMA missed its sampled vector and answered with rows 1e-8 off); likewise a one-equation
+# step's (theta1 where the wrist centre is 6e-8 of the reach from axis 1 took q_ref's value, its
+# rows 6e-8 off: a new user's attack); a nominal table keeps _FREE_TOL (its arm's difference
+# is larger)
 _FREE_TOL_EXACT = 1e-20
 
 
@@ -1708,13 +1710,18 @@ def _cs1(
     near +-1, seeds either side of the fold, _FOLD_SEEDS), and taken as +-1 within _FOLD_TOL
     below (the double root).
 
-    When a^2 + b^2 and e^2 are both at most _FREE_TOL * scale the equation holds for every
-    t (the angle is free; e.g. the elbow folded onto axis 1): _free(ref). Where rest >= 0
-    (a^2 + b^2 - e^2 as a sum of squares: _cs1x), the half-width is atan2(sqrt(rest), e),
-    exact to roundings at the fold, where acos's is not.
+    When a^2 + b^2 is at most _FREE_TOL * scale (_FREE_TOL_EXACT on an exact table: the
+    wrist centre 1e-9 from axis 1 has its theta1) and e^2 at most _FREE_TOL * scale, the
+    equation holds for every t (the angle is free; e.g. the wrist centre on axis 1):
+    _free(ref); so it is where a^2 + b^2 is within _FREE_TOL * scale and no t solves it (an
+    earlier joint's double root, snapped, leaves e 3e-11 off). Where rest >= 0 (a^2 + b^2 -
+    e^2 as a sum of squares: _cs1x), the half-width is atan2(sqrt(rest), e), exact to
+    roundings at the fold, where acos's is not.
     """
     rho = sqrt(a * a + b * b)
-    if rho * rho <= _FREE_TOL * scale:  # (seeding ik_approximate, any value is a seed)
+    small = rho * rho <= _FREE_TOL * scale
+    free = small if _SEED_TOL else rho * rho <= _FREE_TOL_EXACT * scale
+    if free or (small and abs(e) > rho * (1.0 + _CLAMP_TOL)):  # (ik_approximate: any seed)
         return _free(ref) if e * e <= _FREE_TOL * scale or _LOOSE.on else ()
     if rho == 0.0:
         return (ref,) if _LOOSE.on else ()

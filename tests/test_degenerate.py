@@ -85,3 +85,55 @@ def test_a_wrist_nearly_straight_is_solved_to_roundings(generated, name, backend
                 assert max(gap[:, :3].max(), gap[:, 3].max() / m.REACH) <= 1e-12, (q, row)
             gaps = np.abs(np.remainder(rows - q + np.pi, 2 * np.pi) - np.pi).max(axis=1)
             assert len(rows) and gaps.min() <= 1e-12 / q5 + 1e-9, (q5, q, gaps.min())
+
+
+# a PUMA without its shoulder offsets (a1 = 0, d2 = d3 = 0): its wrist centre can lie on axis 1
+ON_AXIS_ROWS = [(0, 0, 0, 0), (-90, 0, 0, 0), (0, 0.4, 0, 0), (-90, 0.02, 0.4, 0)]
+ON_AXIS_ROWS += [(90, 0, 0, 0), (-90, 0, 0, 0)]
+UNIT2 = np.array([0.0, 1.0, 0.0, 0.0, 0.0, 0.0])
+
+
+@pytest.mark.parametrize("backend", ["python", pytest.param("c", marks=needs_cc)])
+def test_a_wrist_centre_near_axis_1_keeps_its_rows_exact(tmp_path, backend):
+    """The wrist centre 1e-12..1e-6 of the reach from axis 1: theta2's two values nearly meet
+    there, and acos(c / sqrt(a^2 + b^2)) rounded their half-width to 0, so theta2 came back on
+    the fold, theta1 free (q_ref's), and the rows missed the pose by the distance (6e-8 at
+    6e-8: robosuite's Spot arm, a new user's attack); theta1 was also free below 1e-7 of the
+    scale (_FREE_TOL), where the exact table's theta1 is defined to 1e-10. Now the half-width
+    is atan2(sqrt(x^2 + y^2), c) (the distance, exact to roundings), and theta1 is free only
+    below 1e-10 of the scale (_FREE_TOL_EXACT), where a row misses by at most the distance:
+    every row within 1e-10 of the pose (measured: 1.6e-12), the sampled vector among them
+    from 1e-8 (theta1 is atan2 of the wrist centre's x, y, exact to 1e-16 of the reach:
+    measured 7.7e-8 away at eps = 1e-8; allowed 1e-14 / eps). Before: no row at all with
+    tol = 1e-10 at eps = 1e-8."""
+    m = build_module(spec_text("on_axis", "modified", ON_AXIS_ROWS), tmp_path, c=True)
+    rng = np.random.default_rng(4)
+
+    def off_axis(q: np.ndarray) -> float:  # (signed: q1 = 0 puts the arm in the x-z plane)
+        return float(m.link_transform(np.r_[0.0, q[1:]], 4)[0, 3])
+
+    for _ in range(10):
+        q = rng.uniform(-math.pi, math.pi, 6)
+        q[2] = rng.uniform(-2.5, 2.5)
+        q[4] = rng.choice((-1.0, 1.0)) * rng.uniform(0.3, 2.8)  # (a wrist nearly straight
+        # multiplies theta1's error by 1 / s5 in theta4 and theta6: 5e-6 at q5 = -0.002)
+        # q2 with the wrist centre on axis 1: the offset is c cos q2 + s sin q2 (axis 2 meets
+        # axis 1), then Newton's steps
+        c, s = off_axis(np.r_[q[0], 0.0, q[2:]]), off_axis(np.r_[q[0], math.pi / 2, q[2:]])
+        q[1] = math.atan2(-c, s)
+        for _ in range(3):
+            slope = (off_axis(q + 1e-7 * UNIT2) - off_axis(q)) / 1e-7
+            q[1] -= off_axis(q) / slope
+        assert abs(off_axis(q)) <= 1e-15
+        for eps in (0.0, 1e-12, 1e-10, 1e-8, 1e-6):
+            sample = q + eps * UNIT2
+            T = m.fk(sample)
+            rows = m.ik(T, backend=backend, tol=1e-10)
+            assert len(rows), eps
+            for row in rows:
+                E = m.fk(row)
+                assert np.abs(E[:3, :3] - T[:3, :3]).max() <= 1e-10, eps
+                assert np.abs(E[:3, 3] - T[:3, 3]).max() <= 1e-10 * m.REACH, eps
+            if eps >= 1e-8:
+                gaps = np.abs(np.remainder(rows - sample + math.pi, 2 * math.pi) - math.pi)
+                assert np.max(gaps, axis=1).min() <= 1e-14 / eps, eps

@@ -43,6 +43,7 @@ from derive.plan import (
     Atan2,
     Cs1,
     Cs1Reach,
+    Cs1Unit,
     Cs2,
     Cs2Reach,
     IkPlan,
@@ -178,6 +179,29 @@ def k_functions() -> dict[str, sp.Expr]:
     }
 
 
+def _axis_distance_rest(
+    a: sp.Expr, b: sp.Expr, e: sp.Expr, k3: sp.Expr, length: float, prismatic3: bool
+) -> sp.Expr | None:
+    """x^2 + y^2 where it is a^2 + b^2 - e^2 of theta2's a c2 + b s2 = e once joint 3 solves
+    the a1 = 0 case's equation r = k3 (r = x^2 + y^2 + z^2), as on an arm whose wrist
+    centre has no offset along axis 2 (its coefficients agree to 1e-12 of the arm's size
+    squared), else None. Near the wrist centre on axis 1 the two values of theta2 meet (a
+    fold), and acos(e / sqrt(a^2 + b^2)) rounds to 0 the half-width that the distance gives:
+    6e-10 of the reach away, theta2 came back on the fold, theta1 free (q_ref's) and the rows
+    6e-10 off the pose (a new user's attack on robosuite's Spot arm)."""
+    x, y, z = (sym.named(n) for n in ("x", "y", "z"))
+    gap = sp.expand(a**2 + b**2 - e**2 - (k3 - z**2))  # (x^2 + y^2 = r - z^2 = k3 - z^2)
+    if not prismatic3:
+        gap = sp.expand(reduce_pairs(gap, [(sym.s(3), sym.c(3))]))
+    if gap.free_symbols:
+        coeffs = sp.Poly(gap, *sorted(gap.free_symbols, key=str)).coeffs()
+    else:
+        coeffs = [gap]
+    if all(abs(float(c)) <= 1e-12 * max(length, 1.0) ** 2 for c in coeffs):
+        return x**2 + y**2
+    return None
+
+
 def position_equations(
     numbers: dict, length: float, refs: tuple[sp.Expr, ...], prismatic3: bool
 ) -> PositionResult:
@@ -274,17 +298,19 @@ def position_equations(
     else:
         ta, tb, tc = linear_coeffs(theta2_eq, c2, s2)
         size = length if is_zero(a1, 1e-12) else 2 * abs(float(a1)) * length
-        steps.append(
-            Cs1(
-                2,
-                (ta, tb, -tc),
-                "theta2: a c2 + b s2 = c by the half-angle method; free when the "
-                "equation vanishes identically",
-                2,
-                refs[1],
-                size**2,
-            )
+        note = (
+            "theta2: a c2 + b s2 = c by the half-angle method; free when the equation "
+            "vanishes identically"
         )
+        rest = _axis_distance_rest(ta, tb, -tc, k3, length, prismatic3)
+        if is_zero(a1, 1e-12) and rest is not None:
+            note += (
+                ", its half-width atan2(sqrt(x^2 + y^2), c): a^2 + b^2 - c^2 is the wrist "
+                "centre's squared distance from axis 1"
+            )
+            steps.append(Cs1Unit(2, (ta, tb, -tc, rest), note, 2, refs[1], size**2))
+        else:
+            steps.append(Cs1(2, (ta, tb, -tc), note, 2, refs[1], size**2))
         fan2 = 2
     g1, g2 = spec["g1"], spec["g2"]
     steps.append(
@@ -347,9 +373,9 @@ def reach_guided(position: list[Step], wrist: list[Step]) -> list[Step]:
                 note=step.note + "; then chosen so that the wrist reaches W33",
             )
         elif isinstance(step, Solve) and step.joint == 2 and step.kind == "cs1":
-            step = step.as_kind(
+            step = step.as_kind(  # (a Cs1Unit's rest is dropped: Cs1Reach solves by acos)
                 Cs1Reach,
-                args=(*step.args, *m, *bounds),
+                args=(*step.args[:3], *m, *bounds),
                 note=step.note + "; then chosen so that a theta1 lets the wrist reach W33",
             )
         out.append(step)

@@ -97,13 +97,18 @@ def _cs1(
     near +-1, seeds either side of the fold, _FOLD_SEEDS), and taken as +-1 within _FOLD_TOL
     below (the double root).
 
-    When a^2 + b^2 and e^2 are both at most _FREE_TOL * scale the equation holds for every
-    t (the angle is free; e.g. the elbow folded onto axis 1): _free(ref). Where rest >= 0
-    (a^2 + b^2 - e^2 as a sum of squares: _cs1x), the half-width is atan2(sqrt(rest), e),
-    exact to roundings at the fold, where acos's is not.
+    When a^2 + b^2 is at most _FREE_TOL * scale (_FREE_TOL_EXACT on an exact table: the
+    wrist centre 1e-9 from axis 1 has its theta1) and e^2 at most _FREE_TOL * scale, the
+    equation holds for every t (the angle is free; e.g. the wrist centre on axis 1):
+    _free(ref); so it is where a^2 + b^2 is within _FREE_TOL * scale and no t solves it (an
+    earlier joint's double root, snapped, leaves e 3e-11 off). Where rest >= 0 (a^2 + b^2 -
+    e^2 as a sum of squares: _cs1x), the half-width is atan2(sqrt(rest), e), exact to
+    roundings at the fold, where acos's is not.
     """
     rho = sqrt(a * a + b * b)
-    if rho * rho <= _FREE_TOL * scale:  # (seeding ik_approximate, any value is a seed)
+    small = rho * rho <= _FREE_TOL * scale
+    free = small if _SEED_TOL else rho * rho <= _FREE_TOL_EXACT * scale
+    if free or (small and abs(e) > rho * (1.0 + _CLAMP_TOL)):  # (ik_approximate: any seed)
         return _free(ref) if e * e <= _FREE_TOL * scale or _LOOSE.on else ()
     if rho == 0.0:
         return (ref,) if _LOOSE.on else ()
@@ -149,7 +154,8 @@ def _cs1_reach(
     """As _cs1; a free t starts at the first value _reach_first1 finds (the next joint must
     still let the wrist reach)."""
     rho = sqrt(a * a + b * b)
-    if rho * rho > _FREE_TOL * scale or e * e > _FREE_TOL * scale:
+    free = _FREE_TOL if _SEED_TOL else _FREE_TOL_EXACT
+    if rho * rho > free * scale or e * e > _FREE_TOL * scale:
         return _cs1(a, b, e, scale, ref)
     return _free(_reach_first1(m00, m01, m02, m10, m11, m12, m20, m21, m22, lo, hi, ref))
 
