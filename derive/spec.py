@@ -616,6 +616,13 @@ def _numbers(value: object, where: str, field: str, count: int) -> tuple[float, 
     return tuple(_number(v, where, f"{field}[{k}]") for k, v in enumerate(value))
 
 
+def _frame_entries(value: object, where: str, field: str) -> tuple[float, ...]:
+    """A row of a frame's 4x4 matrix: 4 numbers, each as _frame_entry takes it."""
+    if not isinstance(value, list) or len(value) != 4:
+        raise SpecError(f"{where}: {field}: must be a list of 4 numbers")
+    return tuple(_frame_entry(v, where, f"{field}[{k}]") for k, v in enumerate(value))
+
+
 def _joint(row: dict, where: str, index: int) -> Joint:
     prefix = f"joint {index}: "
     _no_unknown_keys(row, JOINT_KEYS, where, prefix)
@@ -656,7 +663,11 @@ def _frame(table: object, where: str, field: str, angle_unit: str) -> Frame | No
         rows = table["matrix"]
         if not isinstance(rows, list) or len(rows) != 4:
             raise SpecError(f"{where}: {field}.matrix: must be 4 rows of 4 numbers")
-        flat = sum((_numbers(r, where, f"{field}.matrix[{i}]", 4) for i, r in enumerate(rows)), ())
+        # (any small entry: a base turned by CAD decimals about two axes has entries 1e-11, as
+        # the [exact] frames' rotations hold; the matrix is computed with)
+        flat = sum(
+            (_frame_entries(r, where, f"{field}.matrix[{i}]") for i, r in enumerate(rows)), ()
+        )
         _check_rigid(flat, where, field)
         return Frame(flat, None, (0.0, 0.0, 0.0))
     if "translation" not in table:

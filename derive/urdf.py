@@ -888,8 +888,15 @@ def spec_text(
         if limits is not None:
             lo, hi = (math.degrees(v) for v in limits) if joint_type == "R" else limits
             lines.append(f"limits = [{number(lo)}, {number(hi)}]")
+
+    def entry(x: float) -> str:
+        # a base's or a tool's entry: kept down to rounding noise (a frame turned by CAD
+        # decimals about two axes has entries 1e-11: written as 0, its FK moved 2.7e-11)
+        x = float(x) + 0.0
+        return "0.0" if abs(x) < 1e-15 else repr(float(f"{x:.15g}"))
+
     for title, matrix in (("base", conversion.base), ("tool", conversion.tool)):
-        entries = ", ".join("[" + ", ".join(number(v) for v in row) + "]" for row in matrix)
+        entries = ", ".join("[" + ", ".join(entry(v) for v in row) + "]" for row in matrix)
         lines += ["", f"[{title}]", f"matrix = [{entries}]"]
 
     def strings(values: list[str]) -> str:

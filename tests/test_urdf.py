@@ -91,19 +91,19 @@ def generated_module(path: Path, base: str, tip: str, tmp_path: Path):
 
 
 def test_a_mount_written_with_cad_decimals_keeps_the_table_exact(tmp_path):
-    """A KR210 (its URDF exact) on a mount turned by 1.5708 rad about z (CAD decimals), with
-    a tool turned by 3.1416: a pose's closed form solves B^-1 T E^-1 for any rigid B and E,
-    so the mount and the tool are not snapped. Before, they were taken as right-angle
-    rotations, the arm went nominal (deviation 7e-6) and every row was refined by Newton's
-    steps; now the table is the file's, with no [exact] frames. (A mount also tilted about x
-    gives products of its entries below 1e-9, which a spec writes as 0: that arm keeps
-    [exact] frames 1.7e-10 away and is refined.)"""
+    """A KR210 (its URDF exact) on a mount turned by 1.5708 rad about z and tilted by 1e-5
+    about x (CAD decimals), with a tool turned by 3.1416 about z and 2e-5 about x: a pose's
+    closed form solves B^-1 T E^-1 for any rigid B and E, so the mount and the tool are not
+    snapped. Before, they were taken as right-angle rotations, the arm went nominal (deviation
+    2e-5) and every row was refined by Newton's steps; and kept, their entries of 1e-11 (the
+    two turns' products) were written as 0, which moved FK by 1.7e-10 and kept [exact] frames.
+    Now the table is the file's, with no [exact] frames."""
     extra = (
         '<link name="mount"/><link name="tcp"/>'
         '<joint name="mount_joint" type="fixed"><parent link="mount"/><child link="base_link"/>'
-        '<origin xyz="0.1 0.2 0.3" rpy="0 0 1.5708"/></joint>'
+        '<origin xyz="0.1 0.2 0.3" rpy="1e-5 0 1.5708"/></joint>'
         '<joint name="tcp_joint" type="fixed"><parent link="tool0"/><child link="tcp"/>'
-        '<origin xyz="0 0.01 0.1" rpy="0 0 3.1416"/></joint></robot>'
+        '<origin xyz="0 0.01 0.1" rpy="0.00002 0 3.1416"/></joint></robot>'
     )
     text = (DATA / "kr210l150.urdf").read_text()
     path = tmp_path / "kr210_mounted.urdf"
