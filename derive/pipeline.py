@@ -103,6 +103,8 @@ def build_plan(spec: ArmSpec, method: str | None = None) -> Plan:
         else:
             facts = tuple(f"{fact} (nominal table)" for fact in facts)
     if ik is not None and ik.task_snap > 0.0:
+        if correction is None:  # (the table is exact; its task's virtual link is not)
+            facts = tuple(f"{fact} (nominal table)" for fact in facts)
         correction = snapped_task(correction, ik, arm_info(spec, chain).dh, tol)
     if (
         correction is not None

@@ -61,6 +61,19 @@ def test_the_so_arm100_with_euler_1_57079_keeps_its_exact_frames(tmp_path):
         assert np.max(np.abs(module.fk(q) - expected)) <= 1e-12
 
 
+def test_an_exact_table_whose_task_link_is_snapped_says_nominal_table():
+    """The SO-101's MJCF converts with no snapping, but its tool axis's virtual link is
+    snapped (by 5e-4) and its rows are refined: the summary said nothing of it (a new user's
+    attack; its URDF, whose rows are snapped, said "(nominal table)")."""
+    text, conversion = mjcf.import_mjcf(
+        DATA / "so101_new_calib.xml", Options(base="base", tip="gripperframe")
+    )
+    assert not conversion.snaps
+    plan = build_plan(parse_spec(text, "<so101>"))
+    assert plan.ik is not None and plan.ik.task_snap > 1e-4
+    assert plan.structure[0].endswith("(nominal table)")
+
+
 def test_the_so101_keeps_both_rows_of_its_elbow_near_the_fold(tmp_path):
     """LeRobot's SO-101 (tests/data/mjcf/SOURCES.md) is solved on a nominal table 5e-4 from
     its MJCF frames. Near the elbow's fold the nominal acos argument is just above 1 (1.0018
