@@ -62,6 +62,7 @@ import re
 import stat
 import sys
 import tomllib
+from collections.abc import Callable
 from dataclasses import asdict, dataclass
 from pathlib import Path
 
@@ -610,17 +611,17 @@ def _number(value: object, where: str, field: str) -> float:
     return number
 
 
-def _numbers(value: object, where: str, field: str, count: int) -> tuple[float, ...]:
+def _numbers(
+    value: object,
+    where: str,
+    field: str,
+    count: int,
+    number: Callable[[object, str, str], float] = _number,
+) -> tuple[float, ...]:
+    """A list of count numbers, each as number takes it (_frame_entry: a frame's entries)."""
     if not isinstance(value, list) or len(value) != count:
         raise SpecError(f"{where}: {field}: must be a list of {count} numbers")
-    return tuple(_number(v, where, f"{field}[{k}]") for k, v in enumerate(value))
-
-
-def _frame_entries(value: object, where: str, field: str) -> tuple[float, ...]:
-    """A row of a frame's 4x4 matrix: 4 numbers, each as _frame_entry takes it."""
-    if not isinstance(value, list) or len(value) != 4:
-        raise SpecError(f"{where}: {field}: must be a list of 4 numbers")
-    return tuple(_frame_entry(v, where, f"{field}[{k}]") for k, v in enumerate(value))
+    return tuple(number(v, where, f"{field}[{k}]") for k, v in enumerate(value))
 
 
 def _joint(row: dict, where: str, index: int) -> Joint:
@@ -665,9 +666,8 @@ def _frame(table: object, where: str, field: str, angle_unit: str) -> Frame | No
             raise SpecError(f"{where}: {field}.matrix: must be 4 rows of 4 numbers")
         # (any small entry: a base turned by CAD decimals about two axes has entries 1e-11, as
         # the [exact] frames' rotations hold; the matrix is computed with)
-        flat = sum(
-            (_frame_entries(r, where, f"{field}.matrix[{i}]") for i, r in enumerate(rows)), ()
-        )
+        fields = (f"{field}.matrix[{i}]" for i in range(4))
+        flat = sum((_numbers(r, where, f, 4, _frame_entry) for r, f in zip(rows, fields)), ())
         _check_rigid(flat, where, field)
         return Frame(flat, None, (0.0, 0.0, 0.0))
     if "translation" not in table:

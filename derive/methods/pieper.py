@@ -302,8 +302,10 @@ def position_equations(
             "theta2: a c2 + b s2 = c by the half-angle method; free when the equation "
             "vanishes identically"
         )
-        rest = _axis_distance_rest(ta, tb, -tc, k3, length, prismatic3)
-        if is_zero(a1, 1e-12) and rest is not None:
+        rest = None
+        if is_zero(a1, 1e-12):  # (the identity reads the a1 = 0 case's joint 3 equation)
+            rest = _axis_distance_rest(ta, tb, -tc, k3, length, prismatic3)
+        if rest is not None:
             note += (
                 ", its half-width atan2(sqrt(x^2 + y^2), c): a^2 + b^2 - c^2 is the wrist "
                 "centre's squared distance from axis 1"
