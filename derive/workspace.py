@@ -211,10 +211,12 @@ def workspace(
     if position_only:  # the free joint of a singular position takes q_ref's value: sweep it
         sweeps = [np.eye(module.DOF)[0] * (2.0 * math.pi * k / headings) for k in range(headings)]
         rotations = rotations[:1]
-    width = headings if position_only else len(rotations)
+    # (a position arm's solutions are sorted by the rotations they take: headings about the
+    # normal where planar, the 24 of the cube where spatial)
+    targets = orientations(planar, normal, headings) if position_only else rotations
+    width = len(targets)
     reached = np.zeros((resolution, resolution, width), dtype=bool)
     counts = np.zeros((resolution, resolution), dtype=int)
-    targets = orientations(planar, normal, headings) if position_only else rotations
     start = time.perf_counter()
     # rows solved together: about CHUNK poses per ik_batch call
     step = max(1, CHUNK // (resolution * len(rotations)))

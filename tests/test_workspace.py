@@ -40,6 +40,24 @@ def test_rr_with_equal_links_reaches_the_disk_and_is_dexterous_at_the_origin_onl
     assert "ETA" in out.getvalue()
 
 
+def test_a_spatial_arm_solved_for_its_position_reaches_its_shell(tmp_path):
+    """A 3-joint elbow arm (d1 0.3, a2 0.4, a3 0.3), solved for the position: its section
+    through axis 1 is the annulus 0.1 <= r <= 0.7 about the shoulder. Its solutions are sorted
+    by the 24 rotations of the cube, which the map's array had sized by the planar headings
+    (36): a traceback on every spatial position arm (a new user's attack)."""
+    text = spec_text("elbow3", "standard", [(90, 0.0, 0.3, 0), (0, 0.4, 0, 0), (0, 0.3, 0, 0)])
+    m = build_module(text, tmp_path)
+    assert m.IK_COMPONENTS == "position"
+    wmap = workspace(m, False, "standard", resolution=61, progress=None)
+    exact = math.pi * (0.7**2 - 0.1**2)
+    assert abs(wmap.area(wmap.reachable) - exact) <= 0.02 * exact, wmap.summary()
+    U, V = np.meshgrid(wmap.u, wmap.v)  # (the section: x along u, z along v)
+    r = np.hypot(U, V - 0.3)
+    assert wmap.reachable[(r > 0.13) & (r < 0.67)].all()
+    assert not wmap.reachable[(r < 0.07) | (r > 0.73)].any()
+    assert not wmap.dexterous.any()  # (three joints take a position, not every rotation)
+
+
 def test_the_orientations_are_the_24_rotations_of_the_cube():
     R = orientations(False, np.array([0.0, 0.0, 1.0]), 0)
     assert R.shape == (24, 3, 3)
