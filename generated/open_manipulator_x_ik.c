@@ -21,6 +21,15 @@
 /* how far the solver's equations may miss and still seed a refinement onto the exact chain
    (0: the closed form solves the arm's own table) */
 #define DK_SEED_TOL (0.0)
+/* the refinement's sizes: the arm's joints, those it moves, the pose components it matches */
+#define DK_REFINE_N 4
+#define DK_REFINE_M 4
+#define DK_REFINE_ROWS 4
+/* the task (0 pose, 1 position, 2 position and direction, 3 look-at, 4 direction only, 5
+   position and the tool axis's angle to a base axis), its tool axis and that base axis */
+#define DK_REFINE_TASK 5
+#define DK_REFINE_AXIS 0
+#define DK_REFINE_CONE 2
 
 /* --- routines shared by every generated C solver (derive/c/, the ones this arm uses) ------- */
 
@@ -812,6 +821,426 @@ static int dk_pose_ok(const double T[16])
     return ok && det > 0.0;
 }
 
+/* (the chain's DK_REFINE_N joints, DK_REFINE_M of them moved, and DK_REFINE_ROWS pose
+   components: the arm's, defined before the runtime) at most this many steps per candidate; a
+   step longer than DK_REFINE_STRIDE is shortened to it; done at DK_REFINE_DONE, given up after
+   DK_REFINE_PATIENCE steps in a row that do not reduce the error; the step from an error
+   within DK_REFINE_LAST (that reduced it) is the last, if it is within DK_REFINE_TRUST times
+   that error (near a singular configuration Newton's step can be long, and miss) */
+#define DK_REFINE_STEPS 60
+
+#define DK_REFINE_STRIDE (0.5)
+
+#define DK_REFINE_DONE (1e-14)
+
+#define DK_REFINE_PATIENCE 10
+
+#define DK_REFINE_LAST (1e-10)
+
+#define DK_REFINE_TRUST (100.0)
+
+/* a step within this (radians, or reach) turns the cos and sin by their series (its terms to
+   d^5: error d^6 / 720 ~ 1e-21), and its Jacobian and factor serve the last step */
+#define DK_REFINE_SMALL (1e-3)
+
+/* a refined row is kept if its pose error is within the smaller of this and ik's tol */
+#define DK_REFINE_TOL (1e-10)
+
+/* where the damped steps give up (DK_REFINE_PATIENCE) within this and above DK_REFINE_DONE,
+   Gauss-Newton steps by QR go on from the best point met (derive/runtime/refine.py,
+   _REFINE_SETTLE, says why) */
+#define DK_REFINE_SETTLE (1e-6)
+
+/* an exact table's row certified within ik's tol but not within this is polished (dk_polish;
+   derive/runtime/refine.py, _REFINE_POLISH, says why) */
+#define DK_REFINE_POLISH (1e-10)
+
+/* x := (L L^T)^-1 x, L the lower triangle of a factor dk_cholesky_solve left in A (its
+   diagonal held as the reciprocals: multiplications, not divisions) */
+static void dk_cholesky_again(const double A[DK_REFINE_M][DK_REFINE_M], double x[DK_REFINE_M])
+{
+    int i, k;
+    for (i = 0; i < DK_REFINE_M; i++) { /* L y = x */
+        for (k = 0; k < i; k++) {
+            x[i] -= A[i][k] * x[k];
+        }
+        x[i] *= A[i][i];
+    }
+    for (i = DK_REFINE_M - 1; i >= 0; i--) { /* L^T x = y */
+        for (k = i + 1; k < DK_REFINE_M; k++) {
+            x[i] -= A[k][i] * x[k];
+        }
+        x[i] *= A[i][i];
+    }
+}
+
+/* x := A^-1 x for the symmetric positive definite A, by Cholesky's factorisation in place (A's
+   lower triangle becomes L, A = L L^T, with 1 / L_jj on the diagonal: dk_cholesky_again
+   solves with it again); 0 where A is not positive definite */
+static int dk_cholesky_solve(double A[DK_REFINE_M][DK_REFINE_M], double x[DK_REFINE_M])
+{
+    int i, j, k;
+    for (j = 0; j < DK_REFINE_M; j++) {
+        double d = A[j][j];
+        for (k = 0; k < j; k++) {
+            d -= A[j][k] * A[j][k];
+        }
+        if (!(d > 0.0)) {
+            return 0;
+        }
+        A[j][j] = 1.0 / sqrt(d);
+        for (i = j + 1; i < DK_REFINE_M; i++) {
+            double v = A[i][j];
+            for (k = 0; k < j; k++) {
+                v -= A[i][k] * A[j][k];
+            }
+            A[i][j] = v * A[j][j];
+        }
+    }
+    dk_cholesky_again((const double(*)[DK_REFINE_M])A, x);
+    return 1;
+}
+
+/* x := the least-squares solution of J x = e (J's first DK_REFINE_ROWS rows; J and e are
+   overwritten) by Householder's QR factorisation: the normal equations square J's condition
+   number, which a singular solution makes large as q nears it. A column the reflections
+   leave empty (a held joint's) gets x = 0. (The Python solver's _qr_solve.) */
+static void dk_qr_solve(double J[6][DK_REFINE_M], double e[6], double x[DK_REFINE_M])
+{
+    double diag[DK_REFINE_M];
+    int i, j, k;
+    for (k = 0; k < DK_REFINE_M; k++) {
+        double norm = 0.0, vv, s;
+        for (i = k; i < DK_REFINE_ROWS; i++) {
+            norm += J[i][k] * J[i][k];
+        }
+        norm = sqrt(norm);
+        diag[k] = J[k < DK_REFINE_ROWS ? k : 0][k] > 0.0 ? -norm : norm;
+        if (norm == 0.0) {
+            continue;
+        }
+        vv = 2.0 * norm * (norm + fabs(J[k][k])); /* v = the column - diag e_k: v^T v */
+        J[k][k] -= diag[k];
+        for (j = k + 1; j < DK_REFINE_M; j++) { /* (I - 2 v v^T / v^T v) on the columns after */
+            s = 0.0;
+            for (i = k; i < DK_REFINE_ROWS; i++) {
+                s += J[i][k] * J[i][j];
+            }
+            s *= 2.0 / vv;
+            for (i = k; i < DK_REFINE_ROWS; i++) {
+                J[i][j] -= s * J[i][k];
+            }
+        }
+        s = 0.0; /* ... and on e */
+        for (i = k; i < DK_REFINE_ROWS; i++) {
+            s += J[i][k] * e[i];
+        }
+        s *= 2.0 / vv;
+        for (i = k; i < DK_REFINE_ROWS; i++) {
+            e[i] -= s * J[i][k];
+        }
+    }
+    for (k = DK_REFINE_M - 1; k >= 0; k--) { /* R x = Q^T e */
+        double s = k < DK_REFINE_ROWS ? e[k] : 0.0;
+        for (j = k + 1; j < DK_REFINE_M; j++) {
+            s -= (k < DK_REFINE_ROWS ? J[k][j] : 0.0) * x[j];
+        }
+        x[k] = diag[k] == 0.0 ? 0.0 : s / diag[k];
+    }
+}
+
+/* a task's Jacobian column k (the "direction", "lookat", "pointing" and "axisangle" tasks,
+   DK_REFINE_TASK 2 to 5): given the column of the pose's position rows (J[0..2][k], set), the
+   derivative of the direction error u x t_u (rows 3..5: t_u x (z x u); a pointing's position
+   rows 0), of the tool axis's component along the base axis DK_REFINE_CONE (row 3), or
+   of the ray offset v - (v.u) u, v the target point minus the origin (rows 0..2), for a
+   revolute joint's axis z (NULL: a prismatic joint, which moves the origin only) */
+static void dk_task_column(const double pose[12], const double t[12], double J[6][DK_REFINE_M],
+                           int k, const double *z, double reach)
+{
+    const int x = DK_REFINE_AXIS;
+    const double u[3] = {pose[x], pose[4 + x], pose[8 + x]};
+    double du[3] = {0.0, 0.0, 0.0}, v[3], dv[3], along = 0.0, dalong = 0.0;
+    int r;
+    if (z != NULL) {
+        du[0] = z[1] * u[2] - z[2] * u[1];
+        du[1] = z[2] * u[0] - z[0] * u[2];
+        du[2] = z[0] * u[1] - z[1] * u[0];
+    }
+    if (DK_REFINE_TASK == 5) {
+        J[3][k] = du[DK_REFINE_CONE];
+        return;
+    }
+    if (DK_REFINE_TASK == 2 || DK_REFINE_TASK == 4) {
+        const double tu[3] = {t[x], t[4 + x], t[8 + x]};
+        J[3][k] = tu[1] * du[2] - tu[2] * du[1];
+        J[4][k] = tu[2] * du[0] - tu[0] * du[2];
+        J[5][k] = tu[0] * du[1] - tu[1] * du[0];
+        if (DK_REFINE_TASK == 4) {
+            J[0][k] = J[1][k] = J[2][k] = 0.0;
+        }
+        return;
+    }
+    for (r = 0; r < 3; r++) {
+        v[r] = t[4 * r + 3] - pose[4 * r + 3];
+        dv[r] = -J[r][k] * reach;
+        along += v[r] * u[r];
+    }
+    for (r = 0; r < 3; r++) {
+        dalong += dv[r] * u[r] + v[r] * du[r];
+    }
+    for (r = 0; r < 3; r++) {
+        J[r][k] = (dv[r] - dalong * u[r] - along * du[r]) / reach;
+    }
+}
+
+/* Newton's steps, damped by the error's square, on the chain of fixed frames (12 entries each:
+   T(q) = F_0 J_1(q_1) F_1 ... J_n(q_n) F_n) towards the pose t (12 top entries), moving the
+   joints in solved: q in place (the best point met); the pose error there (the largest
+   rotation entry's difference, unless DK_REFINE_ROWS is 3; positions / reach). The joints'
+   cos and sin follow the steps by the angle-sum formulas where a step is within
+   DK_REFINE_SMALL (a few terms of their series), and the last step (from an error within
+   DK_REFINE_LAST) reuses the previous step's Jacobian and factor where that step was within
+   DK_REFINE_SMALL: its error is that error times the Jacobian's change, ~1e-13 or less; the
+   two save two thirds of a seed's work (a nominal seed takes two steps). The joints whose bit
+   is set in held (arm indices) keep their values: their columns are 0, their rows of the
+   normal equations the identity's. */
+static double dk_refine(const double chain[DK_REFINE_N + 1][12], const int revolute[DK_REFINE_N],
+                        const int solved[DK_REFINE_M], double reach, const double t[12],
+                        double q[DK_REFINE_N], unsigned held)
+{
+    double cur[DK_REFINE_N], cs[DK_REFINE_N][2], best = HUGE_VAL, reused = HUGE_VAL;
+    double J[6][DK_REFINE_M], normal[DK_REFINE_M][DK_REFINE_M];
+    int worse = 0, settle = 0, last, it, i, r, c, k;
+    for (i = 0; i < DK_REFINE_N; i++) {
+        cur[i] = q[i];
+        cs[i][0] = cos(q[i]);
+        cs[i][1] = sin(q[i]);
+    }
+    for (it = 0; it < DK_REFINE_STEPS; it++) {
+        double pose[12], axes[DK_REFINE_N][3], origins[DK_REFINE_N][3], error[6];
+        double step[DK_REFINE_M], size = 0.0, mu = 0.0, longest = 0.0;
+        for (k = 0; k < 12; k++) {
+            pose[k] = chain[0][k];
+        }
+        for (i = 0; i < DK_REFINE_N; i++) {
+            const double *f = chain[i + 1];
+            for (r = 0; r < 3; r++) {
+                axes[i][r] = pose[4 * r + 2];
+                origins[i][r] = pose[4 * r + 3];
+            }
+            if (revolute[i]) {
+                const double cq = cs[i][0], sq = cs[i][1];
+                for (r = 0; r < 3; r++) {
+                    const double x = pose[4 * r], y = pose[4 * r + 1];
+                    pose[4 * r] = cq * x + sq * y;
+                    pose[4 * r + 1] = cq * y - sq * x;
+                }
+            } else {
+                for (r = 0; r < 3; r++) {
+                    pose[4 * r + 3] += cur[i] * pose[4 * r + 2];
+                }
+            }
+            for (r = 0; r < 3; r++) { /* pose := pose F_{i+1} (unrolled: a fifth of the time) */
+                double *row = pose + 4 * r;
+                const double p0 = row[0], p1 = row[1], p2 = row[2];
+                row[0] = p0 * f[0] + p1 * f[4] + p2 * f[8];
+                row[1] = p0 * f[1] + p1 * f[5] + p2 * f[9];
+                row[2] = p0 * f[2] + p1 * f[6] + p2 * f[10];
+                row[3] = p0 * f[3] + p1 * f[7] + p2 * f[11] + row[3];
+            }
+        }
+        for (r = 0; r < 3; r++) {
+            int a = (r + 1) % 3, b = (r + 2) % 3;
+            double total = 0.0;
+            error[r] = DK_REFINE_TASK == 4 ? 0.0 : (t[4 * r + 3] - pose[4 * r + 3]) / reach;
+            size = fabs(error[r]) > size ? fabs(error[r]) : size;
+            for (k = 0; k < 3; k++) {
+                total += pose[4 * a + k] * t[4 * b + k] - pose[4 * b + k] * t[4 * a + k];
+                if (DK_REFINE_TASK == 0) {
+                    const double gap = fabs(t[4 * r + k] - pose[4 * r + k]);
+                    size = gap > size ? gap : size;
+                }
+            }
+            error[3 + r] = 0.5 * total;
+            if (DK_REFINE_TASK == 2 || DK_REFINE_TASK == 4) { /* u x t_u: u the tool axis */
+                const int x = DK_REFINE_AXIS;
+                const double gap = fabs(t[4 * r + x] - pose[4 * r + x]);
+                error[3 + r] = pose[4 * a + x] * t[4 * b + x] - pose[4 * b + x] * t[4 * a + x];
+                size = gap > size ? gap : size;
+            }
+        }
+        if (DK_REFINE_TASK == 5) { /* the tool axis's component along the base axis */
+            const int e = 4 * DK_REFINE_CONE + DK_REFINE_AXIS;
+            error[3] = t[e] - pose[e];
+            size = fabs(error[3]) > size ? fabs(error[3]) : size;
+        }
+        if (DK_REFINE_TASK == 3) { /* minus the target point's offset from the ray, / reach */
+            const int x = DK_REFINE_AXIS;
+            double along = 0.0;
+            for (r = 0; r < 3; r++) {
+                along += (t[4 * r + 3] - pose[4 * r + 3]) * pose[4 * r + x];
+            }
+            for (r = 0; r < 3; r++) {
+                error[r] = -(t[4 * r + 3] - pose[4 * r + 3] - along * pose[4 * r + x]) / reach;
+            }
+            size = dk_ray_gap(pose, t, x) / reach;
+        }
+        if (size < best) {
+            best = size;
+            worse = 0;
+            for (i = 0; i < DK_REFINE_N; i++) {
+                q[i] = cur[i];
+            }
+        } else { /* (near a singular configuration the error can grow before it converges) */
+            worse++;
+        }
+        if (worse == DK_REFINE_PATIENCE && !settle && best <= DK_REFINE_SETTLE) {
+            settle = 1; /* (Gauss-Newton by QR from the best point, measured at each step) */
+            worse = 0;
+            reused = HUGE_VAL;
+            for (i = 0; i < DK_REFINE_N; i++) {
+                cur[i] = q[i];
+                cs[i][0] = cos(q[i]);
+                cs[i][1] = sin(q[i]);
+            }
+            continue;
+        }
+        if (size <= DK_REFINE_DONE || worse == DK_REFINE_PATIENCE) {
+            break;
+        }
+        last = size <= DK_REFINE_LAST && worse == 0 && !settle;
+        if (last && reused <= DK_REFINE_SMALL) { /* the last step, with the previous factor */
+            for (i = 0; i < DK_REFINE_M; i++) {
+                step[i] = 0.0;
+                for (r = 0; r < DK_REFINE_ROWS; r++) {
+                    step[i] += J[r][i] * error[r];
+                }
+            }
+            dk_cholesky_again((const double(*)[DK_REFINE_M])normal, step);
+            for (i = 0; i < DK_REFINE_M; i++) {
+                longest = fabs(step[i]) > longest ? fabs(step[i]) : longest;
+            }
+            if (longest <= DK_REFINE_TRUST * size) {
+                for (k = 0; k < DK_REFINE_M; k++) {
+                    cur[solved[k]] += step[k];
+                }
+                for (i = 0; i < DK_REFINE_N; i++) {
+                    q[i] = cur[i];
+                }
+                break;
+            }
+            longest = 0.0; /* (else a step of its own, from a Jacobian of its own) */
+        }
+        for (k = 0; k < DK_REFINE_M; k++) {
+            const int j = solved[k];
+            const double *z = axes[j];
+            if (revolute[j]) {
+                const double dx = pose[3] - origins[j][0], dy = pose[7] - origins[j][1];
+                const double dz = pose[11] - origins[j][2];
+                J[0][k] = (z[1] * dz - z[2] * dy) / reach;
+                J[1][k] = (z[2] * dx - z[0] * dz) / reach;
+                J[2][k] = (z[0] * dy - z[1] * dx) / reach;
+                J[3][k] = z[0];
+                J[4][k] = z[1];
+                J[5][k] = z[2];
+            } else {
+                for (r = 0; r < 3; r++) {
+                    J[r][k] = z[r] / reach;
+                    J[3 + r][k] = 0.0;
+                }
+            }
+            if (DK_REFINE_TASK >= 2) {
+                dk_task_column(pose, t, J, k, revolute[j] ? z : NULL, reach);
+            }
+            if (held >> j & 1u) {
+                for (r = 0; r < 6; r++) {
+                    J[r][k] = 0.0;
+                }
+            }
+        }
+        if (settle) {
+            dk_qr_solve(J, error, step);
+        } else {
+            for (r = 0; r < DK_REFINE_ROWS; r++) {
+                mu += error[r] * error[r];
+            }
+        }
+        for (i = 0; i < DK_REFINE_M && !settle; i++) { /* (J^T J + mu) step = J^T error */
+            step[i] = 0.0;
+            for (r = 0; r < DK_REFINE_ROWS; r++) {
+                step[i] += J[r][i] * error[r];
+            }
+            for (c = 0; c <= i; c++) {
+                double v = 0.0;
+                for (r = 0; r < DK_REFINE_ROWS; r++) {
+                    v += J[r][i] * J[r][c];
+                }
+                normal[i][c] = normal[c][i] = v;
+            }
+            normal[i][i] = held >> solved[i] & 1u ? 1.0 : normal[i][i] + mu;
+        }
+        if (!settle && !dk_cholesky_solve(normal, step)) { /* (J^T J singular to roundings:
+            a singular solution near; given up as after DK_REFINE_PATIENCE steps, so QR's steps
+            go on from the best point where that is within DK_REFINE_SETTLE) */
+            worse = DK_REFINE_PATIENCE - 1;
+            continue;
+        }
+        for (k = 0; k < DK_REFINE_M; k++) {
+            longest = fabs(step[k]) > longest ? fabs(step[k]) : longest;
+        }
+        if (!(longest < HUGE_VAL)) {
+            break;
+        }
+        for (k = 0; k < DK_REFINE_M; k++) {
+            const int j = solved[k];
+            const double d = longest > DK_REFINE_STRIDE ? step[k] * (DK_REFINE_STRIDE / longest)
+                                                        : step[k];
+            cur[j] += d;
+            if (revolute[j] && fabs(d) <= DK_REFINE_SMALL) { /* (cos, sin) turned by d */
+                const double d2 = d * d, cd = 1.0 - d2 / 2.0 * (1.0 - d2 / 12.0);
+                const double sd = d * (1.0 - d2 / 6.0 * (1.0 - d2 / 20.0));
+                const double c0 = cs[j][0], s0 = cs[j][1];
+                cs[j][0] = c0 * cd - s0 * sd;
+                cs[j][1] = s0 * cd + c0 * sd;
+            } else if (revolute[j]) {
+                cs[j][0] = cos(cur[j]);
+                cs[j][1] = sin(cur[j]);
+            }
+        }
+        reused = longest;
+        if (last && longest <= DK_REFINE_TRUST * size) { /* (Newton's step from there: the
+                                                            error squared, not measured) */
+            for (i = 0; i < DK_REFINE_N; i++) {
+                q[i] = cur[i];
+            }
+            break;
+        }
+    }
+    return best;
+}
+
+/* q, a closed form's row of an exact table certified within ik's tol but not within
+   DK_REFINE_POLISH (a value taken at a fold within DK_FOLD_TOL of it, a root at the edge of its
+   polynomial's conditioning: a look-at point ten reaches away), polished: Newton's steps on
+   the exact chain (dk_refine), the joints in held (a bit per arm joint: those the pose left
+   free) kept, taken where they bring it within DK_REFINE_TOL (the Python solver's _keep) */
+static void dk_polish(const double chain[DK_REFINE_N + 1][12], const int revolute[DK_REFINE_N],
+                      const int solved[DK_REFINE_M], double reach, const double t[12],
+                      double q[DK_REFINE_N], unsigned held)
+{
+    double moved[DK_REFINE_N];
+    int i;
+    for (i = 0; i < DK_REFINE_N; i++) {
+        moved[i] = q[i];
+    }
+    if (dk_refine(chain, revolute, solved, reach, t, moved, held) <= DK_REFINE_TOL) {
+        for (i = 0; i < DK_REFINE_N; i++) {
+            q[i] = moved[i];
+        }
+    }
+}
+
 /* The pose of frame k of a chain of n joints and fixed frames (12 entries each: T(q) = F_0
    J_1(q_1) F_1 ... J_n(q_n) F_n, J_i = Rz(q_i) or Tz(q_i)), top three rows into out: k = 1..n
    the frame of joint k, F_0 J_1 F_1 ... F_{k-1} J_k (its z the joint's axis, its origin on
@@ -1023,6 +1452,8 @@ static const double DK_BASE[12] = {
     0.0, 1.0, 0.0, 0.0,
     0.0, 0.0, 1.0, 0.017
 };
+/* the joints (0-based) the refinement moves */
+static const int DK_SOLVED[DK_REFINE_M] = {0, 1, 2, 3};
 
 const double open_manipulator_x_limits[DK_DOF][2] = {
     {-HUGE_VAL, HUGE_VAL},
@@ -1114,6 +1545,7 @@ static int dk_solve(const double t[12], double tol, const double ref[DK_DOF],
     double w31 = t[8];
     double wz = t[11];
     const double ptol = tol * DK_REACH;
+    const double dk_fine = fmin(tol, DK_REFINE_POLISH);
     int n = 0;
     int dk_close = 1;
     /* tool point in frame 0: (B X0)^-1 p */
@@ -1219,11 +1651,18 @@ static int dk_solve(const double t[12], double tol, const double ref[DK_DOF],
                                 0.124*dk_h7 - 0.130231*s2 + 0.0765;
                         const double e[12] = {dk_e0, dk_e1, dk_e2, dk_e3, dk_e4, dk_e5, dk_e6,
                                 dk_e7, dk_e8, dk_e9, dk_e10, dk_e11};
-                        if (n < DK_MAX && dk_match(e, t, tol, ptol, 5, 8)) {
+                        const int dk_fine_ok = n < DK_MAX && dk_match(e, t, dk_fine, dk_fine *
+                                DK_REACH, 5, 8);
+                        if (dk_fine_ok || (n < DK_MAX && dk_match(e, t, tol, ptol, 5, 8))) {
                             found[n][0] = theta1;
                             found[n][1] = theta2 + 1.3854483816190182;
                             found[n][2] = theta3 - 1.3854483816190182;
                             found[n][3] = theta4;
+                            if (!dk_fine_ok) { /* (the joints the pose left free held) */
+                                dk_polish(DK_CHAIN, DK_REVOLUTE, DK_SOLVED, DK_REACH, t, found[n],
+                                        (dk_v1.free ? 1u : 0u) | (dk_v2.free ? 2u : 0u) |
+                                        (dk_v3.free ? 4u : 0u) | (dk_v4.free ? 8u : 0u));
+                            }
                             n++;
                         }
                         if (dk_v4.free && n > dk_m4) {

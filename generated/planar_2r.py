@@ -1355,6 +1355,11 @@ PATH_JUMP = 0.5
 PATH_NEAR = 0.25
 
 
+# ... and a step whose row moves a joint more than PATH_NEAR is taken in halves, at most this
+# many times (2^6 = 64 parts; _follow)
+PATH_SPLITS = 6
+
+
 def ik_path(
     Ts: ArrayLike,
     q0: ArrayLike,
@@ -1414,23 +1419,7 @@ def ik_path(
     out[0] = q
     breaks: list[tuple[int, str]] = []
     for k in range(1, len(poses)):
-        if IK_COMPONENTS == "pose":
-            change = float(np.linalg.norm(_pose_step(poses[k - 1], poses[k])))
-            least = manipulability(q)[0] if DOF >= 6 else 1.0
-        else:  # (the task's components and their Jacobian: what the task's rows follow)
-            error, columns, _ = _pose_error(q.tolist(), poses[k][:3].ravel().tolist(), False)
-            change = float(np.linalg.norm(error))
-            least = float(np.linalg.svd(np.array(columns).T, compute_uv=False)[-1])
-        bound = PATH_GAIN * change / max(least, 1e-300)
-        row, why = _continuation(poses[k], q, branch(q), bound, within_limits, backend)
-        if not why and least < PATH_SINGULAR:
-            jump = np.abs(row - q) / np.where(np.array(_REVOLUTE), 1.0, REACH)
-            if jump.max() > PATH_JUMP:
-                j = int(np.argmax(jump))
-                why = (
-                    f"q{j + 1} jumps by {jump[j]:.3g} at a singular configuration (the path "
-                    "passes one; where it goes from there the poses do not say)"
-                )
+        row, why, least = _follow(poses[k - 1], poses[k], q, within_limits, backend, 0)
         if why:
             breaks.append((k, f"pose {k}: {why}; sigma_min {least:.3g}"))
             if on_break == "stop":
@@ -1440,6 +1429,55 @@ def ik_path(
         out[k] = row
         q = row
     return out, breaks
+
+
+def _step_bound(q, A, B):
+    """The joint step a continuous branch can take from q (a solution of the pose A) to the
+    pose B: PATH_GAIN |dX| / sigma_min, dX the pose step (an arm solved for a task: its
+    components' error at B), sigma_min the smallest singular value of the Jacobian at q
+    (of the task's); and sigma_min."""
+    if IK_COMPONENTS == "pose":
+        change = float(np.linalg.norm(_pose_step(A, B)))
+        least = manipulability(q)[0] if DOF >= 6 else 1.0
+    else:  # (the task's components and their Jacobian: what the task's rows follow)
+        error, columns, _ = _pose_error(q.tolist(), B[:3].ravel().tolist(), False)
+        change = float(np.linalg.norm(error))
+        least = float(np.linalg.svd(np.array(columns).T, compute_uv=False)[-1])
+    return PATH_GAIN * change / max(least, 1e-300), least
+
+
+def _follow(A, B, q, within_limits, backend, depth):
+    """ik_path's step from q (a solution of the pose A) to the pose B: _continuation, but
+    where its row moves a joint by more than PATH_NEAR (radians, or REACH) or finds no
+    continuation, the step in halves (straight_line's middle pose), up to PATH_SPLITS times:
+    near a singular configuration a branch turns fast (the wrist centre passing near axis 1
+    turned a KR 10's q1 by 1.6 rad in one of 20 steps, sigma_min 4e-3), and the other
+    shoulder's row, nearer by joint distance, was taken with no break reported (a new user's
+    attack). A step from where sigma_min is below PATH_SINGULAR whose row moves a joint more
+    than PATH_JUMP is a break: the first-order bound allows any step there, and which way the
+    path goes depends on how finely it is sampled. Returns (row, why) as _continuation, and
+    sigma_min where the step starts."""
+    bound, least = _step_bound(q, A, B)
+    row, why = _continuation(B, q, branch(q), bound, within_limits, backend)
+    if row is None or "limits" in why:
+        return row, why, least
+    units = np.where(np.array(_REVOLUTE), 1.0, REACH)
+    jump = np.abs(_turned(row - q, np.array(_REVOLUTE))) / units
+    if depth < PATH_SPLITS and (why or float(jump.max()) > PATH_NEAR):
+        middle = straight_line(A, B, 3)[1]
+        half, first, _ = _follow(A, middle, q, within_limits, backend, depth + 1)
+        if half is not None and not first:
+            split, why_split, _ = _follow(middle, B, half, within_limits, backend, depth + 1)
+            if split is not None:
+                row, why = split, why_split
+                jump = np.abs(_turned(row - q, np.array(_REVOLUTE))) / units
+    if not why and depth == 0 and least < PATH_SINGULAR and float(jump.max()) > PATH_JUMP:
+        j = int(np.argmax(jump))
+        why = (
+            f"q{j + 1} jumps by {jump[j]:.3g} at a singular configuration (the path passes "
+            "one; where it goes from there the poses do not say)"
+        )
+    return row, why, least
 
 
 def _continuation(T, q, label, bound, within_limits, backend):
@@ -1748,6 +1786,24 @@ _REFINE_LAST = 1e-10
 _REFINE_TRUST = 100.0
 
 
+# a refined row is returned if its pose error is within the smaller of this and ik's tol
+_REFINE_TOL = 1e-10
+
+
+# where the damped steps give up (_REFINE_PATIENCE steps without a better point) within this
+# and above _REFINE_DONE, Gauss-Newton steps by QR (_qr_solve) go on from the best point met:
+# at a singular solution (a pose on the wrist's or the shoulder's singular set) the normal
+# equations' steps alternate between damped and overshooting ones and stall 1e-10 to 1e-9
+# short of it, and 4 of 8,400 such poses of zoo URDF arms got no row (a new user's attack)
+_REFINE_SETTLE = 1e-6
+
+
+# an exact table's row certified within ik's tol but not within this is polished (_keep): a
+# far look-at point's rows came within 1e-10 of the ray by the certification's largest
+# entry and 1.5e-10 by its length (a new user's attack)
+_REFINE_POLISH = 1e-10
+
+
 # ik_approximate's least squares: at most this many steps, done where the gradient of half
 # the squared error is this flat
 _LSQ_STEPS = 200
@@ -1763,30 +1819,39 @@ def _refine(q, t, held=()):
     arithmetic."""
     m = len(_SOLVED)
     cur = [float(x) for x in q]
-    best, best_size, worse = list(cur), math.inf, 0
+    best, best_size, worse, settle = list(cur), math.inf, 0, False
     for _ in range(_REFINE_STEPS):
         error, columns, size = _pose_error(cur, t, False)
         if size < best_size:
             best, best_size, worse = list(cur), size, 0
         else:  # (near a singular configuration the error can grow before it converges)
             worse += 1
+        if worse == _REFINE_PATIENCE and not settle and best_size <= _REFINE_SETTLE:
+            settle, worse, cur = True, 0, list(best)  # (Gauss-Newton by QR from the best)
+            continue
         if size <= _REFINE_DONE or worse == _REFINE_PATIENCE:
             break
-        last = size <= _REFINE_LAST and worse == 0
+        last = size <= _REFINE_LAST and worse == 0 and not settle
         if held:  # (a held joint's column 0, its row of the normal equations the identity's)
             columns = [[0.0] * len(c) if _SOLVED[k] in held else c for k, c in enumerate(columns)]
-        mu = sum(e * e for e in error)
-        step = [sum(c * e for c, e in zip(column, error)) for column in columns]
-        normal = [
-            [sum(a * b for a, b in zip(columns[i], columns[j])) + (mu if i == j else 0.0)
-             for j in range(m)]
-            for i in range(m)
-        ]  # fmt: skip
-        for k in range(m):
-            if _SOLVED[k] in held:
-                normal[k][k] = 1.0
-        if not _cholesky_solve(normal, step):
-            break
+        if settle:
+            step = _qr_solve(columns, error)
+        else:
+            mu = sum(e * e for e in error)
+            step = [sum(c * e for c, e in zip(column, error)) for column in columns]
+            normal = [
+                [sum(a * b for a, b in zip(columns[i], columns[j])) + (mu if i == j else 0.0)
+                 for j in range(m)]
+                for i in range(m)
+            ]  # fmt: skip
+            for k in range(m):
+                if _SOLVED[k] in held:
+                    normal[k][k] = 1.0
+            if not _cholesky_solve(normal, step):  # (J^T J singular to roundings: a singular
+                # solution near; given up as after _REFINE_PATIENCE steps, so Gauss-Newton by
+                # QR goes on from the best point where that is within _REFINE_SETTLE)
+                worse = _REFINE_PATIENCE - 1
+                continue
         longest = max(map(abs, step))
         if not longest < math.inf:
             break
@@ -1797,6 +1862,39 @@ def _refine(q, t, held=()):
             best = cur  # (Newton's step from there: the error squared, not measured)
             break
     return tuple(best), best_size
+
+
+def _qr_solve(columns, e):
+    """The least-squares solution x of J x = e, J's columns given (each as long as e), by
+    Householder's QR factorisation: the normal equations square J's condition number, which
+    a singular solution makes large as q nears it. A column the reflections leave empty (a
+    held joint's) gets x = 0. (The C solver's dk_qr_solve.)"""
+    A = [list(c) for c in columns]
+    b = list(e)
+    rows, m = len(b), len(A)
+    diag = [0.0] * m
+    for k in range(m):
+        norm = math.sqrt(sum(A[k][i] * A[k][i] for i in range(k, rows)))
+        head = A[k][k] if k < rows else A[k][0]
+        diag[k] = -norm if head > 0.0 else norm
+        if norm == 0.0:
+            continue
+        vv = 2.0 * norm * (norm + abs(A[k][k]))  # (v = the column - diag e_k: v^T v)
+        A[k][k] -= diag[k]
+        for j in range(k + 1, m):  # (I - 2 v v^T / v^T v) on the columns after, and on b
+            s = sum(A[k][i] * A[j][i] for i in range(k, rows)) * (2.0 / vv)
+            for i in range(k, rows):
+                A[j][i] -= s * A[k][i]
+        s = sum(A[k][i] * b[i] for i in range(k, rows)) * (2.0 / vv)
+        for i in range(k, rows):
+            b[i] -= s * A[k][i]
+    x = [0.0] * m
+    for k in range(m - 1, -1, -1):  # R x = Q^T b
+        s = b[k] if k < rows else 0.0
+        for j in range(k + 1, m):
+            s -= (A[j][k] if k < rows else 0.0) * x[j]
+        x[k] = 0.0 if diag[k] == 0.0 else s / diag[k]
+    return x
 
 
 def _least_squares(q, t):
@@ -2029,11 +2127,27 @@ def _cs_columns(Q):
     return (c1, s1, c2, s2,)
 
 
-def _keep(found, t, q, e, tol):
-    """Append q if its forward kinematics e reproduces the target t (certification)."""
-    ptol = tol * REACH
-    if abs(e[3] - t[3]) <= ptol and abs(e[7] - t[7]) <= ptol and abs(e[11] - t[11]) <= ptol:
+def _keep(found, t, q, e, tol, frees=()):
+    """Append q if its forward kinematics e reproduces the target t within tol
+    (certification). A row that does, but not within _REFINE_POLISH (a value taken at a fold
+    within _FOLD_TOL of it, a root at the edge of its polynomial's conditioning: a look-at
+    point ten reaches away), is polished first: Newton's steps on the exact chain (_refine),
+    taken where they bring it within _REFINE_TOL (dk_polish in C). frees: (values, arm joint
+    index) of the steps whose joint can be free; a free one (q_ref's value: the pose leaves
+    it free) is held, so that the steps do not carry it along the self-motion."""
+    if _matches(e, t, min(tol, _REFINE_POLISH)):  # (most rows: one comparison settles it)
         found.append(q)
+    elif _matches(e, t, tol):
+        held = [i for values, i in frees if values.__class__ is _Free]
+        moved, size = _refine(q, t, held)
+        found.append(moved if size <= _REFINE_TOL else q)
+
+
+def _matches(e, t, tol):
+    """Whether the pose e (12 top entries) reproduces t in the task's components: rotation
+    entries within tol, positions within tol * REACH."""
+    ptol = tol * REACH
+    return abs(e[3] - t[3]) <= ptol and abs(e[7] - t[7]) <= ptol and abs(e[11] - t[11]) <= ptol
 
 
 def _ik_scalar(target, qr1, qr2, tol):
@@ -2057,7 +2171,8 @@ def _ik_scalar(target, qr1, qr2, tol):
         for theta1 in (_v1 := _cs2(k1, -k2, px, s2, c2 + 1.0, py, 4.0, 4.0, qr1)):
             c1 = cos(theta1)
             s1 = sin(theta1)
-            _keep(found, target, (theta1, theta2,), _fk_from_cs(c1, s1, c2, s2), tol)
+            _keep(found, target, (theta1, theta2,), _fk_from_cs(c1, s1, c2, s2), tol, ((_v1, 0),
+                (_v2, 1), ))
             if _v1.__class__ is _Free and len(found) > _n1:
                 break
         if _v2.__class__ is _Free and len(found) > _n2:

@@ -65,7 +65,7 @@ def test_the_c_runtime_holds_the_python_runtimes_constants():
         assert float(found[f"DK_{name}"]) == getattr(constants, f"_{name}"), name
     for name in ("DEDUP_TOL", "POSE_TOL"):
         assert float(found[f"DK_{name}"]) == getattr(constants, name), name
-    for name in ("STEPS", "STRIDE", "DONE", "PATIENCE", "LAST", "TRUST", "TOL"):
+    for name in ("STEPS", "STRIDE", "DONE", "PATIENCE", "LAST", "TRUST", "TOL", "POLISH", "SETTLE"):
         assert float(found[f"DK_REFINE_{name}"]) == getattr(refine, f"_REFINE_{name}"), name
     assert float(found["DK_PI"]) == np.pi and float(found["DK_TWO_PI"]) == 2 * np.pi
     assert table(runtime, "DK_FREE_STEPS").tolist() == list(constants._FREE_STEPS)
@@ -76,9 +76,10 @@ def test_the_c_runtime_holds_the_python_runtimes_constants():
     found = defines(gen)
     for name in ("RANK_TOL", "COND_LIMIT", "IMAG_TOL", "IMAG_LOOSE", "CLUSTER_TOL", "GOOD"):
         assert float(found[f"DK_RR_{name}"]) == getattr(constants, f"_RR_{name}"), name
-    for name in ("NULL2_TOL", "NEWTON_STEPS", "NEWTON_REACH", "PAIR_TOL", "SEARCH_FROM"):
+    for name in ("NULL2_TOL", "NEWTON_STEPS", "NEWTON_REACH", "PAIR_TOL", "PAIR_ANGLE"):
         assert float(found[f"DK_RR_{name}"]) == getattr(constants, f"_RR_{name}"), name
     for name in (
+        "SEARCH_FROM",
         "SEARCH_BAIL",
         "SEARCH_STEPS",
         "SEARCH_SLIDE",

@@ -10,7 +10,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from conftest import BUNDLED, GENERATED
+from conftest import BUNDLED, GENERATED, build_module, needs_cc
 
 
 def differences(module, q: np.ndarray, step: float = 1e-6) -> np.ndarray:
@@ -311,6 +311,45 @@ def test_a_path_near_the_elbow_s_fold_keeps_its_branch_where_nearest_flips(gener
         nearest_kept += kept
     assert followed == paths
     assert nearest_kept < paths, "no path where nearest flips: the test no longer tests it"
+
+
+@needs_cc
+def test_a_path_past_axis_1_follows_the_shoulder_turning_fast(tmp_path):
+    """A KR 6's straight line (20 poses) whose wrist centre passes 0.004 of the reach from
+    axis 1: q1 turns 1.8 rad in one step there (sigma_min 5.4e-3, regular), and the other
+    shoulder's row was nearer by joint distance: ik_path took it with no break, 3.14 rad off
+    to the end (a new user's attack found it on a KR 10). A step whose row moves a joint more than
+    PATH_NEAR is taken in halves (_follow): the path is the one a 100 times finer nearest-row
+    walk takes, to 1e-6. (With PATH_SPLITS = 0, as before, it switches: the test's check.)"""
+    from test_nominal import TABLES
+
+    rows = "\n".join(
+        f'[[joint]]\ntype = "R"\nalpha = {al!r}\na = {a!r}\nd = {d!r}\ntheta = {th!r}\n'
+        for al, a, d, th in TABLES["kr6"]
+    )
+    text = f'name = "kr6"\nconvention = "standard"\nangle_unit = "deg"\nlength_unit = "m"\n{rows}'
+    module = build_module(text, tmp_path, c=True)
+    qa = np.array(
+        [-1.94726328, -1.614339749, -1.099557429, -2.347726286, -0.733173589, 0.215642423]
+    )
+    qb = np.array(
+        [-1.881506244, -2.011658169, -1.099557429, -2.407308438, -1.207125495, 0.271059476]
+    )
+    fine = module.straight_line(module.fk(qa), module.fk(qb), 19 * 100 + 1)
+    Q, valid = module.ik_batch(fine)
+    walk, largest = [qa], 0.0
+    for rows_k, ok in zip(Q[1:], valid[1:]):
+        gaps = np.abs(np.remainder(rows_k[ok] - walk[-1] + np.pi, 2 * np.pi) - np.pi).max(axis=1)
+        largest = max(largest, float(gaps.min()))
+        walk.append(rows_k[ok][int(np.argmin(gaps))])
+    reference = np.array(walk)[::100]
+    assert largest < 0.05  # (the finer walk is continuous)
+    Ts = module.straight_line(module.fk(qa), module.fk(qb), 20)
+    for splits, follows in ((module.PATH_SPLITS, True), (0, False)):
+        module.PATH_SPLITS = splits
+        path, breaks = module.ik_path(Ts, qa)
+        gaps = np.abs(np.remainder(path - reference + np.pi, 2 * np.pi) - np.pi)
+        assert (breaks == [] and gaps.max() <= 1e-6) == follows, (splits, breaks, gaps.max())
 
 
 def _label_changes(module, q: np.ndarray, joint: int) -> np.ndarray:

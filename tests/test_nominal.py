@@ -387,7 +387,46 @@ def test_pairs_near_a_fold_of_the_nominal_table_are_found(xarm6, backend):
             assert np.max(np.abs(np.array(urdf.urdf_fk(chain, list(row))) - T)) <= 1e-9
         gaps = np.abs(np.remainder(rows - q + math.pi, 2 * math.pi) - math.pi)
         missed += bool(np.min(np.max(gaps, axis=1)) > 1e-6)
-    assert missed <= 4, missed  # (3 in C and 2 in Python when written: 14 and 14 before)
+    # (C 0 and Python 2 since pairs are judged in theta3's angle (_RR_PAIR_ANGLE); 3 and 2
+    # before, 14 and 14 before the fold seeds)
+    assert missed <= 2, missed
+
+
+# random joint vectors of the xArm6 (uniform in its limits, seed 5: 5 of the 10 of 10,000
+# whose vector was missed, sigma_min of the Jacobian 1.6e-3 to 3.6e-3)
+XARM6_PAIRS = [
+    [-0.241935734621, 1.194327360523, -0.510965043124,
+     1.908286988848, -0.126995239237, 0.248328512519],
+    [-0.274109836358, 1.526956061762, -0.060134790649,
+     2.451387580792, -1.513343902868, -2.937541539197],
+    [-2.171750899942, 0.750695981704, -0.048310717183,
+     2.081579260991, 0.094424396444, -0.72670261331],
+    [-1.604211322682, 1.895227601771, -2.668277119527,
+     2.990404653537, -0.132413150174, -2.896322128969],
+    [-3.041242056158, 1.404672508446, -1.081659639115,
+     2.294482582648, -0.087143400266, 0.689767386253],
+]  # fmt: skip
+
+
+@pytest.mark.parametrize("backend", ["c", "python"])
+def test_a_pair_the_perturbed_table_makes_complex_is_tried(xarm6, backend):
+    """Two solutions of the arm 0.02-0.2 rad apart (a random pose near a fold) are a complex
+    pair on the perturbed table the general method solves for the xArm6, up to 0.8 (1 + |y|)
+    off the real line in the pencil's variable y but 0.007-0.11 rad in theta3's. Judged in y
+    (within 0.05 (1 + |y|)) the pair was not tried and both were lost: 10 of 10,000 uniform
+    samples missed their vector, in C and Python. Judged in theta3 (_RR_PAIR_ANGLE) none of
+    10,000 (sigma_min 4e-5 to 1e-2 among them): these 5 come back, with their twins."""
+    from derive import urdf
+
+    module, chain = xarm6
+    for q in np.array(XARM6_PAIRS):
+        T = np.array(urdf.urdf_fk(chain, list(q)))
+        rows = module.ik(T, backend=backend)
+        gaps = np.abs(np.remainder(rows - q + math.pi, 2 * math.pi) - math.pi).max(axis=1)
+        assert np.min(gaps) <= 1e-8, (q, len(rows))
+        assert np.sum(gaps <= 0.25) >= 2, (q, np.sort(gaps)[:3])  # (the twin too)
+        for row in rows:
+            assert np.max(np.abs(np.array(urdf.urdf_fk(chain, list(row))) - T)) <= 1e-9
 
 
 def noisy_urdf(name: str, seed: int, decimals: int = 7) -> str:
@@ -487,6 +526,37 @@ def test_industrial_arms_written_as_noisy_urdfs_are_answered_exactly(name, tmp_p
             gaps = np.abs(np.remainder(rows - q + math.pi, 2 * math.pi) - math.pi)
             missed += bool(np.min(np.max(gaps, axis=1)) > 1e-8)
     assert regular >= 100 and missed == 0
+
+
+@needs_cc
+def test_a_singular_pose_of_a_zoo_urdf_gets_its_rows(tmp_path):
+    """A UR3e written as a zoo URDF (tests/data/urdf/SOURCES.md), at q5 = 0 (its wrist
+    singular within the file's 7 decimals: sigma_min 3.4e-9): the nominal seeds' damped
+    Newton steps stalled 4e-10..4e-9 short of the solution (J^T J singular to roundings,
+    their steps alternating between damped and overshooting ones), and the pose got no row,
+    in C and Python (a new user's attack: 4 of 8,400 singular poses of 14 such arms). Gauss-
+    Newton steps by QR from the best point (_REFINE_SETTLE) reach it: the sampled vector."""
+    from derive import urdf
+    from derive.load import solver_sources
+
+    from conftest import import_path
+
+    path = Path(__file__).parent / "data" / "urdf" / "ur3e_zoo.urdf"
+    chain = urdf.chain_between(urdf.read_urdf(path), "base_link", "tool0", str(path))
+    spec = urdf.load_urdf(path, urdf.Options(base="base_link", tip="tool0"))
+    for file, text in solver_sources(build_plan(spec)).items():
+        (tmp_path / file).write_text(text, encoding="utf-8")
+    module = import_path(tmp_path / f"{spec.name}.py")
+    q = [2.5660304203790067, -5.91884129979904, 0.9656558511937567, 2.1975822054816243, 0.0,
+         -2.5833321467713]  # fmt: skip
+    T = np.array(urdf.urdf_fk(chain, q))
+    for backend in ("c", "python"):
+        rows = module.ik(T, backend=backend)
+        gaps = np.abs(np.remainder(rows - np.array(q) + math.pi, 2 * math.pi) - math.pi)
+        assert len(rows) and np.min(np.max(gaps, axis=1)) <= 1e-6, (backend, rows)
+        for row in rows:
+            E = np.array(urdf.urdf_fk(chain, list(row))) - T
+            assert max(np.abs(E[:3, :3]).max(), np.abs(E[:3, 3]).max() / module.REACH) <= 1e-10
 
 
 @needs_cc

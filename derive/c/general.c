@@ -26,6 +26,7 @@
 #define DK_RR_MAX 16  /* eigenvalues of one split */
 #define DK_RR_CANDS (8 * DK_RR_MAX) /* candidates of one split, the extras' too */
 #define DK_RR_PAIR_TOL (0.05)
+#define DK_RR_PAIR_ANGLE (0.15)
 #define DK_RR_SEARCH_FROM (0.1)
 #define DK_RR_SEARCH_BAIL (0.3)
 #define DK_RR_SEARCH_STEPS 40
@@ -1188,6 +1189,31 @@ static int dk_rr_within_reach(const double rows[7][4], const double *moebius, do
            fabs(moebius[0] * y + moebius[1]) <= reach * fabs(moebius[2] * y + moebius[3]);
 }
 
+/* the value of y tried for side (-1 or +1) of a nearly real pair re +- i im (im > 0: two
+   near-equal real roots that rounding, or a perturbed table's difference, split apart), in
+   *y; 0 where the pair is not nearly real. Nearly real is judged by theta3's imaginary part,
+   2 |det M| im / ((ma re + mb)^2 + (mc re + md)^2) to first order (M the Moebius map): within
+   DK_RR_PAIR_ANGLE, the pair is tried at theta3's real part -+ that; a sliding joint 3 (x3 is
+   d3) at re -+ im, within DK_RR_PAIR_TOL (1 + |y|) (the Python solver's _rr_pair_extras) */
+static int dk_rr_pair_value(const double rows[7][4], const double *moebius, double re,
+                            double im, int side, double *y)
+{
+    const double ma = moebius[0], mb = moebius[1], mc = moebius[2], md = moebius[3];
+    const double num = ma * re + mb, den = mc * re + md;
+    double spread, half;
+    if (rows[6][0] != 0.0) {
+        *y = re + side * im;
+        return im <= DK_RR_PAIR_TOL * (1.0 + hypot(re, im));
+    }
+    spread = 2.0 * fabs(ma * md - mb * mc) * im / (num * num + den * den);
+    if (!(spread <= DK_RR_PAIR_ANGLE)) {
+        return 0;
+    }
+    half = tan((2.0 * atan2(num, den) + side * spread) / 2.0);
+    *y = (md * half - mb) / (ma - mc * half);
+    return isfinite(*y);
+}
+
 /* whether split k solves a perturbed table (the arm's own pencils are singular) */
 static int dk_rr_perturbed(int k)
 {
@@ -1361,10 +1387,11 @@ static int dk_rr_candidates(const double values[490], const double F[4][4],
             if (dk_rr_within_reach(rows, moebius, wr[i], reach)) {
                 reals[n_real++] = wr[i];
             }
-        } else if (imag_tol * size < wi[i] && wi[i] <= DK_RR_PAIR_TOL * size) {
-            for (side = -1; side <= 1; side += 2) { /* a nearly real pair: Re -+ Im */
-                const double y = wr[i] + side * wi[i];
-                if (dk_rr_within_reach(rows, moebius, y, reach)) {
+        } else if (imag_tol * size < wi[i]) {
+            for (side = -1; side <= 1; side += 2) { /* a nearly real pair (dk_rr_pair_value) */
+                double y;
+                if (dk_rr_pair_value(rows, moebius, wr[i], wi[i], side, &y) &&
+                    dk_rr_within_reach(rows, moebius, y, reach)) {
                     extras[n_extra++] = y;
                 }
             }

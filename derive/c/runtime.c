@@ -1528,6 +1528,13 @@ static int dk_pose_ok(const double T[16])
 #define DK_REFINE_SMALL (1e-3)
 /* a refined row is kept if its pose error is within the smaller of this and ik's tol */
 #define DK_REFINE_TOL (1e-10)
+/* where the damped steps give up (DK_REFINE_PATIENCE) within this and above DK_REFINE_DONE,
+   Gauss-Newton steps by QR go on from the best point met (derive/runtime/refine.py,
+   _REFINE_SETTLE, says why) */
+#define DK_REFINE_SETTLE (1e-6)
+/* an exact table's row certified within ik's tol but not within this is polished (dk_polish;
+   derive/runtime/refine.py, _REFINE_POLISH, says why) */
+#define DK_REFINE_POLISH (1e-10)
 
 /* x := (L L^T)^-1 x, L the lower triangle of a factor dk_cholesky_solve left in A (its
    diagonal held as the reciprocals: multiplications, not divisions) */
@@ -1573,6 +1580,54 @@ static int dk_cholesky_solve(double A[DK_REFINE_M][DK_REFINE_M], double x[DK_REF
     }
     dk_cholesky_again((const double(*)[DK_REFINE_M])A, x);
     return 1;
+}
+
+/* x := the least-squares solution of J x = e (J's first DK_REFINE_ROWS rows; J and e are
+   overwritten) by Householder's QR factorisation: the normal equations square J's condition
+   number, which a singular solution makes large as q nears it. A column the reflections
+   leave empty (a held joint's) gets x = 0. (The Python solver's _qr_solve.) */
+static void dk_qr_solve(double J[6][DK_REFINE_M], double e[6], double x[DK_REFINE_M])
+{
+    double diag[DK_REFINE_M];
+    int i, j, k;
+    for (k = 0; k < DK_REFINE_M; k++) {
+        double norm = 0.0, vv, s;
+        for (i = k; i < DK_REFINE_ROWS; i++) {
+            norm += J[i][k] * J[i][k];
+        }
+        norm = sqrt(norm);
+        diag[k] = J[k < DK_REFINE_ROWS ? k : 0][k] > 0.0 ? -norm : norm;
+        if (norm == 0.0) {
+            continue;
+        }
+        vv = 2.0 * norm * (norm + fabs(J[k][k])); /* v = the column - diag e_k: v^T v */
+        J[k][k] -= diag[k];
+        for (j = k + 1; j < DK_REFINE_M; j++) { /* (I - 2 v v^T / v^T v) on the columns after */
+            s = 0.0;
+            for (i = k; i < DK_REFINE_ROWS; i++) {
+                s += J[i][k] * J[i][j];
+            }
+            s *= 2.0 / vv;
+            for (i = k; i < DK_REFINE_ROWS; i++) {
+                J[i][j] -= s * J[i][k];
+            }
+        }
+        s = 0.0; /* ... and on e */
+        for (i = k; i < DK_REFINE_ROWS; i++) {
+            s += J[i][k] * e[i];
+        }
+        s *= 2.0 / vv;
+        for (i = k; i < DK_REFINE_ROWS; i++) {
+            e[i] -= s * J[i][k];
+        }
+    }
+    for (k = DK_REFINE_M - 1; k >= 0; k--) { /* R x = Q^T e */
+        double s = k < DK_REFINE_ROWS ? e[k] : 0.0;
+        for (j = k + 1; j < DK_REFINE_M; j++) {
+            s -= (k < DK_REFINE_ROWS ? J[k][j] : 0.0) * x[j];
+        }
+        x[k] = diag[k] == 0.0 ? 0.0 : s / diag[k];
+    }
 }
 
 /* whether q is one of the first n rows of found (within DK_DEDUP_TOL, revolute joints a full
@@ -1661,7 +1716,7 @@ static double dk_refine(const double chain[DK_REFINE_N + 1][12], const int revol
 {
     double cur[DK_REFINE_N], cs[DK_REFINE_N][2], best = HUGE_VAL, reused = HUGE_VAL;
     double J[6][DK_REFINE_M], normal[DK_REFINE_M][DK_REFINE_M];
-    int worse = 0, last, it, i, r, c, k;
+    int worse = 0, settle = 0, last, it, i, r, c, k;
     for (i = 0; i < DK_REFINE_N; i++) {
         cur[i] = q[i];
         cs[i][0] = cos(q[i]);
@@ -1745,10 +1800,21 @@ static double dk_refine(const double chain[DK_REFINE_N + 1][12], const int revol
         } else { /* (near a singular configuration the error can grow before it converges) */
             worse++;
         }
+        if (worse == DK_REFINE_PATIENCE && !settle && best <= DK_REFINE_SETTLE) {
+            settle = 1; /* (Gauss-Newton by QR from the best point, measured at each step) */
+            worse = 0;
+            reused = HUGE_VAL;
+            for (i = 0; i < DK_REFINE_N; i++) {
+                cur[i] = q[i];
+                cs[i][0] = cos(q[i]);
+                cs[i][1] = sin(q[i]);
+            }
+            continue;
+        }
         if (size <= DK_REFINE_DONE || worse == DK_REFINE_PATIENCE) {
             break;
         }
-        last = size <= DK_REFINE_LAST && worse == 0;
+        last = size <= DK_REFINE_LAST && worse == 0 && !settle;
         if (last && reused <= DK_REFINE_SMALL) { /* the last step, with the previous factor */
             for (i = 0; i < DK_REFINE_M; i++) {
                 step[i] = 0.0;
@@ -1798,10 +1864,14 @@ static double dk_refine(const double chain[DK_REFINE_N + 1][12], const int revol
                 }
             }
         }
-        for (r = 0; r < DK_REFINE_ROWS; r++) {
-            mu += error[r] * error[r];
+        if (settle) {
+            dk_qr_solve(J, error, step);
+        } else {
+            for (r = 0; r < DK_REFINE_ROWS; r++) {
+                mu += error[r] * error[r];
+            }
         }
-        for (i = 0; i < DK_REFINE_M; i++) { /* (J^T J + mu) step = J^T error */
+        for (i = 0; i < DK_REFINE_M && !settle; i++) { /* (J^T J + mu) step = J^T error */
             step[i] = 0.0;
             for (r = 0; r < DK_REFINE_ROWS; r++) {
                 step[i] += J[r][i] * error[r];
@@ -1815,8 +1885,11 @@ static double dk_refine(const double chain[DK_REFINE_N + 1][12], const int revol
             }
             normal[i][i] = held >> solved[i] & 1u ? 1.0 : normal[i][i] + mu;
         }
-        if (!dk_cholesky_solve(normal, step)) {
-            break;
+        if (!settle && !dk_cholesky_solve(normal, step)) { /* (J^T J singular to roundings:
+            a singular solution near; given up as after DK_REFINE_PATIENCE steps, so QR's steps
+            go on from the best point where that is within DK_REFINE_SETTLE) */
+            worse = DK_REFINE_PATIENCE - 1;
+            continue;
         }
         for (k = 0; k < DK_REFINE_M; k++) {
             longest = fabs(step[k]) > longest ? fabs(step[k]) : longest;
@@ -1877,6 +1950,27 @@ static double dk_refine_held(const double chain[DK_REFINE_N + 1][12],
         }
     }
     return dk_refine(chain, revolute, solved, reach, t, q, 0u);
+}
+
+/* q, a closed form's row of an exact table certified within ik's tol but not within
+   DK_REFINE_POLISH (a value taken at a fold within DK_FOLD_TOL of it, a root at the edge of its
+   polynomial's conditioning: a look-at point ten reaches away), polished: Newton's steps on
+   the exact chain (dk_refine), the joints in held (a bit per arm joint: those the pose left
+   free) kept, taken where they bring it within DK_REFINE_TOL (the Python solver's _keep) */
+static void dk_polish(const double chain[DK_REFINE_N + 1][12], const int revolute[DK_REFINE_N],
+                      const int solved[DK_REFINE_M], double reach, const double t[12],
+                      double q[DK_REFINE_N], unsigned held)
+{
+    double moved[DK_REFINE_N];
+    int i;
+    for (i = 0; i < DK_REFINE_N; i++) {
+        moved[i] = q[i];
+    }
+    if (dk_refine(chain, revolute, solved, reach, t, moved, held) <= DK_REFINE_TOL) {
+        for (i = 0; i < DK_REFINE_N; i++) {
+            q[i] = moved[i];
+        }
+    }
 }
 
 /* The pose of frame k of a chain of n joints and fixed frames (12 entries each: T(q) = F_0

@@ -267,6 +267,8 @@ def solve_lines(plan: Plan) -> tuple[tuple[int, str], ...]:
     fix = plan.correction is not None
     if not fix:
         body.append(Line(0, "const double ptol = tol * DK_REACH;"))
+        # (rows within this need no polish: dk_polish; most are, and one dk_match settles it)
+        body.append(Line(0, "const double dk_fine = fmin(tol, DK_REFINE_POLISH);"))
     body.append(Line(0, "int n = 0;"))
     # whether two rows can repeat: where two values of one step lie within DK_DEDUP_TOL (or
     # always, where a row's joints are not the steps' values themselves, or are refined)
@@ -401,8 +403,23 @@ def solve_lines(plan: Plan) -> tuple[tuple[int, str], ...]:
         axis = plan.ik.tool_axis
         if plan.ik.certify == "axisangle":  # (the entry compared: the axis's base-axis one)
             axis += 4 * plan.ik.cone
-        body.append(Line(depth, f"if (n < DK_MAX && dk_match(e, t, tol, ptol, {task}, {axis})) {{"))
+        match = f"dk_match(e, t, {{}}, {{}}, {task}, {axis})"
+        fine = match.format("dk_fine", "dk_fine * DK_REACH")
+        body.append(Line(depth, f"const int dk_fine_ok = n < DK_MAX && {fine};"))
+        body.append(
+            Line(depth, f"if (dk_fine_ok || (n < DK_MAX && {match.format('tol', 'ptol')})) {{")
+        )
         body += [Line(depth + 1, f"found[n][{k}] = {v};") for k, v in enumerate(outputs)]
+        # (a row within tol but not DK_REFINE_POLISH is polished on the exact chain)
+        body.append(
+            Line(depth + 1, "if (!dk_fine_ok) { /* (the joints the pose left free held) */")
+        )
+        held = " | ".join(f"(dk_v{j}.free ? {1 << i}u : 0u)" for j, i in held_joints(plan))
+        polish = (
+            f"dk_polish(DK_CHAIN, DK_REVOLUTE, DK_SOLVED, DK_REACH, t, found[n], {held or '0u'});"
+        )
+        body.append(Line(depth + 2, polish))
+        body.append(Line(depth + 1, "}"))
         body.append(Line(depth + 1, "n++;"))
         body.append(Line(depth, "}"))
     for line in reversed(closing):

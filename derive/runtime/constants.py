@@ -122,8 +122,12 @@ _RR_MOEBIUS = ((1.0, 0.3, -0.4, 1.0), (1.0, -0.7, 0.5, 1.0), (0.6, 1.0, -1.0, 0.
 # the special values joints and offsets take (with no shift, theta4 or theta5 = pi at 0 or 180
 # degree samples put the solution at x = infinity and the first split lost it)
 _RR_SHIFT45 = (0.37, -0.61)
-# a complex pair with 0 < Im <= _RR_PAIR_TOL (1 + |y|) is also tried, at Re -+ Im (two near
-# real roots its rounding split apart)
+# a complex pair whose theta3 is within _RR_PAIR_ANGLE (radians) of real is also tried, at
+# its real part -+ its imaginary part (two near real roots that rounding, or a perturbed
+# table's difference, split apart: on xArm6's perturbed table such pairs of the arm's
+# solutions lay 0.007-0.113 rad off real, 10 of 10,000 random poses); a sliding joint 3's
+# (x3 = d3) within _RR_PAIR_TOL (1 + |y|)
+_RR_PAIR_ANGLE = 0.15
 _RR_PAIR_TOL = 0.05
 _RR_IMAG_TOL = 1e-6
 # where nothing certifies otherwise (the pose's pencil is singular: a curve of solutions), the

@@ -12,8 +12,8 @@ and Q (``_rr_fill``). From there the steps are the same for every arm (docs/algo
 3. the null space of the matrix at each eigenvalue (SVD) gives theta4 and theta5 (its
    variables are x = tan((theta - shift) / 2), shifts _RR_SHIFT45, so that theta4, theta5 =
    pi are finite too); a two-dimensional one (two solutions sharing theta3) is split by the
-   monomial structure; a nearly real pair of eigenvalues (imaginary part within
-   _RR_PAIR_TOL (1 + |y|)) is also tried at Re -+ Im, as optional candidates;
+   monomial structure; a nearly real pair of eigenvalues (theta3's imaginary part within
+   _RR_PAIR_ANGLE) is also tried at theta3's real part -+ that, as optional candidates;
 4. theta1, theta2 by least squares from Q m12 = P m45, theta6 from the pose;
 5. Newton steps on the arm's forward kinematics polish every candidate, then, where they do
    not converge (a pose with a curve of solutions), Levenberg-Marquardt steps.
@@ -57,6 +57,7 @@ from derive.runtime.constants import (
     _RR_NEWTON_REACH,
     _RR_NEWTON_STEPS,
     _RR_NULL2_TOL,
+    _RR_PAIR_ANGLE,
     _RR_PAIR_TOL,
     _RR_PATH,
     _RR_PATH_STEPS,
@@ -433,13 +434,8 @@ def _rr_candidates(P0, Ps, Pc, Q, F, rows, slide=_RR_TURNS, imag_tol=_RR_IMAG_TO
         return None, True, []
     values, (A, B, C), moebius = found
     size = 1.0 + np.abs(values)
-    real = values[np.abs(values.imag) <= imag_tol * size].real
-    # a pair y +- i eta nearly real (two near-equal real roots of a near-singular pose the
-    # pencil's rounding split apart: the twins of a nearly folded elbow or wrist) is tried at
-    # y - eta and y + eta (Newton and the certification decide)
-    pair = values[(values.imag > imag_tol * size) & (values.imag <= _RR_PAIR_TOL * size)]
-    extra = np.sort(np.concatenate((pair.real - pair.imag, pair.real + pair.imag)))
-    real = np.sort(real)
+    real = np.sort(values[np.abs(values.imag) <= imag_tol * size].real)
+    extra = _rr_pair_extras(values[values.imag > imag_tol * size], moebius, slide[0])
     ma, mb, mc, md = moebius
     if slide[0]:
         # a sliding joint 3 moves the flange by d3 along its axis, the other links by at most
@@ -494,6 +490,30 @@ def _rr_candidates(P0, Ps, Pc, Q, F, rows, slide=_RR_TURNS, imag_tol=_RR_IMAG_TO
     X = np.column_stack((theta1, theta2, T345[owner]))
     extras = np.array(optional)[owner].tolist()
     return list(np.column_stack((X, _rr_theta6_many(rows, F, X, slide)))), doubt, extras
+
+
+def _rr_pair_extras(upper, moebius, slides):
+    """The values of y tried for the nearly real pairs among the eigenvalues upper (those
+    with Im > 0): two near-equal real roots that the pencil's rounding split apart (the twins
+    of a nearly folded elbow or wrist), or that a perturbed table's difference made complex.
+    Nearly real is judged by the imaginary part theta3 takes, 2 |det M| Im y / ((ma y + mb)^2
+    + (mc y + md)^2) to first order (M the Moebius map): the map changes from pose to pose,
+    and a pair the imaginary part of y calls far (up to 0.8 (1 + |y|), measured on xArm6)
+    can be 0.01 rad from real. A pair within _RR_PAIR_ANGLE is tried at theta3's real part
+    -+ that imaginary part (Newton and the certification decide); a sliding joint 3 (x3 is
+    d3) at Re y -+ Im y, within _RR_PAIR_TOL (1 + |y|)."""
+    if slides:
+        pair = upper[upper.imag <= _RR_PAIR_TOL * (1.0 + np.abs(upper))]
+        return np.sort(np.concatenate((pair.real - pair.imag, pair.real + pair.imag)))
+    ma, mb, mc, md = moebius
+    num, den = ma * upper.real + mb, mc * upper.real + md
+    spread = 2.0 * abs(ma * md - mb * mc) * upper.imag / (num * num + den * den)
+    near = spread <= _RR_PAIR_ANGLE
+    centre = 2.0 * np.arctan2(num[near], den[near])
+    half = np.tan(np.concatenate((centre - spread[near], centre + spread[near])) / 2.0)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        y = (md * half - mb) / (ma - mc * half)
+    return np.sort(y[np.isfinite(y)])
 
 
 def _rr_joints12_many(rows, F, T345, slide):

@@ -205,6 +205,9 @@ PATH_JUMP = 0.5
 # (radians, or REACH) or PATH_GAIN times the nearest row's (near a fold, the other branch's
 # row can be the nearer one by more than PATH_GAIN: measured on open_manipulator_x)
 PATH_NEAR = 0.25
+# ... and a step whose row moves a joint more than PATH_NEAR is taken in halves, at most this
+# many times (2^6 = 64 parts; _follow)
+PATH_SPLITS = 6
 
 
 def ik_path(
@@ -266,23 +269,7 @@ def ik_path(
     out[0] = q
     breaks: list[tuple[int, str]] = []
     for k in range(1, len(poses)):
-        if IK_COMPONENTS == "pose":
-            change = float(np.linalg.norm(_pose_step(poses[k - 1], poses[k])))
-            least = manipulability(q)[0] if DOF >= 6 else 1.0
-        else:  # (the task's components and their Jacobian: what the task's rows follow)
-            error, columns, _ = _pose_error(q.tolist(), poses[k][:3].ravel().tolist(), False)
-            change = float(np.linalg.norm(error))
-            least = float(np.linalg.svd(np.array(columns).T, compute_uv=False)[-1])
-        bound = PATH_GAIN * change / max(least, 1e-300)
-        row, why = _continuation(poses[k], q, branch(q), bound, within_limits, backend)
-        if not why and least < PATH_SINGULAR:
-            jump = np.abs(row - q) / np.where(np.array(_REVOLUTE), 1.0, REACH)
-            if jump.max() > PATH_JUMP:
-                j = int(np.argmax(jump))
-                why = (
-                    f"q{j + 1} jumps by {jump[j]:.3g} at a singular configuration (the path "
-                    "passes one; where it goes from there the poses do not say)"
-                )
+        row, why, least = _follow(poses[k - 1], poses[k], q, within_limits, backend, 0)
         if why:
             breaks.append((k, f"pose {k}: {why}; sigma_min {least:.3g}"))
             if on_break == "stop":
@@ -292,6 +279,55 @@ def ik_path(
         out[k] = row
         q = row
     return out, breaks
+
+
+def _step_bound(q, A, B):
+    """The joint step a continuous branch can take from q (a solution of the pose A) to the
+    pose B: PATH_GAIN |dX| / sigma_min, dX the pose step (an arm solved for a task: its
+    components' error at B), sigma_min the smallest singular value of the Jacobian at q
+    (of the task's); and sigma_min."""
+    if IK_COMPONENTS == "pose":
+        change = float(np.linalg.norm(_pose_step(A, B)))
+        least = manipulability(q)[0] if DOF >= 6 else 1.0
+    else:  # (the task's components and their Jacobian: what the task's rows follow)
+        error, columns, _ = _pose_error(q.tolist(), B[:3].ravel().tolist(), False)
+        change = float(np.linalg.norm(error))
+        least = float(np.linalg.svd(np.array(columns).T, compute_uv=False)[-1])
+    return PATH_GAIN * change / max(least, 1e-300), least
+
+
+def _follow(A, B, q, within_limits, backend, depth):
+    """ik_path's step from q (a solution of the pose A) to the pose B: _continuation, but
+    where its row moves a joint by more than PATH_NEAR (radians, or REACH) or finds no
+    continuation, the step in halves (straight_line's middle pose), up to PATH_SPLITS times:
+    near a singular configuration a branch turns fast (the wrist centre passing near axis 1
+    turned a KR 10's q1 by 1.6 rad in one of 20 steps, sigma_min 4e-3), and the other
+    shoulder's row, nearer by joint distance, was taken with no break reported (a new user's
+    attack). A step from where sigma_min is below PATH_SINGULAR whose row moves a joint more
+    than PATH_JUMP is a break: the first-order bound allows any step there, and which way the
+    path goes depends on how finely it is sampled. Returns (row, why) as _continuation, and
+    sigma_min where the step starts."""
+    bound, least = _step_bound(q, A, B)
+    row, why = _continuation(B, q, branch(q), bound, within_limits, backend)
+    if row is None or "limits" in why:
+        return row, why, least
+    units = np.where(np.array(_REVOLUTE), 1.0, REACH)
+    jump = np.abs(_turned(row - q, np.array(_REVOLUTE))) / units
+    if depth < PATH_SPLITS and (why or float(jump.max()) > PATH_NEAR):
+        middle = straight_line(A, B, 3)[1]
+        half, first, _ = _follow(A, middle, q, within_limits, backend, depth + 1)
+        if half is not None and not first:
+            split, why_split, _ = _follow(middle, B, half, within_limits, backend, depth + 1)
+            if split is not None:
+                row, why = split, why_split
+                jump = np.abs(_turned(row - q, np.array(_REVOLUTE))) / units
+    if not why and depth == 0 and least < PATH_SINGULAR and float(jump.max()) > PATH_JUMP:
+        j = int(np.argmax(jump))
+        why = (
+            f"q{j + 1} jumps by {jump[j]:.3g} at a singular configuration (the path passes "
+            "one; where it goes from there the poses do not say)"
+        )
+    return row, why, least
 
 
 def _continuation(T, q, label, bound, within_limits, backend):

@@ -46,6 +46,16 @@ _REFINE_LAST = 1e-10
 _REFINE_TRUST = 100.0
 # a refined row is returned if its pose error is within the smaller of this and ik's tol
 _REFINE_TOL = 1e-10
+# where the damped steps give up (_REFINE_PATIENCE steps without a better point) within this
+# and above _REFINE_DONE, Gauss-Newton steps by QR (_qr_solve) go on from the best point met:
+# at a singular solution (a pose on the wrist's or the shoulder's singular set) the normal
+# equations' steps alternate between damped and overshooting ones and stall 1e-10 to 1e-9
+# short of it, and 4 of 8,400 such poses of zoo URDF arms got no row (a new user's attack)
+_REFINE_SETTLE = 1e-6
+# an exact table's row certified within ik's tol but not within this is polished (_keep): a
+# far look-at point's rows came within 1e-10 of the ray by the certification's largest
+# entry and 1.5e-10 by its length (a new user's attack)
+_REFINE_POLISH = 1e-10
 # ik_approximate's least squares: at most this many steps, done where the gradient of half
 # the squared error is this flat
 _LSQ_STEPS = 200
@@ -79,30 +89,39 @@ def _refine(q, t, held=()):
     arithmetic."""
     m = len(_SOLVED)
     cur = [float(x) for x in q]
-    best, best_size, worse = list(cur), math.inf, 0
+    best, best_size, worse, settle = list(cur), math.inf, 0, False
     for _ in range(_REFINE_STEPS):
         error, columns, size = _pose_error(cur, t, False)
         if size < best_size:
             best, best_size, worse = list(cur), size, 0
         else:  # (near a singular configuration the error can grow before it converges)
             worse += 1
+        if worse == _REFINE_PATIENCE and not settle and best_size <= _REFINE_SETTLE:
+            settle, worse, cur = True, 0, list(best)  # (Gauss-Newton by QR from the best)
+            continue
         if size <= _REFINE_DONE or worse == _REFINE_PATIENCE:
             break
-        last = size <= _REFINE_LAST and worse == 0
+        last = size <= _REFINE_LAST and worse == 0 and not settle
         if held:  # (a held joint's column 0, its row of the normal equations the identity's)
             columns = [[0.0] * len(c) if _SOLVED[k] in held else c for k, c in enumerate(columns)]
-        mu = sum(e * e for e in error)
-        step = [sum(c * e for c, e in zip(column, error)) for column in columns]
-        normal = [
-            [sum(a * b for a, b in zip(columns[i], columns[j])) + (mu if i == j else 0.0)
-             for j in range(m)]
-            for i in range(m)
-        ]  # fmt: skip
-        for k in range(m):
-            if _SOLVED[k] in held:
-                normal[k][k] = 1.0
-        if not _cholesky_solve(normal, step):
-            break
+        if settle:
+            step = _qr_solve(columns, error)
+        else:
+            mu = sum(e * e for e in error)
+            step = [sum(c * e for c, e in zip(column, error)) for column in columns]
+            normal = [
+                [sum(a * b for a, b in zip(columns[i], columns[j])) + (mu if i == j else 0.0)
+                 for j in range(m)]
+                for i in range(m)
+            ]  # fmt: skip
+            for k in range(m):
+                if _SOLVED[k] in held:
+                    normal[k][k] = 1.0
+            if not _cholesky_solve(normal, step):  # (J^T J singular to roundings: a singular
+                # solution near; given up as after _REFINE_PATIENCE steps, so Gauss-Newton by
+                # QR goes on from the best point where that is within _REFINE_SETTLE)
+                worse = _REFINE_PATIENCE - 1
+                continue
         longest = max(map(abs, step))
         if not longest < math.inf:
             break
@@ -113,6 +132,39 @@ def _refine(q, t, held=()):
             best = cur  # (Newton's step from there: the error squared, not measured)
             break
     return tuple(best), best_size
+
+
+def _qr_solve(columns, e):
+    """The least-squares solution x of J x = e, J's columns given (each as long as e), by
+    Householder's QR factorisation: the normal equations square J's condition number, which
+    a singular solution makes large as q nears it. A column the reflections leave empty (a
+    held joint's) gets x = 0. (The C solver's dk_qr_solve.)"""
+    A = [list(c) for c in columns]
+    b = list(e)
+    rows, m = len(b), len(A)
+    diag = [0.0] * m
+    for k in range(m):
+        norm = math.sqrt(sum(A[k][i] * A[k][i] for i in range(k, rows)))
+        head = A[k][k] if k < rows else A[k][0]
+        diag[k] = -norm if head > 0.0 else norm
+        if norm == 0.0:
+            continue
+        vv = 2.0 * norm * (norm + abs(A[k][k]))  # (v = the column - diag e_k: v^T v)
+        A[k][k] -= diag[k]
+        for j in range(k + 1, m):  # (I - 2 v v^T / v^T v) on the columns after, and on b
+            s = sum(A[k][i] * A[j][i] for i in range(k, rows)) * (2.0 / vv)
+            for i in range(k, rows):
+                A[j][i] -= s * A[k][i]
+        s = sum(A[k][i] * b[i] for i in range(k, rows)) * (2.0 / vv)
+        for i in range(k, rows):
+            b[i] -= s * A[k][i]
+    x = [0.0] * m
+    for k in range(m - 1, -1, -1):  # R x = Q^T b
+        s = b[k] if k < rows else 0.0
+        for j in range(k + 1, m):
+            s -= (A[j][k] if k < rows else 0.0) * x[j]
+        x[k] = 0.0 if diag[k] == 0.0 else s / diag[k]
+    return x
 
 
 def _least_squares(q, t):
