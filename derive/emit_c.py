@@ -57,14 +57,12 @@ class PrintedC:
     # how far the solver's equations may miss and still seed a refinement (0.0: exact arms)
     seed_tol: str = "0.0"
     # the exact chain's frames (each three lines of 4 numbers, link_transform's and the
-    # refinement's) and the base's (3 lines); the joints (0-based) the refinement moves, where
-    # the closed form solves a nominal table (refined), else ()
+    # refinement's) and the base's (3 lines); whether the closed form solves a nominal table
+    # (refined: every row is refined onto the chain; else a row within tol but not 1e-10 is
+    # polished there, dk_polish); the joints (0-based) the steps move
     chain: tuple[tuple[str, ...], ...] = ()
     base: tuple[str, ...] = ()
     refined: bool = False
-    # the closed form solves the arm's own table: a row certified within tol but not within
-    # the refinement's tolerance is polished on the exact chain (dk_polish)
-    polished: bool = False
     # a planar arm's plane task (derive/tasks.py, Plane): "xy_heading", "xy" or ""; the tool's
     # rotation at q = 0 (9 numbers), the heading there, the plane's height, a sliding joint
     plane: str = ""
@@ -176,7 +174,6 @@ def print_c(plan: Plan) -> PrintedC:
     if ik is None:
         raise GenerationError(f"{arm.name}: no IK method, so no C solver: {plan.refusal}")
     solve = c.solve_lines(plan)
-    polished = plan.correction is None
     fk_pose, fk_joints, fk_params = c.fk_lines(plan)
     jacobian = c.jacobian_lines(plan)
     upper = arm.name.upper()
@@ -212,8 +209,7 @@ def print_c(plan: Plan) -> PrintedC:
         chain=tuple(_frame_rows(f) for f in plan.frames),
         base=_frame_rows(arm.base[:12]),
         refined=plan.correction is not None,
-        polished=polished,
-        solved=plan.solved if plan.correction or polished else (),
+        solved=plan.solved,
         refine_rows={"position": 3, "lookat": 3, "axisangle": 4}.get(ik.certify, 6),  # (pointing:
         # 3 zero)
         task_code=TASK_CODES[ik.certify],

@@ -1446,8 +1446,9 @@ def _follow(A, B, q, within_limits, backend, depth):
     row, why = _continuation(B, q, branch(q), bound, within_limits, backend)
     if row is None or "limits" in why:
         return row, why, least
-    units = np.where(np.array(_REVOLUTE), 1.0, REACH)
-    jump = np.abs(_turned(row - q, np.array(_REVOLUTE))) / units
+    revolute = np.array(_REVOLUTE)
+    units = np.where(revolute, 1.0, REACH)
+    jump = np.abs(_turned(row - q, revolute)) / units
     if depth < PATH_SPLITS and (why or float(jump.max()) > PATH_NEAR):
         middle = straight_line(A, B, 3)[1]
         half, first, _ = _follow(A, middle, q, within_limits, backend, depth + 1)
@@ -1455,7 +1456,7 @@ def _follow(A, B, q, within_limits, backend, depth):
             split, why_split, _ = _follow(middle, B, half, within_limits, backend, depth + 1)
             if split is not None:
                 row, why = split, why_split
-                jump = np.abs(_turned(row - q, np.array(_REVOLUTE))) / units
+                jump = np.abs(_turned(row - q, revolute)) / units
     if not why and depth == 0 and least < PATH_SINGULAR and float(jump.max()) > PATH_JUMP:
         j = int(np.argmax(jump))
         why = (

@@ -372,11 +372,13 @@ def solve_lines(plan: Plan) -> tuple[tuple[int, str], ...]:
             ]
         depth += 1
     outputs = [printer.doprint(e) for e in plan.ik.outputs]
+    # (the joints the pose left free, a bit each: a refinement holds them first, a polish
+    # throughout)
+    held = " | ".join(f"(dk_v{j}.free ? {1 << i}u : 0u)" for j, i in held_joints(plan))
     if fix:  # refined onto the exact chain, certified there
         body.append(Line(depth, "if (n < DK_MAX) {"))
         body.append(Line(depth + 1, f"double dk_q[DK_DOF] = {{{', '.join(outputs)}}};"))
         # (the joints the pose left free, held first: derive/c/runtime.c dk_refine_held)
-        held = " | ".join(f"(dk_v{j}.free ? {1 << i}u : 0u)" for j, i in held_joints(plan))
         body.append(Line(depth + 1, f"const unsigned dk_held = {held or '0u'};"))
         body.append(Line(depth + 1, "const double dk_limit = fmin(tol, DK_REFINE_TOL);"))
         body.append(
@@ -414,7 +416,6 @@ def solve_lines(plan: Plan) -> tuple[tuple[int, str], ...]:
         body.append(
             Line(depth + 1, "if (!dk_fine_ok) { /* (the joints the pose left free held) */")
         )
-        held = " | ".join(f"(dk_v{j}.free ? {1 << i}u : 0u)" for j, i in held_joints(plan))
         polish = (
             f"dk_polish(DK_CHAIN, DK_REVOLUTE, DK_SOLVED, DK_REACH, t, found[n], {held or '0u'});"
         )

@@ -76,17 +76,16 @@ def ik_lines(plan: Plan) -> tuple[tuple[int, str], ...]:
             loops.append((depth, step.joint))
         depth += 1
     outputs = ", ".join(printer.doprint(e) for e in plan.ik.outputs)
+    # (the joints the pose left free: a refinement holds them first, a polish throughout)
+    frees = "".join(f"(_v{j}, {i}), " for j, i in held_joints(plan))
     if plan.correction is not None:  # refined onto the exact chain, certified there
-        frees = "".join(f"(_v{j}, {i}), " for j, i in held_joints(plan))
         lines.append(Line(depth, f"_seed(found, target, ({outputs},), tol, ({frees}))"))
-    else:  # (a polish keeps the joints the pose left free: held_joints)
-        frees = "".join(f"(_v{j}, {i}), " for j, i in held_joints(plan))
-        if same_joints(plan):
-            fk = f"_fk_from_cs({cs_arguments(plan)})"
-            lines.append(Line(depth, f"_keep(found, target, ({outputs},), {fk}, tol, ({frees}))"))
-        else:
-            lines.append(Line(depth, f"q = ({outputs},)"))
-            lines.append(Line(depth, f"_keep(found, target, q, _fk_q(q), tol, ({frees}))"))
+    elif same_joints(plan):
+        fk = f"_fk_from_cs({cs_arguments(plan)})"
+        lines.append(Line(depth, f"_keep(found, target, ({outputs},), {fk}, tol, ({frees}))"))
+    else:
+        lines.append(Line(depth, f"q = ({outputs},)"))
+        lines.append(Line(depth, f"_keep(found, target, q, _fk_q(q), tol, ({frees}))"))
     for level, joint in reversed(loops):
         # a free joint's loop (over _Free values) ends at its first value that gave a solution
         lines.append(
