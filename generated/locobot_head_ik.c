@@ -1292,8 +1292,7 @@ static int dk_pose_ok(const double T[16])
 
 #define DK_REFINE_TRUST (100.0)
 
-/* a step within this (radians, or reach) turns the cos and sin by their series (its terms to
-   d^5: error d^6 / 720 ~ 1e-21), and its Jacobian and factor serve the last step */
+/* a step within this (radians, or reach): its Jacobian and factor serve the last step */
 #define DK_REFINE_SMALL (1e-3)
 
 /* a refined row is kept if its pose error is within the smaller of this and ik's tol */
@@ -1447,12 +1446,191 @@ static void dk_task_column(const double pose[12], const double t[12], double J[6
     }
 }
 
+/* The pose of the chain of fixed frames (12 entries each: T(q) = F_0 J_1(q_1) F_1 ...
+   J_n(q_n) F_n) at q, the revolute joints' cos and sin in cs: its top three rows into pose,
+   and each joint's axis and a point on it (the z and the origin of the frame it turns) into
+   axes and origins. The product is kept in twelve scalars (a row written entry by entry and
+   read back as a pair stalls the processor's store forwarding: a fifth of the time). */
+static void dk_chain_pose(const double chain[DK_REFINE_N + 1][12],
+                          const int revolute[DK_REFINE_N], const double q[DK_REFINE_N],
+                          const double cs[DK_REFINE_N][2], double pose[12],
+                          double axes[DK_REFINE_N][3], double origins[DK_REFINE_N][3])
+{
+    double r00 = chain[0][0], r01 = chain[0][1], r02 = chain[0][2], r03 = chain[0][3];
+    double r10 = chain[0][4], r11 = chain[0][5], r12 = chain[0][6], r13 = chain[0][7];
+    double r20 = chain[0][8], r21 = chain[0][9], r22 = chain[0][10], r23 = chain[0][11];
+    int i;
+    for (i = 0; i < DK_REFINE_N; i++) {
+        const double *f = chain[i + 1];
+        double a, b, c;
+        axes[i][0] = r02;
+        axes[i][1] = r12;
+        axes[i][2] = r22;
+        origins[i][0] = r03;
+        origins[i][1] = r13;
+        origins[i][2] = r23;
+        if (revolute[i]) { /* := Rz(q_i): the first two columns turn */
+            const double cq = cs[i][0], sq = cs[i][1];
+            a = r00;
+            r00 = cq * a + sq * r01;
+            r01 = cq * r01 - sq * a;
+            a = r10;
+            r10 = cq * a + sq * r11;
+            r11 = cq * r11 - sq * a;
+            a = r20;
+            r20 = cq * a + sq * r21;
+            r21 = cq * r21 - sq * a;
+        } else { /* := Tz(q_i) */
+            r03 += q[i] * r02;
+            r13 += q[i] * r12;
+            r23 += q[i] * r22;
+        }
+        a = r00, b = r01, c = r02; /* := F_{i+1}, row by row */
+        r00 = a * f[0] + b * f[4] + c * f[8];
+        r01 = a * f[1] + b * f[5] + c * f[9];
+        r02 = a * f[2] + b * f[6] + c * f[10];
+        r03 += a * f[3] + b * f[7] + c * f[11];
+        a = r10, b = r11, c = r12;
+        r10 = a * f[0] + b * f[4] + c * f[8];
+        r11 = a * f[1] + b * f[5] + c * f[9];
+        r12 = a * f[2] + b * f[6] + c * f[10];
+        r13 += a * f[3] + b * f[7] + c * f[11];
+        a = r20, b = r21, c = r22;
+        r20 = a * f[0] + b * f[4] + c * f[8];
+        r21 = a * f[1] + b * f[5] + c * f[9];
+        r22 = a * f[2] + b * f[6] + c * f[10];
+        r23 += a * f[3] + b * f[7] + c * f[11];
+    }
+    pose[0] = r00, pose[1] = r01, pose[2] = r02, pose[3] = r03;
+    pose[4] = r10, pose[5] = r11, pose[6] = r12, pose[7] = r13;
+    pose[8] = r20, pose[9] = r21, pose[10] = r22, pose[11] = r23;
+}
+
+/* The task's error from pose to the target t (12 top entries each) into error (positions /
+   reach, then the rotation's 1/2 sum_k r_k x t_k, or the task's own rows: dk_task_column
+   says which), and its size: the largest rotation entry's difference (unless
+   DK_REFINE_ROWS is 3), positions / reach */
+static double dk_task_error(const double pose[12], const double t[12], double reach,
+                            double error[6])
+{
+    double size = 0.0;
+    int r, k;
+    for (r = 0; r < 3; r++) {
+        int a = (r + 1) % 3, b = (r + 2) % 3;
+        double total = 0.0;
+        error[r] = DK_REFINE_TASK == 4 ? 0.0 : (t[4 * r + 3] - pose[4 * r + 3]) / reach;
+        size = fabs(error[r]) > size ? fabs(error[r]) : size;
+        for (k = 0; k < 3; k++) {
+            total += pose[4 * a + k] * t[4 * b + k] - pose[4 * b + k] * t[4 * a + k];
+            if (DK_REFINE_TASK == 0) {
+                const double gap = fabs(t[4 * r + k] - pose[4 * r + k]);
+                size = gap > size ? gap : size;
+            }
+        }
+        error[3 + r] = 0.5 * total;
+        if (DK_REFINE_TASK == 2 || DK_REFINE_TASK == 4) { /* u x t_u: u the tool axis */
+            const int x = DK_REFINE_AXIS;
+            const double gap = fabs(t[4 * r + x] - pose[4 * r + x]);
+            error[3 + r] = pose[4 * a + x] * t[4 * b + x] - pose[4 * b + x] * t[4 * a + x];
+            size = gap > size ? gap : size;
+        }
+    }
+    if (DK_REFINE_TASK == 5) { /* the tool axis's component along the base axis */
+        const int e = 4 * DK_REFINE_CONE + DK_REFINE_AXIS;
+        error[3] = t[e] - pose[e];
+        size = fabs(error[3]) > size ? fabs(error[3]) : size;
+    }
+    if (DK_REFINE_TASK == 3) { /* minus the target point's offset from the ray, / reach */
+        const int x = DK_REFINE_AXIS;
+        double along = 0.0;
+        for (r = 0; r < 3; r++) {
+            along += (t[4 * r + 3] - pose[4 * r + 3]) * pose[4 * r + x];
+        }
+        for (r = 0; r < 3; r++) {
+            error[r] = -(t[4 * r + 3] - pose[4 * r + 3] - along * pose[4 * r + x]) / reach;
+        }
+        size = dk_ray_gap(pose, t, x) / reach;
+    }
+    return size;
+}
+
+/* The task error's Jacobian at pose (dk_chain_pose's axes and origins) into J, a column per
+   joint in solved: the geometric one, (z x (p - o) / reach, z) for a revolute joint's axis z
+   through o, (z / reach, 0) for a prismatic one, or the task's own rows (dk_task_column); a
+   joint whose bit is set in held (arm indices) gets a column of zeros */
+static void dk_task_jacobian(const double pose[12], const double axes[DK_REFINE_N][3],
+                             const double origins[DK_REFINE_N][3],
+                             const int revolute[DK_REFINE_N], const int solved[DK_REFINE_M],
+                             double reach, const double t[12], unsigned held,
+                             double J[6][DK_REFINE_M])
+{
+    int k, r;
+    for (k = 0; k < DK_REFINE_M; k++) {
+        const int j = solved[k];
+        const double *z = axes[j];
+        if (revolute[j]) {
+            const double dx = pose[3] - origins[j][0], dy = pose[7] - origins[j][1];
+            const double dz = pose[11] - origins[j][2];
+            J[0][k] = (z[1] * dz - z[2] * dy) / reach;
+            J[1][k] = (z[2] * dx - z[0] * dz) / reach;
+            J[2][k] = (z[0] * dy - z[1] * dx) / reach;
+            J[3][k] = z[0];
+            J[4][k] = z[1];
+            J[5][k] = z[2];
+        } else {
+            for (r = 0; r < 3; r++) {
+                J[r][k] = z[r] / reach;
+                J[3 + r][k] = 0.0;
+            }
+        }
+        if (DK_REFINE_TASK >= 2) {
+            dk_task_column(pose, t, J, k, revolute[j] ? z : NULL, reach);
+        }
+        if (held >> j & 1u) {
+            for (r = 0; r < 6; r++) {
+                J[r][k] = 0.0;
+            }
+        }
+    }
+}
+
+/* a step within this turns a joint's cos and sin by the angle-sum formulas, with their series
+   to d^7 (error d^8 / 40320: 1e-15 at the bound) for the step's */
+#define DK_REFINE_TURN (0.05)
+
+/* the joints in solved moved by step (its longest entry longest: shortened to
+   DK_REFINE_STRIDE), their cos and sin turned by the step where it is within DK_REFINE_TURN
+   (a nominal seed's first step can be 1e-3 to 1e-2 long: two library calls a joint saved) */
+static void dk_take_step(const int revolute[DK_REFINE_N], const int solved[DK_REFINE_M],
+                         const double step[DK_REFINE_M], double longest, double cur[DK_REFINE_N],
+                         double cs[DK_REFINE_N][2])
+{
+    int k;
+    for (k = 0; k < DK_REFINE_M; k++) {
+        const int j = solved[k];
+        const double d = longest > DK_REFINE_STRIDE ? step[k] * (DK_REFINE_STRIDE / longest)
+                                                    : step[k];
+        cur[j] += d;
+        if (revolute[j] && fabs(d) <= DK_REFINE_TURN) {
+            const double d2 = d * d;
+            const double cd = 1.0 - d2 / 2.0 * (1.0 - d2 / 12.0 * (1.0 - d2 / 30.0));
+            const double sd = d * (1.0 - d2 / 6.0 * (1.0 - d2 / 20.0 * (1.0 - d2 / 42.0)));
+            const double c0 = cs[j][0], s0 = cs[j][1];
+            cs[j][0] = c0 * cd - s0 * sd;
+            cs[j][1] = s0 * cd + c0 * sd;
+        } else if (revolute[j]) {
+            cs[j][0] = cos(cur[j]);
+            cs[j][1] = sin(cur[j]);
+        }
+    }
+}
+
 /* Newton's steps, damped by the error's square, on the chain of fixed frames (12 entries each:
    T(q) = F_0 J_1(q_1) F_1 ... J_n(q_n) F_n) towards the pose t (12 top entries), moving the
    joints in solved: q in place (the best point met); the pose error there (the largest
    rotation entry's difference, unless DK_REFINE_ROWS is 3; positions / reach). The joints'
    cos and sin follow the steps by the angle-sum formulas where a step is within
-   DK_REFINE_SMALL (a few terms of their series), and the last step (from an error within
+   DK_REFINE_TURN (dk_take_step), and the last step (from an error within
    DK_REFINE_LAST) reuses the previous step's Jacobian and factor where that step was within
    DK_REFINE_SMALL: its error is that error times the Jacobian's change, ~1e-13 or less; the
    two save two thirds of a seed's work (a nominal seed takes two steps). The joints whose bit
@@ -1472,73 +1650,9 @@ static double dk_refine(const double chain[DK_REFINE_N + 1][12], const int revol
     }
     for (it = 0; it < DK_REFINE_STEPS; it++) {
         double pose[12], axes[DK_REFINE_N][3], origins[DK_REFINE_N][3], error[6];
-        double step[DK_REFINE_M], size = 0.0, mu = 0.0, longest = 0.0;
-        for (k = 0; k < 12; k++) {
-            pose[k] = chain[0][k];
-        }
-        for (i = 0; i < DK_REFINE_N; i++) {
-            const double *f = chain[i + 1];
-            for (r = 0; r < 3; r++) {
-                axes[i][r] = pose[4 * r + 2];
-                origins[i][r] = pose[4 * r + 3];
-            }
-            if (revolute[i]) {
-                const double cq = cs[i][0], sq = cs[i][1];
-                for (r = 0; r < 3; r++) {
-                    const double x = pose[4 * r], y = pose[4 * r + 1];
-                    pose[4 * r] = cq * x + sq * y;
-                    pose[4 * r + 1] = cq * y - sq * x;
-                }
-            } else {
-                for (r = 0; r < 3; r++) {
-                    pose[4 * r + 3] += cur[i] * pose[4 * r + 2];
-                }
-            }
-            for (r = 0; r < 3; r++) { /* pose := pose F_{i+1} (unrolled: a fifth of the time) */
-                double *row = pose + 4 * r;
-                const double p0 = row[0], p1 = row[1], p2 = row[2];
-                row[0] = p0 * f[0] + p1 * f[4] + p2 * f[8];
-                row[1] = p0 * f[1] + p1 * f[5] + p2 * f[9];
-                row[2] = p0 * f[2] + p1 * f[6] + p2 * f[10];
-                row[3] = p0 * f[3] + p1 * f[7] + p2 * f[11] + row[3];
-            }
-        }
-        for (r = 0; r < 3; r++) {
-            int a = (r + 1) % 3, b = (r + 2) % 3;
-            double total = 0.0;
-            error[r] = DK_REFINE_TASK == 4 ? 0.0 : (t[4 * r + 3] - pose[4 * r + 3]) / reach;
-            size = fabs(error[r]) > size ? fabs(error[r]) : size;
-            for (k = 0; k < 3; k++) {
-                total += pose[4 * a + k] * t[4 * b + k] - pose[4 * b + k] * t[4 * a + k];
-                if (DK_REFINE_TASK == 0) {
-                    const double gap = fabs(t[4 * r + k] - pose[4 * r + k]);
-                    size = gap > size ? gap : size;
-                }
-            }
-            error[3 + r] = 0.5 * total;
-            if (DK_REFINE_TASK == 2 || DK_REFINE_TASK == 4) { /* u x t_u: u the tool axis */
-                const int x = DK_REFINE_AXIS;
-                const double gap = fabs(t[4 * r + x] - pose[4 * r + x]);
-                error[3 + r] = pose[4 * a + x] * t[4 * b + x] - pose[4 * b + x] * t[4 * a + x];
-                size = gap > size ? gap : size;
-            }
-        }
-        if (DK_REFINE_TASK == 5) { /* the tool axis's component along the base axis */
-            const int e = 4 * DK_REFINE_CONE + DK_REFINE_AXIS;
-            error[3] = t[e] - pose[e];
-            size = fabs(error[3]) > size ? fabs(error[3]) : size;
-        }
-        if (DK_REFINE_TASK == 3) { /* minus the target point's offset from the ray, / reach */
-            const int x = DK_REFINE_AXIS;
-            double along = 0.0;
-            for (r = 0; r < 3; r++) {
-                along += (t[4 * r + 3] - pose[4 * r + 3]) * pose[4 * r + x];
-            }
-            for (r = 0; r < 3; r++) {
-                error[r] = -(t[4 * r + 3] - pose[4 * r + 3] - along * pose[4 * r + x]) / reach;
-            }
-            size = dk_ray_gap(pose, t, x) / reach;
-        }
+        double step[DK_REFINE_M], size, mu = 0.0, longest = 0.0;
+        dk_chain_pose(chain, revolute, cur, (const double(*)[2])cs, pose, axes, origins);
+        size = dk_task_error(pose, t, reach, error);
         if (size < best) {
             best = size;
             worse = 0;
@@ -1585,33 +1699,8 @@ static double dk_refine(const double chain[DK_REFINE_N + 1][12], const int revol
             }
             longest = 0.0; /* (else a step of its own, from a Jacobian of its own) */
         }
-        for (k = 0; k < DK_REFINE_M; k++) {
-            const int j = solved[k];
-            const double *z = axes[j];
-            if (revolute[j]) {
-                const double dx = pose[3] - origins[j][0], dy = pose[7] - origins[j][1];
-                const double dz = pose[11] - origins[j][2];
-                J[0][k] = (z[1] * dz - z[2] * dy) / reach;
-                J[1][k] = (z[2] * dx - z[0] * dz) / reach;
-                J[2][k] = (z[0] * dy - z[1] * dx) / reach;
-                J[3][k] = z[0];
-                J[4][k] = z[1];
-                J[5][k] = z[2];
-            } else {
-                for (r = 0; r < 3; r++) {
-                    J[r][k] = z[r] / reach;
-                    J[3 + r][k] = 0.0;
-                }
-            }
-            if (DK_REFINE_TASK >= 2) {
-                dk_task_column(pose, t, J, k, revolute[j] ? z : NULL, reach);
-            }
-            if (held >> j & 1u) {
-                for (r = 0; r < 6; r++) {
-                    J[r][k] = 0.0;
-                }
-            }
-        }
+        dk_task_jacobian(pose, (const double(*)[3])axes, (const double(*)[3])origins, revolute,
+                         solved, reach, t, held, J);
         if (settle) {
             dk_qr_solve(J, error, step);
         } else {
@@ -1645,22 +1734,7 @@ static double dk_refine(const double chain[DK_REFINE_N + 1][12], const int revol
         if (!(longest < HUGE_VAL)) {
             break;
         }
-        for (k = 0; k < DK_REFINE_M; k++) {
-            const int j = solved[k];
-            const double d = longest > DK_REFINE_STRIDE ? step[k] * (DK_REFINE_STRIDE / longest)
-                                                        : step[k];
-            cur[j] += d;
-            if (revolute[j] && fabs(d) <= DK_REFINE_SMALL) { /* (cos, sin) turned by d */
-                const double d2 = d * d, cd = 1.0 - d2 / 2.0 * (1.0 - d2 / 12.0);
-                const double sd = d * (1.0 - d2 / 6.0 * (1.0 - d2 / 20.0));
-                const double c0 = cs[j][0], s0 = cs[j][1];
-                cs[j][0] = c0 * cd - s0 * sd;
-                cs[j][1] = s0 * cd + c0 * sd;
-            } else if (revolute[j]) {
-                cs[j][0] = cos(cur[j]);
-                cs[j][1] = sin(cur[j]);
-            }
-        }
+        dk_take_step(revolute, solved, step, longest, cur, cs);
         reused = longest;
         if (last && longest <= DK_REFINE_TRUST * size) { /* (Newton's step from there: the
                                                             error squared, not measured) */
