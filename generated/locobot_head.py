@@ -616,7 +616,26 @@ def ik(
     target = _pose(T)
     if max(abs(target[3]), abs(target[7]), abs(target[11])) > _FAR:
         return result(_finish([]))
-    return result(_finish(_ik_scalar(target, *solve, tol)))
+    return result(_finish(_solve(target, solve, tol)))
+
+
+def _solve(target, solve, tol):
+    """The Python solver's certified rows of target. On a nominal table (_SEED_TOL > 0: the
+    rows refined onto the exact chain) a pose the exact arm reaches can leave the nominal
+    closed form no seed near a singular configuration (an equation the nominal arm misses by
+    more than its seeds' bands there); where it gives no row, the seeds ik_approximate takes
+    (each equation solved at its boundary where it misses) whose pose error is within
+    _SEED_TOL are refined too (a pose out of reach gives seeds far from it: measured 0.026 or
+    more on a hextilt arm, where the seeds that reach the pose were within 2e-4), and kept
+    where certified (_seed)."""
+    rows = _ik_scalar(target, *solve, tol)
+    if rows or not _SEED_TOL:
+        return rows
+    _LOOSE.on = _LOOSE.near = True
+    try:
+        return _ik_scalar(target, *solve, tol)
+    finally:
+        _LOOSE.on = _LOOSE.near = False
 
 
 def ik_approximate(
@@ -1683,9 +1702,12 @@ def _newton(c: list[float] | np.ndarray, x: float) -> float:
 
 class _Loose(threading.local):
     """Per thread: whether the solver is seeding ik_approximate (then an equation that misses
-    is solved at its boundary, and a complex root gives its real part)."""
+    is solved at its boundary, and a complex root gives its real part); near: such seeds are
+    refined only where their pose error is within _SEED_TOL, and kept only where certified
+    (ik's second pass on a nominal table: derive/runtime/api.py, _solve)."""
 
     on = False
+    near = False
 
 
 _LOOSE = _Loose()
@@ -1710,6 +1732,8 @@ def _ray_gap(e, t, axis):
 
 
 def _free(t: float) -> _Free:
+    if _LOOSE.near:  # (ik's second pass: noise near a boundary, not a search of the free values)
+        return _Free([t])
     return _Free([t + step for step in _FREE_STEPS])
 
 

@@ -661,7 +661,26 @@ def ik(
     target = _pose(T)
     if max(abs(target[3]), abs(target[7]), abs(target[11])) > _FAR:
         return result(_finish([]))
-    return result(_finish(_ik_scalar(target, *solve, tol)))
+    return result(_finish(_solve(target, solve, tol)))
+
+
+def _solve(target, solve, tol):
+    """The Python solver's certified rows of target. On a nominal table (_SEED_TOL > 0: the
+    rows refined onto the exact chain) a pose the exact arm reaches can leave the nominal
+    closed form no seed near a singular configuration (an equation the nominal arm misses by
+    more than its seeds' bands there); where it gives no row, the seeds ik_approximate takes
+    (each equation solved at its boundary where it misses) whose pose error is within
+    _SEED_TOL are refined too (a pose out of reach gives seeds far from it: measured 0.026 or
+    more on a hextilt arm, where the seeds that reach the pose were within 2e-4), and kept
+    where certified (_seed)."""
+    rows = _ik_scalar(target, *solve, tol)
+    if rows or not _SEED_TOL:
+        return rows
+    _LOOSE.on = _LOOSE.near = True
+    try:
+        return _ik_scalar(target, *solve, tol)
+    finally:
+        _LOOSE.on = _LOOSE.near = False
 
 
 def ik_approximate(
@@ -1669,9 +1688,12 @@ def _kwrap(t: float) -> float:
 
 class _Loose(threading.local):
     """Per thread: whether the solver is seeding ik_approximate (then an equation that misses
-    is solved at its boundary, and a complex root gives its real part)."""
+    is solved at its boundary, and a complex root gives its real part); near: such seeds are
+    refined only where their pose error is within _SEED_TOL, and kept only where certified
+    (ik's second pass on a nominal table: derive/runtime/api.py, _solve)."""
 
     on = False
+    near = False
 
 
 _LOOSE = _Loose()
@@ -1700,6 +1722,8 @@ def _ray_gap(e, t, axis):
 
 
 def _free(t: float) -> _Free:
+    if _LOOSE.near:  # (ik's second pass: noise near a boundary, not a search of the free values)
+        return _Free([t])
     return _Free([t + step for step in _FREE_STEPS])
 
 
@@ -1718,7 +1742,10 @@ def _cs1(
 ) -> tuple[float, ...]:
     """Angles t with a cos t + b sin t = e: atan2(b, a) +- acos(e / sqrt(a^2 + b^2)), the
     acos argument clamped when it exceeds 1 by at most _CLAMP_TOL (and _SEED_MISS: a nominal
-    table's equation seeds the refinement onto the exact arm at its boundary; where
+    table's equation seeds the refinement onto the exact arm at its boundary, as it does where
+    |e| exceeds sqrt(a^2 + b^2) by at most _SEED_TOL sqrt(scale): the table's difference moves
+    e by about that, which near a singular configuration, a and b small, is far beyond
+    _SEED_MISS of the ratio: a hextilt arm's 0.0008 over 0.0092, 9%; where
     sqrt(a^2 + b^2) itself is within _SPREAD_WIDTH _SEED_TOL sqrt(scale), as where two links
     of nearly equal length fold back, _SPREAD_COUNT seeds all round; where the argument is
     near +-1, seeds either side of the fold, _FOLD_SEEDS), and taken as +-1 within _FOLD_TOL
@@ -1742,7 +1769,11 @@ def _cs1(
     if rho <= _SPREAD_WIDTH * _SEED_TOL * sqrt(scale) and not _LOOSE.on:
         return _all_round(atan2(b, a))  # (a nominal fold)
     ratio = e / rho
-    if abs(ratio) > 1.0 + _CLAMP_TOL + _SEED_MISS and not _LOOSE.on:
+    if (
+        abs(ratio) > 1.0 + _CLAMP_TOL + _SEED_MISS
+        and abs(e) - rho > _SEED_TOL * sqrt(scale)
+        and not _LOOSE.on
+    ):
         return ()
     base = atan2(b, a)
     if rest >= 0.0 and not _SEED_TOL:  # (a nominal table's fold keeps acos's: see _cs1x)

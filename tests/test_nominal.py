@@ -596,6 +596,46 @@ def test_a_wrist_singular_within_rounding_keeps_q_ref_s_free_joint(tmp_path):
                     assert max(gap[:, :3].max(), gap[:, 3].max() / module.REACH) <= 1e-10
 
 
+@needs_cc
+def test_a_task_arm_near_its_singular_configuration_is_answered(tmp_path):
+    """example-robot-data's hextilt flying arm (tests/data/urdf/SOURCES.md: five joints,
+    position + direction of the tool x axis; axes 1-3 parallel on the nominal table, pi/2
+    written 1.5708) near q4 = pi/2, where axis 5 is parallel to axes 1-3 (a new user's
+    attack: 9 of 200 poses 0.01 rad from there got no row). (a) An equation of the nominal
+    closed form, a cos + b sin = e with a and b small there (sqrt(a^2 + b^2) = 0.0092),
+    missed by 0.0008 (9% of it: beyond the relative band _SEED_BAND), where a cos + b sin
+    moves by the table's difference times its scale: it now seeds where the miss is within
+    _SEED_TOL of the scale too, in C and Python. (b) 1e-4 rad from there the nominal closed
+    form gives no seed at all; Python's second pass solves each equation at its boundary
+    (ik_approximate's seeds) and refines the seeds within _SEED_TOL of the pose (C has no
+    such pass: it answers nothing there, as before)."""
+    from derive import urdf
+    from derive.load import solver_sources
+
+    from conftest import import_path
+
+    path = Path(__file__).parent / "data" / "urdf" / "hextilt_flying_arm_5.urdf"
+    base, tip = "flying_arm_5__base_link", "flying_arm_5__gripper"
+    spec = urdf.load_urdf(path, urdf.Options(base=base, tip=tip))
+    for file, text in solver_sources(build_plan(spec)).items():
+        (tmp_path / file).write_text(text, encoding="utf-8")
+    module = import_path(tmp_path / f"{spec.name}.py")
+    assert module._SEED_TOL > 0.0  # (the nominal closed form, refined)
+    near = [1.3287403839903897, 0.23162178599699912, -0.734598188427157, 1.5807926535948966,
+            0.03920609479688619]  # fmt: skip
+    nearer = [0.47510992428080967, -0.0367204573588078, -1.5718792526051966,
+              1.5708926535948966, -0.7991661508491638]  # fmt: skip
+    for q, backends in ((near, ("c", "python")), (nearer, ("python",))):
+        T = module.fk(np.array(q))
+        for backend in backends:
+            rows = module.ik(T, backend=backend)
+            gaps = np.abs(np.remainder(rows - np.array(q) + math.pi, 2 * math.pi) - math.pi)
+            assert len(rows) and np.min(np.max(gaps, axis=1)) <= 1e-7, (backend, q, rows)
+            for row in rows:  # (the task's components: position over the reach, tool x)
+                gap = np.abs(module.fk(row) - T)[:3]
+                assert max(gap[:, 0].max(), gap[:, 3].max() / module.REACH) <= 1e-10
+
+
 def _objective(module, q: np.ndarray, T: np.ndarray) -> float:
     """Half the squared pose error ik_approximate minimises (derive/runtime/refine.py)."""
     E = module.fk(q)

@@ -1260,7 +1260,8 @@ static int dk_cs1x(dk_values *v, double a, double b, double e, double rest, doub
     }
     inverse = 1.0 / rho;
     ratio = e * inverse;
-    if (fabs(ratio) > 1.0 + DK_CLAMP_TOL + DK_SEED_MISS) {
+    if (fabs(ratio) > 1.0 + DK_CLAMP_TOL + DK_SEED_MISS &&
+        fabs(e) - rho > DK_SEED_TOL * sqrt(scale)) { /* (the Python _cs1 says why) */
         return 0;
     }
     if (rest >= 0.0 && DK_SEED_TOL == 0.0) { /* (a nominal table keeps acos's: see _cs1x) */

@@ -25,6 +25,7 @@ import math
 from derive.runtime.arm import (
     _CHAIN,
     _REVOLUTE,
+    _SEED_TOL,
     _SOLVED,
     CONE_AXIS,
     IK_COMPONENTS,
@@ -74,13 +75,15 @@ def _seed(found, t, q, tol, frees=()):
     near-null direction would otherwise carry it anywhere, away from q_ref)."""
     held = [i for values, i in frees if values.__class__ is _Free]
     limit = min(tol, _REFINE_TOL)
+    if _LOOSE.near and _pose_error(q, t, False)[2] > _SEED_TOL:
+        return  # (ik's second pass: a seed this far is a pose out of reach, not noise)
     if held:
         moved, size = _refine(q, t, held)
         if size <= limit:
             found.append(moved)
             return
     q, size = _refine(q, t)
-    if size <= limit or _LOOSE.on:  # (ik_approximate keeps every seed)
+    if size <= limit or (_LOOSE.on and not _LOOSE.near):  # (ik_approximate keeps every seed)
         found.append(q)
 
 

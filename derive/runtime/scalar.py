@@ -42,9 +42,12 @@ from derive.runtime.constants import (
 
 class _Loose(threading.local):
     """Per thread: whether the solver is seeding ik_approximate (then an equation that misses
-    is solved at its boundary, and a complex root gives its real part)."""
+    is solved at its boundary, and a complex root gives its real part); near: such seeds are
+    refined only where their pose error is within _SEED_TOL, and kept only where certified
+    (ik's second pass on a nominal table: derive/runtime/api.py, _solve)."""
 
     on = False
+    near = False
 
 
 _LOOSE = _Loose()
@@ -73,6 +76,8 @@ def _ray_gap(e, t, axis):
 
 
 def _free(t: float) -> _Free:
+    if _LOOSE.near:  # (ik's second pass: noise near a boundary, not a search of the free values)
+        return _Free([t])
     return _Free([t + step for step in _FREE_STEPS])
 
 
@@ -91,7 +96,10 @@ def _cs1(
 ) -> tuple[float, ...]:
     """Angles t with a cos t + b sin t = e: atan2(b, a) +- acos(e / sqrt(a^2 + b^2)), the
     acos argument clamped when it exceeds 1 by at most _CLAMP_TOL (and _SEED_MISS: a nominal
-    table's equation seeds the refinement onto the exact arm at its boundary; where
+    table's equation seeds the refinement onto the exact arm at its boundary, as it does where
+    |e| exceeds sqrt(a^2 + b^2) by at most _SEED_TOL sqrt(scale): the table's difference moves
+    e by about that, which near a singular configuration, a and b small, is far beyond
+    _SEED_MISS of the ratio: a hextilt arm's 0.0008 over 0.0092, 9%; where
     sqrt(a^2 + b^2) itself is within _SPREAD_WIDTH _SEED_TOL sqrt(scale), as where two links
     of nearly equal length fold back, _SPREAD_COUNT seeds all round; where the argument is
     near +-1, seeds either side of the fold, _FOLD_SEEDS), and taken as +-1 within _FOLD_TOL
@@ -115,7 +123,11 @@ def _cs1(
     if rho <= _SPREAD_WIDTH * _SEED_TOL * sqrt(scale) and not _LOOSE.on:
         return _all_round(atan2(b, a))  # (a nominal fold)
     ratio = e / rho
-    if abs(ratio) > 1.0 + _CLAMP_TOL + _SEED_MISS and not _LOOSE.on:
+    if (
+        abs(ratio) > 1.0 + _CLAMP_TOL + _SEED_MISS
+        and abs(e) - rho > _SEED_TOL * sqrt(scale)
+        and not _LOOSE.on
+    ):
         return ()
     base = atan2(b, a)
     if rest >= 0.0 and not _SEED_TOL:  # (a nominal table's fold keeps acos's: see _cs1x)

@@ -36,6 +36,11 @@ WANTED = (
     ("irb140", "rtb_data", "abb_irb140_description/urdf/irb140.urdf"),
     ("lbr_iiwa_14_r820", "rtb_data", "kuka_lbr_iiwa/urdf/lbr_iiwa_14_r820.urdf"),
     ("al5d", "rtb_data", "lynxmotion_al5d_description/urdf/al5d_robot.urdf"),
+    (
+        "hextilt_flying_arm_5",
+        "example_robot_data",
+        "robots/hextilt_description/urdf/hextilt_flying_arm_5.urdf",
+    ),
     ("xarm6", "pybullet", "pybullet_data/xarm/xarm6_robot.urdf"),
     ("locobot", "nav_planning", "nav_planning/resources/robot/locobot/locobot.urdf"),
 )
