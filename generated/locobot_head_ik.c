@@ -95,10 +95,12 @@ static const double DK_FREE_STEPS[DK_FREE_COUNT] = {
 
 /* The values of one joint: at most DK_VALUES_MAX (a polynomial's roots; a nominal fold's
    DK_SPREAD_COUNT seeds), or a free joint's DK_FREE_COUNT values stepped out from ref (one
-   value, ref, for a free length). */
+   value, ref, for a free length). loose, set by the caller on a nominal table (DK_SEED_TOL >
+   0; read only there): the solver's second pass (dk_cs1x says what it changes). */
 typedef struct {
     int n;
     int free;
+    int loose;
     double ref;
     double t[DK_VALUES_MAX], c[DK_VALUES_MAX], s[DK_VALUES_MAX];
 } dk_values;
@@ -1187,7 +1189,7 @@ static int dk_cs2_value(dk_values *v, double a1, double b1, double e1, double a2
 static void dk_wrist_spread(dk_values *v, double det, double det_scale)
 {
     const double width = DK_WRIST_WIDTH * DK_SEED_TOL;
-    if (DK_SEED_TOL > 0.0 && fabs(det) <= width * width * det_scale) {
+    if (DK_SEED_TOL > 0.0 && !v->loose && fabs(det) <= width * width * det_scale) {
         dk_all_round(v, v->t[0]);
     }
 }
@@ -2029,11 +2031,14 @@ static void dk_fk_q(const double q[DK_DOF], double e[12])
 }
 
 /* The certified solutions of the pose t (its 12 top entries) into found, before wrapping and
-   dropping repeats: their count, or DK_UNSETTLED. ref: q_ref's values (free joints': theirs). */
+   dropping repeats: their count, or DK_UNSETTLED. ref: q_ref's values (free joints': theirs).
+   loose: the second pass of a nominal table (DK_SEED_TOL > 0), where the first gave no row
+   (derive/runtime/api.py, _solve, says why, and derive/c/runtime.c, what changes). */
 static int dk_solve(const double t[12], double tol, const double ref[DK_DOF],
-                    double found[DK_MAX][DK_DOF], int *repeats)
+                    double found[DK_MAX][DK_DOF], int *repeats, int loose)
 {
     (void)ref;
+    (void)loose;
     double qr1 = ref[0];
     double qr2 = ref[1];
     double wx = t[3];
@@ -2342,7 +2347,10 @@ int locobot_head_ik_ref(const double T[16], const double *free, const double *q_
     {
         const double t[12] = {T[0], T[1], T[2],  T[3],  T[4],  T[5],
                               T[6], T[7], T[8],  T[9],  T[10], T[11]};
-        count = dk_solve(t, tol, ref, found, &repeats);
+        count = dk_solve(t, tol, ref, found, &repeats, 0);
+        if (count == 0 && DK_SEED_TOL > 0.0) { /* (a nominal table: the second pass) */
+            count = dk_solve(t, tol, ref, found, &repeats, 1);
+        }
     }
     if (count < 0) {
         return LOCOBOT_HEAD_UNSETTLED;

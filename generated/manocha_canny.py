@@ -719,18 +719,18 @@ def _solve(target, solve, tol):
     rows refined onto the exact chain) a pose the exact arm reaches can leave the nominal
     closed form no seed near a singular configuration (an equation the nominal arm misses by
     more than its seeds' bands there); where it gives no row, the seeds ik_approximate takes
-    (each equation solved at its boundary where it misses) whose pose error is within
+    (each a cos + b sin = e solved at its boundary where it misses) whose pose error is within
     _SEED_TOL are refined too (a pose out of reach gives seeds far from it: measured 0.026 or
     more on a hextilt arm, where the seeds that reach the pose were within 2e-4), and kept
-    where certified (_seed)."""
+    where certified (_seed). The C solver takes the same second pass (dk_solve, loose)."""
     rows = _ik_scalar(target, *solve, tol)
     if rows or not _SEED_TOL:
         return rows
-    _LOOSE.on = _LOOSE.near = True
+    _LOOSE.near = True
     try:
         return _ik_scalar(target, *solve, tol)
     finally:
-        _LOOSE.on = _LOOSE.near = False
+        _LOOSE.near = False
 
 
 def ik_approximate(
@@ -2555,10 +2555,13 @@ def _rr_solve_many(J, error, damped):
 
 
 class _Loose(threading.local):
-    """Per thread: whether the solver is seeding ik_approximate (then an equation that misses
-    is solved at its boundary, and a complex root gives its real part); near: such seeds are
-    refined only where their pose error is within _SEED_TOL, and kept only where certified
-    (ik's second pass on a nominal table: derive/runtime/api.py, _solve)."""
+    """Per thread: on, whether the solver is seeding ik_approximate (then an equation that
+    misses is solved at its boundary, and a complex root gives its real part); near, whether
+    it is taking ik's second pass on a nominal table (derive/runtime/api.py, _solve; C's
+    dk_solve with loose): then _cs1 solves at its boundary where it misses, neither _cs1 nor
+    _wrist_spread adds seeds round a fold, a free joint takes q_ref's value only, and the
+    seeds are refined only where their pose error is within _SEED_TOL, and kept where
+    certified (refine.py, _seed)."""
 
     on = False
     near = False

@@ -3459,11 +3459,14 @@ static void dk_fk_q(const double q[DK_DOF], double e[12])
 }
 
 /* The certified solutions of the pose t (its 12 top entries) into found, before wrapping and
-   dropping repeats: their count, or DK_UNSETTLED. ref: q_ref's values (free joints': theirs). */
+   dropping repeats: their count, or DK_UNSETTLED. ref: q_ref's values (free joints': theirs).
+   loose: the second pass of a nominal table (DK_SEED_TOL > 0), where the first gave no row
+   (derive/runtime/api.py, _solve, says why, and derive/c/runtime.c, what changes). */
 static int dk_solve(const double t[12], double tol, const double ref[DK_DOF],
-                    double found[DK_MAX][DK_DOF], int *repeats)
+                    double found[DK_MAX][DK_DOF], int *repeats, int loose)
 {
     (void)ref;
+    (void)loose;
     double w11 = t[0];
     double w12 = t[1];
     double w13 = t[2];
@@ -3932,7 +3935,10 @@ int manocha_canny_ik_ref(const double T[16], const double *free, const double *q
     {
         const double t[12] = {T[0], T[1], T[2],  T[3],  T[4],  T[5],
                               T[6], T[7], T[8],  T[9],  T[10], T[11]};
-        count = dk_solve(t, tol, ref, found, &repeats);
+        count = dk_solve(t, tol, ref, found, &repeats, 0);
+        if (count == 0 && DK_SEED_TOL > 0.0) { /* (a nominal table: the second pass) */
+            count = dk_solve(t, tol, ref, found, &repeats, 1);
+        }
     }
     if (count < 0) {
         return MANOCHA_CANNY_UNSETTLED;

@@ -115,10 +115,12 @@ static const double DK_FREE_STEPS[DK_FREE_COUNT] = {
 
 /* The values of one joint: at most DK_VALUES_MAX (a polynomial's roots; a nominal fold's
    DK_SPREAD_COUNT seeds), or a free joint's DK_FREE_COUNT values stepped out from ref (one
-   value, ref, for a free length). */
+   value, ref, for a free length). loose, set by the caller on a nominal table (DK_SEED_TOL >
+   0; read only there): the solver's second pass (dk_cs1x says what it changes). */
 typedef struct {
     int n;
     int free;
+    int loose;
     double ref;
     double t[DK_VALUES_MAX], c[DK_VALUES_MAX], s[DK_VALUES_MAX];
 } dk_values;
@@ -1222,26 +1224,37 @@ static int dk_cs1x(dk_values *v, double a, double b, double e, double rest, doub
        (an earlier joint's snapped double root leaves e 3e-11 off): the Python _cs1 */
     const int small = rho * rho <= DK_FREE_TOL * scale;
     const int free = DK_SEED_TOL > 0.0 ? small : rho * rho <= DK_FREE_TOL_EXACT * scale;
+    /* the second pass on a nominal table (the Python solver's _LOOSE.near): the equation
+       solved at its boundary where it misses, no seeds round a fold, a free joint at ref
+       only */
+    const int loose = DK_SEED_TOL > 0.0 && v->loose;
     v->n = 0;
     v->free = 0;
     v->ref = 0.0; /* (unread unless free; set so that no compiler sees it unset) */
     if (free || (small && fabs(e) > rho * (1.0 + DK_CLAMP_TOL))) {
-        if (e * e <= DK_FREE_TOL * scale) {
+        if (e * e <= DK_FREE_TOL * scale || loose) {
             dk_set_free(v, ref, 1);
+            v->n = loose ? 1 : v->n;
         }
         return 0;
     }
     if (rho == 0.0) {
+        if (loose) { /* (one value, ref: as the Python solver's (ref,)) */
+            v->n = 1;
+            v->t[0] = ref;
+            v->c[0] = cos(ref);
+            v->s[0] = sin(ref);
+        }
         return 0;
     }
-    if (rho <= DK_SPREAD_WIDTH * DK_SEED_TOL * sqrt(scale)) { /* a nominal fold: seeds all round */
-        dk_all_round(v, atan2(b, a));
+    if (rho <= DK_SPREAD_WIDTH * DK_SEED_TOL * sqrt(scale) && !loose) {
+        dk_all_round(v, atan2(b, a)); /* (a nominal fold: seeds all round) */
         return 0;
     }
     inverse = 1.0 / rho;
     ratio = e * inverse;
     if (fabs(ratio) > 1.0 + DK_CLAMP_TOL + DK_SEED_MISS &&
-        fabs(e) - rho > DK_SEED_TOL * sqrt(scale)) { /* (the Python _cs1 says why) */
+        fabs(e) - rho > DK_SEED_TOL * sqrt(scale) && !loose) { /* (the Python _cs1 says why) */
         return 0;
     }
     if (rest >= 0.0 && DK_SEED_TOL == 0.0) { /* (a nominal table keeps acos's: see _cs1x) */
@@ -1262,7 +1275,7 @@ static int dk_cs1x(dk_values *v, double a, double b, double e, double rest, doub
     v->s[1] = sb * ratio - cb * sd;
     /* (b = 0: (c, s) and (c, -s) exactly, and dk_uangle is odd in s: no second call) */
     v->t[1] = sb == 0.0 && sd > 0.0 ? -v->t[0] : dk_uangle(v->s[1], v->c[1]);
-    if (DK_SEED_TOL > 0.0 && fabs(ratio) > DK_FOLD_NEAR) {
+    if (DK_SEED_TOL > 0.0 && !loose && fabs(ratio) > DK_FOLD_NEAR) {
         /* a nominal fold: seeds either side of it (the Python solver's order) */
         const double fold = atan2(b, a) + (ratio > 0.0 ? 0.0 : DK_PI);
         int k;
@@ -1327,7 +1340,7 @@ static int dk_cs2_value(dk_values *v, double a1, double b1, double e1, double a2
 static void dk_wrist_spread(dk_values *v, double det, double det_scale)
 {
     const double width = DK_WRIST_WIDTH * DK_SEED_TOL;
-    if (DK_SEED_TOL > 0.0 && fabs(det) <= width * width * det_scale) {
+    if (DK_SEED_TOL > 0.0 && !v->loose && fabs(det) <= width * width * det_scale) {
         dk_all_round(v, v->t[0]);
     }
 }
@@ -2262,11 +2275,14 @@ static void dk_fk_q(const double q[DK_DOF], double e[12])
 }
 
 /* The certified solutions of the pose t (its 12 top entries) into found, before wrapping and
-   dropping repeats: their count, or DK_UNSETTLED. ref: q_ref's values (free joints': theirs). */
+   dropping repeats: their count, or DK_UNSETTLED. ref: q_ref's values (free joints': theirs).
+   loose: the second pass of a nominal table (DK_SEED_TOL > 0), where the first gave no row
+   (derive/runtime/api.py, _solve, says why, and derive/c/runtime.c, what changes). */
 static int dk_solve(const double t[12], double tol, const double ref[DK_DOF],
-                    double found[DK_MAX][DK_DOF], int *repeats)
+                    double found[DK_MAX][DK_DOF], int *repeats, int loose)
 {
     (void)ref;
+    (void)loose;
     double qr1 = ref[0];
     double qr3 = ref[2];
     double qr4 = ref[3];
@@ -2877,7 +2893,10 @@ int panda_ik_ref(const double T[16], const double *free, const double *q_ref, do
     {
         const double t[12] = {T[0], T[1], T[2],  T[3],  T[4],  T[5],
                               T[6], T[7], T[8],  T[9],  T[10], T[11]};
-        count = dk_solve(t, tol, ref, found, &repeats);
+        count = dk_solve(t, tol, ref, found, &repeats, 0);
+        if (count == 0 && DK_SEED_TOL > 0.0) { /* (a nominal table: the second pass) */
+            count = dk_solve(t, tol, ref, found, &repeats, 1);
+        }
     }
     if (count < 0) {
         return PANDA_UNSETTLED;

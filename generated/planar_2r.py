@@ -653,18 +653,18 @@ def _solve(target, solve, tol):
     rows refined onto the exact chain) a pose the exact arm reaches can leave the nominal
     closed form no seed near a singular configuration (an equation the nominal arm misses by
     more than its seeds' bands there); where it gives no row, the seeds ik_approximate takes
-    (each equation solved at its boundary where it misses) whose pose error is within
+    (each a cos + b sin = e solved at its boundary where it misses) whose pose error is within
     _SEED_TOL are refined too (a pose out of reach gives seeds far from it: measured 0.026 or
     more on a hextilt arm, where the seeds that reach the pose were within 2e-4), and kept
-    where certified (_seed)."""
+    where certified (_seed). The C solver takes the same second pass (dk_solve, loose)."""
     rows = _ik_scalar(target, *solve, tol)
     if rows or not _SEED_TOL:
         return rows
-    _LOOSE.on = _LOOSE.near = True
+    _LOOSE.near = True
     try:
         return _ik_scalar(target, *solve, tol)
     finally:
-        _LOOSE.on = _LOOSE.near = False
+        _LOOSE.near = False
 
 
 def ik_approximate(
@@ -1650,10 +1650,13 @@ def straight_line(A: ArrayLike, B: ArrayLike, n: int) -> np.ndarray:
 
 
 class _Loose(threading.local):
-    """Per thread: whether the solver is seeding ik_approximate (then an equation that misses
-    is solved at its boundary, and a complex root gives its real part); near: such seeds are
-    refined only where their pose error is within _SEED_TOL, and kept only where certified
-    (ik's second pass on a nominal table: derive/runtime/api.py, _solve)."""
+    """Per thread: on, whether the solver is seeding ik_approximate (then an equation that
+    misses is solved at its boundary, and a complex root gives its real part); near, whether
+    it is taking ik's second pass on a nominal table (derive/runtime/api.py, _solve; C's
+    dk_solve with loose): then _cs1 solves at its boundary where it misses, neither _cs1 nor
+    _wrist_spread adds seeds round a fold, a free joint takes q_ref's value only, and the
+    seeds are refined only where their pose error is within _SEED_TOL, and kept where
+    certified (refine.py, _seed)."""
 
     on = False
     near = False
@@ -1715,17 +1718,18 @@ def _cs1(
     rho = sqrt(a * a + b * b)
     small = rho * rho <= _FREE_TOL * scale
     free = small if _SEED_TOL else rho * rho <= _FREE_TOL_EXACT * scale
-    if free or (small and abs(e) > rho * (1.0 + _CLAMP_TOL)):  # (ik_approximate: any seed)
-        return _free(ref) if e * e <= _FREE_TOL * scale or _LOOSE.on else ()
+    loose = _LOOSE.on or _LOOSE.near  # (ik_approximate's seeds, or ik's second pass)
+    if free or (small and abs(e) > rho * (1.0 + _CLAMP_TOL)):  # (loose: any seed)
+        return _free(ref) if e * e <= _FREE_TOL * scale or loose else ()
     if rho == 0.0:
-        return (ref,) if _LOOSE.on else ()
-    if rho <= _SPREAD_WIDTH * _SEED_TOL * sqrt(scale) and not _LOOSE.on:
+        return (ref,) if loose else ()
+    if rho <= _SPREAD_WIDTH * _SEED_TOL * sqrt(scale) and not loose:
         return _all_round(atan2(b, a))  # (a nominal fold)
     ratio = e / rho
     if (
         abs(ratio) > 1.0 + _CLAMP_TOL + _SEED_MISS
         and abs(e) - rho > _SEED_TOL * sqrt(scale)
-        and not _LOOSE.on
+        and not loose
     ):
         return ()
     base = atan2(b, a)
@@ -1735,7 +1739,7 @@ def _cs1(
         delta = 0.0 if ratio > 0.0 else math.pi
     else:
         delta = acos(ratio)
-    if _SEED_TOL and not _LOOSE.on and abs(ratio) > _FOLD_NEAR:
+    if _SEED_TOL and not loose and abs(ratio) > _FOLD_NEAR:
         fold = base if ratio > 0.0 else base + math.pi  # (a nominal fold: seeds either side)
         sides = tuple(fold + s * d for d in _FOLD_SEEDS for s in (1.0, -1.0))
         if delta in (0.0, math.pi):  # (the double root once, not twice)
@@ -1773,7 +1777,8 @@ def _wrist_spread(t: float, det: float, det_scale: float) -> tuple[float, ...]:
     det_scale) within _WRIST_WIDTH _SEED_TOL: the wrist nearly straight, where the arm's
     difference moves t anywhere) t and _SPREAD_COUNT - 1 more seeds all round, as _cs1's
     nominal fold (a calibrated UR5 at q5 = 1.5e-4 got t 0.77 rad off and no row)."""
-    if _SEED_TOL and not _LOOSE.on and abs(det) <= (_WRIST_WIDTH * _SEED_TOL) ** 2 * det_scale:
+    loose = _LOOSE.on or _LOOSE.near
+    if _SEED_TOL and not loose and abs(det) <= (_WRIST_WIDTH * _SEED_TOL) ** 2 * det_scale:
         return _all_round(t)
     return (t,)
 

@@ -64,10 +64,12 @@ static const double DK_FREE_STEPS[DK_FREE_COUNT] = {
 
 /* The values of one joint: at most DK_VALUES_MAX (a polynomial's roots; a nominal fold's
    DK_SPREAD_COUNT seeds), or a free joint's DK_FREE_COUNT values stepped out from ref (one
-   value, ref, for a free length). */
+   value, ref, for a free length). loose, set by the caller on a nominal table (DK_SEED_TOL >
+   0; read only there): the solver's second pass (dk_cs1x says what it changes). */
 typedef struct {
     int n;
     int free;
+    int loose;
     double ref;
     double t[DK_VALUES_MAX], c[DK_VALUES_MAX], s[DK_VALUES_MAX];
 } dk_values;
@@ -1242,26 +1244,37 @@ static int dk_cs1x(dk_values *v, double a, double b, double e, double rest, doub
        (an earlier joint's snapped double root leaves e 3e-11 off): the Python _cs1 */
     const int small = rho * rho <= DK_FREE_TOL * scale;
     const int free = DK_SEED_TOL > 0.0 ? small : rho * rho <= DK_FREE_TOL_EXACT * scale;
+    /* the second pass on a nominal table (the Python solver's _LOOSE.near): the equation
+       solved at its boundary where it misses, no seeds round a fold, a free joint at ref
+       only */
+    const int loose = DK_SEED_TOL > 0.0 && v->loose;
     v->n = 0;
     v->free = 0;
     v->ref = 0.0; /* (unread unless free; set so that no compiler sees it unset) */
     if (free || (small && fabs(e) > rho * (1.0 + DK_CLAMP_TOL))) {
-        if (e * e <= DK_FREE_TOL * scale) {
+        if (e * e <= DK_FREE_TOL * scale || loose) {
             dk_set_free(v, ref, 1);
+            v->n = loose ? 1 : v->n;
         }
         return 0;
     }
     if (rho == 0.0) {
+        if (loose) { /* (one value, ref: as the Python solver's (ref,)) */
+            v->n = 1;
+            v->t[0] = ref;
+            v->c[0] = cos(ref);
+            v->s[0] = sin(ref);
+        }
         return 0;
     }
-    if (rho <= DK_SPREAD_WIDTH * DK_SEED_TOL * sqrt(scale)) { /* a nominal fold: seeds all round */
-        dk_all_round(v, atan2(b, a));
+    if (rho <= DK_SPREAD_WIDTH * DK_SEED_TOL * sqrt(scale) && !loose) {
+        dk_all_round(v, atan2(b, a)); /* (a nominal fold: seeds all round) */
         return 0;
     }
     inverse = 1.0 / rho;
     ratio = e * inverse;
     if (fabs(ratio) > 1.0 + DK_CLAMP_TOL + DK_SEED_MISS &&
-        fabs(e) - rho > DK_SEED_TOL * sqrt(scale)) { /* (the Python _cs1 says why) */
+        fabs(e) - rho > DK_SEED_TOL * sqrt(scale) && !loose) { /* (the Python _cs1 says why) */
         return 0;
     }
     if (rest >= 0.0 && DK_SEED_TOL == 0.0) { /* (a nominal table keeps acos's: see _cs1x) */
@@ -1282,7 +1295,7 @@ static int dk_cs1x(dk_values *v, double a, double b, double e, double rest, doub
     v->s[1] = sb * ratio - cb * sd;
     /* (b = 0: (c, s) and (c, -s) exactly, and dk_uangle is odd in s: no second call) */
     v->t[1] = sb == 0.0 && sd > 0.0 ? -v->t[0] : dk_uangle(v->s[1], v->c[1]);
-    if (DK_SEED_TOL > 0.0 && fabs(ratio) > DK_FOLD_NEAR) {
+    if (DK_SEED_TOL > 0.0 && !loose && fabs(ratio) > DK_FOLD_NEAR) {
         /* a nominal fold: seeds either side of it (the Python solver's order) */
         const double fold = atan2(b, a) + (ratio > 0.0 ? 0.0 : DK_PI);
         int k;
@@ -1399,7 +1412,7 @@ static int dk_cs2_value(dk_values *v, double a1, double b1, double e1, double a2
 static void dk_wrist_spread(dk_values *v, double det, double det_scale)
 {
     const double width = DK_WRIST_WIDTH * DK_SEED_TOL;
-    if (DK_SEED_TOL > 0.0 && fabs(det) <= width * width * det_scale) {
+    if (DK_SEED_TOL > 0.0 && !v->loose && fabs(det) <= width * width * det_scale) {
         dk_all_round(v, v->t[0]);
     }
 }
@@ -2129,6 +2142,24 @@ static double dk_chord(const double chain[DK_REFINE_N + 1][12], const int revolu
         }
     }
     return HUGE_VAL;
+}
+
+/* whether the pose of the chain at q is within DK_SEED_TOL of the target t (the task's
+   error): the solver's second pass refines only such seeds (a pose out of reach gives seeds
+   far from it; the Python solver's _seed, with _LOOSE.near) */
+static int dk_seed_near(const double chain[DK_REFINE_N + 1][12],
+                        const int revolute[DK_REFINE_N], double reach, const double t[12],
+                        const double q[DK_REFINE_N])
+{
+    double cs[DK_REFINE_N][2], pose[12], axes[DK_REFINE_N][3], origins[DK_REFINE_N][3];
+    double error[6];
+    int i;
+    for (i = 0; i < DK_REFINE_N; i++) {
+        cs[i][0] = cos(q[i]);
+        cs[i][1] = sin(q[i]);
+    }
+    dk_chain_pose(chain, revolute, q, (const double(*)[2])cs, pose, axes, origins);
+    return dk_task_error(pose, t, reach, error) <= DK_SEED_TOL;
 }
 
 /* dk_refine of a nominal solution q, the joints in held (a bit per arm joint: those the pose

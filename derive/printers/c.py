@@ -305,6 +305,8 @@ def solve_lines(plan: Plan) -> tuple[tuple[int, str], ...]:
         if call.before:
             body.append(Line(depth, call.before))
         body.append(Line(depth, f"dk_values dk_v{j};"))
+        if fix:  # (the second pass's flag: derive/c/runtime.c dk_values)
+            body.append(Line(depth, f"dk_v{j}.loose = loose;"))
         solve = f"{call.routine}(&dk_v{j}, {', '.join(call.args)}) < 0"
         if flip and j in flip[1:]:  # the second theta5 branch: the first's turned by pi
             body.append(Line(depth, "if (dk_flip) {"))
@@ -381,10 +383,12 @@ def solve_lines(plan: Plan) -> tuple[tuple[int, str], ...]:
         # (the joints the pose left free, held first: derive/c/runtime.c dk_refine_held)
         body.append(Line(depth + 1, f"const unsigned dk_held = {held or '0u'};"))
         body.append(Line(depth + 1, "const double dk_limit = fmin(tol, DK_REFINE_TOL);"))
+        # (the second pass refines only the seeds near the pose: dk_seed_near)
         body.append(
             Line(
                 depth + 1,
-                "if (dk_refine_held(DK_CHAIN, DK_REVOLUTE, DK_SOLVED, DK_REACH, t, dk_q, dk_held, "
+                "if ((!loose || dk_seed_near(DK_CHAIN, DK_REVOLUTE, DK_REACH, t, dk_q)) && "
+                "dk_refine_held(DK_CHAIN, DK_REVOLUTE, DK_SOLVED, DK_REACH, t, dk_q, dk_held, "
                 "dk_limit) <= dk_limit && !dk_seen((const double(*)[DK_DOF])found, n, DK_REVOLUTE, "
                 "dk_q)) {",
             )

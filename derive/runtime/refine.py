@@ -83,7 +83,7 @@ def _seed(found, t, q, tol, frees=()):
             found.append(moved)
             return
     q, size = _refine(q, t)
-    if size <= limit or (_LOOSE.on and not _LOOSE.near):  # (ik_approximate keeps every seed)
+    if size <= limit or _LOOSE.on:  # (ik_approximate keeps every seed)
         found.append(q)
 
 
