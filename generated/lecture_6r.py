@@ -212,12 +212,27 @@ _RESIDUAL_TOL = 1e-8
 _MERGE_TOL = 1e-6
 
 
+# ... two merged roots whose mean leaves the polynomial above this times its largest
+# coefficient are two roots, not one split by rounding (the split of a double root by
+# coefficients eps * max|p_k| off is about 2 sqrt(eps max|p_k| / |lead|); at four times that,
+# p(mean) = lead (gap / 2)^2 is 16 eps max|p_k|): they follow their mean (_accept)
+_SPLIT_TOL = 16 * 2.220446049250313e-16
+
+
 _CLUSTER_TOL = 1e-3
 
 
 # a cos + b sin = e with |e| up to (1 + _CLAMP_TOL) sqrt(a^2 + b^2) is solved at the boundary:
 # earlier joints from a double root (elbow stretched) carry errors of ~1e-8
 _CLAMP_TOL = 1e-7
+
+
+# ... and so is one with |e| up to sqrt(a^2 + b^2) + _CLAMP_ABS sqrt(scale), the equation's own
+# size: a small a and b make the ratio sensitive beyond _CLAMP_TOL to an earlier joint's error
+# (a Solo12 leg's knee 3e-7 from folded back: its angle from a root 1.5e-7 of 1/u, 7e-5 off
+# in the last places of its constant term, and the hip's equation then missed by 3e-11 of its
+# scale, 2.3e-4 of its ratio); a row from such a miss is certified as any other
+_CLAMP_ABS = 1e-10
 
 
 # ... and from |e| down to (1 - _FOLD_TOL) sqrt(a^2 + b^2) as the double root acos(+-1): there
@@ -1696,6 +1711,15 @@ def _small_residual(p: list[float] | np.ndarray, x: float) -> bool:
     )
 
 
+def _two_roots(p: list[float] | np.ndarray, x: float) -> bool:
+    """Whether the mean x of two close roots of p leaves p above _SPLIT_TOL of its largest
+    coefficient: two roots, not a double root split by rounding."""
+    value = 0.0
+    for k in p:
+        value = value * x + k
+    return abs(value) > _SPLIT_TOL * max(abs(k) for k in p)
+
+
 def _newton(c: list[float] | np.ndarray, x: float) -> float:
     """Two Newton steps on the polynomial c (highest degree first), skipped if unstable."""
     for _ in range(2):
@@ -1770,8 +1794,9 @@ def _cs1(
     a: float, b: float, e: float, scale: float = 0.0, ref: float = 0.0, rest: float = -1.0
 ) -> tuple[float, ...]:
     """Angles t with a cos t + b sin t = e: atan2(b, a) +- acos(e / sqrt(a^2 + b^2)), the
-    acos argument clamped when it exceeds 1 by at most _CLAMP_TOL (and _SEED_MISS: a nominal
-    table's equation seeds the refinement onto the exact arm at its boundary, as it does where
+    acos argument clamped when it exceeds 1 by at most _CLAMP_TOL, or |e| exceeds
+    sqrt(a^2 + b^2) by at most _CLAMP_ABS sqrt(scale) (and _SEED_MISS: a nominal table's
+    equation seeds the refinement onto the exact arm at its boundary, as it does where
     |e| exceeds sqrt(a^2 + b^2) by at most _SEED_TOL sqrt(scale): the table's difference moves
     e by about that, which near a singular configuration, a and b small, is far beyond
     _SEED_MISS of the ratio: a hextilt arm's 0.0008 over 0.0092, 9%; where
@@ -1801,7 +1826,7 @@ def _cs1(
     ratio = e / rho
     if (
         abs(ratio) > 1.0 + _CLAMP_TOL + _SEED_MISS
-        and abs(e) - rho > _SEED_TOL * sqrt(scale)
+        and abs(e) - rho > max(_SEED_TOL, _CLAMP_ABS) * sqrt(scale)
         and not loose
     ):
         return ()
@@ -1942,7 +1967,10 @@ def _accept(p: list[float], zs: list[complex], check: bool = True) -> list[float
     """Polished real parts of the near-real zs; None if one fails the residual test.
 
     A double root comes out split, as a complex pair or as two reals about sqrt(eps) apart;
-    roots closer than _MERGE_TOL are replaced by their mean, which is accurate. A root of
+    roots closer than _MERGE_TOL give their mean, which is accurate, and where the mean is
+    farther from a root than rounding splits one (_SPLIT_TOL), themselves after it: two roots
+    that close can be two (a finger's knee within 1e-6 of folded back: 1/u's roots 1e-7 to
+    5e-7 apart, and 76 of 200 such positions got no row from the mean alone). A root of
     multiplicity k splits by about eps^(1/k) (1e-4 for k = 4) into a cluster, not all real,
     whose mean is accurate too: such a cluster within _CLUSTER_TOL gives its mean. Merged
     roots and cluster means are not Newton-polished: at a multiple root p and p' both
@@ -1968,14 +1996,19 @@ def _accept(p: list[float], zs: list[complex], check: bool = True) -> list[float
     k = 0
     while k < len(xs):
         x, simple = xs[k]
+        pair: tuple[float, ...] = ()
         if k + 1 < len(xs) and xs[k + 1][0] - x <= _MERGE_TOL * (1.0 + abs(x)):
-            x = 0.5 * (x + xs[k + 1][0])
+            mean = 0.5 * (x + xs[k + 1][0])
+            if _two_roots(p, mean):  # (not one split by rounding: they follow their mean)
+                pair = (x, xs[k + 1][0])
+            x = mean
             k += 1
         elif simple:
             x = _newton(p, x)
         if check and not _small_residual(p, x):
             return None
         out.append(x)
+        out.extend(pair)
         k += 1
     if _SEED_TOL or _LOOSE.on:  # a nominal table's near-double root, split by the arm's
         # difference (or any complex root, seeding ik_approximate)

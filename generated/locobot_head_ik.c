@@ -17,7 +17,7 @@
 /* the size of the polynomial steps' arrays: the most roots one of this arm's polynomials has */
 #define DK_POLY_MAX 4
 /* the most values one joint's step gives (the polynomials' roots; a nominal fold's seeds) */
-#define DK_VALUES_MAX 4
+#define DK_VALUES_MAX 6
 /* how far the solver's equations may miss and still seed a refinement onto the exact chain
    (0: the closed form solves the arm's own table) */
 #define DK_SEED_TOL (0.0)
@@ -46,6 +46,8 @@
 #define DK_CLUSTER_TOL (0.001)
 
 #define DK_MERGE_TOL (1e-06)
+
+#define DK_SPLIT_TOL (3.552713678800501e-15)
 
 #define DK_RESIDUAL_TOL (1e-08)
 
@@ -795,6 +797,20 @@ static int dk_small_residual(const double *p, int d, double x)
            fabs(value) <= DK_RESIDUAL_TOL * (1.0 + ax) * fabs(slope);
 }
 
+/* whether the mean x of two close roots of p (degree d) leaves p above DK_SPLIT_TOL of its
+   largest coefficient: two roots, not a double root split by rounding (the Python
+   _two_roots) */
+static int dk_two_roots(const double *p, int d, double x)
+{
+    double value = 0.0, size = 0.0;
+    int k;
+    for (k = 0; k <= d; k++) {
+        value = value * x + p[k];
+        size = fmax(size, fabs(p[k]));
+    }
+    return fabs(value) > DK_SPLIT_TOL * size;
+}
+
 /* two Newton steps on p (highest degree first), skipped if unstable */
 static double dk_newton(const double *p, int d, double x)
 {
@@ -892,8 +908,10 @@ static int dk_accept(const double *p, int d, const dk_cx *zs, int m, int check, 
     }
     for (k = 0; k < n; k++) {
         double x = xs[k];
+        int pair = 0;
         if (k + 1 < n && xs[k + 1] - x <= DK_MERGE_TOL * (1.0 + fabs(x))) {
             x = 0.5 * (x + xs[k + 1]);
+            pair = dk_two_roots(p, d, x);
             k++;
         } else if (simple[k]) {
             x = dk_newton(p, d, x);
@@ -902,6 +920,10 @@ static int dk_accept(const double *p, int d, const dk_cx *zs, int m, int check, 
             return -1;
         }
         out[count++] = x;
+        if (pair) { /* (two roots, not one split: they follow their mean; _accept) */
+            out[count++] = xs[k - 1];
+            out[count++] = xs[k];
+        }
     }
     if (DK_SEED_TOL > 0.0) { /* a nominal near-double root, split by the arm's difference */
         const double near = sqrt(DK_SEED_TOL);

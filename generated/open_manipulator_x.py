@@ -209,6 +209,14 @@ DEDUP_TOL = 1e-6
 _CLAMP_TOL = 1e-7
 
 
+# ... and so is one with |e| up to sqrt(a^2 + b^2) + _CLAMP_ABS sqrt(scale), the equation's own
+# size: a small a and b make the ratio sensitive beyond _CLAMP_TOL to an earlier joint's error
+# (a Solo12 leg's knee 3e-7 from folded back: its angle from a root 1.5e-7 of 1/u, 7e-5 off
+# in the last places of its constant term, and the hip's equation then missed by 3e-11 of its
+# scale, 2.3e-4 of its ratio); a row from such a miss is certified as any other
+_CLAMP_ABS = 1e-10
+
+
 # ... and from |e| down to (1 - _FOLD_TOL) sqrt(a^2 + b^2) as the double root acos(+-1): there
 # the angle moves by up to acos(1 - _FOLD_TOL) ~ 1.4e-7 while the equation's residual stays
 # below _FOLD_TOL sqrt(a^2 + b^2), and every backend gives the same value (acos near +-1 turns
@@ -1742,8 +1750,9 @@ def _cs1(
     a: float, b: float, e: float, scale: float = 0.0, ref: float = 0.0, rest: float = -1.0
 ) -> tuple[float, ...]:
     """Angles t with a cos t + b sin t = e: atan2(b, a) +- acos(e / sqrt(a^2 + b^2)), the
-    acos argument clamped when it exceeds 1 by at most _CLAMP_TOL (and _SEED_MISS: a nominal
-    table's equation seeds the refinement onto the exact arm at its boundary, as it does where
+    acos argument clamped when it exceeds 1 by at most _CLAMP_TOL, or |e| exceeds
+    sqrt(a^2 + b^2) by at most _CLAMP_ABS sqrt(scale) (and _SEED_MISS: a nominal table's
+    equation seeds the refinement onto the exact arm at its boundary, as it does where
     |e| exceeds sqrt(a^2 + b^2) by at most _SEED_TOL sqrt(scale): the table's difference moves
     e by about that, which near a singular configuration, a and b small, is far beyond
     _SEED_MISS of the ratio: a hextilt arm's 0.0008 over 0.0092, 9%; where
@@ -1773,7 +1782,7 @@ def _cs1(
     ratio = e / rho
     if (
         abs(ratio) > 1.0 + _CLAMP_TOL + _SEED_MISS
-        and abs(e) - rho > _SEED_TOL * sqrt(scale)
+        and abs(e) - rho > max(_SEED_TOL, _CLAMP_ABS) * sqrt(scale)
         and not loose
     ):
         return ()

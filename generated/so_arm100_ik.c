@@ -17,7 +17,7 @@
 /* the size of the polynomial steps' arrays: the most roots one of this arm's polynomials has */
 #define DK_POLY_MAX 4
 /* the most values one joint's step gives (the polynomials' roots; a nominal fold's seeds) */
-#define DK_VALUES_MAX 4
+#define DK_VALUES_MAX 6
 /* how far the solver's equations may miss and still seed a refinement onto the exact chain
    (0: the closed form solves the arm's own table) */
 #define DK_SEED_TOL (0.0)
@@ -40,6 +40,8 @@
 #define DK_FREE_TOL_EXACT (1e-20)
 
 #define DK_CLAMP_TOL (1e-07)
+
+#define DK_CLAMP_ABS (1e-10)
 
 #define DK_FOLD_TOL (1e-14)
 
@@ -694,7 +696,8 @@ static int dk_cs1x(dk_values *v, double a, double b, double e, double rest, doub
     inverse = 1.0 / rho;
     ratio = e * inverse;
     if (fabs(ratio) > 1.0 + DK_CLAMP_TOL + DK_SEED_MISS &&
-        fabs(e) - rho > DK_SEED_TOL * sqrt(scale) && !loose) { /* (the Python _cs1 says why) */
+        fabs(e) - rho > fmax(DK_SEED_TOL, DK_CLAMP_ABS) * sqrt(scale) && !loose) {
+        /* (the Python _cs1 says why) */
         return 0;
     }
     if (rest >= 0.0 && DK_SEED_TOL == 0.0) { /* (a nominal table keeps acos's: see _cs1x) */

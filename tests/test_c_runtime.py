@@ -56,8 +56,8 @@ def table(text: str, name: str) -> np.ndarray:
 def test_the_c_runtime_holds_the_python_runtimes_constants():
     runtime, gen = c_text("runtime.c"), c_text("general.c")
     found = defines(runtime)
-    tolerances = ("FREE_TOL", "FREE_TOL_EXACT", "CLAMP_TOL", "FOLD_TOL", "LEAD_TOL")
-    for name in (*tolerances, "ROOT_IMAG_TOL", "MERGE_TOL"):
+    tolerances = ("FREE_TOL", "FREE_TOL_EXACT", "CLAMP_TOL", "CLAMP_ABS", "FOLD_TOL", "LEAD_TOL")
+    for name in (*tolerances, "ROOT_IMAG_TOL", "MERGE_TOL", "SPLIT_TOL"):
         assert float(found[f"DK_{name}"]) == getattr(constants, f"_{name}"), name
     for name in ("CLUSTER_TOL", "RESIDUAL_TOL", "SEAM", "SEAM_SNAP", "BRANCH_FOLD", "FOLD_NEAR"):
         assert float(found[f"DK_{name}"]) == getattr(constants, f"_{name}"), name

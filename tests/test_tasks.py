@@ -295,6 +295,43 @@ def test_so_arm100_with_its_roll_near_90_deg_is_answered(generated, backend):
             assert np.max(gaps, axis=1).min() <= 1e-13 / eps, (eps, q)
 
 
+@needs_cc
+def test_a_three_joint_finger_nearly_folded_back_is_answered(tmp_path):
+    """example-robot-data's finger_edu (tests/data/urdf/SOURCES.md: three joints, solved for
+    its tip's position) with its lower link within 1e-6 of folded back, the tip 1e-7 from the
+    middle joint's axis (a new user's attack): the knee's polynomial in 1/u then has two real
+    roots 1e-7 to 5e-7 apart, which _accept merged into their mean, and 77 and 76 of 200
+    positions 3e-7 and 1e-6 from there got no row (in C and Python: the mean is no root); and
+    where a root's last places are off (7e-5 of a constant term 2.3e-15), the hip's equation
+    missed by 3e-11 of its scale. The two roots now follow their mean, and such a miss within
+    _CLAMP_ABS of the equation's scale is solved at its boundary: 40 positions at each of
+    1e-7, 3e-7 and 1e-6, each answered by both solvers, every row reproducing the position to
+    1e-10 of the reach."""
+    from derive import urdf
+    from derive.load import solver_sources
+
+    from conftest import import_path
+
+    path = Path(__file__).parent / "data" / "urdf" / "finger_edu.urdf"
+    spec = urdf.load_urdf(path, urdf.Options(base="base_link", tip="finger_tip_link"))
+    for file, text in solver_sources(build_plan(spec)).items():
+        (tmp_path / file).write_text(text, encoding="utf-8")
+    module = import_path(tmp_path / f"{spec.name}.py")
+    assert module.IK_COMPONENTS == "position"
+    rng = np.random.default_rng(9)
+    lo, hi = np.array(module.LIMITS).T
+    for delta in (1e-7, 3e-7, 1e-6):
+        Q = rng.uniform(np.maximum(lo, -3.0), np.minimum(hi, 3.0), (40, 3))
+        Q[:, 2] = math.pi - delta
+        for q in Q:
+            p = module.fk(q)[:3, 3]
+            for backend in ("c", "python"):
+                rows = module.ik_position(p, backend=backend)
+                assert len(rows), (delta, q, backend)
+                gaps = [np.abs(module.fk(r)[:3, 3] - p).max() / module.REACH for r in rows]
+                assert max(gaps) <= 1e-10, (delta, q, backend)
+
+
 FIVE_R_ROWS = [(0, 0, 0.3, 0), (90, 0.05, 0, 0), (0, 0.35, 0, 0), (0, 0.3, 0.02, 0)]
 FIVE_R_ROWS += [(90, 0, 0.12, 0)]
 

@@ -11,11 +11,13 @@
 #define DK_FREE_TOL (1e-14)
 #define DK_FREE_TOL_EXACT (1e-20)
 #define DK_CLAMP_TOL (1e-07)
+#define DK_CLAMP_ABS (1e-10)
 #define DK_FOLD_TOL (1e-14)
 #define DK_LEAD_TOL (1e-10)
 #define DK_ROOT_IMAG_TOL (1e-06)
 #define DK_CLUSTER_TOL (0.001)
 #define DK_MERGE_TOL (1e-06)
+#define DK_SPLIT_TOL (3.552713678800501e-15)
 #define DK_RESIDUAL_TOL (1e-08)
 #define DK_DEDUP_TOL (1e-06)
 #define DK_POSE_TOL (1e-06)
@@ -881,6 +883,20 @@ static int dk_small_residual(const double *p, int d, double x)
            fabs(value) <= DK_RESIDUAL_TOL * (1.0 + ax) * fabs(slope);
 }
 
+/* whether the mean x of two close roots of p (degree d) leaves p above DK_SPLIT_TOL of its
+   largest coefficient: two roots, not a double root split by rounding (the Python
+   _two_roots) */
+static int dk_two_roots(const double *p, int d, double x)
+{
+    double value = 0.0, size = 0.0;
+    int k;
+    for (k = 0; k <= d; k++) {
+        value = value * x + p[k];
+        size = fmax(size, fabs(p[k]));
+    }
+    return fabs(value) > DK_SPLIT_TOL * size;
+}
+
 /* two Newton steps on p (highest degree first), skipped if unstable */
 static double dk_newton(const double *p, int d, double x)
 {
@@ -978,8 +994,10 @@ static int dk_accept(const double *p, int d, const dk_cx *zs, int m, int check, 
     }
     for (k = 0; k < n; k++) {
         double x = xs[k];
+        int pair = 0;
         if (k + 1 < n && xs[k + 1] - x <= DK_MERGE_TOL * (1.0 + fabs(x))) {
             x = 0.5 * (x + xs[k + 1]);
+            pair = dk_two_roots(p, d, x);
             k++;
         } else if (simple[k]) {
             x = dk_newton(p, d, x);
@@ -988,6 +1006,10 @@ static int dk_accept(const double *p, int d, const dk_cx *zs, int m, int check, 
             return -1;
         }
         out[count++] = x;
+        if (pair) { /* (two roots, not one split: they follow their mean; _accept) */
+            out[count++] = xs[k - 1];
+            out[count++] = xs[k];
+        }
     }
     if (DK_SEED_TOL > 0.0) { /* a nominal near-double root, split by the arm's difference */
         const double near = sqrt(DK_SEED_TOL);
@@ -1274,7 +1296,8 @@ static int dk_cs1x(dk_values *v, double a, double b, double e, double rest, doub
     inverse = 1.0 / rho;
     ratio = e * inverse;
     if (fabs(ratio) > 1.0 + DK_CLAMP_TOL + DK_SEED_MISS &&
-        fabs(e) - rho > DK_SEED_TOL * sqrt(scale) && !loose) { /* (the Python _cs1 says why) */
+        fabs(e) - rho > fmax(DK_SEED_TOL, DK_CLAMP_ABS) * sqrt(scale) && !loose) {
+        /* (the Python _cs1 says why) */
         return 0;
     }
     if (rest >= 0.0 && DK_SEED_TOL == 0.0) { /* (a nominal table keeps acos's: see _cs1x) */

@@ -10,7 +10,7 @@ from math import atan2, cos, sin, sqrt
 
 import numpy as np
 
-from derive.runtime.constants import _FREE_STEPS, _OMEGA, _RESIDUAL_TOL, _TWO_PI
+from derive.runtime.constants import _FREE_STEPS, _OMEGA, _RESIDUAL_TOL, _SPLIT_TOL, _TWO_PI
 
 
 def _reach_first1(m00, m01, m02, m10, m11, m12, m20, m21, m22, lo, hi, ref):
@@ -164,6 +164,15 @@ def _small_residual(p: list[float] | np.ndarray, x: float) -> bool:
     return abs(value) <= _RESIDUAL_TOL * size or abs(value) <= _RESIDUAL_TOL * (1.0 + ax) * abs(
         slope
     )
+
+
+def _two_roots(p: list[float] | np.ndarray, x: float) -> bool:
+    """Whether the mean x of two close roots of p leaves p above _SPLIT_TOL of its largest
+    coefficient: two roots, not a double root split by rounding."""
+    value = 0.0
+    for k in p:
+        value = value * x + k
+    return abs(value) > _SPLIT_TOL * max(abs(k) for k in p)
 
 
 def _newton(c: list[float] | np.ndarray, x: float) -> float:

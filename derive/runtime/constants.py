@@ -11,10 +11,21 @@ DEDUP_TOL = 1e-6
 _ROOT_IMAG_TOL = 1e-6
 _RESIDUAL_TOL = 1e-8
 _MERGE_TOL = 1e-6
+# ... two merged roots whose mean leaves the polynomial above this times its largest
+# coefficient are two roots, not one split by rounding (the split of a double root by
+# coefficients eps * max|p_k| off is about 2 sqrt(eps max|p_k| / |lead|); at four times that,
+# p(mean) = lead (gap / 2)^2 is 16 eps max|p_k|): they follow their mean (_accept)
+_SPLIT_TOL = 16 * 2.220446049250313e-16
 _CLUSTER_TOL = 1e-3
 # a cos + b sin = e with |e| up to (1 + _CLAMP_TOL) sqrt(a^2 + b^2) is solved at the boundary:
 # earlier joints from a double root (elbow stretched) carry errors of ~1e-8
 _CLAMP_TOL = 1e-7
+# ... and so is one with |e| up to sqrt(a^2 + b^2) + _CLAMP_ABS sqrt(scale), the equation's own
+# size: a small a and b make the ratio sensitive beyond _CLAMP_TOL to an earlier joint's error
+# (a Solo12 leg's knee 3e-7 from folded back: its angle from a root 1.5e-7 of 1/u, 7e-5 off
+# in the last places of its constant term, and the hip's equation then missed by 3e-11 of its
+# scale, 2.3e-4 of its ratio); a row from such a miss is certified as any other
+_CLAMP_ABS = 1e-10
 # ... and from |e| down to (1 - _FOLD_TOL) sqrt(a^2 + b^2) as the double root acos(+-1): there
 # the angle moves by up to acos(1 - _FOLD_TOL) ~ 1.4e-7 while the equation's residual stays
 # below _FOLD_TOL sqrt(a^2 + b^2), and every backend gives the same value (acos near +-1 turns

@@ -17,10 +17,12 @@ from derive.runtime.closed import (
     _reach_first1,
     _reach_first2,
     _small_residual,
+    _two_roots,
 )
 from derive.runtime.common import _wrap
 from derive.runtime.constants import (
     _BRANCH_FOLD,
+    _CLAMP_ABS,
     _CLAMP_TOL,
     _CLUSTER_TOL,
     _FOLD_NEAR,
@@ -98,8 +100,9 @@ def _cs1(
     a: float, b: float, e: float, scale: float = 0.0, ref: float = 0.0, rest: float = -1.0
 ) -> tuple[float, ...]:
     """Angles t with a cos t + b sin t = e: atan2(b, a) +- acos(e / sqrt(a^2 + b^2)), the
-    acos argument clamped when it exceeds 1 by at most _CLAMP_TOL (and _SEED_MISS: a nominal
-    table's equation seeds the refinement onto the exact arm at its boundary, as it does where
+    acos argument clamped when it exceeds 1 by at most _CLAMP_TOL, or |e| exceeds
+    sqrt(a^2 + b^2) by at most _CLAMP_ABS sqrt(scale) (and _SEED_MISS: a nominal table's
+    equation seeds the refinement onto the exact arm at its boundary, as it does where
     |e| exceeds sqrt(a^2 + b^2) by at most _SEED_TOL sqrt(scale): the table's difference moves
     e by about that, which near a singular configuration, a and b small, is far beyond
     _SEED_MISS of the ratio: a hextilt arm's 0.0008 over 0.0092, 9%; where
@@ -129,7 +132,7 @@ def _cs1(
     ratio = e / rho
     if (
         abs(ratio) > 1.0 + _CLAMP_TOL + _SEED_MISS
-        and abs(e) - rho > _SEED_TOL * sqrt(scale)
+        and abs(e) - rho > max(_SEED_TOL, _CLAMP_ABS) * sqrt(scale)
         and not loose
     ):
         return ()
@@ -353,7 +356,10 @@ def _accept(p: list[float], zs: list[complex], check: bool = True) -> list[float
     """Polished real parts of the near-real zs; None if one fails the residual test.
 
     A double root comes out split, as a complex pair or as two reals about sqrt(eps) apart;
-    roots closer than _MERGE_TOL are replaced by their mean, which is accurate. A root of
+    roots closer than _MERGE_TOL give their mean, which is accurate, and where the mean is
+    farther from a root than rounding splits one (_SPLIT_TOL), themselves after it: two roots
+    that close can be two (a finger's knee within 1e-6 of folded back: 1/u's roots 1e-7 to
+    5e-7 apart, and 76 of 200 such positions got no row from the mean alone). A root of
     multiplicity k splits by about eps^(1/k) (1e-4 for k = 4) into a cluster, not all real,
     whose mean is accurate too: such a cluster within _CLUSTER_TOL gives its mean. Merged
     roots and cluster means are not Newton-polished: at a multiple root p and p' both
@@ -379,14 +385,19 @@ def _accept(p: list[float], zs: list[complex], check: bool = True) -> list[float
     k = 0
     while k < len(xs):
         x, simple = xs[k]
+        pair: tuple[float, ...] = ()
         if k + 1 < len(xs) and xs[k + 1][0] - x <= _MERGE_TOL * (1.0 + abs(x)):
-            x = 0.5 * (x + xs[k + 1][0])
+            mean = 0.5 * (x + xs[k + 1][0])
+            if _two_roots(p, mean):  # (not one split by rounding: they follow their mean)
+                pair = (x, xs[k + 1][0])
+            x = mean
             k += 1
         elif simple:
             x = _newton(p, x)
         if check and not _small_residual(p, x):
             return None
         out.append(x)
+        out.extend(pair)
         k += 1
     if _SEED_TOL or _LOOSE.on:  # a nominal table's near-double root, split by the arm's
         # difference (or any complex root, seeding ik_approximate)

@@ -36,6 +36,7 @@ WANTED = (
     ("irb140", "rtb_data", "abb_irb140_description/urdf/irb140.urdf"),
     ("lbr_iiwa_14_r820", "rtb_data", "kuka_lbr_iiwa/urdf/lbr_iiwa_14_r820.urdf"),
     ("al5d", "rtb_data", "lynxmotion_al5d_description/urdf/al5d_robot.urdf"),
+    ("finger_edu", "example_robot_data", "robots/finger_edu_description/robots/finger_edu.urdf"),
     (
         "hextilt_flying_arm_5",
         "example_robot_data",
