@@ -262,10 +262,7 @@ def render_c(plan: Plan) -> dict[str, str]:
         "m": printed,
         "generator": GENERATOR,
         "poly_max": poly_max(plan),
-        # (a polynomial's values: its roots, and the two of each pair merged (dk_accept))
-        "values_max": max(
-            poly_max(plan) * 3 // 2, constants._SPREAD_COUNT if plan.correction else 0
-        ),
+        "values_max": max(poly_max(plan), constants._SPREAD_COUNT if plan.correction else 0),
         "arm_general": general,
     }
     arm = env.get_template("arm.c.j2")

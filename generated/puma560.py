@@ -214,7 +214,7 @@ _MERGE_TOL = 1e-6
 # ... two merged roots whose mean leaves the polynomial above this times its largest
 # coefficient are two roots, not one split by rounding (the split of a double root by
 # coefficients eps * max|p_k| off is about 2 sqrt(eps max|p_k| / |lead|); at four times that,
-# p(mean) = lead (gap / 2)^2 is 16 eps max|p_k|): they follow their mean (_accept)
+# p(mean) = lead (gap / 2)^2 is 16 eps max|p_k|): both are kept, not their mean (_accept)
 _SPLIT_TOL = 16 * 2.220446049250313e-16
 
 
@@ -1966,10 +1966,11 @@ def _accept(p: list[float], zs: list[complex], check: bool = True) -> list[float
     """Polished real parts of the near-real zs; None if one fails the residual test.
 
     A double root comes out split, as a complex pair or as two reals about sqrt(eps) apart;
-    roots closer than _MERGE_TOL give their mean, which is accurate, and where the mean is
-    farther from a root than rounding splits one (_SPLIT_TOL), themselves after it: two roots
-    that close can be two (a finger's knee within 1e-6 of folded back: 1/u's roots 1e-7 to
-    5e-7 apart, and 76 of 200 such positions got no row from the mean alone). A root of
+    roots closer than _MERGE_TOL give their mean, which is accurate, unless the mean is
+    farther from a root than rounding splits one (_SPLIT_TOL): two roots that close can be
+    two, and are kept (a finger's knee within 1e-6 of folded back: 1/u's roots 1e-7 to 5e-7
+    apart, and 76 of 200 such positions got no row from the mean alone; with the mean as well,
+    its row at the fold, within 1e-13 of the pose, took the place of a root's at dedup). A root of
     multiplicity k splits by about eps^(1/k) (1e-4 for k = 4) into a cluster, not all real,
     whose mean is accurate too: such a cluster within _CLUSTER_TOL gives its mean. Merged
     roots and cluster means are not Newton-polished: at a multiple root p and p' both
@@ -1995,19 +1996,21 @@ def _accept(p: list[float], zs: list[complex], check: bool = True) -> list[float
     k = 0
     while k < len(xs):
         x, simple = xs[k]
-        pair: tuple[float, ...] = ()
         if k + 1 < len(xs) and xs[k + 1][0] - x <= _MERGE_TOL * (1.0 + abs(x)):
-            mean = 0.5 * (x + xs[k + 1][0])
-            if _two_roots(p, mean):  # (not one split by rounding: they follow their mean)
-                pair = (x, xs[k + 1][0])
-            x = mean
+            y = xs[k + 1][0]
             k += 1
+            if _two_roots(p, 0.5 * (x + y)):  # (two roots, not one split by rounding: both)
+                if check and not (_small_residual(p, x) and _small_residual(p, y)):
+                    return None
+                out += [x, y]
+                k += 1
+                continue
+            x = 0.5 * (x + y)
         elif simple:
             x = _newton(p, x)
         if check and not _small_residual(p, x):
             return None
         out.append(x)
-        out.extend(pair)
         k += 1
     if _SEED_TOL or _LOOSE.on:  # a nominal table's near-double root, split by the arm's
         # difference (or any complex root, seeding ik_approximate)

@@ -17,7 +17,7 @@
 /* the size of the polynomial steps' arrays: the most roots one of this arm's polynomials has */
 #define DK_POLY_MAX 4
 /* the most values one joint's step gives (the polynomials' roots; a nominal fold's seeds) */
-#define DK_VALUES_MAX 6
+#define DK_VALUES_MAX 4
 /* how far the solver's equations may miss and still seed a refinement onto the exact chain
    (0: the closed form solves the arm's own table) */
 #define DK_SEED_TOL (0.0)

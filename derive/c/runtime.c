@@ -994,11 +994,18 @@ static int dk_accept(const double *p, int d, const dk_cx *zs, int m, int check, 
     }
     for (k = 0; k < n; k++) {
         double x = xs[k];
-        int pair = 0;
         if (k + 1 < n && xs[k + 1] - x <= DK_MERGE_TOL * (1.0 + fabs(x))) {
-            x = 0.5 * (x + xs[k + 1]);
-            pair = dk_two_roots(p, d, x);
-            k++;
+            const double y = xs[++k];
+            if (dk_two_roots(p, d, 0.5 * (x + y))) { /* (two roots, not one split by
+                rounding: both; the Python _accept) */
+                if (check && !(dk_small_residual(p, d, x) && dk_small_residual(p, d, y))) {
+                    return -1;
+                }
+                out[count++] = x;
+                out[count++] = y;
+                continue;
+            }
+            x = 0.5 * (x + y);
         } else if (simple[k]) {
             x = dk_newton(p, d, x);
         }
@@ -1006,10 +1013,6 @@ static int dk_accept(const double *p, int d, const dk_cx *zs, int m, int check, 
             return -1;
         }
         out[count++] = x;
-        if (pair) { /* (two roots, not one split: they follow their mean; _accept) */
-            out[count++] = xs[k - 1];
-            out[count++] = xs[k];
-        }
     }
     if (DK_SEED_TOL > 0.0) { /* a nominal near-double root, split by the arm's difference */
         const double near = sqrt(DK_SEED_TOL);

@@ -14,7 +14,7 @@ _MERGE_TOL = 1e-6
 # ... two merged roots whose mean leaves the polynomial above this times its largest
 # coefficient are two roots, not one split by rounding (the split of a double root by
 # coefficients eps * max|p_k| off is about 2 sqrt(eps max|p_k| / |lead|); at four times that,
-# p(mean) = lead (gap / 2)^2 is 16 eps max|p_k|): they follow their mean (_accept)
+# p(mean) = lead (gap / 2)^2 is 16 eps max|p_k|): both are kept, not their mean (_accept)
 _SPLIT_TOL = 16 * 2.220446049250313e-16
 _CLUSTER_TOL = 1e-3
 # a cos + b sin = e with |e| up to (1 + _CLAMP_TOL) sqrt(a^2 + b^2) is solved at the boundary:
