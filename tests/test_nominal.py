@@ -636,6 +636,29 @@ def test_a_task_arm_near_its_singular_configuration_is_answered(tmp_path):
                 assert max(gap[:, 0].max(), gap[:, 3].max() / module.REACH) <= 1e-10
 
 
+@needs_cc
+def test_c_keeps_both_rows_of_a_calibrated_pair_near_the_elbow_s_fold(tmp_path):
+    """A calibrated Staubli TX2-90 (tests/data/specs/tx2_90_cal.toml, a new user's: every
+    alpha and theta moved by up to 0.02 deg, a and d by up to 0.2 mm) 0.037 rad from its elbow's
+    fold (sigma_min 4e-3, a regular sample): Python answered 2 rows, the sampled vector one of
+    them, and C one, 0.074 rad from it, after C's refinement took chord steps (undamped Newton
+    steps with one factor) first: from one of the pair's seeds they went to the other's row.
+    Those steps are gone; C's damped steps keep both, as Python's do."""
+    path = Path(__file__).parent / "data" / "specs" / "tx2_90_cal.toml"
+    module = build_module(path.read_text(encoding="utf-8"), tmp_path, c=True)
+    for q in (
+        [3.1232532945474976, 1.733100979428724, -0.03752701012562058, 3.0502035923300936,
+         -1.1655873658588392, -2.2286303369054],
+        [3.1232504437855217, 1.6959688361192322, 0.03673562983668521, 3.048655041760597,
+         -1.1286159289214304, -2.2248719494172615],
+    ):  # fmt: skip
+        T = module.fk(np.array(q))
+        c_rows, rows = (module.ik(T, backend=b) for b in ("c", "python"))
+        assert c_rows.shape == rows.shape and np.allclose(c_rows, rows, atol=1e-9), q
+        gaps = np.abs(np.remainder(rows - np.array(q) + math.pi, 2 * math.pi) - math.pi)
+        assert np.min(np.max(gaps, axis=1)) <= 1e-9, q
+
+
 def _objective(module, q: np.ndarray, T: np.ndarray) -> float:
     """Half the squared pose error ik_approximate minimises (derive/runtime/refine.py)."""
     E = module.fk(q)

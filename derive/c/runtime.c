@@ -2039,137 +2039,6 @@ static double dk_refine(const double chain[DK_REFINE_N + 1][12], const int revol
     return best;
 }
 
-/* Newton's steps that keep their Jacobian's factor while it serves (chord steps): a seed
-   within DK_CHORD_START of a solution (a nominal solution of a calibrated arm, 1e-4 to 1e-3
-   off) is taken there by Newton's step, and then by steps with the same Jacobian, factored
-   once (LU, partial pivoting; the task's rows are as many as the joints moved), each of which
-   multiplies the error by about the Jacobian's change along the way; a step that does not
-   divide the error by 1 / DK_CHORD_RATE is followed by a Newton step (a new factor). A seed
-   takes three measured steps and one factor where dk_refine takes two Jacobians, their normal
-   equations and two factors. At most DK_CHORD_STEPS steps, each reducing the error, the
-   pivots above DK_CHORD_PIVOT of the Jacobian's largest entry; else HUGE_VAL, and the caller
-   takes dk_refine's steps from the seed (a seed near a singular configuration, or far). q in
-   place, as dk_refine: the error measured before the last step (within DK_REFINE_LAST). */
-#define DK_CHORD_START (1e-2)
-#define DK_CHORD_RATE (1e-2)
-#define DK_CHORD_STEPS 8
-#define DK_CHORD_PIVOT (1e-6)
-
-/* J (the first DK_REFINE_M rows) := L U, rows swapped as pivot says, L's unit diagonal not
-   held, U's diagonal held as its reciprocals; 0 where a pivot is within DK_CHORD_PIVOT of the
-   largest entry */
-static int dk_lu(double J[6][DK_REFINE_M], int pivot[DK_REFINE_M])
-{
-    double largest = 0.0;
-    int i, r, k;
-    for (r = 0; r < DK_REFINE_M; r++) {
-        for (k = 0; k < DK_REFINE_M; k++) {
-            largest = fabs(J[r][k]) > largest ? fabs(J[r][k]) : largest;
-        }
-    }
-    for (k = 0; k < DK_REFINE_M; k++) {
-        int p = k;
-        for (r = k + 1; r < DK_REFINE_M; r++) {
-            p = fabs(J[r][k]) > fabs(J[p][k]) ? r : p;
-        }
-        if (!(fabs(J[p][k]) > DK_CHORD_PIVOT * largest)) {
-            return 0;
-        }
-        pivot[k] = p;
-        for (i = 0; i < DK_REFINE_M; i++) {
-            const double swap = J[k][i];
-            J[k][i] = J[p][i];
-            J[p][i] = swap;
-        }
-        J[k][k] = 1.0 / J[k][k];
-        for (r = k + 1; r < DK_REFINE_M; r++) {
-            const double l = J[r][k] * J[k][k];
-            J[r][k] = l;
-            for (i = k + 1; i < DK_REFINE_M; i++) {
-                J[r][i] -= l * J[k][i];
-            }
-        }
-    }
-    return 1;
-}
-
-/* x := J^-1 e for dk_lu's factor of J (e is reordered); the longest entry of x returned */
-static double dk_lu_solve(const double J[6][DK_REFINE_M], const int pivot[DK_REFINE_M],
-                          double e[6], double x[DK_REFINE_M])
-{
-    double longest = 0.0;
-    int r, k;
-    for (k = 0; k < DK_REFINE_M; k++) {
-        const double swap = e[pivot[k]];
-        e[pivot[k]] = e[k];
-        e[k] = swap;
-    }
-    for (r = 0; r < DK_REFINE_M; r++) { /* L y = P e */
-        double v = e[r];
-        for (k = 0; k < r; k++) {
-            v -= J[r][k] * x[k];
-        }
-        x[r] = v;
-    }
-    for (r = DK_REFINE_M - 1; r >= 0; r--) { /* U x = y */
-        double v = x[r];
-        for (k = r + 1; k < DK_REFINE_M; k++) {
-            v -= J[r][k] * x[k];
-        }
-        x[r] = v * J[r][r];
-        longest = fabs(x[r]) > longest ? fabs(x[r]) : longest;
-    }
-    return longest;
-}
-
-static double dk_chord(const double chain[DK_REFINE_N + 1][12], const int revolute[DK_REFINE_N],
-                       const int solved[DK_REFINE_M], double reach, const double t[12],
-                       double q[DK_REFINE_N])
-{
-    double cur[DK_REFINE_N], cs[DK_REFINE_N][2], J[6][DK_REFINE_M], last = DK_CHORD_START;
-    int pivot[DK_REFINE_M], it, i, fresh = 0;
-    if (DK_REFINE_ROWS != DK_REFINE_M) {
-        return HUGE_VAL;
-    }
-    for (i = 0; i < DK_REFINE_N; i++) {
-        cur[i] = q[i];
-        cs[i][0] = cos(q[i]);
-        cs[i][1] = sin(q[i]);
-    }
-    for (it = 0; it < DK_CHORD_STEPS; it++) {
-        double pose[12], axes[DK_REFINE_N][3], origins[DK_REFINE_N][3], error[6];
-        double step[DK_REFINE_M], size, longest;
-        dk_chain_pose(chain, revolute, cur, (const double(*)[2])cs, pose, axes, origins);
-        size = dk_task_error(pose, t, reach, error);
-        if (!(it == 0 ? size <= last : size < last)) {
-            return HUGE_VAL;
-        }
-        if (it == 0 || (size > DK_CHORD_RATE * last && !fresh)) { /* (a Newton step) */
-            dk_task_jacobian(pose, (const double(*)[3])axes, (const double(*)[3])origins,
-                             revolute, solved, reach, t, 0u, J);
-            if (!dk_lu(J, pivot)) {
-                return HUGE_VAL;
-            }
-            fresh = 1;
-        } else {
-            fresh = 0;
-        }
-        last = size;
-        longest = dk_lu_solve((const double(*)[DK_REFINE_M])J, pivot, error, step);
-        if (size <= DK_REFINE_LAST && !(longest <= DK_REFINE_TRUST * size)) {
-            return HUGE_VAL;
-        }
-        dk_take_step(revolute, solved, step, longest, cur, cs);
-        if (size <= DK_REFINE_LAST) { /* (the step from there: the error squared, unmeasured) */
-            for (i = 0; i < DK_REFINE_N; i++) {
-                q[i] = cur[i];
-            }
-            return size;
-        }
-    }
-    return HUGE_VAL;
-}
-
 /* whether the pose of the chain at q is within DK_SEED_TOL of the target t (the task's
    error): the solver's second pass refines only such seeds (a pose out of reach gives seeds
    far from it; the Python solver's _seed, with _LOOSE.near) */
@@ -2192,7 +2061,7 @@ static int dk_seed_near(const double chain[DK_REFINE_N + 1][12],
    left free on the nominal table, at q_ref's value or a step from it) first held there, and
    moved too only where holding does not reach limit (on the exact arm, nearly singular there,
    Newton's steps along the near-null direction would otherwise carry them anywhere, away from
-   q_ref): the Python solver's _seed. A seed with no joint held tries dk_chord's steps first. */
+   q_ref): the Python solver's _seed. */
 static double dk_refine_held(const double chain[DK_REFINE_N + 1][12],
                              const int revolute[DK_REFINE_N], const int solved[DK_REFINE_M],
                              double reach, const double t[12], double q[DK_REFINE_N],
@@ -2205,17 +2074,6 @@ static double dk_refine_held(const double chain[DK_REFINE_N + 1][12],
             kept[i] = q[i];
         }
         size = dk_refine(chain, revolute, solved, reach, t, q, held);
-        if (size <= limit) {
-            return size;
-        }
-        for (i = 0; i < DK_REFINE_N; i++) {
-            q[i] = kept[i];
-        }
-    } else {
-        for (i = 0; i < DK_REFINE_N; i++) {
-            kept[i] = q[i];
-        }
-        size = dk_chord(chain, revolute, solved, reach, t, q);
         if (size <= limit) {
             return size;
         }

@@ -13,9 +13,7 @@ revolute joint, (z_i / REACH, 0) for a prismatic one; only the joints in _SOLVED
 joints keep the caller's values). The C solver's dk_refine takes the same steps, but turns
 the joints' cos and sin by their series after a small step and takes the last step (from an
 error within _REFINE_LAST) with the step before's Jacobian and factor: the two agree to
-~1e-13. Before them the C solver tries chord steps (dk_chord: Newton's step, then steps with
-the same factor while each divides the error by 100), which reach the same solution from a
-nominal seed with one factor instead of two; a seed they do not take there gets dk_refine's.
+~1e-13.
 """
 
 from __future__ import annotations
