@@ -65,6 +65,7 @@ def build_plan(spec: ArmSpec, method: str | None = None) -> Plan:
     ik, refusal = choose(chain, structure, spec.free, closed, task, tol)
     correction = None
     facts = structure.describe(chain.dof)
+    far = ""  # (a nominal table too far from the arm to refine from)
     if ik is None and closed:
         near = nominal(spec, tol)
         if near.changes:
@@ -79,13 +80,15 @@ def build_plan(spec: ArmSpec, method: str | None = None) -> Plan:
                         f"{fact} (nominal table)" for fact in near_structure.describe(chain.dof)
                     )
                 else:  # (snapping that far changes the arm: its seeds would not reach)
-                    refusal = (
+                    far = refusal = (
                         f"the table within structure_tol {tol:g} of a special one moves the "
                         f"arm by {fix.deviation:.3g} (at most {NOMINAL_MAX:g} is refined)"
                     )
     if ik is None and general.NAME in names:
         ik, why = choose(chain, structure, spec.free, (general.NAME,), task, tol)
         reasons = [r for r in (refusal, why) if r]
+        if ik is not None and far:  # (the summary says why the nominal one was not used)
+            facts = (*facts, far)
         refusal = "; ".join(dict.fromkeys(reasons)) if ik is None else ""
     if correction is None and spec.exact is not None:
         # the table is the nominal one of the [exact] frames (a URDF's, snapped)

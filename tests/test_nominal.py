@@ -721,6 +721,11 @@ def test_a_structure_tol_that_moves_the_arm_far_is_not_refined_from():
     plan = build_plan(spec, method="three-parallel")  # (the general method would answer)
     assert plan.ik is None and plan.correction is None
     assert "moves the arm by" in plan.refusal and "at most 0.01 is refined" in plan.refusal
+    # the general method answers, and the summary says why the nominal table did not (a new
+    # user's attack: its line said only "no three consecutive axes meet or are parallel")
+    plan = build_plan(spec)
+    assert plan.ik is not None and plan.ik.method == "general" and plan.correction is None
+    assert any("moves the arm by" in fact for fact in plan.structure), plan.structure
 
 
 def test_structure_tol_of_the_wrong_type_says_so():
