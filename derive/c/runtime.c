@@ -2061,7 +2061,7 @@ static int dk_seed_near(const double chain[DK_REFINE_N + 1][12],
    left free on the nominal table, at q_ref's value or a step from it) first held there, and
    moved too only where holding does not reach limit (on the exact arm, nearly singular there,
    Newton's steps along the near-null direction would otherwise carry them anywhere, away from
-   q_ref): the Python solver's _seed. */
+   q_ref): the Python solver's _seed */
 static double dk_refine_held(const double chain[DK_REFINE_N + 1][12],
                              const int revolute[DK_REFINE_N], const int solved[DK_REFINE_M],
                              double reach, const double t[12], double q[DK_REFINE_N],
