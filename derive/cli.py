@@ -255,7 +255,9 @@ def cmd_solve(args: argparse.Namespace) -> int:
         print(f"free joints: {', '.join(given)} (degrees for R joints)")
     print(f"{len(sols)} solution(s) (degrees for R joints):")
     branches = getattr(module, "BRANCHES", ())
-    if branches and len(sols):
+    if branches == ("det J",) and len(sols):  # (the general method: printers/branches.py)
+        print("(branch: the sign of det J; 0 at a singular configuration)")
+    elif branches and len(sols):
         print(f"(branch: the signs of the steps of {', '.join(branches)}; 0 at a fold)")
     for k, q in enumerate(sols, start=1):
         shown = [math.degrees(v) if t == "R" else v for v, t in zip(q, spec.joint_types)]

@@ -6,6 +6,7 @@ same bytes."""
 from __future__ import annotations
 
 import functools
+import textwrap
 from dataclasses import dataclass
 from typing import Any
 
@@ -50,6 +51,7 @@ class PrintedC:
     # <name>_branch's body and the joints its signs name (the Python module's BRANCHES)
     branch: tuple[str, ...]
     branch_names: tuple[str, ...]
+    branch_doc: str
     fk_params: str
     solve: tuple[tuple[int, str], ...]
     # dk_solve brings every revolute output to ik's range (c.seamed_outputs): dk_finish copies
@@ -105,6 +107,37 @@ def general_constants(plan: Plan) -> dict[str, object]:
         "fill": c.general_fill(plan),
         **spurious_constants(step),
     }
+
+
+def branch_doc(plan: Plan) -> str:
+    """The header's comment on <NAME>_BRANCHES: what the signs of <name>_branch are."""
+    names = branches.branch_names(plan)
+    if names == (branches.JACOBIAN_BRANCH,):
+        text = (
+            'the branch of a solution (1 sign; the Python module\'s BRANCHES, ("det J",), and '
+            "branch): no step of this arm's method names one (it solves all joints at once), so "
+            "the sign is det J's over the joints the pose fixes, +1 or -1, 0 at a singular "
+            "configuration (|det J| within 1e-9 of the product of its columns' lengths); it "
+            "changes only where a path crosses a singular configuration, but two solutions "
+            "can share it"
+        )
+    else:
+        solving = f": the steps solving {', '.join(names)}" if names else ""
+        text = (
+            f"the branches of the closed form ({len(names)}{solving}; the Python module's "
+            "BRANCHES and branch): one sign per step that gives several values, +1 or -1 (the "
+            "sign of the derivative of the step's equation at the value), 0 at a fold, where "
+            "the step's values meet (a singular configuration: the elbow stretched, the wrist "
+            "straight); the signs change only where a path crosses a fold, so they name a "
+            "solution's configuration (shoulder, elbow, wrist)"
+        )
+        if not names:
+            text += (
+                "; this arm has none (its method solves all joints at once, or q alone cannot "
+                "tell its branch)"
+            )
+    lines = textwrap.wrap(f"/* {text} */", 96, subsequent_indent="   ")
+    return "\n".join(lines)
 
 
 def spurious_constants(step: Eigen) -> dict[str, object]:
@@ -200,8 +233,9 @@ def print_c(plan: Plan) -> PrintedC:
         fk_pose=fk_pose,
         fk_joints=fk_joints,
         jacobian=jacobian,
-        branch=c.branch_lines(plan),
+        branch=c.branch_lines(plan, arm.name),
         branch_names=branches.branch_names(plan),
+        branch_doc=branch_doc(plan),
         fk_params=fk_params,
         solve=solve,
         seamed=bool(c.seamed_outputs(plan)),

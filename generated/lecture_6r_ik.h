@@ -47,12 +47,11 @@ void lecture_6r_fk(const double q[6], double T[16]);
    world (fk's frame), 1: in the tool frame (rotated by fk's R^T) */
 void lecture_6r_jacobian(const double q[6], int frame, double J[6][6]);
 
-/* the branches of the closed form (2: the steps solving q3, q5; the
-   Python module's BRANCHES and branch): one sign per step that gives several values, +1 or
-   -1 (the sign of the derivative of the step's equation at the value), 0 at a fold, where
-   the step's values meet (a singular configuration: the elbow stretched, the wrist straight);
-   the signs change only where a path crosses a fold, so they name a solution's configuration
-   (shoulder, elbow, wrist) */
+/* the branches of the closed form (2: the steps solving q3, q5; the Python module's BRANCHES
+   and branch): one sign per step that gives several values, +1 or -1 (the sign of the
+   derivative of the step's equation at the value), 0 at a fold, where the step's values meet (a
+   singular configuration: the elbow stretched, the wrist straight); the signs change only where
+   a path crosses a fold, so they name a solution's configuration (shoulder, elbow, wrist) */
 #define LECTURE_6R_BRANCHES 2
 
 /* signs = the branch of the solution q of its own pose fk(q); returns LECTURE_6R_BRANCHES, or

@@ -47,12 +47,11 @@ void lecture_rrr_fk(const double q[3], double T[16]);
    world (fk's frame), 1: in the tool frame (rotated by fk's R^T) */
 void lecture_rrr_jacobian(const double q[3], int frame, double J[6][3]);
 
-/* the branches of the closed form (1: the steps solving q2; the
-   Python module's BRANCHES and branch): one sign per step that gives several values, +1 or
-   -1 (the sign of the derivative of the step's equation at the value), 0 at a fold, where
-   the step's values meet (a singular configuration: the elbow stretched, the wrist straight);
-   the signs change only where a path crosses a fold, so they name a solution's configuration
-   (shoulder, elbow, wrist) */
+/* the branches of the closed form (1: the steps solving q2; the Python module's BRANCHES and
+   branch): one sign per step that gives several values, +1 or -1 (the sign of the derivative of
+   the step's equation at the value), 0 at a fold, where the step's values meet (a singular
+   configuration: the elbow stretched, the wrist straight); the signs change only where a path
+   crosses a fold, so they name a solution's configuration (shoulder, elbow, wrist) */
 #define LECTURE_RRR_BRANCHES 1
 
 /* signs = the branch of the solution q of its own pose fk(q); returns LECTURE_RRR_BRANCHES, or

@@ -47,13 +47,12 @@ void locobot_head_fk(const double q[2], double T[16]);
    world (fk's frame), 1: in the tool frame (rotated by fk's R^T) */
 void locobot_head_jacobian(const double q[2], int frame, double J[6][2]);
 
-/* the branches of the closed form (0; the
-   Python module's BRANCHES and branch): one sign per step that gives several values, +1 or
-   -1 (the sign of the derivative of the step's equation at the value), 0 at a fold, where
-   the step's values meet (a singular configuration: the elbow stretched, the wrist straight);
-   the signs change only where a path crosses a fold, so they name a solution's configuration
-   (shoulder, elbow, wrist); this arm has none (its method solves
-   all joints at once, or q alone cannot tell its branch) */
+/* the branches of the closed form (0; the Python module's BRANCHES and branch): one sign per
+   step that gives several values, +1 or -1 (the sign of the derivative of the step's equation
+   at the value), 0 at a fold, where the step's values meet (a singular configuration: the elbow
+   stretched, the wrist straight); the signs change only where a path crosses a fold, so they
+   name a solution's configuration (shoulder, elbow, wrist); this arm has none (its method
+   solves all joints at once, or q alone cannot tell its branch) */
 #define LOCOBOT_HEAD_BRANCHES 0
 
 /* signs = the branch of the solution q of its own pose fk(q); returns LOCOBOT_HEAD_BRANCHES, or

@@ -682,6 +682,10 @@ static void dk_rr_fill(int k, double l_x, double l_y, double l_z, double p_x, do
 
 #define DK_SEAM_SNAP (1e-12)
 
+/* a branch's sign is 0 (a fold: two values meet) where the derivative of its step's
+   equation is below this of the equation's scale (derive/runtime/constants.py) */
+#define DK_BRANCH_FOLD (1e-09)
+
 #define DK_PI (3.141592653589793)
 
 #define DK_TWO_PI (6.283185307179586)
@@ -694,6 +698,53 @@ static double dk_wrap(double t)
     }
     w = t - DK_TWO_PI * floor(t / DK_TWO_PI + 0.5);
     return w <= -DK_PI ? w + DK_TWO_PI : w;
+}
+
+/* the branch of a solution where the closed form names none (the general method): the sign
+   of det A, A (6 x 6, row by row: a[6 k + r] is row r of column k) the Jacobian's columns of
+   the joints the pose fixes; 0 where |det A| is within DK_BRANCH_FOLD of the product of its
+   columns' lengths (Hadamard's bound). LU with partial pivoting, as numpy's det
+   (derive/runtime/motion.py's _jacobian_sign). */
+static int dk_det_sign(double a[36])
+{
+    double bound = 1.0;
+    int sign = 1, k, r, c;
+    for (k = 0; k < 6; k++) {
+        double length = 0.0;
+        for (r = 0; r < 6; r++) {
+            length += a[6 * k + r] * a[6 * k + r];
+        }
+        bound *= sqrt(length);
+    }
+    double det = 1.0;
+    for (c = 0; c < 6; c++) { /* (column c eliminated below the pivot, in rows c + 1..5) */
+        int pivot = c;
+        for (r = c + 1; r < 6; r++) {
+            pivot = fabs(a[6 * c + r]) > fabs(a[6 * c + pivot]) ? r : pivot;
+        }
+        if (a[6 * c + pivot] == 0.0) {
+            return 0;
+        }
+        if (pivot != c) {
+            for (k = c; k < 6; k++) {
+                const double t = a[6 * k + c];
+                a[6 * k + c] = a[6 * k + pivot];
+                a[6 * k + pivot] = t;
+            }
+            sign = -sign;
+        }
+        det *= a[6 * c + c];
+        for (r = c + 1; r < 6; r++) {
+            const double f = a[6 * c + r] / a[6 * c + c];
+            for (k = c + 1; k < 6; k++) {
+                a[6 * k + r] -= f * a[6 * k + c];
+            }
+        }
+    }
+    if (fabs(det) <= DK_BRANCH_FOLD * bound) {
+        return 0;
+    }
+    return sign * det > 0.0 ? 1 : -1;
 }
 
 /* the distance of the point t's position from the ray of e's tool axis (0 x, 1 y, 2 z) from
@@ -3830,9 +3881,46 @@ int manocha_canny_branch(const double q[DK_DOF], int signs[1])
             return MANOCHA_CANNY_INVALID_ARGUMENT;
         }
     }
-    (void)q;
-    (void)signs;
-    return 0;
+    double dk_j[6][DK_DOF], dk_a[36];
+    manocha_canny_jacobian(q, 0, dk_j);
+    dk_a[0] = dk_j[0][0];
+    dk_a[1] = dk_j[1][0];
+    dk_a[2] = dk_j[2][0];
+    dk_a[3] = dk_j[3][0];
+    dk_a[4] = dk_j[4][0];
+    dk_a[5] = dk_j[5][0];
+    dk_a[6] = dk_j[0][1];
+    dk_a[7] = dk_j[1][1];
+    dk_a[8] = dk_j[2][1];
+    dk_a[9] = dk_j[3][1];
+    dk_a[10] = dk_j[4][1];
+    dk_a[11] = dk_j[5][1];
+    dk_a[12] = dk_j[0][2];
+    dk_a[13] = dk_j[1][2];
+    dk_a[14] = dk_j[2][2];
+    dk_a[15] = dk_j[3][2];
+    dk_a[16] = dk_j[4][2];
+    dk_a[17] = dk_j[5][2];
+    dk_a[18] = dk_j[0][3];
+    dk_a[19] = dk_j[1][3];
+    dk_a[20] = dk_j[2][3];
+    dk_a[21] = dk_j[3][3];
+    dk_a[22] = dk_j[4][3];
+    dk_a[23] = dk_j[5][3];
+    dk_a[24] = dk_j[0][4];
+    dk_a[25] = dk_j[1][4];
+    dk_a[26] = dk_j[2][4];
+    dk_a[27] = dk_j[3][4];
+    dk_a[28] = dk_j[4][4];
+    dk_a[29] = dk_j[5][4];
+    dk_a[30] = dk_j[0][5];
+    dk_a[31] = dk_j[1][5];
+    dk_a[32] = dk_j[2][5];
+    dk_a[33] = dk_j[3][5];
+    dk_a[34] = dk_j[4][5];
+    dk_a[35] = dk_j[5][5];
+    signs[0] = dk_det_sign(dk_a);
+    return 1;
 }
 
 void manocha_canny_fk(const double q[DK_DOF], double T[16])

@@ -48,14 +48,12 @@ void manocha_canny_fk(const double q[6], double T[16]);
    world (fk's frame), 1: in the tool frame (rotated by fk's R^T) */
 void manocha_canny_jacobian(const double q[6], int frame, double J[6][6]);
 
-/* the branches of the closed form (0; the
-   Python module's BRANCHES and branch): one sign per step that gives several values, +1 or
-   -1 (the sign of the derivative of the step's equation at the value), 0 at a fold, where
-   the step's values meet (a singular configuration: the elbow stretched, the wrist straight);
-   the signs change only where a path crosses a fold, so they name a solution's configuration
-   (shoulder, elbow, wrist); this arm has none (its method solves
-   all joints at once, or q alone cannot tell its branch) */
-#define MANOCHA_CANNY_BRANCHES 0
+/* the branch of a solution (1 sign; the Python module's BRANCHES, ("det J",), and branch): no
+   step of this arm's method names one (it solves all joints at once), so the sign is det J's
+   over the joints the pose fixes, +1 or -1, 0 at a singular configuration (|det J| within 1e-9
+   of the product of its columns' lengths); it changes only where a path crosses a singular
+   configuration, but two solutions can share it */
+#define MANOCHA_CANNY_BRANCHES 1
 
 /* signs = the branch of the solution q of its own pose fk(q); returns MANOCHA_CANNY_BRANCHES, or
    -1 where q solves no pose of the task's (a task's auxiliary step has no value there), or

@@ -49,12 +49,11 @@ void open_manipulator_x_fk(const double q[4], double T[16]);
    world (fk's frame), 1: in the tool frame (rotated by fk's R^T) */
 void open_manipulator_x_jacobian(const double q[4], int frame, double J[6][4]);
 
-/* the branches of the closed form (3: the steps solving q1, virtual, q3; the
-   Python module's BRANCHES and branch): one sign per step that gives several values, +1 or
-   -1 (the sign of the derivative of the step's equation at the value), 0 at a fold, where
-   the step's values meet (a singular configuration: the elbow stretched, the wrist straight);
-   the signs change only where a path crosses a fold, so they name a solution's configuration
-   (shoulder, elbow, wrist) */
+/* the branches of the closed form (3: the steps solving q1, virtual, q3; the Python module's
+   BRANCHES and branch): one sign per step that gives several values, +1 or -1 (the sign of the
+   derivative of the step's equation at the value), 0 at a fold, where the step's values meet (a
+   singular configuration: the elbow stretched, the wrist straight); the signs change only where
+   a path crosses a fold, so they name a solution's configuration (shoulder, elbow, wrist) */
 #define OPEN_MANIPULATOR_X_BRANCHES 3
 
 /* signs = the branch of the solution q of its own pose fk(q); returns OPEN_MANIPULATOR_X_BRANCHES,

@@ -1360,8 +1360,11 @@ def branch(q: ArrayLike) -> tuple[int, ...]:
     equation in its joint's value (a cos t + b sin t = e: +1 for the + acos value); it changes
     only where a path of solutions crosses a fold, so it names the configuration (shoulder,
     elbow, wrist) whatever the distances between solutions; "virtual" in BRANCHES is the
-    task's own value (the axis-angle task's tilt). () where the derivation has no such steps
-    (the general method, a look-at: its distance along the ray is the point's, not q's).
+    task's own value (the axis-angle task's tilt). Where the derivation has no such steps
+    (the general method), an arm solved for the pose with six joints not free has one label,
+    the sign of det J over them (BRANCHES == ("det J",)): it too changes only where a path
+    crosses a singular configuration, but two solutions can share it. () where neither
+    applies (a look-at: its distance along the ray is the point's, not q's).
 
     Raises:
         ValueError: q is not DOF finite numbers.
@@ -1507,10 +1510,12 @@ def _follow(A, B, q, within_limits, backend, depth):
     near a singular configuration a branch turns fast (the wrist centre passing near axis 1
     turned a KR 10's q1 by 1.6 rad in one of 20 steps, sigma_min 4e-3), and the other
     shoulder's row, nearer by joint distance, was taken with no break reported (a new user's
-    attack). A step from where sigma_min is below PATH_SINGULAR whose row moves a joint more
-    than PATH_JUMP is a break: the first-order bound allows any step there, and which way the
-    path goes depends on how finely it is sampled. Returns (row, why) as _continuation, and
-    sigma_min where the step starts."""
+    attack). A step whose row moves a joint more than PATH_JUMP where sigma_min is below
+    PATH_SINGULAR, at its start or at the start of any of its parts, is a break: the
+    first-order bound allows any step there, and which way the path goes depends on how
+    finely it is sampled (a GP7's elbow line passing sigma_min 3.5e-4 mid-step turned q1 by
+    2.8 rad in one of 19 steps with no break: a new user's attack). Returns (row, why) as
+    _continuation, and the least sigma_min at the starts of the step and its parts."""
     bound, least = _step_bound(q, A, B)
     row, why = _continuation(B, q, branch(q), bound, within_limits, backend)
     if row is None or "limits" in why:
@@ -1520,12 +1525,21 @@ def _follow(A, B, q, within_limits, backend, depth):
     jump = np.abs(_turned(row - q, revolute)) / units
     if depth < PATH_SPLITS and (why or float(jump.max()) > PATH_NEAR):
         middle = straight_line(A, B, 3)[1]
-        half, first, _ = _follow(A, middle, q, within_limits, backend, depth + 1)
-        if half is not None and not first:
-            split, why_split, _ = _follow(middle, B, half, within_limits, backend, depth + 1)
+        half, first, least_first = _follow(A, middle, q, within_limits, backend, depth + 1)
+        if (half is None or first) and not why:  # (the step's row jumps, and its first half
+            # finds no continuation: the branch ends within the step, at a fold where q's
+            # branch meets another, and the row is another branch's; a GP7's elbow line
+            # jumped so by 3.1 rad with no break, sigma_min 1.1e-2 at the step's start)
+            why = first or "the middle of the step is out of reach"
+            least = min(least, least_first)
+        elif half is not None and not first:
+            split, why_split, least_split = _follow(
+                middle, B, half, within_limits, backend, depth + 1
+            )
             if split is not None:
                 row, why = split, why_split
                 jump = np.abs(_turned(row - q, revolute)) / units
+                least = min(least, least_first, least_split)  # (the parts' own starts)
     if not why and depth == 0 and least < PATH_SINGULAR and float(jump.max()) > PATH_JUMP:
         j = int(np.argmax(jump))
         why = (

@@ -366,6 +366,47 @@ def _label_changes(module, q: np.ndarray, joint: int) -> np.ndarray:
     return values[changed + 1]
 
 
+GP7 = [  # (Yaskawa GP7's public DH table, standard: alpha, a, d, theta offset; deg and m)
+    (-90, 0.040, 0.330, 0),
+    (180, 0.445, 0.0, -90),
+    (-90, 0.040, 0.0, 0),
+    (90, 0.0, -0.440, 0),
+    (-90, 0.0, 0.0, 0),
+    (180, 0.0, -0.080, 0),
+]
+
+
+def test_a_path_whose_branch_ends_within_a_step_breaks_there(tmp_path):
+    """A GP7's straight line (20 poses) on which q's branch ends between poses 16 and 17: the
+    wrist centre crosses a fold of the quartic in theta3 (8 solutions become 4; Newton's
+    iteration from q16 along 2,000 poses between them stops converging there). Pose 17's
+    row nearest Newton's iteration from q16 is another branch's, 3.1 rad away, and
+    sigma_min at q16 (2.5e-3) let the step pass: ik_path took it with no break (a new user's
+    attack found it on a GP7 URDF). The step's first half finds no continuation, so the
+    step is a break."""
+    rows = "\n".join(
+        f'[[joint]]\ntype = "R"\nalpha = {al!r}\na = {a!r}\nd = {d!r}\ntheta = {th!r}\n'
+        for al, a, d, th in GP7
+    )
+    text = f'name = "gp7"\nconvention = "standard"\nangle_unit = "deg"\nlength_unit = "m"\n{rows}'
+    module = build_module(text, tmp_path, c=True)
+    qa = np.array([-1.65484, -2.921283, 1.697773, 2.829662, -1.720035, -2.119624])
+    qb = np.array([-1.837715, -3.421963, 1.877452, 2.671925, -1.645061, -1.632604])
+    Ts = module.straight_line(module.fk(qa), module.fk(qb), 20)
+    for backend in ("c", "python"):
+        path, breaks = module.ik_path(Ts, qa, backend=backend)
+        assert [k for k, _ in breaks] == [17], breaks
+        assert "no solution continues the path" in breaks[0][1]
+        assert np.isnan(path[17:]).all() and not np.isnan(path[:17]).any()
+    q, stalled = path[16], False  # (the branch ends: Newton's iteration, solver-free)
+    for T in module.straight_line(Ts[16], Ts[17], 2000)[1:]:
+        q, size = module._newton_to(q, T)
+        if size > 1e-8:
+            stalled = True
+            break
+    assert stalled
+
+
 @pytest.mark.parametrize(
     ("name", "names"),
     [
@@ -465,9 +506,46 @@ def test_branches_change_only_at_folds(generated):
         assert module.manipulability(q)[0] < 1e-3
     q[4] = 0.0
     assert module.branch(q)[2] == 0
-    assert module.BRANCHES and generated("manocha_canny").BRANCHES == ()  # (the general method)
+    assert module.BRANCHES and generated("manocha_canny").BRANCHES == ("det J",)
     # (a look-at's distance along the ray is the point's, not q's: no branch from q alone)
     assert generated("locobot_head").BRANCHES == ()
+
+
+def test_the_general_method_s_branch_is_det_j_s_sign_and_changes_only_where_it_vanishes(
+    generated,
+):
+    """The general method names no branch, so branch() is the sign of det J (the arm's six
+    joints; printers/branches.py): on manocha_canny's rows of 100 random poses it is numpy's
+    det's sign, both signs occur, and over a turn of each joint it changes only where the
+    Jacobian is singular (sigma_min there below 1e-3 of the largest singular value)."""
+    module = generated("manocha_canny")
+    rng = np.random.default_rng(5)
+    lo, hi = np.clip(np.array(module.LIMITS).T, -np.pi, np.pi)
+    seen = set()
+    for _ in range(100):
+        for row in module.ik(module.fk(rng.uniform(lo, hi))):
+            (sign,) = module.branch(row)
+            assert sign == np.sign(np.linalg.det(module.jacobian(row)))
+            seen.add(sign)
+    assert seen == {-1, 1}
+    q = rng.uniform(lo, hi)
+    values = np.linspace(-np.pi, np.pi, 4001)  # (1.6e-3 rad apart)
+    changes = 0
+    for joint in range(6):
+        labels = []
+        for value in values:
+            q = q.copy()
+            q[joint] = value
+            labels.append(module.branch(q)[0])
+        for k in np.flatnonzero(np.diff(labels)):  # (det J vanishes between k and k + 1)
+            ratios = []
+            for value in values[k : k + 2]:
+                q[joint] = value
+                sigma = np.linalg.svd(module.jacobian(q), compute_uv=False)
+                ratios.append(sigma[-1] / sigma[0])
+            assert min(ratios) <= 5e-4, (joint, values[k], ratios)
+            changes += 1
+    assert changes >= 2, changes
 
 
 def test_straight_line_turns_half_a_turn_and_refuses_what_is_not_rigid(generated):

@@ -429,6 +429,33 @@ def test_a_pair_the_perturbed_table_makes_complex_is_tried(xarm6, backend):
             assert np.max(np.abs(np.array(urdf.urdf_fk(chain, list(row))) - T)) <= 1e-9
 
 
+def test_a_path_of_the_general_method_keeps_the_sign_of_det_j(xarm6):
+    """The general method names no branch, so ik_path chose by distance alone, and on this
+    xArm6 line (20 poses; sigma_min >= 5.3e-3 on it, a 100 times finer nearest-row walk
+    continuous) Newton's iteration from pose 18's row reached another solution of pose 19,
+    0.39 rad from the branch, with det J's sign flipped and no break (a new user's attack).
+    branch() is now det J's sign there (printers/branches.py), and the path keeps it: it is
+    the finer walk, to 1e-6."""
+    module, _ = xarm6
+    assert module.BRANCHES == ("det J",)
+    qa = np.array([-1.145437, 0.865626, -2.24392, 2.929105, 0.302053, -2.408472])
+    qb = np.array([-0.851761, 1.141195, -2.092532, 3.177675, -0.117195, -2.376806])
+    fine = module.straight_line(module.fk(qa), module.fk(qb), 19 * 100 + 1)
+    Q, valid = module.ik_batch(fine)
+    walk, largest = [qa], 0.0
+    for rows_k, ok in zip(Q[1:], valid[1:]):
+        gaps = np.abs(np.remainder(rows_k[ok] - walk[-1] + np.pi, 2 * np.pi) - np.pi).max(axis=1)
+        largest = max(largest, float(gaps.min()))
+        walk.append(rows_k[ok][int(np.argmin(gaps))])
+    assert largest < 0.05  # (the finer walk is continuous)
+    reference = np.array(walk)[::100]
+    for backend in ("c", "python"):
+        path, breaks = module.ik_path(fine[::100], qa, backend=backend)
+        assert breaks == []
+        assert np.abs(np.remainder(path - reference + np.pi, 2 * np.pi) - np.pi).max() <= 1e-6
+        assert {module.branch(q) for q in path} == {(-1,)}
+
+
 def noisy_urdf(name: str, seed: int, decimals: int = 7) -> str:
     """The arm of TABLES written as zoo URDFs are: every link frame the DH frame of its joint
     turned and moved along the joint's axis by a random rigid transform, every number with

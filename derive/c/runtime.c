@@ -665,6 +665,53 @@ static int dk_polyd_branch(const double *p, int n, double d)
     return slope > 0.0 ? 1 : -1;
 }
 
+/* the branch of a solution where the closed form names none (the general method): the sign
+   of det A, A (6 x 6, row by row: a[6 k + r] is row r of column k) the Jacobian's columns of
+   the joints the pose fixes; 0 where |det A| is within DK_BRANCH_FOLD of the product of its
+   columns' lengths (Hadamard's bound). LU with partial pivoting, as numpy's det
+   (derive/runtime/motion.py's _jacobian_sign). */
+static int dk_det_sign(double a[36])
+{
+    double bound = 1.0;
+    int sign = 1, k, r, c;
+    for (k = 0; k < 6; k++) {
+        double length = 0.0;
+        for (r = 0; r < 6; r++) {
+            length += a[6 * k + r] * a[6 * k + r];
+        }
+        bound *= sqrt(length);
+    }
+    double det = 1.0;
+    for (c = 0; c < 6; c++) { /* (column c eliminated below the pivot, in rows c + 1..5) */
+        int pivot = c;
+        for (r = c + 1; r < 6; r++) {
+            pivot = fabs(a[6 * c + r]) > fabs(a[6 * c + pivot]) ? r : pivot;
+        }
+        if (a[6 * c + pivot] == 0.0) {
+            return 0;
+        }
+        if (pivot != c) {
+            for (k = c; k < 6; k++) {
+                const double t = a[6 * k + c];
+                a[6 * k + c] = a[6 * k + pivot];
+                a[6 * k + pivot] = t;
+            }
+            sign = -sign;
+        }
+        det *= a[6 * c + c];
+        for (r = c + 1; r < 6; r++) {
+            const double f = a[6 * c + r] / a[6 * c + c];
+            for (k = c + 1; k < 6; k++) {
+                a[6 * k + r] -= f * a[6 * k + c];
+            }
+        }
+    }
+    if (fabs(det) <= DK_BRANCH_FOLD * bound) {
+        return 0;
+    }
+    return sign * det > 0.0 ? 1 : -1;
+}
+
 /* complex numbers, for the quartic's fallback (no complex.h: math.h only) */
 typedef struct {
     double re, im;

@@ -220,9 +220,33 @@ def _read(
     return kept[::-1]
 
 
+# BRANCHES where the closed form names no branch and branch(q) is the sign of the Jacobian's
+# determinant (jacobian_branch)
+JACOBIAN_BRANCH = "det J"
+
+
+def jacobian_branch(plan: Plan) -> bool:
+    """Whether a solution's branch is the sign of det J over the joints the pose fixes (the
+    runtimes' _jacobian_sign, dk_det_sign): where no step of the solve names one (the
+    general method solves all joints at once) and the arm is solved for the whole pose with
+    six joints not free, so that J over them is square. det J changes sign only where a path
+    of solutions crosses a singular configuration, so two solutions of opposite signs are on
+    different branches (the converse need not hold: a 6R arm has up to 16 solutions and
+    det J two signs)."""
+    assert plan.ik is not None
+    return (
+        not branch_steps(plan)
+        and plan.ik.certify == "pose"
+        and plan.arm.dof - len(plan.ik.free) == 6
+    )
+
+
 def branch_names(plan: Plan) -> tuple[str, ...]:
     """The arm's joints whose steps choose a branch (BRANCHES in the module: "q3", ...), in
-    the order they are solved (a reversed chain's theta_k is another joint of the arm)."""
+    the order they are solved (a reversed chain's theta_k is another joint of the arm); or
+    (JACOBIAN_BRANCH,) where the branch is det J's sign (jacobian_branch)."""
+    if jacobian_branch(plan):
+        return (JACOBIAN_BRANCH,)
     out = []
     for step in branch_steps(plan) or ():
         value = from_joints(plan, step)

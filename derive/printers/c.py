@@ -34,7 +34,7 @@ from derive.plan import (
     PolyD,
     Solve,
 )
-from derive.printers.branches import First, Sign, branch_program
+from derive.printers.branches import First, Sign, branch_program, jacobian_branch
 from derive.printers.common import (
     CodePrinter,
     Line,
@@ -450,10 +450,24 @@ SIGNS: dict[type[Solve], str] = {
 }
 
 
-def branch_lines(plan: Plan) -> tuple[str, ...]:
+def branch_lines(plan: Plan, name: str) -> tuple[str, ...]:
     """Body of <name>_branch(q, signs): the branch program (printers/branches.py) as C, the
-    signs stored in signs[0..] and their count returned (0 where the arm has none)."""
+    signs stored in signs[0..] and their count returned (0 where the arm has none); or det J's
+    sign over the joints not free (jacobian_branch; <name>_jacobian's columns)."""
     program = branch_program(plan)
+    if program is None and jacobian_branch(plan):
+        assert plan.ik is not None
+        fixed = [j for j in range(plan.arm.dof) if j + 1 not in plan.ik.free]
+        copy = [
+            f"dk_a[{6 * k + r}] = dk_j[{r}][{j}];" for k, j in enumerate(fixed) for r in range(6)
+        ]
+        return (
+            "double dk_j[6][DK_DOF], dk_a[36];",
+            f"{name}_jacobian(q, 0, dk_j);",
+            *copy,
+            "signs[0] = dk_det_sign(dk_a);",
+            "return 1;",
+        )
     if program is None:
         return ("(void)q;", "(void)signs;", "return 0;")
     printer = CPrinter()

@@ -25,7 +25,7 @@ from derive.plan import (
     PolyD,
     Solve,
 )
-from derive.printers.branches import First, Sign, branch_program
+from derive.printers.branches import First, Sign, branch_program, jacobian_branch
 from derive.printers.common import (
     CodePrinter,
     Line,
@@ -147,7 +147,7 @@ def branch_lines(plan: Plan) -> tuple[tuple[int, str], ...]:
     a body returning () where the arm has none."""
     program = branch_program(plan)
     if program is None:
-        return ((0, "return ()"),)
+        return ((0, "return (_jacobian_sign(q),)" if jacobian_branch(plan) else "return ()"),)
     printer = CodePrinter()
     world = ", ".join(name or "_" for name in program.world)
     joints = ", ".join(name or "_" for name in program.joints)
