@@ -932,7 +932,9 @@ static int dk_pose_ok(const double T[16])
 /* a step within this (radians, or reach): its Jacobian and factor serve the last step */
 #define DK_REFINE_SMALL (1e-3)
 
-/* a refined row is kept if its pose error is within the smaller of this and ik's tol */
+/* a refined row is kept if its pose error is within the smaller of this and ik's tol, or of
+   DK_REFINE_STALL in the second pass (loose; derive/runtime/refine.py, _REFINE_STALL, says
+   why) */
 #define DK_REFINE_TOL (1e-10)
 
 /* where the damped steps give up (DK_REFINE_PATIENCE) within this and above DK_REFINE_DONE,

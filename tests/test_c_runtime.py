@@ -65,7 +65,9 @@ def test_the_c_runtime_holds_the_python_runtimes_constants():
         assert float(found[f"DK_{name}"]) == getattr(constants, f"_{name}"), name
     for name in ("DEDUP_TOL", "POSE_TOL"):
         assert float(found[f"DK_{name}"]) == getattr(constants, name), name
-    for name in ("STEPS", "STRIDE", "DONE", "PATIENCE", "LAST", "TRUST", "TOL", "POLISH", "SETTLE"):
+    for name in ("STEPS", "STRIDE", "DONE", "PATIENCE", "LAST", "TRUST", "TOL", "STALL", "POLISH"):
+        assert float(found[f"DK_REFINE_{name}"]) == getattr(refine, f"_REFINE_{name}"), name
+    for name in ("SETTLE",):
         assert float(found[f"DK_REFINE_{name}"]) == getattr(refine, f"_REFINE_{name}"), name
     assert float(found["DK_PI"]) == np.pi and float(found["DK_TWO_PI"]) == 2 * np.pi
     assert table(runtime, "DK_FREE_STEPS").tolist() == list(constants._FREE_STEPS)

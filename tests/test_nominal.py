@@ -661,6 +661,19 @@ def test_a_task_arm_near_its_singular_configuration_is_answered(tmp_path):
             for row in rows:  # (the task's components: position over the reach, tool x)
                 gap = np.abs(module.fk(row) - T)[:3]
                 assert max(gap[:, 0].max(), gap[:, 3].max() / module.REACH) <= 1e-10
+    # (c) 1e-5 rad from there the exact arm's solutions nearly form a curve, and the second
+    # pass's refinement stalls on it at 2e-10 to 1e-9: it keeps rows within _REFINE_STALL
+    # (1e-9) where the first pass has none (before, no row in either backend; the sampled
+    # vector is not among them: 1.2-1.4 rad away)
+    nearest = [-1.2545926264665233, 1.535885482537841, 0.5190257461010466, 1.5708026535948967,
+               -0.008604719649109693]  # fmt: skip
+    T = module.fk(np.array(nearest))
+    for backend in ("c", "python"):
+        rows = module.ik(T, backend=backend)
+        assert len(rows), backend
+        for row in rows:
+            gap = np.abs(module.fk(row) - T)[:3]
+            assert max(gap[:, 0].max(), gap[:, 3].max() / module.REACH) <= module._REFINE_STALL
 
 
 @needs_cc

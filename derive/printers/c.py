@@ -382,7 +382,12 @@ def solve_lines(plan: Plan) -> tuple[tuple[int, str], ...]:
         body.append(Line(depth + 1, f"double dk_q[DK_DOF] = {{{', '.join(outputs)}}};"))
         # (the joints the pose left free, held first: derive/c/runtime.c dk_refine_held)
         body.append(Line(depth + 1, f"const unsigned dk_held = {held or '0u'};"))
-        body.append(Line(depth + 1, "const double dk_limit = fmin(tol, DK_REFINE_TOL);"))
+        body.append(
+            Line(
+                depth + 1,
+                "const double dk_limit = fmin(tol, loose ? DK_REFINE_STALL : DK_REFINE_TOL);",
+            )
+        )
         # (the second pass refines only the seeds near the pose: dk_seed_near)
         body.append(
             Line(

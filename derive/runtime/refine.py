@@ -47,6 +47,10 @@ _REFINE_LAST = 1e-10
 _REFINE_TRUST = 100.0
 # a refined row is returned if its pose error is within the smaller of this and ik's tol
 _REFINE_TOL = 1e-10
+# ... or of this in ik's second pass (no row within _REFINE_TOL): at a singular configuration
+# of the nominal arm (an IRB 4600's wrist centre on axis 1, sigma_min 2e-10) the exact arm's
+# solutions lie in a valley whose floor the damped and QR steps stall on at 1e-10 to 2e-10
+_REFINE_STALL = 1e-9
 # where the damped steps give up (_REFINE_PATIENCE steps without a better point) within this
 # and above _REFINE_DONE, Gauss-Newton steps by QR (_qr_solve) go on from the best point met:
 # at a singular solution (a pose on the wrist's or the shoulder's singular set) the normal
@@ -66,13 +70,14 @@ _LSQ_FLAT = 1e-13
 def _seed(found, t, q, tol, frees=()):
     """Append q refined onto the exact chain if its pose there reproduces the target t (the
     12 top entries) within tol and _REFINE_TOL (rotation entries; positions within that times
-    REACH). frees: (values, arm joint index) of the steps whose joint can be free: a joint
-    whose step's values are _Free (the pose left it free on the nominal table: it took q_ref's
-    value, or a step from it) is first held there, and moves only where holding does not
-    reach the tolerance (on the exact arm, nearly singular there, Newton's steps along the
-    near-null direction would otherwise carry it anywhere, away from q_ref)."""
+    REACH; _REFINE_STALL in ik's second pass). frees: (values, arm joint index) of the steps
+    whose joint can be free: a joint whose step's values are _Free (the pose left it free on
+    the nominal table: it took q_ref's value, or a step from it) is first held there, and
+    moves only where holding does not reach the tolerance (on the exact arm, nearly singular
+    there, Newton's steps along the near-null direction would otherwise carry it anywhere,
+    away from q_ref)."""
     held = [i for values, i in frees if values.__class__ is _Free]
-    limit = min(tol, _REFINE_TOL)
+    limit = min(tol, _REFINE_STALL if _LOOSE.near else _REFINE_TOL)
     if _LOOSE.near and _pose_error(q, t, False)[2] > _SEED_TOL:
         return  # (ik's second pass: a seed this far is a pose out of reach, not noise)
     if held:
