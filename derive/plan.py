@@ -90,8 +90,10 @@ class Solve:
             below 1e-10 of it the polynomial vanishes identically and the joint is free.
             For ``cs1``: the typical size of a^2 + b^2; when a^2 + b^2 and e^2 are below
             1e-14 of it the equation holds for every angle, and the joint is free.
-        unit: for ``polyd``: the arm's length; the roots are found for d_i / unit, so that the
-            coefficients, powers of a length, are compared at one scale.
+        unit: for ``polyd``: the length the roots are found in (d_i / unit), so that the
+            coefficients, powers of a length, are compared at one scale: the arm's length, or
+            an expression in the step's inputs where d_i can be far longer (a look-at's
+            distance along its ray: the arm's length plus the point's distance).
     """
 
     joint: int
@@ -100,7 +102,7 @@ class Solve:
     fanout: int
     ref: sp.Expr = sp.S.Zero
     scale: float = 0.0
-    unit: float = 1.0
+    unit: float | sp.Expr = 1.0
 
     # the kind's short name (in the report and the module docstring's table)
     kind: ClassVar[str] = ""

@@ -85,7 +85,7 @@ import sys
 import tempfile
 import threading
 import warnings
-from math import atan2, cos, sin
+from math import atan2, cos, sin, sqrt
 from operator import sub as _sub
 from time import time as _time
 from typing import Any
@@ -1764,6 +1764,19 @@ def _ray_gap(e, t, axis):
     return max(abs(v[0] - along * u[0]), abs(v[1] - along * u[1]), abs(v[2] - along * u[2]))
 
 
+def _aims_at(e, t, tol):
+    """Whether e's ray (the look-at task's: IK_COMPONENTS "lookat", TOOL_AXIS) passes t's
+    point within tol radians, its miss over the point's distance along it (at least REACH):
+    a point many reaches away is missed by the angles' roundings times that distance, beyond
+    tol * REACH, and such a row is polished before it is certified (_keep). False for every
+    other task."""
+    if IK_COMPONENTS != "lookat":
+        return False
+    v = (t[3] - e[3], t[7] - e[7], t[11] - e[11])
+    along = v[0] * e[TOOL_AXIS] + v[1] * e[4 + TOOL_AXIS] + v[2] * e[8 + TOOL_AXIS]
+    return along > 0.0 and _ray_gap(e, t, TOOL_AXIS) <= tol * max(along, REACH)
+
+
 def _free(t: float) -> _Free:
     if _LOOSE.near:  # (ik's second pass: noise near a boundary, not a search of the free values)
         return _Free([t])
@@ -2321,13 +2334,18 @@ def _keep(found, t, q, e, tol, frees=()):
     point ten reaches away), is polished first: Newton's steps on the exact chain (_refine),
     taken where they bring it within _REFINE_TOL (dk_polish in C). frees: (values, arm joint
     index) of the steps whose joint can be free; a free one (q_ref's value: the pose leaves
-    it free) is held, so that the steps do not carry it along the self-motion."""
+    it free) is held, so that the steps do not carry it along the self-motion. A look-at row
+    whose ray passes the point within tol radians but not within tol * REACH (a point far
+    away: _aims_at) is polished too, and kept if that brings it within tol."""
     if _matches(e, t, min(tol, _REFINE_POLISH)):  # (most rows: one comparison settles it)
         found.append(q)
-    elif _matches(e, t, tol):
+    elif (certified := _matches(e, t, tol)) or _aims_at(e, t, tol):
         held = [i for values, i in frees if values.__class__ is _Free]
         moved, size = _refine(q, t, held)
-        found.append(moved if size <= _REFINE_TOL else q)
+        if size <= (_REFINE_TOL if certified else tol):
+            found.append(moved)
+        elif certified:
+            found.append(q)
 
 
 def _matches(e, t, tol):
@@ -2355,7 +2373,7 @@ def _ik_scalar(target, qr1, qr2, tol):
     _n3 = len(found)
     for d3 in (_v3 := _poly_real((1.0, 0.21272, 0.01632777225 - 2.0*r, 0.000533429717054 -
         0.21272*r, r*r - 0.007522127274*r + 0.002506804624*z*z + 7.056074237000755e-06,), 0.0,
-        1e-10, 0.09572299999999997)):
+        1e-10, sqrt(r) + 0.09572299999999997)):
         # theta2: r and z equations, linear in (c2, s2)
         _n2 = len(found)
         for theta2 in (_v2 := _cs2(-4.506119999990612e-07, 0.050068*d3 + 0.00266261624, -d3*d3 -

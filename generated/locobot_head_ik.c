@@ -1244,6 +1244,19 @@ static double dk_ray_gap(const double e[12], const double t[12], int axis)
     return fmax(fmax(fabs(v0 - along * u0), fabs(v1 - along * u1)), fabs(v2 - along * u2));
 }
 
+/* whether the ray of e's tool axis `axis` (the look-at task, 3) passes t's point within tol
+   radians: its miss over the point's distance along it (at least reach); a point many reaches
+   away is missed by the angles' roundings times that distance, beyond tol * reach, and such a
+   row is polished before it is certified (dk_polish). 0 for every other task. (The Python
+   solver's _aims_at.) */
+static int dk_aims_at(const double e[12], const double t[12], double tol, double reach,
+                      int task, int axis)
+{
+    const double v0 = t[3] - e[3], v1 = t[7] - e[7], v2 = t[11] - e[11];
+    const double along = v0 * e[axis] + v1 * e[4 + axis] + v2 * e[8 + axis];
+    return task == 3 && along > 0.0 && dk_ray_gap(e, t, axis) <= tol * fmax(along, reach);
+}
+
 /* whether e (a pose's 12 top entries) matches t in the task's components (0 the pose, 1 the
    position, 2 the position and tool axis `axis`'s direction, 3 the ray of that axis through
    t's position, 4 that axis's direction, 5 the position and entry `axis` (the tool axis's
@@ -1780,21 +1793,26 @@ static double dk_refine(const double chain[DK_REFINE_N + 1][12], const int revol
    DK_REFINE_POLISH (a value taken at a fold within DK_FOLD_TOL of it, a root at the edge of its
    polynomial's conditioning: a look-at point ten reaches away), polished: Newton's steps on
    the exact chain (dk_refine), the joints in held (a bit per arm joint: those the pose left
-   free) kept, taken where they bring it within DK_REFINE_TOL (the Python solver's _keep) */
-static void dk_polish(const double chain[DK_REFINE_N + 1][12], const int revolute[DK_REFINE_N],
-                      const int solved[DK_REFINE_M], double reach, const double t[12],
-                      double q[DK_REFINE_N], unsigned held)
+   free) kept, taken where they bring it within DK_REFINE_TOL; or a look-at row not certified
+   but aimed within tol radians (dk_aims_at), taken where they bring it within tol. Returns
+   whether q is kept: certified, or brought within tol (the Python solver's _keep). */
+static int dk_polish(const double chain[DK_REFINE_N + 1][12], const int revolute[DK_REFINE_N],
+                     const int solved[DK_REFINE_M], double reach, const double t[12],
+                     double q[DK_REFINE_N], unsigned held, double tol, int certified)
 {
     double moved[DK_REFINE_N];
     int i;
     for (i = 0; i < DK_REFINE_N; i++) {
         moved[i] = q[i];
     }
-    if (dk_refine(chain, revolute, solved, reach, t, moved, held) <= DK_REFINE_TOL) {
+    if (dk_refine(chain, revolute, solved, reach, t, moved, held) <=
+        (certified ? DK_REFINE_TOL : tol)) {
         for (i = 0; i < DK_REFINE_N; i++) {
             q[i] = moved[i];
         }
+        return 1;
     }
+    return certified;
 }
 
 /* The pose of frame k of a chain of n joints and fixed frames (12 entries each: T(q) = F_0
@@ -2088,7 +2106,7 @@ static int dk_solve(const double t[12], double tol, const double ref[DK_DOF],
     const double dk_p3[] = {1.0, 0.21272, 0.01632777225 - 2.0*r, 0.000533429717054 - 0.21272*r,
             (r*r) - 0.007522127274*r + 0.002506804624*(z*z) + 7.056074237000755e-06};
     dk_values dk_v3;
-    if (dk_poly(&dk_v3, dk_p3, 4, 0, 1e-10, 0.09572299999999997, 0.0) < 0) {
+    if (dk_poly(&dk_v3, dk_p3, 4, 0, 1e-10, sqrt(r) + 0.09572299999999997, 0.0) < 0) {
         return DK_UNSETTLED;
     }
     const int dk_m3 = n;
@@ -2143,14 +2161,15 @@ static int dk_solve(const double t[12], double tol, const double ref[DK_DOF],
                         dk_e9, dk_e10, dk_e11};
                 const int dk_fine_ok = n < DK_MAX && dk_match(e, t, dk_fine, dk_fine * DK_REACH, 3,
                         2);
-                if (dk_fine_ok || (n < DK_MAX && dk_match(e, t, tol, ptol, 3, 2))) {
+                const int dk_ok = dk_fine_ok || (n < DK_MAX && dk_match(e, t, tol, ptol, 3, 2));
+                if (dk_ok || (n < DK_MAX && dk_aims_at(e, t, tol, DK_REACH, 3, 2))) {
                     found[n][0] = theta1;
                     found[n][1] = theta2 - 1.5707963267948966;
-                    if (!dk_fine_ok) { /* (the joints the pose left free held) */
-                        dk_polish(DK_CHAIN, DK_REVOLUTE, DK_SOLVED, DK_REACH, t, found[n],
-                                (dk_v1.free ? 1u : 0u) | (dk_v2.free ? 2u : 0u));
+                    if (dk_fine_ok || dk_polish(DK_CHAIN, DK_REVOLUTE, DK_SOLVED, DK_REACH, t,
+                            found[n], (dk_v1.free ? 1u : 0u) | (dk_v2.free ? 2u : 0u), tol, dk_ok))
+                            {
+                        n++;
                     }
-                    n++;
                 }
                 if (dk_v1.free && n > dk_m1) {
                     break;

@@ -1390,21 +1390,26 @@ static double dk_refine(const double chain[DK_REFINE_N + 1][12], const int revol
    DK_REFINE_POLISH (a value taken at a fold within DK_FOLD_TOL of it, a root at the edge of its
    polynomial's conditioning: a look-at point ten reaches away), polished: Newton's steps on
    the exact chain (dk_refine), the joints in held (a bit per arm joint: those the pose left
-   free) kept, taken where they bring it within DK_REFINE_TOL (the Python solver's _keep) */
-static void dk_polish(const double chain[DK_REFINE_N + 1][12], const int revolute[DK_REFINE_N],
-                      const int solved[DK_REFINE_M], double reach, const double t[12],
-                      double q[DK_REFINE_N], unsigned held)
+   free) kept, taken where they bring it within DK_REFINE_TOL; or a look-at row not certified
+   but aimed within tol radians (dk_aims_at), taken where they bring it within tol. Returns
+   whether q is kept: certified, or brought within tol (the Python solver's _keep). */
+static int dk_polish(const double chain[DK_REFINE_N + 1][12], const int revolute[DK_REFINE_N],
+                     const int solved[DK_REFINE_M], double reach, const double t[12],
+                     double q[DK_REFINE_N], unsigned held, double tol, int certified)
 {
     double moved[DK_REFINE_N];
     int i;
     for (i = 0; i < DK_REFINE_N; i++) {
         moved[i] = q[i];
     }
-    if (dk_refine(chain, revolute, solved, reach, t, moved, held) <= DK_REFINE_TOL) {
+    if (dk_refine(chain, revolute, solved, reach, t, moved, held) <=
+        (certified ? DK_REFINE_TOL : tol)) {
         for (i = 0; i < DK_REFINE_N; i++) {
             q[i] = moved[i];
         }
+        return 1;
     }
+    return certified;
 }
 
 /* The pose of frame k of a chain of n joints and fixed frames (12 entries each: T(q) = F_0
@@ -1899,13 +1904,12 @@ static int dk_solve(const double t[12], double tol, const double ref[DK_DOF],
                                 found[n][2] = theta3;
                                 found[n][3] = theta4 - 1.5707963267948966;
                                 found[n][4] = theta5 - 1.5707963267948966;
-                                if (!dk_fine_ok) { /* (the joints the pose left free held) */
-                                    dk_polish(DK_CHAIN, DK_REVOLUTE, DK_SOLVED, DK_REACH, t,
-                                            found[n], (dk_v1.free ? 1u : 0u) | (dk_v2.free ? 2u :
-                                            0u) | (dk_v3.free ? 4u : 0u) | (dk_v4.free ? 8u : 0u) |
-                                            (dk_v5.free ? 16u : 0u));
+                                if (dk_fine_ok || dk_polish(DK_CHAIN, DK_REVOLUTE, DK_SOLVED,
+                                        DK_REACH, t, found[n], (dk_v1.free ? 1u : 0u) | (dk_v2.free
+                                        ? 2u : 0u) | (dk_v3.free ? 4u : 0u) | (dk_v4.free ? 8u : 0u)
+                                        | (dk_v5.free ? 16u : 0u), tol, 1)) {
+                                    n++;
                                 }
-                                n++;
                             }
                             if (dk_v4.free && n > dk_m4) {
                                 break;

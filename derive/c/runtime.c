@@ -1538,6 +1538,19 @@ static double dk_ray_gap(const double e[12], const double t[12], int axis)
     return fmax(fmax(fabs(v0 - along * u0), fabs(v1 - along * u1)), fabs(v2 - along * u2));
 }
 
+/* whether the ray of e's tool axis `axis` (the look-at task, 3) passes t's point within tol
+   radians: its miss over the point's distance along it (at least reach); a point many reaches
+   away is missed by the angles' roundings times that distance, beyond tol * reach, and such a
+   row is polished before it is certified (dk_polish). 0 for every other task. (The Python
+   solver's _aims_at.) */
+static int dk_aims_at(const double e[12], const double t[12], double tol, double reach,
+                      int task, int axis)
+{
+    const double v0 = t[3] - e[3], v1 = t[7] - e[7], v2 = t[11] - e[11];
+    const double along = v0 * e[axis] + v1 * e[4 + axis] + v2 * e[8 + axis];
+    return task == 3 && along > 0.0 && dk_ray_gap(e, t, axis) <= tol * fmax(along, reach);
+}
+
 /* whether e (a pose's 12 top entries) matches t in the task's components (0 the pose, 1 the
    position, 2 the position and tool axis `axis`'s direction, 3 the ray of that axis through
    t's position, 4 that axis's direction, 5 the position and entry `axis` (the tool axis's
@@ -2138,21 +2151,26 @@ static double dk_refine_held(const double chain[DK_REFINE_N + 1][12],
    DK_REFINE_POLISH (a value taken at a fold within DK_FOLD_TOL of it, a root at the edge of its
    polynomial's conditioning: a look-at point ten reaches away), polished: Newton's steps on
    the exact chain (dk_refine), the joints in held (a bit per arm joint: those the pose left
-   free) kept, taken where they bring it within DK_REFINE_TOL (the Python solver's _keep) */
-static void dk_polish(const double chain[DK_REFINE_N + 1][12], const int revolute[DK_REFINE_N],
-                      const int solved[DK_REFINE_M], double reach, const double t[12],
-                      double q[DK_REFINE_N], unsigned held)
+   free) kept, taken where they bring it within DK_REFINE_TOL; or a look-at row not certified
+   but aimed within tol radians (dk_aims_at), taken where they bring it within tol. Returns
+   whether q is kept: certified, or brought within tol (the Python solver's _keep). */
+static int dk_polish(const double chain[DK_REFINE_N + 1][12], const int revolute[DK_REFINE_N],
+                     const int solved[DK_REFINE_M], double reach, const double t[12],
+                     double q[DK_REFINE_N], unsigned held, double tol, int certified)
 {
     double moved[DK_REFINE_N];
     int i;
     for (i = 0; i < DK_REFINE_N; i++) {
         moved[i] = q[i];
     }
-    if (dk_refine(chain, revolute, solved, reach, t, moved, held) <= DK_REFINE_TOL) {
+    if (dk_refine(chain, revolute, solved, reach, t, moved, held) <=
+        (certified ? DK_REFINE_TOL : tol)) {
         for (i = 0; i < DK_REFINE_N; i++) {
             q[i] = moved[i];
         }
+        return 1;
     }
+    return certified;
 }
 
 /* The pose of frame k of a chain of n joints and fixed frames (12 entries each: T(q) = F_0

@@ -278,7 +278,11 @@ def position_equations(
             degree,
             refs[2],
             typical_magnitude(coeffs, length),
-            length if prismatic3 else 1.0,
+            # (d3 is as long as the wrist centre is far, and a look-at's point can be any
+            # distance along its ray: a head's axes 3 mm apart lost every point 1 m away
+            # when its quartic's leading coefficient, scaled by the arm's length alone,
+            # fell below _LEAD_TOL of the largest: a new user's attack on a GR3 head)
+            length + sp.sqrt(r) if prismatic3 else 1.0,
         ),
     ]
     if theta2_eq is None:

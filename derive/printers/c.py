@@ -125,7 +125,8 @@ def _poly(step: Solve, values: list[str], ref: str) -> Call:
     angles = "1" if step.angle else "0"
     coeffs = f"dk_p{step.joint}"
     array = f"const double {coeffs}[] = {{{', '.join(values)}}};"
-    return Call("dk_poly", (coeffs, str(degree), angles, repr(free), repr(unit), ref), array)
+    length = CPrinter().doprint(unit) if isinstance(unit, sp.Expr) else repr(unit)
+    return Call("dk_poly", (coeffs, str(degree), angles, repr(free), length, ref), array)
 
 
 def _cs1(step: Solve, values: list[str], ref: str) -> Call:
@@ -417,20 +418,24 @@ def solve_lines(plan: Plan) -> tuple[tuple[int, str], ...]:
         match = f"dk_match(e, t, {{}}, {{}}, {task}, {axis})"
         fine = match.format("dk_fine", "dk_fine * DK_REACH")
         body.append(Line(depth, f"const int dk_fine_ok = n < DK_MAX && {fine};"))
-        body.append(
-            Line(depth, f"if (dk_fine_ok || (n < DK_MAX && {match.format('tol', 'ptol')})) {{")
-        )
+        certified = f"dk_fine_ok || (n < DK_MAX && {match.format('tol', 'ptol')})"
+        if plan.ik.certify == "lookat":  # (a far point's row aimed within tol: dk_aims_at)
+            body.append(Line(depth, f"const int dk_ok = {certified};"))
+            aimed = f"dk_aims_at(e, t, tol, DK_REACH, {task}, {axis})"
+            certified, flag = f"dk_ok || (n < DK_MAX && {aimed})", "dk_ok"
+        else:
+            flag = "1"
+        body.append(Line(depth, f"if ({certified}) {{"))
         body += [Line(depth + 1, f"found[n][{k}] = {v};") for k, v in enumerate(outputs)]
-        # (a row within tol but not DK_REFINE_POLISH is polished on the exact chain)
-        body.append(
-            Line(depth + 1, "if (!dk_fine_ok) { /* (the joints the pose left free held) */")
-        )
+        # (a row within tol but not DK_REFINE_POLISH is polished on the exact chain, the
+        # joints the pose left free held)
         polish = (
-            f"dk_polish(DK_CHAIN, DK_REVOLUTE, DK_SOLVED, DK_REACH, t, found[n], {held or '0u'});"
+            f"dk_polish(DK_CHAIN, DK_REVOLUTE, DK_SOLVED, DK_REACH, t, found[n], {held or '0u'}, "
+            f"tol, {flag})"
         )
-        body.append(Line(depth + 2, polish))
+        body.append(Line(depth + 1, f"if (dk_fine_ok || {polish}) {{"))
+        body.append(Line(depth + 2, "n++;"))
         body.append(Line(depth + 1, "}"))
-        body.append(Line(depth + 1, "n++;"))
         body.append(Line(depth, "}"))
     for line in reversed(closing):
         body += endings.get(id(line), [])

@@ -240,5 +240,6 @@ def live_steps(plan: Plan) -> tuple[tuple[Live, ...], frozenset[str]]:
                 out.append(Live(step, after))
             continue
         out.append(Live(step, after))
-        live |= {str(s) for e in (*step.args, step.ref) for s in e.free_symbols}
+        unit = (step.unit,) if isinstance(step.unit, sp.Expr) else ()
+        live |= {str(s) for e in (*step.args, step.ref, *unit) for s in e.free_symbols}
     return tuple(reversed(out)), frozenset(live)

@@ -37,12 +37,20 @@ from derive.printers.common import (
     step_arguments,
 )
 
+
+def _unit(step: Solve) -> str:
+    """A polyd step's unit as Python: a number, or an expression in the step's inputs."""
+    if isinstance(step.unit, sp.Expr):
+        return CodePrinter().doprint(step.unit)
+    return repr(step.unit)
+
+
 # Solve kind -> the call giving the joint's values, from the step and its printed arguments,
 # reference value and free-polynomial threshold
 SolvePrinter = Callable[[Solve, str, str, str], str]
 SOLVES: dict[type[Solve], SolvePrinter] = {
     Poly: lambda step, args, ref, free: f"_poly_angles(({args},), {ref}, {free})",
-    PolyD: lambda step, args, ref, free: f"_poly_real(({args},), {ref}, {free}, {step.unit!r})",
+    PolyD: lambda step, args, ref, free: f"_poly_real(({args},), {ref}, {free}, {_unit(step)})",
     Cs1: lambda step, args, ref, free: f"_cs1({args}, {step.scale!r}, {ref})",
     Cs1Unit: lambda step, args, ref, free: f"_cs1x({args}, {step.scale!r}, {ref})",
     Cs1Reach: lambda step, args, ref, free: f"_cs1_reach({args}, {step.scale!r}, {ref})",

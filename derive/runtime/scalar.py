@@ -9,7 +9,7 @@ from math import acos, atan2, cos, sin, sqrt
 
 import numpy as np
 
-from derive.runtime.arm import _SEED_TOL
+from derive.runtime.arm import _SEED_TOL, IK_COMPONENTS, REACH, TOOL_AXIS
 from derive.runtime.closed import (
     _kquadratic,
     _kquartic,
@@ -78,6 +78,19 @@ def _ray_gap(e, t, axis):
     if along < 0.0:
         return math.sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2])
     return max(abs(v[0] - along * u[0]), abs(v[1] - along * u[1]), abs(v[2] - along * u[2]))
+
+
+def _aims_at(e, t, tol):
+    """Whether e's ray (the look-at task's: IK_COMPONENTS "lookat", TOOL_AXIS) passes t's
+    point within tol radians, its miss over the point's distance along it (at least REACH):
+    a point many reaches away is missed by the angles' roundings times that distance, beyond
+    tol * REACH, and such a row is polished before it is certified (_keep). False for every
+    other task."""
+    if IK_COMPONENTS != "lookat":
+        return False
+    v = (t[3] - e[3], t[7] - e[7], t[11] - e[11])
+    along = v[0] * e[TOOL_AXIS] + v[1] * e[4 + TOOL_AXIS] + v[2] * e[8 + TOOL_AXIS]
+    return along > 0.0 and _ray_gap(e, t, TOOL_AXIS) <= tol * max(along, REACH)
 
 
 def _free(t: float) -> _Free:
