@@ -154,7 +154,7 @@ def model_robot(
             kind, name = int(model.jnt_type[j]), names[j]
             anchor = _vector(model.jnt_pos[j])
             if kind in (FREE, BALL):  # (chain_between refuses it between base and tip)
-                joint = UrdfJoint(name, "floating" if kind == FREE else "ball", above,
+                joint = UrdfJoint(name, "free" if kind == FREE else "ball", above,
                                   f"{body}#{name}", place,
                                   (0.0, 0.0, 1.0), None, False)  # fmt: skip
                 place = _frame((0.0, 0.0, 0.0))
@@ -348,7 +348,9 @@ def import_mjcf(path: Path, options: urdf.Options) -> tuple[str, urdf.Conversion
             f"{where}: --base {urdf._shown(options.base)}: a site; the chain starts from a body "
             "(a site, a frame fixed to a body, can be the --tip)"
         )
-    chain = urdf.chain_between(robot, options.base, options.tip, where)
+    chain = urdf.chain_between(
+        robot, options.base, options.tip, where, "hinge, slide (a body without joints is fixed)"
+    )
     check_numbers(model, chain, index, where)
     check_couplings(model, chain, index, options.base, where)
     ids = [places[options.base], places[options.tip]]

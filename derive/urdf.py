@@ -346,8 +346,15 @@ def _joint(element, where: str) -> UrdfJoint:
     )
 
 
-def chain_between(robot: Robot, base: str, tip: str, where: str) -> list[UrdfJoint]:
-    """The joints from base down to tip, in order."""
+def chain_between(
+    robot: Robot,
+    base: str,
+    tip: str,
+    where: str,
+    allowed: str = "revolute, continuous, prismatic, fixed",
+) -> list[UrdfJoint]:
+    """The joints from base down to tip, in order; allowed: the joint kinds a refusal names
+    (an MJCF file's own words, derive/mjcf.py)."""
     for link, what in ((base, "--base"), (tip, "--tip")):
         if link not in robot.links:
             known = _listing(list(robot.links))
@@ -372,10 +379,10 @@ def chain_between(robot: Robot, base: str, tip: str, where: str) -> list[UrdfJoi
             f"allowed at most {MAX_CHAIN}"
         )
     for joint in path:
-        if joint.kind in ("floating", "planar", "ball"):
+        if joint.kind in ("floating", "planar", "ball", "free"):
             raise UrdfError(
                 f"{where}: joint {_shown(joint.name)}: a {joint.kind} joint between base and tip; "
-                "allowed: revolute, continuous, prismatic, fixed"
+                f"allowed: {allowed}"
             )
         if joint.mimic and joint.kind in MOVING:
             raise UrdfError(

@@ -195,7 +195,14 @@ def test_task_tool_axis_and_method_options_reach_the_spec(tmp_path, capsys):
             "</worldbody></mujoco>",
             "world",
             "b",
-            "a ball joint between base and tip",
+            "a ball joint between base and tip; allowed: hinge, slide",
+        ),
+        (  # (MJCF's words, not URDF's: a new user's attack)
+            '<mujoco><worldbody><body name="a"><freejoint/><body name="b"/></body>'
+            "</worldbody></mujoco>",
+            "world",
+            "b",
+            "a free joint between base and tip; allowed: hinge, slide",
         ),
     ],
 )
