@@ -201,6 +201,12 @@ def workspace_figure(wmap: Any, title: str) -> Any:
         (wmap.dexterous, f"dexterous (all {wmap.orientations} orientations)", "Greys"),
         (wmap.counts, "solutions (most over the orientations)", "viridis"),
     )
+    if wmap.orientations == 0:  # (a look-at arm: points, no orientation read)
+        panels = (
+            (wmap.reachable, "points the tool axis passes through", "Greys"),
+            (wmap.dexterous, "dexterous: none (a look-at reads no orientation)", "Greys"),
+            (wmap.counts, "solutions", "viridis"),
+        )
     for ax, (values, name, cmap) in zip(axes, panels):
         image = ax.imshow(
             values.astype(float), origin="lower", extent=extent, cmap=cmap, interpolation="nearest"

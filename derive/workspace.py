@@ -48,7 +48,9 @@ class WorkspaceMap:
         counts: (len(v), len(u)) the most solutions over the sampled orientations.
         planar: the section is the arm's own plane (else a plane through axis 1).
         limits: the joint limits were honoured.
-        orientations: how many orientations were sampled per position.
+        orientations: how many orientations were sampled per position; 0 for a look-at
+            arm, whose task reads a point only (no orientation to sample: no dexterous
+            workspace; reachable is the points its tool axis can pass through).
     """
 
     u: np.ndarray
@@ -81,6 +83,16 @@ class WorkspaceMap:
     def summary(self) -> str:
         """The figures in words."""
         reach = self.area(self.reachable)
+        if self.orientations == 0:  # (a look-at: a new user's attack had every point
+            # "dexterous (all 24 orientations)", as ik reads no orientation)
+            text = (
+                f"points its tool axis can pass through {reach:.6g} (area of the section); the "
+                "look-at task reads a point only: no orientations, no dexterous workspace; "
+                f"joint limits {'honoured' if self.limits else 'ignored'}"
+            )
+            if not self.planar:
+                text += f"; volume swept about axis 1: {self.volume(self.reachable):.6g}"
+            return text
         share = self.dexterous.sum() / max(int(self.reachable.sum()), 1)
         text = (
             f"reachable {reach:.6g} (area of the section), "
@@ -207,6 +219,9 @@ def workspace(
     normal = np.cross(du, dv)
     rotations = orientations(planar, normal, headings)
     position_only = module.IK_COMPONENTS == "position"
+    point_only = module.IK_COMPONENTS == "lookat"  # (no orientation read: one sampled)
+    if point_only:
+        rotations = rotations[:1]
     sweeps = [np.zeros(module.DOF)]
     if position_only:  # the free joint of a singular position takes q_ref's value: sweep it
         sweeps = [np.eye(module.DOF)[0] * (2.0 * math.pi * k / headings) for k in range(headings)]
@@ -265,10 +280,11 @@ def workspace(
     if progress is not None:  # end the progress line: what is printed next starts a line
         progress.write("\n")
     reachable = counts > 0
-    dexterous = reached.all(axis=2) & reachable
+    dexterous = reached.all(axis=2) & reachable & (not point_only)
     return WorkspaceMap(
-        u, v, origin, du, dv, reachable, dexterous, counts, planar, limits, len(targets)
-    )
+        u, v, origin, du, dv, reachable, dexterous, counts, planar, limits,
+        0 if point_only else len(targets),
+    )  # fmt: skip
 
 
 def progress_line(out: TextIO, label: str, done: int, total: int, start: float, unit: str) -> None:

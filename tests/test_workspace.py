@@ -58,6 +58,19 @@ def test_a_spatial_arm_solved_for_its_position_reaches_its_shell(tmp_path):
     assert not wmap.dexterous.any()  # (three joints take a position, not every rotation)
 
 
+def test_a_look_at_head_maps_the_points_it_sees_and_no_dexterous_workspace(generated):
+    """A look-at reads a point only, so every sampled orientation of a point it sees had a
+    row: the map called every such point dexterous, "all 24 orientations" (a new user's
+    attack on a GR3 head). Now it samples no orientation and says so: the points its camera
+    axis passes through (those farther from its pan axis than the axes' offset), no
+    dexterous workspace."""
+    m = generated("locobot_head")
+    wmap = workspace(m, False, "modified", resolution=21, progress=None)
+    assert wmap.orientations == 0 and not wmap.dexterous.any()
+    assert 0.5 * wmap.reachable.size < wmap.reachable.sum() < wmap.reachable.size
+    assert "no dexterous workspace" in wmap.summary() and "orientations per" not in wmap.summary()
+
+
 def test_the_orientations_are_the_24_rotations_of_the_cube():
     R = orientations(False, np.array([0.0, 0.0, 1.0]), 0)
     assert R.shape == (24, 3, 3)
