@@ -1558,9 +1558,9 @@ PATH_SLACK = 1e-6
 
 
 # ... and q0 must reach Ts[0] within this (its pose error, as ik's certification measures it);
-# a step of more than PATH_JUMP (radians, or REACH) where sigma_min is below PATH_SINGULAR is
-# a break: the first-order bound allows any step there, and which way the path goes depends
-# on how finely it is sampled
+# a step whose finest part (_follow's halves) moves more than PATH_JUMP (radians, or REACH)
+# where sigma_min is below PATH_SINGULAR is a break: the first-order bound allows any step
+# there, and which way the path goes depends on how finely it is sampled
 PATH_START_TOL = 1e-6
 
 
@@ -1640,7 +1640,7 @@ def ik_path(
     out[0] = q
     breaks: list[tuple[int, str]] = []
     for k in range(1, len(poses)):
-        row, why, least = _follow(poses[k - 1], poses[k], q, within_limits, backend, 0)
+        row, why, least, _ = _follow(poses[k - 1], poses[k], q, within_limits, backend, 0)
         if why:
             breaks.append((k, f"pose {k}: {why}; sigma_min {least:.3g}"))
             if on_break == "stop":
@@ -1674,43 +1674,46 @@ def _follow(A, B, q, within_limits, backend, depth):
     near a singular configuration a branch turns fast (the wrist centre passing near axis 1
     turned a KR 10's q1 by 1.6 rad in one of 20 steps, sigma_min 4e-3), and the other
     shoulder's row, nearer by joint distance, was taken with no break reported (a new user's
-    attack). A step whose row moves a joint more than PATH_JUMP where sigma_min is below
-    PATH_SINGULAR, at its start or at the start of any of its parts, is a break: the
-    first-order bound allows any step there, and which way the path goes depends on how
-    finely it is sampled (a GP7's elbow line passing sigma_min 3.5e-4 mid-step turned q1 by
-    2.8 rad in one of 19 steps with no break: a new user's attack). Returns (row, why) as
-    _continuation, and the least sigma_min at the starts of the step and its parts."""
+    attack). A jumping step whose first half finds no continuation is a break: the branch
+    ends within it (a GP7's elbow line jumped 3.1 rad so, onto another branch, with no break).
+    A step one of whose finest parts (the step itself where it was not split) still moves a
+    joint more than PATH_JUMP, where sigma_min at the part's start is below PATH_SINGULAR, is
+    a break: the first-order bound allows any step there, and which way the path goes depends
+    on how finely it is sampled; a step whose parts all move less is a branch followed
+    closely enough, however fast it turns. Returns (row, why) as _continuation, the least
+    sigma_min at the starts of the step and its parts, and (jump, sigma_min, joint) of the
+    part that moves a joint most."""
     bound, least = _step_bound(q, A, B)
     row, why = _continuation(B, q, branch(q), bound, within_limits, backend)
     if row is None or "limits" in why:
-        return row, why, least
+        return row, why, least, (0.0, least, 0)
     revolute = np.array(_REVOLUTE)
     units = np.where(revolute, 1.0, REACH)
     jump = np.abs(_turned(row - q, revolute)) / units
-    if depth < PATH_SPLITS and (why or float(jump.max()) > PATH_NEAR):
+    worst = (float(jump.max()), least, int(np.argmax(jump)))
+    if depth < PATH_SPLITS and (why or worst[0] > PATH_NEAR):
         middle = straight_line(A, B, 3)[1]
-        half, first, least_first = _follow(A, middle, q, within_limits, backend, depth + 1)
-        if (half is None or first) and not why:  # (the step's row jumps, and its first half
-            # finds no continuation: the branch ends within the step, at a fold where q's
-            # branch meets another, and the row is another branch's; a GP7's elbow line
-            # jumped so by 3.1 rad with no break, sigma_min 1.1e-2 at the step's start)
+        half, first, least_first, worst_first = _follow(
+            A, middle, q, within_limits, backend, depth + 1
+        )
+        if (half is None or first) and not why:  # (the branch ends within the step, at a
+            # fold where q's branch meets another, and the row is another branch's)
             why = first or "the middle of the step is out of reach"
             least = min(least, least_first)
         elif half is not None and not first:
-            split, why_split, least_split = _follow(
+            split, why_split, least_split, worst_split = _follow(
                 middle, B, half, within_limits, backend, depth + 1
             )
             if split is not None:
                 row, why = split, why_split
-                jump = np.abs(_turned(row - q, revolute)) / units
                 least = min(least, least_first, least_split)  # (the parts' own starts)
-    if not why and depth == 0 and least < PATH_SINGULAR and float(jump.max()) > PATH_JUMP:
-        j = int(np.argmax(jump))
+                worst = max(worst_first, worst_split)
+    if not why and depth == 0 and worst[1] < PATH_SINGULAR and worst[0] > PATH_JUMP:
         why = (
-            f"q{j + 1} jumps by {jump[j]:.3g} at a singular configuration (the path passes "
-            "one; where it goes from there the poses do not say)"
+            f"q{worst[2] + 1} jumps by {worst[0]:.3g} at a singular configuration (the path "
+            "passes one; where it goes from there the poses do not say)"
         )
-    return row, why, least
+    return row, why, least, worst
 
 
 def _continuation(T, q, label, bound, within_limits, backend):

@@ -376,7 +376,18 @@ GP7 = [  # (Yaskawa GP7's public DH table, standard: alpha, a, d, theta offset; 
 ]
 
 
-def test_a_path_whose_branch_ends_within_a_step_breaks_there(tmp_path):
+@pytest.fixture(scope="module")
+def gp7(tmp_path_factory):
+    """The GP7's module (its exact table), with its C solver."""
+    rows = "\n".join(
+        f'[[joint]]\ntype = "R"\nalpha = {al!r}\na = {a!r}\nd = {d!r}\ntheta = {th!r}\n'
+        for al, a, d, th in GP7
+    )
+    text = f'name = "gp7"\nconvention = "standard"\nangle_unit = "deg"\nlength_unit = "m"\n{rows}'
+    return build_module(text, tmp_path_factory.mktemp("gp7"), c=True)
+
+
+def test_a_path_whose_branch_ends_within_a_step_breaks_there(gp7):
     """A GP7's straight line (20 poses) on which q's branch ends between poses 16 and 17: the
     wrist centre crosses a fold of the quartic in theta3 (8 solutions become 4; Newton's
     iteration from q16 along 2,000 poses between them stops converging there). Pose 17's
@@ -384,12 +395,7 @@ def test_a_path_whose_branch_ends_within_a_step_breaks_there(tmp_path):
     sigma_min at q16 (2.5e-3) let the step pass: ik_path took it with no break (a new user's
     attack found it on a GP7 URDF). The step's first half finds no continuation, so the
     step is a break."""
-    rows = "\n".join(
-        f'[[joint]]\ntype = "R"\nalpha = {al!r}\na = {a!r}\nd = {d!r}\ntheta = {th!r}\n'
-        for al, a, d, th in GP7
-    )
-    text = f'name = "gp7"\nconvention = "standard"\nangle_unit = "deg"\nlength_unit = "m"\n{rows}'
-    module = build_module(text, tmp_path, c=True)
+    module = gp7
     qa = np.array([-1.65484, -2.921283, 1.697773, 2.829662, -1.720035, -2.119624])
     qb = np.array([-1.837715, -3.421963, 1.877452, 2.671925, -1.645061, -1.632604])
     Ts = module.straight_line(module.fk(qa), module.fk(qb), 20)
@@ -405,6 +411,49 @@ def test_a_path_whose_branch_ends_within_a_step_breaks_there(tmp_path):
             stalled = True
             break
     assert stalled
+
+
+def _fine_walk(module, qa, qb, n, fine):
+    """The nearest-row walk along the straight line fk(qa) -> fk(qb) sampled `fine` times
+    finer than n poses: its rows at the n poses, and its largest step."""
+    poses = module.straight_line(module.fk(qa), module.fk(qb), (n - 1) * fine + 1)
+    Q, valid = module.ik_batch(poses)
+    walk, largest = [qa], 0.0
+    for rows, ok in zip(Q[1:], valid[1:]):
+        gaps = np.abs(np.remainder(rows[ok] - walk[-1] + np.pi, 2 * np.pi) - np.pi).max(axis=1)
+        largest = max(largest, float(gaps.min()))
+        walk.append(rows[ok][int(np.argmin(gaps))])
+    return np.array(walk)[::fine], largest
+
+
+def test_a_branch_turning_fast_is_followed_and_a_jump_through_axis_1_is_a_break(gp7):
+    """Two GP7 lines of 20 poses near singular configurations. On the first, q6 turns 3.0
+    rad in one step (sigma_min 2e-4 on the way), but a 2,000 times finer walk takes steps of
+    6e-3 rad at most: one branch, continuous. The step's parts (PATH_SPLITS halvings) each
+    move less than PATH_JUMP, so it is followed, to that walk, with no break; it had been
+    reported as a jump at a singular configuration (the rule then read the whole step), as
+    were 15 of 300 such random lines. On the second, the wrist centre passes axis 1 (sigma_min
+    4.5e-9 there): the finer walk jumps pi in q1 too, and even the finest part of that step
+    does, so the step is a break, in C and in Python."""
+    qa = np.array([-2.027949, 2.026065, -1.254458, 0.852345, -0.903818, -1.795966])
+    qb = np.array([-2.417218, 1.511205, -1.765132, 0.335254, -1.395916, -1.395131])
+    reference, largest = _fine_walk(gp7, qa, qb, 20, 2000)
+    assert largest < 0.01
+    Ts = gp7.straight_line(gp7.fk(qa), gp7.fk(qb), 20)
+    for backend in ("c", "python"):
+        path, breaks = gp7.ik_path(Ts, qa, backend=backend)
+        assert breaks == []
+        assert np.abs(np.remainder(path - reference + np.pi, 2 * np.pi) - np.pi).max() <= 1e-9
+        assert np.abs(np.diff(path, axis=0)).max() > 2.9  # (a fast turn, not a short one)
+    qa = np.array([2.461032, -0.507344, -1.477101, -3.016816, -1.327296, 1.763842])
+    qb = np.array([1.885237, -0.909352, -1.703939, -2.978403, -1.491644, 2.22301])
+    _, largest = _fine_walk(gp7, qa, qb, 20, 2000)
+    assert largest > 3.0
+    Ts = gp7.straight_line(gp7.fk(qa), gp7.fk(qb), 20)
+    for backend in ("c", "python"):
+        _, breaks = gp7.ik_path(Ts, qa, backend=backend)
+        assert [k for k, _ in breaks] == [15], breaks
+        assert "q1 jumps by 3.14 at a singular configuration" in breaks[0][1]
 
 
 @pytest.mark.parametrize(
