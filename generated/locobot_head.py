@@ -1358,9 +1358,9 @@ PATH_JUMP = 0.5
 PATH_NEAR = 0.25
 
 
-# ... and a step whose row moves a joint more than PATH_NEAR is taken in halves, at most this
-# many times (2^6 = 64 parts; _follow)
-PATH_SPLITS = 6
+# ... and a step whose row moves a joint more than PATH_NEAR, or changes branch, is taken in
+# halves, at most this many times (2^10 = 1,024 parts; _follow)
+PATH_SPLITS = 10
 
 
 def ik_path(
@@ -1451,12 +1451,16 @@ def _step_bound(q, A, B):
 
 def _follow(A, B, q, within_limits, backend, depth):
     """ik_path's step from q (a solution of the pose A) to the pose B: _continuation, but
-    where its row moves a joint by more than PATH_NEAR (radians, or REACH) or finds no
-    continuation, the step in halves (straight_line's middle pose), up to PATH_SPLITS times:
+    where its row moves a joint by more than PATH_NEAR (radians, or REACH), finds no
+    continuation or changes branch, the step in halves (straight_line's middle pose), up to
+    PATH_SPLITS times:
     near a singular configuration a branch turns fast (the wrist centre passing near axis 1
     turned a KR 10's q1 by 1.6 rad in one of 20 steps, sigma_min 4e-3), and the other
     shoulder's row, nearer by joint distance, was taken with no break reported (a new user's
-    attack). A jumping step whose first half finds no continuation is a break: the branch
+    attack); a straight line passing 0.003 rad from a KR 10's wrist singularity took the
+    partner (q4 + pi, -q5, q6 + pi), 0.15 rad away, where q's branch turns q4 and q6 by pi
+    within the step (a second attack). A jumping step whose first half finds no continuation
+    is a break: the branch
     ends within it (a GP7's elbow line jumped 3.1 rad so, onto another branch, with no break).
     A step one of whose finest parts (the step itself where it was not split) still moves a
     joint more than PATH_JUMP, where sigma_min at the part's start is below PATH_SINGULAR, is
@@ -1473,13 +1477,16 @@ def _follow(A, B, q, within_limits, backend, depth):
     units = np.where(revolute, 1.0, REACH)
     jump = np.abs(_turned(row - q, revolute)) / units
     worst = (float(jump.max()), least, int(np.argmax(jump)))
-    if depth < PATH_SPLITS and (why or worst[0] > PATH_NEAR):
+    label = branch(q)
+    switched = bool(label) and not _same_branch(branch(row), label)
+    if depth < PATH_SPLITS and (why or worst[0] > PATH_NEAR or switched):
         middle = straight_line(A, B, 3)[1]
         half, first, least_first, worst_first = _follow(
             A, middle, q, within_limits, backend, depth + 1
         )
-        if (half is None or first) and not why:  # (the branch ends within the step, at a
-            # fold where q's branch meets another, and the row is another branch's)
+        if (half is None or first) and not why and worst[0] > PATH_NEAR:  # (the branch ends
+            # within the step, at a fold where q's branch meets another, and the row is
+            # another branch's)
             why = first or "the middle of the step is out of reach"
             least = min(least, least_first)
         elif half is not None and not first:

@@ -249,36 +249,62 @@ def joint_line(module, rng, joint: int, cross: float, n: int) -> np.ndarray:
     return qa + np.linspace(0.0, 1.0, n)[:, None] * (qb - qa)
 
 
-def test_a_path_through_the_wrist_flip_region_keeps_its_branch(generated):
-    """ik_path on 100 continuous joint paths of the PUMA whose theta5 crosses 0 (the wrist
-    flip: the partner (theta4 + pi, -theta5, theta6 + pi) is one branch away), 20 poses each:
-    wherever the path stays regular (smallest singular value >= 1e-3 at every pose), it is
-    followed to 1e-6 with no break and every joint step within the first-order bound; the
-    pose-by-pose nearest is counted beside it (it stays too here: its steps are small)."""
+def test_a_straight_line_past_the_wrist_flip_keeps_its_branch(generated):
+    """ik_path on straight lines (20 poses) between poses of the PUMA on either side of its
+    wrist flip (theta5 from -0.3..-0.002 to 0.002..0.3 rad, the other joints moving up to 0.5
+    rad; the partner (theta4 + pi, -theta5, theta6 + pi) is one branch away). A line passes
+    near the singular set, not through it, so the branch that stays continuous keeps
+    theta5's sign and turns theta4 and theta6 by up to half a turn. Where a finer
+    nearest-row walk is continuous (steps within 0.05 rad), ik_path is that walk to 1e-9 at
+    every pose with no break, on theta5's first sign throughout, where the pose-by-pose
+    nearest takes the partner on some (measured: 45 of 60 lines continuous at 100 times
+    finer, nearest flips on 4); where the walk jumps, ik_path breaks or takes the walk's rows
+    or small steps, never a silent jump. The two fixed lines pass within 0.01 rad of the
+    singular set: before, ik_path broke the first (its finest part, after 6 halvings, still
+    turned q4 by 0.55 rad) and took the partner on the second (the nearer row by more than
+    PATH_GAIN, a KR 10's defect found by a new user's attack), against walks 1,000 times finer
+    whose steps are within 0.04 rad."""
     module = generated("puma560")
-    rng = np.random.default_rng(44)
-    followed = nearest_kept = 0
-    for _ in range(100):
-        Qt = joint_line(module, rng, 4, 0.0, 20)
-        if min(module.manipulability(q)[0] for q in Qt) < 1e-3:
-            continue
-        Ts = module.fk_batch(Qt)
-        Q, breaks = module.ik_path(Ts, Qt[0])
+
+    def check(qa, qb, fine):
+        walk, largest = _fine_walk(module, qa, qb, 20, fine)
+        Ts = module.straight_line(module.fk(qa), module.fk(qb), 20)
+        path, breaks = module.ik_path(Ts, qa)
+        gaps = np.abs(np.remainder(path - walk + np.pi, 2 * np.pi) - np.pi).max(axis=1)
+        if largest > 0.05:
+            if not breaks:
+                assert gaps.max() <= 1e-9 or np.abs(np.diff(path, axis=0)).max() <= 0.5
+            return None
         assert breaks == []
-        gaps = np.abs(np.remainder(Q - Qt + np.pi, 2 * np.pi) - np.pi)
-        assert gaps.max() <= 1e-6
-        for k in range(1, len(Ts)):
-            twist = np.linalg.norm(module._pose_step(Ts[k - 1], Ts[k]))
-            bound = module.PATH_GAIN * twist / module.manipulability(Q[k - 1])[0]
-            assert np.abs(Q[k] - Q[k - 1]).max() <= bound + module.PATH_SLACK
-        followed += 1
-        q, kept = Qt[0], True
-        for T, target in zip(Ts[1:], Qt[1:]):
+        assert gaps.max() <= 1e-9
+        assert (path[:, 4] < 0.0).all()
+        q, switched = qa, False
+        for T in Ts[1:]:
             q = module.nearest(T, q, within_limits=False)
-            kept &= bool(np.abs(np.remainder(q - target + np.pi, 2 * np.pi) - np.pi).max() < 1e-6)
-        nearest_kept += kept
-    assert followed >= 70, followed  # (76 of the 100 stay regular)
-    assert nearest_kept <= followed
+            switched |= bool(q[4] > 0.0)
+        return switched
+
+    rng = np.random.default_rng(44)
+    outcomes = []
+    for _ in range(60):
+        qa = rng.uniform(-np.pi, np.pi, 6)
+        qb = qa + rng.uniform(-0.5, 0.5, 6)
+        qa[4] = -rng.uniform(0.002, 0.3)
+        qb[4] = rng.uniform(0.002, 0.3)
+        outcomes.append(check(qa, qb, 100))
+    assert outcomes.count(None) <= 15, outcomes.count(None)
+    assert outcomes.count(True) >= 4  # (the flips ik_path does not take)
+    for qa, qb in (
+        (
+            [-3.0333207699, 0.2001865833, -1.3548207381, 1.7557794649, -0.0016298626, 2.1993227187],
+            [-2.7756583573, 0.6759794315, -1.3080298599, 1.4762654427, 0.0062455936, 2.2351425164],
+        ),
+        (
+            [1.5893472236, -0.6106621196, 0.8291898266, 0.5515482576, -0.0113527452, 1.766025701],
+            [1.2282026498, -1.0692784316, 0.3792439667, 0.5162583437, 0.0136471398, 1.9978229366],
+        ),
+    ):
+        assert check(np.array(qa), np.array(qb), 1000) is not None  # (the walk continuous)
 
 
 def test_a_path_near_the_elbow_s_fold_keeps_its_branch_where_nearest_flips(generated):
@@ -415,11 +441,14 @@ def test_a_path_whose_branch_ends_within_a_step_breaks_there(gp7):
 
 def _fine_walk(module, qa, qb, n, fine):
     """The nearest-row walk along the straight line fk(qa) -> fk(qb) sampled `fine` times
-    finer than n poses: its rows at the n poses, and its largest step."""
+    finer than n poses: its rows at the n poses, and its largest step (NaN rows and inf
+    where the line leaves the workspace)."""
     poses = module.straight_line(module.fk(qa), module.fk(qb), (n - 1) * fine + 1)
     Q, valid = module.ik_batch(poses)
     walk, largest = [qa], 0.0
     for rows, ok in zip(Q[1:], valid[1:]):
+        if not ok.any():  # (the line leaves the workspace)
+            return np.full((n, module.DOF), np.nan), np.inf
         gaps = np.abs(np.remainder(rows[ok] - walk[-1] + np.pi, 2 * np.pi) - np.pi).max(axis=1)
         largest = max(largest, float(gaps.min()))
         walk.append(rows[ok][int(np.argmin(gaps))])
@@ -434,7 +463,9 @@ def test_a_branch_turning_fast_is_followed_and_a_jump_through_axis_1_is_a_break(
     reported as a jump at a singular configuration (the rule then read the whole step), as
     were 15 of 300 such random lines. On the second, the wrist centre passes axis 1 (sigma_min
     4.5e-9 there): the finer walk jumps pi in q1 too, and even the finest part of that step
-    does, so the step is a break, in C and in Python."""
+    does (with 6 halvings; with 10, Newton's iteration from the branch's last row no longer
+    converges in the finest part, sigma_min 7.9e-5), so the step is a break, in C and in
+    Python."""
     qa = np.array([-2.027949, 2.026065, -1.254458, 0.852345, -0.903818, -1.795966])
     qb = np.array([-2.417218, 1.511205, -1.765132, 0.335254, -1.395916, -1.395131])
     reference, largest = _fine_walk(gp7, qa, qb, 20, 2000)
@@ -453,7 +484,10 @@ def test_a_branch_turning_fast_is_followed_and_a_jump_through_axis_1_is_a_break(
     for backend in ("c", "python"):
         _, breaks = gp7.ik_path(Ts, qa, backend=backend)
         assert [k for k, _ in breaks] == [15], breaks
-        assert "q1 jumps by 3.14 at a singular configuration" in breaks[0][1]
+        assert (  # (after 10 halvings the branch's Newton iteration no longer converges there)
+            "q1 jumps by 3.14 at a singular configuration" in breaks[0][1]
+            or "no solution continues the path (Newton's iteration" in breaks[0][1]
+        )
 
 
 @pytest.mark.parametrize(
