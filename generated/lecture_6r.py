@@ -303,6 +303,17 @@ _SPREAD_COUNT = 8
 _WRIST_WIDTH = 0.03
 
 
+# ... and beyond that, where the table's difference over the square root (_WRIST_SPREAD
+# _SEED_TOL / sqrt(|det| / scale): the angle's uncertainty u, _SEED_TOL being 100 times the
+# difference) is at least _WRIST_NEAR radians, t +- u and t +- 2 u seed the refinement too: a
+# UR3e zoo URDF (difference 2e-7) 1e-6 rad from its wrist straight got theta6 0.15 rad off,
+# the elbow's acos beyond 1 and no row (a new user's attack)
+_WRIST_SPREAD = 0.01
+
+
+_WRIST_NEAR = 0.05
+
+
 # ... and where its acos argument is beyond _FOLD_NEAR (cos 1e-3: its two values within 1e-3
 # of their fold, or one clamped value, where the exact arm's pair may lie up to acos(1 -
 # _SEED_MISS) apart), the fold's angle +- each of _FOLD_SEEDS seeds the refinement too: two
@@ -1783,6 +1794,20 @@ class _Free(tuple):
     +-90 deg reaches only part of the orientations)."""
 
 
+class _Spread(list):
+    """A nominal table's angle that its equation fixes only roughly (_wrist_spread): [t], and
+    the values the solver adds (widen) where t gave no row: t -+ u, t -+ 2 u."""
+
+    def __init__(self, first: float, more: tuple[float, ...]) -> None:
+        super().__init__((first,))
+        self.more = more
+
+    def widen(self) -> None:
+        """Add the other values (once)."""
+        self.extend(self.more)
+        self.more = ()
+
+
 # how far beyond 1 a nominal table's acos argument still seeds the refinement (0: exact arms)
 _SEED_MISS = max(_SEED_TOL, _SEED_BAND) if _SEED_TOL > 0.0 else 0.0
 
@@ -1893,7 +1918,7 @@ def _cs2(
     det_scale: float,
     rhs_scale: float,
     ref: float,
-) -> tuple[float, ...]:
+) -> tuple[float, ...] | _Spread:
     """The angle t with a1 c + b1 s = e1 and a2 c + b2 s = e2; ref where t is free.
 
     t is free when the system is singular or, for a consistent system, when its right-hand
@@ -1907,14 +1932,23 @@ def _cs2(
     return _wrist_spread(t, det, det_scale)
 
 
-def _wrist_spread(t: float, det: float, det_scale: float) -> tuple[float, ...]:
+def _wrist_spread(t: float, det: float, det_scale: float) -> tuple[float, ...] | _Spread:
     """(t,), or on a nominal table where the system is nearly singular (sqrt(|det| /
     det_scale) within _WRIST_WIDTH _SEED_TOL: the wrist nearly straight, where the arm's
     difference moves t anywhere) t and _SPREAD_COUNT - 1 more seeds all round, as _cs1's
-    nominal fold (a calibrated UR5 at q5 = 1.5e-4 got t 0.77 rad off and no row)."""
+    nominal fold (a calibrated UR5 at q5 = 1.5e-4 got t 0.77 rad off and no row); where it is
+    less singular but the difference still moves t by u = _WRIST_SPREAD _SEED_TOL / sqrt(|det|
+    / det_scale) >= _WRIST_NEAR, [t] as a _Spread, widened by t -+ u and t -+ 2 u where t
+    gives no row (a seed that does not converge costs ~20 Newton steps: a calibrated KR6's
+    C ik took 35% longer with all five always)."""
     loose = _LOOSE.on or _LOOSE.near
-    if _SEED_TOL and not loose and abs(det) <= (_WRIST_WIDTH * _SEED_TOL) ** 2 * det_scale:
+    if not _SEED_TOL or loose:
+        return (t,)
+    if abs(det) <= (_WRIST_WIDTH * _SEED_TOL) ** 2 * det_scale:
         return _all_round(t)
+    u = _WRIST_SPREAD * _SEED_TOL / sqrt(abs(det) / det_scale)
+    if u >= _WRIST_NEAR:
+        return _Spread(t, (t - u, t + u, t - 2.0 * u, t + 2.0 * u))
     return (t,)
 
 

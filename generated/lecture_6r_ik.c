@@ -79,6 +79,10 @@
 
 #define DK_WRIST_WIDTH (0.03)
 
+#define DK_WRIST_SPREAD (0.01)
+
+#define DK_WRIST_NEAR (0.05)
+
 #define DK_SEED_BAND (0.05)
 
 /* beyond this acos argument (a nominal fold), the fold's angle +- each of these seeds the
@@ -126,6 +130,7 @@ typedef struct {
     int free;
     int loose;
     double ref;
+    double more; /* (set by the caller to 0; dk_wrist_spread's u: dk_spread_more) */
     double t[DK_VALUES_MAX], c[DK_VALUES_MAX], s[DK_VALUES_MAX];
 } dk_values;
 
@@ -1375,13 +1380,24 @@ static int dk_cs2_value(dk_values *v, double a1, double b1, double e1, double a2
 
 /* v's one value, or on a nominal table where the system is nearly singular (sqrt(|det| /
    det_scale) within DK_WRIST_WIDTH DK_SEED_TOL: the wrist nearly straight, where the arm's
-   difference moves it anywhere) it and DK_SPREAD_COUNT - 1 more all round (the Python
-   solver's _wrist_spread) */
+   difference moves it anywhere) it and DK_SPREAD_COUNT - 1 more all round; where it is less
+   singular but the difference still moves it by u = DK_WRIST_SPREAD DK_SEED_TOL / sqrt(|det|
+   / det_scale) >= DK_WRIST_NEAR, u in v->more: the solver adds it -+ u and -+ 2 u where it
+   gives no row (dk_spread_more; the Python solver's _wrist_spread) */
 static void dk_wrist_spread(dk_values *v, double det, double det_scale)
 {
     const double width = DK_WRIST_WIDTH * DK_SEED_TOL;
-    if (DK_SEED_TOL > 0.0 && !v->loose && fabs(det) <= width * width * det_scale) {
+    double u;
+    if (!(DK_SEED_TOL > 0.0) || v->loose) {
+        return;
+    }
+    if (fabs(det) <= width * width * det_scale) {
         dk_all_round(v, v->t[0]);
+        return;
+    }
+    u = DK_WRIST_SPREAD * DK_SEED_TOL / sqrt(fabs(det) / det_scale);
+    if (u >= DK_WRIST_NEAR) {
+        v->more = u;
     }
 }
 

@@ -61,7 +61,14 @@ def test_the_c_runtime_holds_the_python_runtimes_constants():
         assert float(found[f"DK_{name}"]) == getattr(constants, f"_{name}"), name
     for name in ("CLUSTER_TOL", "RESIDUAL_TOL", "SEAM", "SEAM_SNAP", "BRANCH_FOLD", "FOLD_NEAR"):
         assert float(found[f"DK_{name}"]) == getattr(constants, f"_{name}"), name
-    for name in ("SPREAD_WIDTH", "SPREAD_COUNT", "SEED_BAND", "WRIST_WIDTH"):
+    for name in (
+        "SPREAD_WIDTH",
+        "SPREAD_COUNT",
+        "SEED_BAND",
+        "WRIST_WIDTH",
+        "WRIST_SPREAD",
+        "WRIST_NEAR",
+    ):
         assert float(found[f"DK_{name}"]) == getattr(constants, f"_{name}"), name
     for name in ("DEDUP_TOL", "POSE_TOL"):
         assert float(found[f"DK_{name}"]) == getattr(constants, name), name

@@ -308,6 +308,8 @@ def solve_lines(plan: Plan) -> tuple[tuple[int, str], ...]:
         body.append(Line(depth, f"dk_values dk_v{j};"))
         if fix:  # (the second pass's flag: derive/c/runtime.c dk_values)
             body.append(Line(depth, f"dk_v{j}.loose = loose;"))
+        if fix and type(step) in (Cs2, Cs2Reach):  # (a rough value's spread: dk_wrist_spread)
+            body.append(Line(depth, f"dk_v{j}.more = 0.0;"))
         solve = f"{call.routine}(&dk_v{j}, {', '.join(call.args)}) < 0"
         if flip and j in flip[1:]:  # the second theta5 branch: the first's turned by pi
             body.append(Line(depth, "if (dk_flip) {"))
@@ -366,6 +368,15 @@ def solve_lines(plan: Plan) -> tuple[tuple[int, str], ...]:
             body.append(Line(depth + 1, f"(void){s_name};"))
         # a free joint's loop ends at its first value that gave a solution
         closing.append(Line(depth + 1, f"if (dk_v{j}.free && n > dk_m{j}) {{"))
+        if fix and type(step) in (Cs2, Cs2Reach):  # (a rough value that gave no row: the
+            # values around it too, dk_wrist_spread)
+            endings.setdefault(id(closing[-1]), []).extend(
+                [
+                    Line(depth + 1, f"if (dk_v{j}.more > 0.0 && n == dk_m{j}) {{"),
+                    Line(depth + 2, f"dk_spread_more(&dk_v{j});"),
+                    Line(depth + 1, "}"),
+                ]
+            )
         if flip and j == flip[0]:
             j4, j6 = flip[1:]
             endings[id(closing[-1])] = [

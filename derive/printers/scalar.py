@@ -94,12 +94,18 @@ def ik_lines(plan: Plan) -> tuple[tuple[int, str], ...]:
     else:
         lines.append(Line(depth, f"q = ({outputs},)"))
         lines.append(Line(depth, f"_keep(found, target, q, _fk_q(q), tol, ({frees}))"))
+    spread = {s.joint for s in plan.ik.steps if isinstance(s, (Cs2, Cs2Reach))}
     for level, joint in reversed(loops):
         # a free joint's loop (over _Free values) ends at its first value that gave a solution
         lines.append(
             Line(level + 1, f"if _v{joint}.__class__ is _Free and len(found) > _n{joint}:")
         )
         lines.append(Line(level + 2, "break"))
+        if plan.correction is not None and joint in spread:  # (a rough value gave no row:
+            # the values around it too, _wrist_spread)
+            check = f"_v{joint}.__class__ is _Spread and len(found) == _n{joint}"
+            lines.append(Line(level + 1, f"if {check}:"))
+            lines.append(Line(level + 2, f"_v{joint}.widen()"))
     lines.append(Line(0, "return found"))
     return tuple((ln.depth, ln.text) for ln in lines)
 

@@ -70,6 +70,13 @@ _SPREAD_COUNT = 8
 # 0.03; 5, 1, 3 with 0.2. The seeds that do not converge cost: KR6's C ik 9.6 us on uniform
 # poses, 12.7 with 0.01, 14.8 with 0.03, 33.7 with 0.2
 _WRIST_WIDTH = 0.03
+# ... and beyond that, where the table's difference over the square root (_WRIST_SPREAD
+# _SEED_TOL / sqrt(|det| / scale): the angle's uncertainty u, _SEED_TOL being 100 times the
+# difference) is at least _WRIST_NEAR radians, t +- u and t +- 2 u seed the refinement too: a
+# UR3e zoo URDF (difference 2e-7) 1e-6 rad from its wrist straight got theta6 0.15 rad off,
+# the elbow's acos beyond 1 and no row (a new user's attack)
+_WRIST_SPREAD = 0.01
+_WRIST_NEAR = 0.05
 # ... and where its acos argument is beyond _FOLD_NEAR (cos 1e-3: its two values within 1e-3
 # of their fold, or one clamped value, where the exact arm's pair may lie up to acos(1 -
 # _SEED_MISS) apart), the fold's angle +- each of _FOLD_SEEDS seeds the refinement too: two

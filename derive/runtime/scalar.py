@@ -38,6 +38,8 @@ from derive.runtime.constants import (
     _SPREAD_COUNT,
     _SPREAD_WIDTH,
     _TWO_PI,
+    _WRIST_NEAR,
+    _WRIST_SPREAD,
     _WRIST_WIDTH,
 )
 
@@ -63,6 +65,20 @@ class _Free(tuple):
     it in both directions. The solver stops at the first value that gives a certified
     solution: a later joint may not reach from every value (a wrist whose twists are not
     +-90 deg reaches only part of the orientations)."""
+
+
+class _Spread(list):
+    """A nominal table's angle that its equation fixes only roughly (_wrist_spread): [t], and
+    the values the solver adds (widen) where t gave no row: t -+ u, t -+ 2 u."""
+
+    def __init__(self, first: float, more: tuple[float, ...]) -> None:
+        super().__init__((first,))
+        self.more = more
+
+    def widen(self) -> None:
+        """Add the other values (once)."""
+        self.extend(self.more)
+        self.more = ()
 
 
 # how far beyond 1 a nominal table's acos argument still seeds the refinement (0: exact arms)
@@ -202,7 +218,7 @@ def _cs2(
     det_scale: float,
     rhs_scale: float,
     ref: float,
-) -> tuple[float, ...]:
+) -> tuple[float, ...] | _Spread:
     """The angle t with a1 c + b1 s = e1 and a2 c + b2 s = e2; ref where t is free.
 
     t is free when the system is singular or, for a consistent system, when its right-hand
@@ -216,14 +232,23 @@ def _cs2(
     return _wrist_spread(t, det, det_scale)
 
 
-def _wrist_spread(t: float, det: float, det_scale: float) -> tuple[float, ...]:
+def _wrist_spread(t: float, det: float, det_scale: float) -> tuple[float, ...] | _Spread:
     """(t,), or on a nominal table where the system is nearly singular (sqrt(|det| /
     det_scale) within _WRIST_WIDTH _SEED_TOL: the wrist nearly straight, where the arm's
     difference moves t anywhere) t and _SPREAD_COUNT - 1 more seeds all round, as _cs1's
-    nominal fold (a calibrated UR5 at q5 = 1.5e-4 got t 0.77 rad off and no row)."""
+    nominal fold (a calibrated UR5 at q5 = 1.5e-4 got t 0.77 rad off and no row); where it is
+    less singular but the difference still moves t by u = _WRIST_SPREAD _SEED_TOL / sqrt(|det|
+    / det_scale) >= _WRIST_NEAR, [t] as a _Spread, widened by t -+ u and t -+ 2 u where t
+    gives no row (a seed that does not converge costs ~20 Newton steps: a calibrated KR6's
+    C ik took 35% longer with all five always)."""
     loose = _LOOSE.on or _LOOSE.near
-    if _SEED_TOL and not loose and abs(det) <= (_WRIST_WIDTH * _SEED_TOL) ** 2 * det_scale:
+    if not _SEED_TOL or loose:
+        return (t,)
+    if abs(det) <= (_WRIST_WIDTH * _SEED_TOL) ** 2 * det_scale:
         return _all_round(t)
+    u = _WRIST_SPREAD * _SEED_TOL / sqrt(abs(det) / det_scale)
+    if u >= _WRIST_NEAR:
+        return _Spread(t, (t - u, t + u, t - 2.0 * u, t + 2.0 * u))
     return (t,)
 
 
@@ -248,7 +273,7 @@ def _cs2_reach(
     lo: float,
     hi: float,
     ref: float,
-) -> tuple[float, ...]:
+) -> tuple[float, ...] | _Spread:
     """As _cs2; a free t starts at _reach_first2's value (reachability of later joints)."""
     det = a1 * b2 - a2 * b1
     free = _FREE_TOL if _SEED_TOL else _FREE_TOL_EXACT
