@@ -67,6 +67,7 @@ def test_the_c_runtime_holds_the_python_runtimes_constants():
         "SEED_BAND",
         "WRIST_WIDTH",
         "WRIST_SPREAD",
+        "AIM_POLISH",
         "WRIST_NEAR",
     ):
         assert float(found[f"DK_{name}"]) == getattr(constants, f"_{name}"), name

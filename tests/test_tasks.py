@@ -268,18 +268,21 @@ tool_axis = "x"
 
 
 @pytest.mark.parametrize("backend", ["c", "python"])
-def test_a_head_whose_axes_are_3_mm_apart_sees_points_100_m_away(tmp_path, backend):
+def test_a_head_whose_axes_are_3_mm_apart_sees_points_3_km_away(tmp_path, backend):
     """A pan-tilt whose axes are 2.85 mm apart (a new user's GR3 head, fourier-robot-
     descriptions, reduced to its table) got no row for any point 1 m or more away: the look-at
     quartic in d3 was solved for d3 / the arm's length, and its leading coefficient, 1e-11 of
     the largest there, was dropped as a vanishing one (_LEAD_TOL); and 20 m away the angles,
     right to 7e-9 rad, missed the point by 1.5e-7 m, beyond tol * REACH (1e-8 m). Now the unit
     is the arm's length plus the point's distance, and a row aimed within tol radians is
-    polished before it is certified (_aims_at, dk_aims_at): 100 points each at 1, 20 and 100
-    m get rows, the sampled vector among them, every ray within 1e-9 of the reach."""
+    polished before it is certified (_aims_at, dk_aims_at); at 1 and 3 km the angles, 1e-5 rad
+    off there (the quartic's two roots near d3 = distance, then r - d3^2 cancelling), missed
+    that, and 46 and 98 of 100 points got no row: a row aimed within _AIM_POLISH (0.01 rad) is now
+    polished too. 100 points each at 1, 20, 100, 1,000 and 3,000 m get rows, the sampled
+    vector among them, every ray within 1e-9 of the reach."""
     module = build_module(PAN_TILT_3MM, tmp_path, c=backend == "c")
     rng = np.random.default_rng(1)
-    for distance in (1.0, 20.0, 100.0):
+    for distance in (1.0, 20.0, 100.0, 1000.0, 3000.0):
         Q = rng.uniform(-1.3, 1.3, (100, 2))
         F = module.fk_batch(Q)
         for q, p in zip(Q, F[:, :3, 3] + distance * F[:, :3, 0]):

@@ -33,6 +33,8 @@
 #define DK_WRIST_WIDTH (0.03)
 #define DK_WRIST_SPREAD (0.01)
 #define DK_WRIST_NEAR (0.05)
+/* a look-at row aimed within this many radians (or tol) is polished (dk_aims_at) */
+#define DK_AIM_POLISH (0.01)
 #define DK_SEED_BAND (0.05)
 /* beyond this acos argument (a nominal fold), the fold's angle +- each of these seeds the
    refinement too (derive/runtime/constants.py, _FOLD_NEAR and _FOLD_SEEDS, say why) */
@@ -1567,16 +1569,17 @@ static double dk_ray_gap(const double e[12], const double t[12], int axis)
 }
 
 /* whether the ray of e's tool axis `axis` (the look-at task, 3) passes t's point within tol
-   radians: its miss over the point's distance along it (at least reach); a point many reaches
-   away is missed by the angles' roundings times that distance, beyond tol * reach, and such a
-   row is polished before it is certified (dk_polish). 0 for every other task. (The Python
-   solver's _aims_at.) */
+   or DK_AIM_POLISH radians: its miss over the point's distance along it (at least reach); a
+   point many reaches away is missed by the angles' errors times that distance, beyond tol *
+   reach, and such a row is polished before it is certified (dk_polish). 0 for every other
+   task. (The Python solver's _aims_at.) */
 static int dk_aims_at(const double e[12], const double t[12], double tol, double reach,
                       int task, int axis)
 {
     const double v0 = t[3] - e[3], v1 = t[7] - e[7], v2 = t[11] - e[11];
     const double along = v0 * e[axis] + v1 * e[4 + axis] + v2 * e[8 + axis];
-    return task == 3 && along > 0.0 && dk_ray_gap(e, t, axis) <= tol * fmax(along, reach);
+    return task == 3 && along > 0.0 &&
+           dk_ray_gap(e, t, axis) <= fmax(tol, DK_AIM_POLISH) * fmax(along, reach);
 }
 
 /* whether e (a pose's 12 top entries) matches t in the task's components (0 the pose, 1 the

@@ -77,6 +77,13 @@ _WRIST_WIDTH = 0.03
 # the elbow's acos beyond 1 and no row (a new user's attack)
 _WRIST_SPREAD = 0.01
 _WRIST_NEAR = 0.05
+# a look-at row whose ray passes the point within this many radians (or ik's tol, if larger)
+# but not within tol * REACH is polished on the exact chain, and kept where that certifies it
+# (_aims_at): a point a km away from a head whose axes are 3 mm apart got angles 5e-6 rad
+# off (d3's quartic near a double root, then r - d3^2 cancelling) and no row (a new user's
+# attack on the GR3 URDF: 100 points per distance, empty 6, 22, 89 at 100 m, 300 m, 1 km;
+# 0, 0, 0 with 1e-2, 0, 1, 7 with 1e-4)
+_AIM_POLISH = 1e-2
 # ... and where its acos argument is beyond _FOLD_NEAR (cos 1e-3: its two values within 1e-3
 # of their fold, or one clamped value, where the exact arm's pair may lie up to acos(1 -
 # _SEED_MISS) apart), the fold's angle +- each of _FOLD_SEEDS seeds the refinement too: two

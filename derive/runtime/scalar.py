@@ -21,6 +21,7 @@ from derive.runtime.closed import (
 )
 from derive.runtime.common import _wrap
 from derive.runtime.constants import (
+    _AIM_POLISH,
     _BRANCH_FOLD,
     _CLAMP_ABS,
     _CLAMP_TOL,
@@ -98,15 +99,15 @@ def _ray_gap(e, t, axis):
 
 def _aims_at(e, t, tol):
     """Whether e's ray (the look-at task's: IK_COMPONENTS "lookat", TOOL_AXIS) passes t's
-    point within tol radians, its miss over the point's distance along it (at least REACH):
-    a point many reaches away is missed by the angles' roundings times that distance, beyond
-    tol * REACH, and such a row is polished before it is certified (_keep). False for every
-    other task."""
+    point within tol or _AIM_POLISH radians, its miss over the point's distance along it (at
+    least REACH): a point many reaches away is missed by the angles' errors times that
+    distance, beyond tol * REACH, and such a row is polished before it is certified (_keep).
+    False for every other task."""
     if IK_COMPONENTS != "lookat":
         return False
     v = (t[3] - e[3], t[7] - e[7], t[11] - e[11])
     along = v[0] * e[TOOL_AXIS] + v[1] * e[4 + TOOL_AXIS] + v[2] * e[8 + TOOL_AXIS]
-    return along > 0.0 and _ray_gap(e, t, TOOL_AXIS) <= tol * max(along, REACH)
+    return along > 0.0 and _ray_gap(e, t, TOOL_AXIS) <= max(tol, _AIM_POLISH) * max(along, REACH)
 
 
 def _free(t: float) -> _Free:
