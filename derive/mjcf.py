@@ -97,8 +97,11 @@ def _compile(mujoco: Any, path: Path) -> Any:
             spec.compiler.boundmass = 1e-6  # (bodies without geoms: MuJoCo wants mass)
             spec.compiler.boundinertia = 1e-9
             return spec.compile()
-        except Exception:  # (MuJoCo's first message says what is wrong)
-            message = " ".join(str(first).split())[:COMPILE_SHOWN]
+        except Exception as second:  # (without the meshes MuJoCo's message names what is
+            # wrong with the kinematics; where the file does not parse, both say that; a new
+            # user's WidowX MJCF with an axis "0 0 0" and its meshes absent was refused for
+            # the missing meshes only)
+            message = " ".join(str(second or first).split())[:COMPILE_SHOWN]
             raise UrdfError(f"{where}: MuJoCo cannot compile it: {message}") from None
 
 

@@ -204,6 +204,15 @@ def test_task_tool_axis_and_method_options_reach_the_spec(tmp_path, capsys):
             "b",
             "a free joint between base and tip; allowed: hinge, slide",
         ),
+        (  # (its meshes absent: the message is the kinematics', not the missing mesh's, as
+            # a new user's WidowX AI MJCF got)
+            '<mujoco><asset><mesh name="m" file="absent.stl"/></asset><worldbody>'
+            '<body name="a"><joint name="j" axis="0 0 0"/><geom type="mesh" mesh="m"/>'
+            '<body name="b"/></body></worldbody></mujoco>',
+            "world",
+            "b",
+            "MuJoCo cannot compile it: Error: axis too small in joint",
+        ),
     ],
 )
 def test_bad_mjcf_input_is_one_line_naming_the_file(xml, base, tip, message, tmp_path, capsys):
