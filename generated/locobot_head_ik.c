@@ -1369,6 +1369,12 @@ static int dk_pose_ok(const double T[16])
    derive/runtime/refine.py, _REFINE_POLISH, says why) */
 #define DK_REFINE_POLISH (1e-10)
 
+/* ... with this patience (DK_REFINE_STEPS / DK_REFINE_PATIENCE times as many steps at most):
+   a row taken at a fold lies on a singular configuration, where the damped steps cross a
+   plateau before they converge (derive/runtime/refine.py, _REFINE_POLISH_PATIENCE, says
+   why) */
+#define DK_REFINE_POLISH_PATIENCE 50
+
 /* x := (L L^T)^-1 x, L the lower triangle of a factor dk_cholesky_solve left in A (its
    diagonal held as the reciprocals: multiplications, not divisions) */
 static void dk_cholesky_again(const double A[DK_REFINE_M][DK_REFINE_M], double x[DK_REFINE_M])
@@ -1700,7 +1706,7 @@ static void dk_take_step(const int revolute[DK_REFINE_N], const int solved[DK_RE
    normal equations the identity's. */
 static double dk_refine(const double chain[DK_REFINE_N + 1][12], const int revolute[DK_REFINE_N],
                         const int solved[DK_REFINE_M], double reach, const double t[12],
-                        double q[DK_REFINE_N], unsigned held)
+                        double q[DK_REFINE_N], unsigned held, int patience)
 {
     double cur[DK_REFINE_N], cs[DK_REFINE_N][2], best = HUGE_VAL, reused = HUGE_VAL;
     double J[6][DK_REFINE_M], normal[DK_REFINE_M][DK_REFINE_M];
@@ -1710,7 +1716,7 @@ static double dk_refine(const double chain[DK_REFINE_N + 1][12], const int revol
         cs[i][0] = cos(q[i]);
         cs[i][1] = sin(q[i]);
     }
-    for (it = 0; it < DK_REFINE_STEPS; it++) {
+    for (it = 0; it < DK_REFINE_STEPS / DK_REFINE_PATIENCE * patience; it++) {
         double pose[12], axes[DK_REFINE_N][3], origins[DK_REFINE_N][3], error[6];
         double step[DK_REFINE_M], size, mu = 0.0, longest = 0.0;
         dk_chain_pose(chain, revolute, cur, (const double(*)[2])cs, pose, axes, origins);
@@ -1724,7 +1730,7 @@ static double dk_refine(const double chain[DK_REFINE_N + 1][12], const int revol
         } else { /* (near a singular configuration the error can grow before it converges) */
             worse++;
         }
-        if (worse == DK_REFINE_PATIENCE && !settle && best <= DK_REFINE_SETTLE) {
+        if (worse == patience && !settle && best <= DK_REFINE_SETTLE) {
             settle = 1; /* (Gauss-Newton by QR from the best point, measured at each step) */
             worse = 0;
             reused = HUGE_VAL;
@@ -1735,7 +1741,7 @@ static double dk_refine(const double chain[DK_REFINE_N + 1][12], const int revol
             }
             continue;
         }
-        if (size <= DK_REFINE_DONE || worse == DK_REFINE_PATIENCE) {
+        if (size <= DK_REFINE_DONE || worse == patience) {
             break;
         }
         last = size <= DK_REFINE_LAST && worse == 0 && !settle;
@@ -1785,9 +1791,9 @@ static double dk_refine(const double chain[DK_REFINE_N + 1][12], const int revol
             normal[i][i] = held >> solved[i] & 1u ? 1.0 : normal[i][i] + mu;
         }
         if (!settle && !dk_cholesky_solve(normal, step)) { /* (J^T J singular to roundings:
-            a singular solution near; given up as after DK_REFINE_PATIENCE steps, so QR's steps
+            a singular solution near; given up as after `patience` steps, so QR's steps
             go on from the best point where that is within DK_REFINE_SETTLE) */
-            worse = DK_REFINE_PATIENCE - 1;
+            worse = patience - 1;
             continue;
         }
         for (k = 0; k < DK_REFINE_M; k++) {
@@ -1809,24 +1815,54 @@ static double dk_refine(const double chain[DK_REFINE_N + 1][12], const int revol
     return best;
 }
 
+/* dk_refine of a nominal solution q, the joints in held (a bit per arm joint: those the pose
+   left free on the nominal table, at q_ref's value or a step from it) first held there, and
+   moved too only where holding does not reach limit (on the exact arm, nearly singular there,
+   Newton's steps along the near-null direction would otherwise carry them anywhere, away from
+   q_ref): the Python solver's _seed */
+static double dk_refine_held(const double chain[DK_REFINE_N + 1][12],
+                             const int revolute[DK_REFINE_N], const int solved[DK_REFINE_M],
+                             double reach, const double t[12], double q[DK_REFINE_N],
+                             unsigned held, double limit, int patience)
+{
+    double kept[DK_REFINE_N], size;
+    int i;
+    if (held) {
+        for (i = 0; i < DK_REFINE_N; i++) {
+            kept[i] = q[i];
+        }
+        size = dk_refine(chain, revolute, solved, reach, t, q, held, patience);
+        if (size <= limit) {
+            return size;
+        }
+        for (i = 0; i < DK_REFINE_N; i++) {
+            q[i] = kept[i];
+        }
+    }
+    return dk_refine(chain, revolute, solved, reach, t, q, 0u, patience);
+}
+
 /* q, a closed form's row of an exact table certified within ik's tol but not within
    DK_REFINE_POLISH (a value taken at a fold within DK_FOLD_TOL of it, a root at the edge of its
    polynomial's conditioning: a look-at point ten reaches away), polished: Newton's steps on
-   the exact chain (dk_refine), the joints in held (a bit per arm joint: those the pose left
-   free) kept, taken where they bring it within DK_REFINE_TOL; or a look-at row not certified
-   but aimed within tol radians (dk_aims_at), taken where they bring it within tol. Returns
+   the exact chain (dk_refine_held: the joints in held, a bit per arm joint, those the pose
+   left free, kept first, and moved too where keeping them does not reach DK_REFINE_TOL):
+   the best point met, never worse than q; or a look-at row not certified but aimed within
+   tol or DK_AIM_POLISH radians (dk_aims_at), taken where they bring it within tol. Returns
    whether q is kept: certified, or brought within tol (the Python solver's _keep). */
 static int dk_polish(const double chain[DK_REFINE_N + 1][12], const int revolute[DK_REFINE_N],
                      const int solved[DK_REFINE_M], double reach, const double t[12],
                      double q[DK_REFINE_N], unsigned held, double tol, int certified)
 {
+    const double limit = certified ? DK_REFINE_TOL : tol;
     double moved[DK_REFINE_N];
     int i;
     for (i = 0; i < DK_REFINE_N; i++) {
         moved[i] = q[i];
     }
-    if (dk_refine(chain, revolute, solved, reach, t, moved, held) <=
-        (certified ? DK_REFINE_TOL : tol)) {
+    if (dk_refine_held(chain, revolute, solved, reach, t, moved, held, limit,
+                       DK_REFINE_POLISH_PATIENCE) <= limit ||
+        certified) {
         for (i = 0; i < DK_REFINE_N; i++) {
             q[i] = moved[i];
         }

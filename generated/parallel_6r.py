@@ -211,8 +211,11 @@ _CLAMP_TOL = 1e-7
 # size: a small a and b make the ratio sensitive beyond _CLAMP_TOL to an earlier joint's error
 # (a Solo12 leg's knee 3e-7 from folded back: its angle from a root 1.5e-7 of 1/u, 7e-5 off
 # in the last places of its constant term, and the hip's equation then missed by 3e-11 of its
-# scale, 2.3e-4 of its ratio); a row from such a miss is certified as any other
-_CLAMP_ABS = 1e-10
+# scale, 2.3e-4 of its ratio; an OpenArm's elbow 3e-7 from straight: its angle from a root
+# 1.5e-7 of 1/u, the shoulder's equation then missed by 1.4e-9 of its scale, 0.9% of its
+# ratio, and 13 of 300 such poses got no row); a row from such a miss is certified as any
+# other
+_CLAMP_ABS = 1e-8
 
 
 # ... and from |e| down to (1 - _FOLD_TOL) sqrt(a^2 + b^2) as the double root acos(+-1): there
@@ -2009,6 +2012,13 @@ _REFINE_SETTLE = 1e-6
 _REFINE_POLISH = 1e-10
 
 
+# ... with this patience (and _REFINE_STEPS / _REFINE_PATIENCE times as many steps at most):
+# a row taken at a fold lies on a singular configuration, where the damped steps cross a
+# plateau before they converge (an OpenArm's elbow 1e-7 from straight: rows 1e-9 to 1.7e-8
+# off with 10, none beyond 1e-10 with 50; 1e-8 from straight, 2 of 172 beyond 1e-9)
+_REFINE_POLISH_PATIENCE = 50
+
+
 # ik_approximate's least squares: at most this many steps, done where the gradient of half
 # the squared error is this flat
 _LSQ_STEPS = 200
@@ -2017,24 +2027,25 @@ _LSQ_STEPS = 200
 _LSQ_FLAT = 1e-13
 
 
-def _refine(q, t, held=()):
-    """q after Newton's steps towards t on the exact chain, and its pose error there (the
-    largest rotation entry's difference, or position difference / REACH); the joints in held
-    (arm indices) keep their values. Plain floats: numpy's calls cost more than this size of
-    arithmetic."""
+def _refine(q, t, held=(), patience=_REFINE_PATIENCE):
+    """q after Newton's steps towards t on the exact chain (the best point met), and its pose
+    error there (the largest rotation entry's difference, or position difference / REACH);
+    the joints in held (arm indices) keep their values; given up after `patience` steps in a
+    row that do not reduce the error. Plain floats: numpy's calls cost more than this size
+    of arithmetic."""
     m = len(_SOLVED)
     cur = [float(x) for x in q]
     best, best_size, worse, settle = list(cur), math.inf, 0, False
-    for _ in range(_REFINE_STEPS):
+    for _ in range(_REFINE_STEPS // _REFINE_PATIENCE * patience):
         error, columns, size = _pose_error(cur, t, False)
         if size < best_size:
             best, best_size, worse = list(cur), size, 0
         else:  # (near a singular configuration the error can grow before it converges)
             worse += 1
-        if worse == _REFINE_PATIENCE and not settle and best_size <= _REFINE_SETTLE:
+        if worse == patience and not settle and best_size <= _REFINE_SETTLE:
             settle, worse, cur = True, 0, list(best)  # (Gauss-Newton by QR from the best)
             continue
-        if size <= _REFINE_DONE or worse == _REFINE_PATIENCE:
+        if size <= _REFINE_DONE or worse == patience:
             break
         last = size <= _REFINE_LAST and worse == 0 and not settle
         if held:  # (a held joint's column 0, its row of the normal equations the identity's)
@@ -2053,9 +2064,9 @@ def _refine(q, t, held=()):
                 if _SOLVED[k] in held:
                     normal[k][k] = 1.0
             if not _cholesky_solve(normal, step):  # (J^T J singular to roundings: a singular
-                # solution near; given up as after _REFINE_PATIENCE steps, so Gauss-Newton by
+                # solution near; given up as after `patience` steps, so Gauss-Newton by
                 # QR goes on from the best point where that is within _REFINE_SETTLE)
-                worse = _REFINE_PATIENCE - 1
+                worse = patience - 1
                 continue
         longest = max(map(abs, step))
         if not longest < math.inf:
@@ -2467,21 +2478,25 @@ def _keep(found, t, q, e, tol, frees=()):
     """Append q if its forward kinematics e reproduces the target t within tol
     (certification). A row that does, but not within _REFINE_POLISH (a value taken at a fold
     within _FOLD_TOL of it, a root at the edge of its polynomial's conditioning: a look-at
-    point ten reaches away), is polished first: Newton's steps on the exact chain (_refine),
-    taken where they bring it within _REFINE_TOL (dk_polish in C). frees: (values, arm joint
+    point ten reaches away), is polished first: Newton's steps on the exact chain (_refine:
+    the best point they meet, never worse than q; dk_polish in C). frees: (values, arm joint
     index) of the steps whose joint can be free; a free one (q_ref's value: the pose leaves
-    it free) is held, so that the steps do not carry it along the self-motion. A look-at row
-    whose ray passes the point within tol radians but not within tol * REACH (a point far
-    away: _aims_at) is polished too, and kept if that brings it within tol."""
+    it free) is held first, so that the steps do not carry it along the self-motion, and
+    moves too where holding it does not reach the tolerance (an OpenArm's elbow 1e-7 from
+    straight, snapped to the fold: q3 free there, but fixed at the pose, and rows 2.6e-8 off
+    were returned). A look-at row whose ray passes the point within tol or _AIM_POLISH
+    radians but not within tol * REACH (a point far away: _aims_at) is polished too, and kept
+    if that brings it within tol."""
     if _matches(e, t, min(tol, _REFINE_POLISH)):  # (most rows: one comparison settles it)
         found.append(q)
     elif (certified := _matches(e, t, tol)) or _aims_at(e, t, tol):
+        limit = _REFINE_TOL if certified else tol
         held = [i for values, i in frees if values.__class__ is _Free]
-        moved, size = _refine(q, t, held)
-        if size <= (_REFINE_TOL if certified else tol):
+        moved, size = _refine(q, t, held, _REFINE_POLISH_PATIENCE)
+        if size > limit and held:
+            moved, size = _refine(q, t, (), _REFINE_POLISH_PATIENCE)
+        if certified or size <= limit:
             found.append(moved)
-        elif certified:
-            found.append(q)
 
 
 def _matches(e, t, tol):

@@ -73,7 +73,18 @@ def test_the_c_runtime_holds_the_python_runtimes_constants():
         assert float(found[f"DK_{name}"]) == getattr(constants, f"_{name}"), name
     for name in ("DEDUP_TOL", "POSE_TOL"):
         assert float(found[f"DK_{name}"]) == getattr(constants, name), name
-    for name in ("STEPS", "STRIDE", "DONE", "PATIENCE", "LAST", "TRUST", "TOL", "STALL", "POLISH"):
+    for name in (
+        "STEPS",
+        "STRIDE",
+        "DONE",
+        "PATIENCE",
+        "LAST",
+        "TRUST",
+        "TOL",
+        "STALL",
+        "POLISH",
+        "POLISH_PATIENCE",
+    ):
         assert float(found[f"DK_REFINE_{name}"]) == getattr(refine, f"_REFINE_{name}"), name
     for name in ("SETTLE",):
         assert float(found[f"DK_REFINE_{name}"]) == getattr(refine, f"_REFINE_{name}"), name

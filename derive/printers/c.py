@@ -406,8 +406,8 @@ def solve_lines(plan: Plan) -> tuple[tuple[int, str], ...]:
                 depth + 1,
                 "if ((!loose || dk_seed_near(DK_CHAIN, DK_REVOLUTE, DK_REACH, t, dk_q)) && "
                 "dk_refine_held(DK_CHAIN, DK_REVOLUTE, DK_SOLVED, DK_REACH, t, dk_q, dk_held, "
-                "dk_limit) <= dk_limit && !dk_seen((const double(*)[DK_DOF])found, n, DK_REVOLUTE, "
-                "dk_q)) {",
+                "dk_limit, DK_REFINE_PATIENCE) <= dk_limit && "
+                "!dk_seen((const double(*)[DK_DOF])found, n, DK_REVOLUTE, dk_q)) {",
             )
         )
         body += [Line(depth + 2, f"found[n][{k}] = dk_q[{k}];") for k in range(len(outputs))]

@@ -24,8 +24,11 @@ _CLAMP_TOL = 1e-7
 # size: a small a and b make the ratio sensitive beyond _CLAMP_TOL to an earlier joint's error
 # (a Solo12 leg's knee 3e-7 from folded back: its angle from a root 1.5e-7 of 1/u, 7e-5 off
 # in the last places of its constant term, and the hip's equation then missed by 3e-11 of its
-# scale, 2.3e-4 of its ratio); a row from such a miss is certified as any other
-_CLAMP_ABS = 1e-10
+# scale, 2.3e-4 of its ratio; an OpenArm's elbow 3e-7 from straight: its angle from a root
+# 1.5e-7 of 1/u, the shoulder's equation then missed by 1.4e-9 of its scale, 0.9% of its
+# ratio, and 13 of 300 such poses got no row); a row from such a miss is certified as any
+# other
+_CLAMP_ABS = 1e-8
 # ... and from |e| down to (1 - _FOLD_TOL) sqrt(a^2 + b^2) as the double root acos(+-1): there
 # the angle moves by up to acos(1 - _FOLD_TOL) ~ 1.4e-7 while the equation's residual stays
 # below _FOLD_TOL sqrt(a^2 + b^2), and every backend gives the same value (acos near +-1 turns

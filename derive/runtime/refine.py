@@ -61,6 +61,11 @@ _REFINE_SETTLE = 1e-6
 # far look-at point's rows came within 1e-10 of the ray by the certification's largest
 # entry and 1.5e-10 by its length (a new user's attack)
 _REFINE_POLISH = 1e-10
+# ... with this patience (and _REFINE_STEPS / _REFINE_PATIENCE times as many steps at most):
+# a row taken at a fold lies on a singular configuration, where the damped steps cross a
+# plateau before they converge (an OpenArm's elbow 1e-7 from straight: rows 1e-9 to 1.7e-8
+# off with 10, none beyond 1e-10 with 50; 1e-8 from straight, 2 of 172 beyond 1e-9)
+_REFINE_POLISH_PATIENCE = 50
 # ik_approximate's least squares: at most this many steps, done where the gradient of half
 # the squared error is this flat
 _LSQ_STEPS = 200
@@ -90,24 +95,25 @@ def _seed(found, t, q, tol, frees=()):
         found.append(q)
 
 
-def _refine(q, t, held=()):
-    """q after Newton's steps towards t on the exact chain, and its pose error there (the
-    largest rotation entry's difference, or position difference / REACH); the joints in held
-    (arm indices) keep their values. Plain floats: numpy's calls cost more than this size of
-    arithmetic."""
+def _refine(q, t, held=(), patience=_REFINE_PATIENCE):
+    """q after Newton's steps towards t on the exact chain (the best point met), and its pose
+    error there (the largest rotation entry's difference, or position difference / REACH);
+    the joints in held (arm indices) keep their values; given up after `patience` steps in a
+    row that do not reduce the error. Plain floats: numpy's calls cost more than this size
+    of arithmetic."""
     m = len(_SOLVED)
     cur = [float(x) for x in q]
     best, best_size, worse, settle = list(cur), math.inf, 0, False
-    for _ in range(_REFINE_STEPS):
+    for _ in range(_REFINE_STEPS // _REFINE_PATIENCE * patience):
         error, columns, size = _pose_error(cur, t, False)
         if size < best_size:
             best, best_size, worse = list(cur), size, 0
         else:  # (near a singular configuration the error can grow before it converges)
             worse += 1
-        if worse == _REFINE_PATIENCE and not settle and best_size <= _REFINE_SETTLE:
+        if worse == patience and not settle and best_size <= _REFINE_SETTLE:
             settle, worse, cur = True, 0, list(best)  # (Gauss-Newton by QR from the best)
             continue
-        if size <= _REFINE_DONE or worse == _REFINE_PATIENCE:
+        if size <= _REFINE_DONE or worse == patience:
             break
         last = size <= _REFINE_LAST and worse == 0 and not settle
         if held:  # (a held joint's column 0, its row of the normal equations the identity's)
@@ -126,9 +132,9 @@ def _refine(q, t, held=()):
                 if _SOLVED[k] in held:
                     normal[k][k] = 1.0
             if not _cholesky_solve(normal, step):  # (J^T J singular to roundings: a singular
-                # solution near; given up as after _REFINE_PATIENCE steps, so Gauss-Newton by
+                # solution near; given up as after `patience` steps, so Gauss-Newton by
                 # QR goes on from the best point where that is within _REFINE_SETTLE)
-                worse = _REFINE_PATIENCE - 1
+                worse = patience - 1
                 continue
         longest = max(map(abs, step))
         if not longest < math.inf:
