@@ -55,11 +55,11 @@ Every solution `ik` returns has been checked by forward kinematics against T (to
 CERTIFY_TOL in rotation and CERTIFY_TOL * REACH in position). Revolute values are wrapped to
 (-pi, pi], a value just above -pi (_SEAM_BAND) given as its equivalent just above pi, one
 within _SEAM_SNAP of pi as pi, so that each solution has one value at the seam in every
-backend. Rows come in branch order: the joints in the order they are solved, each joint's
-values in the order its step produces them (polynomial roots by increasing angle, `+acos`
-before `-acos`). At a singular configuration a joint that the pose leaves free (the wrist
-centre on axis 1, a singular wrist) takes its value from q_ref (0 by default) and the joints
-after it absorb the rest: one representative per branch.
+backend. Rows come in the order the eigenvalue problem gives them: the C and Python
+solvers have their own eigenvalue routines, so their orders can differ (compare rows as
+sets; `branch(q)` is each row's label). At a singular configuration a joint that the pose
+leaves free (the wrist centre on axis 1, a singular wrist) takes its value from q_ref (0 by
+default) and the joints after it absorb the rest: one representative per branch.
 """
 
 from __future__ import annotations
