@@ -1579,7 +1579,7 @@ def _continuation(T, q, label, bound, within_limits, backend):
     on q's own branch nearest q continues the path if its step is within the bound and
     within PATH_NEAR or PATH_GAIN times the nearest solution's: near a fold (the elbow nearly
     stretched) both branches lie within one step, and Newton's iteration may cross to the
-    other."""
+    other. (Not where the branch is det J's sign: _follow halves a step that changes it.)"""
     revolute = np.array(_REVOLUTE)
     units = np.where(revolute, 1.0, REACH)
     guess = np.array(q, dtype=float)
@@ -1596,7 +1596,11 @@ def _continuation(T, q, label, bound, within_limits, backend):
     gaps = _turned(rows - guess, revolute)
     misses = np.abs(gaps / units).max(axis=1)
     best = int(np.argmin(misses))
-    if label:  # (the row of q's branch nearest q continues it if its step is within the
+    if label and BRANCHES != ("det J",):  # (det J's sign is no branch of its own: two
+        # solutions share it, and a path crosses det J = 0 smoothly where it touches a fold;
+        # a manocha_canny line took another solution of q's sign 0.55 rad away, where a 1,520
+        # times finer walk steps 1e-5 rad, and broke: _follow halves a step whose sign changes)
+        # (the row of q's branch nearest q continues it if its step is within the
         # bound and within PATH_NEAR or PATH_GAIN times the nearest row's: else the path
         # crosses a fold, as the wrist turning through straight, where the row of q's branch
         # turns joints 4 and 6 by half a turn)

@@ -631,6 +631,29 @@ def test_the_general_method_s_branch_is_det_j_s_sign_and_changes_only_where_it_v
     assert changes >= 2, changes
 
 
+def test_a_path_of_the_general_method_crosses_det_j_s_zero_where_it_is_smooth(generated):
+    """manocha_canny (the general method: det J's sign is its branch), a straight line of 7
+    poses between two vectors 0.1 rad apart in q5 on either side of det J = 0: a 1,520 times
+    finer nearest-row walk steps 1e-5 rad at most, crossing det J = 0 smoothly. ik_path
+    preferred the nearest row of the last row's sign, another solution 0.55 rad away, and
+    broke ("q4 jumps by 0.547 at a singular configuration"; a second new user's attack). det
+    J's sign names no one solution, so it is no preference now: ik_path is the walk, with no
+    break, in C and Python."""
+    module = generated("manocha_canny")
+    qa = np.array([1.6254943524157062, 2.378061135353623, -2.498697623537253, 2.197659278883968,
+                   -2.077880510051634, -0.12764967328721077])  # fmt: skip
+    qb = qa.copy()
+    qb[4] = -1.9816189249775085
+    walk, largest = _fine_walk(module, qa, qb, 7, 1520)
+    assert largest <= 1e-4
+    assert module.branch(walk[0]) != module.branch(walk[-1])  # (the walk crosses det J = 0)
+    Ts = module.straight_line(module.fk(qa), module.fk(qb), 7)
+    for backend in ("c", "python"):
+        path, breaks = module.ik_path(Ts, qa, backend=backend)
+        assert breaks == [], (backend, breaks)
+        assert np.abs(np.remainder(path - walk + np.pi, 2 * np.pi) - np.pi).max() <= 1e-8
+
+
 def test_straight_line_turns_half_a_turn_and_refuses_what_is_not_rigid(generated):
     """A half turn between A and B (where the rotation vector's sine part vanishes) is
     followed to B; a scaled pose is refused; ik_path refuses a q0 that does not reach Ts[0]."""
