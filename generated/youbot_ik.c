@@ -49,6 +49,8 @@
 
 #define DK_POSE_TOL (1e-06)
 
+#define DK_RIGID_SNAP (1e-14)
+
 #define DK_SEAM (3.141592652589793)
 
 #define DK_SEAM_SNAP (1e-12)
@@ -925,6 +927,56 @@ static int dk_pose_ok(const double T[16])
     det = T[0] * (T[5] * T[10] - T[6] * T[9]) - T[1] * (T[4] * T[10] - T[6] * T[8]) +
           T[2] * (T[4] * T[9] - T[5] * T[8]);
     return ok && det > 0.0;
+}
+
+/* t := T's top 12 entries, its rotation R (orthonormal within DK_POSE_TOL: dk_pose_ok) the
+   nearest rotation where it is not within DK_RIGID_SNAP (a pose rounded to float32): its
+   polar factor, by Newton-Schulz steps R := (3 I - R R^T) R / 2 (the Python solver's _rigid,
+   whose constants say why) */
+static void dk_rigid(const double T[16], double t[12])
+{
+    double R[3][3], G[3][3], worst = 0.0;
+    int r, c, k, step;
+    for (r = 0; r < 3; r++) {
+        for (c = 0; c < 4; c++) {
+            t[4 * r + c] = T[4 * r + c];
+        }
+        for (c = 0; c < 3; c++) {
+            R[r][c] = T[4 * r + c];
+        }
+    }
+    for (r = 0; r < 3; r++) {
+        for (c = r; c < 3; c++) {
+            const double dot = R[r][0] * R[c][0] + R[r][1] * R[c][1] + R[r][2] * R[c][2];
+            worst = fmax(worst, fabs(r == c ? dot - 1.0 : dot));
+        }
+    }
+    if (worst <= DK_RIGID_SNAP) {
+        return;
+    }
+    for (step = 0; step < 3; step++) {
+        double next[3][3];
+        for (r = 0; r < 3; r++) {
+            for (c = 0; c < 3; c++) {
+                G[r][c] = R[r][0] * R[c][0] + R[r][1] * R[c][1] + R[r][2] * R[c][2];
+            }
+        }
+        for (r = 0; r < 3; r++) {
+            for (c = 0; c < 3; c++) {
+                double s = 0.0;
+                for (k = 0; k < 3; k++) {
+                    s += G[r][k] * R[k][c];
+                }
+                next[r][c] = 1.5 * R[r][c] - 0.5 * s;
+            }
+        }
+        for (r = 0; r < 3; r++) {
+            for (c = 0; c < 3; c++) {
+                R[r][c] = next[r][c];
+                t[4 * r + c] = next[r][c];
+            }
+        }
+    }
 }
 
 /* (the chain's DK_REFINE_N joints, DK_REFINE_M of them moved, and DK_REFINE_ROWS pose
@@ -2281,8 +2333,8 @@ int youbot_ik_ref(const double T[16], const double *free, const double *q_ref, d
         return 0;
     }
     {
-        const double t[12] = {T[0], T[1], T[2],  T[3],  T[4],  T[5],
-                              T[6], T[7], T[8],  T[9],  T[10], T[11]};
+        double t[12]; /* (T's rotation the nearest rotation where it is not one: dk_rigid) */
+        dk_rigid(T, t);
         count = dk_solve(t, tol, ref, found, &repeats, 0);
         if (count == 0 && DK_SEED_TOL > 0.0) { /* (a nominal table: the second pass) */
             count = dk_solve(t, tol, ref, found, &repeats, 1);

@@ -73,6 +73,7 @@ def test_the_c_runtime_holds_the_python_runtimes_constants():
         assert float(found[f"DK_{name}"]) == getattr(constants, f"_{name}"), name
     for name in ("DEDUP_TOL", "POSE_TOL"):
         assert float(found[f"DK_{name}"]) == getattr(constants, name), name
+    assert float(found["DK_RIGID_SNAP"]) == constants._RIGID_SNAP
     for name in (
         "STEPS",
         "STRIDE",

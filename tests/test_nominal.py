@@ -801,3 +801,30 @@ def test_a_structure_tol_that_moves_the_arm_far_is_not_refined_from():
 def test_structure_tol_of_the_wrong_type_says_so():
     with pytest.raises(SpecError, match=r"ik\.structure_tol: must be a number \(got str\)"):
         parse_spec(calibrated("ur5") + '\n[ik]\nstructure_tol = "1e-3"\n', "<t>")
+
+
+@needs_cc
+@pytest.mark.parametrize("backend", ["c", "python"])
+def test_a_pose_rounded_to_float32_is_answered_by_a_calibrated_arm(tmp_path, backend):
+    """A calibrated PUMA's poses rounded to float32 (6e-8 off), or with 1e-8 and 1e-7 of
+    noise in every entry: no joint vector reaches a rotation that is not one, and the
+    nominal closed form's rows, refined within 1e-10 of the pose, were refused for every such
+    pose (a new user's attack: 100 of 100, also with tol=1e-4). The pose is now solved for
+    its nearest rotation (_rigid, dk_rigid): every pose answered, every row within a few
+    times the noise of the pose as given; an exact pose is solved as it was."""
+    module = build_module(calibrated("puma"), tmp_path, c=backend == "c")
+    rng = np.random.default_rng(0)
+    for noise in ("float32", 1e-8, 1e-7):
+        for q in rng.uniform(-3.0, 3.0, (30, 6)):
+            T = module.fk(q)
+            if noise == "float32":
+                given, size = T.astype(np.float32).astype(np.float64), 1e-7
+            else:
+                given = T.copy()
+                given[:3] += noise * rng.standard_normal((3, 4))
+                size = 10 * noise
+            rows = module.ik(given, backend=backend)
+            assert len(rows), (noise, q)
+            for row in rows:
+                E = module.fk(row) - given
+                assert max(np.abs(E[:3, :3]).max(), np.abs(E[:3, 3]).max() / module.REACH) <= size

@@ -21,6 +21,7 @@
 #define DK_RESIDUAL_TOL (1e-08)
 #define DK_DEDUP_TOL (1e-06)
 #define DK_POSE_TOL (1e-06)
+#define DK_RIGID_SNAP (1e-14)
 #define DK_SEAM (3.141592652589793)
 #define DK_SEAM_SNAP (1e-12)
 /* a branch's sign is 0 (a fold: two values meet) where the derivative of its step's
@@ -1637,6 +1638,56 @@ static int dk_pose_ok(const double T[16])
     det = T[0] * (T[5] * T[10] - T[6] * T[9]) - T[1] * (T[4] * T[10] - T[6] * T[8]) +
           T[2] * (T[4] * T[9] - T[5] * T[8]);
     return ok && det > 0.0;
+}
+
+/* t := T's top 12 entries, its rotation R (orthonormal within DK_POSE_TOL: dk_pose_ok) the
+   nearest rotation where it is not within DK_RIGID_SNAP (a pose rounded to float32): its
+   polar factor, by Newton-Schulz steps R := (3 I - R R^T) R / 2 (the Python solver's _rigid,
+   whose constants say why) */
+static void dk_rigid(const double T[16], double t[12])
+{
+    double R[3][3], G[3][3], worst = 0.0;
+    int r, c, k, step;
+    for (r = 0; r < 3; r++) {
+        for (c = 0; c < 4; c++) {
+            t[4 * r + c] = T[4 * r + c];
+        }
+        for (c = 0; c < 3; c++) {
+            R[r][c] = T[4 * r + c];
+        }
+    }
+    for (r = 0; r < 3; r++) {
+        for (c = r; c < 3; c++) {
+            const double dot = R[r][0] * R[c][0] + R[r][1] * R[c][1] + R[r][2] * R[c][2];
+            worst = fmax(worst, fabs(r == c ? dot - 1.0 : dot));
+        }
+    }
+    if (worst <= DK_RIGID_SNAP) {
+        return;
+    }
+    for (step = 0; step < 3; step++) {
+        double next[3][3];
+        for (r = 0; r < 3; r++) {
+            for (c = 0; c < 3; c++) {
+                G[r][c] = R[r][0] * R[c][0] + R[r][1] * R[c][1] + R[r][2] * R[c][2];
+            }
+        }
+        for (r = 0; r < 3; r++) {
+            for (c = 0; c < 3; c++) {
+                double s = 0.0;
+                for (k = 0; k < 3; k++) {
+                    s += G[r][k] * R[k][c];
+                }
+                next[r][c] = 1.5 * R[r][c] - 0.5 * s;
+            }
+        }
+        for (r = 0; r < 3; r++) {
+            for (c = 0; c < 3; c++) {
+                R[r][c] = next[r][c];
+                t[4 * r + c] = next[r][c];
+            }
+        }
+    }
 }
 
 

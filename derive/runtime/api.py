@@ -38,6 +38,7 @@ from derive.runtime.common import (
 )
 from derive.runtime.constants import (
     _LIMIT_SLACK,
+    _RIGID_SNAP,
     _SEAM,
     _TWO_PI,
     BACKEND,
@@ -444,7 +445,23 @@ def _pose(T):
     )
     if worst > POSE_TOL or det < 0.0:
         raise ValueError(f"T's rotation is not orthonormal within {POSE_TOL}")
+    if worst > _RIGID_SNAP:
+        v = _rigid(v)
     return tuple(v[:12])
+
+
+def _rigid(v):
+    """The pose's entries v (row-major) with its rotation R replaced by the nearest rotation,
+    its polar factor, by Newton-Schulz steps R := (3 I - R R^T) R / 2 (each squares the
+    distance from orthonormal: 1e-6, 1e-12, 1e-24); the C solver's dk_rigid."""
+    R = [v[0:3], v[4:7], v[8:11]]
+    for _ in range(3):
+        G = [[sum(R[i][k] * R[j][k] for k in range(3)) for j in range(3)] for i in range(3)]
+        R = [
+            [1.5 * R[i][c] - 0.5 * sum(G[i][k] * R[k][c] for k in range(3)) for c in range(3)]
+            for i in range(3)
+        ]
+    return [*R[0], v[3], *R[1], v[7], *R[2], v[11]]
 
 
 def _finish(found):

@@ -7,6 +7,11 @@ import math
 BACKEND = "auto"
 CERTIFY_TOL = 1e-6
 POSE_TOL = 1e-6
+# a pose whose rotation is orthonormal within POSE_TOL but not within this (rounded to float32,
+# printed to 8 decimals) is solved for its nearest rotation (_rigid): no joint vector reaches
+# a rotation that is not one, and a nominal table's rows, refined within 1e-10 of the pose,
+# were refused for every such pose of every such arm (a new user's attack: 100 of 100)
+_RIGID_SNAP = 1e-14
 DEDUP_TOL = 1e-6
 _ROOT_IMAG_TOL = 1e-6
 _RESIDUAL_TOL = 1e-8
