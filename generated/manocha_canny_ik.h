@@ -86,7 +86,8 @@ int manocha_canny_ik_velocity(const double q[6], const double twist[6], int fram
                              double dq[6]);
 
 /* Every solution of the pose T, each certified by forward kinematics (rotation within tol,
-   position within tol * reach), revolute values in (-pi, pi], in the Python solver's order.
+   position within tol * reach), revolute values in (-pi, pi], in the order its eigenvalue
+   routine gives them (the Python solver's can differ: compare rows as sets).
    free: the free joints' values (MANOCHA_CANNY_FREE_COUNT of them; may be NULL: q_ref's, or 0),
    each within 1e6 rad (1e6 times the reach for a length); a revolute one is solved with, and
    returned as, its value in (-pi, pi].
