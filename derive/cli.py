@@ -33,6 +33,7 @@ from derive.outputs import (
     describe_difference,
     output_file,
     output_folder,
+    writable_file,
     write_atomic,
 )
 from derive.pipeline import build_plan
@@ -366,7 +367,7 @@ def figure_output(args: argparse.Namespace, default: str) -> tuple[Path, str]:
     fmt = output.suffix.lstrip(".").lower()
     if fmt not in ("svg", "png"):
         raise UsageError(f"-o: {output}: the file must end in .svg or .png")
-    output_file(output)  # (a file, or none yet: said before the work)
+    writable_file(output)  # (a file, or none yet, where one can be made: before the work)
     return output, fmt
 
 
@@ -645,12 +646,12 @@ def cmd_reach(args: argparse.Namespace) -> int:
             figure = Path(args.output_plot), Path(args.output_plot).suffix.lstrip(".").lower()
             if figure[1] not in ("svg", "png"):
                 raise UsageError(f"--plot: {figure[0]}: the file must end in .svg or .png")
-            output_file(figure[0])
+            writable_file(figure[0])
             from derive.plot import pyplot
 
             pyplot()  # say at once if matplotlib is missing
         if args.hdf5:
-            output_file(Path(args.hdf5))
+            writable_file(Path(args.hdf5))
             reach.h5py_module()  # (likewise h5py)
         if args.dask:
             reach.dask_workers(args.dask)  # (a bad address, or no dask.distributed)

@@ -34,7 +34,10 @@ def write_atomic(path: Path, text: str | bytes) -> None:
         mode = stat.S_IMODE(path.stat().st_mode)
     except FileNotFoundError:
         mode = 0o666 & ~current_umask()
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=TMP_SUFFIX, dir=path.parent)
+    try:
+        fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=TMP_SUFFIX, dir=path.parent)
+    except OSError as exc:  # (the user's path in the message, not the temporary file's)
+        raise OSError(exc.errno, exc.strerror, str(path)) from None
     try:
         if isinstance(text, bytes):
             with os.fdopen(fd, "wb") as binary:
@@ -87,6 +90,24 @@ def output_file(path: Path) -> Path:
     target = Path(os.path.realpath(path))
     if not target.parent.is_dir():  # (no folders made where a dangling link points)
         raise OutputError(f"{path}: a symbolic link to {target}, whose folder does not exist")
+    return target
+
+
+def writable_file(path: Path) -> Path:
+    """output_file(path), where a file can be made in its folder (or the nearest folder above
+    it that exists: write_atomic makes the rest): said before the work, not after it (a new
+    user's ``derive path ... -o /proc/p.svg`` printed its table, then named a temporary file
+    that could not be made)."""
+    target = output_file(path)
+    folder = target.parent
+    while not folder.exists() and folder != folder.parent:
+        folder = folder.parent
+    try:
+        fd, probe = tempfile.mkstemp(prefix=f".{target.name}.", suffix=TMP_SUFFIX, dir=folder)
+    except OSError as exc:
+        raise OutputError(f"{path}: cannot write there: {exc.strerror}") from None
+    os.close(fd)
+    Path(probe).unlink(missing_ok=True)
     return target
 
 

@@ -6,6 +6,7 @@ from __future__ import annotations
 import os
 import subprocess
 import sys
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -101,6 +102,29 @@ def test_without_matplotlib_plot_says_what_to_install(monkeypatch, tmp_path, cap
 def test_plot_refuses_other_file_types(tmp_path, capsys):
     assert main(["plot", "puma560", "--q", *["20"] * 6, "-o", str(tmp_path / "p.jpg")]) == 2
     assert "must end in .svg or .png" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize(
+    "command",
+    [
+        ["path", "puma560", "--from", *["5"] * 6, "--to", "10", "20", "30", "40", "50", "60"],
+        ["workspace", "puma560"],
+    ],
+)
+def test_a_figure_that_cannot_be_written_is_refused_before_the_work(tmp_path, capsys, command):
+    """-o where no file can be made (below a regular file; in /proc, where the folder exists
+    but takes no new files): one line naming the path the user gave, before anything is
+    printed or computed (a new user's `derive path ... -o /proc/p.svg` printed its table,
+    then named a temporary file)."""
+    (tmp_path / "plain").write_text("not a folder")
+    for out in (tmp_path / "plain" / "p.svg", Path("/proc/derive-test.svg")):
+        if out.parent == Path("/proc") and not out.parent.is_dir():
+            continue  # (no /proc here)
+        assert main([*command, "-o", str(out)]) == 2
+        captured = capsys.readouterr()
+        assert captured.out == ""
+        assert captured.err.startswith(f"error: {out}: ") and captured.err.count("\n") == 1
+        assert "Not a directory" in captured.err or "cannot write there" in captured.err
 
 
 @pytest.mark.parametrize(("fmt", "ext"), [("md", "svg"), ("tex", "png")])
