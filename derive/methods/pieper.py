@@ -197,7 +197,7 @@ def _axis_distance_rest(
         coeffs = sp.Poly(gap, *sorted(gap.free_symbols, key=str)).coeffs()
     else:
         coeffs = [gap]
-    if all(abs(float(c)) <= 1e-12 * max(length, 1.0) ** 2 for c in coeffs):
+    if all(abs(float(c)) <= 1e-12 * length**2 for c in coeffs):
         return x**2 + y**2
     return None
 
