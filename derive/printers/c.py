@@ -36,6 +36,7 @@ from derive.plan import (
 )
 from derive.printers.branches import First, Sign, branch_program, jacobian_branch
 from derive.printers.common import (
+    SPREAD_STEPS,
     CodePrinter,
     Line,
     cs_arguments,
@@ -308,7 +309,7 @@ def solve_lines(plan: Plan) -> tuple[tuple[int, str], ...]:
         body.append(Line(depth, f"dk_values dk_v{j};"))
         if fix:  # (the second pass's flag: derive/c/runtime.c dk_values)
             body.append(Line(depth, f"dk_v{j}.loose = loose;"))
-        if fix and type(step) in (Cs2, Cs2Reach):  # (a rough value's spread: dk_wrist_spread)
+        if fix and isinstance(step, SPREAD_STEPS):  # (a rough value's spread: dk_wrist_spread)
             body.append(Line(depth, f"dk_v{j}.more = 0.0;"))
         solve = f"{call.routine}(&dk_v{j}, {', '.join(call.args)}) < 0"
         if flip and j in flip[1:]:  # the second theta5 branch: the first's turned by pi
@@ -368,7 +369,7 @@ def solve_lines(plan: Plan) -> tuple[tuple[int, str], ...]:
             body.append(Line(depth + 1, f"(void){s_name};"))
         # a free joint's loop ends at its first value that gave a solution
         closing.append(Line(depth + 1, f"if (dk_v{j}.free && n > dk_m{j}) {{"))
-        if fix and type(step) in (Cs2, Cs2Reach):  # (a rough value that gave no row: the
+        if fix and isinstance(step, SPREAD_STEPS):  # (a rough value that gave no row: the
             # values around it too, dk_wrist_spread)
             endings.setdefault(id(closing[-1]), []).extend(
                 [

@@ -15,13 +15,17 @@ import sympy as sp
 from sympy.printing.str import StrPrinter
 
 from derive import symbols as sym
-from derive.plan import Assign, Plan, Solve, Step
+from derive.plan import Assign, Cs2, Cs2Reach, Plan, Solve, Step
 
 
 class UnprintableError(Exception):
     """An expression holds a function the generated code has no name for (the function's
     name is the message); emit turns it into a GenerationError naming the arm and step."""
 
+
+# the steps whose value a nominal table fixes only roughly where the wrist is nearly straight:
+# their loops try the values around it where it gives no row (runtime _wrist_spread)
+SPREAD_STEPS = (Cs2, Cs2Reach)
 
 # SymPy function -> the name the generated code calls it by: from `math` in scalar code,
 # `np.` in vectorised code (the module imports exactly these)

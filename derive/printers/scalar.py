@@ -27,6 +27,7 @@ from derive.plan import (
 )
 from derive.printers.branches import First, Sign, branch_program, jacobian_branch
 from derive.printers.common import (
+    SPREAD_STEPS,
     CodePrinter,
     Line,
     assign_lines,
@@ -94,7 +95,7 @@ def ik_lines(plan: Plan) -> tuple[tuple[int, str], ...]:
     else:
         lines.append(Line(depth, f"q = ({outputs},)"))
         lines.append(Line(depth, f"_keep(found, target, q, _fk_q(q), tol, ({frees}))"))
-    spread = {s.joint for s in plan.ik.steps if isinstance(s, (Cs2, Cs2Reach))}
+    spread = {s.joint for s in plan.ik.steps if isinstance(s, SPREAD_STEPS)}
     for level, joint in reversed(loops):
         # a free joint's loop (over _Free values) ends at its first value that gave a solution
         lines.append(
