@@ -108,6 +108,7 @@ def test_the_c_runtime_holds_the_python_runtimes_constants():
         "PATH_STEPS",
         "SAME",
         "NEAR_SINGULAR",
+        "PAIR_DOUBT",
         "FOLD_STEP",
     ):
         assert float(found[f"DK_RR_{name}"]) == getattr(constants, f"_RR_{name}"), name

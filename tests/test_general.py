@@ -419,6 +419,53 @@ def test_cobots_with_singular_pencils_are_answered_completely(name, tmp_path):
         assert len(newton) == len(rows)  # (here Newton finds them all: 4, 8, 8; 8, 8, 12)
 
 
+# two regular poses of the CRX-like arm (sigma_min 1e-4 and 1.5e-4: elbow and wrist 3e-4 and
+# 8e-4 rad from their singular values) where its perturbed table made four of the eight
+# solutions complex pairs (within _RR_PAIR_DOUBT of real): only the fallback split finds them
+CRX_NEAR_FOLD = [
+    [2.2120449088852858, -0.03858859322493611, -1.5702677829083875, 3.0998822176362762e-4,
+     -1.7162256413562258, 1.3583331526550546],
+    [-0.28052510817171283, 2.6520967173553247, -1.5699634596904142, 8.2622228461607479e-4,
+     -1.8941381072573877, 1.2985344989926408],
+]  # fmt: skip
+
+
+@pytest.mark.parametrize("backend", ["python", pytest.param("c", marks=needs_cc)])
+def test_a_perturbed_table_s_fallback_split_runs_only_where_rows_may_be_missing(backend, tmp_path):
+    """A perturbed table's clusters ask for the fallback split only where the first split's
+    rows fall short of its real eigenvalues or a complex pair is nearly real
+    (_RR_PAIR_DOUBT). Near the CRX-like arm's folds that second condition keeps all eight
+    rows (without it, four); on uniform poses of the Jaco2 the fallback split runs at a
+    minority of poses (before: at all 40 of these, finding nothing new there)."""
+    crx = build_module(spec_text("crx_like", "standard", COBOTS["crx_like"]), tmp_path)
+    for q in CRX_NEAR_FOLD:
+        T = crx.fk(np.array(q))
+        rows = crx.ik(T, backend=backend)
+        assert len(rows) == 8
+        assert all(np.abs(crx.fk(row) - T).max() < 1e-10 for row in rows)
+        assert min(np.abs((rows - np.array(q) + math.pi) % (2 * math.pi) - math.pi).max(1)) < 1e-9
+    if backend == "c":
+        return
+    jaco = build_module(spec_text("jaco2", "standard", COBOTS["jaco2"]), tmp_path)
+    splits: list[int] = []
+    plain = jaco._rr_split
+
+    def counted(k, *args, **kwargs):
+        splits.append(k)
+        return plain(k, *args, **kwargs)
+
+    jaco._rr_split = counted
+    rng = np.random.default_rng(11)
+    fallbacks = 0
+    for q in rng.uniform(-math.pi, math.pi, (40, 6)):
+        splits.clear()
+        T = jaco.fk(q)
+        rows = jaco.ik(T)
+        assert min(np.abs((rows - q + math.pi) % (2 * math.pi) - math.pi).max(1)) < 1e-9
+        fallbacks += splits[:2] == [0, 1]
+    assert fallbacks <= 16, fallbacks
+
+
 # ABB's GoFa 12 (CRB 15000), modified DH from robotkinematicscatalogue 1.1.2 (PyPI), and two
 # regular poses near a fold (Jacobian's singular values 8e-5 and 7e-5 of the largest) whose
 # pair of nearby solutions a one-step continuation lost (a new user's attack): (q, a solution)

@@ -82,7 +82,7 @@ def test_the_run_time_steps_find_the_joint_values_of_random_arms(seed):
     P0, Ps, Pc, Q = (
         np.array(sp.lambdify(rr.GENS, m)(*args), dtype=float) for m in (f.P0, f.Ps, f.Pc, f.Q)
     )
-    candidates, _, _ = general._rr_candidates(P0, Ps, Pc, Q, F, rows)
+    candidates, _, _, _ = general._rr_candidates(P0, Ps, Pc, Q, F, rows)
     gap = [np.abs((c - theta + np.pi) % (2 * np.pi) - np.pi).max() for c in candidates]
     assert min(gap) <= 1e-6
 

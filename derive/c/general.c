@@ -46,6 +46,10 @@
 /* where a perturbed table answered and a row found is within this of a singular configuration
    (Hadamard's ratio of its Jacobian), the rescue is tried too */
 #define DK_RR_NEAR_SINGULAR (0.001)
+/* a perturbed table's clusters ask for the fallback split unless the split's rows number its
+   real eigenvalues and no complex one is within DK_RR_PAIR_DOUBT (1 + |y|) of the real line
+   (the Python solver's _RR_PAIR_DOUBT) */
+#define DK_RR_PAIR_DOUBT (0.03)
 /* on a nominal table (DK_SEED_TOL > 0), a candidate the steps leave within DK_SEED_TOL of the
    pose seeds the refinement, with the points this far each way along the direction the
    table's Jacobian nearly loses (a pair of the exact arm near a fold: dk_rr_fold_seeds) */
@@ -1286,10 +1290,12 @@ static int dk_rr_deflate(double K[24][24], int k, const double *moebius)
 
 /* the candidate joint vectors of one split: their count written to out, extra[c] set for
    those from nearly real pairs; *doubt: whether the answer is in doubt (clusters on the
-   arm's own table, or no usable pencil) */
+   arm's own table, or no usable pencil); *reals: the real eigenvalues within reach, *pair:
+   the least |Im y| / (1 + |y|) of the others (HUGE_VAL where none) */
 static int dk_rr_candidates(const double values[490], const double F[4][4],
                             const double rows[7][4], double out[DK_RR_CANDS][6], int extra[],
-                            int *doubt, double imag_tol, int split)
+                            int *doubt, double imag_tol, int split, int *reals_found,
+                            double *pair)
 {
     double N[14][14], A6[6][9], B6[6][9], C6[6][9], pencil[3][12][12], best_pencil[3][12][12];
     double K[24][24], rhs[12][24], wr[24], wi[24], reals[24], extras[48], V[3][12];
@@ -1303,6 +1309,8 @@ static int dk_rr_candidates(const double values[490], const double F[4][4],
     const double(*Pc)[9] = (const double(*)[9])(values + 252);
     const double(*Q)[8] = (const double(*)[8])(values + 378);
     *doubt = DK_RR_RESCUE;
+    *reals_found = 0;
+    *pair = HUGE_VAL;
     for (i = 0; i < 6; i++) {
         reach += fabs(rows[i][0]) + fabs(rows[i][1]);
     }
@@ -1388,6 +1396,7 @@ static int dk_rr_candidates(const double values[490], const double F[4][4],
                 reals[n_real++] = wr[i];
             }
         } else if (imag_tol * size < wi[i]) {
+            *pair = fmin(*pair, wi[i] / size);
             for (side = -1; side <= 1; side += 2) { /* a nearly real pair (dk_rr_pair_value) */
                 double y;
                 if (dk_rr_pair_value(rows, moebius, wr[i], wi[i], side, &y) &&
@@ -1397,6 +1406,7 @@ static int dk_rr_candidates(const double values[490], const double F[4][4],
             }
         }
     }
+    *reals_found = n_real;
     dk_sort_doubles(reals, n_real);
     dk_sort_doubles(extras, n_extra);
     *doubt = 0;
@@ -1579,13 +1589,15 @@ static int dk_rr_split(int k, const double F[4][4], const double moved[4][4],
 {
     double values[490], cands[DK_RR_CANDS][6], between[7][4];
     const int known = count;
-    int extra[DK_RR_CANDS], perturbed = dk_rr_perturbed(k), damped = 0, n, c, i, j, r;
+    double pair;
+    int extra[DK_RR_CANDS], perturbed = dk_rr_perturbed(k), damped = 0, reals, n, c, i, j, r;
     for (i = 0; i < 490; i++) {
         values[i] = 0.0;
     }
     dk_rr_fill(k, moved[0][2], moved[1][2], moved[2][2], moved[0][3], moved[1][3], moved[2][3],
                values);
-    n = dk_rr_candidates(values, moved, DK_RR_FILL[k], cands, extra, doubt, imag_tol, k);
+    n = dk_rr_candidates(values, moved, DK_RR_FILL[k], cands, extra, doubt, imag_tol, k, &reals,
+                         &pair);
     for (c = 0; c < n; c++) {
         double q[6], arm[6], error;
         int seen = 0;
@@ -1624,6 +1636,9 @@ static int dk_rr_split(int k, const double F[4][4], const double moved[4][4],
         if (count == DK_RR_ROWS) {
             return count;
         }
+    }
+    if (*doubt == DK_RR_FALLBACK && count - known >= reals && pair > DK_RR_PAIR_DOUBT) {
+        *doubt = 0; /* (every real root gave its row, and no pair is nearly real) */
     }
     return count;
 }

@@ -361,7 +361,7 @@ def score(
         for i, t in enumerate(q):
             F = F @ runtime._rr_joint(i, t, true_rows, slide)
         P0, Ps, Pc, Q = matrices_at(fill_rows, F, slide)
-        candidates, _, _ = runtime._rr_candidates(P0, Ps, Pc, Q, F, fill_rows, slide)
+        candidates, _, _, _ = runtime._rr_candidates(P0, Ps, Pc, Q, F, fill_rows, slide)
         conds.append(leading_condition(P0, Ps, Pc, Q))
         if candidates:
             # (Newton's steps only, as the splits were always measured)

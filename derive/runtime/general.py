@@ -58,6 +58,7 @@ from derive.runtime.constants import (
     _RR_NEWTON_STEPS,
     _RR_NULL2_TOL,
     _RR_PAIR_ANGLE,
+    _RR_PAIR_DOUBT,
     _RR_PAIR_TOL,
     _RR_PATH,
     _RR_PATH_STEPS,
@@ -351,7 +352,7 @@ def _rr_split(k, F, moved, leads, known=(), imag_tol=_RR_IMAG_TOL):
     Q = values[378:].reshape(14, 8)
     count = _RR_SPURIOUS_COUNT[k]
     spurious = (_RR_SPURIOUS[k, :, :count], _RR_PIVOTS[k, : count // 2]) if count else None
-    candidates, doubt, extras = _rr_candidates(
+    candidates, doubt, extras, (reals, pair) = _rr_candidates(
         P0, Ps, Pc, Q, moved, fill_rows, slide, imag_tol, spurious
     )
     # a perturbed table's solutions are walked back to the arm's in steps (a continuation),
@@ -368,7 +369,7 @@ def _rr_split(k, F, moved, leads, known=(), imag_tol=_RR_IMAG_TOL):
     # its special geometry makes common: both come from the plane, and the partners and the
     # search find one lost; they ask for the fallback split only (on 2,000 poses of each of
     # two cobots, the rescue they started added rows at 14 poses, 13 of them with an odd
-    # count, which starts it anyway)
+    # count, which starts it anyway), and only where a row may be missing (_rr_settled)
     doubt = (_FALLBACK if fill_rows != true_rows else _RESCUE) if doubt else 0
     if known and candidates:  # (one within _RR_SAME of a known row is that row again)
         rows = np.array(known)
@@ -383,7 +384,7 @@ def _rr_split(k, F, moved, leads, known=(), imag_tol=_RR_IMAG_TOL):
         candidates = [candidates[c] for c in kept]
         extras = [extras[c] for c in kept]
     if not candidates:
-        return out, close, doubt
+        return out, close, _rr_settled(doubt, known, [], reals, pair)
     # every candidate at once (numpy's stacked products and solves: the Python solver's time
     # went to calling numpy on 4 x 4 matrices one candidate at a time)
     Q = np.array(candidates)
@@ -409,7 +410,19 @@ def _rr_split(k, F, moved, leads, known=(), imag_tol=_RR_IMAG_TOL):
             close.append(q)
         if fill_rows == true_rows:  # (a perturbed table has solutions the arm has not)
             doubt = _RESCUE
-    return out, close, doubt
+    return out, close, _rr_settled(doubt, known, [_rr_to_arm(k, q) for q in out], reals, pair)
+
+
+def _rr_settled(doubt, known, rows, reals, pair):
+    """A perturbed table's doubt (_FALLBACK, from its clusters) lifted where the split's rows
+    new to known number its real eigenvalues (reals) and no complex one is within
+    _RR_PAIR_DOUBT of real (pair): every real root gave its row, and the table's difference
+    made no pair of the arm's solutions complex (_RR_PAIR_DOUBT). The doubt otherwise."""
+    if doubt != _FALLBACK or pair <= _RR_PAIR_DOUBT:
+        return doubt
+    merged = list(known)
+    _rr_merge(merged, rows)
+    return 0 if len(merged) - len(known) >= reals else doubt
 
 
 def _rr_between(fill_rows, true_rows, t):
@@ -427,14 +440,17 @@ def _rr_candidates(P0, Ps, Pc, Q, F, rows, slide=_RR_TURNS, imag_tol=_RR_IMAG_TO
     """The unpolished joint values of one split from its matrices (docs/algorithms.md, "The
     general 6R method"), whether the eigenvalues came in clusters (an answer in doubt), and
     which candidates are extras (from nearly real pairs: one that does not polish puts nothing
-    in doubt). Where joint 3 slides (slide[0] set) the eigen-variable x3 is d3 itself, not
-    tan(theta3 / 2)."""
+    in doubt), and (the number of real eigenvalues within reach, the least |Im y| / (1 + |y|)
+    of the others, inf where none). Where joint 3 slides (slide[0] set) the eigen-variable x3
+    is d3 itself, not tan(theta3 / 2)."""
     found = _rr_eigenvalues(P0, Ps, Pc, Q, spurious)
     if found is None:  # (a singular pencil: None, where no eigenvalue is real gives [])
-        return None, True, []
+        return None, True, [], (0, math.inf)
     values, (A, B, C), moebius = found
     size = 1.0 + np.abs(values)
     real = np.sort(values[np.abs(values.imag) <= imag_tol * size].real)
+    upper = values.imag > imag_tol * size
+    pair = float((values.imag[upper] / size[upper]).min()) if upper.any() else math.inf
     extra = _rr_pair_extras(values[values.imag > imag_tol * size], moebius, slide[0])
     ma, mb, mc, md = moebius
     if slide[0]:
@@ -445,6 +461,7 @@ def _rr_candidates(P0, Ps, Pc, Q, F, rows, slide=_RR_TURNS, imag_tol=_RR_IMAG_TO
         reach = float(np.abs(F[:3, 3]).sum()) + sum(abs(r[0]) + abs(r[1]) for r in rows)
         real = real[np.abs(ma * real + mb) <= reach * np.abs(mc * real + md)]
         extra = extra[np.abs(ma * extra + mb) <= reach * np.abs(mc * extra + md)]
+    spread = (len(real), pair)
     doubt = False
     ys: list[list[float]] = []
     for y in real:
@@ -456,7 +473,7 @@ def _rr_candidates(P0, Ps, Pc, Q, F, rows, slide=_RR_TURNS, imag_tol=_RR_IMAG_TO
     primary = len(ys)
     ys += [[y] for y in extra]  # (on their own: they put nothing in doubt)
     if not ys:
-        return [], doubt, []
+        return [], doubt, [], spread
     # every cluster's null space at once (one stacked SVD), then every candidate's theta1,
     # theta2 and theta6 at once
     centres = np.array([sum(cluster) / len(cluster) for cluster in ys])
@@ -486,10 +503,11 @@ def _rr_candidates(P0, Ps, Pc, Q, F, rows, slide=_RR_TURNS, imag_tol=_RR_IMAG_TO
     )
     owner, theta1, theta2 = _rr_joints12_many(rows, F, T345, slide)
     if not owner.size:
-        return [], doubt, []
+        return [], doubt, [], spread
     X = np.column_stack((theta1, theta2, T345[owner]))
     extras = np.array(optional)[owner].tolist()
-    return list(np.column_stack((X, _rr_theta6_many(rows, F, X, slide)))), doubt, extras
+    candidates = list(np.column_stack((X, _rr_theta6_many(rows, F, X, slide))))
+    return candidates, doubt, extras, spread
 
 
 def _rr_pair_extras(upper, moebius, slides):
