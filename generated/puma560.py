@@ -1771,9 +1771,12 @@ def _kquartic(B, C, D, E):
     return y1 - a, y2 - a, y3 - a, y4 - a
 
 
-def _small_residual(p: list[float] | np.ndarray, x: float) -> bool:
-    """p(x) is negligible against the size of its terms, or Newton's step from x is."""
-    value = size = slope = 0.0
+def _small_residual(p: list[float] | np.ndarray, x: complex) -> bool:
+    """p(x) is negligible against the size of its terms, or Newton's step from x is (x real,
+    or complex: a closed form's complex root is checked too, _accept)."""
+    value: complex = 0.0
+    slope: complex = 0.0
+    size = 0.0
     ax = abs(x)
     for k in p:
         slope = slope * x + value
@@ -2073,7 +2076,11 @@ def _real_roots(p: list[float]) -> list[float]:
 
 
 def _accept(p: list[float], zs: list[complex], check: bool = True) -> list[float] | None:
-    """Polished real parts of the near-real zs; None if one fails the residual test.
+    """Polished real parts of the near-real zs; None if one fails the residual test, or
+    (check) if a complex one does: Ferrari's formulas for a quartic whose leading coefficient is
+    1e-9 of the largest (both ends nearly vanish: a FANUC LR Mate's shoulder and elbow 1e-8
+    from -90 and 0 deg) gave one real root right and three wrong, complex, and lost six of
+    eight rows; the companion matrix then finds all four.
 
     A double root comes out split, as a complex pair or as two reals about sqrt(eps) apart;
     roots closer than _MERGE_TOL give their mean, which is accurate, unless the mean is
@@ -2093,7 +2100,10 @@ def _accept(p: list[float], zs: list[complex], check: bool = True) -> list[float
         z = complex(z)
         if abs(z.imag) <= _ROOT_IMAG_TOL * (1.0 + abs(z)):
             xs.append((z.real, True))
-        elif abs(z.imag) <= _CLUSTER_TOL * (1.0 + abs(z)):
+            continue
+        if check and not _small_residual(p, z):  # (a closed form's complex root, wrong)
+            return None
+        if abs(z.imag) <= _CLUSTER_TOL * (1.0 + abs(z)):
             split = True
     if split:
         xs = [

@@ -890,6 +890,21 @@ static int dk_small_residual(const double *p, int d, double x)
            fabs(value) <= DK_RESIDUAL_TOL * (1.0 + ax) * fabs(slope);
 }
 
+/* dk_small_residual at a complex z (a closed form's complex root: dk_accept) */
+static int dk_small_residual_cx(const double *p, int d, dk_cx z)
+{
+    dk_cx value = dk_cx_make(0.0, 0.0), slope = dk_cx_make(0.0, 0.0);
+    double size = 0.0, az = dk_cx_abs(z);
+    int k;
+    for (k = 0; k <= d; k++) {
+        slope = dk_cx_add(dk_cx_mul(slope, z), value);
+        value = dk_cx_add(dk_cx_mul(value, z), dk_cx_make(p[k], 0.0));
+        size = size * az + fabs(p[k]);
+    }
+    return dk_cx_abs(value) <= DK_RESIDUAL_TOL * size ||
+           dk_cx_abs(value) <= DK_RESIDUAL_TOL * (1.0 + az) * dk_cx_abs(slope);
+}
+
 /* whether the mean x of two close roots of p (degree d) leaves p above DK_SPLIT_TOL of its
    largest coefficient: two roots, not a double root split by rounding (the Python
    _two_roots) */
@@ -928,7 +943,8 @@ static double dk_newton(const double *p, int d, double x)
 
 /* the real parts of the near-real zs[0..m), polished (simple roots) and merged (near-equal
    ones, and clusters of a split multiple root that are not all real: their mean), ascending,
-   into out: their count, or -1 where check is set and one fails the residual test */
+   into out: their count, or -1 where check is set and one, or a complex one, fails the
+   residual test */
 static int dk_accept(const double *p, int d, const dk_cx *zs, int m, int check, double *out)
 {
     double xs[DK_POLY_MAX];
@@ -944,7 +960,12 @@ static int dk_accept(const double *p, int d, const dk_cx *zs, int m, int check, 
         if (fabs(zs[k].im) <= DK_ROOT_IMAG_TOL * size) {
             xs[n] = zs[k].re;
             simple[n++] = 1;
-        } else if (fabs(zs[k].im) <= DK_CLUSTER_TOL * size) {
+            continue;
+        }
+        if (check && !dk_small_residual_cx(p, d, zs[k])) { /* (a closed form's, wrong) */
+            return -1;
+        }
+        if (fabs(zs[k].im) <= DK_CLUSTER_TOL * size) {
             split = 1;
         }
     }

@@ -12,7 +12,7 @@ from derive.spec import parse_spec
 from derive.verify import roundtrip, sample_joints
 
 from cases import PIEPER_CASES, PUMA_REPORT_FLAGS, PUMA_REPORT_SOLUTIONS
-from conftest import build_module, needs_cc, spec_text, wrapped_close
+from conftest import build_module, needs_cc, reference_fk, spec_text, wrapped_close
 
 
 def cup_pose() -> np.ndarray:
@@ -344,3 +344,54 @@ def test_fewer_real_solutions_return_only_the_real_ones(tmp_path):
     m = hard_case_module(data["rows"], tmp_path)
     T = np.vstack([np.array(data["T"]), [0, 0, 0, 1.0]])
     assert len(m.ik(T)) == 4
+
+
+# two published standard-DH tables (ir-support-extra-robots 0.2.1, PyPI, MIT: robots/EpsonVT6,
+# robots/FanucLRMate200iC), (alpha, a, d, theta) in rad and m, whose quartic in
+# u = tan(theta3/2) has both ends nearly vanishing near q3 = 0 (the Epson's elbow roots are
+# theta3 and pi - theta3) or near q2 = -90 deg, q3 = 0 (the LR Mate)
+_HALF = math.pi / 2
+EPSON_VT6 = [
+    (_HALF, -0.09816, 0.411523, 0.0),
+    (0.0, 0.4234, 0.0, 0.0),
+    (_HALF, 0.0, 0.0, 0.0),
+    (_HALF, 0.0, -0.395804, 0.0),
+    (_HALF, 0.0, 0.0, 0.0),
+    (0.0, 0.0, -0.087348, 0.0),
+]
+LR_MATE_200IC = [
+    (-_HALF, 0.075, 0.33, 0.0),
+    (0.0, 0.3, 0.0, -_HALF),
+    (-_HALF, 0.075, 0.0, 0.0),
+    (_HALF, 0.0, 0.32, 0.0),
+    (-_HALF, 0.0, 0.0, 0.0),
+    (0.0, 0.0, 0.08, 0.0),
+]
+
+
+@pytest.mark.parametrize("backend", ["python", pytest.param("c", marks=needs_cc)])
+@pytest.mark.parametrize("name", ["epson_vt6", "lr_mate_200ic"])
+def test_a_quartic_whose_both_ends_nearly_vanish_keeps_all_its_roots(name, backend, tmp_path):
+    """Where the quartic's first and last coefficients are 1e-9 of its largest, Ferrari's
+    formulas gave one real root right and three complex ones wrong: the rows of the other
+    three roots were lost (the Epson VT6 missed the sampled vector at 23 of 100 such poses in
+    C, 33 in Python; the LR Mate at 12 of 100 in Python). A closed form's complex root that
+    fails the residual test now sends the quartic to the companion matrix (C: Aberth's
+    iteration). Poses from the textbook FK (a rounding away from the module's own), the
+    chosen joints 1e-8 to 1e-5 rad from their values: every sampled vector found, every row
+    within 1e-10."""
+    rows = EPSON_VT6 if name == "epson_vt6" else LR_MATE_200IC
+    m = build_module(spec_text(name, "standard", rows, unit="rad"), tmp_path)
+    rng = np.random.default_rng(5)
+    for k in range(60):
+        q = rng.uniform(-math.pi, math.pi, 6)
+        nudge = 10.0 ** rng.uniform(-8, -5) * rng.choice([-1.0, 1.0], 2)
+        if name == "epson_vt6":
+            q[2] = nudge[0]
+        else:
+            q[1], q[2] = -_HALF + nudge[0], nudge[1]
+        T = reference_fk("standard", rows, "RRRRRR", q)
+        sols = m.ik(T, backend=backend)
+        assert any(wrapped_close(s, q, 1e-6) for s in sols), (k, q)
+        for s in sols:
+            assert np.abs(reference_fk("standard", rows, "RRRRRR", s) - T).max() <= 1e-10

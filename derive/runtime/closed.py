@@ -153,9 +153,12 @@ def _kquartic(B, C, D, E):
     return y1 - a, y2 - a, y3 - a, y4 - a
 
 
-def _small_residual(p: list[float] | np.ndarray, x: float) -> bool:
-    """p(x) is negligible against the size of its terms, or Newton's step from x is."""
-    value = size = slope = 0.0
+def _small_residual(p: list[float] | np.ndarray, x: complex) -> bool:
+    """p(x) is negligible against the size of its terms, or Newton's step from x is (x real,
+    or complex: a closed form's complex root is checked too, _accept)."""
+    value: complex = 0.0
+    slope: complex = 0.0
+    size = 0.0
     ax = abs(x)
     for k in p:
         slope = slope * x + value

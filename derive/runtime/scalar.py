@@ -392,7 +392,11 @@ def _real_roots(p: list[float]) -> list[float]:
 
 
 def _accept(p: list[float], zs: list[complex], check: bool = True) -> list[float] | None:
-    """Polished real parts of the near-real zs; None if one fails the residual test.
+    """Polished real parts of the near-real zs; None if one fails the residual test, or
+    (check) if a complex one does: Ferrari's formulas for a quartic whose leading coefficient is
+    1e-9 of the largest (both ends nearly vanish: a FANUC LR Mate's shoulder and elbow 1e-8
+    from -90 and 0 deg) gave one real root right and three wrong, complex, and lost six of
+    eight rows; the companion matrix then finds all four.
 
     A double root comes out split, as a complex pair or as two reals about sqrt(eps) apart;
     roots closer than _MERGE_TOL give their mean, which is accurate, unless the mean is
@@ -412,7 +416,10 @@ def _accept(p: list[float], zs: list[complex], check: bool = True) -> list[float
         z = complex(z)
         if abs(z.imag) <= _ROOT_IMAG_TOL * (1.0 + abs(z)):
             xs.append((z.real, True))
-        elif abs(z.imag) <= _CLUSTER_TOL * (1.0 + abs(z)):
+            continue
+        if check and not _small_residual(p, z):  # (a closed form's complex root, wrong)
+            return None
+        if abs(z.imag) <= _CLUSTER_TOL * (1.0 + abs(z)):
             split = True
     if split:
         xs = [
