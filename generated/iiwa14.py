@@ -765,16 +765,21 @@ def ik(
 
 
 def _solve(target, solve, tol):
-    """The Python solver's certified rows of target. On a nominal table (_SEED_TOL > 0: the
-    rows refined onto the exact chain) a pose the exact arm reaches can leave the nominal
-    closed form no seed near a singular configuration (an equation the nominal arm misses by
-    more than its seeds' bands there); where it gives no row, the seeds ik_approximate takes
-    (each a cos + b sin = e solved at its boundary where it misses) whose pose error is within
-    _SEED_TOL are refined too (a pose out of reach gives seeds far from it: measured 0.026 or
-    more on a hextilt arm, where the seeds that reach the pose were within 2e-4), and kept
-    where certified (_seed). The C solver takes the same second pass (dk_solve, loose)."""
+    """The Python solver's certified rows of target. Where the first pass gives none, a
+    second takes each a cos + b sin = e that misses at its boundary (_LOOSE.near): near a
+    singular configuration a pose the arm reaches can leave an equation missed by more than
+    its band. On an exact table an earlier step's rounding, divided by a nearly vanishing
+    factor, does it (a three-parallel arm's elbow and wrist both 1e-8 rad from straight:
+    theta6 from s5's terms, then the elbow's law of cosines beyond 1 by 2e-7 of its ratio; a
+    MyCobot 320 got no row at 31 of 100 such poses); its rows are certified and polished as
+    in the first pass (_keep). On a nominal table (_SEED_TOL > 0: the rows refined onto the
+    exact chain) the table's difference does it, near a singular configuration; there the
+    seeds whose pose error is within _SEED_TOL are refined (a pose out of reach gives seeds far
+    from it: measured 0.026 or more on a hextilt arm, where the seeds that reach the pose
+    were within 2e-4), and kept where certified (_seed). The C solver takes the same second
+    pass (dk_solve, loose)."""
     rows = _ik_scalar(target, *solve, tol)
-    if rows or not _SEED_TOL:
+    if rows:
         return rows
     _LOOSE.near = True
     try:
@@ -2015,11 +2020,11 @@ def _newton(c: list[float] | np.ndarray, x: float) -> float:
 class _Loose(threading.local):
     """Per thread: on, whether the solver is seeding ik_approximate (then an equation that
     misses is solved at its boundary, and a complex root gives its real part); near, whether
-    it is taking ik's second pass on a nominal table (derive/runtime/api.py, _solve; C's
-    dk_solve with loose): then _cs1 solves at its boundary where it misses, neither _cs1 nor
-    _wrist_spread adds seeds round a fold, a free joint takes q_ref's value only, and the
-    seeds are refined only where their pose error is within _SEED_TOL, and kept where
-    certified (refine.py, _seed)."""
+    it is taking ik's second pass, where the first gave no row (derive/runtime/api.py,
+    _solve; C's dk_solve with loose): then _cs1 solves at its boundary where it misses, a
+    free joint takes q_ref's value only, and on a nominal table neither _cs1 nor
+    _wrist_spread adds seeds round a fold, and the seeds are refined only where their pose
+    error is within _SEED_TOL, and kept where certified (refine.py, _seed)."""
 
     on = False
     near = False
@@ -2438,6 +2443,14 @@ _REFINE_POLISH = 1e-10
 # plateau before they converge (an OpenArm's elbow 1e-7 from straight: rows 1e-9 to 1.7e-8
 # off with 10, none beyond 1e-10 with 50; 1e-8 from straight, 2 of 172 beyond 1e-9)
 _REFINE_POLISH_PATIENCE = 50
+
+
+# in ik's second pass (no row in the first) an exact table's row within this of the pose,
+# though not within ik's tol, is polished too, and kept if that brings it within tol (_keep):
+# a myCobot 320's elbow and wrist 1e-10 rad from straight, the elbow's law of cosines solved
+# at its boundary, left rows 1.04e-6 from the pose (with tol 1e-6: no row) and 1e-13 once
+# polished; a pose out of reach by more than this gives no seed within it
+_LOOSE_REACH = 1e-4
 
 
 # ik_approximate's least squares: at most this many steps, done where the gradient of half
@@ -2929,11 +2942,16 @@ def _keep(found, t, q, e, tol, frees=()):
     moves too where holding it does not reach the tolerance (an OpenArm's elbow 1e-7 from
     straight, snapped to the fold: q3 free there, but fixed at the pose, and rows 2.6e-8 off
     were returned). A look-at row whose ray passes the point within tol or _AIM_POLISH
-    radians but not within tol * REACH (a point far away: _aims_at) is polished too, and kept
-    if that brings it within tol."""
+    radians but not within tol * REACH (a point far away: _aims_at), and in ik's second pass
+    a row within _LOOSE_REACH of the pose, are polished too, and kept if that brings them
+    within tol."""
     if _matches(e, t, min(tol, _REFINE_POLISH)):  # (most rows: one comparison settles it)
         found.append(q)
-    elif (certified := _matches(e, t, tol)) or _aims_at(e, t, tol):
+    elif (
+        (certified := _matches(e, t, tol))
+        or _aims_at(e, t, tol)
+        or (_LOOSE.near and _matches(e, t, _LOOSE_REACH))
+    ):
         limit = _REFINE_TOL if certified else tol
         held = [i for values, i in frees if values.__class__ is _Free]
         moved, size = _refine(q, t, held, _REFINE_POLISH_PATIENCE)

@@ -125,8 +125,8 @@ static const double DK_FREE_STEPS[DK_FREE_COUNT] = {
 
 /* The values of one joint: at most DK_VALUES_MAX (a polynomial's roots; a nominal fold's
    DK_SPREAD_COUNT seeds), or a free joint's DK_FREE_COUNT values stepped out from ref (one
-   value, ref, for a free length). loose, set by the caller on a nominal table (DK_SEED_TOL >
-   0; read only there): the solver's second pass (dk_cs1x says what it changes). */
+   value, ref, for a free length). loose, set by the caller: the solver's second pass, where
+   the first gave no row (dk_cs1x says what it changes; a free joint takes ref only). */
 typedef struct {
     int n;
     int free;
@@ -153,7 +153,7 @@ static void dk_set_free(dk_values *v, double ref, int angle)
 {
     v->free = angle;
     v->ref = ref;
-    v->n = angle ? DK_FREE_COUNT : 1;
+    v->n = angle && !v->loose ? DK_FREE_COUNT : 1; /* (the second pass: ref only) */
     v->t[0] = ref;
     v->c[0] = 1.0;
     v->s[0] = 0.0;
@@ -1297,17 +1297,16 @@ static int dk_cs1x(dk_values *v, double a, double b, double e, double rest, doub
        (an earlier joint's snapped double root leaves e 3e-11 off): the Python _cs1 */
     const int small = rho * rho <= DK_FREE_TOL * scale;
     const int free = DK_SEED_TOL > 0.0 ? small : rho * rho <= DK_FREE_TOL_EXACT * scale;
-    /* the second pass on a nominal table (the Python solver's _LOOSE.near): the equation
-       solved at its boundary where it misses, no seeds round a fold, a free joint at ref
-       only */
-    const int loose = DK_SEED_TOL > 0.0 && v->loose;
+    /* the second pass (the Python solver's _LOOSE.near): the equation solved at its
+       boundary where it misses, a free joint at ref only, and on a nominal table no seeds
+       round a fold */
+    const int loose = v->loose;
     v->n = 0;
     v->free = 0;
     v->ref = 0.0; /* (unread unless free; set so that no compiler sees it unset) */
     if (free || (small && fabs(e) > rho * (1.0 + DK_CLAMP_TOL))) {
         if (e * e <= DK_FREE_TOL * scale || loose) {
             dk_set_free(v, ref, 1);
-            v->n = loose ? 1 : v->n;
         }
         return 0;
     }
@@ -1600,6 +1599,11 @@ static void dk_rigid(const double T[16], double t[12])
 /* an exact table's row certified within ik's tol but not within this is polished (dk_polish;
    derive/runtime/refine.py, _REFINE_POLISH, says why) */
 #define DK_REFINE_POLISH (1e-10)
+
+/* in the second pass (loose) an exact table's row within this of the pose, though not within
+   tol, is polished too, and kept if that brings it within tol (derive/runtime/refine.py,
+   _LOOSE_REACH, says why) */
+#define DK_LOOSE_REACH (1e-4)
 
 /* ... with this patience (DK_REFINE_STEPS / DK_REFINE_PATIENCE times as many steps at most):
    a row taken at a fold lies on a singular configuration, where the damped steps cross a
@@ -2419,8 +2423,8 @@ static void dk_fk_q(const double q[DK_DOF], double e[12])
 
 /* The certified solutions of the pose t (its 12 top entries) into found, before wrapping and
    dropping repeats: their count, or DK_UNSETTLED. ref: q_ref's values (free joints': theirs).
-   loose: the second pass of a nominal table (DK_SEED_TOL > 0), where the first gave no row
-   (derive/runtime/api.py, _solve, says why, and derive/c/runtime.c, what changes). */
+   loose: the second pass, where the first gave no row (derive/runtime/api.py, _solve, says
+   why, and derive/c/runtime.c, what changes). */
 static int dk_solve(const double t[12], double tol, const double ref[DK_DOF],
                     double found[DK_MAX][DK_DOF], int *repeats, int loose)
 {
@@ -2469,6 +2473,7 @@ static int dk_solve(const double t[12], double tol, const double ref[DK_DOF],
             2.0*x0 + 7200.0*x1 + 316127094272.0, x3 - 186946339840.0, -410288.0*r + x2 +
             41348782336.0};
     dk_values dk_v3;
+    dk_v3.loose = loose;
     if (dk_poly(&dk_v3, dk_p3, 4, 1, 20.845498492269137, 1.0, qr3) < 0) {
         return DK_UNSETTLED;
     }
@@ -2480,6 +2485,7 @@ static int dk_solve(const double t[12], double tol, const double ref[DK_DOF],
         theta3 = dk_v3.free ? dk_seam(theta3) : dk_unit_seam(theta3);
         /* theta2: r and z equations, linear in (c2, s2) */
         dk_values dk_v2;
+        dk_v2.loose = loose;
         if (dk_cs2(&dk_v2, 2400.0*c3 + 20280.0*s3 - 20400.0, 20280.0*c3 - 2400.0*s3, 27200.0*c3 + r
                 + 229840.0*s3 - 232344.0, -338.0*c3 + 40.0*s3, 40.0*c3 + 338.0*s3 - 340.0, z,
                 33570240.0, 0.0, qr2) < 0) {
@@ -2501,6 +2507,7 @@ static int dk_solve(const double t[12], double tol, const double ref[DK_DOF],
             double g2 = 0.0;
             /* theta1: x = c1 g1 - s1 g2, y = s1 g1 + c1 g2; free with the wrist centre on axis 1 */
             dk_values dk_v1;
+            dk_v1.loose = loose;
             if (dk_cs2(&dk_v1, g1, -g2, x, g2, g1, y, 559504.0, 559504.0, qr1) < 0) {
                 return DK_UNSETTLED;
             }
@@ -2540,6 +2547,7 @@ static int dk_solve(const double t[12], double tol, const double ref[DK_DOF],
                 /* theta5: W33 = e3^T Rx(alpha4) Rz(theta5) Rx(alpha5) e3, its half-width
                         atan2(sqrt(W13^2 + W23^2), W33) (the Z-Y-Z Euler angle's) */
                 dk_values dk_v5;
+                dk_v5.loose = loose;
                 if (dk_cs1x(&dk_v5, 1.0, 0.0, W33, (W13*W13) + (W23*W23), 0.0, 0.0) < 0) {
                     return DK_UNSETTLED;
                 }
@@ -2557,6 +2565,7 @@ static int dk_solve(const double t[12], double tol, const double ref[DK_DOF],
                     double v2 = 0.0;
                     /* theta4: (W13, W23) = Rz(theta4) (v1, v2); free at a singular wrist */
                     dk_values dk_v4;
+                    dk_v4.loose = loose;
                     if (dk_flip) {
                         dk_flipped(&dk_v4, dk_f4[0], dk_f4[1], dk_f4[2]);
                     } else if (dk_cs2(&dk_v4, v1, -v2, W13, v2, v1, W23, 1.0, 1.0, qr4) < 0) {
@@ -2597,6 +2606,7 @@ static int dk_solve(const double t[12], double tol, const double ref[DK_DOF],
                         /* theta6: Rz(theta6) = (Rx(alpha4) Rz(theta5) Rx(alpha5))^T Rz(theta4)^T W
                                 */
                         dk_values dk_v6;
+                        dk_v6.loose = loose;
                         if (dk_flip) {
                             dk_flipped(&dk_v6, dk_f6[0], dk_f6[1], dk_f6[2]);
                         } else if (dk_atan2(&dk_v6, -W11*s4 + W21*c4, W11*c4*c5 + W21*c5*s4 +
@@ -2624,7 +2634,10 @@ static int dk_solve(const double t[12], double tol, const double ref[DK_DOF],
                                     dk_e7, dk_e8, dk_e9, dk_e10, dk_e11};
                             const int dk_fine_ok = n < DK_MAX && dk_match(e, t, dk_fine, dk_fine *
                                     DK_REACH, 0, 2);
-                            if (dk_fine_ok || (n < DK_MAX && dk_match(e, t, tol, ptol, 0, 2))) {
+                            const int dk_ok = dk_fine_ok || (n < DK_MAX && dk_match(e, t, tol, ptol,
+                                    0, 2));
+                            if (dk_ok || (loose && n < DK_MAX && dk_match(e, t, DK_LOOSE_REACH,
+                                    DK_LOOSE_REACH * DK_REACH, 0, 2))) {
                                 found[n][0] = theta1;
                                 found[n][1] = theta2;
                                 found[n][2] = theta3;
@@ -2635,7 +2648,7 @@ static int dk_solve(const double t[12], double tol, const double ref[DK_DOF],
                                         DK_REACH, t, found[n], (dk_v1.free ? 1u : 0u) | (dk_v2.free
                                         ? 2u : 0u) | (dk_v3.free ? 4u : 0u) | (dk_v4.free ? 8u : 0u)
                                         | (dk_v5.free ? 16u : 0u) | (dk_v6.free ? 32u : 0u), tol,
-                                        1)) {
+                                        dk_ok)) {
                                     n++;
                                 }
                             }
@@ -3000,6 +3013,9 @@ int lecture_6r_ik_ref(const double T[16], const double *free, const double *q_re
         dk_rigid(T, t);
         /* (the rows straight into q, in range already: only repeats to drop, in place) */
         count = dk_solve(t, tol, ref, q, &repeats, 0);
+        if (count == 0) { /* (the second pass: _solve in derive/runtime/api.py says why) */
+            count = dk_solve(t, tol, ref, q, &repeats, 1);
+        }
     }
     if (count < 0) {
         return LECTURE_6R_UNSETTLED;

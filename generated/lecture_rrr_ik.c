@@ -113,8 +113,8 @@ static const double DK_FREE_STEPS[DK_FREE_COUNT] = {
 
 /* The values of one joint: at most DK_VALUES_MAX (a polynomial's roots; a nominal fold's
    DK_SPREAD_COUNT seeds), or a free joint's DK_FREE_COUNT values stepped out from ref (one
-   value, ref, for a free length). loose, set by the caller on a nominal table (DK_SEED_TOL >
-   0; read only there): the solver's second pass (dk_cs1x says what it changes). */
+   value, ref, for a free length). loose, set by the caller: the solver's second pass, where
+   the first gave no row (dk_cs1x says what it changes; a free joint takes ref only). */
 typedef struct {
     int n;
     int free;
@@ -141,7 +141,7 @@ static void dk_set_free(dk_values *v, double ref, int angle)
 {
     v->free = angle;
     v->ref = ref;
-    v->n = angle ? DK_FREE_COUNT : 1;
+    v->n = angle && !v->loose ? DK_FREE_COUNT : 1; /* (the second pass: ref only) */
     v->t[0] = ref;
     v->c[0] = 1.0;
     v->s[0] = 0.0;
@@ -649,17 +649,16 @@ static int dk_cs1x(dk_values *v, double a, double b, double e, double rest, doub
        (an earlier joint's snapped double root leaves e 3e-11 off): the Python _cs1 */
     const int small = rho * rho <= DK_FREE_TOL * scale;
     const int free = DK_SEED_TOL > 0.0 ? small : rho * rho <= DK_FREE_TOL_EXACT * scale;
-    /* the second pass on a nominal table (the Python solver's _LOOSE.near): the equation
-       solved at its boundary where it misses, no seeds round a fold, a free joint at ref
-       only */
-    const int loose = DK_SEED_TOL > 0.0 && v->loose;
+    /* the second pass (the Python solver's _LOOSE.near): the equation solved at its
+       boundary where it misses, a free joint at ref only, and on a nominal table no seeds
+       round a fold */
+    const int loose = v->loose;
     v->n = 0;
     v->free = 0;
     v->ref = 0.0; /* (unread unless free; set so that no compiler sees it unset) */
     if (free || (small && fabs(e) > rho * (1.0 + DK_CLAMP_TOL))) {
         if (e * e <= DK_FREE_TOL * scale || loose) {
             dk_set_free(v, ref, 1);
-            v->n = loose ? 1 : v->n;
         }
         return 0;
     }
@@ -958,6 +957,11 @@ static void dk_rigid(const double T[16], double t[12])
 /* an exact table's row certified within ik's tol but not within this is polished (dk_polish;
    derive/runtime/refine.py, _REFINE_POLISH, says why) */
 #define DK_REFINE_POLISH (1e-10)
+
+/* in the second pass (loose) an exact table's row within this of the pose, though not within
+   tol, is polished too, and kept if that brings it within tol (derive/runtime/refine.py,
+   _LOOSE_REACH, says why) */
+#define DK_LOOSE_REACH (1e-4)
 
 /* ... with this patience (DK_REFINE_STEPS / DK_REFINE_PATIENCE times as many steps at most):
    a row taken at a fold lies on a singular configuration, where the damped steps cross a
@@ -1733,8 +1737,8 @@ static void dk_fk_q(const double q[DK_DOF], double e[12])
 
 /* The certified solutions of the pose t (its 12 top entries) into found, before wrapping and
    dropping repeats: their count, or DK_UNSETTLED. ref: q_ref's values (free joints': theirs).
-   loose: the second pass of a nominal table (DK_SEED_TOL > 0), where the first gave no row
-   (derive/runtime/api.py, _solve, says why, and derive/c/runtime.c, what changes). */
+   loose: the second pass, where the first gave no row (derive/runtime/api.py, _solve, says
+   why, and derive/c/runtime.c, what changes). */
 static int dk_solve(const double t[12], double tol, const double ref[DK_DOF],
                     double found[DK_MAX][DK_DOF], int *repeats, int loose)
 {
@@ -1757,6 +1761,7 @@ static int dk_solve(const double t[12], double tol, const double ref[DK_DOF],
     double py = wy;
     /* theta2: law of cosines, x^2 + y^2 = 4*c2/5 + 29/25 (elbow up / down) */
     dk_values dk_v2;
+    dk_v2.loose = loose;
     if (dk_cs1(&dk_v2, 0.8, 0.0, (px*px) + (py*py) - 1.16, 0.0, 0.0) < 0) {
         return DK_UNSETTLED;
     }
@@ -1777,6 +1782,7 @@ static int dk_solve(const double t[12], double tol, const double ref[DK_DOF],
         double k2 = 0.4*s2;
         /* theta1: x = k1 c1 - k2 s1, y = k1 s1 + k2 c1, i.e. atan2(y, x) - atan2(k2, k1) */
         dk_values dk_v1;
+        dk_v1.loose = loose;
         if (dk_cs2(&dk_v1, k1, -k2, px, 0.4*s2, 0.4*c2 + 1.0, py, 1.9599999999999997,
                 1.9599999999999997, qr1) < 0) {
             return DK_UNSETTLED;
@@ -1800,6 +1806,7 @@ static int dk_solve(const double t[12], double tol, const double ref[DK_DOF],
             double x1 = c2*s1;
             double x2 = s1*s2;
             dk_values dk_v3;
+            dk_v3.loose = loose;
             if (dk_atan2(&dk_v3, c1*c2*r21 - r11*x0 - r11*x1 - r21*x2, c1*c2*r11 - r11*x2 + r21*x0 +
                     r21*x1, qr3) < 0) {
                 return DK_UNSETTLED;
@@ -1819,13 +1826,15 @@ static int dk_solve(const double t[12], double tol, const double ref[DK_DOF],
                         dk_e9, dk_e10, dk_e11};
                 const int dk_fine_ok = n < DK_MAX && dk_match(e, t, dk_fine, dk_fine * DK_REACH, 0,
                         2);
-                if (dk_fine_ok || (n < DK_MAX && dk_match(e, t, tol, ptol, 0, 2))) {
+                const int dk_ok = dk_fine_ok || (n < DK_MAX && dk_match(e, t, tol, ptol, 0, 2));
+                if (dk_ok || (loose && n < DK_MAX && dk_match(e, t, DK_LOOSE_REACH, DK_LOOSE_REACH *
+                        DK_REACH, 0, 2))) {
                     found[n][0] = theta1;
                     found[n][1] = theta2;
                     found[n][2] = theta3;
                     if (dk_fine_ok || dk_polish(DK_CHAIN, DK_REVOLUTE, DK_SOLVED, DK_REACH, t,
                             found[n], (dk_v1.free ? 1u : 0u) | (dk_v2.free ? 2u : 0u) | (dk_v3.free
-                            ? 4u : 0u), tol, 1)) {
+                            ? 4u : 0u), tol, dk_ok)) {
                         n++;
                     }
                 }
@@ -2063,6 +2072,9 @@ int lecture_rrr_ik_ref(const double T[16], const double *free, const double *q_r
         dk_rigid(T, t);
         /* (the rows straight into q, in range already: only repeats to drop, in place) */
         count = dk_solve(t, tol, ref, q, &repeats, 0);
+        if (count == 0) { /* (the second pass: _solve in derive/runtime/api.py says why) */
+            count = dk_solve(t, tol, ref, q, &repeats, 1);
+        }
     }
     if (count < 0) {
         return LECTURE_RRR_UNSETTLED;

@@ -106,8 +106,8 @@ static const double DK_FREE_STEPS[DK_FREE_COUNT] = {
 
 /* The values of one joint: at most DK_VALUES_MAX (a polynomial's roots; a nominal fold's
    DK_SPREAD_COUNT seeds), or a free joint's DK_FREE_COUNT values stepped out from ref (one
-   value, ref, for a free length). loose, set by the caller on a nominal table (DK_SEED_TOL >
-   0; read only there): the solver's second pass (dk_cs1x says what it changes). */
+   value, ref, for a free length). loose, set by the caller: the solver's second pass, where
+   the first gave no row (dk_cs1x says what it changes; a free joint takes ref only). */
 typedef struct {
     int n;
     int free;
@@ -134,7 +134,7 @@ static void dk_set_free(dk_values *v, double ref, int angle)
 {
     v->free = angle;
     v->ref = ref;
-    v->n = angle ? DK_FREE_COUNT : 1;
+    v->n = angle && !v->loose ? DK_FREE_COUNT : 1; /* (the second pass: ref only) */
     v->t[0] = ref;
     v->c[0] = 1.0;
     v->s[0] = 0.0;
@@ -1442,6 +1442,11 @@ static void dk_rigid(const double T[16], double t[12])
    derive/runtime/refine.py, _REFINE_POLISH, says why) */
 #define DK_REFINE_POLISH (1e-10)
 
+/* in the second pass (loose) an exact table's row within this of the pose, though not within
+   tol, is polished too, and kept if that brings it within tol (derive/runtime/refine.py,
+   _LOOSE_REACH, says why) */
+#define DK_LOOSE_REACH (1e-4)
+
 /* ... with this patience (DK_REFINE_STEPS / DK_REFINE_PATIENCE times as many steps at most):
    a row taken at a fold lies on a singular configuration, where the damped steps cross a
    plateau before they converge (derive/runtime/refine.py, _REFINE_POLISH_PATIENCE, says
@@ -2206,8 +2211,8 @@ static void dk_fk_q(const double q[DK_DOF], double e[12])
 
 /* The certified solutions of the pose t (its 12 top entries) into found, before wrapping and
    dropping repeats: their count, or DK_UNSETTLED. ref: q_ref's values (free joints': theirs).
-   loose: the second pass of a nominal table (DK_SEED_TOL > 0), where the first gave no row
-   (derive/runtime/api.py, _solve, says why, and derive/c/runtime.c, what changes). */
+   loose: the second pass, where the first gave no row (derive/runtime/api.py, _solve, says
+   why, and derive/c/runtime.c, what changes). */
 static int dk_solve(const double t[12], double tol, const double ref[DK_DOF],
                     double found[DK_MAX][DK_DOF], int *repeats, int loose)
 {
@@ -2235,6 +2240,7 @@ static int dk_solve(const double t[12], double tol, const double ref[DK_DOF],
     const double dk_p3[] = {1.0, 0.21272, 0.01632777225 - 2.0*r, 0.000533429717054 - 0.21272*r,
             (r*r) - 0.007522127274*r + 0.002506804624*(z*z) + 7.056074237000755e-06};
     dk_values dk_v3;
+    dk_v3.loose = loose;
     if (dk_poly(&dk_v3, dk_p3, 4, 0, 1e-10, sqrt(r) + 0.09572299999999997, 0.0) < 0) {
         return DK_UNSETTLED;
     }
@@ -2248,6 +2254,7 @@ static int dk_solve(const double t[12], double tol, const double ref[DK_DOF],
         (void)dk_s3;
         /* theta2: r and z equations, linear in (c2, s2) */
         dk_values dk_v2;
+        dk_v2.loose = loose;
         if (dk_cs2(&dk_v2, -4.506119999990612e-07, 0.050068*d3 + 0.00266261624, -(d3*d3) -
                 0.10636*d3 + r - 0.003761063637, d3 + 0.05318, 8.99999999998125e-06, z,
                 0.00045876771315557177, 0.0, qr2 + 1.5707963267948966) < 0) {
@@ -2265,6 +2272,7 @@ static int dk_solve(const double t[12], double tol, const double ref[DK_DOF],
             double g2 = 0.0175;
             /* theta1: x = c1 g1 - s1 g2, y = s1 g1 + c1 g2; free with the wrist centre on axis 1 */
             dk_values dk_v1;
+            dk_v1.loose = loose;
             if (dk_cs2(&dk_v1, g1, -g2, x, g2, g1, y, 0.009162892728999995, 0.009162892728999995,
                     qr1) < 0) {
                 return DK_UNSETTLED;
@@ -2291,7 +2299,8 @@ static int dk_solve(const double t[12], double tol, const double ref[DK_DOF],
                 const int dk_fine_ok = n < DK_MAX && dk_match(e, t, dk_fine, dk_fine * DK_REACH, 3,
                         2);
                 const int dk_ok = dk_fine_ok || (n < DK_MAX && dk_match(e, t, tol, ptol, 3, 2));
-                if (dk_ok || (n < DK_MAX && dk_aims_at(e, t, tol, DK_REACH, 3, 2))) {
+                if (dk_ok || (loose && n < DK_MAX && dk_match(e, t, DK_LOOSE_REACH, DK_LOOSE_REACH *
+                        DK_REACH, 3, 2)) || (n < DK_MAX && dk_aims_at(e, t, tol, DK_REACH, 3, 2))) {
                     found[n][0] = theta1;
                     found[n][1] = theta2 - 1.5707963267948966;
                     if (dk_fine_ok || dk_polish(DK_CHAIN, DK_REVOLUTE, DK_SOLVED, DK_REACH, t,
@@ -2523,7 +2532,7 @@ int locobot_head_ik_ref(const double T[16], const double *free, const double *q_
         double t[12]; /* (T's rotation the nearest rotation where it is not one: dk_rigid) */
         dk_rigid(T, t);
         count = dk_solve(t, tol, ref, found, &repeats, 0);
-        if (count == 0 && DK_SEED_TOL > 0.0) { /* (a nominal table: the second pass) */
+        if (count == 0) { /* (the second pass: _solve in derive/runtime/api.py says why) */
             count = dk_solve(t, tol, ref, found, &repeats, 1);
         }
     }

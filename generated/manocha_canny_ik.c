@@ -904,6 +904,11 @@ static void dk_rigid(const double T[16], double t[12])
    derive/runtime/refine.py, _REFINE_POLISH, says why) */
 #define DK_REFINE_POLISH (1e-10)
 
+/* in the second pass (loose) an exact table's row within this of the pose, though not within
+   tol, is polished too, and kept if that brings it within tol (derive/runtime/refine.py,
+   _LOOSE_REACH, says why) */
+#define DK_LOOSE_REACH (1e-4)
+
 /* ... with this patience (DK_REFINE_STEPS / DK_REFINE_PATIENCE times as many steps at most):
    a row taken at a fold lies on a singular configuration, where the damped steps cross a
    plateau before they converge (derive/runtime/refine.py, _REFINE_POLISH_PATIENCE, says
@@ -3622,8 +3627,8 @@ static void dk_fk_q(const double q[DK_DOF], double e[12])
 
 /* The certified solutions of the pose t (its 12 top entries) into found, before wrapping and
    dropping repeats: their count, or DK_UNSETTLED. ref: q_ref's values (free joints': theirs).
-   loose: the second pass of a nominal table (DK_SEED_TOL > 0), where the first gave no row
-   (derive/runtime/api.py, _solve, says why, and derive/c/runtime.c, what changes). */
+   loose: the second pass, where the first gave no row (derive/runtime/api.py, _solve, says
+   why, and derive/c/runtime.c, what changes). */
 static int dk_solve(const double t[12], double tol, const double ref[DK_DOF],
                     double found[DK_MAX][DK_DOF], int *repeats, int loose)
 {
@@ -3771,7 +3776,9 @@ static int dk_solve(const double t[12], double tol, const double ref[DK_DOF],
         const double e[12] = {dk_e0, dk_e1, dk_e2, dk_e3, dk_e4, dk_e5, dk_e6, dk_e7, dk_e8, dk_e9,
                 dk_e10, dk_e11};
         const int dk_fine_ok = n < DK_MAX && dk_match(e, t, dk_fine, dk_fine * DK_REACH, 0, 2);
-        if (dk_fine_ok || (n < DK_MAX && dk_match(e, t, tol, ptol, 0, 2))) {
+        const int dk_ok = dk_fine_ok || (n < DK_MAX && dk_match(e, t, tol, ptol, 0, 2));
+        if (dk_ok || (loose && n < DK_MAX && dk_match(e, t, DK_LOOSE_REACH, DK_LOOSE_REACH *
+                DK_REACH, 0, 2))) {
             found[n][0] = theta1;
             found[n][1] = theta2;
             found[n][2] = theta3;
@@ -3779,7 +3786,7 @@ static int dk_solve(const double t[12], double tol, const double ref[DK_DOF],
             found[n][4] = theta5;
             found[n][5] = theta6;
             if (dk_fine_ok || dk_polish(DK_CHAIN, DK_REVOLUTE, DK_SOLVED, DK_REACH, t, found[n], 0u,
-                    tol, 1)) {
+                    tol, dk_ok)) {
                 n++;
             }
         }
@@ -4135,7 +4142,7 @@ int manocha_canny_ik_ref(const double T[16], const double *free, const double *q
         double t[12]; /* (T's rotation the nearest rotation where it is not one: dk_rigid) */
         dk_rigid(T, t);
         count = dk_solve(t, tol, ref, found, &repeats, 0);
-        if (count == 0 && DK_SEED_TOL > 0.0) { /* (a nominal table: the second pass) */
+        if (count == 0) { /* (the second pass: _solve in derive/runtime/api.py says why) */
             count = dk_solve(t, tol, ref, found, &repeats, 1);
         }
     }

@@ -113,8 +113,8 @@ static const double DK_FREE_STEPS[DK_FREE_COUNT] = {
 
 /* The values of one joint: at most DK_VALUES_MAX (a polynomial's roots; a nominal fold's
    DK_SPREAD_COUNT seeds), or a free joint's DK_FREE_COUNT values stepped out from ref (one
-   value, ref, for a free length). loose, set by the caller on a nominal table (DK_SEED_TOL >
-   0; read only there): the solver's second pass (dk_cs1x says what it changes). */
+   value, ref, for a free length). loose, set by the caller: the solver's second pass, where
+   the first gave no row (dk_cs1x says what it changes; a free joint takes ref only). */
 typedef struct {
     int n;
     int free;
@@ -141,7 +141,7 @@ static void dk_set_free(dk_values *v, double ref, int angle)
 {
     v->free = angle;
     v->ref = ref;
-    v->n = angle ? DK_FREE_COUNT : 1;
+    v->n = angle && !v->loose ? DK_FREE_COUNT : 1; /* (the second pass: ref only) */
     v->t[0] = ref;
     v->c[0] = 1.0;
     v->s[0] = 0.0;
@@ -649,17 +649,16 @@ static int dk_cs1x(dk_values *v, double a, double b, double e, double rest, doub
        (an earlier joint's snapped double root leaves e 3e-11 off): the Python _cs1 */
     const int small = rho * rho <= DK_FREE_TOL * scale;
     const int free = DK_SEED_TOL > 0.0 ? small : rho * rho <= DK_FREE_TOL_EXACT * scale;
-    /* the second pass on a nominal table (the Python solver's _LOOSE.near): the equation
-       solved at its boundary where it misses, no seeds round a fold, a free joint at ref
-       only */
-    const int loose = DK_SEED_TOL > 0.0 && v->loose;
+    /* the second pass (the Python solver's _LOOSE.near): the equation solved at its
+       boundary where it misses, a free joint at ref only, and on a nominal table no seeds
+       round a fold */
+    const int loose = v->loose;
     v->n = 0;
     v->free = 0;
     v->ref = 0.0; /* (unread unless free; set so that no compiler sees it unset) */
     if (free || (small && fabs(e) > rho * (1.0 + DK_CLAMP_TOL))) {
         if (e * e <= DK_FREE_TOL * scale || loose) {
             dk_set_free(v, ref, 1);
-            v->n = loose ? 1 : v->n;
         }
         return 0;
     }
@@ -948,6 +947,11 @@ static void dk_rigid(const double T[16], double t[12])
 /* an exact table's row certified within ik's tol but not within this is polished (dk_polish;
    derive/runtime/refine.py, _REFINE_POLISH, says why) */
 #define DK_REFINE_POLISH (1e-10)
+
+/* in the second pass (loose) an exact table's row within this of the pose, though not within
+   tol, is polished too, and kept if that brings it within tol (derive/runtime/refine.py,
+   _LOOSE_REACH, says why) */
+#define DK_LOOSE_REACH (1e-4)
 
 /* ... with this patience (DK_REFINE_STEPS / DK_REFINE_PATIENCE times as many steps at most):
    a row taken at a fold lies on a singular configuration, where the damped steps cross a
@@ -1709,8 +1713,8 @@ static void dk_fk_q(const double q[DK_DOF], double e[12])
 
 /* The certified solutions of the pose t (its 12 top entries) into found, before wrapping and
    dropping repeats: their count, or DK_UNSETTLED. ref: q_ref's values (free joints': theirs).
-   loose: the second pass of a nominal table (DK_SEED_TOL > 0), where the first gave no row
-   (derive/runtime/api.py, _solve, says why, and derive/c/runtime.c, what changes). */
+   loose: the second pass, where the first gave no row (derive/runtime/api.py, _solve, says
+   why, and derive/c/runtime.c, what changes). */
 static int dk_solve(const double t[12], double tol, const double ref[DK_DOF],
                     double found[DK_MAX][DK_DOF], int *repeats, int loose)
 {
@@ -1728,6 +1732,7 @@ static int dk_solve(const double t[12], double tol, const double ref[DK_DOF],
     double py = wy;
     /* theta2: law of cosines, x^2 + y^2 = 2*c2 + 2 (elbow up / down) */
     dk_values dk_v2;
+    dk_v2.loose = loose;
     if (dk_cs1(&dk_v2, 2.0, 0.0, (px*px) + (py*py) - 2.0, 0.0, 0.0) < 0) {
         return DK_UNSETTLED;
     }
@@ -1748,6 +1753,7 @@ static int dk_solve(const double t[12], double tol, const double ref[DK_DOF],
         double k2 = s2;
         /* theta1: x = k1 c1 - k2 s1, y = k1 s1 + k2 c1, i.e. atan2(y, x) - atan2(k2, k1) */
         dk_values dk_v1;
+        dk_v1.loose = loose;
         if (dk_cs2(&dk_v1, k1, -k2, px, s2, c2 + 1.0, py, 4.0, 4.0, qr1) < 0) {
             return DK_UNSETTLED;
         }
@@ -1767,11 +1773,13 @@ static int dk_solve(const double t[12], double tol, const double ref[DK_DOF],
             const double e[12] = {dk_e0, dk_e1, dk_e2, dk_e3, dk_e4, dk_e5, dk_e6, dk_e7, dk_e8,
                     dk_e9, dk_e10, dk_e11};
             const int dk_fine_ok = n < DK_MAX && dk_match(e, t, dk_fine, dk_fine * DK_REACH, 1, 2);
-            if (dk_fine_ok || (n < DK_MAX && dk_match(e, t, tol, ptol, 1, 2))) {
+            const int dk_ok = dk_fine_ok || (n < DK_MAX && dk_match(e, t, tol, ptol, 1, 2));
+            if (dk_ok || (loose && n < DK_MAX && dk_match(e, t, DK_LOOSE_REACH, DK_LOOSE_REACH *
+                    DK_REACH, 1, 2))) {
                 found[n][0] = theta1;
                 found[n][1] = theta2;
                 if (dk_fine_ok || dk_polish(DK_CHAIN, DK_REVOLUTE, DK_SOLVED, DK_REACH, t, found[n],
-                        (dk_v1.free ? 1u : 0u) | (dk_v2.free ? 2u : 0u), tol, 1)) {
+                        (dk_v1.free ? 1u : 0u) | (dk_v2.free ? 2u : 0u), tol, dk_ok)) {
                     n++;
                 }
             }
@@ -1991,6 +1999,9 @@ int planar_2r_ik_ref(const double T[16], const double *free, const double *q_ref
         dk_rigid(T, t);
         /* (the rows straight into q, in range already: only repeats to drop, in place) */
         count = dk_solve(t, tol, ref, q, &repeats, 0);
+        if (count == 0) { /* (the second pass: _solve in derive/runtime/api.py says why) */
+            count = dk_solve(t, tol, ref, q, &repeats, 1);
+        }
     }
     if (count < 0) {
         return PLANAR_2R_UNSETTLED;

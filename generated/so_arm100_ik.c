@@ -113,8 +113,8 @@ static const double DK_FREE_STEPS[DK_FREE_COUNT] = {
 
 /* The values of one joint: at most DK_VALUES_MAX (a polynomial's roots; a nominal fold's
    DK_SPREAD_COUNT seeds), or a free joint's DK_FREE_COUNT values stepped out from ref (one
-   value, ref, for a free length). loose, set by the caller on a nominal table (DK_SEED_TOL >
-   0; read only there): the solver's second pass (dk_cs1x says what it changes). */
+   value, ref, for a free length). loose, set by the caller: the solver's second pass, where
+   the first gave no row (dk_cs1x says what it changes; a free joint takes ref only). */
 typedef struct {
     int n;
     int free;
@@ -141,7 +141,7 @@ static void dk_set_free(dk_values *v, double ref, int angle)
 {
     v->free = angle;
     v->ref = ref;
-    v->n = angle ? DK_FREE_COUNT : 1;
+    v->n = angle && !v->loose ? DK_FREE_COUNT : 1; /* (the second pass: ref only) */
     v->t[0] = ref;
     v->c[0] = 1.0;
     v->s[0] = 0.0;
@@ -673,17 +673,16 @@ static int dk_cs1x(dk_values *v, double a, double b, double e, double rest, doub
        (an earlier joint's snapped double root leaves e 3e-11 off): the Python _cs1 */
     const int small = rho * rho <= DK_FREE_TOL * scale;
     const int free = DK_SEED_TOL > 0.0 ? small : rho * rho <= DK_FREE_TOL_EXACT * scale;
-    /* the second pass on a nominal table (the Python solver's _LOOSE.near): the equation
-       solved at its boundary where it misses, no seeds round a fold, a free joint at ref
-       only */
-    const int loose = DK_SEED_TOL > 0.0 && v->loose;
+    /* the second pass (the Python solver's _LOOSE.near): the equation solved at its
+       boundary where it misses, a free joint at ref only, and on a nominal table no seeds
+       round a fold */
+    const int loose = v->loose;
     v->n = 0;
     v->free = 0;
     v->ref = 0.0; /* (unread unless free; set so that no compiler sees it unset) */
     if (free || (small && fabs(e) > rho * (1.0 + DK_CLAMP_TOL))) {
         if (e * e <= DK_FREE_TOL * scale || loose) {
             dk_set_free(v, ref, 1);
-            v->n = loose ? 1 : v->n;
         }
         return 0;
     }
@@ -1013,6 +1012,11 @@ static void dk_rigid(const double T[16], double t[12])
 /* an exact table's row certified within ik's tol but not within this is polished (dk_polish;
    derive/runtime/refine.py, _REFINE_POLISH, says why) */
 #define DK_REFINE_POLISH (1e-10)
+
+/* in the second pass (loose) an exact table's row within this of the pose, though not within
+   tol, is polished too, and kept if that brings it within tol (derive/runtime/refine.py,
+   _LOOSE_REACH, says why) */
+#define DK_LOOSE_REACH (1e-4)
 
 /* ... with this patience (DK_REFINE_STEPS / DK_REFINE_PATIENCE times as many steps at most):
    a row taken at a fold lies on a singular configuration, where the damped steps cross a
@@ -1825,8 +1829,8 @@ static void dk_fk_q(const double q[DK_DOF], double e[12])
 
 /* The certified solutions of the pose t (its 12 top entries) into found, before wrapping and
    dropping repeats: their count, or DK_UNSETTLED. ref: q_ref's values (free joints': theirs).
-   loose: the second pass of a nominal table (DK_SEED_TOL > 0), where the first gave no row
-   (derive/runtime/api.py, _solve, says why, and derive/c/runtime.c, what changes). */
+   loose: the second pass, where the first gave no row (derive/runtime/api.py, _solve, says
+   why, and derive/c/runtime.c, what changes). */
 static int dk_solve(const double t[12], double tol, const double ref[DK_DOF],
                     double found[DK_MAX][DK_DOF], int *repeats, int loose)
 {
@@ -1866,6 +1870,7 @@ static int dk_solve(const double t[12], double tol, const double ref[DK_DOF],
     double pz = -4.24264237430805e-06*wy + 0.999999999991*wz - 0.11900019176728732;
     /* theta1: translation entry (3,4) of the invariant equation, a c1 + b s1 = c */
     dk_values dk_v1;
+    dk_v1.loose = loose;
     if (dk_cs1(&dk_v1, py, -px, 0.0, 0.11675903098938938, qr1) < 0) {
         return DK_UNSETTLED;
     }
@@ -1878,6 +1883,7 @@ static int dk_solve(const double t[12], double tol, const double ref[DK_DOF],
         double dk_h18 = 4.24264237430805e-06*s1;
         /* theta5: entry (3,3) of the invariant equation, its half-width atan2(sqrt(rest), e) */
         dk_values dk_v5;
+        dk_v5.loose = loose;
         if (dk_cs1x(&dk_v5, 1.0, 0.0, -c1*r23 + r13*s1, ((c1*r21 - r11*s1)*(c1*r21 - r11*s1)) +
                 ((c1*r22 - r12*s1)*(c1*r22 - r12*s1)), 0.0, 0.0) < 0) {
             return DK_UNSETTLED;
@@ -1906,6 +1912,7 @@ static int dk_solve(const double t[12], double tol, const double ref[DK_DOF],
             double x8 = 0.5*rad180;
             double x9 = x7 + x8;
             dk_values dk_v6;
+            dk_v6.loose = loose;
             if (dk_cs2r(&dk_v6, -s5, 0.0, -c1*r21 + r11*s1, 0.0, s5, -c1*r22 + r12*s1, 1.0, 0.0, x9,
                     x7 - x8, rad90 - x9, 0.0003610062344729771, 0.06300110356552706, 0.0) < 0) {
                 return DK_UNSETTLED;
@@ -1942,6 +1949,7 @@ static int dk_solve(const double t[12], double tol, const double ref[DK_DOF],
                         7920263725000003897292014177/250000000000000000000000000000 (elbow up /
                         down) */
                 dk_values dk_v3;
+                dk_v3.loose = loose;
                 if (dk_cs1(&dk_v3, 0.03132004866552704, 0.0, (G14*G14) + (G24*G24) -
                         0.03168105490000001, 0.0, 0.0) < 0) {
                     return DK_UNSETTLED;
@@ -1957,6 +1965,7 @@ static int dk_solve(const double t[12], double tol, const double ref[DK_DOF],
                     /* theta2: x = k1 c2 - k2 s2, y = k1 s2 + k2 c2, i.e. atan2(y, x) - atan2(k2,
                             k1) */
                     dk_values dk_v2;
+                    dk_v2.loose = loose;
                     if (dk_cs2(&dk_v2, k1, -k2, G14, 0.135000185185058*s3, 0.135000185185058*c3 +
                             0.116000021120688, G24, 0.11675903098938938, 0.11675903098938938, qr2 +
                             0.24378056638519918) < 0) {
@@ -1989,6 +1998,7 @@ static int dk_solve(const double t[12], double tol, const double ref[DK_DOF],
                         double x34 = c3*s2;
                         double x35 = s2*s3;
                         dk_values dk_v4;
+                        dk_v4.loose = loose;
                         if (dk_atan2(&dk_v4, -G11*x33 - G11*x34 + G21*c2*c3 - G21*x35, G11*c2*c3 -
                                 G11*x35 + G21*x33 + G21*x34, qr4 - 1.5322620031578618) < 0) {
                             return DK_UNSETTLED;
@@ -2025,7 +2035,10 @@ static int dk_solve(const double t[12], double tol, const double ref[DK_DOF],
                                     dk_e7, dk_e8, dk_e9, dk_e10, dk_e11};
                             const int dk_fine_ok = n < DK_MAX && dk_match(e, t, dk_fine, dk_fine *
                                     DK_REACH, 2, 2);
-                            if (dk_fine_ok || (n < DK_MAX && dk_match(e, t, tol, ptol, 2, 2))) {
+                            const int dk_ok = dk_fine_ok || (n < DK_MAX && dk_match(e, t, tol, ptol,
+                                    2, 2));
+                            if (dk_ok || (loose && n < DK_MAX && dk_match(e, t, DK_LOOSE_REACH,
+                                    DK_LOOSE_REACH * DK_REACH, 2, 2))) {
                                 found[n][0] = theta1;
                                 found[n][1] = theta2 - 0.24378056638519918;
                                 found[n][2] = theta3 + 0.28230856322733766;
@@ -2034,7 +2047,7 @@ static int dk_solve(const double t[12], double tol, const double ref[DK_DOF],
                                 if (dk_fine_ok || dk_polish(DK_CHAIN, DK_REVOLUTE, DK_SOLVED,
                                         DK_REACH, t, found[n], (dk_v1.free ? 1u : 0u) | (dk_v2.free
                                         ? 2u : 0u) | (dk_v3.free ? 4u : 0u) | (dk_v4.free ? 8u : 0u)
-                                        | (dk_v5.free ? 16u : 0u), tol, 1)) {
+                                        | (dk_v5.free ? 16u : 0u), tol, dk_ok)) {
                                     n++;
                                 }
                             }
@@ -2374,7 +2387,7 @@ int so_arm100_ik_ref(const double T[16], const double *free, const double *q_ref
         double t[12]; /* (T's rotation the nearest rotation where it is not one: dk_rigid) */
         dk_rigid(T, t);
         count = dk_solve(t, tol, ref, found, &repeats, 0);
-        if (count == 0 && DK_SEED_TOL > 0.0) { /* (a nominal table: the second pass) */
+        if (count == 0) { /* (the second pass: _solve in derive/runtime/api.py says why) */
             count = dk_solve(t, tol, ref, found, &repeats, 1);
         }
     }

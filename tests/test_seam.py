@@ -99,7 +99,11 @@ def tally(m, backends: tuple[str, ...]) -> dict[str, dict[str, int]]:
 # poses beyond 1e-12 between the Python ik and ik_batch, and against the compiled ik 15 such,
 # 4 at the seam and 1 whose theta6 is 1.3e-8 above -pi in one backend and 1.2e-8 above pi in
 # the other (its rows differ by 5e-8 throughout: a near-singular pose, q5 near -90 deg);
-# panda has one pose beyond 1e-12.
+# panda has one pose beyond 1e-12. iiwa14 has 24 poses more whose elbow is folded back (q4 =
+# +-pi: the inner boundary of the reach), which q7 = 0 instead of the sampled value leaves
+# 2e-8 to 7e-7 out of reach: they had no row in either backend, and get rows within tol from
+# the second pass (an equation that misses solved at its boundary, polished), polished to
+# different points where the fold stalls the steps (1e-6 to 0.6 rad apart: "turn").
 # parallel_6r in C (since the C solver replaced numba's, issue 38): 3 of 10,000 poses have a
 # joint exactly pi in one solver and pi -+ 1e-12..1e-9 in the other (the C solver's own
 # asin table and atan2 round apart from the math library's near pi), 8 more by rounding.
@@ -117,7 +121,7 @@ ALLOWED = {
     "open_manipulator_x": {"rounding": 3},
     "youbot": {"count": 1, "rounding": 5, "seam": 2},
     "so_arm100": {"rounding": 1, "seam": 1},
-    "iiwa14": {"rounding": 30, "seam": 10, "turn": 2},
+    "iiwa14": {"rounding": 30, "seam": 10, "turn": 26},
     "panda": {"rounding": 5},
     "lecture_6r": {"rounding": 500, "seam": 50, "turn": 1, "count": 1},
     "manocha_canny": {"rounding": 10, "seam": 5, "turn": 12, "count": 5},

@@ -71,8 +71,8 @@ static const double DK_FREE_STEPS[DK_FREE_COUNT] = {
 
 /* The values of one joint: at most DK_VALUES_MAX (a polynomial's roots; a nominal fold's
    DK_SPREAD_COUNT seeds), or a free joint's DK_FREE_COUNT values stepped out from ref (one
-   value, ref, for a free length). loose, set by the caller on a nominal table (DK_SEED_TOL >
-   0; read only there): the solver's second pass (dk_cs1x says what it changes). */
+   value, ref, for a free length). loose, set by the caller: the solver's second pass, where
+   the first gave no row (dk_cs1x says what it changes; a free joint takes ref only). */
 typedef struct {
     int n;
     int free;
@@ -99,7 +99,7 @@ static void dk_set_free(dk_values *v, double ref, int angle)
 {
     v->free = angle;
     v->ref = ref;
-    v->n = angle ? DK_FREE_COUNT : 1;
+    v->n = angle && !v->loose ? DK_FREE_COUNT : 1; /* (the second pass: ref only) */
     v->t[0] = ref;
     v->c[0] = 1.0;
     v->s[0] = 0.0;
@@ -1343,17 +1343,16 @@ static int dk_cs1x(dk_values *v, double a, double b, double e, double rest, doub
        (an earlier joint's snapped double root leaves e 3e-11 off): the Python _cs1 */
     const int small = rho * rho <= DK_FREE_TOL * scale;
     const int free = DK_SEED_TOL > 0.0 ? small : rho * rho <= DK_FREE_TOL_EXACT * scale;
-    /* the second pass on a nominal table (the Python solver's _LOOSE.near): the equation
-       solved at its boundary where it misses, no seeds round a fold, a free joint at ref
-       only */
-    const int loose = DK_SEED_TOL > 0.0 && v->loose;
+    /* the second pass (the Python solver's _LOOSE.near): the equation solved at its
+       boundary where it misses, a free joint at ref only, and on a nominal table no seeds
+       round a fold */
+    const int loose = v->loose;
     v->n = 0;
     v->free = 0;
     v->ref = 0.0; /* (unread unless free; set so that no compiler sees it unset) */
     if (free || (small && fabs(e) > rho * (1.0 + DK_CLAMP_TOL))) {
         if (e * e <= DK_FREE_TOL * scale || loose) {
             dk_set_free(v, ref, 1);
-            v->n = loose ? 1 : v->n;
         }
         return 0;
     }
@@ -1740,6 +1739,10 @@ static void dk_rigid(const double T[16], double t[12])
 /* an exact table's row certified within ik's tol but not within this is polished (dk_polish;
    derive/runtime/refine.py, _REFINE_POLISH, says why) */
 #define DK_REFINE_POLISH (1e-10)
+/* in the second pass (loose) an exact table's row within this of the pose, though not within
+   tol, is polished too, and kept if that brings it within tol (derive/runtime/refine.py,
+   _LOOSE_REACH, says why) */
+#define DK_LOOSE_REACH (1e-4)
 /* ... with this patience (DK_REFINE_STEPS / DK_REFINE_PATIENCE times as many steps at most):
    a row taken at a fold lies on a singular configuration, where the damped steps cross a
    plateau before they converge (derive/runtime/refine.py, _REFINE_POLISH_PATIENCE, says

@@ -307,8 +307,7 @@ def solve_lines(plan: Plan) -> tuple[tuple[int, str], ...]:
         if call.before:
             body.append(Line(depth, call.before))
         body.append(Line(depth, f"dk_values dk_v{j};"))
-        if fix:  # (the second pass's flag: derive/c/runtime.c dk_values)
-            body.append(Line(depth, f"dk_v{j}.loose = loose;"))
+        body.append(Line(depth, f"dk_v{j}.loose = loose;"))  # (derive/c/runtime.c dk_values)
         if fix and isinstance(step, SPREAD_STEPS):  # (a rough value's spread: dk_wrist_spread)
             body.append(Line(depth, f"dk_v{j}.more = 0.0;"))
         solve = f"{call.routine}(&dk_v{j}, {', '.join(call.args)}) < 0"
@@ -431,12 +430,13 @@ def solve_lines(plan: Plan) -> tuple[tuple[int, str], ...]:
         fine = match.format("dk_fine", "dk_fine * DK_REACH")
         body.append(Line(depth, f"const int dk_fine_ok = n < DK_MAX && {fine};"))
         certified = f"dk_fine_ok || (n < DK_MAX && {match.format('tol', 'ptol')})"
+        body.append(Line(depth, f"const int dk_ok = {certified};"))
+        # (the second pass's row within DK_LOOSE_REACH, polished: _keep says why)
+        near = match.format("DK_LOOSE_REACH", "DK_LOOSE_REACH * DK_REACH")
+        certified, flag = f"dk_ok || (loose && n < DK_MAX && {near})", "dk_ok"
         if plan.ik.certify == "lookat":  # (a far point's row aimed within tol: dk_aims_at)
-            body.append(Line(depth, f"const int dk_ok = {certified};"))
             aimed = f"dk_aims_at(e, t, tol, DK_REACH, {task}, {axis})"
-            certified, flag = f"dk_ok || (n < DK_MAX && {aimed})", "dk_ok"
-        else:
-            flag = "1"
+            certified += f" || (n < DK_MAX && {aimed})"
         body.append(Line(depth, f"if ({certified}) {{"))
         body += [Line(depth + 1, f"found[n][{k}] = {v};") for k, v in enumerate(outputs)]
         # (a row within tol but not DK_REFINE_POLISH is polished on the exact chain, the
@@ -517,6 +517,7 @@ def branch_lines(plan: Plan, name: str) -> tuple[str, ...]:
             if call.before:
                 lines.append(call.before)
             lines.append(f"dk_values dk_v{j};")
+            lines.append(f"dk_v{j}.loose = 0;")
             lines.append(f"double dk_c{j}, dk_s{j};")
             lines.append(
                 f"if ({call.routine}(&dk_v{j}, {', '.join(call.args)}) < 0 || !dk_v{j}.n) {{"

@@ -13,7 +13,6 @@ from numpy.typing import ArrayLike
 from derive.runtime.arm import (
     _C_SOURCE,
     _REVOLUTE,
-    _SEED_TOL,
     DOF,
     LIMITS,
     MAX_SOLUTIONS,
@@ -179,16 +178,21 @@ def ik(
 
 
 def _solve(target, solve, tol):
-    """The Python solver's certified rows of target. On a nominal table (_SEED_TOL > 0: the
-    rows refined onto the exact chain) a pose the exact arm reaches can leave the nominal
-    closed form no seed near a singular configuration (an equation the nominal arm misses by
-    more than its seeds' bands there); where it gives no row, the seeds ik_approximate takes
-    (each a cos + b sin = e solved at its boundary where it misses) whose pose error is within
-    _SEED_TOL are refined too (a pose out of reach gives seeds far from it: measured 0.026 or
-    more on a hextilt arm, where the seeds that reach the pose were within 2e-4), and kept
-    where certified (_seed). The C solver takes the same second pass (dk_solve, loose)."""
+    """The Python solver's certified rows of target. Where the first pass gives none, a
+    second takes each a cos + b sin = e that misses at its boundary (_LOOSE.near): near a
+    singular configuration a pose the arm reaches can leave an equation missed by more than
+    its band. On an exact table an earlier step's rounding, divided by a nearly vanishing
+    factor, does it (a three-parallel arm's elbow and wrist both 1e-8 rad from straight:
+    theta6 from s5's terms, then the elbow's law of cosines beyond 1 by 2e-7 of its ratio; a
+    MyCobot 320 got no row at 31 of 100 such poses); its rows are certified and polished as
+    in the first pass (_keep). On a nominal table (_SEED_TOL > 0: the rows refined onto the
+    exact chain) the table's difference does it, near a singular configuration; there the
+    seeds whose pose error is within _SEED_TOL are refined (a pose out of reach gives seeds far
+    from it: measured 0.026 or more on a hextilt arm, where the seeds that reach the pose
+    were within 2e-4), and kept where certified (_seed). The C solver takes the same second
+    pass (dk_solve, loose)."""
     rows = _ik_scalar(target, *solve, tol)
-    if rows or not _SEED_TOL:
+    if rows:
         return rows
     _LOOSE.near = True
     try:

@@ -66,6 +66,12 @@ _REFINE_POLISH = 1e-10
 # plateau before they converge (an OpenArm's elbow 1e-7 from straight: rows 1e-9 to 1.7e-8
 # off with 10, none beyond 1e-10 with 50; 1e-8 from straight, 2 of 172 beyond 1e-9)
 _REFINE_POLISH_PATIENCE = 50
+# in ik's second pass (no row in the first) an exact table's row within this of the pose,
+# though not within ik's tol, is polished too, and kept if that brings it within tol (_keep):
+# a myCobot 320's elbow and wrist 1e-10 rad from straight, the elbow's law of cosines solved
+# at its boundary, left rows 1.04e-6 from the pose (with tol 1e-6: no row) and 1e-13 once
+# polished; a pose out of reach by more than this gives no seed within it
+_LOOSE_REACH = 1e-4
 # ik_approximate's least squares: at most this many steps, done where the gradient of half
 # the squared error is this flat
 _LSQ_STEPS = 200

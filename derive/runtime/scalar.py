@@ -48,11 +48,11 @@ from derive.runtime.constants import (
 class _Loose(threading.local):
     """Per thread: on, whether the solver is seeding ik_approximate (then an equation that
     misses is solved at its boundary, and a complex root gives its real part); near, whether
-    it is taking ik's second pass on a nominal table (derive/runtime/api.py, _solve; C's
-    dk_solve with loose): then _cs1 solves at its boundary where it misses, neither _cs1 nor
-    _wrist_spread adds seeds round a fold, a free joint takes q_ref's value only, and the
-    seeds are refined only where their pose error is within _SEED_TOL, and kept where
-    certified (refine.py, _seed)."""
+    it is taking ik's second pass, where the first gave no row (derive/runtime/api.py,
+    _solve; C's dk_solve with loose): then _cs1 solves at its boundary where it misses, a
+    free joint takes q_ref's value only, and on a nominal table neither _cs1 nor
+    _wrist_spread adds seeds round a fold, and the seeds are refined only where their pose
+    error is within _SEED_TOL, and kept where certified (refine.py, _seed)."""
 
     on = False
     near = False
