@@ -378,6 +378,16 @@ def _validate(data: dict, where: str) -> ArmSpec:
     if not 1 <= len(rows) <= MAX_JOINTS:
         raise SpecError(f"{where}: joint: {len(rows)} joints; allowed 1 to {MAX_JOINTS}")
     joints = tuple(_joint(row, where, i + 1) for i, row in enumerate(rows))
+    if angle_unit == "rad":  # (a table in degrees with the unit left at "rad")
+        for i, joint in enumerate(joints, start=1):
+            for key in ("alpha", "theta"):
+                value = getattr(joint, key)
+                if abs(value) > 2.0 * math.pi + 1e-9:
+                    raise SpecError(
+                        f"{where}: joint {i}: {key}: {value:g} is beyond 2 pi with angle_unit "
+                        '= "rad"; allowed: radians from -2 pi to 2 pi (is the table in degrees? '
+                        'then set angle_unit = "deg")'
+                    )
     base = _frame(data.get("base"), where, "base", angle_unit)
     tool = _frame(data.get("tool"), where, "tool", angle_unit)
     example_q, example_pose = _example(data.get("example"), where, len(joints))

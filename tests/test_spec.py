@@ -34,6 +34,7 @@ BAD = [
     (GOOD.replace('name = "arm"\n', ""), "name: missing"),
     (GOOD.replace('"standard"', '"craig"'), "convention"),
     (GOOD.replace('angle_unit = "deg"', 'angle_unit = "grad"'), "angle_unit"),
+    (GOOD.replace('angle_unit = "deg"', 'angle_unit = "rad"'), "joint 1: alpha: -90 is beyond"),
     (GOOD + "colour = 1\n", "colour: unknown key"),
     (GOOD.replace("a = 1.0", "a = 1.0\nb = 2.0"), "joint 2: b: unknown key"),
     (GOOD.replace("a = 1.0", 'a = "1.0"'), "joint 2: a: must be a number"),
