@@ -49,9 +49,40 @@ class Nominal:
     tol: float
 
 
+# two axes within this (radians) of parallel, but not exactly parallel, have their common
+# normal far out along them: link_size sums their offsets d first
+NEARLY_PARALLEL = 0.05
+
+
+def link_size(spec: ArmSpec) -> float:
+    """The sum of the table's lengths |a| + |d|, the offsets d of two joints whose axes are
+    nearly parallel (within NEARLY_PARALLEL, not exactly) summed first: their common normal,
+    which the table's frames lie on, is far out along them, and their d's are large and
+    cancel (a calibrated KR6 URDF's axes 2 and 3, 2e-5 rad from parallel: d2 = 15.5958 m, d3 =
+    -15.5958 m, which made the arm's size 32 m, not 1.4 m: its real 25 mm shoulder offset
+    was then snapped to 0 and its rows certified 20 times too loosely). A run of such joints
+    is one group."""
+    to_rad = math.radians if spec.angle_unit == "deg" else float
+    joints = spec.joints
+    # the twist between axes k and k + 1 (0-based): modified row k + 1's, standard row k's
+    twists = [to_rad(j.alpha) for j in (joints[1:] if spec.convention == "modified" else joints)]
+    size = sum(abs(j.a) for j in joints)
+    group = 0.0
+    for k, joint in enumerate(joints):
+        group += joint.d if joint.kind == "R" else 0.0
+        twist = twists[k] if k < len(twists) else 0.0
+        off = abs(math.remainder(twist, math.pi))
+        if k + 1 < len(joints) and 0.0 < off <= NEARLY_PARALLEL:
+            continue  # (joint k + 1's offset joins this group)
+        size += abs(group)
+        group = 0.0
+    size += sum(abs(j.d) for j in joints if j.kind == "P")
+    return size
+
+
 def nominal(spec: ArmSpec, tol: float = STRUCTURE_TOL) -> Nominal:
     """The spec with every structure parameter within tol of its special value snapped."""
-    size = sum(abs(j.a) + abs(j.d) for j in spec.joints) or 1.0
+    size = link_size(spec) or 1.0
     quarter = 90.0 if spec.angle_unit == "deg" else math.pi / 2
     to_rad = math.radians if spec.angle_unit == "deg" else float
     unit = "deg" if spec.angle_unit == "deg" else "rad"

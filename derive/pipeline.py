@@ -19,6 +19,7 @@ from derive.nominal import (
     deviation,
     frames_factors,
     frames_pose,
+    link_size,
     nominal,
 )
 from derive.plan import ArmInfo, Correction, IkPlan, Plan
@@ -479,7 +480,7 @@ def arm_info(spec: ArmSpec, chain: Chain) -> ArmInfo:
             limits.append((to_rad(j.limits[0]), to_rad(j.limits[1])))
         else:
             limits.append(j.limits)
-    reach = sum(abs(j.a) + abs(j.d) for j in spec.joints)
+    reach = link_size(spec)  # (|a| + |d|, nearly parallel axes' offsets summed first)
     reach += sum(
         max(abs(lo), abs(hi))
         for (lo, hi), j in zip(limits, spec.joints)

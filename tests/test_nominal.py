@@ -456,11 +456,17 @@ def test_a_path_of_the_general_method_keeps_the_sign_of_det_j(xarm6):
         assert {module.branch(q) for q in path} == {(-1,)}
 
 
-def noisy_urdf(name: str, seed: int, decimals: int = 7) -> str:
+def noisy_urdf(name: str, seed: int, decimals: int = 7, calibrated: bool = False) -> str:
     """The arm of TABLES written as zoo URDFs are: every link frame the DH frame of its joint
     turned and moved along the joint's axis by a random rigid transform, every number with
-    7 decimals (so the axes are ~1e-7 off parallel, meeting, or 90 deg), or `decimals`."""
+    7 decimals (so the axes are ~1e-7 off parallel, meeting, or 90 deg), or `decimals`;
+    calibrated: the table first moved as a calibration moves it (alpha and theta by up to
+    0.02 deg, a and d by up to 0.2 mm)."""
     rng = np.random.default_rng(seed)
+    table = TABLES[name]
+    if calibrated:
+        moves = rng.uniform(-1.0, 1.0, (len(table), 4)) * [0.02, 2e-4, 2e-4, 0.02]
+        table = [tuple(float(v) for v in np.add(row, move)) for row, move in zip(table, moves)]
 
     def rz(t: float) -> np.ndarray:
         c, s = math.cos(t), math.sin(t)
@@ -476,7 +482,7 @@ def noisy_urdf(name: str, seed: int, decimals: int = 7) -> str:
         return m
 
     frames = [np.eye(4)]  # standard DH: frame i - 1 holds joint i's axis as its z
-    for alpha, a, d, theta in TABLES[name]:
+    for alpha, a, d, theta in table:
         step = rz(math.radians(theta)) @ moved(a, d) @ rx(math.radians(alpha))
         frames.append(frames[-1] @ step)
     links = [np.eye(4)]
@@ -553,6 +559,54 @@ def test_industrial_arms_written_as_noisy_urdfs_are_answered_exactly(name, tmp_p
             gaps = np.abs(np.remainder(rows - q + math.pi, 2 * math.pi) - math.pi)
             missed += bool(np.min(np.max(gaps, axis=1)) > 1e-8)
     assert regular >= 100 and missed == 0
+
+
+@needs_cc
+def test_a_calibrated_urdf_s_nearly_parallel_axes_do_not_inflate_its_size(tmp_path):
+    """A calibration written into a URDF: the KR6's table moved as a calibration moves it,
+    then written as noisy_urdf writes it. Its axes 2 and 3 are 1e-4 rad from parallel, and the
+    conversion's common normal lies metres out along them (d2 = -d3, metres): the arm's size,
+    the sum |a| + |d| of its table, was 22 times the real one (a new user's calibrated KR6
+    URDF: 32.6 m), which snapped its real 25 mm shoulder offset to 0 and certified its rows 20
+    times too loosely, and the sampled vector was missed at 37 of 1,954 regular poses in C.
+    The size now sums those two offsets first (derive/nominal.py, link_size): REACH within 1.5
+    times the arm's own sum (before: 20.7 m, 14.6 times), every row within 1e-10 of the URDF's
+    pose (positions over that sum), the URDF's joint vector found on every regular sample
+    (smallest singular value of the Jacobian, positions over that sum, at least 0.05)."""
+    from derive import urdf
+    from derive.load import solver_sources
+
+    from conftest import import_path
+
+    path = tmp_path / "kr6_calibrated.urdf"
+    path.write_text(noisy_urdf("kr6", 2, calibrated=True), encoding="utf-8")
+    chain = urdf.chain_between(urdf.read_urdf(path), "l0", "tool", str(path))
+    spec = urdf.load_urdf(path, urdf.Options(base="l0", tip="tool"))
+    assert max(abs(j.d) for j in spec.joints) > 1.0  # (the common normal far out)
+    folder = tmp_path / "module"
+    folder.mkdir()
+    for file, text in solver_sources(build_plan(spec)).items():
+        (folder / file).write_text(text, encoding="utf-8")
+    module = import_path(folder / f"{spec.name}.py")
+    size = sum(abs(a) + abs(d) for _alpha, a, d, _theta in TABLES["kr6"])
+    assert module.REACH / size <= 1.5, module.REACH
+    rng = np.random.default_rng(4)
+    regular = missed = 0
+    for _ in range(300):
+        q = rng.uniform(-3.1, 3.1, 6)
+        T = np.array(urdf.urdf_fk(chain, list(q)))
+        rows = module.ik(T, backend="c")
+        assert len(rows) > 0
+        for row in rows:
+            E = np.array(urdf.urdf_fk(chain, list(row))) - T
+            assert max(np.abs(E[:3, :3]).max(), np.abs(E[:3, 3]).max() / size) <= 1e-10
+        J = module.jacobian(q)
+        J[:3] /= size
+        if np.linalg.svd(J, compute_uv=False)[-1] >= 0.05:
+            regular += 1
+            gaps = np.abs(np.remainder(rows - q + math.pi, 2 * math.pi) - math.pi)
+            missed += bool(np.min(np.max(gaps, axis=1)) > 1e-8)
+    assert regular >= 120 and missed == 0, (regular, missed)
 
 
 def zoo_ur3e(folder: Path):
