@@ -1602,7 +1602,8 @@ static int dk_rr_split(int k, const double F[4][4], const double moved[4][4],
         double q[6], arm[6], error;
         int seen = 0;
         dk_rr_arm(k, cands[c], arm);
-        for (r = 0; r < known && !seen; r++) {
+        /* (on a perturbed table, a row this split found too: _rr_split says why) */
+        for (r = 0; r < (perturbed ? count : known) && !seen; r++) {
             seen = dk_rr_gap(arm, out[r]) <= DK_RR_SAME;
         }
         if (seen) {
