@@ -74,7 +74,7 @@ def build_plan(spec: ArmSpec, method: str | None = None) -> Plan:
             near_structure = classify(near_chain)
             near_ik, _ = choose(near_chain, near_structure, spec.free, closed, task, tol)
             if near_ik is not None:
-                fix = make_correction(near, near_chain, frames)
+                fix = make_correction(near, near_chain, frames, arm_info(spec, chain).reach)
                 if fix.deviation <= NOMINAL_MAX:
                     ik, refusal, correction = near_ik, "", fix
                     facts = tuple(
@@ -93,7 +93,9 @@ def build_plan(spec: ArmSpec, method: str | None = None) -> Plan:
         refusal = "; ".join(dict.fromkeys(reasons)) if ik is None else ""
     if correction is None and spec.exact is not None:
         # the table is the nominal one of the [exact] frames (a URDF's, snapped)
-        correction = make_correction(Nominal(spec, (), 0.0), chain, frames)
+        correction = make_correction(
+            Nominal(spec, (), 0.0), chain, frames, arm_info(spec, chain).reach
+        )
         if correction.deviation > NOMINAL_MAX:
             raise SpecError(
                 f"{spec.source}: exact.frames: the arm they describe differs from the table's "
@@ -337,11 +339,14 @@ def snapped_task(
 
 
 def make_correction(
-    near: Nominal, near_chain: Chain, frames: tuple[tuple[float, ...], ...]
+    near: Nominal, near_chain: Chain, frames: tuple[tuple[float, ...], ...], reach: float
 ) -> Correction:
-    """How the nominal table's answers are refined onto the exact frames (derive/nominal.py)."""
+    """How the nominal table's answers are refined onto the exact frames (derive/nominal.py);
+    positions are compared over the arm's reach (its own table's: a nominal table with two
+    axes snapped parallel keeps their far common normal's offsets, which link_size then no
+    longer sums first)."""
     info = arm_info(near.spec, near_chain)
-    moved = deviation(frames, chain_frames(near_chain), near.spec.joint_types, info.reach)
+    moved = deviation(frames, chain_frames(near_chain), near.spec.joint_types, reach)
     return Correction(
         nominal_dh=info.dh,
         changes=near.changes,
