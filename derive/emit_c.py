@@ -296,7 +296,10 @@ def render_c(plan: Plan) -> dict[str, str]:
         "m": printed,
         "generator": GENERATOR,
         "poly_max": poly_max(plan),
-        "values_max": max(poly_max(plan), constants._SPREAD_COUNT if plan.correction else 0),
+        "values_max": max(
+            poly_max(plan),
+            max(constants._SPREAD_COUNT, constants._FOLD_SPREAD) if plan.correction else 0,
+        ),
         "arm_general": general,
     }
     arm = env.get_template("arm.c.j2")

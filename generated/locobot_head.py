@@ -1906,10 +1906,10 @@ def _wrist_spread(t: float, det: float, det_scale: float) -> tuple[float, ...] |
     return (t,)
 
 
-def _all_round(first: float) -> tuple[float, ...]:
-    """_SPREAD_COUNT seeds all round from first: a nominal table's angle that its equations fix
+def _all_round(first: float, count: int = _SPREAD_COUNT) -> tuple[float, ...]:
+    """count seeds all round from first: a nominal table's angle that its equations fix
     only roughly."""
-    return tuple(first + _TWO_PI * k / _SPREAD_COUNT for k in range(_SPREAD_COUNT))
+    return tuple(first + _TWO_PI * k / count for k in range(count))
 
 
 def _poly_real(

@@ -281,6 +281,14 @@ _SPREAD_WIDTH = 0.2
 _SPREAD_COUNT = 8
 
 
+# ... _FOLD_SPREAD of them for one equation's angle (_cs1): near a UR arm's shoulder
+# singularity theta1's a and b nearly cancel on the nominal table, and a pair of the exact
+# arm's solutions 0.002 rad apart in theta1 was missed (a calibrated UR5 written as a URDF, 7
+# of 1,962 regular poses in C with 8; 1 with 16; the calibrated KR6's time unchanged: its
+# all-round seeds are the wrist's, which stay _SPREAD_COUNT: 16 made it 22% slower)
+_FOLD_SPREAD = 16
+
+
 # ... and a nominal two-equation step (a wrist's theta6 from s5's terms) whose determinant's
 # square root is within _WRIST_WIDTH _SEED_TOL of 0 (the wrist nearly straight: the arm's
 # difference over s5 moves the angle anywhere; _SEED_TOL is 100 times the nominal deviation)
@@ -1929,7 +1937,7 @@ def _cs1(
     e by about that, which near a singular configuration, a and b small, is far beyond
     _SEED_MISS of the ratio: a hextilt arm's 0.0008 over 0.0092, 9%; where
     sqrt(a^2 + b^2) itself is within _SPREAD_WIDTH _SEED_TOL sqrt(scale), as where two links
-    of nearly equal length fold back, _SPREAD_COUNT seeds all round; where the argument is
+    of nearly equal length fold back, _FOLD_SPREAD seeds all round; where the argument is
     near +-1, seeds either side of the fold, _FOLD_SEEDS), and taken as +-1 within _FOLD_TOL
     below (the double root).
 
@@ -1950,7 +1958,7 @@ def _cs1(
     if rho == 0.0:
         return (ref,) if loose else ()
     if rho <= _SPREAD_WIDTH * _SEED_TOL * sqrt(scale) and not loose:
-        return _all_round(atan2(b, a))  # (a nominal fold)
+        return _all_round(atan2(b, a), _FOLD_SPREAD)  # (a nominal fold)
     ratio = e / rho
     if (
         abs(ratio) > 1.0 + _CLAMP_TOL + _SEED_MISS
@@ -2018,10 +2026,10 @@ def _wrist_spread(t: float, det: float, det_scale: float) -> tuple[float, ...] |
     return (t,)
 
 
-def _all_round(first: float) -> tuple[float, ...]:
-    """_SPREAD_COUNT seeds all round from first: a nominal table's angle that its equations fix
+def _all_round(first: float, count: int = _SPREAD_COUNT) -> tuple[float, ...]:
+    """count seeds all round from first: a nominal table's angle that its equations fix
     only roughly."""
-    return tuple(first + _TWO_PI * k / _SPREAD_COUNT for k in range(_SPREAD_COUNT))
+    return tuple(first + _TWO_PI * k / count for k in range(count))
 
 
 def _cs2_reach(

@@ -64,6 +64,7 @@ def test_the_c_runtime_holds_the_python_runtimes_constants():
     for name in (
         "SPREAD_WIDTH",
         "SPREAD_COUNT",
+        "FOLD_SPREAD",
         "SEED_BAND",
         "WRIST_WIDTH",
         "WRIST_SPREAD",

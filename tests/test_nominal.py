@@ -609,6 +609,32 @@ def test_a_calibrated_urdf_s_nearly_parallel_axes_do_not_inflate_its_size(tmp_pa
     assert regular >= 120 and missed == 0, (regular, missed)
 
 
+@needs_cc
+def test_a_calibrated_ur5_s_pair_near_its_shoulder_singularity_is_found(tmp_path):
+    """A calibrated UR5 written as a URDF (tests/data/urdf/SOURCES.md), at a regular pose
+    (sigma_min 3.5e-3) near its shoulder singularity: theta1's a and b nearly cancel on the
+    nominal table, which seeds theta1 all round, and the exact arm has two solutions 0.002
+    rad apart in theta1. With 8 seeds all round both backends returned 4 of the 6 rows
+    (multistart Newton finds 6) and missed the sampled vector; with _FOLD_SPREAD (16) all 6,
+    every row within 1e-10 of the URDF's pose."""
+    from derive import urdf
+    from derive.load import solver_sources
+
+    from conftest import import_path
+
+    path = Path(__file__).parent / "data" / "urdf" / "ur5_calibrated.urdf"
+    chain = urdf.chain_between(urdf.read_urdf(path), "l0", "tool", str(path))
+    spec = urdf.load_urdf(path, urdf.Options(base="l0", tip="tool"))
+    for file, text in solver_sources(build_plan(spec)).items():
+        (tmp_path / file).write_text(text, encoding="utf-8")
+    module = import_path(tmp_path / f"{spec.name}.py")
+    q = [-1.2444148265129171, -1.4225892133925557, 0.06213054133889662, 2.978737269109371]
+    q += [0.7793403827191305, 1.188327148642589]
+    answered_with(chain, module, q, 1e-9)
+    for backend in ("c", "python"):
+        assert len(module.ik(np.array(urdf.urdf_fk(chain, q)), backend=backend)) == 6
+
+
 def zoo_ur3e(folder: Path):
     """The UR3e zoo URDF's chain (tests/data/urdf/SOURCES.md: its numbers with 7 decimals, a
     nominal table 2e-7 from it) and its generated module, written into folder."""

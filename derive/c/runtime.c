@@ -31,6 +31,7 @@
 #define DK_TWO_PI (6.283185307179586)
 #define DK_SPREAD_WIDTH (0.2)
 #define DK_SPREAD_COUNT 8
+#define DK_FOLD_SPREAD 16 /* (one equation's: the Python runtime's _FOLD_SPREAD says why) */
 #define DK_WRIST_WIDTH (0.03)
 #define DK_WRIST_SPREAD (0.01)
 #define DK_WRIST_NEAR (0.05)
@@ -1319,11 +1320,11 @@ static int dk_poly(dk_values *v, const double *coeffs, int d, int angles, double
 /* v's values after its first v->n: first + 2 pi k / DK_SPREAD_COUNT for k = v->n .. (at most
    DK_VALUES_MAX in all): seeds all round a nominal table's angle that its equations fix only
    roughly (the Python solver's _all_round) */
-static void dk_all_round(dk_values *v, double first)
+static void dk_all_round(dk_values *v, double first, int count)
 {
     int k;
-    for (k = v->n; k < DK_SPREAD_COUNT && v->n < DK_VALUES_MAX; k++) {
-        const double t = first + DK_TWO_PI * k / DK_SPREAD_COUNT;
+    for (k = v->n; k < count && v->n < DK_VALUES_MAX; k++) {
+        const double t = first + DK_TWO_PI * k / count;
         v->t[v->n] = t;
         v->c[v->n] = cos(t);
         v->s[v->n] = sin(t);
@@ -1366,7 +1367,7 @@ static int dk_cs1x(dk_values *v, double a, double b, double e, double rest, doub
         return 0;
     }
     if (rho <= DK_SPREAD_WIDTH * DK_SEED_TOL * sqrt(scale) && !loose) {
-        dk_all_round(v, atan2(b, a)); /* (a nominal fold: seeds all round) */
+        dk_all_round(v, atan2(b, a), DK_FOLD_SPREAD); /* (a nominal fold: seeds all round) */
         return 0;
     }
     inverse = 1.0 / rho;
@@ -1518,7 +1519,7 @@ static void dk_wrist_spread(dk_values *v, double det, double det_scale)
         return;
     }
     if (fabs(det) <= width * width * det_scale) {
-        dk_all_round(v, v->t[0]);
+        dk_all_round(v, v->t[0], DK_SPREAD_COUNT);
         return;
     }
     u = DK_WRIST_SPREAD * DK_SEED_TOL / sqrt(fabs(det) / det_scale);

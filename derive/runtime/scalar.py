@@ -28,6 +28,7 @@ from derive.runtime.constants import (
     _CLUSTER_TOL,
     _FOLD_NEAR,
     _FOLD_SEEDS,
+    _FOLD_SPREAD,
     _FOLD_TOL,
     _FREE_STEPS,
     _FREE_TOL,
@@ -137,7 +138,7 @@ def _cs1(
     e by about that, which near a singular configuration, a and b small, is far beyond
     _SEED_MISS of the ratio: a hextilt arm's 0.0008 over 0.0092, 9%; where
     sqrt(a^2 + b^2) itself is within _SPREAD_WIDTH _SEED_TOL sqrt(scale), as where two links
-    of nearly equal length fold back, _SPREAD_COUNT seeds all round; where the argument is
+    of nearly equal length fold back, _FOLD_SPREAD seeds all round; where the argument is
     near +-1, seeds either side of the fold, _FOLD_SEEDS), and taken as +-1 within _FOLD_TOL
     below (the double root).
 
@@ -158,7 +159,7 @@ def _cs1(
     if rho == 0.0:
         return (ref,) if loose else ()
     if rho <= _SPREAD_WIDTH * _SEED_TOL * sqrt(scale) and not loose:
-        return _all_round(atan2(b, a))  # (a nominal fold)
+        return _all_round(atan2(b, a), _FOLD_SPREAD)  # (a nominal fold)
     ratio = e / rho
     if (
         abs(ratio) > 1.0 + _CLAMP_TOL + _SEED_MISS
@@ -253,10 +254,10 @@ def _wrist_spread(t: float, det: float, det_scale: float) -> tuple[float, ...] |
     return (t,)
 
 
-def _all_round(first: float) -> tuple[float, ...]:
-    """_SPREAD_COUNT seeds all round from first: a nominal table's angle that its equations fix
+def _all_round(first: float, count: int = _SPREAD_COUNT) -> tuple[float, ...]:
+    """count seeds all round from first: a nominal table's angle that its equations fix
     only roughly."""
-    return tuple(first + _TWO_PI * k / _SPREAD_COUNT for k in range(_SPREAD_COUNT))
+    return tuple(first + _TWO_PI * k / count for k in range(count))
 
 
 def _cs2_reach(
