@@ -2071,15 +2071,7 @@ def _rr_split(k, F, moved, leads, known=(), imag_tol=_RR_IMAG_TOL):
     # count, which starts it anyway), and only where a row may be missing (_rr_settled)
     doubt = (_FALLBACK if fill_rows != true_rows else _RESCUE) if doubt else 0
     if known and candidates:  # (one within _RR_SAME of a known row is that row again)
-        rows = np.array(known)
-        kept = [
-            c
-            for c, q in enumerate(candidates)
-            if (
-                np.abs((rows - _rr_to_arm(k, q) + math.pi) % _TWO_PI - math.pi).max(axis=1)
-                > _RR_SAME
-            ).all()
-        ]
+        kept = [c for c, q in enumerate(candidates) if not _rr_near(_rr_to_arm(k, q), known)]
         candidates = [candidates[c] for c in kept]
         extras = [extras[c] for c in kept]
     if not candidates:
@@ -2099,7 +2091,7 @@ def _rr_split(k, F, moved, leads, known=(), imag_tol=_RR_IMAG_TOL):
             # compiled ik of it and of the CRX-like arm took 18% and 17% less time, 3,000
             # uniform poses, the same rows at every one), so it is not kept here either
             continue
-        if was_damped and fill_rows == true_rows and not extra:  # Newton did not settle it
+        if was_damped and not perturbed and not extra:  # Newton did not settle it
             doubt = _RESCUE
         if residual <= _RR_GOOD:
             out.append(q)
@@ -2115,7 +2107,7 @@ def _rr_split(k, F, moved, leads, known=(), imag_tol=_RR_IMAG_TOL):
             continue
         if residual <= _RR_NEAR:
             close.append(q)
-        if fill_rows == true_rows:  # (a perturbed table has solutions the arm has not)
+        if not perturbed:  # (a perturbed table has solutions the arm has not)
             doubt = _RESCUE
     return out, close, _rr_settled(doubt, known, [_rr_to_arm(k, q) for q in out], reals, pair)
 
