@@ -279,6 +279,14 @@ _FREE_TOL = 1e-14  # squared sizes: a joint is free below 1e-7 of its equation's
 _FREE_TOL_EXACT = 1e-20
 
 
+# ... and in ik's second pass (where the first gave no row: _LOOSE.near) a two-equation step's
+# determinant below 1e-4 of its scale (squared: 1e-8) leaves its angle free: an earlier
+# joint's error there (a root of a near-double pair, 1e-7 off) made a wrist's s5 3.7e-6
+# instead of 0, theta6 came from noise and no row from it (ManiSkill's SO100 URDF, exact, at
+# its home pose: a new user's attack); the second pass's rows are polished and certified
+_FREE_TOL_LOOSE = 1e-8
+
+
 # a joint value within this of a limit is inside it: a row on a limit comes back a rounding
 # past it (1e-15 from the closed forms, 3e-12 from a quartic's root: KR3's q2 at its limit
 # was dropped at 1e-12, a new user's attack); C's DK_LIMIT_SLACK
@@ -749,13 +757,13 @@ def _solve(target, solve, tol):
     seeds whose pose error is within _SEED_TOL are refined (a pose out of reach gives seeds far
     from it: measured 0.026 or more on a hextilt arm, where the seeds that reach the pose
     were within 2e-4), and kept where certified (_seed). The C solver takes the same second
-    pass (dk_solve, loose)."""
+    pass (dk_solve, loose), and keeps rows within _LOOSE_TOL (or tol, if smaller) only."""
     rows = _ik_scalar(target, *solve, tol)
     if rows:
         return rows
     _LOOSE.near = True
     try:
-        return _ik_scalar(target, *solve, tol)
+        return _ik_scalar(target, *solve, min(tol, _LOOSE_TOL))
     finally:
         _LOOSE.near = False
 
@@ -1980,11 +1988,20 @@ def _cs2(
     side vanishes (then so does the determinant, up to the errors of earlier joints).
     """
     det = a1 * b2 - a2 * b1
-    free = _FREE_TOL if _SEED_TOL else _FREE_TOL_EXACT
+    free = _cs2_free_tol()
     if abs(det) <= free * det_scale or e1 * e1 + e2 * e2 <= free * rhs_scale:
         return _free(ref)
     t = atan2((a1 * e2 - a2 * e1) / det, (e1 * b2 - b1 * e2) / det)
     return _wrist_spread(t, det, det_scale)
+
+
+def _cs2_free_tol() -> float:
+    """Below this times its scale a two-equation step's determinant (or its right-hand side's
+    square) leaves its angle free: _FREE_TOL on a nominal table, _FREE_TOL_EXACT on an exact
+    one, _FREE_TOL_LOOSE in ik's second pass."""
+    if _LOOSE.near:
+        return _FREE_TOL_LOOSE
+    return _FREE_TOL if _SEED_TOL else _FREE_TOL_EXACT
 
 
 def _wrist_spread(t: float, det: float, det_scale: float) -> tuple[float, ...] | _Spread:
@@ -1997,7 +2014,7 @@ def _wrist_spread(t: float, det: float, det_scale: float) -> tuple[float, ...] |
     gives no row (a seed that does not converge costs ~20 Newton steps: a calibrated KR6's
     C ik took 35% longer with all five always)."""
     loose = _LOOSE.on or _LOOSE.near
-    if not _SEED_TOL or loose:
+    if not _SEED_TOL or loose or det_scale <= 0.0:  # (a scale of 0: a system never free)
         return (t,)
     if abs(det) <= (_WRIST_WIDTH * _SEED_TOL) ** 2 * det_scale:
         return _all_round(t)
@@ -2260,6 +2277,15 @@ _REFINE_POLISH_PATIENCE = 50
 # at its boundary, left rows 1.04e-6 from the pose (with tol 1e-6: no row) and 1e-13 once
 # polished; a pose out of reach by more than this gives no seed within it
 _LOOSE_REACH = 1e-4
+
+
+# ... and the second pass keeps rows within this (or ik's tol, if smaller) only: near a
+# singular configuration of an exact table that nearly has a curve of solutions (ManiSkill's
+# SO100 URDF, pi/2 written 1.5708, its wrist straight) the polish stops at the error's local
+# least, 4e-8 to 2e-7 from the pose, which is no solution; where the pose is singular to
+# rounding (a myCobot 320's elbow and wrist 1e-10 from straight, sigma_min 1e-17) the rows
+# stall at up to 2.7e-9 (200 poses), and they are the answer
+_LOOSE_TOL = 1e-8
 
 
 # ik_approximate's least squares: at most this many steps, done where the gradient of half

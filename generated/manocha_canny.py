@@ -759,13 +759,13 @@ def _solve(target, solve, tol):
     seeds whose pose error is within _SEED_TOL are refined (a pose out of reach gives seeds far
     from it: measured 0.026 or more on a hextilt arm, where the seeds that reach the pose
     were within 2e-4), and kept where certified (_seed). The C solver takes the same second
-    pass (dk_solve, loose)."""
+    pass (dk_solve, loose), and keeps rows within _LOOSE_TOL (or tol, if smaller) only."""
     rows = _ik_scalar(target, *solve, tol)
     if rows:
         return rows
     _LOOSE.near = True
     try:
-        return _ik_scalar(target, *solve, tol)
+        return _ik_scalar(target, *solve, min(tol, _LOOSE_TOL))
     finally:
         _LOOSE.near = False
 
@@ -2774,6 +2774,15 @@ _REFINE_POLISH_PATIENCE = 50
 # at its boundary, left rows 1.04e-6 from the pose (with tol 1e-6: no row) and 1e-13 once
 # polished; a pose out of reach by more than this gives no seed within it
 _LOOSE_REACH = 1e-4
+
+
+# ... and the second pass keeps rows within this (or ik's tol, if smaller) only: near a
+# singular configuration of an exact table that nearly has a curve of solutions (ManiSkill's
+# SO100 URDF, pi/2 written 1.5708, its wrist straight) the polish stops at the error's local
+# least, 4e-8 to 2e-7 from the pose, which is no solution; where the pose is singular to
+# rounding (a myCobot 320's elbow and wrist 1e-10 from straight, sigma_min 1e-17) the rows
+# stall at up to 2.7e-9 (200 poses), and they are the answer
+_LOOSE_TOL = 1e-8
 
 
 # ik_approximate's least squares: at most this many steps, done where the gradient of half

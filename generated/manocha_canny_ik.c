@@ -909,6 +909,9 @@ static void dk_rigid(const double T[16], double t[12])
    _LOOSE_REACH, says why) */
 #define DK_LOOSE_REACH (1e-4)
 
+/* ... and it keeps rows within this (or tol, if smaller) only (_LOOSE_TOL says why) */
+#define DK_LOOSE_TOL (1e-8)
+
 /* ... with this patience (DK_REFINE_STEPS / DK_REFINE_PATIENCE times as many steps at most):
    a row taken at a fold lies on a singular configuration, where the damped steps cross a
    plateau before they converge (derive/runtime/refine.py, _REFINE_POLISH_PATIENCE, says
@@ -4144,7 +4147,7 @@ int manocha_canny_ik_ref(const double T[16], const double *free, const double *q
         dk_rigid(T, t);
         count = dk_solve(t, tol, ref, found, &repeats, 0);
         if (count == 0) { /* (the second pass: _solve in derive/runtime/api.py says why) */
-            count = dk_solve(t, tol, ref, found, &repeats, 1);
+            count = dk_solve(t, fmin(tol, DK_LOOSE_TOL), ref, found, &repeats, 1);
         }
     }
     if (count < 0) {

@@ -39,6 +39,8 @@
 
 #define DK_FREE_TOL_EXACT (1e-20)
 
+#define DK_FREE_TOL_LOOSE (1e-08)
+
 #define DK_CLAMP_TOL (1e-07)
 
 #define DK_CLAMP_ABS (1e-08)
@@ -1392,12 +1394,14 @@ static int dk_one(dk_values *v, double y, double x)
 }
 
 /* the angle t with a1 c + b1 s = e1 and a2 c + b2 s = e2; free where the system is singular
-   or its right-hand side vanishes (on an exact table to roundings: DK_FREE_TOL_EXACT) */
+   or its right-hand side vanishes (on an exact table to roundings: DK_FREE_TOL_EXACT; in the
+   second pass, loose, below DK_FREE_TOL_LOOSE: the Python solver's _cs2_free_tol) */
 static int dk_cs2_free(double a1, double b1, double e1, double a2, double b2, double e2,
-                       double det_scale, double rhs_scale)
+                       double det_scale, double rhs_scale, int loose)
 {
     const double det = a1 * b2 - a2 * b1;
-    const double free = DK_SEED_TOL > 0.0 ? DK_FREE_TOL : DK_FREE_TOL_EXACT;
+    const double exact = DK_SEED_TOL > 0.0 ? DK_FREE_TOL : DK_FREE_TOL_EXACT;
+    const double free = loose ? DK_FREE_TOL_LOOSE : exact;
     return fabs(det) <= free * det_scale || e1 * e1 + e2 * e2 <= free * rhs_scale;
 }
 
@@ -1418,7 +1422,8 @@ static void dk_wrist_spread(dk_values *v, double det, double det_scale)
 {
     const double width = DK_WRIST_WIDTH * DK_SEED_TOL;
     double u;
-    if (!(DK_SEED_TOL > 0.0) || v->loose) {
+    if (!(DK_SEED_TOL > 0.0) || v->loose || !(det_scale > 0.0)) { /* (a scale of 0: a system
+                                                                       never free) */
         return;
     }
     if (fabs(det) <= width * width * det_scale) {
@@ -1434,7 +1439,7 @@ static void dk_wrist_spread(dk_values *v, double det, double det_scale)
 static int dk_cs2(dk_values *v, double a1, double b1, double e1, double a2, double b2,
                   double e2, double det_scale, double rhs_scale, double ref)
 {
-    if (dk_cs2_free(a1, b1, e1, a2, b2, e2, det_scale, rhs_scale)) {
+    if (dk_cs2_free(a1, b1, e1, a2, b2, e2, det_scale, rhs_scale, v->loose)) {
         dk_set_free(v, ref, 1);
         return 0;
     }
@@ -1612,6 +1617,9 @@ static void dk_rigid(const double T[16], double t[12])
    tol, is polished too, and kept if that brings it within tol (derive/runtime/refine.py,
    _LOOSE_REACH, says why) */
 #define DK_LOOSE_REACH (1e-4)
+
+/* ... and it keeps rows within this (or tol, if smaller) only (_LOOSE_TOL says why) */
+#define DK_LOOSE_TOL (1e-8)
 
 /* ... with this patience (DK_REFINE_STEPS / DK_REFINE_PATIENCE times as many steps at most):
    a row taken at a fold lies on a singular configuration, where the damped steps cross a
@@ -2988,7 +2996,7 @@ int puma560_ik_ref(const double T[16], const double *free, const double *q_ref, 
         /* (the rows straight into q, in range already: only repeats to drop, in place) */
         count = dk_solve(t, tol, ref, q, &repeats, 0);
         if (count == 0) { /* (the second pass: _solve in derive/runtime/api.py says why) */
-            count = dk_solve(t, tol, ref, q, &repeats, 1);
+            count = dk_solve(t, fmin(tol, DK_LOOSE_TOL), ref, q, &repeats, 1);
         }
     }
     if (count < 0) {

@@ -787,6 +787,74 @@ def test_a_task_arm_near_its_singular_configuration_is_answered(tmp_path):
 
 
 @needs_cc
+def test_a_wrist_system_with_no_scale_is_solved_not_divided_by_zero(tmp_path):
+    """ManiSkill's SO100 URDF (tests/data/urdf/SOURCES.md; five joints, position + direction
+    of the tool z axis, axes 2-4 parallel on the nominal table, pi/2 written 1.5708): its
+    theta5 step is a 2 x 2 system printed with a scale of 0 (never free), which the nominal
+    table's spread divided by (a new user's attack: `derive generate` ended in a
+    ZeroDivisionError traceback, and the module's Python solver raised on every pose). A
+    scale of 0 now spreads nothing, in Python and C; every row reproduces the URDF's own
+    position and tool axis, the sampled vector among them."""
+    from derive import urdf
+    from derive.load import solver_sources
+
+    from conftest import import_path
+
+    path = Path(__file__).parent / "data" / "urdf" / "so100_maniskill.urdf"
+    spec = urdf.load_urdf(path, urdf.Options(base="Base", tip="Fixed_Jaw_tip"))
+    chain = urdf.chain_between(urdf.read_urdf(path), "Base", "Fixed_Jaw_tip", str(path))
+    for file, text in solver_sources(build_plan(spec)).items():
+        (tmp_path / file).write_text(text, encoding="utf-8")
+    module = import_path(tmp_path / f"{spec.name}.py")
+    assert module._SEED_TOL > 0.0  # (the nominal closed form, refined)
+    rng = np.random.default_rng(3)
+    for q in [np.zeros(5), *rng.uniform(-1.5, 1.5, (4, 5))]:
+        T = np.array(urdf.urdf_fk(chain, list(q)))
+        for backend in ("c", "python"):
+            rows = module.ik_direction(T[:3, 3], T[:3, 2], backend=backend)
+            gaps = np.abs(np.remainder(rows - q + math.pi, 2 * math.pi) - math.pi)
+            assert len(rows) and np.min(np.max(gaps, axis=1)) <= 1e-7, (backend, q, rows)
+            for row in rows:
+                E = np.array(urdf.urdf_fk(chain, list(row)))
+                assert np.abs(E[:3, 2] - T[:3, 2]).max() <= 1e-10
+                assert np.abs(E[:3, 3] - T[:3, 3]).max() / module.REACH <= 1e-10
+
+
+@needs_cc
+def test_an_exact_table_s_straight_wrist_is_answered_by_its_second_pass(tmp_path):
+    """The same SO100 URDF converted exactly (--exact: its 1.5708 kept, axes 2-4 parallel
+    exactly) with its wrist straight (q5 = 0: the task's Jacobian singular to 7e-7). theta1
+    comes from a near-double root of its quartic 1e-7 off, which the wrist's small offset
+    (a5 = 0.01 m) turns into an s5 of 3.7e-6 instead of 0, and theta6 from noise: no row at
+    the home pose in either backend (a new user's attack). ik's second pass now leaves a
+    two-equation step free below 1e-8 of its scale (_FREE_TOL_LOOSE), and keeps only rows
+    within _LOOSE_TOL (1e-8): its polish stalls 4e-8 to 2e-7 from the pose on the nearly
+    continuous solutions elsewhere, and such rows are no solutions."""
+    from derive import urdf
+    from derive.load import solver_sources
+
+    from conftest import import_path
+
+    path = Path(__file__).parent / "data" / "urdf" / "so100_maniskill.urdf"
+    spec = urdf.load_urdf(path, urdf.Options(base="Base", tip="Fixed_Jaw_tip", exact=True))
+    chain = urdf.chain_between(urdf.read_urdf(path), "Base", "Fixed_Jaw_tip", str(path))
+    for file, text in solver_sources(build_plan(spec)).items():
+        (tmp_path / file).write_text(text, encoding="utf-8")
+    module = import_path(tmp_path / f"{spec.name}.py")
+    assert module._SEED_TOL == 0.0  # (the exact table's own closed form)
+    for q in ([0.0] * 5, [0.2, 0.0, 0.0, 0.0, 0.0], [0.0, 0.1, -0.1, 0.2, 0.0]):
+        T = np.array(urdf.urdf_fk(chain, q))
+        for backend in ("c", "python"):
+            rows = module.ik_direction(T[:3, 3], T[:3, 2], backend=backend)
+            gaps = np.abs(np.remainder(rows - np.array(q) + math.pi, 2 * math.pi) - math.pi)
+            assert len(rows) and np.min(np.max(gaps, axis=1)) <= 1e-9, (backend, q, rows)
+            for row in rows:
+                E = np.array(urdf.urdf_fk(chain, list(row)))
+                assert np.abs(E[:3, 2] - T[:3, 2]).max() <= 1e-10, (backend, q, row)
+                assert np.abs(E[:3, 3] - T[:3, 3]).max() / module.REACH <= 1e-10
+
+
+@needs_cc
 def test_c_keeps_both_rows_of_a_calibrated_pair_near_the_elbow_s_fold(tmp_path):
     """A calibrated Staubli TX2-90 (tests/data/specs/tx2_90_cal.toml, a new user's: every
     alpha and theta moved by up to 0.02 deg, a and d by up to 0.2 mm) 0.037 rad from its elbow's

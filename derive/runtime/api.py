@@ -53,7 +53,7 @@ from derive.runtime.native import (
     _native_solver,
     _scratch,
 )
-from derive.runtime.refine import _least_squares, _pose_error
+from derive.runtime.refine import _LOOSE_TOL, _least_squares, _pose_error
 from derive.runtime.scalar import _LOOSE
 
 
@@ -190,13 +190,13 @@ def _solve(target, solve, tol):
     seeds whose pose error is within _SEED_TOL are refined (a pose out of reach gives seeds far
     from it: measured 0.026 or more on a hextilt arm, where the seeds that reach the pose
     were within 2e-4), and kept where certified (_seed). The C solver takes the same second
-    pass (dk_solve, loose)."""
+    pass (dk_solve, loose), and keeps rows within _LOOSE_TOL (or tol, if smaller) only."""
     rows = _ik_scalar(target, *solve, tol)
     if rows:
         return rows
     _LOOSE.near = True
     try:
-        return _ik_scalar(target, *solve, tol)
+        return _ik_scalar(target, *solve, min(tol, _LOOSE_TOL))
     finally:
         _LOOSE.near = False
 

@@ -56,6 +56,12 @@ _FREE_TOL = 1e-14  # squared sizes: a joint is free below 1e-7 of its equation's
 # rows 6e-8 off: a new user's attack); a nominal table keeps _FREE_TOL (its arm's difference
 # is larger)
 _FREE_TOL_EXACT = 1e-20
+# ... and in ik's second pass (where the first gave no row: _LOOSE.near) a two-equation step's
+# determinant below 1e-4 of its scale (squared: 1e-8) leaves its angle free: an earlier
+# joint's error there (a root of a near-double pair, 1e-7 off) made a wrist's s5 3.7e-6
+# instead of 0, theta6 came from noise and no row from it (ManiSkill's SO100 URDF, exact, at
+# its home pose: a new user's attack); the second pass's rows are polished and certified
+_FREE_TOL_LOOSE = 1e-8
 # a joint value within this of a limit is inside it: a row on a limit comes back a rounding
 # past it (1e-15 from the closed forms, 3e-12 from a quartic's root: KR3's q2 at its limit
 # was dropped at 1e-12, a new user's attack); C's DK_LIMIT_SLACK

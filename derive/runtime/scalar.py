@@ -33,6 +33,7 @@ from derive.runtime.constants import (
     _FREE_STEPS,
     _FREE_TOL,
     _FREE_TOL_EXACT,
+    _FREE_TOL_LOOSE,
     _LEAD_TOL,
     _MERGE_TOL,
     _ROOT_IMAG_TOL,
@@ -227,11 +228,20 @@ def _cs2(
     side vanishes (then so does the determinant, up to the errors of earlier joints).
     """
     det = a1 * b2 - a2 * b1
-    free = _FREE_TOL if _SEED_TOL else _FREE_TOL_EXACT
+    free = _cs2_free_tol()
     if abs(det) <= free * det_scale or e1 * e1 + e2 * e2 <= free * rhs_scale:
         return _free(ref)
     t = atan2((a1 * e2 - a2 * e1) / det, (e1 * b2 - b1 * e2) / det)
     return _wrist_spread(t, det, det_scale)
+
+
+def _cs2_free_tol() -> float:
+    """Below this times its scale a two-equation step's determinant (or its right-hand side's
+    square) leaves its angle free: _FREE_TOL on a nominal table, _FREE_TOL_EXACT on an exact
+    one, _FREE_TOL_LOOSE in ik's second pass."""
+    if _LOOSE.near:
+        return _FREE_TOL_LOOSE
+    return _FREE_TOL if _SEED_TOL else _FREE_TOL_EXACT
 
 
 def _wrist_spread(t: float, det: float, det_scale: float) -> tuple[float, ...] | _Spread:
@@ -244,7 +254,7 @@ def _wrist_spread(t: float, det: float, det_scale: float) -> tuple[float, ...] |
     gives no row (a seed that does not converge costs ~20 Newton steps: a calibrated KR6's
     C ik took 35% longer with all five always)."""
     loose = _LOOSE.on or _LOOSE.near
-    if not _SEED_TOL or loose:
+    if not _SEED_TOL or loose or det_scale <= 0.0:  # (a scale of 0: a system never free)
         return (t,)
     if abs(det) <= (_WRIST_WIDTH * _SEED_TOL) ** 2 * det_scale:
         return _all_round(t)
@@ -278,7 +288,7 @@ def _cs2_reach(
 ) -> tuple[float, ...] | _Spread:
     """As _cs2; a free t starts at _reach_first2's value (reachability of later joints)."""
     det = a1 * b2 - a2 * b1
-    free = _FREE_TOL if _SEED_TOL else _FREE_TOL_EXACT
+    free = _cs2_free_tol()
     if abs(det) > free * det_scale and e1 * e1 + e2 * e2 > free * rhs_scale:
         t = atan2((a1 * e2 - a2 * e1) / det, (e1 * b2 - b1 * e2) / det)
         return _wrist_spread(t, det, det_scale)
