@@ -31,6 +31,8 @@ def _xml_file(path: Path, options: urdf.Options) -> ArmSpec:
     root = re.search(rb"<\s*([A-Za-z_][\w.-]*)", re.sub(rb"<[?!][^>]*>", b"", head))
     if root is not None and root.group(1) == b"robot":
         return urdf.load_urdf(path, options)
+    if root is not None and root.group(1) == b"sdf":
+        raise SpecError(f"{path}: an SDFormat file (its root element is <sdf>); {FORMATS}")
     return mjcf.load_mjcf(path, options)
 
 
@@ -42,7 +44,7 @@ def _sdf_file(path: Path, options: urdf.Options) -> ArmSpec:
 # what the readers read, for messages
 FORMATS = (
     "derive reads spec files (.toml), URDF (.urdf, or .xml with a <robot> root) and MJCF "
-    "(.xml, .mjcf)"
+    "(.xml, .mjcf); a file of another suffix is read as XML where it starts with '<'"
 )
 
 # file suffix (lower case) -> reader
@@ -54,6 +56,20 @@ READERS: dict[str, Reader] = {
     ".xml": _xml_file,
     ".mjcf": mjcf.load_mjcf,
 }
+
+
+def _starts_with_markup(path: Path) -> bool:
+    """Whether the file's first character that is not white space (or a byte order mark) is
+    "<": XML, where a spec (TOML) cannot start so. Only a regular file is opened (a named
+    pipe would block until a writer came)."""
+    if not path.is_file():
+        return False
+    try:
+        with path.open("rb") as stream:
+            head = stream.read(4096)
+    except OSError:
+        return False
+    return head.lstrip(b"\xef\xbb\xbf \t\r\n").startswith(b"<")
 
 
 def conversion_options(options: urdf.Options | None) -> list[str]:
@@ -83,6 +99,10 @@ def resolve_spec(text: str, options: urdf.Options | None = None) -> ArmSpec:
     by name."""
     path = Path(text)
     reader = READERS.get(path.suffix.lower())
+    if reader is None and path.is_dir():
+        raise SpecError(f"{text}: a folder, not an arm's file; {FORMATS}")
+    if reader is None and _starts_with_markup(path):  # (a URDF or MJCF named otherwise, e.g.
+        reader = _xml_file  # robot.txt: its root element says which)
     if reader is not None and reader is not _spec_file:
         return reader(path, options or urdf.Options())
     if given := conversion_options(options):

@@ -20,6 +20,7 @@ kinematics against the URDF's on random joint vectors. A deviation above a bound
 from __future__ import annotations
 
 import hashlib
+import keyword
 import math
 import random
 import re
@@ -35,7 +36,15 @@ from xml.sax.xmlreader import AttributesImpl
 import defusedxml.sax as SafeSax
 from defusedxml import DefusedXmlException
 
-from derive.spec import IK_METHODS, IK_TASKS, TOOL_AXES, ArmSpec, SpecError, parse_spec
+from derive.spec import (
+    IK_METHODS,
+    IK_TASKS,
+    SHADOWED_MODULES,
+    TOOL_AXES,
+    ArmSpec,
+    SpecError,
+    parse_spec,
+)
 
 MAX_BYTES = 10_000_000
 MOVING = ("revolute", "continuous", "prismatic")
@@ -814,11 +823,16 @@ def measure(spec: ArmSpec, path: list[UrdfJoint], reach: float, samples: int = S
 
 
 def spec_name(text: str) -> str:
-    """A spec name ([a-z][a-z0-9_]*) from a robot's name."""
+    """A spec name ([a-z][a-z0-9_]*) from a robot's name; "_arm" after a Python keyword or a
+    module's name, which a spec refuses (<robot name="class">, "site", "numpy": the user did
+    not choose it, so it is not theirs to change)."""
     name = re.sub(r"[^a-z0-9_]+", "_", text.lower()).strip("_")
     if not name or not name[0].isalpha():
         name = "arm_" + name
-    return name[:60]
+    name = name[:60]
+    if keyword.iskeyword(name) or name in SHADOWED_MODULES or name in sys.stdlib_module_names:
+        name += "_arm"
+    return name
 
 
 def arm_name(given: str, path: Path) -> str:

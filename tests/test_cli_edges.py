@@ -328,12 +328,12 @@ def test_solve_names_free_when_a_free_value_is_out_of_range(capsys):
             "puma560: --base, --tip: options of a URDF or MJCF file's conversion",
         ),
         (["generate", "arm.sdf"], "arm.sdf: an SDFormat (.sdf) file; derive reads spec files"),
-        (["generate", "arm.model"], "not valid TOML (Invalid statement (at line 1, column 1)); "),
+        (["generate", "arm.model"], "arm.model: an SDFormat file (its root element is <sdf>)"),
     ],
 )
 def test_input_that_is_not_read_as_given_is_one_line(argv, message, tmp_path, capsys):
-    """A conversion's options on a spec would be ignored, an SDFormat or unknown file read as
-    TOML: each is refused in one line that says what is read."""
+    """A conversion's options on a spec would be ignored, an SDFormat file read as TOML (or, of
+    another suffix, as XML: as MJCF): each is refused in one line that says what is read."""
     for name in ("arm.sdf", "arm.model"):
         (tmp_path / name).write_text("<sdf version='1.7'><model name='m'/></sdf>\n")
     argv = [str(tmp_path / a) if a.startswith("arm.") else a for a in argv]

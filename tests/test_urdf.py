@@ -441,3 +441,18 @@ def test_a_robot_named_with_no_letter_or_digit_is_named_after_its_file(tmp_path)
     assert urdf.load_urdf(path, options(base, tip)).name == "left_leg"
     path.write_text(text)
     assert urdf.load_urdf(path, options(base, tip)).name == "chain"
+
+
+NAMES = [("class", "class_arm"), ("site", "site_arm"), ("numpy", "numpy_arm"),
+         ("2-finger pro", "arm_2_finger_pro")]  # fmt: skip
+
+
+@pytest.mark.parametrize(("robot", "name"), NAMES)
+def test_a_robot_named_as_a_keyword_or_a_module_gets_a_spec_name_it_may_have(robot, name, tmp_path):
+    """<robot name="class"> (or "site", "numpy") was refused in a spec's words, naming neither
+    the URDF nor --name (a new user's attack); the user did not choose the name, so the
+    conversion makes it one a spec takes, as it does for "2-finger pro"."""
+    text, base, tip = random_chain(random.Random(1))
+    path = tmp_path / "finger.urdf"
+    path.write_text(text.replace('<robot name="chain">', f'<robot name="{robot}">'))
+    assert urdf.load_urdf(path, options(base, tip)).name == name

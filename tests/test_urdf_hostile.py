@@ -378,3 +378,21 @@ def test_a_file_named_urdf_xacro_is_read_as_a_urdf_and_said_to_expand(tmp_path, 
     path.write_text(EXPANDED.replace('xyz="0 0 0.1575"', 'xyz="0 0 ${d1}"'))
     line = fails("generate", str(path), "--base", "base", "--tip", "l3")
     assert "expand it first" in line and "TOML" not in line
+
+
+def test_a_urdf_of_another_suffix_is_read_by_its_root_and_a_folder_is_named(tmp_path, fails):
+    """A URDF saved as robot.txt, and a folder given as the arm, both got "--base, --tip:
+    options of a URDF or MJCF file's conversion, and this arm is a spec" (a new user's attack):
+    a file of another suffix that starts with "<" is read as XML (its root says URDF or MJCF),
+    and a folder is refused as one."""
+    text = urdf_text(two_joints(), ["a", "b", "c"])
+    path = tmp_path / "robot.txt"
+    path.write_text(text)
+    out = tmp_path / "out"
+    assert main(["generate", str(path), "--base", "a", "--tip", "c", "--out", str(out)]) == 0
+    assert len(list(out.glob("*.py"))) == 1
+    line = fails("generate", str(tmp_path), "--base", "a", "--tip", "c")
+    assert "a folder, not an arm's file" in line and "--base" not in line
+    pipe = tmp_path / "robot.pipe"  # (a named pipe of another suffix: not opened to look)
+    os.mkfifo(pipe)
+    assert "robot.pipe" in fails("generate", str(pipe), "--base", "a", "--tip", "c")
