@@ -351,6 +351,14 @@ _RR_PATH_STEPS = 2
 _RR_SAME = 1e-2
 
 
+# a polished candidate within _RR_SAME of a row found, but not within the dedup's 1e-7, whose
+# pose error is above this (not settled to rounding) takes two more Newton steps before it is
+# compared: near a fold a candidate 1e-12 from the pose can lie 1e-6 from the solution (a G1
+# arm's pair 1e-4 apart, found again by the rescue's moved poses: C returned 10 rows to
+# Python's 8, a new user's attack)
+_RR_SETTLED = 1e-13
+
+
 # where a perturbed table answered and a row found is within _RR_NEAR_SINGULAR of a singular
 # configuration (Hadamard's ratio of its Jacobian: |det J| over the product of its column
 # norms), the rescue is tried too: there solutions meet, and the perturbed table's
@@ -2094,6 +2102,9 @@ def _rr_split(k, F, moved, leads, known=(), imag_tol=_RR_IMAG_TOL):
         if was_damped and not perturbed and not extra:  # Newton did not settle it
             doubt = _RESCUE
         if residual <= _RR_GOOD:
+            if residual > _RR_SETTLED and _rr_unsettled_copy(k, q, known, out):
+                Q1, errors = _rr_steps_many(true_rows, F, q[None], slide, False, steps=2)
+                q, residual = Q1[0], min(residual, float(errors[0]))
             out.append(q)
             continue
         if residual <= _RR_SEARCH_FROM:
@@ -2122,6 +2133,17 @@ def _rr_settled(doubt, known, rows, reals, pair):
     merged = list(known)
     _rr_merge(merged, rows)
     return 0 if len(merged) - len(known) >= reals else doubt
+
+
+def _rr_unsettled_copy(k, q, known, out):
+    """Whether split k's q (not settled to rounding) lies within _RR_SAME of a row found
+    (known: the arm's values; out: this split's) but not within the dedup's 1e-7: perhaps a
+    copy of that row near a fold (_RR_SETTLED says why)."""
+    rows = list(known) + [_rr_to_arm(k, r) for r in out]
+    if not rows:
+        return False
+    gaps = np.abs((np.array(rows) - _rr_to_arm(k, q) + math.pi) % _TWO_PI - math.pi).max(axis=1)
+    return bool(((gaps <= _RR_SAME) & (gaps > 1e-7)).any())
 
 
 def _rr_near(q, rows):

@@ -38,6 +38,7 @@
    and a few terms of the step's series (error d^6 / 720 ~ 1e-21), not by calling sincos */
 #define DK_RR_SMALL (1e-3)
 #define DK_RR_SAME (0.01)
+#define DK_RR_SETTLED (1e-13)
 /* an answer in doubt: the fallback split is tried (clusters on a perturbed table), and the
    rescue too (clusters on the arm's own table, a candidate Newton does not settle there, or
    no usable pencil) */
@@ -1497,6 +1498,24 @@ static double dk_rr_gap(const double a[6], const double b[6])
     return gap;
 }
 
+/* whether split k's q lies within DK_RR_SAME of one of out[0..count) but not within the
+   dedup's 1e-7: perhaps a copy of that row near a fold, not settled to rounding (the Python
+   solver's _rr_unsettled_copy; _RR_SETTLED says why) */
+static int dk_rr_unsettled_copy(int k, const double q[6], const double out[DK_RR_ROWS][6],
+                                int count)
+{
+    double arm[6];
+    int r;
+    dk_rr_arm(k, q, arm);
+    for (r = 0; r < count; r++) {
+        const double gap = dk_rr_gap(arm, out[r]);
+        if (gap <= DK_RR_SAME && gap > 1e-7) {
+            return 1;
+        }
+    }
+    return 0;
+}
+
 /* split k's joint values q (as the arm's) added to out[0..count) unless there already (within
    1e-7): the new count */
 static int dk_rr_add(int k, const double q[6], double out[DK_RR_ROWS][6], int count)
@@ -1632,6 +1651,10 @@ static int dk_rr_split(int k, const double F[4][4], const double moved[4][4],
                 *doubt = DK_RR_RESCUE;
             }
             continue;
+        }
+        if (error > DK_RR_SETTLED &&
+            dk_rr_unsettled_copy(k, q, (const double(*)[6])out, count)) {
+            error = fmin(error, dk_rr_walk(DK_RR_TRUE[k], F, q, 0, 2, DK_RR_NEWTON_REACH, 0));
         }
         count = dk_rr_add(k, q, out, count);
         if (count == DK_RR_ROWS) {

@@ -203,6 +203,12 @@ _RR_PATH_STEPS = 2
 # fallback split's candidates polished onto a row found; a new row was at least 0.02 from
 # every earlier one)
 _RR_SAME = 1e-2
+# a polished candidate within _RR_SAME of a row found, but not within the dedup's 1e-7, whose
+# pose error is above this (not settled to rounding) takes two more Newton steps before it is
+# compared: near a fold a candidate 1e-12 from the pose can lie 1e-6 from the solution (a G1
+# arm's pair 1e-4 apart, found again by the rescue's moved poses: C returned 10 rows to
+# Python's 8, a new user's attack)
+_RR_SETTLED = 1e-13
 # where a perturbed table answered and a row found is within _RR_NEAR_SINGULAR of a singular
 # configuration (Hadamard's ratio of its Jacobian: |det J| over the product of its column
 # norms), the rescue is tried too: there solutions meet, and the perturbed table's

@@ -69,6 +69,7 @@ from derive.runtime.constants import (
     _RR_SEARCH_FROM,
     _RR_SEARCH_SLIDE,
     _RR_SEARCH_STEPS,
+    _RR_SETTLED,
     _RR_SHIFT45,
     _TWO_PI,
 )
@@ -395,6 +396,9 @@ def _rr_split(k, F, moved, leads, known=(), imag_tol=_RR_IMAG_TOL):
         if was_damped and not perturbed and not extra:  # Newton did not settle it
             doubt = _RESCUE
         if residual <= _RR_GOOD:
+            if residual > _RR_SETTLED and _rr_unsettled_copy(k, q, known, out):
+                Q1, errors = _rr_steps_many(true_rows, F, q[None], slide, False, steps=2)
+                q, residual = Q1[0], min(residual, float(errors[0]))
             out.append(q)
             continue
         if residual <= _RR_SEARCH_FROM:
@@ -423,6 +427,17 @@ def _rr_settled(doubt, known, rows, reals, pair):
     merged = list(known)
     _rr_merge(merged, rows)
     return 0 if len(merged) - len(known) >= reals else doubt
+
+
+def _rr_unsettled_copy(k, q, known, out):
+    """Whether split k's q (not settled to rounding) lies within _RR_SAME of a row found
+    (known: the arm's values; out: this split's) but not within the dedup's 1e-7: perhaps a
+    copy of that row near a fold (_RR_SETTLED says why)."""
+    rows = list(known) + [_rr_to_arm(k, r) for r in out]
+    if not rows:
+        return False
+    gaps = np.abs((np.array(rows) - _rr_to_arm(k, q) + math.pi) % _TWO_PI - math.pi).max(axis=1)
+    return bool(((gaps <= _RR_SAME) & (gaps > 1e-7)).any())
 
 
 def _rr_near(q, rows):

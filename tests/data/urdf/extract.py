@@ -45,6 +45,7 @@ WANTED = (
     ("xarm6", "pybullet", "pybullet_data/xarm/xarm6_robot.urdf"),
     ("locobot", "nav_planning", "nav_planning/resources/robot/locobot/locobot.urdf"),
     ("so100_maniskill", "mani_skill", "mani_skill/assets/robots/so100/so100.urdf"),
+    ("g1_maniskill", "mani_skill", "mani_skill/assets/robots/g1_humanoid/g1.urdf"),
 )
 
 
