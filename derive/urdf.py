@@ -95,6 +95,9 @@ class UrdfJoint:
     axis: Vector
     limits: tuple[float, float] | None
     mimic: bool
+    # a revolute or prismatic joint whose <limit> gives neither lower nor upper (read as
+    # unlimited, and said in a note: URDF's defaults, 0 and 0, would hold it at 0)
+    unbounded: bool = False
 
 
 @dataclass(frozen=True)
@@ -352,6 +355,10 @@ def _joint(element, where: str) -> UrdfJoint:
         axis=(axis[0] / norm, axis[1] / norm, axis[2] / norm) if norm else (1.0, 0.0, 0.0),
         limits=limits,
         mimic=element.find("mimic") is not None,
+        unbounded=limit is not None
+        and kind in ("revolute", "prismatic")
+        and limit.get("lower") is None
+        and limit.get("upper") is None,
     )
 
 
@@ -1056,6 +1063,11 @@ def import_chain(
         raise UrdfError(
             f"{where}: the spec's FK differs from the {source}'s by {conversion.deviation:.3g} "
             f"{cause}; allowed {bound:g} (--max-deviation; --exact to switch snapping off)"
+        )
+    if unbounded := [joint.name for joint in chain if joint.unbounded]:
+        conversion.notes.append(
+            f"{where}: joint(s) {_listing(unbounded)}: <limit> gives neither lower nor upper; "
+            "read as unlimited (URDF's defaults, 0 and 0, would hold the joint at 0)"
         )
     if robot.ignored:
         conversion.notes.append(

@@ -396,3 +396,18 @@ def test_a_urdf_of_another_suffix_is_read_by_its_root_and_a_folder_is_named(tmp_
     pipe = tmp_path / "robot.pipe"  # (a named pipe of another suffix: not opened to look)
     os.mkfifo(pipe)
     assert "robot.pipe" in fails("generate", str(pipe), "--base", "a", "--tip", "c")
+
+
+def test_a_limit_with_no_bounds_is_read_as_unlimited_and_said_so(tmp_path, capsys):
+    """<limit effort="1" velocity="1"/> on a revolute joint (no lower, no upper) became an
+    unlimited joint with no word (a new user's attack); URDF's defaults would hold it at 0.
+    The reading stays (a joint the file means to move), and a note says so."""
+    text = urdf_text(two_joints(), ["a", "b", "c"])
+    bounded = '<limit lower="-1" upper="1"/>'
+    head, tail = text.rsplit(bounded, 1)  # (j2's: no bounds)
+    path = write(tmp_path, head + '<limit effort="1" velocity="1"/>' + tail)
+    spec = urdf.load_urdf(path, options("a", "c"))
+    assert spec.joints[0].limits is not None and spec.joints[1].limits is None
+    err = capsys.readouterr().err
+    assert "'j2': <limit> gives neither lower nor upper; read as unlimited" in err, err
+    assert "'j1'" not in err
