@@ -98,6 +98,9 @@ class UrdfJoint:
     # a revolute or prismatic joint whose <limit> gives neither lower nor upper (read as
     # unlimited, and said in a note: URDF's defaults, 0 and 0, would hold it at 0)
     unbounded: bool = False
+    # where its <limit>'s lower is above its upper: the message (a chain through it is refused;
+    # one elsewhere in the file is not: a NICO's left arm, read for its head)
+    inverted: str = ""
 
 
 @dataclass(frozen=True)
@@ -339,12 +342,13 @@ def _joint(element, where: str) -> UrdfJoint:
     if kind in MOVING and norm < 1e-9:
         raise UrdfError(f"{at}: axis xyz is zero")
     limits = None
+    inverted = ""
     limit = element.find("limit")
     if kind in ("revolute", "prismatic") and limit is not None:
         lo = _numbers(limit.get("lower"), 1, f"{at}: limit lower", (0.0,))[0]
         hi = _numbers(limit.get("upper"), 1, f"{at}: limit upper", (0.0,))[0]
-        if lo > hi:
-            raise UrdfError(f"{at}: limit lower {lo} is above upper {hi}")
+        if lo > hi:  # (refused where the chain uses the joint: import_chain)
+            inverted = f"{at}: limit lower {lo} is above upper {hi}"
         limits = (lo, hi) if lo < hi else None  # lower = upper = 0: URDF's "no limits given"
     return UrdfJoint(
         name=name,
@@ -359,6 +363,7 @@ def _joint(element, where: str) -> UrdfJoint:
         and kind in ("revolute", "prismatic")
         and limit.get("lower") is None
         and limit.get("upper") is None,
+        inverted=inverted,
     )
 
 
@@ -1041,6 +1046,9 @@ def import_chain(
     then the tip's)."""
     where = str(path)
     assert options.base is not None and options.tip is not None
+    for joint in chain:
+        if joint.inverted:
+            raise UrdfError(joint.inverted)
     conversion = convert(
         chain, where, options.angle_tol, options.length_tol, options.exact, options.task
     )

@@ -41,6 +41,14 @@ from derive.transforms import Chain, JointZ, inverse, product, rot_z, trans, x_f
 NAME = "cone"
 
 
+# a tool axis whose angle to the base axis the joints can move by less than this (its cos
+# by at most CONE_FLAT) is no axis for the task: nearly along joints 2-4's axes, it leaves
+# joint 4 nearly free and the angle nearly fixed (a Seeed B601's gripper z axis, 3.7e-6 rad off
+# them in its URDF: every row valid, the sampled vector never among them, and a whole branch
+# of theta1 missing; a new user's attack), and the next axis is tried
+CONE_FLAT = 1e-3
+
+
 def derive(chain: Chain, axis: int, cone: int, tol: float = 0.0) -> IkPlan:
     """The plan of the task for the tool axis `axis` (0 x, 1 y, 2 z) and the base axis `cone`
     (a five-joint arm's joint 5 taken as turning about the tool axis within tol: radians, and
@@ -92,10 +100,12 @@ def derive(chain: Chain, axis: int, cone: int, tol: float = 0.0) -> IkPlan:
     turned = rot_z(sym.c(aux), sym.s(aux))[:3, :3]
     tilt = (x1[:3, :3] * turned * flip * after[:3, :3])[2, axis] * sign
     ca, sa, cc = _linear(sp.expand(tilt), aux)
-    if ca == 0 and sa == 0:
+    swing = math.hypot(float(ca), float(sa))  # (how far the angle's cos can move)
+    if swing <= CONE_FLAT:
         raise NotApplicable(
-            f"the tool {AXES[axis]} axis is along joints 2-4's axes: its angle to the base "
-            f"{AXES[cone]} axis does not change"
+            f"the tool {AXES[axis]} axis is along joints 2-4's axes (within "
+            f"{math.degrees(math.asin(min(swing, 1.0))):.2g} deg): its angle to the base "
+            f"{AXES[cone]} axis does not change, and joint 4 moves neither it nor the point"
         )
     # the tool point in frame 1' (after X1) as M's: wrist W(theta2, theta3) + Rz(phi) F t4
     wrist = product(
