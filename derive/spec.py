@@ -348,6 +348,12 @@ def parse_spec(raw: bytes | str, where: str = "<memory>") -> ArmSpec:
     return _validate(data, where)
 
 
+def shadows_a_module(name: str) -> bool:
+    """Whether a generated <name>.py would shadow a module its folder imports (SHADOWED_MODULES,
+    or the standard library's)."""
+    return name in SHADOWED_MODULES or name in sys.stdlib_module_names
+
+
 def _validate(data: dict, where: str) -> ArmSpec:
     _no_unknown_keys(data, TOP_KEYS, where, "")
     name = _choice_or_text(data, "name", where)
@@ -356,7 +362,7 @@ def _validate(data: dict, where: str) -> ArmSpec:
             f"{where}: name: {name[:40]!r} is not allowed; use [a-z][a-z0-9_]* "
             f"(at most {NAME_MAX} characters, not a Python keyword)"
         )
-    if name in SHADOWED_MODULES or name in sys.stdlib_module_names:
+    if shadows_a_module(name):
         raise SpecError(
             f"{where}: name: {name!r} is the name of a module the generated code or Python "
             f"uses; {name}.py would shadow it for every import in its folder; choose another "

@@ -39,11 +39,11 @@ from defusedxml import DefusedXmlException
 from derive.spec import (
     IK_METHODS,
     IK_TASKS,
-    SHADOWED_MODULES,
     TOOL_AXES,
     ArmSpec,
     SpecError,
     parse_spec,
+    shadows_a_module,
 )
 
 MAX_BYTES = 10_000_000
@@ -842,7 +842,7 @@ def spec_name(text: str) -> str:
     if not name or not name[0].isalpha():
         name = "arm_" + name
     name = name[:60]
-    if keyword.iskeyword(name) or name in SHADOWED_MODULES or name in sys.stdlib_module_names:
+    if keyword.iskeyword(name) or shadows_a_module(name):
         name += "_arm"
     return name
 
