@@ -1524,10 +1524,13 @@ def _step_bound(q, A, B):
     """The joint step a continuous branch can take from q (a solution of the pose A) to the
     pose B: PATH_GAIN |dX| / sigma_min, dX the pose step (an arm solved for a task: its
     components' error at B), sigma_min the smallest singular value of the Jacobian at q
-    (of the task's); and sigma_min."""
+    (of the task's); and sigma_min. An arm of fewer than six joints solved for the pose (a
+    planar arm) has as many singular values as joints, and its least is the bound's too (it
+    was taken as 1: a lecture_rrr line at sigma_min 0.18 broke where its branch went on, 12
+    of 100 random lines, a new user's attack)."""
     if IK_COMPONENTS == "pose":
         change = float(np.linalg.norm(_pose_step(A, B)))
-        least = manipulability(q)[0] if DOF >= 6 else 1.0
+        least = manipulability(q)[0]
     else:  # (the task's components and their Jacobian: what the task's rows follow)
         error, columns, _ = _pose_error(q.tolist(), B[:3].ravel().tolist(), False)
         change = float(np.linalg.norm(error))

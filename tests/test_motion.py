@@ -696,6 +696,29 @@ def test_a_path_out_of_reach_or_limits_breaks_where_and_why(generated):
     assert (Q[:k, 4] <= module.LIMITS[4][1]).all()
 
 
+def test_a_planar_arm_s_path_is_bounded_by_its_own_sigma_min(generated):
+    """lecture_rrr (three joints, the planar pose) on a line whose sigma_min stays 0.18 to
+    0.25: its step bound took sigma_min as 1 for arms of fewer than six joints, and the path
+    broke at pose 8, q2 moving 0.10 rad where the bound allowed 0.093 (a new user's attack:
+    12 of 100 random lines). Now no break, in either backend, and every row is the branch of
+    the first, each step within the bound of its own sigma_min."""
+    module = generated("lecture_rrr")
+    qa = np.array([-0.9335432012860139, -1.3199479320408152, -1.4659897139641638])
+    qb = np.array([-0.932116231453883, -0.6126198522739282, -2.172873686996787])
+    Ts = module.straight_line(module.fk(qa), module.fk(qb), 10)
+    for backend in ("python", "c"):
+        Q, breaks = module.ik_path(Ts, qa, backend=backend)
+        assert breaks == [], (backend, breaks)
+        assert {module.branch(q) for q in Q} == {module.branch(qa)}
+        for k in range(1, 10):
+            assert np.abs(module.fk(Q[k]) - Ts[k]).max() < 1e-10
+            least = module.manipulability(Q[k - 1])[0]
+            dX = np.linalg.norm(Ts[k][:3, 3] - Ts[k - 1][:3, 3]) + np.linalg.norm(
+                Ts[k][:3, :3] - Ts[k - 1][:3, :3]
+            )
+            assert np.abs(Q[k] - Q[k - 1]).max() <= 3.0 * dX / least
+
+
 def test_a_path_of_an_arm_with_free_joints_moves_them_smoothly(generated):
     """The iiwa14 (q7 free) on 20 continuous joint paths: every row reproduces its pose, the
     free joint follows Newton's iteration (steps of at most 0.2 rad), no break
