@@ -1392,6 +1392,11 @@ PATH_CONVERGED = 1e-10
 PATH_GAIN = 3.0
 
 
+# where a pose has no row with the free joints' values of a path, it is tried at this many
+# values of each over its limits before it is called out of reach (_unreached)
+PATH_FREE_SAMPLES = 16
+
+
 PATH_SLACK = 1e-6
 
 
@@ -1583,8 +1588,13 @@ def _continuation(T, q, label, bound, within_limits, backend):
     converged = size <= PATH_CONVERGED
     free = [guess[j - 1] for j in FREE] if FREE else None
     rows = ik(T, free=free, q_ref=guess, backend=backend)
+    if len(rows) == 0 and converged:  # (Newton's iteration reached a solution that the
+        # closed form, at a singular configuration of the joints it solves, did not give: a
+        # panda line 7e-4 from its wrist's fold broke as "out of reach" at a pose ik solves
+        # with other values of q7, a new user's attack)
+        rows = guess[None]
     if len(rows) == 0:
-        return None, "out of reach"
+        return None, _unreached(T, guess, backend)
     gaps = _turned(rows - guess, revolute)
     misses = np.abs(gaps / units).max(axis=1)
     best = int(np.argmin(misses))
@@ -1617,6 +1627,31 @@ def _continuation(T, q, label, bound, within_limits, backend):
             + ": a singular crossing where the branch ends, or another branch)"
         )  # fmt: skip
     return _within(row, within_limits)
+
+
+def _unreached(T, guess, backend):
+    """Why the pose T has no row continuing a path: out of reach, or, on an arm with free
+    joints, no solution with the values Newton's iteration gave them while other values of
+    them reach T (PATH_FREE_SAMPLES each over its limits; a panda line 7e-4 from a singular
+    configuration broke as "out of reach" at a pose ik solves with other values of q7, a new
+    user's attack)."""
+    if not FREE:
+        return "out of reach"
+    held = ", ".join(f"q{j} = {guess[j - 1]:.6g}" for j in FREE)
+    grids = [
+        np.linspace(*np.clip(LIMITS[j - 1], -math.pi, math.pi), PATH_FREE_SAMPLES)
+        if _REVOLUTE[j - 1]
+        else np.linspace(*LIMITS[j - 1], PATH_FREE_SAMPLES)
+        for j in FREE
+    ]
+    for values in np.stack(np.meshgrid(*grids), axis=-1).reshape(-1, len(FREE)):
+        if len(ik(T, free=list(values), backend=backend)):
+            return (
+                f"no solution with {held}, the free joints' values Newton's iteration from "
+                "the last row reached (the pose has solutions with other values: a singular "
+                "crossing where the branch ends)"
+            )
+    return f"out of reach (with {held} and at {PATH_FREE_SAMPLES} values of each free joint)"
 
 
 def _turned(d: np.ndarray, revolute: np.ndarray) -> np.ndarray:

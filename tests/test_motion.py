@@ -719,6 +719,32 @@ def test_a_planar_arm_s_path_is_bounded_by_its_own_sigma_min(generated):
             assert np.abs(Q[k] - Q[k - 1]).max() <= 3.0 * dX / least
 
 
+def test_a_free_joint_arm_s_break_says_whether_the_pose_is_out_of_reach(generated):
+    """A panda line from 7e-4 of a singular configuration (a new user's attack): the pose
+    after the start has no solution with q7 where Newton's iteration from the start takes it
+    (the path crosses the singular set there), but ik solves it with other values of q7; the
+    break said "out of reach". Now it says which values failed and that others reach the
+    pose; a line leaving the workspace is still out of reach, at every value tried."""
+    module = generated("panda")
+    qa = np.array([1.2752525193927384, -2.657016184357835, 0.18540596695513056,
+                   2.672264233629589, -2.9940017186037986, 2.3442612963468785,
+                   -2.527232092977591])  # fmt: skip
+    qb = np.array([0.7426394801606604, -2.3326402623300164, 0.09188090162695406,
+                   1.9729034668211312, -3.1110455961975108, 2.4760438687211743,
+                   -2.813911837621783])  # fmt: skip
+    Ts = module.straight_line(module.fk(qa), module.fk(qb), 30)
+    for backend in ("python", "c"):
+        _, breaks = module.ik_path(Ts, qa, backend=backend)
+        (k, why), *_ = breaks
+        assert "out of reach" not in why and "no solution with q7 = " in why, why
+        assert "the pose has solutions with other values" in why
+        assert len(module.ik(Ts[k], backend=backend)) > 0
+    far = module.fk(qa)
+    far[:3, 3] *= 5.0
+    _, breaks = module.ik_path(module.straight_line(module.fk(qa), far, 10), qa)
+    assert "out of reach (with q7 = " in breaks[0][1] and "16 values" in breaks[0][1]
+
+
 def test_a_path_of_an_arm_with_free_joints_moves_them_smoothly(generated):
     """The iiwa14 (q7 free) on 20 continuous joint paths: every row reproduces its pose, the
     free joint follows Newton's iteration (steps of at most 0.2 rad), no break
