@@ -48,6 +48,7 @@ class PrintedC:
     fk_pose: tuple[str, ...]
     fk_joints: tuple[str, ...]
     jacobian: tuple[str, ...]
+    jacobian_tool: tuple[str, ...]
     # <name>_branch's body and the joints its signs name (the Python module's BRANCHES)
     branch: tuple[str, ...]
     branch_names: tuple[str, ...]
@@ -208,7 +209,7 @@ def print_c(plan: Plan) -> PrintedC:
         raise GenerationError(f"{arm.name}: no IK method, so no C solver: {plan.refusal}")
     solve = c.solve_lines(plan)
     fk_pose, fk_joints, fk_params = c.fk_lines(plan)
-    jacobian = c.jacobian_lines(plan)
+    jacobian, jacobian_tool = c.jacobian_lines(plan)
     upper = arm.name.upper()
     text = ik.free_text
     return PrintedC(
@@ -233,6 +234,7 @@ def print_c(plan: Plan) -> PrintedC:
         fk_pose=fk_pose,
         fk_joints=fk_joints,
         jacobian=jacobian,
+        jacobian_tool=jacobian_tool,
         branch=c.branch_lines(plan, arm.name),
         branch_names=branches.branch_names(plan),
         branch_doc=branch_doc(plan),

@@ -1352,7 +1352,8 @@ def link_transform(q: ArrayLike, k: int) -> np.ndarray:
 
 # ik_velocity's damping: none while the Jacobian's smallest singular value is at least
 # VELOCITY_BAND; below it, lambda^2 = VELOCITY_DAMPING^2 (1 - (sigma / VELOCITY_BAND)^2), which
-# bounds every joint rate by |twist| / (2 VELOCITY_DAMPING) at a singular configuration
+# bounds every joint rate by |twist| / (2 VELOCITY_DAMPING) at a singular configuration and,
+# VELOCITY_DAMPING being VELOCITY_BAND, by |twist| / VELOCITY_BAND anywhere
 VELOCITY_BAND = 0.05
 
 
@@ -1360,8 +1361,9 @@ VELOCITY_DAMPING = 0.05
 
 
 # the drift of ik_velocity stays off the directions whose singular values exceed _RANK_TOL
-# times the largest (at least 1): the C ik_velocity's singular values come from J^T J's
-# eigenvalues, which carry about 1e-16 of the largest's square, so this is their accuracy
+# times the largest (at least 1): the C ik_velocity's singular values once came from J^T J's
+# eigenvalues, which carry about 1e-16 of the largest's square (now from J's own, by one-sided
+# Jacobi rotations; the threshold stays, so that the two agree where it decides)
 _RANK_TOL = 1e-7
 
 
@@ -1381,10 +1383,11 @@ def ik_velocity(
     Away from singular configurations (every singular value at least band) lambda is 0 and
     J dq reproduces the twist (to rounding) where the arm can move that way; within band of one
     the damping grows to damping^2 as the smallest singular value goes to 0, which bounds the
-    joint rates (by |twist| / (2 damping)) at the price of the twist's component along the lost
-    direction. An arm of fewer than 6 joints gets the least-squares dq of the whole twist (a
-    direction arm cannot follow a roll about its tool axis, a position arm any rotation: give
-    a twist its task can follow, and read J dq for what it does).
+    joint rates (by |twist| / (2 damping) at a singular configuration, by |twist| / band
+    anywhere where damping >= band, as the defaults) at the price of the twist's component
+    along the lost direction. An arm of fewer than 6 joints gets the least-squares dq of the
+    whole twist (a direction arm cannot follow a roll about its tool axis, a position arm any
+    rotation: give a twist its task can follow, and read J dq for what it does).
 
     Args:
         q: DOF joint values; twist: 6 numbers, v (length units per second) then w (rad/s).
@@ -1721,12 +1724,12 @@ def _unreached(T, guess, backend):
     if not FREE:
         return "out of reach"
     held = ", ".join(f"q{j} = {guess[j - 1]:.6g}" for j in FREE)
-    grids = [
-        np.linspace(*np.clip(LIMITS[j - 1], -math.pi, math.pi), PATH_FREE_SAMPLES)
-        if _REVOLUTE[j - 1]
-        else np.linspace(*LIMITS[j - 1], PATH_FREE_SAMPLES)
-        for j in FREE
-    ]
+    grids = []
+    for j in FREE:
+        lo, hi = (float(v) for v in LIMITS[j - 1])
+        if _REVOLUTE[j - 1]:
+            lo, hi = max(lo, -math.pi), min(hi, math.pi)
+        grids.append(np.linspace(lo, hi, PATH_FREE_SAMPLES))
     for values in np.stack(np.meshgrid(*grids), axis=-1).reshape(-1, len(FREE)):
         if len(ik(T, free=list(values), backend=backend)):
             return (

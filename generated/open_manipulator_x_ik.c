@@ -1494,134 +1494,135 @@ static void dk_chain_frame(const double (*chain)[12], const int *revolute, int n
     }
 }
 
-/* the most joints an arm has (derive/spec.py, MAX_JOINTS): the size of dk_sym_eigen's arrays */
+/* the most joints an arm has (derive/spec.py, MAX_JOINTS): the size of dk_svd_columns's arrays */
 #define DK_JOINTS_MAX 12
 
-/* Jacobi's sweeps stop when the off-diagonal entries' squares sum to this fraction of the
-   diagonal's (or after DK_EIGEN_SWEEPS sweeps) */
-#define DK_EIGEN_DONE (1e-30)
+/* Jacobi's sweeps stop when every pair of columns is orthogonal to this fraction of their
+   lengths' product (or after DK_SVD_SWEEPS sweeps) */
+#define DK_SVD_DONE (1e-15)
 
-#define DK_EIGEN_SWEEPS 30
+#define DK_SVD_SWEEPS 30
 
-/* The eigenvalues of the symmetric n x n matrix A (row-major; destroyed), by Jacobi's
-   rotations, into w in decreasing order, with unit eigenvectors as the columns of V
-   (row-major, n x n) in the same order; n <= DK_JOINTS_MAX */
-static void dk_sym_eigen(double *A, int n, double *w, double *V)
+/* The singular values of the 6 x n matrix J (row-major), by one-sided Jacobi rotations
+   (Hestenes): W := J V, V orthogonal, its pairs of columns turned until each pair is
+   orthogonal; then s_k = |W_k| are J's singular values, to a relative accuracy J^T J's
+   eigenvalues do not have (they square J's condition number: a lecture_6r in mm, s_1 677 and
+   s_6 0.061, reproduced a twist only to 6e-9 so, a new user's attack), V's columns its right
+   singular vectors and W_k = s_k u_k. Into s in decreasing order, W's and V's columns (V
+   row-major, n x n) in the same order; n <= DK_JOINTS_MAX */
+static void dk_svd_columns(const double *J, int n, double W[6][DK_JOINTS_MAX], double *s,
+                           double *V)
 {
     int sweep, p, r, i, j;
+    for (i = 0; i < 6; i++) {
+        for (j = 0; j < n; j++) {
+            W[i][j] = J[n * i + j];
+        }
+    }
     for (i = 0; i < n; i++) {
         for (j = 0; j < n; j++) {
             V[n * i + j] = i == j ? 1.0 : 0.0;
         }
     }
-    for (sweep = 0; sweep < DK_EIGEN_SWEEPS; sweep++) {
-        double off = 0.0, diagonal = 0.0;
-        for (i = 0; i < n; i++) {
-            diagonal += A[n * i + i] * A[n * i + i];
-            for (j = i + 1; j < n; j++) {
-                off += A[n * i + j] * A[n * i + j];
-            }
-        }
-        if (off <= DK_EIGEN_DONE * diagonal) {
-            break;
-        }
+    for (sweep = 0; sweep < DK_SVD_SWEEPS; sweep++) {
+        int turned = 0;
         for (p = 0; p < n; p++) {
-            for (r = p + 1; r < n; r++) { /* the rotation that zeroes A[p][r] */
-                const double apr = A[n * p + r];
-                double theta, t, c, s;
-                if (apr == 0.0) {
+            for (r = p + 1; r < n; r++) { /* the rotation that makes columns p and r orthogonal */
+                double alpha = 0.0, beta = 0.0, gamma = 0.0, zeta, t, c, sn;
+                for (i = 0; i < 6; i++) {
+                    alpha += W[i][p] * W[i][p];
+                    beta += W[i][r] * W[i][r];
+                    gamma += W[i][p] * W[i][r];
+                }
+                if (gamma == 0.0 || fabs(gamma) <= DK_SVD_DONE * sqrt(alpha * beta)) {
                     continue;
                 }
-                theta = (A[n * r + r] - A[n * p + p]) / (2.0 * apr);
-                t = (theta >= 0.0 ? 1.0 : -1.0) / (fabs(theta) + sqrt(theta * theta + 1.0));
+                turned = 1;
+                zeta = (beta - alpha) / (2.0 * gamma);
+                t = (zeta >= 0.0 ? 1.0 : -1.0) / (fabs(zeta) + sqrt(zeta * zeta + 1.0));
                 c = 1.0 / sqrt(t * t + 1.0);
-                s = t * c;
-                for (i = 0; i < n; i++) { /* A := A G (columns p and r) */
-                    const double x = A[n * i + p], y = A[n * i + r];
-                    A[n * i + p] = c * x - s * y;
-                    A[n * i + r] = s * x + c * y;
+                sn = t * c;
+                for (i = 0; i < 6; i++) {
+                    const double x = W[i][p], y = W[i][r];
+                    W[i][p] = c * x - sn * y;
+                    W[i][r] = sn * x + c * y;
                 }
-                for (i = 0; i < n; i++) { /* A := G^T A (rows p and r) */
-                    const double x = A[n * p + i], y = A[n * r + i];
-                    A[n * p + i] = c * x - s * y;
-                    A[n * r + i] = s * x + c * y;
-                }
-                for (i = 0; i < n; i++) { /* V := V G */
+                for (i = 0; i < n; i++) {
                     const double x = V[n * i + p], y = V[n * i + r];
-                    V[n * i + p] = c * x - s * y;
-                    V[n * i + r] = s * x + c * y;
+                    V[n * i + p] = c * x - sn * y;
+                    V[n * i + r] = sn * x + c * y;
                 }
             }
         }
-    }
-    for (i = 0; i < n; i++) {
-        w[i] = A[n * i + i];
-    }
-    for (i = 0; i < n; i++) { /* (selection sort, decreasing, columns of V along) */
-        int best = i;
-        for (j = i + 1; j < n; j++) {
-            best = w[j] > w[best] ? j : best;
+        if (!turned) {
+            break;
         }
-        if (best != i) {
-            const double x = w[i];
-            w[i] = w[best];
-            w[best] = x;
-            for (j = 0; j < n; j++) {
-                const double y = V[n * j + i];
-                V[n * j + i] = V[n * j + best];
-                V[n * j + best] = y;
+    }
+    for (j = 0; j < n; j++) {
+        double sum = 0.0;
+        for (i = 0; i < 6; i++) {
+            sum += W[i][j] * W[i][j];
+        }
+        s[j] = sqrt(sum);
+    }
+    for (j = 0; j < n; j++) { /* (selection sort, decreasing, the columns along) */
+        int best = j;
+        for (i = j + 1; i < n; i++) {
+            best = s[i] > s[best] ? i : best;
+        }
+        if (best != j) {
+            const double x = s[j];
+            s[j] = s[best];
+            s[best] = x;
+            for (i = 0; i < 6; i++) {
+                const double y = W[i][j];
+                W[i][j] = W[i][best];
+                W[i][best] = y;
+            }
+            for (i = 0; i < n; i++) {
+                const double y = V[n * i + j];
+                V[n * i + j] = V[n * i + best];
+                V[n * i + best] = y;
             }
         }
     }
 }
 
 /* Damped least squares (derive/runtime/motion.py, ik_velocity) with the 6 x n Jacobian J
-   (row-major): the eigenpairs (s_k^2, v_k) of J^T J, the m = min(6, n) largest (J's singular
-   values and right singular vectors), give dq = sum_k v_k (v_k . J^T t) / (s_k^2 + lambda^2),
-   lambda^2 = damping^2 (1 - (s_m / band)^2) where s_m < band, else 0; with drift (not NULL),
-   plus drift's part outside the v_k with s_k > DK_RANK_TOL max(1, s_1) (the null space's:
-   the tool does not move). The normal matrix's eigenvalues carry about 1e-16 s_1^2 of
-   rounding, so the rank's threshold is the square root of that, not numpy's 1e-12. */
+   (row-major): its singular values s_k and vectors (dk_svd_columns: W_k = s_k u_k, v_k), the
+   m = min(6, n) largest, give dq = sum_k v_k (W_k . t) / (s_k^2 + lambda^2), lambda^2 =
+   damping^2 (1 - (s_m / band)^2) where s_m < band, else 0; with drift (not NULL), plus
+   drift's part outside the v_k with s_k > DK_RANK_TOL max(1, s_1) (the null space's: the
+   tool does not move), the Python ik_velocity's _RANK_TOL. */
 #define DK_RANK_TOL (1e-7)
 
 static void dk_dls(const double *J, int n, const double t[6], double damping, double band,
                    const double *drift, double *dq)
 {
-    double A[DK_JOINTS_MAX * DK_JOINTS_MAX], V[DK_JOINTS_MAX * DK_JOINTS_MAX];
-    double w[DK_JOINTS_MAX], jt[DK_JOINTS_MAX], least, lam2 = 0.0, top;
+    double W[6][DK_JOINTS_MAX], V[DK_JOINTS_MAX * DK_JOINTS_MAX], s[DK_JOINTS_MAX] = {0.0};
+    double least, lam2 = 0.0, top;
     const int m = n < 6 ? n : 6;
-    int i, j, k, r;
-    for (i = 0; i < n; i++) {
-        jt[i] = 0.0;
-        for (r = 0; r < 6; r++) {
-            jt[i] += J[n * r + i] * t[r];
-        }
-        for (j = 0; j <= i; j++) {
-            double v = 0.0;
-            for (r = 0; r < 6; r++) {
-                v += J[n * r + i] * J[n * r + j];
-            }
-            A[n * i + j] = A[n * j + i] = v;
-        }
-    }
-    dk_sym_eigen(A, n, w, V);
-    least = sqrt(fmax(w[m - 1], 0.0));
+    int i, k, r;
+    dk_svd_columns(J, n, W, s, V);
+    least = s[m - 1];
     if (least < band) {
         lam2 = damping * damping * (1.0 - (least / band) * (least / band));
     }
     for (i = 0; i < n; i++) {
         dq[i] = drift ? drift[i] : 0.0;
     }
-    top = DK_RANK_TOL * fmax(1.0, sqrt(fmax(w[0], 0.0)));
+    top = DK_RANK_TOL * fmax(1.0, s[0]);
     for (k = 0; k < m; k++) {
         double along = 0.0, share = 0.0;
-        const double s2 = fmax(w[k], 0.0);
+        const double s2 = s[k] * s[k];
+        for (r = 0; r < 6; r++) {
+            along += W[r][k] * t[r];
+        }
         for (i = 0; i < n; i++) {
-            along += V[n * i + k] * jt[i];
             share += drift ? V[n * i + k] * drift[i] : 0.0;
         }
         along = s2 + lam2 > 0.0 ? along / (s2 + lam2) : 0.0;
-        share = s2 > top * top ? share : 0.0;
+        share = s[k] > top ? share : 0.0;
         for (i = 0; i < n; i++) {
             dq[i] += V[n * i + k] * (along - share);
         }
@@ -1956,96 +1957,95 @@ static int dk_finish(double found[DK_MAX][DK_DOF], int count, int repeats,
 
 void open_manipulator_x_jacobian(const double q[DK_DOF], int frame, double J[6][DK_DOF])
 {
-    {
-        const double theta1 = q[0];
-        const double c1 = cos(theta1);
-        const double s1 = sin(theta1);
-        const double theta2 = q[1] - 1.3854483816190182;
-        const double c2 = cos(theta2);
-        const double s2 = sin(theta2);
-        const double theta3 = q[2] + 1.3854483816190182;
-        const double c3 = cos(theta3);
-        const double s3 = sin(theta3);
-        const double theta4 = q[3];
-        const double c4 = cos(theta4);
-        const double s4 = sin(theta4);
-        double x0 = 0.130231*c2;
-        double x1 = s2*s3;
-        double x2 = s1*x1;
-        double x3 = c2*c3;
-        double x4 = s1*x3;
-        double x5 = 0.126*c4;
-        double x6 = c2*s3;
-        double x7 = c3*s2;
-        double x8 = 0.126*s4;
-        double x9 = x5*(-x2 + x4) + x8*(-s1*x6 - s1*x7);
-        double x10 = -0.124*x2 + 0.124*x4 + x9;
-        double x11 = s1*x0 + x10;
-        double x12 = s2*s3 - x3;
-        double x13 = -x6 - x7;
-        double x14 = -0.126*c4*x13 - 0.126*s4*x12 + 0.124*x6 + 0.124*x7;
-        double x15 = -0.130231*s2 - x14;
-        double x16 = -x14;
-        double x17 = x12*x8 + x13*x5;
-        double x18 = c1*x1;
-        double x19 = c1*x3;
-        double x20 = x5*(-x18 + x19) + x8*(-c1*x6 - c1*x7);
-        double x21 = -0.124*x18 + 0.124*x19 + x20;
-        double x22 = c1*x0 + x21;
-        double x23 = -s1;
-        double j0_0 = -x11;
-        double j0_1 = c1*x15;
-        double j0_2 = c1*x16;
-        double j0_3 = c1*x17;
-        double j1_0 = x22;
-        double j1_1 = s1*x15;
-        double j1_2 = s1*x16;
-        double j1_3 = s1*x17;
-        double j2_0 = 0.0;
-        double j2_1 = -c1*x22 - s1*x11;
-        double j2_2 = -c1*x21 - s1*x10;
-        double j2_3 = -c1*x20 - s1*x9;
-        double j3_0 = 0.0;
-        double j3_1 = x23;
-        double j3_2 = x23;
-        double j3_3 = x23;
-        double j4_0 = 0.0;
-        double j4_1 = c1;
-        double j4_2 = c1;
-        double j4_3 = c1;
-        double j5_0 = 1.0;
-        double j5_1 = 0.0;
-        double j5_2 = 0.0;
-        double j5_3 = 0.0;
-        J[0][0] = j0_0;
-        J[0][1] = j0_1;
-        J[0][2] = j0_2;
-        J[0][3] = j0_3;
-        J[1][0] = j1_0;
-        J[1][1] = j1_1;
-        J[1][2] = j1_2;
-        J[1][3] = j1_3;
-        J[2][0] = j2_0;
-        J[2][1] = j2_1;
-        J[2][2] = j2_2;
-        J[2][3] = j2_3;
-        J[3][0] = j3_0;
-        J[3][1] = j3_1;
-        J[3][2] = j3_2;
-        J[3][3] = j3_3;
-        J[4][0] = j4_0;
-        J[4][1] = j4_1;
-        J[4][2] = j4_2;
-        J[4][3] = j4_3;
-        J[5][0] = j5_0;
-        J[5][1] = j5_1;
-        J[5][2] = j5_2;
-        J[5][3] = j5_3;
-    }
-    if (frame) { /* (the tool frame: v and w rotated by R^T) */
-        double e[12], column[6];
+    const double theta1 = q[0];
+    const double c1 = cos(theta1);
+    const double s1 = sin(theta1);
+    const double theta2 = q[1] - 1.3854483816190182;
+    const double c2 = cos(theta2);
+    const double s2 = sin(theta2);
+    const double theta3 = q[2] + 1.3854483816190182;
+    const double c3 = cos(theta3);
+    const double s3 = sin(theta3);
+    const double theta4 = q[3];
+    const double c4 = cos(theta4);
+    const double s4 = sin(theta4);
+    double x0 = 0.130231*c2;
+    double x1 = s2*s3;
+    double x2 = s1*x1;
+    double x3 = c2*c3;
+    double x4 = s1*x3;
+    double x5 = 0.126*c4;
+    double x6 = c2*s3;
+    double x7 = c3*s2;
+    double x8 = 0.126*s4;
+    double x9 = x5*(-x2 + x4) + x8*(-s1*x6 - s1*x7);
+    double x10 = -0.124*x2 + 0.124*x4 + x9;
+    double x11 = s1*x0 + x10;
+    double x12 = s2*s3 - x3;
+    double x13 = -x6 - x7;
+    double x14 = -0.126*c4*x13 - 0.126*s4*x12 + 0.124*x6 + 0.124*x7;
+    double x15 = -0.130231*s2 - x14;
+    double x16 = -x14;
+    double x17 = x12*x8 + x13*x5;
+    double x18 = c1*x1;
+    double x19 = c1*x3;
+    double x20 = x5*(-x18 + x19) + x8*(-c1*x6 - c1*x7);
+    double x21 = -0.124*x18 + 0.124*x19 + x20;
+    double x22 = c1*x0 + x21;
+    double x23 = -s1;
+    double j0_0 = -x11;
+    double j0_1 = c1*x15;
+    double j0_2 = c1*x16;
+    double j0_3 = c1*x17;
+    double j1_0 = x22;
+    double j1_1 = s1*x15;
+    double j1_2 = s1*x16;
+    double j1_3 = s1*x17;
+    double j2_0 = 0.0;
+    double j2_1 = -c1*x22 - s1*x11;
+    double j2_2 = -c1*x21 - s1*x10;
+    double j2_3 = -c1*x20 - s1*x9;
+    double j3_0 = 0.0;
+    double j3_1 = x23;
+    double j3_2 = x23;
+    double j3_3 = x23;
+    double j4_0 = 0.0;
+    double j4_1 = c1;
+    double j4_2 = c1;
+    double j4_3 = c1;
+    double j5_0 = 1.0;
+    double j5_1 = 0.0;
+    double j5_2 = 0.0;
+    double j5_3 = 0.0;
+    J[0][0] = j0_0;
+    J[0][1] = j0_1;
+    J[0][2] = j0_2;
+    J[0][3] = j0_3;
+    J[1][0] = j1_0;
+    J[1][1] = j1_1;
+    J[1][2] = j1_2;
+    J[1][3] = j1_3;
+    J[2][0] = j2_0;
+    J[2][1] = j2_1;
+    J[2][2] = j2_2;
+    J[2][3] = j2_3;
+    J[3][0] = j3_0;
+    J[3][1] = j3_1;
+    J[3][2] = j3_2;
+    J[3][3] = j3_3;
+    J[4][0] = j4_0;
+    J[4][1] = j4_1;
+    J[4][2] = j4_2;
+    J[4][3] = j4_3;
+    J[5][0] = j5_0;
+    J[5][1] = j5_1;
+    J[5][2] = j5_2;
+    J[5][3] = j5_3;
+    if (frame) { /* (the tool frame: v and w turned by R^T, R from the same c_i, s_i) */
+        double e[12];
+        dk_fk_cs(c1, s1, c2, s2, c3, s3, c4, s4, e);
+        double column[6];
         int j, r;
-        dk_fk_q(q, e);
         for (j = 0; j < DK_DOF; j++) {
             for (r = 0; r < 3; r++) {
                 column[r] = e[r] * J[0][j] + e[4 + r] * J[1][j] + e[8 + r] * J[2][j];
