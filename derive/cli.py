@@ -213,12 +213,27 @@ def parse_numbers(values: list[str], what: str) -> list[float]:
 
 
 def joint_vector(spec: ArmSpec, values: list[float], radians: bool) -> list[float]:
-    """Joint values from the user's units (degrees for R joints unless --rad)."""
+    """Joint values from the user's units (degrees for R joints unless --rad); a revolute
+    value beyond MAX_TURN radians is refused (a new user's `--from 1e308` printed 300-digit
+    angles and a path that did not converge)."""
     if len(values) != spec.dof:
         raise UsageError(f"expected {spec.dof} joint values for {spec.name}, got {len(values)}")
-    return [
+    out = [
         math.radians(v) if k == "R" and not radians else v for v, k in zip(values, spec.joint_types)
     ]
+    for i, (v, k) in enumerate(zip(out, spec.joint_types)):
+        if k == "R" and abs(v) > MAX_TURN:
+            raise UsageError(
+                f"q{i + 1}: {values[i]:g} {'rad' if radians else 'deg'} is beyond {MAX_TURN:g} "
+                "rad, where an angle's own rounding exceeds the solvers' 1e-10 (give it within "
+                "a turn)"
+            )
+    return out
+
+
+# a revolute joint's value on the command line is at most this many radians: beyond 2^20 its
+# double's spacing is above 1e-10 rad, the certification's tolerance
+MAX_TURN = 2.0**20
 
 
 def format_pose(pose: Iterable[Iterable[float]]) -> str:
@@ -303,7 +318,7 @@ def cmd_path(args: argparse.Namespace) -> int:
         raise UsageError(f"--steps: an integer from 2 to 100000, got {args.steps}")
     start = np.array(joint_vector(spec, parse_numbers(args.start, "--from"), args.rad))
     end = np.array(joint_vector(spec, parse_numbers(args.end, "--to"), args.rad))
-    output = figure_output(args, f"{spec.name}_path.svg") if args.output else None
+    output = figure_output(args, f"{spec.name}_path.svg") if args.output is not None else None
     if output is not None:  # (matplotlib first: not after the whole path is printed)
         from derive.plot import PlotUnavailable, pyplot
 
@@ -363,6 +378,8 @@ def ik_module(args: argparse.Namespace) -> tuple[ArmSpec, ModuleType]:
 
 def figure_output(args: argparse.Namespace, default: str) -> tuple[Path, str]:
     """The picture's file (-o, else default) and its format, svg or png."""
+    if args.output == "":  # (not the default: `-o ""` drew nothing and said nothing)
+        raise UsageError("-o: an empty file name; give FILE.svg or FILE.png")
     output = Path(args.output or default)
     fmt = output.suffix.lstrip(".").lower()
     if fmt not in ("svg", "png"):
@@ -918,7 +935,7 @@ def parser() -> argparse.ArgumentParser:
     gen.add_argument(
         "specs", nargs="*", help="spec files or bundled arm names (default: all bundled)"
     )
-    gen.add_argument("--out", default=DEFAULT_OUT, help="output folder (default ./generated)")
+    gen.add_argument("-o", "--out", default=DEFAULT_OUT, help="output folder (default ./generated)")
     gen.add_argument("--require-ik", action="store_true", help="exit 3 if an arm has no IK method")
     gen.add_argument(
         "--lang",

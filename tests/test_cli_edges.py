@@ -360,3 +360,26 @@ def test_a_spec_s_method_is_the_only_one_tried():
         SpecError, match=r'six_r.toml: ik.method: \'fast\' is not allowed; one of "pieper"'
     ):
         parse_spec(text + '\n[ik]\nmethod = "fast"\n', "six_r.toml")
+
+
+def test_an_empty_picture_name_and_a_joint_value_past_precision_are_refused(tmp_path, capsys):
+    """A new user's attack on `derive path`: `-o ""` exited 0 with no picture and no word,
+    and `--from 1e308 ...` printed 300-digit angles and a break blamed on Newton's iteration.
+    Each is now one line naming the option and exit 2; `derive generate -o DIR` is taken as
+    `--out DIR`, as `build`, `path` and `report` take -o."""
+    rows = [(0, 0, 0, 0), (0, 1, 0, 0)]
+    spec = tmp_path / "two.toml"
+    spec.write_text(spec_text("two", "modified", rows), encoding="utf-8")
+    args = ["path", "puma560", "--from", *["20"] * 6, "--to", *["0"] * 6]
+    assert main([*args, "-o", ""]) == 2
+    assert capsys.readouterr().err.strip() == (
+        "error: -o: an empty file name; give FILE.svg or FILE.png"
+    )
+    assert main(["path", "puma560", "--from", "1e308", *["0"] * 5, "--to", *["0"] * 6]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.startswith("error: q1: 1e+308 deg is beyond") and "\n" not in err
+    assert main(["fk", "puma560", "--rad", "2e6", *["0"] * 5]) == 2
+    assert "q1: 2e+06 rad is beyond" in capsys.readouterr().err
+    assert main(["fk", "puma560", "1e7", *["0"] * 5]) == 0  # (1.7e5 rad: taken)
+    assert main(["generate", str(spec), "-o", str(tmp_path / "g")]) == 0
+    assert (tmp_path / "g" / "two.py").is_file()
