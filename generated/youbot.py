@@ -1616,9 +1616,11 @@ def _follow(A, B, q, within_limits, backend, depth):
         half, first, least_first, worst_first = _follow(
             A, middle, q, within_limits, backend, depth + 1
         )
-        if (half is None or first) and not why and worst[0] > PATH_NEAR:  # (the branch ends
-            # within the step, at a fold where q's branch meets another, and the row is
-            # another branch's)
+        if (half is None or first) and not why and (worst[0] > PATH_NEAR or switched):  # (the
+            # branch ends within the step, at a fold where q's branch meets another, and the
+            # row is another branch's: a jump, or a row 0.087 rad away of the other sign of
+            # det J, the fold's partner, where a 100,000 times finer walk ends 0.29 into the
+            # step with the nearest solution 0.6 rad away, a new user's Alicia D line)
             why = first or "the middle of the step is out of reach"
             least = min(least, least_first)
         elif half is not None and not first:

@@ -657,6 +657,34 @@ def test_a_path_of_the_general_method_crosses_det_j_s_zero_where_it_is_smooth(ge
         assert np.abs(np.remainder(path - walk + np.pi, 2 * np.pi) - np.pi).max() <= 1e-8
 
 
+def test_a_general_method_path_whose_branch_ends_in_a_step_breaks_not_switches(generated):
+    """manocha_canny, a random line of 10 poses: between poses 8 and 9 the last row's branch
+    ends (a 4,000 times finer nearest-row walk of that step jumps, the nearest row 0.1 rad
+    away, half way). ik_path took the row of the other sign of det J 0.06 rad away, the fold's
+    partner, with no break: the halves said the branch ends in the first one, but only a row
+    moving a joint more than PATH_NEAR was called a break (a new user's Alicia D URDF line, 1
+    of 100 lines there and here). A switch of det J's sign whose first half finds no
+    continuation is a break now, in C and Python."""
+    module = generated("manocha_canny")
+    qa = np.array([2.2995234624946796, -1.0761664614656197, -2.4499753099890142,
+                   -2.8264320723286027, -0.3026535732578335, 0.8356188765405905])  # fmt: skip
+    qb = np.array([2.025181496561844, -0.6658712760367703, -2.728956346801935,
+                   -2.4094408952129744, -0.8629596080939114, 0.5508136612854355])  # fmt: skip
+    Ts = module.straight_line(module.fk(qa), module.fk(qb), 10)
+    for backend in ("c", "python"):
+        Q, breaks = module.ik_path(Ts, qa, backend=backend)
+        assert [k for k, _ in breaks] == [9], (backend, breaks)
+        assert "no solution continues the path" in breaks[0][1]
+    poses = module.straight_line(Ts[8], Ts[9], 4001)
+    rows, valid = module.ik_batch(poses)
+    q, jumps = Q[8], []
+    for R, ok in zip(rows[1:], valid[1:]):
+        gaps = np.abs(np.remainder(R[ok] - q + np.pi, 2 * np.pi) - np.pi).max(axis=1)
+        jumps.append(float(gaps.min()))
+        q = R[ok][int(np.argmin(gaps))]
+    assert max(jumps) > 0.05  # (the branch of row 8 ends within the step)
+
+
 def test_straight_line_turns_half_a_turn_and_refuses_what_is_not_rigid(generated):
     """A half turn between A and B (where the rotation vector's sine part vanishes) is
     followed to B; a scaled pose is refused; ik_path refuses a q0 that does not reach Ts[0]."""
