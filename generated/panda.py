@@ -1785,7 +1785,11 @@ def _follow(A, B, q, within_limits, backend, depth):
             # row is another branch's: a jump, or a row 0.087 rad away of the other sign of
             # det J, the fold's partner, where a 100,000 times finer walk ends 0.29 into the
             # step with the nearest solution 0.6 rad away, a new user's Alicia D line)
-            why = first or "the middle of the step is out of reach"
+            why = first or "out of reach"
+            if why.startswith("out of reach") and "part way" not in why:  # (the line leaves the
+                # workspace inside the step: its end may be reached, by other branches too; a
+                # new user's youbot lines said "pose k: out of reach" at poses with 4 rows)
+                why = "out of reach part way through the step" + why[len("out of reach") :]
             least = min(least, least_first)
         elif half is not None and not first:
             split, why_split, least_split, worst_split = _follow(

@@ -685,6 +685,24 @@ def test_a_general_method_path_whose_branch_ends_in_a_step_breaks_not_switches(g
     assert max(jumps) > 0.05  # (the branch of row 8 ends within the step)
 
 
+def test_a_line_leaving_the_workspace_inside_a_step_says_so(generated):
+    """A youbot line (position + direction) whose branch leaves the workspace between poses 0
+    and 1, though pose 1 has 4 rows (of other branches): the break said "pose 1: out of
+    reach" (a new user's attack, 3 of 100 such lines). It says the line is out of reach part
+    way through the step now."""
+    module = generated("youbot")
+    qa = np.array([-2.879191816889362, 3.250914801894547, -1.0307471283487857,
+                   2.4785880468240036, -1.6293785726553773])  # fmt: skip
+    qb = np.array([-2.651580180995318, 2.83005514682247, -1.324480138432621,
+                   2.2726168347560676, -0.827900642500963])  # fmt: skip
+    Ts = module.straight_line(module.fk(qa), module.fk(qb), 10)
+    for backend in ("c", "python"):
+        _, breaks = module.ik_path(Ts, qa, backend=backend)
+        (k, why), *_ = breaks
+        assert k == 1 and why.startswith("out of reach part way through the step"), why
+        assert len(module.ik(Ts[1], backend=backend)) == 4
+
+
 def test_straight_line_turns_half_a_turn_and_refuses_what_is_not_rigid(generated):
     """A half turn between A and B (where the rotation vector's sine part vanishes) is
     followed to B; a scaled pose is refused; ik_path refuses a q0 that does not reach Ts[0]."""
