@@ -699,7 +699,7 @@ def test_a_line_leaving_the_workspace_inside_a_step_says_so(generated):
     for backend in ("c", "python"):
         _, breaks = module.ik_path(Ts, qa, backend=backend)
         (k, why), *_ = breaks
-        assert k == 1 and why.startswith("out of reach part way through the step"), why
+        assert k == 1 and why.startswith("pose 1: out of reach part way through the step"), why
         assert len(module.ik(Ts[1], backend=backend)) == 4
 
 
