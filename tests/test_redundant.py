@@ -421,3 +421,26 @@ def test_nearest_with_q_ref_far_outside_the_limits(generated, name, monkeypatch)
         assert ((lo - 1e-9 <= q) & (q <= hi + 1e-9)).all()
     q = m.nearest(T, q0 + 2 * math.pi, within_limits=False)
     assert q is not None and np.abs(m.fk(q) - T).max() < 1e-9
+
+
+def test_too_many_free_values_are_refused_before_their_grid_is_built(tmp_path, monkeypatch):
+    """A mobile base's three free joints (x and y slides over +-10 m, a turn) at the default
+    free_step gave nearest a grid of 2,001 x 2,001 x 629 values, 19 GiB an array, built before
+    its size was checked (a new user's attack). The count is checked first now: here the
+    PUMA on its rail turned about a column (two free joints, 629 x 301 values with
+    free_step 0.01), and numpy's grid builder made to fail if it is reached."""
+    column = RAIL.replace('type = "P"\n', 'type = "R"\nalpha = 0.0\na = 0.0\nd = 0.5\n'
+                          'theta = 0.0\n[[joint]]\ntype = "P"\n', 1)  # fmt: skip
+    module = build_module(column + "[ik]\nfree = [1, 2]\n", tmp_path)
+    assert module.FREE == (1, 2)
+    q = np.array([0.2, 1.5, 0.3, -0.4, 0.5, 0.6, -0.7, 0.8])
+    T = module.fk(q)
+
+    def no_grid(*args, **kwargs):
+        raise AssertionError("the grid was built before its size was checked")
+
+    monkeypatch.setattr(module.np, "meshgrid", no_grid)
+    with pytest.raises(ValueError, match=r"nearest: 189329 free values \(629 x 301 at"):
+        module.nearest(T, q)
+    with pytest.raises(ValueError, match=r"ik_sweep: 160000 samples \(400 x 400\); at most"):
+        module.ik_sweep(T, n=400)
