@@ -1403,6 +1403,12 @@ PATH_FREE_SAMPLES = 16
 PATH_SLACK = 1e-6
 
 
+# ... or within PATH_GAIN PATH_CONVERGED / sigma_min, at most PATH_SLACK_MOST: how far apart
+# two points within PATH_CONVERGED of the pose can be there (an iiwa14's shoulder at sigma_min
+# 3e-7: Newton's point and the row 5.7e-5 apart, and the path broke, a new user's attack)
+PATH_SLACK_MOST = 1e-2
+
+
 # ... and q0 must reach Ts[0] within this (its pose error, as ik's certification measures it);
 # a step whose finest part (_follow's halves) moves more than PATH_JUMP (radians, or REACH)
 # where sigma_min is below PATH_SINGULAR is a break: the first-order bound allows any step
@@ -1502,13 +1508,21 @@ def _step_bound(q, A, B):
     """The joint step a continuous branch can take from q (a solution of the pose A) to the
     pose B: PATH_GAIN |dX| / sigma_min, dX the pose step (an arm solved for a task: its
     components' error at B), sigma_min the smallest singular value of the Jacobian at q
-    (of the task's); and sigma_min. An arm of fewer than six joints solved for the pose (a
-    planar arm) has as many singular values as joints, and its least is the bound's too (it
-    was taken as 1: a lecture_rrr line at sigma_min 0.18 broke where its branch went on, 12
-    of 100 random lines, a new user's attack)."""
+    (of the task's; of the joints ik solves, not the free ones); and sigma_min. An arm of
+    fewer than six joints solved for the pose (a planar arm) has as many singular values as
+    joints, and its least is the bound's too (it was taken as 1: a lecture_rrr line at
+    sigma_min 0.18 broke where its branch went on, 12 of 100 random lines, a new user's
+    attack)."""
     if IK_COMPONENTS == "pose":
         change = float(np.linalg.norm(_pose_step(A, B)))
-        least = manipulability(q)[0]
+        # (the joints ik solves: the free ones take the values Newton's iteration gives them,
+        # so near a singular configuration of the others, as an iiwa14's shoulder with axes 1
+        # and 3 nearly aligned, those turn fast though the whole arm's sigma_min is not small:
+        # the bound of the whole arm's broke such lines, or took the shoulder's partner row
+        # (q1 + pi, -q2, q3 + pi) with no break, a new user's attack: 8 of 40 iiwa14 lines)
+        columns = [i for i in range(DOF) if i + 1 not in FREE]
+        sigma = np.linalg.svd(jacobian(q)[:, columns], compute_uv=False)
+        least = float(sigma[-1]) if len(sigma) == min(6, len(columns)) else 0.0
     else:  # (the task's components and their Jacobian: what the task's rows follow)
         error, columns, _ = _pose_error(q.tolist(), B[:3].ravel().tolist(), False)
         change = float(np.linalg.norm(error))
@@ -1537,7 +1551,7 @@ def _follow(A, B, q, within_limits, backend, depth):
     sigma_min at the starts of the step and its parts, and (jump, sigma_min, joint) of the
     part that moves a joint most."""
     bound, least = _step_bound(q, A, B)
-    row, why = _continuation(B, q, branch(q), bound, within_limits, backend)
+    row, why = _continuation(B, q, branch(q), bound, least, within_limits, backend)
     if row is None or "limits" in why:
         return row, why, least, (0.0, least, 0)
     revolute = np.array(_REVOLUTE)
@@ -1578,14 +1592,16 @@ def _follow(A, B, q, within_limits, backend, depth):
     return row, why, least, worst
 
 
-def _continuation(T, q, label, bound, within_limits, backend):
+def _continuation(T, q, label, bound, least, within_limits, backend):
     """ik_path's step from q (on the branch label) to the pose T: the solution of T nearest
     Newton's iteration from q (its revolute joints' turn nearest it), and "" if it continues
     the path, else why not (the row None where T has no solution). Before it, the solution
     on q's own branch nearest q continues the path if its step is within the bound and
     within PATH_NEAR or PATH_GAIN times the nearest solution's: near a fold (the elbow nearly
     stretched) both branches lie within one step, and Newton's iteration may cross to the
-    other. (Not where the branch is det J's sign: _follow halves a step that changes it.)"""
+    other. (Not where the branch is det J's sign: _follow halves a step that changes it.)
+    least, sigma_min at q, sets how far Newton's point and the row may differ (PATH_SLACK,
+    PATH_SLACK_MOST)."""
     revolute = np.array(_REVOLUTE)
     units = np.where(revolute, 1.0, REACH)
     guess = np.array(q, dtype=float)
@@ -1595,6 +1611,7 @@ def _continuation(T, q, label, bound, within_limits, backend):
         moved, size = _refine(guess.tolist(), T[:3].ravel().tolist())
         guess = np.array(moved)
     converged = size <= PATH_CONVERGED
+    slack = min(max(PATH_SLACK, PATH_GAIN * PATH_CONVERGED / max(least, 1e-300)), PATH_SLACK_MOST)
     free = [guess[j - 1] for j in FREE] if FREE else None
     rows = ik(T, free=free, q_ref=guess, backend=backend)
     if len(rows) == 0 and converged:  # (Newton's iteration reached a solution that the
@@ -1621,14 +1638,14 @@ def _continuation(T, q, label, bound, within_limits, backend):
         if same:
             kept = min(same, key=lambda i: sizes[i])
             reach = max(PATH_GAIN * sizes.min(), PATH_NEAR)  # (how far q's branch may be)
-            if sizes[kept] <= min(bound, reach) + PATH_SLACK:
+            if sizes[kept] <= min(bound, reach) + slack:
                 return _within(q + moves[kept], within_limits)
     row = guess + gaps[best]
     move = _turned(row - q, revolute)  # (Newton's iteration may have wandered whole turns)
     row = q + move
     step = np.abs(move) / units
     j = int(np.argmax(step))
-    if not converged or misses[best] > PATH_SLACK or step.max() > bound + PATH_SLACK:
+    if not converged or misses[best] > slack or step.max() > bound + slack:
         return row, (
             "no solution continues the path ("
             + ("Newton's iteration from the last row does not converge"
