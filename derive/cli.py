@@ -348,7 +348,8 @@ def cmd_path(args: argparse.Namespace) -> int:
         print(f"{k:4d}  " + "  ".join(f"{v:11.4f}" for v in shown) + f"  {least:9.3g}{signs}{flag}")
     stopped = [k for k, _ in breaks]
     if stopped and not args.flag:
-        print(f"stopped at pose {stopped[0]} of {args.steps}: {notes[stopped[0]]}")
+        k = stopped[0]  # (ik_path's note starts with "pose k: " too)
+        print(f"stopped at pose {k} of {args.steps}: {notes[k].removeprefix(f'pose {k}: ')}")
     elif branches and module.branch(Q[-1]) != module.branch(end):
         print(
             "the path ends on another branch than --to's: the same pose in another "

@@ -383,3 +383,13 @@ def test_an_empty_picture_name_and_a_joint_value_past_precision_are_refused(tmp_
     assert main(["fk", "puma560", "1e7", *["0"] * 5]) == 0  # (1.7e5 rad: taken)
     assert main(["generate", str(spec), "-o", str(tmp_path / "g")]) == 0
     assert (tmp_path / "g" / "two.py").is_file()
+
+
+def test_derive_path_says_where_it_stopped_once(capsys):
+    """A PUMA line through the base's far side (out of reach at pose 3): the last line said
+    "stopped at pose 3 of 10: pose 3: out of reach" (a new user's attack); the pose is named
+    once now."""
+    args = ["path", "puma560", "--from", "0", "-10", "0", "0", "30", "0"]
+    assert main([*args, "--to", "180", "-10", "0", "0", "30", "0", "--steps", "10"]) == 1
+    out = capsys.readouterr().out
+    assert "stopped at pose 3 of 10: out of reach; sigma_min" in out and "pose 3: " not in out
