@@ -526,3 +526,29 @@ def test_a_pair_of_solutions_near_a_fold_is_answered_once_by_each_backend(tmp_pa
         assert gaps.min() <= 1e-7, row
     gaps = np.abs(np.remainder(rows - q + math.pi, 2 * math.pi) - math.pi).max(axis=1)
     assert np.sort(gaps)[:2].max() <= 2e-4 and gaps.min() <= 1e-7  # (the pair; q one of it)
+
+
+@needs_cc
+def test_a_pose_out_of_reach_is_answered_in_c_not_handed_to_python(generated, monkeypatch):
+    """manocha_canny, poses just out of reach (1e-4 to 0.2 of a line's step past its
+    boundary; a new user's path): the C solver returned -1 where no candidate polished, and
+    the module then ran the Python solver, 0.07-0.4 s a pose, for the same empty answer. C
+    now takes the Python solver's last steps itself (the search from the candidates that
+    stopped within _RR_SEARCH_FROM, and the rows within _RR_NEAR): it answers these poses
+    with no row, as Python does, and never hands them over."""
+    module = generated("manocha_canny")
+    qa = np.array([0.07511292579186893, -2.2596462654302245, 1.3508697077031921,
+                   -1.3982818902043994, -1.4291422737693895, -2.8606489707022975])  # fmt: skip
+    qb = np.array([0.4097603189426561, -1.7980440765972903, 0.8884045645539614,
+                   -1.7873615560937648, -1.4684730943114592, -3.259059822639596])  # fmt: skip
+    line = module.straight_line(module.fk(qa), module.fk(qb), 10_001)
+    poses = line[[1, 10, 170, 526, 1667]]
+    python = [len(module.ik(T, backend="python")) for T in poses]
+    assert python == [0] * 5
+
+    def no_python(*args, **kwargs):
+        raise AssertionError("the C solver handed the pose to the Python solver")
+
+    monkeypatch.setattr(module, "_solve", no_python)
+    assert [len(module.ik(T, backend="c")) for T in poses] == [0] * 5
+    assert len(module.ik(line[0], backend="c")) == 4

@@ -1290,9 +1290,10 @@ static int dk_rr_deflate(double K[24][24], int k, const double *moebius)
 }
 
 /* the candidate joint vectors of one split: their count written to out, extra[c] set for
-   those from nearly real pairs; *doubt: whether the answer is in doubt (clusters on the
-   arm's own table, or no usable pencil); *reals: the real eigenvalues within reach, *pair:
-   the least |Im y| / (1 + |y|) of the others (HUGE_VAL where none) */
+   those from nearly real pairs, or -1 where the pencil is singular (no usable one: the Python
+   solver's None); *doubt: whether the answer is in doubt (clusters on the arm's own table, or
+   no usable pencil); *reals: the real eigenvalues within reach, *pair: the least
+   |Im y| / (1 + |y|) of the others (HUGE_VAL where none) */
 static int dk_rr_candidates(const double values[490], const double F[4][4],
                             const double rows[7][4], double out[DK_RR_CANDS][6], int extra[],
                             int *doubt, double imag_tol, int split, int *reals_found,
@@ -1317,7 +1318,7 @@ static int dk_rr_candidates(const double values[490], const double F[4][4],
     }
     rank_rows = dk_null_left(Q, N);
     if (rank_rows == 0) {
-        return 0;
+        return -1;
     }
     for (i = 0; i < 6; i++) {
         for (col = 0; col < 9; col++) {
@@ -1363,7 +1364,7 @@ static int dk_rr_candidates(const double values[490], const double F[4][4],
         }
     }
     if (!(best < 1e16)) {
-        return 0;
+        return -1;
     }
     for (i = 0; i < 24; i++) {
         for (col = 0; col < 24; col++) {
@@ -1378,7 +1379,7 @@ static int dk_rr_candidates(const double values[490], const double F[4][4],
         }
     }
     if (!dk_solve_into(&best_pencil[0][0][0], 12, &rhs[0][0], 24)) {
-        return 0;
+        return -1;
     }
     for (i = 0; i < 12; i++) {
         for (col = 0; col < 24; col++) {
@@ -1387,7 +1388,7 @@ static int dk_rr_candidates(const double values[490], const double F[4][4],
     }
     n_eig = dk_rr_deflate(K, split, moebius);
     if (!dk_eigenvalues((const double(*)[24])K, n_eig, wr, wi)) {
-        return 0;
+        return -1;
     }
     for (i = 0; i < n_eig; i++) {
         const double size = 1.0 + hypot(wr[i], wi[i]);
@@ -1597,6 +1598,18 @@ static int dk_rr_fold_seeds(int k, const double q[6], double seeds[DK_RR_ROWS][6
     return n;
 }
 
+/* what the candidates that did not polish leave for a pose with no row (the Python solver's
+   _RRLeads and its near rows): a singular pencil on the arm's own table, the rows (the arm's
+   values) that stopped within DK_RR_SEARCH_FROM of the pose, where the search starts
+   (dk_rr_search), and those within DK_RR_NEAR of it but extras', which the caller certifies.
+   Before these, a pose with no row was handed to the Python solver (DK_UNSETTLED), which took
+   0.07-0.4 s for each pose out of reach (a new user's manocha_canny path). */
+#define DK_RR_NEAR (1e-07)
+typedef struct {
+    double rows[DK_RR_ROWS][6], near[DK_RR_ROWS][6];
+    int n, n_near, singular;
+} dk_rr_leads;
+
 /* split k's polished candidates for the target F (found from the pose `moved`) added to
    out[count..] where new, until DK_RR_ROWS (a candidate within DK_RR_SAME of a row out had
    before is not polished: that row again); the new count; *doubt as dk_rr_candidates'; on a
@@ -1604,7 +1617,7 @@ static int dk_rr_fold_seeds(int k, const double q[6], double seeds[DK_RR_ROWS][6
    (dk_rr_fold_seeds) */
 static int dk_rr_split(int k, const double F[4][4], const double moved[4][4],
                        double out[DK_RR_ROWS][6], int count, int *doubt, double imag_tol,
-                       double seeds[DK_RR_ROWS][6], int *n_seeds)
+                       double seeds[DK_RR_ROWS][6], int *n_seeds, dk_rr_leads *leads)
 {
     double values[490], cands[DK_RR_CANDS][6], between[7][4];
     const int known = count;
@@ -1617,6 +1630,10 @@ static int dk_rr_split(int k, const double F[4][4], const double moved[4][4],
                values);
     n = dk_rr_candidates(values, moved, DK_RR_FILL[k], cands, extra, doubt, imag_tol, k, &reals,
                          &pair);
+    if (n < 0) { /* (a singular pencil) */
+        leads->singular |= !perturbed;
+        n = 0;
+    }
     for (c = 0; c < n; c++) {
         double q[6], arm[6], error;
         int seen = 0;
@@ -1644,6 +1661,12 @@ static int dk_rr_split(int k, const double F[4][4], const double moved[4][4],
             *doubt = DK_RR_RESCUE;
         }
         if (error > DK_RR_GOOD) {
+            if (error <= DK_RR_SEARCH_FROM && leads->n < DK_RR_ROWS) {
+                leads->n = dk_rr_add(k, q, leads->rows, leads->n);
+            }
+            if (error <= DK_RR_NEAR && !extra[c] && leads->n_near < DK_RR_ROWS) {
+                leads->n_near = dk_rr_add(k, q, leads->near, leads->n_near);
+            }
             if (error <= DK_SEED_TOL) { /* (a nominal table's near miss: 0 elsewhere) */
                 *n_seeds = dk_rr_fold_seeds(k, q, seeds, *n_seeds);
             }
@@ -1735,25 +1758,27 @@ static int dk_rr_partners(const double F[4][4], double out[DK_RR_ROWS][6], int c
 
 /* An odd count (real solutions pair up where the pose is regular): the one missed looked for
    (the Python solver's _rr_search) by damped steps on split 0's frame, without a reach, from
-   the rows found and from DK_RR_SEARCH_STARTS (a sliding joint 3's within +-DK_RR_SEARCH_SLIDE
+   the rows found (or, for a pose with no row, the leads': starts[0..given)) and from
+   DK_RR_SEARCH_STARTS (a sliding joint 3's within +-DK_RR_SEARCH_SLIDE
    of the arm's size); none where no row came within DK_RR_SEARCH_BAIL after a quarter of the
    steps; then Newton's steps from those within DK_RR_SEARCH_FROM. The new count. */
-static int dk_rr_search(const double F[4][4], double out[DK_RR_ROWS][6], int count)
+static int dk_rr_search(const double F[4][4], const double starts[DK_RR_ROWS][6], int given,
+                        double out[DK_RR_ROWS][6], int count)
 {
     double Q[DK_RR_ROWS + DK_RR_SEARCH_COUNT][6], least = HUGE_VAL;
-    const int first = DK_RR_SEARCH_STEPS / 4, n = count + DK_RR_SEARCH_COUNT;
+    const int first = DK_RR_SEARCH_STEPS / 4, n = given + DK_RR_SEARCH_COUNT;
     const int slides = DK_RR_TRUE[0][6][0] != 0.0;
     int r, j;
     for (r = 0; r < n; r++) {
         for (j = 0; j < 6; j++) {
-            if (r < count) { /* the arm's values as split 0's */
-                Q[r][j] = DK_RR_REVERSED[0] ? -out[r][5 - j] : out[r][j];
+            if (r < given) { /* the arm's values as split 0's */
+                Q[r][j] = DK_RR_REVERSED[0] ? -starts[r][5 - j] : starts[r][j];
             } else {
-                Q[r][j] = DK_RR_SEARCH_STARTS[r - count][j];
+                Q[r][j] = DK_RR_SEARCH_STARTS[r - given][j];
             }
         }
         if (slides) {
-            Q[r][2] = r < count ? Q[r][2] / DK_RR_LENGTH
+            Q[r][2] = r < given ? Q[r][2] / DK_RR_LENGTH
                                 : Q[r][2] * (DK_RR_SEARCH_SLIDE / DK_PI);
         }
         least = fmin(least, dk_rr_walk(DK_RR_TRUE[0], F, Q[r], 1, first, HUGE_VAL, 0));
@@ -1773,12 +1798,15 @@ static int dk_rr_search(const double F[4][4], double out[DK_RR_ROWS][6], int cou
 
 /* The general method's solutions of one pose into out (the first DK_RR_ROWS found where a
    self-motion gives more; then, on a nominal table, up to DK_RR_ROWS seeds of its near
-   misses, for the caller to refine and certify): their count, or -1 where none polished and
-   no seed came. flanges: per split, the 12 top entries of the target in the split's frame. */
+   misses, for the caller to refine and certify): their count (0: the pose out of reach, as
+   the Python solver's _general finds it). flanges: per split, the 12 top entries of the
+   target in the split's frame. */
 static int dk_general(const double flanges[DK_RR_SPLIT_COUNT][12], double out[DK_RR_OUT][6])
 {
     double targets[DK_RR_SPLIT_COUNT][4][4], moved[4][4], seeds[DK_RR_ROWS][6];
+    dk_rr_leads leads;
     int count = 0, doubt = DK_RR_RESCUE, perturbed = 0, grew = 0, n_seeds = 0, k, r, c, m, i;
+    leads.n = leads.n_near = leads.singular = 0;
     for (k = 0; k < DK_RR_SPLIT_COUNT; k++) {
         for (r = 0; r < 4; r++) {
             for (c = 0; c < 4; c++) {
@@ -1792,7 +1820,7 @@ static int dk_general(const double flanges[DK_RR_SPLIT_COUNT][12], double out[DK
     for (k = 0; k < DK_RR_SPLIT_COUNT; k++) {
         const int before = count;
         count = dk_rr_split(k, (const double(*)[4])targets[k], (const double(*)[4])targets[k],
-                            out, count, &doubt, DK_RR_IMAG_TOL, seeds, &n_seeds);
+                            out, count, &doubt, DK_RR_IMAG_TOL, seeds, &n_seeds, &leads);
         perturbed |= dk_rr_perturbed(k); /* (a perturbed table walked: the partners below) */
         grew |= k > 0 && count > before; /* (the fallback found what the first split missed) */
         if (count == DK_RR_ROWS) {
@@ -1819,7 +1847,7 @@ static int dk_general(const double flanges[DK_RR_SPLIT_COUNT][12], double out[DK
                     }
                 }
                 count = dk_rr_split(k, (const double(*)[4])targets[k], (const double(*)[4])moved,
-                                    out, count, &ignored, DK_RR_IMAG_TOL, seeds, &n_seeds);
+                                    out, count, &ignored, DK_RR_IMAG_TOL, seeds, &n_seeds, &leads);
                 perturbed |= dk_rr_perturbed(k);
                 if (count == DK_RR_ROWS) {
                     return count;
@@ -1834,7 +1862,8 @@ static int dk_general(const double flanges[DK_RR_SPLIT_COUNT][12], double out[DK
         count = dk_rr_partners((const double(*)[4])targets[0], out, count);
     }
     if (count % 2) {
-        count = dk_rr_search((const double(*)[4])targets[0], out, count);
+        count = dk_rr_search((const double(*)[4])targets[0], (const double(*)[6])out, count, out,
+                             count);
     }
     /* the last resort: a pose whose pencil is singular (a curve of solutions) scatters the
        eigenvalues off the real line; those within DK_RR_IMAG_LOOSE of it, polished */
@@ -1852,11 +1881,25 @@ static int dk_general(const double flanges[DK_RR_SPLIT_COUNT][12], double out[DK
                 }
             }
             count = dk_rr_split(k, (const double(*)[4])targets[k], (const double(*)[4])moved,
-                                out, count, &ignored, DK_RR_IMAG_LOOSE, seeds, &n_seeds);
+                                out, count, &ignored, DK_RR_IMAG_LOOSE, seeds, &n_seeds, &leads);
             if (count == DK_RR_ROWS) {
                 return count;
             }
         }
+    }
+    if (count == 0 && leads.n_near == 0 && (leads.singular || leads.n > 0)) {
+        /* a curve of solutions that none of the above reached: a search from the leads */
+        count = dk_rr_search((const double(*)[4])targets[0], (const double(*)[6])leads.rows,
+                             leads.n, out, count);
+    }
+    if (count == 0 && n_seeds == 0) { /* (a singular pose, where Newton converges slowly: what
+                                         came within DK_RR_NEAR, for the caller to certify) */
+        for (r = 0; r < leads.n_near; r++) {
+            for (i = 0; i < 6; i++) {
+                out[r][i] = leads.near[r][i];
+            }
+        }
+        count = leads.n_near;
     }
     for (r = 0; r < n_seeds && count < DK_RR_OUT; r++) { /* (a budget of their own) */
         /* a nominal table's near misses: seeds the caller refines onto the exact arm and
@@ -1871,5 +1914,5 @@ static int dk_general(const double flanges[DK_RR_SPLIT_COUNT][12], double out[DK
         }
         count = dk_rr_add(0, split, out, count);
     }
-    return count > 0 ? count : -1;
+    return count;
 }

@@ -7,8 +7,9 @@ step over the joint's values; a free joint steps through its values (5 degree st
 its first one) until one gives a certified solution, as the Python solver does. Roots failing
 the residual test are refined by Aberth iterations and split multiple roots merged (numpy's
 role in the Python solver); a polynomial of degree 3 or above 4 (once vanishing leading
-coefficients are dropped), or a general-method pose where no candidate polishes, makes it
-return DK_UNSETTLED: the C solver then says so instead of answering.
+coefficients are dropped), makes it return DK_UNSETTLED: the C solver then says so instead of
+answering (the general method's dk_general answers every pose itself, as the Python
+solver's _general does).
 """
 
 from __future__ import annotations
