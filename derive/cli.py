@@ -1244,6 +1244,14 @@ def main(argv: list[str] | None = None) -> int:
     except (SpecError, UsageError, OutputError, GenerationError, LoadError) as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 2
+    except (RecursionError, MemoryError) as exc:  # (an arm whose expressions grow too large)
+        what = "recursion depth" if isinstance(exc, RecursionError) else "memory"
+        print(
+            f"error: the derivation ran out of {what}: the arm's expressions are too large "
+            "(a chain of many joints with no special structure); give fewer joints",
+            file=sys.stderr,
+        )
+        return 2
     except BrokenPipeError:
         # the reader went away (`derive check | head`): stop quietly, as cat would
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())

@@ -475,3 +475,28 @@ def test_a_tool_axis_nearly_along_joints_2_to_4_is_not_the_default_axisangle_axi
         rows = module.ik_axis_angle(T[:3, 3], angle, backend="python")
         gaps = np.abs(np.remainder(rows - q + math.pi, 2 * math.pi) - math.pi)
         assert len(rows) and np.min(np.max(gaps, axis=1)) <= 1e-8, q
+
+
+def test_a_chain_longer_than_ten_joints_is_refused_at_once(tmp_path, capsys):
+    """A new user's generic chains (0.1 m links, turned frames): 10 joints generated in 73 s,
+    11 ended in a RecursionError traceback after 5 minutes and 3.8 GB, 12 was killed by the
+    kernel at 24 GB. More than MAX_JOINTS (10) is refused in one line before the derivation,
+    naming the count and what to do; 10 is still taken."""
+    links = ['<robot name="long">', '<link name="l0"/>']
+    for i in range(1, 12):
+        links.append(f'<link name="l{i}"/>')
+        links.append(
+            f'<joint name="j{i}" type="revolute"><parent link="l{i - 1}"/><child link="l{i}"/>'
+            f'<origin xyz="0 0 0.1" rpy="{0.3 * i % 3:.3f} 0.2 0"/><axis xyz="0 0 1"/>'
+            '<limit lower="-1" upper="1"/></joint>'
+        )
+    path = tmp_path / "long.urdf"
+    path.write_text("\n".join([*links, "</robot>"]), encoding="utf-8")
+    out = tmp_path / "out"
+    code = main(["generate", str(path), "--base", "l0", "--tip", "l11", "--out", str(out)])
+    err = capsys.readouterr().err
+    assert code == 2 and err.count("\n") == 1, err
+    assert "joint: 11 joints; allowed 1 to 10" in err and "--tip nearer" in err
+    assert not out.exists() or not any(out.iterdir())
+    spec = urdf.load_urdf(path, urdf.Options(base="l0", tip="l10"))
+    assert spec.dof == 10
