@@ -19,6 +19,7 @@ kinematics against the URDF's on random joint vectors. A deviation above a bound
 
 from __future__ import annotations
 
+import difflib
 import hashlib
 import keyword
 import math
@@ -379,7 +380,15 @@ def chain_between(
     for link, what in ((base, "--base"), (tip, "--tip")):
         if link not in robot.links:
             known = _listing(list(robot.links))
-            raise UrdfError(f"{where}: {what} {_shown(link)}: no such link; links: {known}")
+            # (the nearest names first: a misspelled --tip "urdf_hed" got the first links
+            # alphabetically, which did not include "urdf_head", a new user's attack)
+            near = (  # (not for names or files of hostile sizes: each comparison is quadratic)
+                difflib.get_close_matches(link, sorted(robot.links), n=3, cutoff=0.6)
+                if len(link) <= 200 and len(robot.links) <= 10_000
+                else []
+            )
+            hint = f"did you mean {', '.join(map(_shown, near))}? " if near else ""
+            raise UrdfError(f"{where}: {what} {_shown(link)}: no such link; {hint}links: {known}")
     above = {j.child: j for j in robot.joints}
     path: list[UrdfJoint] = []
     link = tip

@@ -500,3 +500,13 @@ def test_a_chain_longer_than_ten_joints_is_refused_at_once(tmp_path, capsys):
     assert not out.exists() or not any(out.iterdir())
     spec = urdf.load_urdf(path, urdf.Options(base="l0", tip="l10"))
     assert spec.dof == 10
+
+
+def test_a_misspelled_tip_is_answered_with_the_nearest_names(tmp_path, capsys):
+    """A new user's `--tip urdf_hed` got the first links alphabetically, without urdf_head;
+    the nearest names come first now."""
+    path = DATA / "puma560.urdf"
+    code = main(["generate", str(path), "--base", "link1", "--tip", "link_6", "--out",
+                 str(tmp_path / "out")])  # fmt: skip
+    err = capsys.readouterr().err
+    assert code == 2 and "--tip 'link_6': no such link; did you mean 'link6'" in err
