@@ -1274,14 +1274,8 @@ def nearest(
             raise ValueError(f"free_step {step!r} gives more than {MAX_FREE_VALUES} values")
         k = np.arange(-math.floor((start - lo) / step), math.floor((hi - start) / step) + 1)
         axes.append(start + step * k)
-    count = math.prod(len(a) for a in axes)  # (before the grid: a base's 2,001 x 2,001 x 629
-    # values of three free joints were 19 GiB an array, a new user's attack)
-    if count > MAX_FREE_VALUES:
-        raise ValueError(
-            f"nearest: {count} free values ({' x '.join(str(len(a)) for a in axes)} at "
-            f"free_step {step:g}); at most {MAX_FREE_VALUES}: give a larger free_step"
-        )
-    grid = np.stack([g.ravel() for g in np.meshgrid(*axes, indexing="ij")], axis=-1)
+    grid = _product_grid(axes, "nearest: {} free values", f" at free_step {step:g}",
+                         "a larger free_step")  # fmt: skip
     columns = [j - 1 for j in FREE]
     own = np.tile(np.array(refs), (len(grid), 1))
     own[:, columns] = grid
@@ -1339,13 +1333,7 @@ def ik_sweep(
     if n is not None and step is not None:
         raise ValueError("ik_sweep: give n or step, not both")
     axes = [_sweep_values(j, 64 if n is None and step is None else n, step) for j in FREE]
-    count = math.prod(len(a) for a in axes)  # (before the grid, as nearest's)
-    if count > MAX_FREE_VALUES:
-        raise ValueError(
-            f"ik_sweep: {count} samples ({' x '.join(str(len(a)) for a in axes)}); at most "
-            f"{MAX_FREE_VALUES}: give a smaller n or a larger step"
-        )
-    grid = np.stack([g.ravel() for g in np.meshgrid(*axes, indexing="ij")], axis=-1)
+    grid = _product_grid(axes, "ik_sweep: {} samples", "", "a smaller n or a larger step")
     A = _real(T, "T")
     if A.shape != (4, 4):
         raise ValueError(f"T must have shape (4, 4), got {A.shape}")
@@ -1358,6 +1346,20 @@ def ik_sweep(
     if within_limits:
         rows = _in_limits(rows, refs, False)
     return rows[:, [j - 1 for j in FREE]], rows
+
+
+def _product_grid(axes, what: str, how: str, advice: str) -> np.ndarray:
+    """Every combination of the free joints' values in axes, (count, len(axes)); its count is
+    checked first (a base's 2,001 x 2,001 x 629 values of three free joints were 19 GiB an
+    array before the check, a new user's attack): ValueError beyond MAX_FREE_VALUES, saying
+    what (its {} the count) and how the sizes came, and the advice."""
+    count = math.prod(len(a) for a in axes)
+    if count > MAX_FREE_VALUES:
+        sizes = " x ".join(str(len(a)) for a in axes)
+        raise ValueError(
+            f"{what.format(count)} ({sizes}{how}); at most {MAX_FREE_VALUES}: give {advice}"
+        )
+    return np.stack([g.ravel() for g in np.meshgrid(*axes, indexing="ij")], axis=-1)
 
 
 def _sweep_values(j: int, n: int | None, step: float | None) -> np.ndarray:
@@ -1592,8 +1594,14 @@ def manipulability(q: ArrayLike) -> tuple[float, float]:
     Raises:
         ValueError: q is not DOF finite numbers.
     """
-    sigma = np.linalg.svd(jacobian(q), compute_uv=False)
-    return float(sigma[-1]) if len(sigma) == min(6, DOF) else 0.0, float(np.prod(sigma))
+    J = jacobian(q)
+    return _least_sigma(J), float(np.prod(np.linalg.svd(J, compute_uv=False)))
+
+
+def _least_sigma(J: np.ndarray) -> float:
+    """The smallest of the min(6, columns) singular values of the 6-row J."""
+    sigma = np.linalg.svd(J, compute_uv=False)
+    return float(sigma[-1]) if len(sigma) == min(6, J.shape[1]) else 0.0
 
 
 def branch(q: ArrayLike) -> tuple[int, ...]:
@@ -1759,9 +1767,7 @@ def _step_bound(q, A, B):
         # and 3 nearly aligned, those turn fast though the whole arm's sigma_min is not small:
         # the bound of the whole arm's broke such lines, or took the shoulder's partner row
         # (q1 + pi, -q2, q3 + pi) with no break, a new user's attack: 8 of 40 iiwa14 lines)
-        columns = [i for i in range(DOF) if i + 1 not in FREE]
-        sigma = np.linalg.svd(jacobian(q)[:, columns], compute_uv=False)
-        least = float(sigma[-1]) if len(sigma) == min(6, len(columns)) else 0.0
+        least = _least_sigma(jacobian(q)[:, [i for i in range(DOF) if i + 1 not in FREE]])
     else:  # (the task's components and their Jacobian: what the task's rows follow)
         error, columns, _ = _pose_error(q.tolist(), B[:3].ravel().tolist(), False)
         change = float(np.linalg.norm(error))
@@ -1854,9 +1860,7 @@ def _continuation(T, q, label, bound, least, within_limits, backend):
     free = [guess[j - 1] for j in FREE] if FREE else None
     rows = ik(T, free=free, q_ref=guess, backend=backend)
     if len(rows) == 0 and converged:  # (Newton's iteration reached a solution that the
-        # closed form, at a singular configuration of the joints it solves, did not give: a
-        # panda line 7e-4 from its wrist's fold broke as "out of reach" at a pose ik solves
-        # with other values of q7, a new user's attack)
+        # closed form, at a singular configuration of the joints it solves, did not give)
         rows = guess[None]
     if len(rows) == 0:
         return None, _unreached(T, guess, backend)

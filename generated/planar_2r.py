@@ -1391,8 +1391,14 @@ def manipulability(q: ArrayLike) -> tuple[float, float]:
     Raises:
         ValueError: q is not DOF finite numbers.
     """
-    sigma = np.linalg.svd(jacobian(q), compute_uv=False)
-    return float(sigma[-1]) if len(sigma) == min(6, DOF) else 0.0, float(np.prod(sigma))
+    J = jacobian(q)
+    return _least_sigma(J), float(np.prod(np.linalg.svd(J, compute_uv=False)))
+
+
+def _least_sigma(J: np.ndarray) -> float:
+    """The smallest of the min(6, columns) singular values of the 6-row J."""
+    sigma = np.linalg.svd(J, compute_uv=False)
+    return float(sigma[-1]) if len(sigma) == min(6, J.shape[1]) else 0.0
 
 
 def branch(q: ArrayLike) -> tuple[int, ...]:
@@ -1558,9 +1564,7 @@ def _step_bound(q, A, B):
         # and 3 nearly aligned, those turn fast though the whole arm's sigma_min is not small:
         # the bound of the whole arm's broke such lines, or took the shoulder's partner row
         # (q1 + pi, -q2, q3 + pi) with no break, a new user's attack: 8 of 40 iiwa14 lines)
-        columns = [i for i in range(DOF) if i + 1 not in FREE]
-        sigma = np.linalg.svd(jacobian(q)[:, columns], compute_uv=False)
-        least = float(sigma[-1]) if len(sigma) == min(6, len(columns)) else 0.0
+        least = _least_sigma(jacobian(q)[:, [i for i in range(DOF) if i + 1 not in FREE]])
     else:  # (the task's components and their Jacobian: what the task's rows follow)
         error, columns, _ = _pose_error(q.tolist(), B[:3].ravel().tolist(), False)
         change = float(np.linalg.norm(error))
@@ -1653,9 +1657,7 @@ def _continuation(T, q, label, bound, least, within_limits, backend):
     free = [guess[j - 1] for j in FREE] if FREE else None
     rows = ik(T, free=free, q_ref=guess, backend=backend)
     if len(rows) == 0 and converged:  # (Newton's iteration reached a solution that the
-        # closed form, at a singular configuration of the joints it solves, did not give: a
-        # panda line 7e-4 from its wrist's fold broke as "out of reach" at a pose ik solves
-        # with other values of q7, a new user's attack)
+        # closed form, at a singular configuration of the joints it solves, did not give)
         rows = guess[None]
     if len(rows) == 0:
         return None, _unreached(T, guess, backend)

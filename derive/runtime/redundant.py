@@ -71,14 +71,8 @@ def nearest(
             raise ValueError(f"free_step {step!r} gives more than {MAX_FREE_VALUES} values")
         k = np.arange(-math.floor((start - lo) / step), math.floor((hi - start) / step) + 1)
         axes.append(start + step * k)
-    count = math.prod(len(a) for a in axes)  # (before the grid: a base's 2,001 x 2,001 x 629
-    # values of three free joints were 19 GiB an array, a new user's attack)
-    if count > MAX_FREE_VALUES:
-        raise ValueError(
-            f"nearest: {count} free values ({' x '.join(str(len(a)) for a in axes)} at "
-            f"free_step {step:g}); at most {MAX_FREE_VALUES}: give a larger free_step"
-        )
-    grid = np.stack([g.ravel() for g in np.meshgrid(*axes, indexing="ij")], axis=-1)
+    grid = _product_grid(axes, "nearest: {} free values", f" at free_step {step:g}",
+                         "a larger free_step")  # fmt: skip
     columns = [j - 1 for j in FREE]
     own = np.tile(np.array(refs), (len(grid), 1))
     own[:, columns] = grid
@@ -136,13 +130,7 @@ def ik_sweep(
     if n is not None and step is not None:
         raise ValueError("ik_sweep: give n or step, not both")
     axes = [_sweep_values(j, 64 if n is None and step is None else n, step) for j in FREE]
-    count = math.prod(len(a) for a in axes)  # (before the grid, as nearest's)
-    if count > MAX_FREE_VALUES:
-        raise ValueError(
-            f"ik_sweep: {count} samples ({' x '.join(str(len(a)) for a in axes)}); at most "
-            f"{MAX_FREE_VALUES}: give a smaller n or a larger step"
-        )
-    grid = np.stack([g.ravel() for g in np.meshgrid(*axes, indexing="ij")], axis=-1)
+    grid = _product_grid(axes, "ik_sweep: {} samples", "", "a smaller n or a larger step")
     A = _real(T, "T")
     if A.shape != (4, 4):
         raise ValueError(f"T must have shape (4, 4), got {A.shape}")
@@ -155,6 +143,20 @@ def ik_sweep(
     if within_limits:
         rows = _in_limits(rows, refs, False)
     return rows[:, [j - 1 for j in FREE]], rows
+
+
+def _product_grid(axes, what: str, how: str, advice: str) -> np.ndarray:
+    """Every combination of the free joints' values in axes, (count, len(axes)); its count is
+    checked first (a base's 2,001 x 2,001 x 629 values of three free joints were 19 GiB an
+    array before the check, a new user's attack): ValueError beyond MAX_FREE_VALUES, saying
+    what (its {} the count) and how the sizes came, and the advice."""
+    count = math.prod(len(a) for a in axes)
+    if count > MAX_FREE_VALUES:
+        sizes = " x ".join(str(len(a)) for a in axes)
+        raise ValueError(
+            f"{what.format(count)} ({sizes}{how}); at most {MAX_FREE_VALUES}: give {advice}"
+        )
+    return np.stack([g.ravel() for g in np.meshgrid(*axes, indexing="ij")], axis=-1)
 
 
 def _sweep_values(j: int, n: int | None, step: float | None) -> np.ndarray:
