@@ -315,11 +315,17 @@ def test_a_path_near_the_elbow_s_fold_keeps_its_branch_where_nearest_flips(gener
     from stretched on one side (one branch at 400 points along each), the other joints moving
     up to 0.8 rad: both elbow branches lie within one step, so the pose-by-pose nearest takes
     the other one on some; ik_path, choosing by the closed form's branch, follows every path
-    to 1e-6 with no break."""
+    to 1e-6. (It asserted no break, too; but ik_path follows the straight line between two
+    poses, and on most of these paths that line leaves the workspace between the poses: ik
+    has no solution near the path's branch at some of its interior points (on most, none at
+    all). Since ik_path checks a step within which
+    a fold may lie, it says so: "out of reach part way through the step" (or that no solution
+    continues the path, where Newton's iteration meets the fold first), and with
+    on_break="flag" goes on on its branch. Each such break is checked against ik here.)"""
     module = generated("puma560")
     rng = np.random.default_rng(7)
     stretched = _label_changes(module, np.zeros(6), 2)[0]  # (the elbow's fold at q = 0)
-    followed = nearest_kept = paths = 0
+    followed = nearest_kept = paths = out_of_reach = 0
     while paths < 60:
         qa = rng.uniform(-2.5, 2.5, 6)
         qb = qa + rng.uniform(-0.8, 0.8, 6)
@@ -330,9 +336,21 @@ def test_a_path_near_the_elbow_s_fold_keeps_its_branch_where_nearest_flips(gener
         paths += 1
         Qt = qa + np.linspace(0.0, 1.0, 10)[:, None] * (qb - qa)
         Ts = module.fk_batch(Qt)
-        Q, breaks = module.ik_path(Ts, Qt[0])
+        Q, breaks = module.ik_path(Ts, Qt[0], on_break="flag")
         gaps = np.abs(np.remainder(Q - Qt + np.pi, 2 * np.pi) - np.pi)
-        followed += breaks == [] and gaps.max() <= 1e-6
+        followed += gaps.max() <= 1e-6
+        for k, why in breaks:
+            assert why.startswith((f"pose {k}: out of reach part way through the step",
+                                   f"pose {k}: no solution continues the path")), why  # fmt: skip
+            chord = module.straight_line(Ts[k - 1], Ts[k], 11)
+            near = []  # (rows within 0.2 rad of the joint line between the poses' rows)
+            for t, T in zip(np.linspace(0.0, 1.0, 11), chord):
+                rows = module.ik(T).reshape(-1, 6)
+                line = Qt[k - 1] + t * (Qt[k] - Qt[k - 1])
+                gap = np.abs(np.remainder(rows - line + np.pi, 2 * np.pi) - np.pi).max(axis=1)
+                near.append(int((gap < 0.2).sum()))
+            assert min(near) == 0, near
+        out_of_reach += bool(breaks)
         q, kept = Qt[0], True
         for T, target in zip(Ts[1:], Qt[1:]):
             q = module.nearest(T, q, within_limits=False)
@@ -340,6 +358,7 @@ def test_a_path_near_the_elbow_s_fold_keeps_its_branch_where_nearest_flips(gener
         nearest_kept += kept
     assert followed == paths
     assert nearest_kept < paths, "no path where nearest flips: the test no longer tests it"
+    assert 0 < out_of_reach < paths  # (and the others are followed with no break)
 
 
 @needs_cc
@@ -701,6 +720,52 @@ def test_a_line_leaving_the_workspace_inside_a_step_says_so(generated):
         (k, why), *_ = breaks
         assert k == 1 and why.startswith("pose 1: out of reach part way through the step"), why
         assert len(module.ik(Ts[1], backend=backend)) == 4
+
+
+@pytest.mark.parametrize(
+    ("name", "qa", "qb", "fold"),
+    [
+        (  # (position + direction: the branch has no row from 0.61 to 0.89 of the last step)
+            "youbot",
+            [-1.9010259396240767, -1.496924768889471, -3.092546162199632, -1.3754596054574584,
+             -0.08870141324434598],
+            [-2.247380062233953, -1.369939571510867, -3.1440525009846714, -1.26672916435439,
+             0.3242498529261054],
+            0.935,
+        ),
+        (  # (the pose: no row from 0.03 of the last step to its end's neighbourhood)
+            "parallel_6r",
+            [-0.7622232251533854, 0.36347450476820425, -0.012186658633691533,
+             -0.44583182331989124, 0.47567358397940157, 2.9386045456667245],
+            [-0.7927203908019557, 0.5095613859007899, 0.07859794043960489, -0.9093105846769035,
+             0.027845808763446778, 2.643524753946161],
+            0.838,
+        ),
+    ],
+)  # fmt: skip
+def test_a_branch_leaving_the_workspace_and_coming_back_within_a_step_is_a_break(
+    generated, name, qa, qb, fold
+):
+    """Lines of 7 poses whose branch ends at a fold inside the last step (at `fold` of the
+    line) and has a row again at its end near the last one: the path went on with no break (a
+    new user's attack; at 20 poses it broke). A walk of the nearest rows 200 times finer jumps
+    there; ik_path breaks at the last pose now, in both backends."""
+    module = generated(name)
+    qa, qb = np.array(qa), np.array(qb)
+    poses = module.straight_line(module.fk(qa), module.fk(qb), 1201)
+    Q, valid = module.ik_batch(poses[::6])
+    walk, jumps = qa, []
+    for rows, ok in zip(Q[1:], valid[1:]):
+        gaps = np.abs(np.remainder(rows[ok] - walk + np.pi, 2 * np.pi) - np.pi).max(axis=1)
+        jumps.append(float(gaps.min()))
+        walk = rows[ok][int(np.argmin(gaps))]
+    k = int(np.argmax(jumps))
+    assert jumps[k] > 1.0 and abs((k + 1) / 200 - fold) < 0.01  # (where the branch ends)
+    assert max(jumps[:k]) < 0.05
+    for backend in ("c", "python"):
+        _, breaks = module.ik_path(poses[::200], qa, backend=backend)
+        assert [k for k, _ in breaks] == [6], breaks
+        assert "no solution continues the path" in breaks[0][1]
 
 
 def test_straight_line_turns_half_a_turn_and_refuses_what_is_not_rigid(generated):

@@ -241,6 +241,11 @@ PATH_NEAR = 0.25
 # ... and a step whose row moves a joint more than PATH_NEAR, or changes branch, is taken in
 # halves, at most this many times (2^10 = 1,024 parts; _follow)
 PATH_SPLITS = 10
+# ... and so is a step within which a fold may lie (_fold_within): sigma_min^2, which falls
+# linearly in the distance to a fold near one, reaches 0 within PATH_FOLD_AHEAD steps from
+# either end at its rate there along the first-order joint step (h = PATH_FOLD_PROBE steps)
+PATH_FOLD_AHEAD = 1.0
+PATH_FOLD_PROBE = 1e-4
 
 
 def ik_path(
@@ -263,7 +268,8 @@ def ik_path(
     reachable), its free joints kept.
 
     Where no solution continues the path (a singular crossing where the branch ends, a joint
-    limit with within_limits, a pose out of reach), the break is reported: (k, why) in the
+    limit with within_limits, a pose out of reach, or the straight line to it leaving the
+    branch's workspace between the poses), the break is reported: (k, why) in the
     returned list, and the path stops there (rows k.. NaN) or, with on_break="flag", goes on
     from the nearest solution.
 
@@ -325,17 +331,49 @@ def _step_bound(q, A, B):
     attack)."""
     if IK_COMPONENTS == "pose":
         change = float(np.linalg.norm(_pose_step(A, B)))
-        # (the joints ik solves: the free ones take the values Newton's iteration gives them,
-        # so near a singular configuration of the others, as an iiwa14's shoulder with axes 1
-        # and 3 nearly aligned, those turn fast though the whole arm's sigma_min is not small:
-        # the bound of the whole arm's broke such lines, or took the shoulder's partner row
-        # (q1 + pi, -q2, q3 + pi) with no break, a new user's attack: 8 of 40 iiwa14 lines)
-        least = _least_sigma(jacobian(q)[:, [i for i in range(DOF) if i + 1 not in FREE]])
-    else:  # (the task's components and their Jacobian: what the task's rows follow)
-        error, columns, _ = _pose_error(q.tolist(), B[:3].ravel().tolist(), False)
-        change = float(np.linalg.norm(error))
-        least = float(np.linalg.svd(np.array(columns).T, compute_uv=False)[-1])
+    else:  # (the task's components: what the task's rows follow)
+        change = float(np.linalg.norm(_pose_error(q.tolist(), B[:3].ravel().tolist(), False)[0]))
+    least = _path_sigma(q, B)
     return PATH_GAIN * change / max(least, 1e-300), least
+
+
+def _path_sigma(q, B):
+    """sigma_min at q of the Jacobian a path follows towards the pose B: of the joints ik
+    solves (the free ones take the values Newton's iteration gives them, so near a singular
+    configuration of the others, as an iiwa14's shoulder with axes 1 and 3 nearly aligned,
+    those turn fast though the whole arm's sigma_min is not small: the bound of the whole
+    arm's broke such lines, or took the shoulder's partner row (q1 + pi, -q2, q3 + pi) with
+    no break, a new user's attack: 8 of 40 iiwa14 lines); of the task's components' for an
+    arm solved for a task."""
+    if IK_COMPONENTS == "pose":
+        return _least_sigma(jacobian(q)[:, [i for i in range(DOF) if i + 1 not in FREE]])
+    columns = _pose_error(q.tolist(), B[:3].ravel().tolist(), False)[1]
+    return float(np.linalg.svd(np.array(columns).T, compute_uv=False)[-1])
+
+
+def _fold_within(q, B, least):
+    """Whether a fold (sigma_min 0, where q's branch can end) may lie within the step from q
+    towards the pose B: sigma_min^2 (of _step_bound's Jacobian) reaches 0 within
+    PATH_FOLD_AHEAD steps at its rate at q along the first-order joint step (Newton's, the
+    pose error over J^+; least, sigma_min at q where known). Near a fold sigma_min^2 falls
+    linearly in the pose's distance to it, so the step's halves (_follow) meet it."""
+    if IK_COMPONENTS == "pose":  # (J^+ from J's singular value decomposition, which gives
+        # sigma_min too where no joint is free)
+        u, values, vt = np.linalg.svd(jacobian(q), full_matrices=False)
+        kept = values > 1e-9 * values[0]
+        step = vt[kept].T @ ((u[:, kept].T @ _pose_error_to(q, B)[0]) / values[kept])
+        if least is None:
+            least = float(values[-1]) if not FREE else _path_sigma(q, B)
+    else:
+        error, columns, _ = _pose_error(q.tolist(), B[:3].ravel().tolist(), False)
+        step = np.zeros(DOF)
+        solved = [i for i in range(DOF) if i + 1 not in FREE]
+        step[solved] = np.linalg.lstsq(np.array(columns).T, np.array(error), rcond=1e-9)[0]
+        if least is None:
+            least = _path_sigma(q, B)
+    probe = _path_sigma(q + PATH_FOLD_PROBE * step, B)
+    rate = (probe * probe - least * least) / PATH_FOLD_PROBE
+    return rate < 0.0 and least * least < -rate * PATH_FOLD_AHEAD
 
 
 def _follow(A, B, q, within_limits, backend, depth):
@@ -368,16 +406,23 @@ def _follow(A, B, q, within_limits, backend, depth):
     worst = (float(jump.max()), least, int(np.argmax(jump)))
     label = branch(q)
     switched = bool(label) and not _same_branch(branch(row), label)
-    if depth < PATH_SPLITS and (why or worst[0] > PATH_NEAR or switched):
+    suspect = worst[0] > PATH_NEAR or switched
+    if depth < PATH_SPLITS and not why and not suspect:  # (a branch can leave the workspace
+        # and come back within one step, its rows at both ends near each other: a youbot line
+        # of 7 poses went on where the branch has no row for 4% of a step, a parallel_6r line
+        # where it has none for most of one, a new user's attack)
+        suspect = _fold_within(q, B, least) or _fold_within(row, A, None)
+    if depth < PATH_SPLITS and (why or suspect):
         middle = straight_line(A, B, 3)[1]
         half, first, least_first, worst_first = _follow(
             A, middle, q, within_limits, backend, depth + 1
         )
-        if (half is None or first) and not why and (worst[0] > PATH_NEAR or switched):  # (the
-            # branch ends within the step, at a fold where q's branch meets another, and the
-            # row is another branch's: a jump, or a row 0.087 rad away of the other sign of
-            # det J, the fold's partner, where a 100,000 times finer walk ends 0.29 into the
-            # step with the nearest solution 0.6 rad away, a new user's Alicia D line)
+        if (half is None or first) and not why and suspect:  # (the branch ends within the
+            # step, at a fold where q's branch meets another, and the row is another
+            # branch's: a jump, or a row 0.087 rad away of the other sign of det J, the
+            # fold's partner, where a 100,000 times finer walk ends 0.29 into the step with
+            # the nearest solution 0.6 rad away, a new user's Alicia D line; or the same
+            # branch's, where the branch comes back)
             why = first or "out of reach"
             if why.startswith("out of reach") and "part way" not in why:  # (the line leaves the
                 # workspace inside the step: its end may be reached, by other branches too; a
