@@ -31,11 +31,14 @@ from derive.transforms import Chain, JointZ, product, x_factor
 REMAINDER_DOF = 6
 
 
-def candidates(chain: Chain, named: tuple[int, ...] | None) -> tuple[tuple[int, ...], ...]:
+def candidates(
+    chain: Chain, named: tuple[int, ...] | None, size: int = REMAINDER_DOF
+) -> tuple[tuple[int, ...], ...]:
     """The free-joint choices to try, best first: the spec's, else the end joints (the last
-    joints first, then the first, then mixes)."""
+    joints first, then the first, then mixes) that leave `size` joints (6 for the pose, 3 for
+    the tool point's position)."""
     n = chain.dof
-    extra = n - REMAINDER_DOF
+    extra = n - size
     if named is not None:
         return (named,)
     out = []
@@ -44,13 +47,16 @@ def candidates(chain: Chain, named: tuple[int, ...] | None) -> tuple[tuple[int, 
     return tuple(dict.fromkeys(out))
 
 
-def refusal(chain: Chain, free: tuple[int, ...]) -> str:
-    """Why this choice of free joints cannot be used, or "" if it can."""
+def refusal(chain: Chain, free: tuple[int, ...], size: int = REMAINDER_DOF) -> str:
+    """Why this choice of free joints cannot be used, or "" if it can (`size`: 6 joints left
+    for the pose, 3 for the tool point's position)."""
     n = chain.dof
-    rank = remainder_rank(chain, free)
-    if rank < REMAINDER_DOF:
+    rank = remainder_rank(chain, free, position=size < REMAINDER_DOF)
+    if rank < size:
+        what = "tool point" if size < REMAINDER_DOF else "tool"
         return (
-            f"with these joints fixed the other joints move the tool in {rank} directions "
+            f"with these joints fixed the other joints move the {what} in {rank} "
+            f"direction{'s' if rank != 1 else ''} "
             f"only (their Jacobian has rank {rank} at random configurations): the remainder "
             "loses a degree of freedom"
         )
@@ -60,16 +66,16 @@ def refusal(chain: Chain, free: tuple[int, ...]) -> str:
     middle = next(i for i in free[k:] if not set(range(i, n + 1)) <= set(free))
     return (
         f"free joint {middle} is a middle joint: only end joints (the first or the last ones) "
-        f"can be free here, so that the other {REMAINDER_DOF} joints form one chain whose base "
+        f"can be free here, so that the other {size} joints form one chain whose base "
         "and tool the free joints move"
     )
 
 
-def remainder_rank(chain: Chain, free: tuple[int, ...]) -> int:
+def remainder_rank(chain: Chain, free: tuple[int, ...], position: bool = False) -> int:
     """The rank of the other joints' Jacobian (rotation and position, lengths in units of the
-    arm's size) at three random configurations, the largest: below 6 where fixing the free
-    joints takes a degree of freedom from the tool (q4 of an S-R-S arm fixes the distance
-    from shoulder to wrist)."""
+    arm's size; the tool point's position only, with `position`) at three random
+    configurations, the largest: below 6 where fixing the free joints takes a degree of
+    freedom from the tool (q4 of an S-R-S arm fixes the distance from shoulder to wrist)."""
     rng = np.random.default_rng(18)
     size = max(
         [1.0]
@@ -77,6 +83,8 @@ def remainder_rank(chain: Chain, free: tuple[int, ...]) -> int:
         + [abs(float(j.d if j.kind == "R" else j.offset)) for j in chain.joints]
     )
     moving = [i for i in range(chain.dof) if i + 1 not in free]
+    tool = np.array(chain.tool.evalf(), dtype=float)
+    tool[:3, 3] /= size
     best = 0
     for _ in range(3):
         q = rng.uniform(-np.pi, np.pi, chain.dof)
@@ -85,7 +93,8 @@ def remainder_rank(chain: Chain, free: tuple[int, ...]) -> int:
             step = np.zeros(chain.dof)
             step[i] = 1e-6
             d = (pose_numbers(chain, q + step, size) - pose_numbers(chain, q - step, size)) / 2e-6
-            columns.append(d[:3].ravel())
+            # (the tool point's: the tool frame moves it, where it does not turn the frame)
+            columns.append(d[:3, :3] @ tool[:3, 3] + d[:3, 3] if position else d[:3].ravel())
         sigma = np.linalg.svd(np.array(columns).T, compute_uv=False)
         best = max(best, int((sigma > 1e-6 * sigma[0]).sum()))
     return best
@@ -131,8 +140,9 @@ def free_z(j: JointZ) -> sp.Matrix:
 
 
 def remainder(chain: Chain, free: tuple[int, ...]) -> Chain:
-    """The 6-joint chain left when the free joints are fixed: joints renumbered 1..6, the
-    free joints (in placeholder symbols) moved into its base and tool."""
+    """The chain left when the free joints are fixed (6 joints for the pose, 3 for the tool
+    point's position): joints renumbered from 1, the free joints (in placeholder symbols)
+    moved into its base and tool."""
     n = chain.dof
     k, m = split(free, n)
     head = [chain.base, x_factor(chain.twists[0])]

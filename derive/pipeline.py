@@ -85,6 +85,15 @@ def build_plan(spec: ArmSpec, method: str | None = None) -> Plan:
                         f"the table within structure_tol {tol:g} of a special one moves the "
                         f"arm by {fix.deviation:.3g} (at most {NOMINAL_MAX:g} is refined)"
                     )
+    if ik is None and task is not None and task.kind == "axisangle" and task.why != NAMED:
+        # (the joints chose the angle task, and neither the table nor a nominal one near it
+        # has its closed form, as a humanoid's shoulder and elbow: the tool point's position,
+        # one joint free)
+        ik, alone = choose(chain, structure, spec.free, closed, POSITION_INSTEAD, tol)
+        if ik is not None:
+            task, refusal = POSITION_INSTEAD, ""
+        elif alone:
+            refusal = f"{refusal}; the tool point's position: {alone}"
     if ik is None and general.NAME in names:
         ik, why = choose(chain, structure, spec.free, (general.NAME,), task, tol)
         reasons = [r for r in (refusal, why) if r]
@@ -161,6 +170,13 @@ def build_plan(spec: ArmSpec, method: str | None = None) -> Plan:
 
 # a task's `why` where the spec names it
 NAMED = "named in the spec"
+# the task of four revolute joints where the angle task does not apply (choose)
+POSITION_INSTEAD = tasks.Task(
+    "position",
+    2,
+    "four revolute joints, the angle of a tool axis to a base axis not solved in closed form "
+    "for them (--task axisangle says why): the tool point's position, one joint free",
+)
 
 
 def task_of(spec: ArmSpec, chain: Chain) -> tasks.Task | None:
@@ -179,9 +195,10 @@ def task_of(spec: ArmSpec, chain: Chain) -> tasks.Task | None:
             raise SpecError(f'{where}: "pose" needs at least 6 joints, the arm has {n}')
         task = None
     elif spec.task == "position":
-        if n != 3:
-            raise SpecError(f'{where}: "position" needs 3 joints, the arm has {n}')
-        task = None
+        if n < 3:
+            raise SpecError(f'{where}: "position" needs at least 3 joints, the arm has {n}')
+        # (more than 3: the others are free joints, three solved for the tool point)
+        task = None if n == 3 else tasks.Task("position", 2, NAMED)
     elif spec.task == "direction":
         if n < 5:
             raise SpecError(f'{where}: "direction" needs at least 5 joints, the arm has {n}')
@@ -222,6 +239,9 @@ def choose(
     """The first of the named methods that solves the chain (an arm of more than 6 joints:
     with free joints; a task's arm: extended by its virtual joint, about the task's tool axis,
     else about the first of z, x, y that works), or None and why none does."""
+    if task is not None and task.kind == "position":  # (three joints solve the tool point,
+        # the others free)
+        return choose_free(chain, named, tuple(n for n in names if n == position.NAME), size=3)
     if task is not None and task.kind == "axisangle":
         return choose_cone(chain, structure, named, names, task, tol)
     if task is not None and task.virtual:
@@ -392,14 +412,23 @@ def choose_free(
     named: tuple[int, ...] | None,
     names: tuple[str, ...],
     reserved: int | None = None,
+    size: int = free.REMAINDER_DOF,
 ) -> tuple[IkPlan | None, str]:
-    """For an arm of more than 6 joints: the first method that solves the remainder of one
-    of the free-joint choices (the spec's, else end joints; every closed form on every choice
-    before the general method; never the reserved joint: a task's virtual one), lifted to the
-    arm; or None and why none does."""
+    """For an arm of more than 6 joints (more than 3 solved for the tool point's position,
+    `size` 3): the first method that solves the remainder of one of the free-joint choices
+    (the spec's, else end joints; every closed form on every choice before the general
+    method; never the reserved joint: a task's virtual one), lifted to the arm; or None and
+    why none does."""
     reasons: list[str] = []
     usable = []
-    choices = free.candidates(chain, named)
+    if not names:  # (the position method is not among those asked for)
+        return None, ""
+    if named is not None and chain.dof - len(named) != size:
+        return None, (
+            f"[ik] free names {len(named)} joints; {chain.dof - size} must be free for "
+            f"{size} to be solved"
+        )
+    choices = free.candidates(chain, named, size)
     if reserved is not None:
         if named is not None and reserved in named:
             return None, f"[ik] free names q{reserved}, which the task needs"
@@ -411,7 +440,7 @@ def choose_free(
             )
     for choice in choices:
         label = "free " + ", ".join(f"q{i}" for i in choice)
-        why = free.refusal(chain, choice)
+        why = free.refusal(chain, choice, size)
         if why:
             reasons.append(f"{label}: {why}")
             continue

@@ -75,9 +75,10 @@ def test_unknown_arm_name_exits_2(capsys):
 
 
 def test_require_ik_exits_3_for_fk_only_arm(tmp_path):
-    # (four joints: no task of a pose's, position's or look-at's fits them)
+    # (three joints whose axes meet at the tool point: it cannot move, so no task fits; a
+    # four-joint arm that had none gets the position, one joint free, since that fallback)
     spec = tmp_path / "four.toml"
-    rows = [(90, 0, 1, 0), (90, 1, 0, 0), (0, 0.5, 0, 0), (90, 0.3, 0, 0)]
+    rows = [(90, 0, 0, 0), (-90, 0, 0, 0), (0, 0, 0, 0)]
     spec.write_text(spec_text("four", "standard", rows))
     assert main(["generate", str(spec), "--out", str(tmp_path)]) == 0
     assert main(["generate", str(spec), "--out", str(tmp_path), "--require-ik"]) == 3

@@ -178,8 +178,87 @@ def test_the_c_ik_position_gives_the_module_s_rows(tmp_path):
     tol = ctypes.c_double(module.CERTIFY_TOL)
     for q in rng.uniform(-math.pi, math.pi, (100, 3)):
         p = np.ascontiguousarray(module.fk(q)[:3, 3])
-        n = call(p.ctypes.data_as(double_p), None, tol, rows.ctypes.data_as(double_p))
+        n = call(p.ctypes.data_as(double_p), None, None, tol, rows.ctypes.data_as(double_p))
         expected = module.ik_position(p, backend="python")
         assert n == len(expected) > 0 and np.allclose(rows[:n], expected, atol=1e-9)
     bad = np.array([0.1, np.inf, 0.2])
-    assert call(bad.ctypes.data_as(double_p), None, tol, rows.ctypes.data_as(double_p)) == -3
+    assert call(bad.ctypes.data_as(double_p), None, None, tol, rows.ctypes.data_as(double_p)) == -3
+
+
+def free_round_trips(module, backend: str, n: int, seed: int) -> tuple[int, int, float]:
+    """ik_position with the free joints at the sample's values: (samples whose joint vector
+    was missed, samples answered with nothing, the worst row's position error over the
+    reach); every row keeps the free values."""
+    rng = np.random.default_rng(seed)
+    missed = empty = 0
+    worst = 0.0
+    for q in rng.uniform(-math.pi, math.pi, (n, module.DOF)):
+        p = module.fk(q)[:3, 3]
+        rows = module.ik_position(p, free=[q[j - 1] for j in module.FREE], backend=backend)
+        empty += len(rows) == 0
+        for row in rows:
+            worst = max(worst, float(np.max(np.abs(module.fk(row)[:3, 3] - p))))
+            assert all(row[j - 1] == q[j - 1] for j in module.FREE)
+        gaps = np.abs(np.remainder(rows - q + math.pi, 2 * math.pi) - math.pi)
+        missed += not len(rows) or bool(np.min(np.max(gaps, axis=1)) > 1e-8)
+    return missed, empty, worst / module.REACH
+
+
+# a 6R arm with its tool 206 mm out along z6 (the wrist's joints move the tool point), and a
+# humanoid's shoulder (three axes meeting), the elbow 0.3 m down the upper arm's roll axis, the
+# hand 0.28 m beyond it
+LECTURE_POSITION = Path("derive/arms/lecture_6r.toml").read_text() + '\n[ik]\ntask = "position"\n'
+SHOULDER_ELBOW = spec_text(
+    "shoulder_elbow",
+    "modified",
+    [(0, 0, 0, 0), (-90, 0, 0, -90), (90, 0, 0.3, 0), (-90, 0, 0, 0)],
+    extra="\n[tool]\nmatrix = [[1, 0, 0, 0.28], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1]]\n",
+)
+
+
+@pytest.mark.parametrize("backend", ["python", pytest.param("c", marks=needs_cc)])
+def test_an_arm_with_more_joints_than_the_position_needs_has_free_joints(backend, tmp_path):
+    """task = "position" on a 6R arm (it was refused: "position" needed exactly 3 joints):
+    joints 4-6 free, 1-3 solved with the tool point in frame 3 computed from the free values
+    first; the sampled joint vector among the rows at every sample, every row within 1e-10."""
+    module = build_module(LECTURE_POSITION, tmp_path, c=backend == "c")
+    assert module.FREE == (4, 5, 6) and module.IK_COMPONENTS == "position"
+    assert "ik_position(p, *, free=None" in module.__doc__
+    missed, empty, worst = free_round_trips(module, backend, 300, 3)
+    assert missed == 0 and empty == 0 and worst <= 1e-10
+
+
+@pytest.mark.parametrize("backend", ["python", pytest.param("c", marks=needs_cc)])
+def test_four_joints_beyond_the_angle_task_solve_the_position_one_free(backend, tmp_path):
+    """A shoulder of three meeting axes and an elbow: the four-joint default, the angle of a
+    tool axis to a base axis, does not apply (joint 1 is not along the base z axis once the
+    tool is turned; it was "FK only", a new user's humanoid arms), so the tool point's
+    position is solved with one end joint free, and the summary says so."""
+    plan = build_plan(parse_spec(SHOULDER_ELBOW, "<test>"))
+    assert plan.ik is not None and plan.ik.certify == "position" and len(plan.ik.free) == 1
+    assert any("the tool point's position, one joint free" in fact for fact in plan.structure)
+    module = build_module(SHOULDER_ELBOW, tmp_path, c=backend == "c")
+    missed, empty, worst = free_round_trips(module, backend, 300, 5)
+    assert missed == 0 and empty == 0 and worst <= 1e-10
+
+
+@needs_cc
+def test_the_c_ik_position_takes_the_free_values(tmp_path):
+    """NAME_ik_position(p, free, q_ref, tol, q) of an arm with free joints: the module's
+    rows for the same free values."""
+    import ctypes
+
+    module = build_module(LECTURE_POSITION, tmp_path, c=True)
+    lib, why = module._c_library()
+    assert lib is not None, why
+    double_p = ctypes.POINTER(ctypes.c_double)
+    call = lib[f"{module.NAME}_ik_position"]
+    rows = np.zeros((module.MAX_SOLUTIONS, module.DOF))
+    tol = ctypes.c_double(module.CERTIFY_TOL)
+    for q in np.random.default_rng(8).uniform(-math.pi, math.pi, (50, 6)):
+        p = np.ascontiguousarray(module.fk(q)[:3, 3])
+        free = np.ascontiguousarray(q[3:])
+        n = call(p.ctypes.data_as(double_p), free.ctypes.data_as(double_p), None, tol,
+                 rows.ctypes.data_as(double_p))  # fmt: skip
+        expected = module.ik_position(p, free=free, backend="python")
+        assert n == len(expected) > 0 and np.allclose(rows[:n], expected, atol=1e-9)

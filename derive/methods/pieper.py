@@ -203,7 +203,11 @@ def _axis_distance_rest(
 
 
 def position_equations(
-    numbers: dict, length: float, refs: tuple[sp.Expr, ...], prismatic3: bool
+    numbers: dict,
+    length: float,
+    refs: tuple[sp.Expr, ...],
+    prismatic3: bool,
+    typical: dict | None = None,
 ) -> PositionResult:
     """Joint 3 from the case's polynomial, then theta2, then theta1 (lecture, Pieper -4, -5).
 
@@ -214,6 +218,9 @@ def position_equations(
         prismatic3: joint 3 is prismatic: the lecture's "theta_i or d_i"; f is affine in d3 and
             the case's equation is a polynomial in d3 (docs/algorithms.md, "A prismatic
             joint 3").
+        typical: values of symbols among the numbers that the solver computes (a tool point
+            that free joints move: derive/methods/position.py) at a typical configuration,
+            for the polynomial's scale.
     """
     general = k_functions()
     spec = {name: sp.expand(e.xreplace(numbers)) for name, e in general.items()}
@@ -277,7 +284,7 @@ def position_equations(
             f"of degree {degree} in {var}; free when it vanishes identically",
             degree,
             refs[2],
-            typical_magnitude(coeffs, length),
+            typical_magnitude(tuple(c.xreplace(typical or {}) for c in coeffs), length),
             # (d3 is as long as the wrist centre is far, and a look-at's point can be any
             # distance along its ray: a head's axes 3 mm apart lost every point 1 m away
             # when its quartic's leading coefficient, scaled by the arm's length alone,

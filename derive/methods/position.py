@@ -37,21 +37,47 @@ def derive(chain: Chain, structure: Structure) -> IkPlan | str:
     numbers = numbers_of(chain)
     point = product([x_factor(chain.twists[-1]), chain.tool])[:3, 3]
     px, py, pz = (sp.expand(v.xreplace(numbers)) for v in point)
-    d4 = sp.sqrt(py**2 + pz**2)
-    ca, sa = (pz / d4, -py / d4) if d4 != 0 else (sp.S.One, sp.S.Zero)  # (alpha3)
-    numbers[sym.link_a(3)] = px
-    numbers[sym.cos_alpha(3)], numbers[sym.sin_alpha(3)] = ca, sa
-    numbers[sym.d(4)] = d4
-    mapping = {"tool_point_a3": px, "tool_point_d4": d4}
-    mapping |= {"tool_point_cos_alpha3": ca, "tool_point_sin_alpha3": sa}
+    moved: list[Step] = []
+    typical: dict[sp.Symbol, sp.Expr] = {}
     length = sum(abs(float(t.a)) for t in chain.twists[:-1])
-    length += (
-        sum(abs(float(j.d)) for j in chain.joints if j.kind == "R") + abs(float(px)) + float(d4)
-    )
+    length += sum(abs(float(j.d)) for j in chain.joints if j.kind == "R")
+    if any(v.free_symbols for v in (px, py, pz)):
+        # free joints after joint 3 move the tool point in frame 3 (derive/free.py): the
+        # solver computes it from their values first, and from it the wrist centre's a3, d4
+        # and alpha3 as below (d4 = 0, the point on axis 4 at those values, has no rows)
+        names = tuple(sym.named(f"tool3{axis}") for axis in "xyz")
+        d4, ca, sa = (sym.named(f"tool3{n}") for n in ("d4", "ca", "sa"))
+        moved += [
+            Assign(names, (px, py, pz), "the tool point in frame 3, moved by the free joints"),
+            Assign((d4,), (sp.sqrt(names[1] ** 2 + names[2] ** 2),), "... as a3, d4 and alpha3"),
+            Assign((ca, sa), (names[2] / d4, -names[1] / d4), "cos(alpha3), sin(alpha3)"),
+        ]
+        numbers[sym.link_a(3)], numbers[sym.d(4)] = names[0], d4
+        numbers[sym.cos_alpha(3)], numbers[sym.sin_alpha(3)] = ca, sa
+        mapping = {"tool_point_in_frame_3": sp.Matrix([px, py, pz])}
+        free_values = {s: sp.S.Zero for v in (px, py, pz) for s in v.free_symbols}
+        free_values |= {s: sp.S.One for s in free_values if s.name.startswith("cfree")}
+        point0 = [v.xreplace(free_values) for v in (px, py, pz)]
+        typical = dict(zip(names, point0))
+        typical[d4] = sp.sqrt(point0[1] ** 2 + point0[2] ** 2)
+        typical[ca] = point0[2] / typical[d4] if typical[d4] != 0 else sp.S.One
+        typical[sa] = -point0[1] / typical[d4] if typical[d4] != 0 else sp.S.Zero
+        length += _farthest(px, py, pz)
+    else:
+        d4 = sp.sqrt(py**2 + pz**2)
+        ca, sa = (pz / d4, -py / d4) if d4 != 0 else (sp.S.One, sp.S.Zero)  # (alpha3)
+        numbers[sym.link_a(3)] = px
+        numbers[sym.cos_alpha(3)], numbers[sym.sin_alpha(3)] = ca, sa
+        numbers[sym.d(4)] = d4
+        mapping = {"tool_point_a3": px, "tool_point_d4": d4}
+        mapping |= {"tool_point_cos_alpha3": ca, "tool_point_sin_alpha3": sa}
+        length += abs(float(px)) + float(d4)
     try:
         # (an arm with every length 0, a pointing task's, moves its point on the unit sphere:
         # derive/tasks.py; 1 is its size)
-        position = position_equations(numbers, length or 1.0, joint_refs(chain), kinds[2] == "P")
+        position = position_equations(
+            numbers, length or 1.0, joint_refs(chain), kinds[2] == "P", typical
+        )
     except NotApplicable as exc:
         return str(exc).replace("Pieper", "position", 1).replace("wrist centre", "tool point")
     head = [chain.base, x_factor(chain.twists[0])]
@@ -64,6 +90,7 @@ def derive(chain: Chain, structure: Structure) -> IkPlan | str:
             tuple(local[:3]),
             "tool point in frame 1 without d1: (B X0 Tz(d1))^-1 p; the arm controls a position",
         ),
+        *moved,
         *position.steps,
     ]
     return IkPlan(
@@ -76,3 +103,15 @@ def derive(chain: Chain, structure: Structure) -> IkPlan | str:
         solves_for="the tool point's position",
         certify="position",
     )
+
+
+def _farthest(*point: sp.Expr) -> float:
+    """The farthest a tool point that free joints move (expressions in their cos and sin, or
+    d) lies from frame 3's origin, bounded by the sum of its terms' sizes."""
+    total = 0.0
+    for v in point:
+        if not v.free_symbols:
+            total += abs(float(v))
+            continue
+        total += sum(abs(float(c)) for c in sp.Poly(v, *sorted(v.free_symbols, key=str)).coeffs())
+    return total

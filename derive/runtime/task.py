@@ -27,25 +27,27 @@ from derive.runtime.constants import CERTIFY_TOL
 def ik_position(
     p: ArrayLike,
     *,
+    free: ArrayLike | None = None,
     within_limits: bool = False,
     q_ref: ArrayLike | None = None,
     tol: float = CERTIFY_TOL,
     backend: str | None = None,
 ) -> np.ndarray:
     """All solutions that put the tool point at p, whatever the tool's orientation (IKFast's
-    Translation3D: an arm of three joints), as an (n, DOF) array; empty if unreachable.
+    Translation3D: three joints solved, any others free), as an (n, DOF) array; empty if
+    unreachable.
 
     Args:
         p: the tool point in the world, 3 numbers.
-        within_limits, q_ref, tol, backend: as ik's. Every row reproduces p within
+        free, within_limits, q_ref, tol, backend: as ik's (free: an arm of more than three
+            joints, the values of its free joints FREE). Every row reproduces p within
             tol * REACH.
 
     Raises:
-        ValueError: p is not 3 finite numbers.
+        ValueError: p is not 3 finite numbers; free as ik says.
     """
-    return ik(
-        _task_pose(p, None), within_limits=within_limits, q_ref=q_ref, tol=tol, backend=backend
-    )
+    T = _task_pose(p, None)
+    return ik(T, free=free, within_limits=within_limits, q_ref=q_ref, tol=tol, backend=backend)
 
 
 def ik_direction(
