@@ -1655,6 +1655,11 @@ PATH_SLACK = 1e-6
 PATH_SLACK_MOST = 1e-2
 
 
+# ... and, within PATH_SLACK_MOST, if the points between them reach the pose within this too
+# (one valley of solutions near a singular configuration: _joined)
+PATH_JOINED = 1e-9
+
+
 # ... and q0 must reach Ts[0] within this (its pose error, as ik's certification measures it);
 # a step whose finest part (_follow's halves) moves more than PATH_JUMP (radians, or REACH)
 # where sigma_min is below PATH_SINGULAR is a break: the first-order bound allows any step
@@ -1856,6 +1861,22 @@ def _follow(A, B, q, within_limits, backend, depth):
     part that moves a joint most."""
     bound, least = _step_bound(q, A, B)
     row, why = _continuation(B, q, branch(q), bound, least, within_limits, backend)
+    if row is None and FREE and depth < PATH_SPLITS:  # (the free joints took values at
+        # which the pose has no solution: Newton's iteration over a long step can wander so,
+        # where shorter steps keep them on the path; a panda line broke so at 7 poses and not
+        # at 20, a new user's attack)
+        middle = straight_line(A, B, 3)[1]
+        half, first, least_first, worst_first = _follow(
+            A, middle, q, within_limits, backend, depth + 1
+        )
+        if half is not None and not first:
+            split, why_split, least_split, worst_split = _follow(
+                middle, B, half, within_limits, backend, depth + 1
+            )
+            if split is not None:
+                worst = max(worst_first, worst_split)
+                least = min(least, least_first, least_split)
+                return split, _jumped(why_split, worst, depth), least, worst
     if row is None or "limits" in why:
         return row, why, least, (0.0, least, 0)
     revolute = np.array(_REVOLUTE)
@@ -1895,12 +1916,18 @@ def _follow(A, B, q, within_limits, backend, depth):
                 row, why = split, why_split
                 least = min(least, least_first, least_split)  # (the parts' own starts)
                 worst = max(worst_first, worst_split)
+    return row, _jumped(why, worst, depth), least, worst
+
+
+def _jumped(why, worst, depth):
+    """why, or, for a whole step (depth 0) that continues, why not where its finest part
+    that moves a joint most, by more than PATH_JUMP, starts below PATH_SINGULAR."""
     if not why and depth == 0 and worst[1] < PATH_SINGULAR and worst[0] > PATH_JUMP:
-        why = (
+        return (
             f"q{worst[2] + 1} jumps by {worst[0]:.3g} at a singular configuration (the path "
             "passes one; where it goes from there the poses do not say)"
         )
-    return row, why, least, worst
+    return why
 
 
 def _continuation(T, q, label, bound, least, within_limits, backend):
@@ -1954,7 +1981,10 @@ def _continuation(T, q, label, bound, least, within_limits, backend):
     row = q + move
     step = np.abs(move) / units
     j = int(np.argmax(step))
-    if not converged or misses[best] > slack or step.max() > bound + slack:
+    joined = misses[best] <= slack or (
+        misses[best] <= PATH_SLACK_MOST and _joined(guess, guess + gaps[best], T)
+    )
+    if not converged or not joined or step.max() > bound + slack:
         return row, (
             "no solution continues the path ("
             + ("Newton's iteration from the last row does not converge"
@@ -1962,6 +1992,17 @@ def _continuation(T, q, label, bound, least, within_limits, backend):
             + ": a singular crossing where the branch ends, or another branch)"
         )  # fmt: skip
     return _within(row, within_limits)
+
+
+def _joined(a, b, T):
+    """Whether the joint vectors a and b, both solutions of the pose T, lie on one valley of
+    solutions: the points between them reach T within PATH_JOINED too. Near a singular
+    configuration Newton's steps wander along the direction J barely moves (a panda with its
+    elbow 4e-3 from straight, axes 3 and 5 nearly one: Newton's point and the row 1.5e-3 rad
+    apart in q3 and q5, both within 3e-11 of the pose, every point between within 2e-11;
+    the path broke there, a new user's attack); two solutions of a fold, as far apart, are
+    not joined (the pose error between them grows as the square of their distance)."""
+    return all(_pose_error_to(a + s * (b - a), T)[1] <= PATH_JOINED for s in (0.25, 0.5, 0.75))
 
 
 def _unreached(T, guess, backend):

@@ -859,6 +859,46 @@ def test_a_free_joint_arm_s_break_says_whether_the_pose_is_out_of_reach(generate
     assert "out of reach (with q7 = " in breaks[0][1] and "16 values" in breaks[0][1]
 
 
+@pytest.mark.parametrize(
+    ("qa", "qb"),
+    [
+        (  # (the elbow 4e-3 rad from straight, axes 3 and 5 nearly one: Newton's point and
+            # the row 1.5e-3 apart in q3 and q5 along the valley of solutions between them)
+            [-0.6473698740136374, 2.2425419403840916, 0.3477870030556951, -0.019210364968099775,
+             -2.5362984019748507, -2.910257687616081, 1.3535255445806602],
+            [-0.5773019153897463, 2.2282445845636087, 0.36024962113217307, 0.014708532308819525,
+             -2.5190966785172866, -2.8617309261317025, 1.337221754599415],
+        ),
+        (  # (a long step: Newton's iteration took q7 where the pose has no solution)
+            [0.41237769945681757, 1.858515342953229, 0.44744957739223556, 2.5012632329868154,
+             -3.0663411282444835, 0.20426683607017315, 1.562096351428906],
+            [-0.23170392250985028, 2.0479413978947716, -0.13081908278180898, 2.844316732541274,
+             -3.892496469273058, 0.9972498649998367, 1.1779038592511826],
+        ),
+    ],
+)  # fmt: skip
+def test_a_redundant_arm_s_path_that_a_finer_one_follows_goes_on(generated, qa, qb):
+    """Two panda lines of 7 poses that broke where 20 poses go on, a walk of the nearest rows
+    13,452 steps along them continuous (a new user's attack): the row 1.5e-3 rad from
+    Newton's point near a singular configuration is taken where every point between them
+    reaches the pose (_joined); a step whose free joint Newton's iteration took where the pose
+    has no solution is taken in halves. Each row reaches its pose, and the rows are those of
+    25 poses within 0.05 rad: the free joint follows Newton's steps, which differ with the
+    sampling (the second line passes near singular sets where q7 turns 1.7 rad; its rows at 7
+    and 25 poses differ by up to 0.035, at 13 by 0.28, no path breaking)."""
+    module = generated("panda")
+    A, B = module.fk(np.array(qa)), module.fk(np.array(qb))
+    for backend in ("c", "python"):
+        Q, breaks = module.ik_path(module.straight_line(A, B, 7), qa, backend=backend)
+        assert breaks == []
+        finer, breaks = module.ik_path(module.straight_line(A, B, 25), qa, backend=backend)
+        assert breaks == []
+        gaps = np.abs(np.remainder(Q - finer[::4] + np.pi, 2 * np.pi) - np.pi)
+        assert gaps.max() < 0.05
+        for q, T in zip(Q, module.straight_line(A, B, 7)):
+            assert np.abs(module.fk(q) - T).max() < 1e-9
+
+
 def test_a_redundant_arm_s_path_near_its_shoulder_fold_goes_on(generated):
     """An iiwa14 line 6e-3 rad from the fold of its shoulder (q2 = 0, axes 1 and 3 aligned;
     a new user's attack) at 60 poses: Newton's point and the closed form's row, 3e-7 from
