@@ -197,8 +197,9 @@ def task_of(spec: ArmSpec, chain: Chain) -> tasks.Task | None:
     elif spec.task == "position":
         if n < 3:
             raise SpecError(f'{where}: "position" needs at least 3 joints, the arm has {n}')
-        # (more than 3: the others are free joints, three solved for the tool point)
-        task = None if n == 3 else tasks.Task("position", 2, NAMED)
+        # (more than 3: the others are free joints, three solved for the tool point; 3: the
+        # position method, not the planar one a planar arm's joints would choose)
+        task = tasks.Task("position", 2, NAMED)
     elif spec.task == "direction":
         if n < 5:
             raise SpecError(f'{where}: "direction" needs at least 5 joints, the arm has {n}')
@@ -241,7 +242,10 @@ def choose(
     else about the first of z, x, y that works), or None and why none does."""
     if task is not None and task.kind == "position":  # (three joints solve the tool point,
         # the others free)
-        return choose_free(chain, named, tuple(n for n in names if n == position.NAME), size=3)
+        solvers = tuple(n for n in names if n == position.NAME)
+        if chain.dof == 3:
+            return choose_method(chain, structure, solvers) if solvers else (None, "")
+        return choose_free(chain, named, solvers, size=3)
     if task is not None and task.kind == "axisangle":
         return choose_cone(chain, structure, named, names, task, tol)
     if task is not None and task.virtual:

@@ -662,6 +662,13 @@ def test_the_position_of_an_arm_of_two_joints_is_refused_and_of_five_has_free_jo
     text = spec_text("five_r", "modified", FIVE_R_ROWS, extra='\n[ik]\ntask = "position"\n')
     plan = build_plan(parse_spec(text, "five_r.toml"))
     assert plan.ik is not None and plan.ik.certify == "position" and len(plan.ik.free) == 2
+    # a planar arm named "position": its point moves in a plane, so no solver, and the
+    # summary says why (it got the planar solver, the task silently dropped: a new user's
+    # attack on lecture_rrr)
+    text = Path("derive/arms/lecture_rrr.toml").read_text() + '\n[ik]\ntask = "position"\n'
+    plan = build_plan(parse_spec(text, "rrr.toml"))
+    assert plan.ik is None and "position: all axes parallel" in plan.refusal
+    assert any("the tool point's position (Translation3D)" in fact for fact in plan.structure)
 
 
 def test_a_tool_axis_without_a_task_of_one_is_refused():
