@@ -100,6 +100,34 @@ def remainder_rank(chain: Chain, free: tuple[int, ...], position: bool = False) 
     return best
 
 
+def position_span(chain: Chain, free: tuple[int, ...]) -> float:
+    """How much room the other joints give the tool point: the median over eight random
+    configurations of |det| of their 3 x 3 position Jacobian, lengths in units of the arm's
+    size. A humanoid arm's wrist moves the hand a few centimetres, its shoulder and elbow the
+    whole reach: with the wrist solved and the shoulder free, almost no point is reached at
+    the given free values (an iCub arm, a new user's attack)."""
+    rng = np.random.default_rng(19)
+    size = max(
+        [1.0]
+        + [abs(float(t.a)) for t in chain.twists]
+        + [abs(float(j.d if j.kind == "R" else j.offset)) for j in chain.joints]
+    )
+    moving = [i for i in range(chain.dof) if i + 1 not in free]
+    tool = np.array(chain.tool.evalf(), dtype=float)
+    tool[:3, 3] /= size
+    dets = []
+    for _ in range(8):
+        q = rng.uniform(-np.pi, np.pi, chain.dof)
+        columns = []
+        for i in moving:
+            step = np.zeros(chain.dof)
+            step[i] = 1e-6
+            d = (pose_numbers(chain, q + step, size) - pose_numbers(chain, q - step, size)) / 2e-6
+            columns.append(d[:3, :3] @ tool[:3, 3] + d[:3, 3])
+        dets.append(abs(float(np.linalg.det(np.array(columns).T))))
+    return float(np.median(dets))
+
+
 def pose_numbers(chain: Chain, q: np.ndarray, size: float) -> np.ndarray:
     """X_0 Z_1 X_1 ... Z_n X_n at joint values q (a prismatic joint's q in units of size),
     lengths divided by size."""

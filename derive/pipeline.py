@@ -458,6 +458,9 @@ def choose_free(
             )
             continue
         usable.append((choice, label, rest, structure))
+    if size < free.REMAINDER_DOF and named is None:  # (the position: the joints that move
+        # the tool point most are solved, the others free: free.position_span)
+        usable.sort(key=lambda u: -free.position_span(chain, u[0]))
     for name in names:
         for choice, label, rest, structure in usable:
             result = METHODS[name](rest, structure)

@@ -262,3 +262,32 @@ def test_the_c_ik_position_takes_the_free_values(tmp_path):
                  rows.ctypes.data_as(double_p))  # fmt: skip
         expected = module.ik_position(p, free=free, backend="python")
         assert n == len(expected) > 0 and np.allclose(rows[:n], expected, atol=1e-9)
+
+
+# a humanoid arm of seven joints: a shoulder of three meeting axes, the elbow 0.3 m down the
+# upper arm, a wrist whose axes are 2-3 cm apart, the hand beyond it
+HUMANOID7 = spec_text(
+    "humanoid7",
+    "modified",
+    [(0, 0, 0, 0), (-90, 0, 0, -90), (90, 0, 0.3, 0), (-90, 0, 0, 0), (90, 0, 0.25, 0),
+     (-90, 0.02, 0, 0), (90, 0.03, 0, 0)],
+    extra="\n[tool]\nmatrix = [[1, 0, 0, 0.05], [0, 1, 0, 0], [0, 0, 1, 0.08], [0, 0, 0, 1]]\n"
+    '\n[ik]\ntask = "position"\n',
+)  # fmt: skip
+
+
+def test_the_position_s_free_joints_leave_the_joints_that_move_the_point_most():
+    """Of the usable choices of free end joints, the one whose solved joints move the tool
+    point most (free.position_span): the shoulder and elbow solved, not the wrist, which
+    moves the hand a few centimetres (an iCub arm solved its wrist, so almost no point was
+    reached at the given free values, a new user's attack); then every sample is found."""
+    plan = build_plan(parse_spec(HUMANOID7, "<test>"))
+    assert plan.ik is not None and plan.ik.free == (1, 5, 6, 7)
+
+
+@needs_cc
+def test_a_humanoid_arm_s_position_round_trips(tmp_path):
+    module = build_module(HUMANOID7, tmp_path, c=True)
+    for backend in ("c", "python"):
+        missed, empty, worst = free_round_trips(module, backend, 200, 9)
+        assert missed == 0 and empty == 0 and worst <= 1e-10
