@@ -76,26 +76,9 @@ def remainder_rank(chain: Chain, free: tuple[int, ...], position: bool = False) 
     arm's size; the tool point's position only, with `position`) at three random
     configurations, the largest: below 6 where fixing the free joints takes a degree of
     freedom from the tool (q4 of an S-R-S arm fixes the distance from shoulder to wrist)."""
-    rng = np.random.default_rng(18)
-    size = max(
-        [1.0]
-        + [abs(float(t.a)) for t in chain.twists]
-        + [abs(float(j.d if j.kind == "R" else j.offset)) for j in chain.joints]
-    )
-    moving = [i for i in range(chain.dof) if i + 1 not in free]
-    tool = np.array(chain.tool.evalf(), dtype=float)
-    tool[:3, 3] /= size
     best = 0
-    for _ in range(3):
-        q = rng.uniform(-np.pi, np.pi, chain.dof)
-        columns = []
-        for i in moving:
-            step = np.zeros(chain.dof)
-            step[i] = 1e-6
-            d = (pose_numbers(chain, q + step, size) - pose_numbers(chain, q - step, size)) / 2e-6
-            # (the tool point's: the tool frame moves it, where it does not turn the frame)
-            columns.append(d[:3, :3] @ tool[:3, 3] + d[:3, 3] if position else d[:3].ravel())
-        sigma = np.linalg.svd(np.array(columns).T, compute_uv=False)
+    for J in remainder_jacobians(chain, free, position, 3, 18):
+        sigma = np.linalg.svd(J, compute_uv=False)
         best = max(best, int((sigma > 1e-6 * sigma[0]).sum()))
     return best
 
@@ -106,7 +89,17 @@ def position_span(chain: Chain, free: tuple[int, ...]) -> float:
     size. A humanoid arm's wrist moves the hand a few centimetres, its shoulder and elbow the
     whole reach: with the wrist solved and the shoulder free, almost no point is reached at
     the given free values (an iCub arm, a new user's attack)."""
-    rng = np.random.default_rng(19)
+    dets = [abs(float(np.linalg.det(J))) for J in remainder_jacobians(chain, free, True, 8, 19)]
+    return float(np.median(dets))
+
+
+def remainder_jacobians(
+    chain: Chain, free: tuple[int, ...], position: bool, count: int, seed: int
+) -> list[np.ndarray]:
+    """The other joints' Jacobian by central differences at `count` random configurations:
+    rows the pose's 12 top entries (the tool point's 3 with `position`), lengths in units of
+    the arm's size, a column per joint not in free."""
+    rng = np.random.default_rng(seed)
     size = max(
         [1.0]
         + [abs(float(t.a)) for t in chain.twists]
@@ -115,17 +108,18 @@ def position_span(chain: Chain, free: tuple[int, ...]) -> float:
     moving = [i for i in range(chain.dof) if i + 1 not in free]
     tool = np.array(chain.tool.evalf(), dtype=float)
     tool[:3, 3] /= size
-    dets = []
-    for _ in range(8):
+    out = []
+    for _ in range(count):
         q = rng.uniform(-np.pi, np.pi, chain.dof)
         columns = []
         for i in moving:
             step = np.zeros(chain.dof)
             step[i] = 1e-6
             d = (pose_numbers(chain, q + step, size) - pose_numbers(chain, q - step, size)) / 2e-6
-            columns.append(d[:3, :3] @ tool[:3, 3] + d[:3, 3])
-        dets.append(abs(float(np.linalg.det(np.array(columns).T))))
-    return float(np.median(dets))
+            # (the tool point's: the tool frame moves it, where it does not turn the frame)
+            columns.append(d[:3, :3] @ tool[:3, 3] + d[:3, 3] if position else d[:3].ravel())
+        out.append(np.array(columns).T)
+    return out
 
 
 def pose_numbers(chain: Chain, q: np.ndarray, size: float) -> np.ndarray:
