@@ -1690,18 +1690,9 @@ def _follow(A, B, q, within_limits, backend, depth):
         # which the pose has no solution: Newton's iteration over a long step can wander so,
         # where shorter steps keep them on the path; a panda line broke so at 7 poses and not
         # at 20, a new user's attack)
-        middle = straight_line(A, B, 3)[1]
-        half, first, least_first, worst_first = _follow(
-            A, middle, q, within_limits, backend, depth + 1
-        )
-        if half is not None and not first:
-            split, why_split, least_split, worst_split = _follow(
-                middle, B, half, within_limits, backend, depth + 1
-            )
-            if split is not None:
-                worst = max(worst_first, worst_split)
-                least = min(least, least_first, least_split)
-                return split, _jumped(why_split, worst, depth), least, worst
+        whole = _halves(A, B, q, least, within_limits, backend, depth)[1]
+        if whole is not None:
+            return whole[0], _jumped(whole[1], whole[3], depth), whole[2], whole[3]
     if row is None or "limits" in why:
         return row, why, least, (0.0, least, 0)
     revolute = np.array(_REVOLUTE)
@@ -1717,9 +1708,8 @@ def _follow(A, B, q, within_limits, backend, depth):
         # where it has none for most of one, a new user's attack)
         suspect = _fold_within(q, B, least) or _fold_within(row, A, None)
     if depth < PATH_SPLITS and (why or suspect):
-        middle = straight_line(A, B, 3)[1]
-        half, first, least_first, worst_first = _follow(
-            A, middle, q, within_limits, backend, depth + 1
+        (half, first, least_first, _), whole = _halves(
+            A, B, q, least, within_limits, backend, depth
         )
         if (half is None or first) and not why and suspect:  # (the branch ends within the
             # step, at a fold where q's branch meets another, and the row is another
@@ -1733,15 +1723,28 @@ def _follow(A, B, q, within_limits, backend, depth):
                 # new user's youbot lines said "pose k: out of reach" at poses with 4 rows)
                 why = "out of reach part way through the step" + why[len("out of reach") :]
             least = min(least, least_first)
-        elif half is not None and not first:
-            split, why_split, least_split, worst_split = _follow(
-                middle, B, half, within_limits, backend, depth + 1
-            )
-            if split is not None:
-                row, why = split, why_split
-                least = min(least, least_first, least_split)  # (the parts' own starts)
-                worst = max(worst_first, worst_split)
+        elif whole is not None:
+            row, why, least, worst = whole  # (the parts' own starts' least sigma_min)
     return row, _jumped(why, worst, depth), least, worst
+
+
+def _halves(A, B, q, least, within_limits, backend, depth):
+    """The step from q (a solution of A) to B in two halves (straight_line's middle pose):
+    _follow's result for the first, and the whole step's (row, why, least sigma_min of least
+    and the parts', the worst part) through both where the first continues the path and the
+    second finds a row, else None."""
+    middle = straight_line(A, B, 3)[1]
+    first = _follow(A, middle, q, within_limits, backend, depth + 1)
+    half, why_first, least_first, worst_first = first
+    if half is None or why_first:
+        return first, None
+    split, why_split, least_split, worst_split = _follow(
+        middle, B, half, within_limits, backend, depth + 1
+    )
+    if split is None:
+        return first, None
+    least = min(least, least_first, least_split)
+    return first, (split, why_split, least, max(worst_first, worst_split))
 
 
 def _jumped(why, worst, depth):
