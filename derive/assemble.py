@@ -1,12 +1,15 @@
-"""The runtime routines a generated module needs, copied from :mod:`derive.runtime`.
+"""The runtime every generated module shares, and what each module takes from it.
 
-Each runtime module is read as source (from the installed package) and split into its
-top-level pieces: a function, a class or an assignment, with the comment lines just above it.
-A piece knows the global names it defines and the names it uses. The emitter asks for the
-pieces that the arm's printed code and the module's public functions use, and everything those
-use in turn; they are copied in the runtime's order (:data:`derive.runtime.MODULES`, then
-source order), which keeps every module-level statement after the names it reads. Imports are
-not copied: the module gets one import block holding exactly the names its code uses.
+The runtime (:mod:`derive.runtime`) is written once, as ordinary Python that is linted,
+type-checked and tested here, and shipped once per output folder as ``derive_ik_runtime.py``
+(:data:`RUNTIME_FILE`): its modules' top-level pieces (a function, a class or an assignment,
+with the comment lines just above it) in the order of :data:`MODULES`, under one import block.
+A generated module defines its arm's names (derive/runtime/arm.py lists them) and then runs
+that file in its own namespace, as if its text were written there. The runtime's public
+names the module does not offer (another task's function, ik_sweep where no joint is free, the
+inverse kinematics of an arm without) are removed again: what a module offers is its
+``__all__``, the public names of the pieces its printed code and its public functions use,
+with everything those use in turn (:func:`closure`).
 """
 
 from __future__ import annotations
@@ -19,6 +22,9 @@ from functools import cache
 from importlib import resources
 
 from derive.runtime import MODULES
+
+# the runtime's file, written beside every generated module
+RUNTIME_FILE = "derive_ik_runtime.py"
 
 # the names the generated module imports, as (import statement, name bound), in the order
 # ruff's isort puts them (standard library, then numpy)
@@ -35,6 +41,7 @@ IMPORTS = (
     ("import tempfile", "tempfile"),
     ("import threading", "threading"),
     ("import warnings", "warnings"),
+    ("from importlib.machinery import SourceFileLoader", "SourceFileLoader"),
     ("from math import {}", "acos"),
     ("from math import {}", "atan2"),
     ("from math import {}", "cos"),
@@ -42,7 +49,8 @@ IMPORTS = (
     ("from math import {}", "sqrt"),
     ("from operator import sub as _sub", "_sub"),
     ("from time import time as _time", "_time"),
-    ("from typing import Any", "Any"),
+    ("from typing import {}", "TYPE_CHECKING"),
+    ("from typing import {}", "Any"),
     ("import numpy as np", "np"),
     ("from numpy.typing import ArrayLike", "ArrayLike"),
 )
@@ -141,16 +149,20 @@ def closure(roots: Iterable[str], pieces: tuple[Piece, ...]) -> tuple[Piece, ...
 
 
 def import_block(source: str) -> str:
-    """The import statements binding exactly the imported names a module's source uses."""
+    """The import statements binding exactly the imported names a module's source uses (the
+    names of one ``from X import {}`` merged into one statement, as ruff's isort wants)."""
     used = {n.id for n in ast.walk(ast.parse(source)) if isinstance(n, ast.Name)}
     lines: list[str] = []
-    from_math = [name for stmt, name in IMPORTS if stmt.startswith("from math") and name in used]
+    merged: dict[str, list[str]] = {}
+    for stmt, name in IMPORTS:
+        if name in used and "{}" in stmt:
+            merged.setdefault(stmt, []).append(name)
     for stmt, name in IMPORTS:
         if name not in used:
             continue
-        if stmt.startswith("from math"):
-            if name == from_math[0]:
-                lines.append(stmt.format(", ".join(from_math)))
+        if "{}" in stmt:
+            if name == merged[stmt][0]:
+                lines.append(stmt.format(", ".join(merged[stmt])))
             continue
         if stmt.startswith("import numpy") and lines:
             lines.append("")
@@ -158,37 +170,80 @@ def import_block(source: str) -> str:
     return "\n".join(lines)
 
 
+def _natural(name: str) -> tuple[tuple[int, int | str], ...]:
+    """A name's natural-order key: digit runs compare as numbers (x9 before x10)."""
+    return tuple((1, int(c)) if c.isdigit() else (0, c) for c in re.findall(r"\d+|\D+", name))
+
+
+def _kind(name: str) -> int:
+    """ruff's isort order of imported names: constants, classes, then the rest."""
+    if len(name) > 1 and name.isupper():
+        return 0
+    return 1 if name[0].isupper() else 2
+
+
+def import_order(names: Iterable[str]) -> tuple[str, ...]:
+    """Names in the order ruff's isort sorts them inside one ``from X import (...)``."""
+    return tuple(sorted(set(names), key=lambda n: (_kind(n), _natural(n.lower()), n)))
+
+
+def all_order(names: Iterable[str]) -> tuple[str, ...]:
+    """Names in the order ruff sorts an ``__all__`` (RUF022)."""
+    return tuple(sorted(set(names), key=lambda n: (_kind(n), _natural(n))))
+
+
 @dataclass(frozen=True)
 class Assembly:
-    """What a generated module is made of beside its layout.
+    """What a generated module takes from the runtime.
 
     Attributes:
-        runtime: the copied runtime pieces' source, separated by two blank lines.
+        offered: the runtime's public names the module offers (in its ``__all__``).
+        used: the runtime's names the arm's printed code calls.
     """
 
-    runtime: str
+    offered: tuple[str, ...]
+    used: tuple[str, ...]
+
+
+def arm_names() -> frozenset[str]:
+    """The names a generated module defines for its arm before it runs the runtime (the
+    stand-ins of derive/runtime/arm.py)."""
+    text = resources.files("derive.runtime").joinpath("arm.py").read_text(encoding="utf-8")
+    return frozenset(n for p in split("arm", text) for n in p.defines) - {"_missing"}
+
+
+def runtime_names() -> frozenset[str]:
+    """Every name the runtime defines."""
+    return frozenset(n for p in runtime_pieces() for n in p.defines)
 
 
 def assemble(arm_source: str, has_ik: bool, free: bool = False, task: str = "pose") -> Assembly:
-    """The runtime pieces for a module whose arm-specific code is arm_source (free: the arm
-    has free joints, and ik_sweep; task: what its ik solves for, and its task function)."""
-    runtime = runtime_pieces()
-    if free:  # redundant's public functions replace api's of the same names
-        replaced = {n for p in runtime if p.module == "redundant" for n in p.defines}
-        runtime = tuple(p for p in runtime if p.module != "api" or not p.defines & replaced)
-    else:
-        runtime = tuple(p for p in runtime if p.module != "redundant")
-    arm = split("arm", arm_source)
-    everything = runtime + arm
+    """What a module whose arm-specific code is arm_source takes from the runtime (free: the
+    arm has free joints, and ik_sweep; task: what its ik solves for, and its task function)."""
     roots = set(IK_ROOTS if has_ik else FK_ROOTS)
     if has_ik and free:
         roots |= set(FREE_ROOTS)
     if has_ik:
         roots |= set(TASK_ROOTS.get(task, ()))
+    arm = split("arm", arm_source)
     for piece in arm:
         roots |= piece.uses
-    copied = tuple(p for p in closure(roots, everything) if p.module != "arm")
-    return Assembly(runtime="\n\n\n".join(p.source for p in copied))
+    defined = runtime_names()
+    offered = {
+        n for p in closure(roots, runtime_pieces()) for n in p.defines if not n.startswith("_")
+    }
+    used = {n for p in arm for n in p.uses} & defined
+    return Assembly(offered=all_order(offered), used=import_order(used))
+
+
+def runtime_source() -> tuple[str, tuple[str, ...], tuple[str, ...]]:
+    """The runtime's pieces as one source, separated by two blank lines, with the arm's
+    names they read (in import order) and the runtime's public names (in ``__all__`` order)."""
+    pieces = runtime_pieces()
+    text = "\n\n\n".join(p.source for p in pieces)
+    read = {n for p in pieces for n in p.uses} & arm_names()
+    public = {n for p in pieces for n in p.defines if not n.startswith("_")}
+    return text, import_order(read), all_order(public)
 
 
 # --- the C runtime (derive/c/): the same pieces and closure, for C -------------------------

@@ -415,7 +415,7 @@ def solve_arguments(
         raise UsageError("--direction: give the tool point too (--point x y z)")
     if args.direction is not None and (args.pose is not None or args.q is not None):
         raise UsageError("--direction: give it with --point (or alone), not with --pose or --q")
-    heading = hasattr(module, "_plane_pose") and task == "pose"  # (a planar arm's heading)
+    heading = hasattr(module, "PLANE_Z") and task == "pose"  # (a planar arm's heading)
     if getattr(args, "angle", None) is not None and (
         (task != "axisangle" and not heading) or args.point is None
     ):
@@ -463,7 +463,7 @@ def task_pose(spec: ArmSpec, module: ModuleType, args: argparse.Namespace) -> An
     task = getattr(module, "IK_COMPONENTS", "pose")
     # (a point beyond any reach: refused here, not solved in overflowing arithmetic)
     far = getattr(module, "FAR_REACH", 1e6) * module.REACH
-    if hasattr(module, "_plane_pose") and args.point is not None:  # (ik_xy(_heading)'s)
+    if hasattr(module, "PLANE_Z") and args.point is not None:  # (ik_xy(_heading)'s)
         return plane_pose(spec, module, args, far)
     if task == "pose":
         raise UsageError(f"--point: {spec.name} is solved for the full pose; give --pose or --q")

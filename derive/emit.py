@@ -8,8 +8,11 @@ shortest repr), terms in SymPy's canonical order, CSE with ``order="canonical"``
 
 from __future__ import annotations
 
+import ast
+import hashlib
 import math
 from dataclasses import dataclass
+from functools import cache
 from importlib import resources
 from typing import Any
 
@@ -18,7 +21,14 @@ import sympy as sp
 
 from derive import symbols as sym
 from derive import tasks
-from derive.assemble import assemble, import_block
+from derive.assemble import (
+    RUNTIME_FILE,
+    all_order,
+    assemble,
+    import_block,
+    import_order,
+    runtime_source,
+)
 from derive.layout import wrap_code
 from derive.plan import Assign, Plan
 from derive.printers import branches, scalar
@@ -469,7 +479,7 @@ def environment() -> jinja2.Environment:
 
 def render_module(plan: Plan) -> str:
     """The generated Python module of an arm: the layout (module.py.j2) around the arm's
-    printed code (arm.py.j2) and the runtime routines that code uses (derive.assemble)."""
+    printed code (arm.py.j2), naming what it takes from the runtime (derive.assemble)."""
     printed = print_plan(plan)
     env = environment()
     arm_code = wrap_code(env.get_template("arm.py.j2").render(m=printed))
@@ -481,15 +491,68 @@ def render_module(plan: Plan) -> str:
     )
     layout = env.get_template("module.py.j2")
 
-    def render(imports: str) -> str:
+    def render(imports: str, offered: tuple[str, ...]) -> str:
         return layout.render(
             m=printed,
             generator=GENERATOR,
             regenerate=REGENERATE,
             imports=imports,
-            runtime=parts.runtime,
+            used=import_order((*parts.used, *parts.offered)),
+            offered=offered,
+            runtime_file=RUNTIME_FILE,
+            runtime_module=RUNTIME_FILE.removesuffix(".py"),
+            runtime_digest=runtime_digest(),
             arm=arm_code.rstrip("\n"),
         )
 
-    # the imports are those the module's code uses, constants included
+    # the imports are those the module's code uses, constants included; it offers the
+    # runtime's public names it uses and its own
+    draft = render(import_block(render("", ()) + _TYPING), ())
+    own = {
+        n.id
+        for node in ast.parse(draft).body
+        if isinstance(node, ast.Assign)
+        for n in node.targets
+        if isinstance(n, ast.Name) and not n.id.startswith("_")
+    }
+    offered = all_order((*own, *parts.offered))
+    return render(import_block(draft + _TYPING), _packed([f'"{n}",' for n in offered], 96))
+
+
+def _packed(words: list[str], width: int) -> tuple[str, ...]:
+    """Words joined by spaces into lines of at most width characters."""
+    lines: list[str] = []
+    for word in words:
+        if lines and len(lines[-1]) + 1 + len(word) <= width:
+            lines[-1] += " " + word
+        else:
+            lines.append(word)
+    return tuple(lines)
+
+
+# (the names every module's layout uses in code ruff sees as unused for import_block)
+_TYPING = "\nTYPE_CHECKING\n"
+
+
+@cache
+def render_runtime() -> str:
+    """The runtime file (runtime.py.j2): every routine of derive/runtime, once."""
+    source, read, public = runtime_source()
+    layout = environment().get_template("runtime.py.j2")
+
+    def render(imports: str) -> str:
+        return layout.render(
+            generator=GENERATOR,
+            regenerate=REGENERATE,
+            imports=imports,
+            read=read,
+            public=public,
+            source=source,
+        )
+
     return render(import_block(render("")))
+
+
+def runtime_digest() -> str:
+    """The digest a module checks its runtime file against: of the file's text."""
+    return hashlib.sha256(render_runtime().encode("utf-8")).hexdigest()[:16]

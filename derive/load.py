@@ -32,11 +32,13 @@ class LoadError(ValueError):
 
 
 def solver_sources(plan: Plan) -> Sources:
-    """The generated module of a plan and, for an arm with IK, the C solver it runs."""
-    from derive.emit import render_module
+    """The generated module of a plan, the runtime it runs, and, for an arm with IK, the C solver
+    it runs."""
+    from derive.assemble import RUNTIME_FILE
+    from derive.emit import render_module, render_runtime
     from derive.emit_c import render_c
 
-    files = {f"{plan.arm.name}.py": render_module(plan)}
+    files = {f"{plan.arm.name}.py": render_module(plan), RUNTIME_FILE: render_runtime()}
     if plan.ik is not None:
         files.update(render_c(plan))
     return files

@@ -65,6 +65,7 @@ from typing import Any, TextIO
 
 import numpy as np
 
+from derive.assemble import RUNTIME_FILE
 from derive.load import Sources, load_solver
 from derive.load import digest as sources_digest
 from derive.workspace import inside_limits, progress_line, section
@@ -542,7 +543,11 @@ def _check_array(path: Path, key: str, array: Any, spec: ArraySpec) -> None:
 
 def _dof(source: Sources) -> int:
     """DOF of a generated module's source (its `DOF = n` line)."""
-    module = next(text for name, text in sorted(source.items()) if name.endswith(".py"))
+    module = next(
+        text
+        for name, text in sorted(source.items())
+        if name.endswith(".py") and name != RUNTIME_FILE
+    )
     for line in module.splitlines():
         if line.startswith("DOF = "):
             return int(line.split("=")[1])

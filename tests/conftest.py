@@ -63,6 +63,14 @@ needs_cc = pytest.mark.skipif(
 )
 
 
+def write_runtime(folder: Path) -> None:
+    """The runtime every generated module runs (derive_ik_runtime.py), written into folder."""
+    from derive.assemble import RUNTIME_FILE
+    from derive.emit import render_runtime
+
+    (folder / RUNTIME_FILE).write_text(render_runtime(), encoding="utf-8")
+
+
 def import_path(path: Path) -> ModuleType:
     """Import a Python file under a unique module name."""
     name = f"_derive_test_{path.stem}_{next(_counter)}"

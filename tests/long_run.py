@@ -37,7 +37,7 @@ from derive.plan import Eigen
 from derive.spec import parse_spec
 from derive.verify import roundtrip, sample_joints
 
-from conftest import import_path, spec_text
+from conftest import import_path, spec_text, write_runtime
 
 SAMPLES = 200
 
@@ -109,6 +109,7 @@ def run_arm(seed: int) -> dict[str, Any]:
     with tempfile.TemporaryDirectory() as folder:
         path = Path(folder) / f"long_run_{seed}.py"
         path.write_text(source, encoding="utf-8")
+        write_runtime(Path(folder))
         module = import_path(path)
         Q = sample_joints(module, SAMPLES, np.random.default_rng(10_000 + seed))
         started = time.perf_counter()

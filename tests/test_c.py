@@ -65,10 +65,13 @@ TURN = {"manocha_canny": 12}
 
 
 def write_module(plan, path: Path) -> Path:
-    """The plan's Python module written to path."""
+    """The plan's Python module written to path (with the runtime beside it)."""
     from derive.emit import render_module
 
+    from conftest import write_runtime
+
     path.write_text(render_module(plan), encoding="utf-8")
+    write_runtime(path.parent)
     return path
 
 

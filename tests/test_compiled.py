@@ -8,6 +8,7 @@ import os
 import shutil
 import subprocess
 import sys
+import types
 from pathlib import Path
 
 import numpy as np
@@ -31,8 +32,8 @@ print(m._native.lib._name)
 
 
 def copy_arm(name: str, folder, c: bool = True):
-    """The bundled arm's module (and, with c, its C files) copied into folder."""
-    files = [f"{name}.py"] + ([f"{name}_ik.c", f"{name}_ik.h"] if c else [])
+    """The bundled arm's module with the runtime (and, with c, its C files) copied into folder."""
+    files = [f"{name}.py", "derive_ik_runtime.py"] + ([f"{name}_ik.c", f"{name}_ik.h"] if c else [])
     for file in files:
         shutil.copy(GENERATED / file, folder / file)
     return folder / f"{name}.py"
@@ -115,6 +116,55 @@ def test_a_module_copied_without_its_c_files_says_so_once_and_solves_in_python(t
     assert np.abs(rows - m.ik(T, backend="python")).max() == 0.0
     with pytest.raises(ValueError, match="backend must be 'auto', 'c' or 'python'"):
         m.ik(T, backend="numba")
+
+
+def test_a_module_runs_the_runtime_it_was_generated_with_and_says_so_where_it_is_not(tmp_path):
+    """The runtime beside a module: line ends turned to CRLF by a checkout are the same
+    runtime; another text (an edit, another derive-ik's) or none is one ImportError line."""
+    path = copy_arm("planar_2r", tmp_path, c=False)
+    runtime = tmp_path / "derive_ik_runtime.py"
+    runtime.write_bytes(runtime.read_bytes().replace(b"\n", b"\r\n"))
+    m = import_path(path)
+    assert (
+        np.abs(
+            m.fk([0.4, 0.5])[:2, 3] - [np.cos(0.4) + np.cos(0.9), np.sin(0.4) + np.sin(0.9)]
+        ).max()
+        < 1e-15
+    )
+    runtime.write_text(runtime.read_text() + "\n# edited\n")
+    with pytest.raises(
+        ImportError,
+        match=r"derive_ik_runtime\.py is not the runtime this module was generated with",
+    ):
+        import_path(path)
+    runtime.unlink()
+    with pytest.raises(ImportError, match=r"planar_2r: needs derive_ik_runtime\.py beside it"):
+        import_path(path)
+
+
+def test_each_module_offers_its_own_api_and_keeps_its_own_state(generated):
+    """The runtime runs in each module's own namespace: a module offers the public names of
+    its __all__ (another task's function, ik_sweep of arms with free joints, are not there),
+    and a setting changed in one module leaves the others as they were."""
+    puma, panda, head = generated("puma560"), generated("panda"), generated("locobot_head")
+    assert hasattr(panda, "ik_sweep") and not hasattr(puma, "ik_sweep")
+    assert hasattr(head, "ik_lookat") and not hasattr(puma, "ik_lookat")
+    for module in (puma, panda, head):
+        names = vars(module)
+        assert set(module.__all__) <= set(names)
+        defined_here = {
+            n
+            for n, v in names.items()
+            if isinstance(v, types.FunctionType) and v.__globals__ is names
+        }
+        assert {n for n in defined_here if not n.startswith("_")} <= set(module.__all__)
+    was = puma.BACKEND, panda.BACKEND
+    try:
+        puma.BACKEND = "python"
+        assert was[1] == panda.BACKEND and panda.ik.__globals__ is vars(panda)
+        assert puma.ik.__globals__ is vars(puma)
+    finally:
+        puma.BACKEND = was[0]
 
 
 @needs_cc

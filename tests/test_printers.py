@@ -6,13 +6,13 @@ from __future__ import annotations
 
 import ast
 import importlib
+import re
 import shutil
 import subprocess
 import sys
 
 import pytest
 
-from derive.assemble import FREE_ROOTS, IK_ROOTS, TASK_ROOTS
 from derive.layout import wrap_code
 from derive.plan import SOLVE_KINDS, Solve
 from derive.printers import BACKENDS
@@ -77,17 +77,37 @@ def test_c_lines_break_between_tokens_only():
     assert wrap_c(define) == define  # a preprocessor line stays whole
 
 
+def _names(tree: ast.AST) -> tuple[set[str], set[str]]:
+    """The functions and classes a module defines at its top level, and every name it reads
+    (or names in a string)."""
+    body = tree.body if isinstance(tree, ast.Module) else []
+    defined = {n.name for n in body if isinstance(n, ast.FunctionDef | ast.ClassDef)}
+    used = {n.id for n in ast.walk(tree) if isinstance(n, ast.Name)}
+    used |= {n.value for n in ast.walk(tree) if isinstance(n, ast.Constant)}
+    return defined, used
+
+
 @pytest.mark.parametrize("name", BUNDLED)
 def test_generated_modules_hold_no_function_they_never_call(name):
-    tree = ast.parse(module_source(name))
-    defined = {n.name for n in tree.body if isinstance(n, ast.FunctionDef | ast.ClassDef)}
-    used = {n.id for n in ast.walk(tree) if isinstance(n, ast.Name)}
-    # functions named in strings (none today), the public API by users
-    named = {n.value for n in ast.walk(tree) if isinstance(n, ast.Constant)}
-    public = set(IK_ROOTS) | set(FREE_ROOTS)  # (derive/assemble.py's lists)
-    public |= {root for roots in TASK_ROOTS.values() for root in roots}
-    unused = sorted(defined - used - named - public)
+    """Each function of an arm's module is called by the module, by the runtime it runs, or
+    is public (in its __all__)."""
+    defined, used = _names(ast.parse(module_source(name)))
+    _, runtime_uses = _names(ast.parse(module_source("derive_ik_runtime")))
+    unused = sorted(defined - used - runtime_uses)
     assert not unused, f"{name}.py never calls {unused}"
+
+
+def test_the_runtime_holds_no_function_nothing_calls():
+    """Each function of the shared runtime is called by the runtime, is public, or is named
+    by the printers of arm code (derive/printers/, templates/arm.py.j2, derive/emit.py: the
+    step routines a printed solver calls)."""
+    defined, used = _names(ast.parse(module_source("derive_ik_runtime")))
+    public = {n for n in defined if not n.startswith("_")}
+    printers = [*(ROOT / "derive" / "printers").glob("*.py"), ROOT / "derive" / "emit.py"]
+    printers.append(ROOT / "templates" / "arm.py.j2")
+    named = set(re.findall(r"\w+", "".join(f.read_text() for f in printers)))
+    unused = sorted(defined - used - public - named)
+    assert not unused, f"derive_ik_runtime.py: nothing calls {unused}"
 
 
 @pytest.mark.parametrize("name", BUNDLED)
@@ -149,7 +169,7 @@ def test_a_new_method_is_one_file_and_one_registration_line(tmp_path, monkeypatc
     from derive.spec import load_spec
 
     import example_method
-    from conftest import spec_text
+    from conftest import spec_text, write_runtime
 
     monkeypatch.setattr(
         pipeline, "METHODS", pipeline.METHODS | {example_method.NAME: example_method.derive}
@@ -160,6 +180,7 @@ def test_a_new_method_is_one_file_and_one_registration_line(tmp_path, monkeypatc
     assert plan.ik is not None and plan.ik.method == "pan-tilt", plan.refusal
     path = tmp_path / "pan_tilt.py"
     path.write_text(render_module(plan))
+    write_runtime(tmp_path)
     loaded = importlib.util.spec_from_file_location("pan_tilt", path)
     assert loaded is not None and loaded.loader is not None
     module = importlib.util.module_from_spec(loaded)

@@ -18,7 +18,7 @@ from derive import urdf
 from derive.emit import render_module
 from derive.pipeline import build_plan
 
-from conftest import ROOT
+from conftest import ROOT, write_runtime
 
 DATA = ROOT / "tests" / "data" / "urdf"
 # (file, base link, tip link, a method solves it)
@@ -81,6 +81,7 @@ def generated_module(path: Path, base: str, tip: str, tmp_path: Path):
     spec = urdf.load_urdf(path, options(base, tip))
     file = tmp_path / f"{spec.name}.py"
     file.write_text(render_module(build_plan(spec)))
+    write_runtime(tmp_path)
     loaded = importlib.util.spec_from_file_location(f"urdf_{spec.name}", file)
     assert loaded is not None and loaded.loader is not None
     module = importlib.util.module_from_spec(loaded)
@@ -390,6 +391,7 @@ def test_the_standard_convention_gives_the_same_arm(name, base, tip, tmp_path):
 
         file = tmp_path / f"{name}_{convention}.py"
         file.write_text(render_module(build_plan(load_spec(spec))))
+        write_runtime(tmp_path)
         loaded = importlib.util.spec_from_file_location(file.stem, file)
         assert loaded is not None and loaded.loader is not None
         module = importlib.util.module_from_spec(loaded)

@@ -391,7 +391,7 @@ def test_a_urdf_of_another_suffix_is_read_by_its_root_and_a_folder_is_named(tmp_
     path.write_text(text)
     out = tmp_path / "out"
     assert main(["generate", str(path), "--base", "a", "--tip", "c", "--out", str(out)]) == 0
-    assert len(list(out.glob("*.py"))) == 1
+    assert sorted(p.name for p in out.glob("*.py")) == ["bad.py", "derive_ik_runtime.py"]
     line = fails("generate", str(tmp_path), "--base", "a", "--tip", "c")
     assert "a folder, not an arm's file" in line and "--base" not in line
     pipe = tmp_path / "robot.pipe"  # (a named pipe of another suffix: not opened to look)

@@ -64,7 +64,7 @@ def test_fresh_user_arm_passes_and_check_writes_nothing(tmp_path, capsys):
     before = {p.name: p.read_bytes() for p in out.iterdir()}
     code, text = check(capsys, str(spec), "--out", str(out))
     assert code == 0, text
-    assert "up to date (4 files)" in text
+    assert "up to date (5 files)" in text
     assert {p.name: p.read_bytes() for p in out.iterdir()} == before
 
 
@@ -132,7 +132,8 @@ def test_generated_module_runs_where_derive_is_not_importable(tmp_path):
     _, _, out = project(tmp_path)
     elsewhere = tmp_path / "robot_package" / "kinematics"
     elsewhere.mkdir(parents=True)
-    shutil.copy(out / "user_arm.py", elsewhere / "user_arm.py")
+    for name in ("user_arm.py", "derive_ik_runtime.py"):
+        shutil.copy(out / name, elsewhere / name)
     result = subprocess.run(
         [sys.executable, "-I", "-c", ISOLATED, str(elsewhere)],
         capture_output=True,

@@ -84,7 +84,7 @@ def test_the_wheel_generates_checks_reports_and_solves(venv, tmp_path):
     # a bundled arm: the same bytes as the committed files, poisoned templates ignored
     result = call([derive, "generate", "puma560", "--out", "g"], work)
     assert result.returncode == 0, result.stderr
-    for name in ("puma560.py", "puma560.md"):
+    for name in ("puma560.py", "puma560.md", "derive_ik_runtime.py"):
         assert (work / "g" / name).read_bytes() == (ROOT / "generated" / name).read_bytes()
     # a user's spec
     (work / "arms").mkdir()

@@ -19,7 +19,7 @@ Per arm, at generation:
    "Choosing the split, singular pencils and the rescue").
 
 The run-time steps (null space of Q, pencil, eigenvalues, back-substitution, Newton, rescue)
-are in :mod:`derive.runtime.general` (Python) and :mod:`derive.runtime.kernel` (compiled).
+are in :mod:`derive.runtime.general` (Python) and derive/c/general.c (C).
 """
 
 from __future__ import annotations
@@ -129,7 +129,7 @@ def everywhere_singular(rows: tuple[Row, ...], slide: tuple[float, float]) -> bo
     for _ in range(8):
         frames = [np.eye(4)]
         for i, t in enumerate(rng.uniform(-math.pi, math.pi, 6)):
-            frames.append(frames[-1] @ runtime._rr_joint(i, t, rows, slide))
+            frames.append(frames[-1] @ _split_joint(i, t, rows, slide))
         end = frames[6][:3, 3]
         z = [f[:3, 2] for f in frames[:6]]
         J = np.array(
@@ -359,7 +359,7 @@ def score(
             q[2] /= math.pi
         F = np.eye(4)
         for i, t in enumerate(q):
-            F = F @ runtime._rr_joint(i, t, true_rows, slide)
+            F = F @ _split_joint(i, t, true_rows, slide)
         P0, Ps, Pc, Q = matrices_at(fill_rows, F, slide)
         candidates, _, _, _ = runtime._rr_candidates(P0, Ps, Pc, Q, F, fill_rows, slide)
         conds.append(leading_condition(P0, Ps, Pc, Q))
@@ -417,3 +417,25 @@ def numeric_matrices():
     lx, ly, lz, px, py, pz): the generic matrices, for measuring splits."""
     f = rr.fundamental()
     return [sp.lambdify(rr.GENS, m, "numpy") for m in (f.P0, f.Ps, f.Pc, f.Q)]
+
+
+def _split_joint(i: int, value: float, rows, slide) -> np.ndarray:
+    """A_i of a split's joint i (0-based) at its value: _split_link, or, for joint 3
+    where it slides, Rz(theta3) Tz(value) Tx(a) Rx(alpha) with theta3 = slide[1] fixed."""
+    if i == 2 and slide[0]:
+        return _split_link(slide[1], (value, *rows[2][1:]))
+    return _split_link(value, rows[i])
+
+
+def _split_link(theta: float, row) -> np.ndarray:
+    """A_i = Rz(theta) Tz(d) Tx(a) Rx(alpha) of standard DH; row = (d, a, cos alpha, sin alpha)."""
+    d, a, ca, sa = row
+    ct, st = math.cos(theta), math.sin(theta)
+    return np.array(
+        [
+            [ct, -st * ca, st * sa, a * ct],
+            [st, ct * ca, -ct * sa, a * st],
+            [0.0, sa, ca, d],
+            [0.0, 0.0, 0.0, 1.0],
+        ]
+    )

@@ -14,8 +14,10 @@ from derive.runtime.arm import (
     _C_SOURCE,
     _REVOLUTE,
     DOF,
+    FREE,
     LIMITS,
     MAX_SOLUTIONS,
+    REACH,
     _cs_columns,
     _fk_from_cs,
     _fk_q,
@@ -43,6 +45,7 @@ from derive.runtime.constants import (
     BACKEND,
     CERTIFY_TOL,
     DEDUP_TOL,
+    FREE_LIMIT,
     MAX_TURN_ROWS,
     POSE_TOL,
 )
@@ -330,21 +333,76 @@ def ik_batch(
 
 
 def _with_free(refs, free):
-    """q_ref's values (this arm has no free joints: free must be None; derive/runtime/
-    redundant.py has the version of arms with free joints)."""
-    if free is not None:
+    """q_ref's values with the free joints' values from free (None: q_ref's own)."""
+    if free is None:
+        return refs
+    if not FREE:
         raise ValueError("free: this arm has no free joints (FREE is empty)")
-    return refs
+    values = _real(free, "free")
+    if values.ndim == 0:
+        values = values.reshape(1)
+    if values.shape != (len(FREE),) or not np.isfinite(values).all():
+        raise ValueError(
+            f"free must be {len(FREE)} finite number(s), one per joint in FREE = {FREE}"
+        )
+    out = list(refs)
+    for j, x in zip(FREE, values.tolist()):
+        out[j - 1] = x
+    return tuple(out)
 
 
 def _free_turns(refs):
-    """refs as they are: no free joint's value to reduce (see _with_free)."""
-    return refs
+    """refs with each revolute free joint's value reduced to (-pi, pi]: the value the solver
+    works with and returns, so that a returned row reproduces the pose with its own values.
+
+    Raises:
+        ValueError: a free value beyond FREE_LIMIT radians (FREE_LIMIT * REACH for a sliding
+            joint), where neither the reduction nor cos and sin are accurate.
+    """
+    if not FREE:
+        return refs
+    out = list(refs)
+    for j in FREE:
+        x = out[j - 1]
+        limit, unit = (FREE_LIMIT, "rad") if _REVOLUTE[j - 1] else (FREE_LIMIT * REACH, "")
+        if not abs(x) <= limit:
+            raise ValueError(
+                f"free joint q{j} = {x!r}: a free value must lie within +-{limit:g} {unit}".rstrip()
+            )
+        if _REVOLUTE[j - 1]:
+            out[j - 1] = math.remainder(x, _TWO_PI)
+    return tuple(out)
 
 
 def _free_rows(free, refs, n):
-    """None: no per-pose free values (see _with_free)."""
-    return _with_free(None, free)
+    """Per pose, q_ref's values with the free joints' values from free ((n, len(FREE)), or
+    (n,) where FREE has one), as an (n, DOF) array; None for free=None."""
+    if free is None:
+        return None
+    if not FREE:
+        raise ValueError("free: this arm has no free joints (FREE is empty)")
+    values = _real(free, "free")
+    if values.ndim == 1 and len(FREE) == 1:
+        values = values[:, None]
+    if values.shape != (n, len(FREE)) or not np.isfinite(values).all():
+        raise ValueError(
+            f"free must be finite numbers of shape ({n}, {len(FREE)}): one value per pose "
+            f"for each joint in FREE = {FREE}"
+        )
+    limits = np.array([FREE_LIMIT if _REVOLUTE[j - 1] else FREE_LIMIT * REACH for j in FREE])
+    if not (np.abs(values) <= limits).all():
+        raise ValueError(
+            f"free values must lie within +-{FREE_LIMIT:g} rad (+-{FREE_LIMIT * REACH:g} for "
+            f"a sliding joint), one per pose for each joint in FREE = {FREE}"
+        )
+    turns = np.array([_REVOLUTE[j - 1] for j in FREE])
+    # fmod is exact; one addition of 2 pi brings its (-2 pi, 2 pi) to (-pi, pi]
+    reduced = np.fmod(values, _TWO_PI)
+    reduced = np.where(reduced > math.pi, reduced - _TWO_PI, reduced)
+    reduced = np.where(reduced <= -math.pi, reduced + _TWO_PI, reduced)
+    rows = np.tile(np.array(refs), (n, 1))
+    rows[:, [j - 1 for j in FREE]] = np.where(turns, reduced, values)
+    return rows
 
 
 def _settle(Q, valid, i, sols):
@@ -354,7 +412,7 @@ def _settle(Q, valid, i, sols):
     Q[i, : len(sols)], valid[i, : len(sols)] = sols, True
 
 
-def nearest(
+def _nearest_fixed(
     T: ArrayLike,
     q_ref: ArrayLike,
     *,

@@ -789,28 +789,6 @@ def _rr_ratio_angles(V, pairs):
     return 2.0 * np.where(low >= high, np.arctan2(across, low), np.arctan2(high, across))
 
 
-def _rr_link(theta, row):
-    """A_i = Rz(theta) Tz(d) Tx(a) Rx(alpha) of standard DH; row = (d, a, cos alpha, sin alpha)."""
-    d, a, ca, sa = row
-    ct, st = math.cos(theta), math.sin(theta)
-    return np.array(
-        [
-            [ct, -st * ca, st * sa, a * ct],
-            [st, ct * ca, -ct * sa, a * st],
-            [0.0, sa, ca, d],
-            [0.0, 0.0, 0.0, 1.0],
-        ]
-    )
-
-
-def _rr_joint(i, value, rows, slide):
-    """A_i of a split's joint i (0-based) at its value: _rr_link, or, for joint 3 where it
-    slides, Rz(theta3) Tz(value) Tx(a) Rx(alpha) with theta3 = slide[1] fixed."""
-    if i == 2 and slide[0]:
-        return _rr_link(slide[1], (value, *rows[2][1:]))
-    return _rr_link(value, rows[i])
-
-
 def _rr_theta6_many(rows, F, X, slide):
     """theta6 of each row of X (theta1..theta5) from the pose: (A1 ... A5)^-1 F = Rz(theta6)
     in the split's frame."""

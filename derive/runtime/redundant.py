@@ -1,6 +1,6 @@
-"""The public functions of a generated module whose arm has free joints (FREE: an arm of
-more than 6 joints): ik_sweep, nearest searching the free joints, and the checks of free
-values. Copied only into such modules; a name defined here replaces api's of that name."""
+"""The public functions of arms with free joints (FREE: more joints than the task fixes):
+ik_sweep, and nearest searching the free joints (an arm without them: api's _nearest_fixed).
+ik_sweep is in the __all__ of those modules only (derive/assemble.py)."""
 
 from __future__ import annotations
 
@@ -9,13 +9,20 @@ import math
 import numpy as np
 from numpy.typing import ArrayLike
 
-from derive.runtime.api import _distances, _in_limits, _nearest_arguments, _pose, ik, ik_batch
+from derive.runtime.api import (
+    _distances,
+    _in_limits,
+    _nearest_arguments,
+    _nearest_fixed,
+    _pose,
+    ik,
+    ik_batch,
+)
 from derive.runtime.arm import _REVOLUTE, FREE, LIMITS, REACH
 from derive.runtime.common import _real, _reference
 from derive.runtime.constants import (
     _TWO_PI,
     CERTIFY_TOL,
-    FREE_LIMIT,
     FREE_STEP,
     MAX_FREE_VALUES,
     NEAREST_BATCH,
@@ -32,15 +39,17 @@ def nearest(
     free_step: float = FREE_STEP,
     backend: str | None = None,
 ) -> np.ndarray | None:
-    """The solution closest to q_ref over the free joints' values, or None.
+    """The solution closest to q_ref, over the free joints' values where FREE has any, or None.
 
-    The free joints start at q_ref's values and step outward by free_step (as MoveIt's IKFast
-    plugin does) to their limits (within_limits) or half a turn; values are solved
-    NEAREST_BATCH at a time, in order of their own distance from q_ref's, and the search
-    stops once that distance alone exceeds the best solution's: the result is the closest
-    solution over the stepped values. With within_limits=True each revolute joint takes its
-    value q + 2 pi k inside LIMITS nearest q_ref's; with within_limits=False revolute
-    differences are wrapped to (-pi, pi] and the solution is returned wrapped.
+    An arm without free joints: its solution closest to q_ref (_nearest_fixed; free_step
+    is not used). With free joints, they start at q_ref's values and step outward by
+    free_step (as MoveIt's IKFast plugin does) to their limits (within_limits) or half a
+    turn; values are solved NEAREST_BATCH at a time, in order of their own distance from
+    q_ref's, and the search stops once that distance alone exceeds the best solution's: the
+    result is the closest solution over the stepped values. With within_limits=True each
+    revolute joint takes its value q + 2 pi k inside LIMITS nearest q_ref's; with
+    within_limits=False revolute differences are wrapped to (-pi, pi] and the solution is
+    returned wrapped.
 
     Args:
         weights: DOF finite non-negative numbers (default ones).
@@ -49,6 +58,10 @@ def nearest(
         free_step: the free joints' step (radians, or length for a prismatic joint).
         backend: as for ik.
     """
+    if not FREE:
+        return _nearest_fixed(
+            T, q_ref, within_limits=within_limits, weights=weights, metric=metric, backend=backend
+        )
     refs, w = _nearest_arguments(q_ref, weights, metric)
     step = float(free_step)
     if not 0.0 < step < math.inf:
@@ -177,76 +190,3 @@ def _sweep_values(j: int, n: int | None, step: float | None) -> np.ndarray:
     if type(n) is bool or not isinstance(n, (int, np.integer)) or not 1 <= n <= MAX_FREE_VALUES:
         raise ValueError(f"n must be an integer 1 to {MAX_FREE_VALUES}, got {n!r}")
     return np.linspace(lo, hi, int(n), endpoint=closed or not _REVOLUTE[j - 1])
-
-
-def _with_free(refs, free):
-    """q_ref's values with the free joints' values from free (None: q_ref's own)."""
-    if free is None:
-        return refs
-    if not FREE:
-        raise ValueError("free: this arm has no free joints (FREE is empty)")
-    values = _real(free, "free")
-    if values.ndim == 0:
-        values = values.reshape(1)
-    if values.shape != (len(FREE),) or not np.isfinite(values).all():
-        raise ValueError(
-            f"free must be {len(FREE)} finite number(s), one per joint in FREE = {FREE}"
-        )
-    out = list(refs)
-    for j, x in zip(FREE, values.tolist()):
-        out[j - 1] = x
-    return tuple(out)
-
-
-def _free_turns(refs):
-    """refs with each revolute free joint's value reduced to (-pi, pi]: the value the solver
-    works with and returns, so that a returned row reproduces the pose with its own values.
-
-    Raises:
-        ValueError: a free value beyond FREE_LIMIT radians (FREE_LIMIT * REACH for a sliding
-            joint), where neither the reduction nor cos and sin are accurate.
-    """
-    if not FREE:
-        return refs
-    out = list(refs)
-    for j in FREE:
-        x = out[j - 1]
-        limit, unit = (FREE_LIMIT, "rad") if _REVOLUTE[j - 1] else (FREE_LIMIT * REACH, "")
-        if not abs(x) <= limit:
-            raise ValueError(
-                f"free joint q{j} = {x!r}: a free value must lie within +-{limit:g} {unit}".rstrip()
-            )
-        if _REVOLUTE[j - 1]:
-            out[j - 1] = math.remainder(x, _TWO_PI)
-    return tuple(out)
-
-
-def _free_rows(free, refs, n):
-    """Per pose, q_ref's values with the free joints' values from free ((n, len(FREE)), or
-    (n,) where FREE has one), as an (n, DOF) array; None for free=None."""
-    if free is None:
-        return None
-    if not FREE:
-        raise ValueError("free: this arm has no free joints (FREE is empty)")
-    values = _real(free, "free")
-    if values.ndim == 1 and len(FREE) == 1:
-        values = values[:, None]
-    if values.shape != (n, len(FREE)) or not np.isfinite(values).all():
-        raise ValueError(
-            f"free must be finite numbers of shape ({n}, {len(FREE)}): one value per pose "
-            f"for each joint in FREE = {FREE}"
-        )
-    limits = np.array([FREE_LIMIT if _REVOLUTE[j - 1] else FREE_LIMIT * REACH for j in FREE])
-    if not (np.abs(values) <= limits).all():
-        raise ValueError(
-            f"free values must lie within +-{FREE_LIMIT:g} rad (+-{FREE_LIMIT * REACH:g} for "
-            f"a sliding joint), one per pose for each joint in FREE = {FREE}"
-        )
-    turns = np.array([_REVOLUTE[j - 1] for j in FREE])
-    # fmod is exact; one addition of 2 pi brings its (-2 pi, 2 pi) to (-pi, pi]
-    reduced = np.fmod(values, _TWO_PI)
-    reduced = np.where(reduced > math.pi, reduced - _TWO_PI, reduced)
-    reduced = np.where(reduced <= -math.pi, reduced + _TWO_PI, reduced)
-    rows = np.tile(np.array(refs), (n, 1))
-    rows[:, [j - 1 for j in FREE]] = np.where(turns, reduced, values)
-    return rows
