@@ -8,6 +8,7 @@ import pytest
 import sympy as sp
 
 from derive import raghavan_roth as rr
+from derive.methods.general import split_link
 from derive.runtime import general
 
 
@@ -76,7 +77,7 @@ def test_the_run_time_steps_find_the_joint_values_of_random_arms(seed):
     d[0] = d[5] = a[5] = alpha[5] = 0.0
     rows = [(d[i], a[i], np.cos(alpha[i]), np.sin(alpha[i])) for i in range(6)]
     theta = rng.uniform(-np.pi, np.pi, 6)
-    F = np.linalg.multi_dot([general._rr_link(t, r) for t, r in zip(theta, rows)])
+    F = np.linalg.multi_dot([split_link(t, r) for t, r in zip(theta, rows)])
     args = (*a[:5], *d[:5], *np.cos(alpha[:5]), *np.sin(alpha[:5]), *F[:3, 2], *F[:3, 3])
     f = rr.fundamental()
     P0, Ps, Pc, Q = (
@@ -125,7 +126,7 @@ def test_the_deflated_eigenvalues_are_the_full_problems_less_the_known_ones(seed
     checked = 0
     for _ in range(5):
         theta = rng.uniform(-np.pi, np.pi, 6)
-        F = np.linalg.multi_dot([general._rr_link(t, r) for t, r in zip(theta, rows)])
+        F = np.linalg.multi_dot([split_link(t, r) for t, r in zip(theta, rows)])
         P0, Ps, Pc, Q = (
             np.array(fn(*numbers, *F[:3, 2], *F[:3, 3]), dtype=float) for fn in functions
         )

@@ -420,14 +420,14 @@ def numeric_matrices():
 
 
 def _split_joint(i: int, value: float, rows, slide) -> np.ndarray:
-    """A_i of a split's joint i (0-based) at its value: _split_link, or, for joint 3
+    """A_i of a split's joint i (0-based) at its value: split_link, or, for joint 3
     where it slides, Rz(theta3) Tz(value) Tx(a) Rx(alpha) with theta3 = slide[1] fixed."""
     if i == 2 and slide[0]:
-        return _split_link(slide[1], (value, *rows[2][1:]))
-    return _split_link(value, rows[i])
+        return split_link(slide[1], (value, *rows[2][1:]))
+    return split_link(value, rows[i])
 
 
-def _split_link(theta: float, row) -> np.ndarray:
+def split_link(theta: float, row) -> np.ndarray:
     """A_i = Rz(theta) Tz(d) Tx(a) Rx(alpha) of standard DH; row = (d, a, cos alpha, sin alpha)."""
     d, a, ca, sa = row
     ct, st = math.cos(theta), math.sin(theta)
