@@ -23,8 +23,9 @@ from importlib import resources
 
 from derive.runtime import MODULES
 
-# the runtime's file, written beside every generated module
+# the runtime's files, written beside every generated module and C solver
 RUNTIME_FILE = "derive_ik_runtime.py"
+C_RUNTIME_FILE = "derive_ik_runtime.h"
 
 # the names the generated module imports, as (import statement, name bound), in the order
 # ruff's isort puts them (standard library, then numpy)
@@ -246,95 +247,19 @@ def runtime_source() -> tuple[str, tuple[str, ...], tuple[str, ...]]:
     return text, import_order(read), all_order(public)
 
 
-# --- the C runtime (derive/c/): the same pieces and closure, for C -------------------------
+# --- the C runtime (derive/c/): one header for every arm's C file ---------------------------
 
 C_MODULES = ("runtime", "general")
-_C_WORD = re.compile(r"[A-Za-z_]\w*")
 
 
-def _without_comments(line: str, inside: bool) -> tuple[str, bool]:
-    """A line of C without its comments, and whether a comment is still open after it."""
-    out: list[str] = []
-    while line:
-        if inside:
-            end = line.find("*/")
-            if end < 0:
-                return "".join(out), True
-            line, inside = line[end + 2 :], False
-        else:
-            start = line.find("/*")
-            if start < 0:
-                out.append(line)
-                break
-            out.append(line[:start] + " ")
-            line, inside = line[start + 2 :], True
-    return "".join(out), inside
-
-
-def _c_defines(code: str) -> set[str]:
-    """The name a top-level C item defines: a macro, a typedef, a function or a variable."""
-    if code.startswith("#define"):
-        return {code.split()[1].split("(")[0]}
-    if code.startswith("typedef"):
-        return {_C_WORD.findall(code.rsplit("}", 1)[-1])[0]}
-    head = code.split("{", 1)[0].split("=", 1)[0]
-    cut = min(i for i in (head.find("("), head.find("["), len(head)) if i >= 0)
-    return {_C_WORD.findall(head[:cut])[-1]}
-
-
-def split_c(module: str, source: str) -> tuple[Piece, ...]:
-    """The top-level items of a C source, in order, each with the comment just above it (a
-    comment followed by a blank line, and #include lines, are left out). An item ends where
-    its braces close on a line ending in ``}`` or ``;`` (or with its line: a #define)."""
-    pieces: list[Piece] = []
-    comment: list[str] = []
-    item: list[str] = []
-    code: list[str] = []
-    depth, inside = 0, False
-    for line in source.split("\n"):
-        bare, inside_after = _without_comments(line, inside)
-        if not item:
-            if line.startswith("#include") or (not line.strip() and not inside):
-                comment = []
-                inside = inside_after
-                continue
-            if inside or (line.lstrip().startswith("/*") and not bare.strip()):
-                comment.append(line)
-                inside = inside_after
-                continue
-        item.append(line)
-        code.append(bare)
-        inside = inside_after
-        depth += bare.count("{") - bare.count("}")
-        ends = bare.rstrip().endswith(("}", ";")) or line.startswith("#define")
-        if depth == 0 and ends:
-            text = " ".join(code)
-            defines = _c_defines(text.strip())
-            pieces.append(
-                Piece(
-                    module=module,
-                    defines=frozenset(defines),
-                    uses=frozenset(_C_WORD.findall(text)) - defines,
-                    source="\n".join(comment + item),
-                    function="(" in text.split("{", 1)[0] and not line.startswith("#"),
-                )
-            )
-            comment, item, code = [], [], []
-    return tuple(pieces)
-
-
-@cache
-def c_runtime_pieces() -> tuple[Piece, ...]:
-    """Every piece of the C runtime (derive/c/), in copy order."""
+def c_runtime_source() -> tuple[str, str]:
+    """The C runtime's text for its shared header: derive/c/runtime.c and general.c as they
+    are, without their file comments and includes (the header has its own)."""
     package = resources.files("derive.c")
-    pieces: list[Piece] = []
+    texts = []
     for module in C_MODULES:
-        pieces += split_c(module, package.joinpath(f"{module}.c").read_text(encoding="utf-8"))
-    return tuple(pieces)
-
-
-def assemble_c(arm_source: str) -> str:
-    """The C runtime's pieces an arm's C code uses, with what they use, in copy order,
-    separated by blank lines."""
-    roots = set(_C_WORD.findall(arm_source))
-    return "\n\n".join(p.source for p in closure(roots, c_runtime_pieces()))
+        text = package.joinpath(f"{module}.c").read_text(encoding="utf-8")
+        body = text[text.index("*/") + 2 :].lstrip("\n")  # (the file's comment)
+        lines = [line for line in body.split("\n") if not line.startswith("#include")]
+        texts.append("\n".join(lines).strip("\n"))
+    return texts[0], texts[1]

@@ -6,6 +6,7 @@ same bytes."""
 from __future__ import annotations
 
 import functools
+import hashlib
 import textwrap
 from dataclasses import dataclass
 from typing import Any
@@ -13,8 +14,8 @@ from typing import Any
 import numpy as np
 
 from derive import tasks
-from derive.assemble import assemble_c
-from derive.emit import GENERATOR, GenerationError, check_printable, environment
+from derive.assemble import C_RUNTIME_FILE, c_runtime_source
+from derive.emit import GENERATOR, REGENERATE, GenerationError, check_printable, environment
 from derive.layout import wrap_c
 from derive.plan import Eigen, Plan, Poly, PolyD
 from derive.printers import branches, c
@@ -305,11 +306,36 @@ def render_c(plan: Plan) -> dict[str, str]:
         "arm_general": general,
     }
     arm = env.get_template("arm.c.j2")
-    runtime = assemble_c(arm.render(**args, runtime=""))
+    runtime = {"runtime_file": C_RUNTIME_FILE, "runtime_digest": c_runtime_digest()}
     return {
         f"{printed.name}_ik.h": wrap_c(env.get_template("arm.h.j2").render(**args)),
-        f"{printed.name}_ik.c": wrap_c(arm.render(**args, runtime=runtime)),
+        f"{printed.name}_ik.c": wrap_c(arm.render(**args, **runtime)),
+        C_RUNTIME_FILE: render_c_runtime(),
     }
+
+
+@functools.cache
+def c_runtime_digest() -> str:
+    """DK_RUNTIME of the C runtime header: 12 hex digits of the SHA-256 of its routines."""
+    runtime, general = c_runtime_source()
+    return hashlib.sha256(f"{runtime}\0{general}".encode()).hexdigest()[:12]
+
+
+@functools.cache
+def render_c_runtime() -> str:
+    """The C runtime header every arm's C file includes (templates/runtime.h.j2)."""
+    runtime, general = c_runtime_source()
+    return (
+        environment()
+        .get_template("runtime.h.j2")
+        .render(
+            generator=GENERATOR,
+            regenerate=REGENERATE,
+            digest=c_runtime_digest(),
+            runtime=runtime,
+            general=general,
+        )
+    )
 
 
 def render_ikfast(plan: Plan) -> dict[str, str]:

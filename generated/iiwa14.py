@@ -680,7 +680,7 @@ def _branch_signs(target, q):
 
 _RUNTIME = "derive_ik_runtime.py"
 # the digest of the runtime this module was generated with (of its text, "\n" line ends)
-_RUNTIME_DIGEST = "f891c12460586515"
+_RUNTIME_DIGEST = "a052376ec902ef32"
 
 
 def _runtime() -> Any:

@@ -1233,7 +1233,7 @@ def _rr_fill(k, l_x, l_y, l_z, p_x, p_y, p_z, out):
 
 _RUNTIME = "derive_ik_runtime.py"
 # the digest of the runtime this module was generated with (of its text, "\n" line ends)
-_RUNTIME_DIGEST = "f891c12460586515"
+_RUNTIME_DIGEST = "a052376ec902ef32"
 
 
 def _runtime() -> Any:

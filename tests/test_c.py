@@ -670,8 +670,8 @@ def test_unit_angle_is_atan2_to_the_last_places(tmp_path):
     """dk_uangle (the division-free angle of a unit vector, from asin's Taylor table) is within
     two units in the last place of pi of the library's atan2: at random angles, at the octant
     and segment boundaries and their neighbours, and at +-pi, +-0."""
-    shutil.copy(GENERATED / "puma560_ik.c", tmp_path)
-    shutil.copy(GENERATED / "puma560_ik.h", tmp_path)
+    for name in ("puma560_ik.c", "puma560_ik.h", "derive_ik_runtime.h"):
+        shutil.copy(GENERATED / name, tmp_path)
     (tmp_path / "probe.c").write_text(UANGLE_PROBE)
     exe = tmp_path / "probe"
     flags = ["-std=c99", "-O2", "-Wno-unused-function"]
@@ -703,7 +703,7 @@ def test_the_readme_cmake_recipe_builds_a_program_that_solves(tmp_path):
         pytest.skip("no cmake")
     readme = (ROOT / "README.md").read_text()
     recipe = readme.split("```cmake\n", 1)[1].split("```", 1)[0]
-    for name in ("puma560_ik.c", "puma560_ik.h"):
+    for name in ("puma560_ik.c", "puma560_ik.h", "derive_ik_runtime.h"):
         shutil.copy(GENERATED / name, tmp_path / name)
     (tmp_path / "main.c").write_text(
         """#include <stdio.h>

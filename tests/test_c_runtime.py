@@ -1,5 +1,5 @@
-"""The C runtime as real C (derive/c/): it compiles on its own, its routines are copied into an
-arm's C by the dependency closure of the arm's code, its constants are the Python runtime's,
+"""The C runtime as real C (derive/c/): it compiles on its own, every arm's C includes it as one
+shared header (derive_ik_runtime.h), its constants are the Python runtime's,
 and its routines answer as the Python ones when called from C."""
 
 from __future__ import annotations
@@ -12,7 +12,6 @@ import numpy as np
 import pytest
 
 from derive import emit_c
-from derive.assemble import assemble_c, c_runtime_pieces, split_c
 from derive.cbuild import WARNINGS, c_compiler
 from derive.runtime import closed, constants, general, refine
 
@@ -130,19 +129,36 @@ def test_the_c_runtime_holds_the_python_runtimes_constants():
         assert table(gen, name).tolist() == np.ravel(values).tolist(), name
 
 
-def test_routines_are_chosen_by_what_the_arms_code_uses():
-    names = {n for p in c_runtime_pieces() for n in p.defines}
-    assert {"dk_poly", "dk_cs1", "dk_general", "DK_UA", "dk_values"} <= names
-    # a code that calls dk_cs1 gets it and what it calls, and nothing of the general method
-    text = assemble_c("n = dk_cs1(&v, a, b, e, 1.0, 0.0);")
-    assert "static int dk_cs1(" in text and "static double dk_uangle(" in text
-    assert "DK_UA[DK_UA_COUNT]" in text and "dk_general" not in text and "dk_poly(" not in text
-    # what the bundled arms' C holds is what their code uses: the PUMA's no general method
-    puma = (GENERATED / "puma560_ik.c").read_text()
-    manocha = (GENERATED / "manocha_canny_ik.c").read_text()
-    assert "static int dk_general(" not in puma and "static int dk_general(" in manocha
-    pieces = split_c("x", "/* a */\nstatic int f(int a)\n{\n    return g(a); /* } */\n}\n")
-    assert [(sorted(p.defines), sorted(p.uses & {"g"})) for p in pieces] == [(["f"], ["g"])]
+def test_every_arm_s_c_includes_one_runtime_header_holding_derive_c_as_it_is():
+    """derive_ik_runtime.h holds derive/c/runtime.c and general.c's routines verbatim (the
+    general method only for arms defining its tables); each arm's C includes it and checks
+    its DK_RUNTIME; a header of another runtime is a compile error naming the file."""
+    header = (GENERATED / "derive_ik_runtime.h").read_text()
+    for name in ("runtime.c", "general.c"):
+        body = c_text(name).split("*/", 1)[1]
+        code = "\n".join(ln for ln in body.split("\n") if not ln.startswith("#include")).strip()
+        assert code in header, name
+    assert header.index("#ifdef DK_RR_SPLIT_COUNT") < header.index("static int dk_general(")
+    digest = re.search(r"#define DK_RUNTIME 0x([0-9a-f]{12})", header)
+    assert digest is not None
+    for path in GENERATED.glob("*_ik.c"):
+        text = path.read_text()
+        assert '#include "derive_ik_runtime.h"' in text, path.name
+        assert f"#if DK_RUNTIME != 0x{digest.group(1)}" in text, path.name
+        assert "static int dk_cs1(" not in text, path.name  # (the routines are the header's)
+
+
+@needs_cc
+def test_an_arm_s_c_with_another_runtime_header_says_so_when_compiled(tmp_path):
+    for name in ("planar_2r_ik.c", "planar_2r_ik.h", "derive_ik_runtime.h"):
+        (tmp_path / name).write_text((GENERATED / name).read_text())
+    header = tmp_path / "derive_ik_runtime.h"
+    header.write_text(re.sub(r"DK_RUNTIME 0x\w+", "DK_RUNTIME 0x1", header.read_text()))
+    source = str(tmp_path / "planar_2r_ik.c")
+    flags = [*WARNINGS, "-c", "-o", str(tmp_path / "x.o")]
+    done = subprocess.run([c_compiler(), *flags, source], capture_output=True, text=True)
+    assert done.returncode != 0
+    assert "derive_ik_runtime.h is another derive-ik's" in done.stderr
 
 
 QUARTIC_PROBE = r"""

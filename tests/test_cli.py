@@ -32,6 +32,7 @@ def test_generate_writes_module_and_reports_structure(tmp_path, capsys):
     assert line.startswith("user_arm: spherical wrist at joints 4-6; IK pieper")
     assert line.endswith(" s")
     assert sorted(p.name for p in (tmp_path / "out").iterdir()) == [
+        "derive_ik_runtime.h",
         "derive_ik_runtime.py",
         "user_arm.md",
         "user_arm.py",
@@ -61,6 +62,7 @@ def test_failure_part_way_keeps_earlier_files(tmp_path, capsys):
     assert f"1 arm(s) failed ({bad}); the other arms were written" in err
     assert (out / "user_arm.py").is_file()
     assert sorted(p.name for p in out.iterdir()) == [
+        "derive_ik_runtime.h",
         "derive_ik_runtime.py",
         "user_arm.md",
         "user_arm.py",

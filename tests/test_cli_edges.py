@@ -60,6 +60,7 @@ def test_leftovers_of_a_killed_run_are_removed(tmp_path):
     assert main(["generate", str(spec), "--out", str(out)]) == 0
     assert not leftover.exists() and other.exists()
     assert sorted(p.name for p in out.iterdir() if not p.name.startswith(".")) == [
+        "derive_ik_runtime.h",
         "derive_ik_runtime.py",
         "edge_arm.md",
         "edge_arm.py",

@@ -33,7 +33,8 @@ print(m._native.lib._name)
 
 def copy_arm(name: str, folder, c: bool = True):
     """The bundled arm's module with the runtime (and, with c, its C files) copied into folder."""
-    files = [f"{name}.py", "derive_ik_runtime.py"] + ([f"{name}_ik.c", f"{name}_ik.h"] if c else [])
+    files = [f"{name}.py", "derive_ik_runtime.py"]
+    files += [f"{name}_ik.c", f"{name}_ik.h", "derive_ik_runtime.h"] if c else []
     for file in files:
         shutil.copy(GENERATED / file, folder / file)
     return folder / f"{name}.py"
@@ -111,7 +112,9 @@ def test_without_a_compiler_one_notice_and_the_python_solver(tmp_path, monkeypat
 def test_a_module_copied_without_its_c_files_says_so_once_and_solves_in_python(tmp_path):
     m = import_path(copy_arm("planar_2r", tmp_path, c=False))
     T = m.fk([0.4, 0.5])
-    with pytest.warns(RuntimeWarning, match=r"planar_2r_ik\.c \(and its \.h\) not found"):
+    with pytest.warns(
+        RuntimeWarning, match=r"planar_2r_ik\.c \(its \.h, derive_ik_runtime\.h\) not found"
+    ):
         rows = m.ik(T)
     assert np.abs(rows - m.ik(T, backend="python")).max() == 0.0
     with pytest.raises(ValueError, match="backend must be 'auto', 'c' or 'python'"):

@@ -147,6 +147,7 @@ def test_generate_with_figures_embeds_them_and_check_reproduces_them(tmp_path, c
     assert main(["generate", "planar_2r", "--figures", "--out", str(out)]) == 0
     names = sorted(p.name for p in out.iterdir())
     assert names == [
+        "derive_ik_runtime.h",
         "derive_ik_runtime.py",
         "planar_2r.md",
         "planar_2r.py",
@@ -157,7 +158,7 @@ def test_generate_with_figures_embeds_them_and_check_reproduces_them(tmp_path, c
     ]
     assert "](planar_2r_workspace.svg)" in (out / "planar_2r.md").read_text()
     assert main(["check", "planar_2r", "--figures", "--out", str(out)]) == 0
-    assert "up to date (7 files)" in capsys.readouterr().out
+    assert "up to date (8 files)" in capsys.readouterr().out
 
 
 def test_panel_titles_clear_the_row_above_and_the_axes_are_labelled(generated):

@@ -60,8 +60,9 @@ def test_generated_lines_fit_in_100_characters(name):
 
 @pytest.mark.parametrize("name", BUNDLED)
 def test_generated_c_lines_fit_in_100_characters(name):
-    for suffix in ("_ik.c", "_ik.h"):
-        text = (ROOT / "generated" / f"{name}{suffix}").read_text()
+    for suffix in ("_ik.c", "_ik.h", "derive_ik_runtime.h"):
+        file = suffix if suffix.startswith("derive") else f"{name}{suffix}"
+        text = (ROOT / "generated" / file).read_text()
         long = [n for n, line in enumerate(text.split("\n"), 1) if len(line) > 100]
         assert not long, f"{name}{suffix} lines {long[:5]} are longer than 100 characters"
 

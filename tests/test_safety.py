@@ -79,6 +79,7 @@ def test_no_partial_file_when_rendering_fails(tmp_path, monkeypatch):
     assert main(["generate", "planar_2r", "--out", str(out)]) == 2
     assert (out / "planar_2r.py").read_bytes() == original
     assert sorted(p.name for p in out.iterdir()) == [
+        "derive_ik_runtime.h",
         "derive_ik_runtime.py",
         "planar_2r.md",
         "planar_2r.py",

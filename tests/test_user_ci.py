@@ -64,7 +64,7 @@ def test_fresh_user_arm_passes_and_check_writes_nothing(tmp_path, capsys):
     before = {p.name: p.read_bytes() for p in out.iterdir()}
     code, text = check(capsys, str(spec), "--out", str(out))
     assert code == 0, text
-    assert "up to date (5 files)" in text
+    assert "up to date (6 files)" in text
     assert {p.name: p.read_bytes() for p in out.iterdir()} == before
 
 

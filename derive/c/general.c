@@ -1,13 +1,13 @@
-/* The general 6R method (Raghavan-Roth, Manocha-Canny) in C, copied into a general arm's C
-   file as derive/c/runtime.c is; it reads the arm's tables (templates/general_arm.c.j2). The
-   Python solver's routines (derive/runtime/general.py) step for step: per split, the 14 x 9 /
-   14 x 8 matrices of the pose, the left null space of Q, the 12 x 12 quadratic matrix
-   polynomial in a Moebius-mapped half-angle of theta3, its 24 x 24 companion matrix's
-   eigenvalues but the 2r known ones (deflated), by Hessenberg reduction and Francis
-   double-shift QR, the null vector of each real root, theta1 and theta2 by back-substitution,
-   theta6, and Levenberg-Marquardt steps on the forward kinematics; where the answer is in
-   doubt, the fallback split and the rescue (the pose moved a little and polished back). No
-   LAPACK. */
+/* The general 6R method (Raghavan-Roth, Manocha-Canny) in C, in derive_ik_runtime.h after
+   derive/c/runtime.c, for the arms that define its tables (DK_RR_SPLIT_COUNT); it reads them
+   (templates/general_arm.c.j2). The Python solver's routines (derive/runtime/general.py) step
+   for step: per split, the 14 x 9 / 14 x 8 matrices of the pose, the left null space of Q, the
+   12 x 12 quadratic matrix polynomial in a Moebius-mapped half-angle of theta3, its 24 x 24
+   companion matrix's eigenvalues but the 2r known ones (deflated), by Hessenberg reduction and
+   Francis double-shift QR, the null vector of each real root, theta1 and theta2 by back-
+   substitution, theta6, and Levenberg-Marquardt steps on the forward kinematics; where the
+   answer is in doubt, the fallback split and the rescue (the pose moved a little and polished
+   back). No LAPACK. */
 #include "runtime.c"
 
 #define DK_RR_RANK_TOL (1e-10)

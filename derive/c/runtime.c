@@ -1,6 +1,6 @@
-/* The routines shared by every generated C solver, as real C: derive/emit_c.py copies into an
-   arm's C file exactly those its code calls, with what they call in turn (derive/assemble.py,
-   split_c), as derive/runtime/ is copied into its Python module. It compiles on its own with
+/* The routines shared by every generated C solver, as real C: derive/emit_c.py writes them into
+   derive_ik_runtime.h (templates/runtime.h.j2), which every arm's C file includes, as
+   derive/runtime/ is written into derive_ik_runtime.py. It compiles on its own with
    the stand-ins of derive/c/standin.h (not copied); tests/test_c.py compiles it so and tests
    its routines from C (tests/c/test_runtime.c). Its constants are the Python runtime's
    (derive/runtime/constants.py, closed.py; emit_c.unit_angle_table): a test holds them equal. */

@@ -40,6 +40,8 @@ _UNSETTLED = -2
 # answers); the bundled arms compile in 0.2-2.5 s
 COMPILE_TIMEOUT = 120.0
 _TMP_PREFIX = "building-"
+# the C runtime every arm's C file includes, beside it (derive/c/, templates/runtime.h.j2)
+_C_RUNTIME = "derive_ik_runtime.h"
 
 
 class _Native:
@@ -142,20 +144,20 @@ def _c_library() -> tuple[Any, str]:
     if not _C_SOURCE:
         return None, "this arm has no C solver"
     source = os.path.join(os.path.dirname(os.path.abspath(__file__)), _C_SOURCE)
+    texts = {}
     try:
-        with open(source, "rb") as file:
-            c_text = file.read()
-        with open(source[:-2] + ".h", "rb") as file:
-            h_text = file.read()
+        for name in _c_files():
+            with open(os.path.join(os.path.dirname(source), name), "rb") as file:
+                texts[name] = file.read()
     except OSError:
-        return None, f"{_C_SOURCE} (and its .h) not found beside {__file__}"
+        return None, f"{_C_SOURCE} (its .h, {_C_RUNTIME}) not found beside {__file__}"
     compiler = _c_compiler()
     if compiler is None:
         return None, "no C compiler (set CC, install cc, or pip install ziglang)"
     if shutil.which(compiler[0]) is None:
         return None, f"the C compiler {compiler[0]!r} (from $CC) is not found"
     key = hashlib.sha256(
-        b"\0".join((c_text, h_text, shlex.join([*compiler, *C_FLAGS]).encode()))
+        b"\0".join((*texts.values(), shlex.join([*compiler, *C_FLAGS]).encode()))
     ).hexdigest()[:24]
     suffix = ".dll" if os.name == "nt" else ".dylib" if sys.platform == "darwin" else ".so"
     folder = _cache_folder()
@@ -163,7 +165,7 @@ def _c_library() -> tuple[Any, str]:
     if not _sound(target):  # (absent, or damaged since it was built: built again)
         try:
             os.makedirs(folder, exist_ok=True)
-            why = _build(compiler, source, c_text, h_text, folder, target)
+            why = _build(compiler, source, texts, folder, target)
         except OSError as exc:
             return None, f"cannot write the compiled solver into {folder}: {exc}"
         if why:
@@ -186,8 +188,13 @@ def _sound(library: str) -> bool:
         return False
 
 
+def _c_files() -> tuple[str, str, str]:
+    """The files the arm's C solver is compiled from: its .c, its .h and the C runtime."""
+    return _C_SOURCE, _C_SOURCE[:-2] + ".h", _C_RUNTIME
+
+
 def _build(
-    compiler: list[str], source: str, c_text: bytes, h_text: bytes, folder: str, target: str
+    compiler: list[str], source: str, texts: dict[str, bytes], folder: str, target: str
 ) -> str:
     """Compile the C into target (with its .sha256), in a temporary folder of the cache (the
     bytes hashed are the bytes compiled; the library appears whole or not at all); "" or why
@@ -198,7 +205,7 @@ def _build(
         if stale and os.path.getmtime(left) < _time() - 3600.0:
             shutil.rmtree(left, ignore_errors=True)
     with tempfile.TemporaryDirectory(prefix=_TMP_PREFIX, dir=folder) as tmp:
-        for name, text in ((_C_SOURCE, c_text), (_C_SOURCE[:-2] + ".h", h_text)):
+        for name, text in texts.items():
             with open(os.path.join(tmp, name), "wb") as file:
                 file.write(text)
         built = os.path.join(tmp, "built" + os.path.splitext(target)[1])
