@@ -35,6 +35,7 @@ IMPORTS = (
     ("import hashlib", "hashlib"),
     ("import math", "math"),
     ("import os", "os"),
+    ("import re", "re"),
     ("import shlex", "shlex"),
     ("import shutil", "shutil"),
     ("import subprocess", "subprocess"),

@@ -11,6 +11,7 @@ from __future__ import annotations
 import ast
 import hashlib
 import math
+import re
 from dataclasses import dataclass
 from functools import cache
 from importlib import resources
@@ -501,7 +502,7 @@ def render_module(plan: Plan) -> str:
             offered=offered,
             runtime_file=RUNTIME_FILE,
             runtime_module=RUNTIME_FILE.removesuffix(".py"),
-            runtime_digest=runtime_digest(),
+            runtime_version=runtime_version(),
             arm=arm_code.rstrip("\n"),
         )
 
@@ -536,11 +537,12 @@ _TYPING = "\nTYPE_CHECKING\n"
 
 @cache
 def render_runtime() -> str:
-    """The runtime file (runtime.py.j2): every routine of derive/runtime, once."""
+    """The runtime file (runtime.py.j2): every routine of derive/runtime, once, with its
+    version (the digest of its text without it)."""
     source, read, public = runtime_source()
     layout = environment().get_template("runtime.py.j2")
 
-    def render(imports: str) -> str:
+    def render(imports: str, version: str) -> str:
         return layout.render(
             generator=GENERATOR,
             regenerate=REGENERATE,
@@ -548,11 +550,16 @@ def render_runtime() -> str:
             read=read,
             public=public,
             source=source,
+            version=version,
         )
 
-    return render(import_block(render("")))
+    imports = import_block(render("", ""))
+    text = render(imports, "")
+    return render(imports, hashlib.sha256(text.encode("utf-8")).hexdigest()[:16])
 
 
-def runtime_digest() -> str:
-    """The digest a module checks its runtime file against: of the file's text."""
-    return hashlib.sha256(render_runtime().encode("utf-8")).hexdigest()[:16]
+def runtime_version() -> str:
+    """The version a module checks its runtime file against (the runtime's _RUNTIME_VERSION)."""
+    found = re.search(r'^_RUNTIME_VERSION = "([0-9a-f]+)"', render_runtime(), re.M)
+    assert found is not None  # (runtime.py.j2 prints it)
+    return found.group(1)

@@ -81,6 +81,7 @@ MAX_MAGNITUDE = 1e9
 # (sys.stdlib_module_names): a generated <name>.py must not shadow them in its folder.
 SHADOWED_MODULES = frozenset(
     {
+        "derive_ik_runtime",  # (the runtime written beside every generated module)
         "numpy",
         "numba",
         "llvmlite",

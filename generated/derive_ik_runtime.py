@@ -31,6 +31,14 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from numpy.typing import ArrayLike
 
+if "_RUNTIME_VERSION" not in globals():  # (imported on its own, not run by a module)
+    raise ImportError(
+        "derive_ik_runtime.py is run by the generated modules beside it, each in its own "
+        "namespace; it is not a module to import"
+    )
+# this runtime's version: a module runs the runtime of its own version only
+_RUNTIME_VERSION = "c6b59eb96f1df6b7"
+
 if TYPE_CHECKING:  # defined by the module running this file
     from derive.runtime.arm import (
         _C_SOURCE,
@@ -575,12 +583,12 @@ def _c_library() -> tuple[Any, str]:
         return None, "this arm has no C solver"
     source = os.path.join(os.path.dirname(os.path.abspath(__file__)), _C_SOURCE)
     texts = {}
-    try:
-        for name in _c_files():
+    for name in _c_files():
+        try:
             with open(os.path.join(os.path.dirname(source), name), "rb") as file:
                 texts[name] = file.read()
-    except OSError:
-        return None, f"{_C_SOURCE} (its .h, {_C_RUNTIME}) not found beside {__file__}"
+        except OSError:
+            return None, f"{name} not found beside {__file__} (with {', '.join(_c_files())})"
     compiler = _c_compiler()
     if compiler is None:
         return None, "no C compiler (set CC, install cc, or pip install ziglang)"

@@ -88,7 +88,9 @@ def test_check_compares_bytes_and_says_so(tmp_path, capsys):
     assert "in bytes, not in lines (line endings" in capsys.readouterr().out
 
 
-@pytest.mark.parametrize("name", ["numpy", "numba", "typing", "token", "math", "json", "derive"])
+@pytest.mark.parametrize(
+    "name", ["numpy", "numba", "typing", "token", "math", "json", "derive", "derive_ik_runtime"]
+)
 def test_names_that_shadow_modules_are_refused(tmp_path, name):
     spec = tmp_path / "arm.toml"
     spec.write_text(ARM.replace('name = "edge_arm"', f'name = "{name}"'))

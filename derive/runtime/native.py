@@ -145,12 +145,12 @@ def _c_library() -> tuple[Any, str]:
         return None, "this arm has no C solver"
     source = os.path.join(os.path.dirname(os.path.abspath(__file__)), _C_SOURCE)
     texts = {}
-    try:
-        for name in _c_files():
+    for name in _c_files():
+        try:
             with open(os.path.join(os.path.dirname(source), name), "rb") as file:
                 texts[name] = file.read()
-    except OSError:
-        return None, f"{_C_SOURCE} (its .h, {_C_RUNTIME}) not found beside {__file__}"
+        except OSError:
+            return None, f"{name} not found beside {__file__} (with {', '.join(_c_files())})"
     compiler = _c_compiler()
     if compiler is None:
         return None, "no C compiler (set CC, install cc, or pip install ziglang)"
