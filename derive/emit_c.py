@@ -1,7 +1,7 @@
 """plan -> the C99 solver: `<name>_ik.h` and `<name>_ik.c` (templates/arm.h.j2, arm.c.j2,
-general_arm.c.j2), printed by derive/printers/c.py, with the routines of the C runtime
-(derive/c/) the arm's code uses. Deterministic as the Python output: the same plan gives the
-same bytes."""
+general_arm.c.j2), printed by derive/printers/c.py, and the C runtime it includes,
+`derive_ik_runtime.h` (derive/c/, templates/runtime.h.j2). Deterministic as the Python
+output: the same plan gives the same bytes."""
 
 from __future__ import annotations
 
@@ -287,8 +287,8 @@ def poly_max(plan: Plan) -> int:
 
 def render_c(plan: Plan) -> dict[str, str]:
     """The C solver's files of an arm: {file name: text}. The arm's code is printed from its
-    plan (templates/arm.c.j2; a general arm's tables: general_arm.c.j2), and the routines of
-    the C runtime (derive/c/) it uses are copied in with what they use (assemble_c)."""
+    plan (templates/arm.c.j2; a general arm's tables: general_arm.c.j2); it includes the C
+    runtime (derive/c/), written beside it as derive_ik_runtime.h (render_c_runtime)."""
     printed = print_c(plan)
     env = environment()
     general = ""
