@@ -558,6 +558,11 @@ def render_runtime() -> str:
     return render(imports, hashlib.sha256(text.encode("utf-8")).hexdigest()[:16])
 
 
+# the runtime's line stating its version, in whatever form a formatter leaves it (the
+# generated module's _RUNTIME_LINE is the same pattern)
+RUNTIME_LINE = re.compile(rb"^_RUNTIME_VERSION\s*(?::\s*str\s*)?=\s*[\"']([0-9a-fA-F]+)[\"']", re.M)
+
+
 def runtime_version() -> str:
     """The version a module checks its runtime file against (the runtime's _RUNTIME_VERSION)."""
     found = re.search(r'^_RUNTIME_VERSION = "([0-9a-f]+)"', render_runtime(), re.M)

@@ -7,6 +7,7 @@ import difflib
 import os
 import stat
 import tempfile
+import time
 from pathlib import Path
 
 
@@ -17,19 +18,29 @@ class OutputError(Exception):
 TMP_SUFFIX = ".derive-tmp"
 
 
+# a temporary file this old is a killed run's leftover (a run writes its files in seconds; two
+# runs writing into one folder at once keep each other's younger ones)
+LEFTOVER_AGE = 60.0
+
+
 def write_atomic(path: Path, text: str | bytes) -> None:
     """Write through a temporary file and rename, so no partial file is ever visible.
 
     The file gets the mode an existing file at ``path`` has, else the mode a new file gets
     under the process's umask (0644 under umask 022). Temporary files of earlier runs that
-    were killed while writing this file (``.NAME.*.derive-tmp``) are removed first. A
+    were killed while writing this file (``.NAME.*.derive-tmp``, LEFTOVER_AGE seconds old:
+    a younger one may be another run's, writing now) are removed first. A
     symbolic link at ``path`` is followed (its target is replaced, the link stays); anything
     else that is not a regular file is refused (see output_file).
     """
     path = output_file(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     for leftover in path.parent.glob(f".{path.name}.*{TMP_SUFFIX}"):
-        leftover.unlink(missing_ok=True)
+        try:
+            if leftover.stat().st_mtime < time.time() - LEFTOVER_AGE:
+                leftover.unlink(missing_ok=True)
+        except FileNotFoundError:  # (its run renamed or removed it meanwhile)
+            pass
     try:
         mode = stat.S_IMODE(path.stat().st_mode)
     except FileNotFoundError:

@@ -399,6 +399,10 @@ def _branch_signs(target, q):
 _RUNTIME = "derive_ik_runtime.py"
 # the version of the runtime this module was generated with (the runtime's _RUNTIME_VERSION)
 _RUNTIME_VERSION = "c6b59eb96f1df6b7"
+# the runtime's line stating its version, in whatever form a formatter leaves it
+_RUNTIME_LINE = re.compile(
+    rb"^_RUNTIME_VERSION\s*(?::\s*str\s*)?=\s*[\"']([0-9a-fA-F]+)[\"']", re.M
+)
 
 
 def _runtime() -> Any:
@@ -409,20 +413,22 @@ def _runtime() -> Any:
         ImportError: the file is missing, or is another runtime than this module's (another
             derive-ik wrote it: generate every arm of a folder with one).
     """
-    path = os.path.join(os.path.dirname(os.path.abspath(__file__)), _RUNTIME)
-    loader = globals().get("__loader__")
+    # (not made absolute: a zip archive's loader knows it by the path sys.path gave)
+    path = os.path.join(os.path.dirname(__file__), _RUNTIME)
+    read = getattr(globals().get("__loader__"), "get_data", None)
     try:
-        if hasattr(loader, "get_data"):
-            data = loader.get_data(path)
+        if read is not None:
+            data = read(path)
         else:
             with open(path, "rb") as handle:
                 data = handle.read()
     except OSError as exc:
         raise ImportError(
-            f"{NAME}: needs {_RUNTIME} beside it ({exc.strerror or exc}); copy it with this file"
+            f"{NAME}: needs {_RUNTIME} beside it ({exc.strerror or 'not there'}); copy it with "
+            "this file"
         ) from None
-    found = re.search(rb"^_RUNTIME_VERSION = [\"']([0-9a-f]+)[\"']", data, re.M)
-    if found is None or found.group(1).decode() != _RUNTIME_VERSION:
+    found = re.search(_RUNTIME_LINE, data)
+    if found is None or found.group(1).decode().lower() != _RUNTIME_VERSION:
         said = found.group(1).decode() if found else "none"
         raise ImportError(
             f"{NAME}: {path} is runtime version {said}, not {_RUNTIME_VERSION} (this module's): "

@@ -7,6 +7,7 @@ import os
 import stat
 import subprocess
 import sys
+import time
 from pathlib import Path
 
 import pytest
@@ -55,10 +56,15 @@ def test_leftovers_of_a_killed_run_are_removed(tmp_path):
     out.mkdir()
     leftover = out / ".edge_arm.py.k2j3h4.derive-tmp"
     leftover.write_text("partial")
+    old = time.time() - 120.0  # (a minute old: a killed run's; younger, another run's now)
+    os.utime(leftover, (old, old))
+    young = out / ".edge_arm.md.x7.derive-tmp"  # another run writing it now: kept
+    young.write_text("partial")
     other = out / ".other.py.x.derive-tmp"  # another arm's, possibly in flight: kept
     other.write_text("partial")
+    os.utime(other, (old, old))
     assert main(["generate", str(spec), "--out", str(out)]) == 0
-    assert not leftover.exists() and other.exists()
+    assert not leftover.exists() and other.exists() and young.exists()
     assert sorted(p.name for p in out.iterdir() if not p.name.startswith(".")) == [
         "derive_ik_runtime.h",
         "derive_ik_runtime.py",

@@ -133,6 +133,9 @@ def test_a_module_runs_the_runtime_of_its_version_and_says_so_where_it_is_not(tm
     x, y = np.cos(0.4) + np.cos(0.9), np.sin(0.4) + np.sin(0.9)
     assert np.abs(m.fk([0.4, 0.5])[:2, 3] - [x, y]).max() < 1e-15
     version = m._RUNTIME_VERSION
+    from derive.emit import RUNTIME_LINE  # (derive generate's check reads the line as the module)
+
+    assert m._RUNTIME_LINE.pattern == RUNTIME_LINE.pattern
     runtime.write_text(text.replace(f'_RUNTIME_VERSION = "{version}"', '_RUNTIME_VERSION = "0f"'))
     with pytest.raises(ImportError, match=rf"is runtime version 0f, not {version} \(this"):
         import_path(path)
@@ -165,9 +168,11 @@ def test_modules_and_their_runtime_import_from_a_zip_archive(tmp_path):
         "q = np.radians([20.0] * 6); rows = m.ik(m.fk(q));"
         "print(len(rows), float(np.abs(rows - q).max(axis=1).min()), p.DOF)"
     )
+    # (by the path sys.path gives, relative here: the archive's loader knows it so)
     done = subprocess.run(
-        [sys.executable, "-I", "-c", script, str(archive)], capture_output=True, text=True
-    )
+        [sys.executable, "-I", "-c", script, "arms.zip"], capture_output=True, text=True,
+        cwd=tmp_path,
+    )  # fmt: skip
     assert done.returncode == 0, done.stderr
     count, gap, dof = done.stdout.split()
     assert int(count) == 8 and float(gap) < 1e-9 and dof == "2"
