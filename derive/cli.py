@@ -101,6 +101,7 @@ def other_runtime_users(out: Path, names: set[str], lang: str = "python") -> lis
     """The files in out of arms not among names whose runtime is not this derive-ik's (a
     module's _RUNTIME_VERSION, a C file's DK_RUNTIME check), where generating lang into out
     would replace that runtime (and in the folder a runtime file in out links to)."""
+    from derive.assemble import C_RUNTIME_FILE, RUNTIME_FILE
     from derive.emit import RUNTIME_LINE, runtime_version
     from derive.emit_c import c_runtime_digest
 
@@ -114,9 +115,8 @@ def other_runtime_users(out: Path, names: set[str], lang: str = "python") -> lis
         del wanted[".py"]
     # the folders whose arms run the runtime files written into out (a symbolic link there
     # is followed: its target is replaced)
-    folders = {out.resolve()} | {
-        (out / f"derive_ik_runtime{suffix}").resolve().parent for suffix in (".py", ".h")
-    }
+    here = out.resolve()
+    folders = {here} | {(out / name).resolve().parent for name in (RUNTIME_FILE, C_RUNTIME_FILE)}
     found = []
     for folder in sorted(folders):
         for path in sorted(folder.iterdir()) if folder.is_dir() else ():
@@ -124,14 +124,14 @@ def other_runtime_users(out: Path, names: set[str], lang: str = "python") -> lis
                 continue
             pattern, version, tail = wanted[path.suffix]
             arm = path.stem.removesuffix(tail) if path.stem.endswith(tail) else ""
-            if not arm or path.name.startswith("derive_ik_runtime"):
+            if not arm or path.name in (RUNTIME_FILE, C_RUNTIME_FILE):
                 continue
-            if arm in names and folder == out.resolve():
+            if arm in names and folder == here:
                 continue
             with open(path, "rb") as handle:
                 said = pattern.search(handle.read(1 << 20))
             if said is not None and said.group(1).decode().lower() != version:
-                found.append(str(path if folder != out.resolve() else path.name))
+                found.append(path.name if folder == here else str(path))
     return found
 
 

@@ -508,7 +508,7 @@ def render_module(plan: Plan) -> str:
 
     # the imports are those the module's code uses, constants included; it offers the
     # runtime's public names it uses and its own
-    draft = render(import_block(render("", ()) + _TYPING), ())
+    draft = render(import_block(render("", ())), ())
     own = {
         n.id
         for node in ast.parse(draft).body
@@ -517,7 +517,7 @@ def render_module(plan: Plan) -> str:
         if isinstance(n, ast.Name) and not n.id.startswith("_")
     }
     offered = all_order((*own, *parts.offered))
-    return render(import_block(draft + _TYPING), _packed([f'"{n}",' for n in offered], 96))
+    return render(import_block(draft), _packed([f'"{n}",' for n in offered], 96))
 
 
 def _packed(words: list[str], width: int) -> tuple[str, ...]:
@@ -531,14 +531,19 @@ def _packed(words: list[str], width: int) -> tuple[str, ...]:
     return tuple(lines)
 
 
-# (the names every module's layout uses in code ruff sees as unused for import_block)
-_TYPING = "\nTYPE_CHECKING\n"
+def render_runtime() -> str:
+    """The runtime file (runtime.py.j2): every routine of derive/runtime, once."""
+    return _runtime()[0]
+
+
+def runtime_version() -> str:
+    """The version a module checks its runtime file against (the runtime's _RUNTIME_VERSION)."""
+    return _runtime()[1]
 
 
 @cache
-def render_runtime() -> str:
-    """The runtime file (runtime.py.j2): every routine of derive/runtime, once, with its
-    version (the digest of its text without it)."""
+def _runtime() -> tuple[str, str]:
+    """The runtime file's text and its version (the digest of its text without it)."""
     source, read, public = runtime_source()
     layout = environment().get_template("runtime.py.j2")
 
@@ -554,17 +559,10 @@ def render_runtime() -> str:
         )
 
     imports = import_block(render("", ""))
-    text = render(imports, "")
-    return render(imports, hashlib.sha256(text.encode("utf-8")).hexdigest()[:16])
+    version = hashlib.sha256(render(imports, "").encode("utf-8")).hexdigest()[:16]
+    return render(imports, version), version
 
 
 # the runtime's line stating its version, in whatever form a formatter leaves it (the
 # generated module's _RUNTIME_LINE is the same pattern)
 RUNTIME_LINE = re.compile(rb"^_RUNTIME_VERSION\s*(?::\s*str\s*)?=\s*[\"']([0-9a-fA-F]+)[\"']", re.M)
-
-
-def runtime_version() -> str:
-    """The version a module checks its runtime file against (the runtime's _RUNTIME_VERSION)."""
-    found = re.search(r'^_RUNTIME_VERSION = "([0-9a-f]+)"', render_runtime(), re.M)
-    assert found is not None  # (runtime.py.j2 prints it)
-    return found.group(1)
