@@ -976,3 +976,82 @@ def test_a_pose_rounded_to_float32_is_answered_by_a_calibrated_arm(tmp_path, bac
             for row in rows:
                 E = module.fk(row) - given
                 assert max(np.abs(E[:3, :3]).max(), np.abs(E[:3, 3]).max() / module.REACH) <= size
+
+
+@needs_cc
+@pytest.mark.parametrize("name", ["kr6", "ur5"])
+def test_seeds_refined_side_by_side_are_refined_as_one_at_a_time(name, tmp_path):
+    """dk_refine_lanes refines DK_LANES seeds at once in GCC's vector types (a lane taking the
+    next seed when its own is done); with DK_SCALAR_LANES defined a lane is one double. Both
+    must give the same rows, bit for bit (C99 without FMA contraction: the same operations in
+    each lane), on uniform and singular poses (a fifth of the joints at 0, +-90 or 180 deg),
+    where seeds leave the plain course and take the lanes longest."""
+    from derive.cbuild import Harness
+    from derive.verify import sample_joints
+
+    plan = build_plan(parse_spec(calibrated(name), "<test>"))
+    (tmp_path / "lanes").mkdir()
+    (tmp_path / "one").mkdir()
+    lanes = Harness(plan, tmp_path / "lanes")
+    one = Harness(plan, tmp_path / "one", opt=("-O2", "-DDK_SCALAR_LANES"))
+    module = build_module(calibrated(name), tmp_path)
+    Q = sample_joints(module, 400, np.random.default_rng(3), degenerate_share=0.2)
+    T = module.fk_batch(Q)
+    counts, rows = lanes.solve(T, np.zeros_like(Q))
+    counts_one, rows_one = one.solve(T, np.zeros_like(Q))
+    assert np.array_equal(counts, counts_one)
+    assert np.array_equal(rows, rows_one)
+    assert (counts > 0).all()
+
+
+def _wrist_centre_on_axis_1(module, q: np.ndarray) -> np.ndarray | None:
+    """q with q3 moved (bisection) until the wrist centre (the tool's origin less d6 along its
+    z) lies on axis 1, where the nominal table's theta1 is free and seeds all round
+    (dk_all_round): more seeds than DK_PENDING wait for refinement; None where no q3 does."""
+
+    def radial(q3: float) -> float:
+        x = q.copy()
+        x[2] = q3
+        T = module.fk(x)
+        centre = T[:3, 3] - 0.08 * T[:3, 2]
+        return float(centre[0] * math.cos(x[0]) + centre[1] * math.sin(x[0]))
+
+    grid = np.linspace(-math.pi, math.pi, 73)
+    values = [radial(g) for g in grid]
+    k = next((i for i in range(72) if values[i] * values[i + 1] < 0), None)
+    if k is None:
+        return None
+    lo, hi = grid[k], grid[k + 1]
+    for _ in range(60):
+        mid = 0.5 * (lo + hi)
+        if radial(lo) * radial(mid) <= 0:
+            hi = mid
+        else:
+            lo = mid
+    out = q.copy()
+    out[2] = 0.5 * (lo + hi)
+    return out
+
+
+@needs_cc
+def test_a_wrist_centre_on_axis_1_seeds_more_than_wait_and_c_answers_as_python(tmp_path):
+    """The calibrated KR6 with its wrist centre on axis 1: the nominal table's theta1 is free
+    there and seeds all round, more seeds than DK_PENDING, so the seeds waiting are refined
+    (dk_settle) before the buffer takes more; C's rows are Python's."""
+    module = build_module(calibrated("kr6"), tmp_path, c=True)
+    rng = np.random.default_rng(21)
+    tried = 0
+    for q in rng.uniform(-2.5, 2.5, (40, 6)):
+        q = _wrist_centre_on_axis_1(module, q)
+        if q is None:
+            continue
+        tried += 1
+        T = module.fk(q)
+        a, b = module.ik(T, backend="c"), module.ik(T, backend="python")
+        assert len(a) > 0 and a.shape == b.shape
+        assert np.allclose(a, b, atol=1e-9)
+        for row in a:
+            E = module.fk(row)
+            assert np.max(np.abs(E[:3, :3] - T[:3, :3])) <= 1e-10
+            assert np.max(np.abs(E[:3, 3] - T[:3, 3])) <= 1e-10 * module.REACH
+    assert tried >= 6

@@ -1858,16 +1858,17 @@ static int dk_seen(const double (*found)[DK_REFINE_N], int n, const int revolute
 {
     int r, j;
     for (r = 0; r < n; r++) {
-        double worst = 0.0;
-        for (j = 0; j < DK_REFINE_N; j++) {
+        for (j = 0; j < DK_REFINE_N; j++) { /* (to the first joint that differs) */
             double d = fabs(q[j] - found[r][j]);
             if (revolute[j] && d > DK_PI) { /* (within a half turn: fmod's value is d) */
                 d = fmod(d, DK_TWO_PI);
                 d = d > DK_PI ? DK_TWO_PI - d : d;
             }
-            worst = d > worst ? d : worst;
+            if (!(d <= DK_DEDUP_TOL)) {
+                break;
+            }
         }
-        if (worst <= DK_DEDUP_TOL) {
+        if (j == DK_REFINE_N) {
             return 1;
         }
     }
@@ -2292,6 +2293,483 @@ static int dk_polish(const double chain[DK_REFINE_N + 1][12], const int revolute
         return 1;
     }
     return certified;
+}
+
+/* --- seeds refined side by side: dk_refine's plain course, DK_LANES seeds at a time ------- */
+
+/* dk_refine_lanes refines DK_LANES seeds at once, each value of the iteration a dk_lane of
+   theirs: a vector of GCC's and Clang's as wide as the processor's vector registers (its
+   vector instructions do the lanes' arithmetic at once: a nominal seed's refinement is most
+   of a calibrated arm's time, and a pose's closed form gives several; a vector wider than
+   the registers took twice a double's time), or one double elsewhere (and where
+   DK_SCALAR_LANES is defined) */
+#if defined(__GNUC__) && !defined(DK_SCALAR_LANES) && (defined(__SSE2__) || defined(__aarch64__))
+#if defined(__AVX__)
+#define DK_LANES 4
+#else
+#define DK_LANES 2
+#endif
+typedef double dk_lane __attribute__((vector_size(DK_LANES * sizeof(double))));
+#define DK_AT(v, l) ((v)[l]) /* lane l of a dk_lane */
+#else
+#define DK_LANES 1
+typedef double dk_lane;
+#define DK_AT(v, l) (v)
+#endif
+/* 1 where the lanes' error and Jacobian are their own: the pose, position, position and
+   direction and direction tasks' (the others' are dk_task_error's and dk_task_jacobian's) */
+#define DK_LANE_TASK (DK_REFINE_TASK <= 2 || DK_REFINE_TASK == 4)
+/* the most seeds waiting to be refined (dk_defer): a pose's rows, with its near-double
+   roots' seeds */
+#define DK_PENDING 16
+
+/* dk_chain_pose of DK_LANES seeds (cur, their cos c and sin s) */
+static void dk_lanes_pose(const double chain[DK_REFINE_N + 1][12],
+                          const int revolute[DK_REFINE_N], const dk_lane cur[DK_REFINE_N],
+                          const dk_lane c[DK_REFINE_N], const dk_lane s[DK_REFINE_N],
+                          dk_lane pose[12], dk_lane axes[DK_REFINE_N][3],
+                          dk_lane origins[DK_REFINE_N][3])
+{
+    const dk_lane zero = {0.0};
+    int i, k, r;
+    for (k = 0; k < 12; k++) {
+        pose[k] = zero + chain[0][k];
+    }
+    for (i = 0; i < DK_REFINE_N; i++) {
+        const double *f = chain[i + 1];
+        for (r = 0; r < 3; r++) {
+            dk_lane x = pose[4 * r], y = pose[4 * r + 1], z = pose[4 * r + 2];
+            dk_lane p = pose[4 * r + 3];
+            axes[i][r] = z;
+            origins[i][r] = p;
+            if (revolute[i]) { /* := Rz(q_i): the first two columns turn */
+                const dk_lane a = x;
+                x = c[i] * a + s[i] * y;
+                y = c[i] * y - s[i] * a;
+            } else { /* := Tz(q_i) */
+                p += cur[i] * z;
+            }
+            pose[4 * r] = x * f[0] + y * f[4] + z * f[8]; /* := F_{i+1}, row by row */
+            pose[4 * r + 1] = x * f[1] + y * f[5] + z * f[9];
+            pose[4 * r + 2] = x * f[2] + y * f[6] + z * f[10];
+            pose[4 * r + 3] = p + (x * f[3] + y * f[7] + z * f[11]);
+        }
+    }
+}
+
+/* x := (L D L^T)^-1 x, L below the diagonal of factor (unit diagonal), 1 / D in inverse: the
+   lanes' normal equations (dk_refine_lanes factors them so: no square roots, and one vector
+   division a column where Cholesky's takes a square root a lane) */
+static void dk_ldl_again(const dk_lane factor[DK_REFINE_M][DK_REFINE_M],
+                         const dk_lane inverse[DK_REFINE_M], dk_lane x[DK_REFINE_M])
+{
+    int i, k;
+    for (i = 0; i < DK_REFINE_M; i++) { /* L y = x */
+        for (k = 0; k < i; k++) {
+            x[i] -= factor[i][k] * x[k];
+        }
+    }
+    for (i = DK_REFINE_M - 1; i >= 0; i--) { /* D L^T x = y */
+        x[i] *= inverse[i];
+        for (k = i + 1; k < DK_REFINE_M; k++) {
+            x[i] -= factor[k][i] * x[k];
+        }
+    }
+}
+
+/* dk_refine of the count seeds in q, their cos and sin in cs (no joint held, patience
+   DK_REFINE_PATIENCE): the best points met into q, their errors into size. The same steps
+   (but for the factor of the normal equations: L D L^T here, the same to roundings), each
+   lane taking the next seed when its own is done. A seed whose normal equations turn out
+   singular to roundings (dk_refine then goes on by QR) is refined by dk_refine alone, from
+   where it began. The errors and Jacobians of the tasks DK_LANE_TASK names are the lanes'
+   too; the other tasks' are dk_task_error's and dk_task_jacobian's, a lane at a time. */
+static void dk_refine_lanes(const double chain[DK_REFINE_N + 1][12],
+                            const int revolute[DK_REFINE_N], const int solved[DK_REFINE_M],
+                            double reach, const double t[12], double q[][DK_REFINE_N],
+                            const double cs[][DK_REFINE_N][2], int count, double size[])
+{
+    const int patience = DK_REFINE_PATIENCE;
+    const int steps = DK_REFINE_STEPS / DK_REFINE_PATIENCE * patience;
+    const dk_lane zero = {0.0};
+    dk_lane cur[DK_REFINE_N], c[DK_REFINE_N], s[DK_REFINE_N];
+    dk_lane J[6][DK_REFINE_M], normal[DK_REFINE_M][DK_REFINE_M];
+    dk_lane pivot[DK_REFINE_M], inverse[DK_REFINE_M];
+    double reused[DK_LANES];
+    /* the seed each lane refines (-1: none), its steps and the steps since its error last
+       fell; whether a seed is to be refined alone */
+    int who[DK_LANES], its[DK_LANES], worse[DK_LANES], alone[DK_PENDING];
+    double seeds[DK_PENDING][DK_REFINE_N];
+    int next = 0, busy = 0, i, k, l, m, r;
+    for (k = 0; k < DK_REFINE_M; k++) {
+        for (r = 0; r < 6; r++) {
+            J[r][k] = zero;
+        }
+        for (m = 0; m < DK_REFINE_M; m++) {
+            normal[k][m] = zero;
+        }
+        pivot[k] = inverse[k] = zero;
+    }
+    for (i = 0; i < DK_REFINE_N; i++) {
+        cur[i] = zero;
+        c[i] = zero + 1.0;
+        s[i] = zero;
+    }
+    for (l = 0; l < DK_LANES; l++) {
+        who[l] = -1;
+        its[l] = worse[l] = 0;
+        reused[l] = HUGE_VAL;
+    }
+    for (k = 0; k < count; k++) {
+        alone[k] = 0;
+        size[k] = HUGE_VAL;
+        for (i = 0; i < DK_REFINE_N; i++) {
+            seeds[k][i] = q[k][i];
+        }
+    }
+    for (;;) {
+        dk_lane pose[12], axes[DK_REFINE_N][3], origins[DK_REFINE_N][3], error[6];
+        dk_lane step[DK_REFINE_M], again[DK_REFINE_M], mu, stride;
+        double now[DK_LANES], longest[DK_LANES], least[DK_LANES];
+        int last[DK_LANES], done[DK_LANES];
+        for (l = 0; l < DK_LANES; l++) { /* (a lane whose seed is done takes the next) */
+            if (who[l] >= 0 || next == count) {
+                continue;
+            }
+            who[l] = next++;
+            its[l] = worse[l] = 0;
+            reused[l] = HUGE_VAL;
+            for (i = 0; i < DK_REFINE_N; i++) {
+                DK_AT(cur[i], l) = q[who[l]][i];
+                DK_AT(c[i], l) = cs[who[l]][i][0];
+                DK_AT(s[i], l) = cs[who[l]][i][1];
+            }
+            busy++;
+        }
+        if (busy == 0) {
+            break;
+        }
+        dk_lanes_pose(chain, revolute, cur, c, s, pose, axes, origins);
+#if DK_LANE_TASK
+        for (r = 0; r < 3; r++) { /* the error (dk_task_error) */
+            const int a = (r + 1) % 3, b = (r + 2) % 3, x = DK_REFINE_AXIS;
+            dk_lane total = zero;
+            error[r] = DK_REFINE_TASK == 4 ? zero : (t[4 * r + 3] - pose[4 * r + 3]) / reach;
+            for (k = 0; k < 3; k++) {
+                total += pose[4 * a + k] * t[4 * b + k] - pose[4 * b + k] * t[4 * a + k];
+            }
+            error[3 + r] = 0.5 * total;
+            if (DK_REFINE_TASK == 2 || DK_REFINE_TASK == 4) { /* u x t_u: u the tool axis */
+                error[3 + r] = pose[4 * a + x] * t[4 * b + x] - pose[4 * b + x] * t[4 * a + x];
+            }
+        }
+        for (l = 0; l < DK_LANES; l++) { /* ... and its size */
+            double most = 0.0;
+            for (r = 0; r < 3; r++) {
+                most = fabs(DK_AT(error[r], l)) > most ? fabs(DK_AT(error[r], l)) : most;
+                for (k = 0; k < 3; k++) {
+                    const double gap = fabs(t[4 * r + k] - DK_AT(pose[4 * r + k], l));
+                    if (DK_REFINE_TASK == 0 || k == DK_REFINE_AXIS) {
+                        most = gap > most ? gap : most;
+                    }
+                }
+            }
+            now[l] = most;
+        }
+#else
+        for (l = 0; l < DK_LANES; l++) { /* (the other tasks' error: dk_task_error's, a lane
+                                            at a time) */
+            double one[12], gaps[6];
+            for (k = 0; k < 12; k++) {
+                one[k] = DK_AT(pose[k], l);
+            }
+            now[l] = dk_task_error(one, t, reach, gaps);
+            for (r = 0; r < 6; r++) {
+                DK_AT(error[r], l) = gaps[r];
+            }
+        }
+#endif
+        for (l = 0; l < DK_LANES; l++) { /* (dk_refine's course, a lane at a time) */
+            const int w = who[l];
+            last[l] = done[l] = 0;
+            if (w < 0) {
+                continue;
+            }
+            if (now[l] < size[w]) {
+                size[w] = now[l];
+                worse[l] = 0;
+                for (i = 0; i < DK_REFINE_N; i++) {
+                    q[w][i] = DK_AT(cur[i], l);
+                }
+            } else { /* (near a singular configuration the error can grow before it falls) */
+                worse[l]++;
+            }
+            if (worse[l] == patience && size[w] <= DK_REFINE_SETTLE) { /* (dk_refine goes on
+                by QR's steps: alone) */
+                alone[w] = done[l] = 1;
+                continue;
+            }
+            done[l] = now[l] <= DK_REFINE_DONE || worse[l] == patience;
+            last[l] = !done[l] && now[l] <= DK_REFINE_LAST && worse[l] == 0;
+        }
+        /* the last step, with the previous factor where the previous step was within
+           DK_REFINE_SMALL (dk_refine's): in every lane, taken in the lanes it is theirs */
+        for (k = 0; k < DK_REFINE_M; k++) {
+            again[k] = zero;
+            for (r = 0; r < DK_REFINE_ROWS; r++) {
+                again[k] += J[r][k] * error[r];
+            }
+        }
+        dk_ldl_again((const dk_lane(*)[DK_REFINE_M])normal, inverse, again);
+        for (l = 0; l < DK_LANES; l++) {
+            double most = 0.0;
+            if (!last[l] || !(reused[l] <= DK_REFINE_SMALL)) {
+                continue;
+            }
+            for (k = 0; k < DK_REFINE_M; k++) {
+                most = fabs(DK_AT(again[k], l)) > most ? fabs(DK_AT(again[k], l)) : most;
+            }
+            if (most <= DK_REFINE_TRUST * now[l]) {
+                for (k = 0; k < DK_REFINE_M; k++) {
+                    q[who[l]][solved[k]] = DK_AT(cur[solved[k]], l) + DK_AT(again[k], l);
+                }
+                done[l] = 1;
+            }
+        }
+        /* the Jacobian (dk_task_jacobian), the normal equations damped by the error's
+           square, their factor */
+#if DK_LANE_TASK
+        for (k = 0; k < DK_REFINE_M; k++) {
+            const int j = solved[k];
+            const dk_lane *z = axes[j];
+            if (revolute[j]) {
+                const dk_lane dx = pose[3] - origins[j][0], dy = pose[7] - origins[j][1];
+                const dk_lane dz = pose[11] - origins[j][2];
+                J[0][k] = (z[1] * dz - z[2] * dy) / reach;
+                J[1][k] = (z[2] * dx - z[0] * dz) / reach;
+                J[2][k] = (z[0] * dy - z[1] * dx) / reach;
+                J[3][k] = z[0];
+                J[4][k] = z[1];
+                J[5][k] = z[2];
+            } else {
+                for (r = 0; r < 3; r++) {
+                    J[r][k] = z[r] / reach;
+                    J[3 + r][k] = zero;
+                }
+            }
+            if (DK_REFINE_TASK == 2 || DK_REFINE_TASK == 4) { /* t_u x (z x u) (dk_task_column) */
+                const int x = DK_REFINE_AXIS;
+                const dk_lane u0 = pose[x], u1 = pose[4 + x], u2 = pose[8 + x];
+                const dk_lane w0 = revolute[j] ? z[1] * u2 - z[2] * u1 : zero;
+                const dk_lane w1 = revolute[j] ? z[2] * u0 - z[0] * u2 : zero;
+                const dk_lane w2 = revolute[j] ? z[0] * u1 - z[1] * u0 : zero;
+                J[3][k] = t[4 + x] * w2 - t[8 + x] * w1;
+                J[4][k] = t[8 + x] * w0 - t[x] * w2;
+                J[5][k] = t[x] * w1 - t[4 + x] * w0;
+                if (DK_REFINE_TASK == 4) {
+                    J[0][k] = J[1][k] = J[2][k] = zero;
+                }
+            }
+        }
+#else
+        for (l = 0; l < DK_LANES; l++) { /* (the other tasks' Jacobian: dk_task_jacobian's, a
+                                            lane at a time) */
+            double one[12], z[DK_REFINE_N][3], o[DK_REFINE_N][3], column[6][DK_REFINE_M];
+            for (k = 0; k < 12; k++) {
+                one[k] = DK_AT(pose[k], l);
+            }
+            for (i = 0; i < DK_REFINE_N; i++) {
+                for (r = 0; r < 3; r++) {
+                    z[i][r] = DK_AT(axes[i][r], l);
+                    o[i][r] = DK_AT(origins[i][r], l);
+                }
+            }
+            dk_task_jacobian(one, (const double(*)[3])z, (const double(*)[3])o, revolute, solved,
+                             reach, t, 0u, column);
+            for (r = 0; r < 6; r++) {
+                for (k = 0; k < DK_REFINE_M; k++) {
+                    DK_AT(J[r][k], l) = column[r][k];
+                }
+            }
+        }
+#endif
+        mu = zero;
+        for (r = 0; r < DK_REFINE_ROWS; r++) {
+            mu += error[r] * error[r];
+        }
+        for (k = 0; k < DK_REFINE_M; k++) { /* (J^T J + mu) step = J^T error */
+            step[k] = zero;
+            for (r = 0; r < DK_REFINE_ROWS; r++) {
+                step[k] += J[r][k] * error[r];
+            }
+            for (m = 0; m <= k; m++) {
+                dk_lane v = zero;
+                for (r = 0; r < DK_REFINE_ROWS; r++) {
+                    v += J[r][k] * J[r][m];
+                }
+                normal[k][m] = v;
+            }
+            normal[k][k] += mu;
+        }
+        for (l = 0; l < DK_LANES; l++) {
+            least[l] = HUGE_VAL;
+        }
+        for (k = 0; k < DK_REFINE_M; k++) { /* L D L^T, L's below normal's diagonal */
+            dk_lane d = normal[k][k], w[DK_REFINE_M];
+            for (m = 0; m < k; m++) {
+                w[m] = normal[k][m] * pivot[m];
+                d -= normal[k][m] * w[m];
+            }
+            pivot[k] = d;
+            inverse[k] = 1.0 / d;
+            for (l = 0; l < DK_LANES; l++) {
+                least[l] = DK_AT(d, l) < least[l] ? DK_AT(d, l) : least[l];
+            }
+            for (i = k + 1; i < DK_REFINE_M; i++) {
+                dk_lane v = normal[i][k];
+                for (m = 0; m < k; m++) {
+                    v -= normal[i][m] * w[m];
+                }
+                normal[i][k] = v * inverse[k];
+            }
+        }
+        dk_ldl_again((const dk_lane(*)[DK_REFINE_M])normal, inverse, step);
+        for (l = 0; l < DK_LANES; l++) { /* (a step longer than DK_REFINE_STRIDE: shortened) */
+            double most = 0.0;
+            for (k = 0; k < DK_REFINE_M; k++) {
+                most = fabs(DK_AT(step[k], l)) > most ? fabs(DK_AT(step[k], l)) : most;
+            }
+            longest[l] = most;
+            DK_AT(stride, l) = most > DK_REFINE_STRIDE ? DK_REFINE_STRIDE / most : 1.0;
+        }
+        for (k = 0; k < DK_REFINE_M; k++) { /* the step (dk_take_step), in every lane */
+            const int j = solved[k];
+            const dk_lane d = step[k] * stride, d2 = d * d;
+            const dk_lane cd = 1.0 - d2 / 2.0 * (1.0 - d2 / 12.0 * (1.0 - d2 / 30.0));
+            const dk_lane sd = d * (1.0 - d2 / 6.0 * (1.0 - d2 / 20.0 * (1.0 - d2 / 42.0)));
+            const dk_lane c0 = c[j], s0 = s[j];
+            cur[j] += d;
+            c[j] = c0 * cd - s0 * sd;
+            s[j] = s0 * cd + c0 * sd;
+            step[k] = d;
+        }
+        for (l = 0; l < DK_LANES; l++) {
+            const int w = who[l];
+            if (w < 0 || done[l]) {
+                continue;
+            }
+            if (!(least[l] > 0.0)) { /* (J^T J singular to roundings: dk_refine's QR course) */
+                alone[w] = done[l] = 1;
+                continue;
+            }
+            if (!(longest[l] < HUGE_VAL)) {
+                done[l] = 1;
+                continue;
+            }
+            for (k = 0; k < DK_REFINE_M; k++) { /* (a long step: cos and sin anew) */
+                const int j = solved[k];
+                if (revolute[j] && fabs(DK_AT(step[k], l)) > DK_REFINE_TURN) {
+                    DK_AT(c[j], l) = cos(DK_AT(cur[j], l));
+                    DK_AT(s[j], l) = sin(DK_AT(cur[j], l));
+                }
+            }
+            reused[l] = longest[l];
+            if (last[l] && longest[l] <= DK_REFINE_TRUST * now[l]) { /* (Newton's step from
+                there: the error squared, not measured) */
+                for (i = 0; i < DK_REFINE_N; i++) {
+                    q[w][i] = DK_AT(cur[i], l);
+                }
+                done[l] = 1;
+                continue;
+            }
+            done[l] = ++its[l] == steps;
+        }
+        for (l = 0; l < DK_LANES; l++) {
+            if (who[l] >= 0 && done[l]) {
+                who[l] = -1;
+                busy--;
+            }
+        }
+    }
+    for (k = 0; k < count; k++) { /* (the seeds refined alone: dk_refine) */
+        if (alone[k]) {
+            for (i = 0; i < DK_REFINE_N; i++) {
+                q[k][i] = seeds[k][i];
+            }
+            size[k] = dk_refine(chain, revolute, solved, reach, t, q[k], 0u, DK_REFINE_PATIENCE);
+        }
+    }
+}
+
+/* the seeds of a pose's rows waiting for dk_refine_lanes, in the solver's order (dk_defer),
+   with what refines them: the exact chain, its revolute joints, the joints it moves, its
+   reach, the pose t, the error a row is kept within, the room for rows (DK_MAX) */
+typedef struct {
+    const double (*chain)[12];
+    const int *revolute;
+    const int *solved;
+    double reach;
+    const double *t;
+    double limit;
+    int room;
+    int count;
+    double q[DK_PENDING][DK_REFINE_N], cs[DK_PENDING][DK_REFINE_N][2];
+} dk_pending;
+
+/* p, with no seed waiting, to refine onto the chain (its revolute joints, the joints it moves,
+   its reach) towards the pose t, keeping rows within limit while fewer than room */
+static void dk_pending_start(dk_pending *p, const double (*chain)[12], const int *revolute,
+                             const int *solved, double reach, const double *t, double limit,
+                             int room)
+{
+    p->chain = chain;
+    p->revolute = revolute;
+    p->solved = solved;
+    p->reach = reach;
+    p->t = t;
+    p->limit = limit;
+    p->room = room;
+    p->count = 0;
+}
+
+/* the waiting seeds refined (dk_refine_lanes), each then a row of found (n of them) where its
+   error is within limit, it is not a row already (dk_seen) and there is room: as the solver
+   kept its seeds one by one. The count of rows, n's new value. */
+static int dk_settle(dk_pending *p, double (*found)[DK_REFINE_N], int *n)
+{
+    double size[DK_PENDING];
+    int l, j;
+    if (p->count > 0) {
+        dk_refine_lanes(p->chain, p->revolute, p->solved, p->reach, p->t, p->q,
+                        (const double(*)[DK_REFINE_N][2])p->cs, p->count, size);
+        for (l = 0; l < p->count; l++) {
+            if (*n < p->room && size[l] <= p->limit &&
+                !dk_seen((const double(*)[DK_REFINE_N])found, *n, p->revolute, p->q[l])) {
+                for (j = 0; j < DK_REFINE_N; j++) {
+                    found[*n][j] = p->q[l][j];
+                }
+                (*n)++;
+            }
+        }
+        p->count = 0;
+    }
+    return *n;
+}
+
+/* the seed q (its joints held nowhere) to wait with up to DK_PENDING others (dk_settle): the
+   solver reads its count of rows through dk_settle only */
+static void dk_defer(dk_pending *p, const double q[DK_REFINE_N], const double cs[DK_REFINE_N][2],
+                     double (*found)[DK_REFINE_N], int *n)
+{
+    int j;
+    for (j = 0; j < DK_REFINE_N; j++) {
+        p->q[p->count][j] = q[j];
+        p->cs[p->count][j][0] = cs[j][0];
+        p->cs[p->count][j][1] = cs[j][1];
+    }
+    if (++p->count == DK_PENDING) {
+        dk_settle(p, found, n);
+    }
 }
 
 /* The pose of frame k of a chain of n joints and fixed frames (12 entries each: T(q) = F_0

@@ -273,6 +273,15 @@ def solve_lines(plan: Plan) -> tuple[tuple[int, str], ...]:
         # (rows within this need no polish: dk_polish; most are, and one dk_match settles it)
         body.append(Line(0, "const double dk_fine = fmin(tol, DK_REFINE_POLISH);"))
     body.append(Line(0, "int n = 0;"))
+    if fix:  # (the seeds wait for others, and are refined with them: dk_defer)
+        body.append(Line(0, "dk_pending dk_p;"))
+        body.append(
+            Line(
+                0,
+                "dk_pending_start(&dk_p, DK_CHAIN, DK_REVOLUTE, DK_SOLVED, DK_REACH, t, "
+                "fmin(tol, loose ? DK_REFINE_STALL : DK_REFINE_TOL), DK_MAX);",
+            )
+        )
     # whether two rows can repeat: where two values of one step lie within DK_DEDUP_TOL (or
     # always, where a row's joints are not the steps' values themselves, or are refined)
     body.append(Line(0, f"int dk_close = {0 if branches_are_outputs(plan) and not fix else 1};"))
@@ -281,6 +290,7 @@ def solve_lines(plan: Plan) -> tuple[tuple[int, str], ...]:
     # lines ending a loop's body, before its free-joint check (by the loop's closing line)
     endings: dict[int, list[Line]] = {}
     flip = wrist_flip(plan)
+    turned: dict[str, tuple[str, str]] = {}  # an angle's variable: its cos and sin
     seamed = seamed_outputs(plan) if not fix else frozenset()
     hoisted = HoistedFK.of(plan) if same_joints(plan) and not fix else None
     for live in steps:
@@ -344,7 +354,16 @@ def solve_lines(plan: Plan) -> tuple[tuple[int, str], ...]:
                 )
             )
             body.append(Line(depth, "int dk_flip = 0;"))
-        body.append(Line(depth, f"const int dk_m{j} = n;"))
+        if fix:  # (a free joint's loop, or one that may spread, counts its rows: dk_settle)
+            spread = f" || dk_v{j}.more > 0.0" if isinstance(step, SPREAD_STEPS) else ""
+            body.append(
+                Line(
+                    depth,
+                    f"const int dk_m{j} = dk_v{j}.free{spread} ? dk_settle(&dk_p, found, &n) : n;",
+                )
+            )
+        else:
+            body.append(Line(depth, f"const int dk_m{j} = n;"))
         if type(step) not in SINGLE:  # (one value, or a free joint's loop: never near)
             body.append(Line(depth, f"dk_close |= dk_near(&dk_v{j});"))
         body.append(Line(depth, f"for (int dk_k{j} = 0; dk_k{j} < dk_v{j}.n; dk_k{j}++) {{"))
@@ -353,6 +372,8 @@ def solve_lines(plan: Plan) -> tuple[tuple[int, str], ...]:
         c_name, s_name = f"c{j}", f"s{j}"
         if not step.angle:
             c_name, s_name = f"dk_c{j}", f"dk_s{j}"
+        else:
+            turned[str(var)] = (c_name, s_name)
         scope.declare(str(var))
         scope.declare(c_name)
         scope.declare(s_name)
@@ -368,12 +389,13 @@ def solve_lines(plan: Plan) -> tuple[tuple[int, str], ...]:
             body.append(Line(depth + 1, f"(void){c_name};"))
             body.append(Line(depth + 1, f"(void){s_name};"))
         # a free joint's loop ends at its first value that gave a solution
-        closing.append(Line(depth + 1, f"if (dk_v{j}.free && n > dk_m{j}) {{"))
+        count = "dk_settle(&dk_p, found, &n)" if fix else "n"  # (the rows found: all settled)
+        closing.append(Line(depth + 1, f"if (dk_v{j}.free && {count} > dk_m{j}) {{"))
         if fix and isinstance(step, SPREAD_STEPS):  # (a rough value that gave no row: the
             # values around it too, dk_wrist_spread)
             endings.setdefault(id(closing[-1]), []).extend(
                 [
-                    Line(depth + 1, f"if (dk_v{j}.more > 0.0 && n == dk_m{j}) {{"),
+                    Line(depth + 1, f"if (dk_v{j}.more > 0.0 && {count} == dk_m{j}) {{"),
                     Line(depth + 2, f"dk_spread_more(&dk_v{j});"),
                     Line(depth + 1, "}"),
                 ]
@@ -395,24 +417,31 @@ def solve_lines(plan: Plan) -> tuple[tuple[int, str], ...]:
         body.append(Line(depth + 1, f"double dk_q[DK_DOF] = {{{', '.join(outputs)}}};"))
         # (the joints the pose left free, held first: derive/c/runtime.c dk_refine_held)
         body.append(Line(depth + 1, f"const unsigned dk_held = {held or '0u'};"))
-        body.append(
-            Line(
-                depth + 1,
-                "const double dk_limit = fmin(tol, loose ? DK_REFINE_STALL : DK_REFINE_TOL);",
-            )
-        )
         # (the second pass refines only the seeds near the pose: dk_seed_near)
         body.append(
             Line(
                 depth + 1,
-                "if ((!loose || dk_seed_near(DK_CHAIN, DK_REVOLUTE, DK_REACH, t, dk_q)) && "
-                "dk_refine_held(DK_CHAIN, DK_REVOLUTE, DK_SOLVED, DK_REACH, t, dk_q, dk_held, "
-                "dk_limit, DK_REFINE_PATIENCE) <= dk_limit && "
+                "if (!loose || dk_seed_near(DK_CHAIN, DK_REVOLUTE, DK_REACH, t, dk_q)) {",
+            )
+        )
+        # (a seed held nowhere waits to be refined with others: dk_defer; one
+        # with joints held is refined now, after those waiting)
+        body.append(Line(depth + 2, "if (!dk_held) {"))
+        cs = ", ".join(f"{{{c}, {s}}}" for c, s in _output_cs(plan.ik.outputs, turned))
+        body.append(Line(depth + 3, f"const double dk_cs[DK_DOF][2] = {{{cs}}};"))
+        body.append(Line(depth + 3, "dk_defer(&dk_p, dk_q, dk_cs, found, &n);"))
+        body.append(
+            Line(
+                depth + 2,
+                "} else if (dk_settle(&dk_p, found, &n) < DK_MAX && dk_refine_held(DK_CHAIN, "
+                "DK_REVOLUTE, DK_SOLVED, DK_REACH, t, dk_q, dk_held, dk_p.limit, "
+                "DK_REFINE_PATIENCE) <= dk_p.limit && "
                 "!dk_seen((const double(*)[DK_DOF])found, n, DK_REVOLUTE, dk_q)) {",
             )
         )
-        body += [Line(depth + 2, f"found[n][{k}] = dk_q[{k}];") for k in range(len(outputs))]
-        body.append(Line(depth + 2, "n++;"))
+        body += [Line(depth + 3, f"found[n][{k}] = dk_q[{k}];") for k in range(len(outputs))]
+        body.append(Line(depth + 3, "n++;"))
+        body.append(Line(depth + 2, "}"))
         body.append(Line(depth + 1, "}"))
         body.append(Line(depth, "}"))
     elif hoisted is not None:
@@ -458,9 +487,42 @@ def solve_lines(plan: Plan) -> tuple[tuple[int, str], ...]:
             body.append(Line(line.depth, "}"))
         body.append(Line(line.depth - 1, "}"))
         scope.levels.pop()
+    if fix:
+        body.append(Line(0, "dk_settle(&dk_p, found, &n);"))
     body.append(Line(0, "*repeats = dk_close;"))
     body.append(Line(0, "return n;"))
     return tuple((ln.depth, ln.text) for ln in body)
+
+
+def _output_cs(
+    outputs: tuple[sp.Expr, ...], turned: dict[str, tuple[str, str]]
+) -> list[tuple[str, str]]:
+    """Each arm joint's cos and sin at a row (C expressions): where its value is +-theta + k,
+    theta an angle of the closed form's (its cos c and sin s in turned), theirs turned by k's
+    (cos(+-theta + k) = c cos k -+ s sin k, sin = +-s cos k + c sin k), else the library's of
+    the row's value dk_q[i] (a length's are not read)."""
+
+    def total(a: str, x: float, b: str, y: float) -> str:  # a x + b y, the signs folded
+        return f"{a} * {x!r} {'-' if y < 0 else '+'} {b} * {abs(y)!r}"
+
+    pairs = []
+    for i, out in enumerate(outputs):
+        pair = (f"cos(dk_q[{i}])", f"sin(dk_q[{i}])")
+        for var in out.free_symbols:
+            if str(var) not in turned:
+                continue
+            c, s = turned[str(var)]
+            for sign in (1, -1):
+                k = sp.expand(out - sign * var)
+                if not k.is_number:
+                    continue
+                ck, sk = math.cos(float(k)), math.sin(float(k))
+                if ck == 1.0 and sk == 0.0:
+                    pair = (c, s if sign == 1 else f"-{s}")
+                else:
+                    pair = (total(c, ck, s, -sign * sk), total(s, sign * ck, c, sk))
+        pairs.append(pair)
+    return pairs
 
 
 # Solve kind -> the C runtime's sign function of its branches (derive/c/runtime.c)
