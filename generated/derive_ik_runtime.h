@@ -9,7 +9,7 @@
    is solved by it): one copy serves every arm of a folder, and each arm's file gets its own
    static copy of the routines, so arms link together in one program. Compile <name>_ik.c
    with it beside the file; do not include it anywhere else. */
-#define DK_RUNTIME 0xf7b9219d829b
+#define DK_RUNTIME 0x6dca206e8b56
 
 #include <math.h>
 #include <stddef.h>
@@ -2483,7 +2483,8 @@ static void dk_refine_lanes(const double chain[DK_REFINE_N + 1][12],
                 most = fabs(DK_AT(error[r], l)) > most ? fabs(DK_AT(error[r], l)) : most;
                 for (k = 0; k < 3; k++) {
                     const double gap = fabs(t[4 * r + k] - DK_AT(pose[4 * r + k], l));
-                    if (DK_REFINE_TASK == 0 || k == DK_REFINE_AXIS) {
+                    if (DK_REFINE_TASK == 0 ||
+                        (DK_REFINE_TASK != 1 && k == DK_REFINE_AXIS)) { /* (the direction's) */
                         most = gap > most ? gap : most;
                     }
                 }

@@ -34,7 +34,7 @@
 /* --- the routines every generated C solver shares: derive_ik_runtime.h beside this file ---- */
 
 #include "derive_ik_runtime.h"
-#if DK_RUNTIME != 0xf7b9219d829b
+#if DK_RUNTIME != 0x6dca206e8b56
 #error "derive_ik_runtime.h is another derive-ik's: generate the arms of a folder with one"
 #endif
 

@@ -1055,3 +1055,44 @@ def test_a_wrist_centre_on_axis_1_seeds_more_than_wait_and_c_answers_as_python(t
             assert np.max(np.abs(E[:3, :3] - T[:3, :3])) <= 1e-10
             assert np.max(np.abs(E[:3, 3] - T[:3, 3])) <= 1e-10 * module.REACH
     assert tried >= 6
+
+
+@needs_cc
+@pytest.mark.parametrize(
+    ("task", "call"),
+    [
+        ("position", lambda m, T, free, b: m.ik_position(T[:3, 3], free=free, backend=b)),
+        (
+            "direction",
+            lambda m, T, free, b: m.ik_direction(T[:3, 3], T[:3, 2], free=free, backend=b),
+        ),
+    ],
+)
+def test_a_refined_task_arm_s_c_answers_as_python(task, call, tmp_path):
+    """A task on an arm refined onto its exact frames (the UR5 written as a noisy URDF): C's
+    lanes compute the task's own error (dk_refine_lanes; a first version measured the
+    position task's error with the tool axis's entries too, and kept only the rows that
+    reproduced the whole pose: one of four). The same rows from either backend."""
+    from derive import urdf
+    from derive.load import solver_sources
+
+    from conftest import import_path
+
+    path = tmp_path / "ur5_noisy.urdf"
+    path.write_text(noisy_urdf("ur5", 1), encoding="utf-8")
+    spec = urdf.load_urdf(path, urdf.Options(base="l0", tip="tool", task=task))
+    assert spec.exact is not None
+    folder = tmp_path / "module"
+    folder.mkdir()
+    for file, text in solver_sources(build_plan(spec)).items():
+        (folder / file).write_text(text, encoding="utf-8")
+    module = import_path(folder / f"{spec.name}.py")
+    rng = np.random.default_rng(4)
+    counts = []
+    for q in rng.uniform(-3.1, 3.1, (60, 6)):
+        T = module.fk(q)
+        free = [q[j - 1] for j in module.FREE]
+        a, b = call(module, T, free, "c"), call(module, T, free, "python")
+        assert a.shape == b.shape and np.allclose(a, b, atol=1e-9)
+        counts.append(len(a))
+    assert max(counts) >= 4

@@ -2469,7 +2469,8 @@ static void dk_refine_lanes(const double chain[DK_REFINE_N + 1][12],
                 most = fabs(DK_AT(error[r], l)) > most ? fabs(DK_AT(error[r], l)) : most;
                 for (k = 0; k < 3; k++) {
                     const double gap = fabs(t[4 * r + k] - DK_AT(pose[4 * r + k], l));
-                    if (DK_REFINE_TASK == 0 || k == DK_REFINE_AXIS) {
+                    if (DK_REFINE_TASK == 0 ||
+                        (DK_REFINE_TASK != 1 && k == DK_REFINE_AXIS)) { /* (the direction's) */
                         most = gap > most ? gap : most;
                     }
                 }
