@@ -9,7 +9,7 @@
    is solved by it): one copy serves every arm of a folder, and each arm's file gets its own
    static copy of the routines, so arms link together in one program. Compile <name>_ik.c
    with it beside the file; do not include it anywhere else. */
-#define DK_RUNTIME 0x7ef82c6c4f5b
+#define DK_RUNTIME 0x167801bae93d
 
 #include <math.h>
 #include <stddef.h>
@@ -1166,12 +1166,12 @@ static void dk_aberth(const double *p, int d, dk_cx *z)
     }
 }
 
-/* the real roots of p (degree 1, 2 or 4, p[0] != 0) as the Python solver's _real_roots: the
-   closed forms' roots, accepted if each passes the residual test, else accepted unchecked
-   (where the Python solver takes numpy.roots' unchecked; forward kinematics certifies every
-   solution either way); where DK_POLY_MAX > 4, another degree up to DK_POLY_MAX: the Aberth
-   iteration's roots from a circle, accepted unchecked (numpy.roots' in the Python solver),
-   else -1 for another degree */
+/* the real roots of p (degree 1 to DK_POLY_MAX, p[0] != 0) as the Python solver's
+   _real_roots: for degree 1, 2 or 4 the closed forms' roots, accepted if each passes the
+   residual test, else accepted unchecked (where the Python solver takes numpy.roots'
+   unchecked; forward kinematics certifies every solution either way); another degree (a
+   cubic: a quartic whose leading coefficient vanished) the Aberth iteration's roots from a
+   circle, accepted unchecked (numpy.roots' in the Python solver); -1 above DK_POLY_MAX */
 static int dk_roots(const double *p, int d, double *out)
 {
     dk_cx z[DK_POLY_MAX];
@@ -1202,8 +1202,8 @@ static int dk_roots(const double *p, int d, double *out)
         dk_quadratic_real(b, c, &z[0], &z[1]);
     } else if (d == 4) {
         dk_quartic_real(p[1] / p[0], p[2] / p[0], p[3] / p[0], p[4] / p[0], z);
-    } else {
-#if DK_POLY_MAX > 4
+    } else { /* (a cubic too: a quartic whose leading coefficient vanished, as an SO-100's
+                theta1 at q1 = 0, where both its ends do) */
         /* starting points on a circle of Fujiwara's bound on the roots' size */
         double bound = 0.0;
         int k;
@@ -1220,9 +1220,6 @@ static int dk_roots(const double *p, int d, double *out)
         }
         dk_aberth(p, d, z);
         return dk_accept(p, d, z, d, 0, out);
-#else
-        return -1;
-#endif
     }
     n = dk_accept(p, d, z, d, 1, out);
     if (n >= 0) {

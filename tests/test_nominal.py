@@ -1116,3 +1116,38 @@ def test_a_last_step_near_a_singular_configuration_is_measured_again(tmp_path):
         E = module.fk(row)
         assert np.max(np.abs(E[:3, :3] - T[:3, :3])) <= 1e-10
         assert np.max(np.abs(E[:3, 3] - T[:3, 3])) <= 1e-10 * module.REACH
+
+
+@needs_cc
+def test_a_quartic_left_a_cubic_is_solved_in_c(tmp_path):
+    """ManiSkill's SO-100 URDF at q1 = 0 or pi: its theta1 quartic's two ends vanish, and
+    dropping the leading one left a cubic, which C's dk_roots refused where DK_POLY_MAX is 4
+    (the pose UNSETTLED, so the module answered in Python, in milliseconds, at the arm's home
+    angle: 100 of 100 poses). C answers them itself now (the harness, no fallback), with
+    Python's rows, the sampled vector among them."""
+    from derive import urdf
+    from derive.cbuild import Harness
+    from derive.load import solver_sources
+
+    from conftest import import_path
+
+    path = Path(__file__).parent / "data" / "urdf" / "so100_maniskill.urdf"
+    spec = urdf.load_urdf(path, urdf.Options(base="Base", tip="Fixed_Jaw_tip"))
+    (tmp_path / "module").mkdir()
+    for file, text in solver_sources(build_plan(spec)).items():
+        (tmp_path / "module" / file).write_text(text, encoding="utf-8")
+    module = import_path(tmp_path / "module" / f"{spec.name}.py")
+    rng = np.random.default_rng(1)
+    Q = rng.uniform(-1.5, 1.5, (40, 5))
+    Q[:20, 0], Q[20:, 0] = 0.0, math.pi
+    T = module.fk_batch(Q)
+    (tmp_path / "harness").mkdir()
+    counts, rows = Harness(build_plan(spec), tmp_path / "harness").solve(T, np.zeros_like(Q))
+    assert (counts > 0).all()
+    for k, q in enumerate(Q):
+        c, p = rows[k, : counts[k]], module.ik(T[k], backend="python")
+        assert len(c) == len(p)
+        wrapped = np.abs(np.remainder(c[:, None] - p[None] + math.pi, 2 * math.pi) - math.pi)
+        assert wrapped.max(axis=2).min(axis=1).max() <= 1e-9
+        gaps = np.abs(np.remainder(c - q + math.pi, 2 * math.pi) - math.pi)
+        assert np.max(gaps, axis=1).min() <= 1e-8
