@@ -9,7 +9,7 @@
    is solved by it): one copy serves every arm of a folder, and each arm's file gets its own
    static copy of the routines, so arms link together in one program. Compile <name>_ik.c
    with it beside the file; do not include it anywhere else. */
-#define DK_RUNTIME 0x167801bae93d
+#define DK_RUNTIME 0xb4211d43b5c8
 
 #include <math.h>
 #include <stddef.h>
@@ -2232,12 +2232,11 @@ static double dk_refine(const double chain[DK_REFINE_N + 1][12], const int revol
     return best;
 }
 
-/* whether the pose of the chain at q is within DK_SEED_TOL of the target t (the task's
-   error): the solver's second pass refines only such seeds (a pose out of reach gives seeds
-   far from it; the Python solver's _seed, with _LOOSE.near) */
-static int dk_seed_near(const double chain[DK_REFINE_N + 1][12],
-                        const int revolute[DK_REFINE_N], double reach, const double t[12],
-                        const double q[DK_REFINE_N])
+/* the task's error (dk_task_error's size) of the chain's pose at q, its cos and sin the
+   library's */
+static double dk_chain_error(const double chain[DK_REFINE_N + 1][12],
+                             const int revolute[DK_REFINE_N], double reach, const double t[12],
+                             const double q[DK_REFINE_N])
 {
     double cs[DK_REFINE_N][2], pose[12], axes[DK_REFINE_N][3], origins[DK_REFINE_N][3];
     double error[6];
@@ -2247,7 +2246,17 @@ static int dk_seed_near(const double chain[DK_REFINE_N + 1][12],
         cs[i][1] = sin(q[i]);
     }
     dk_chain_pose(chain, revolute, q, (const double(*)[2])cs, pose, axes, origins);
-    return dk_task_error(pose, t, reach, error) <= DK_SEED_TOL;
+    return dk_task_error(pose, t, reach, error);
+}
+
+/* whether the pose of the chain at q is within DK_SEED_TOL of the target t (the task's
+   error): the solver's second pass refines only such seeds (a pose out of reach gives seeds
+   far from it; the Python solver's _seed, with _LOOSE.near) */
+static int dk_seed_near(const double chain[DK_REFINE_N + 1][12],
+                        const int revolute[DK_REFINE_N], double reach, const double t[12],
+                        const double q[DK_REFINE_N])
+{
+    return dk_chain_error(chain, revolute, reach, t, q) <= DK_SEED_TOL;
 }
 
 /* dk_refine of a nominal solution q, the joints in held (a bit per arm joint: those the pose
@@ -2722,14 +2731,7 @@ static void dk_refine_lanes(const double chain[DK_REFINE_N + 1][12],
     for (k = 0; k < count; k++) { /* (the seeds refined alone: dk_refine) */
         if (measure[k] && !alone[k] && size[k] <= DK_REFINE_STALL) { /* (its error at the
             point it ends on, with the library's cos and sin: a row's, where it can be one) */
-            double cs1[DK_REFINE_N][2], pose1[12], axes1[DK_REFINE_N][3];
-            double origins1[DK_REFINE_N][3], error1[6];
-            for (i = 0; i < DK_REFINE_N; i++) {
-                cs1[i][0] = cos(q[k][i]);
-                cs1[i][1] = sin(q[k][i]);
-            }
-            dk_chain_pose(chain, revolute, q[k], (const double(*)[2])cs1, pose1, axes1, origins1);
-            size[k] = dk_task_error(pose1, t, reach, error1);
+            size[k] = dk_chain_error(chain, revolute, reach, t, q[k]);
         }
         if (alone[k]) {
             for (i = 0; i < DK_REFINE_N; i++) {

@@ -106,6 +106,19 @@ def calibrated(name: str, seed: int = 7) -> str:
     return head + "\n".join(rows)
 
 
+def spec_module(spec, folder: Path):
+    """The module of a spec (a URDF's conversion, say) generated into folder (made if
+    missing), with its C files, and imported."""
+    from derive.load import solver_sources
+
+    from conftest import import_path
+
+    folder.mkdir(parents=True, exist_ok=True)
+    for file, text in solver_sources(build_plan(spec)).items():
+        (folder / file).write_text(text, encoding="utf-8")
+    return import_path(folder / f"{spec.name}.py")
+
+
 def test_nominal_snaps_the_structure_parameters_within_the_tolerance_only():
     spec = parse_spec(calibrated("puma"), "<test>")
     near = nominal(spec, 1e-3)
@@ -263,17 +276,12 @@ def xarm6(tmp_path_factory):
     its module (the general method on the snapped table, refined onto the URDF's frames) and
     the URDF's own chain."""
     from derive import urdf
-    from derive.load import solver_sources
-
-    from conftest import import_path
 
     chain = urdf.chain_between(urdf.read_urdf(XARM6), "world", "link6", str(XARM6))
     spec = urdf.load_urdf(XARM6, urdf.Options(base="world", tip="link6"))
     assert spec.exact is not None
     folder = tmp_path_factory.mktemp("xarm6")
-    for name, text in solver_sources(build_plan(spec)).items():
-        (folder / name).write_text(text, encoding="utf-8")
-    return import_path(folder / "xarm6.py"), chain
+    return spec_module(spec, folder), chain
 
 
 @needs_cc
@@ -529,20 +537,13 @@ def test_industrial_arms_written_as_noisy_urdfs_are_answered_exactly(name, tmp_p
     URDF's own, every row reproduces the URDF's pose, the URDF's joint vector is found on
     every regular sample and every sample gets an answer."""
     from derive import urdf
-    from derive.load import solver_sources
-
-    from conftest import import_path
 
     path = tmp_path / f"{name}_noisy.urdf"
     path.write_text(noisy_urdf(name, 1), encoding="utf-8")
     chain = urdf.chain_between(urdf.read_urdf(path), "l0", "tool", str(path))
     spec = urdf.load_urdf(path, urdf.Options(base="l0", tip="tool"))
     assert spec.exact is not None
-    folder = tmp_path / "module"
-    folder.mkdir()
-    for file, text in solver_sources(build_plan(spec)).items():
-        (folder / file).write_text(text, encoding="utf-8")
-    module = import_path(folder / f"{spec.name}.py")
+    module = spec_module(spec, tmp_path / "module")
     assert METHODS[name] == module.METHOD
     rng = np.random.default_rng(9)
     regular = missed = 0
@@ -574,20 +575,13 @@ def test_a_calibrated_urdf_s_nearly_parallel_axes_do_not_inflate_its_size(tmp_pa
     pose (positions over that sum), the URDF's joint vector found on every regular sample
     (smallest singular value of the Jacobian, positions over that sum, at least 0.05)."""
     from derive import urdf
-    from derive.load import solver_sources
-
-    from conftest import import_path
 
     path = tmp_path / "kr6_calibrated.urdf"
     path.write_text(noisy_urdf("kr6", 2, calibrated=True), encoding="utf-8")
     chain = urdf.chain_between(urdf.read_urdf(path), "l0", "tool", str(path))
     spec = urdf.load_urdf(path, urdf.Options(base="l0", tip="tool"))
     assert max(abs(j.d) for j in spec.joints) > 1.0  # (the common normal far out)
-    folder = tmp_path / "module"
-    folder.mkdir()
-    for file, text in solver_sources(build_plan(spec)).items():
-        (folder / file).write_text(text, encoding="utf-8")
-    module = import_path(folder / f"{spec.name}.py")
+    module = spec_module(spec, tmp_path / "module")
     size = sum(abs(a) + abs(d) for _alpha, a, d, _theta in TABLES["kr6"])
     assert module.REACH / size <= 1.5, module.REACH
     rng = np.random.default_rng(4)
@@ -618,16 +612,11 @@ def test_a_calibrated_ur5_s_pair_near_its_shoulder_singularity_is_found(tmp_path
     (multistart Newton finds 6) and missed the sampled vector; with _FOLD_SPREAD (16) all 6,
     every row within 1e-10 of the URDF's pose."""
     from derive import urdf
-    from derive.load import solver_sources
-
-    from conftest import import_path
 
     path = Path(__file__).parent / "data" / "urdf" / "ur5_calibrated.urdf"
     chain = urdf.chain_between(urdf.read_urdf(path), "l0", "tool", str(path))
     spec = urdf.load_urdf(path, urdf.Options(base="l0", tip="tool"))
-    for file, text in solver_sources(build_plan(spec)).items():
-        (tmp_path / file).write_text(text, encoding="utf-8")
-    module = import_path(tmp_path / f"{spec.name}.py")
+    module = spec_module(spec, tmp_path)
     q = [-1.2444148265129171, -1.4225892133925557, 0.06213054133889662, 2.978737269109371]
     q += [0.7793403827191305, 1.188327148642589]
     answered_with(chain, module, q, 1e-9)
@@ -639,16 +628,11 @@ def zoo_ur3e(folder: Path):
     """The UR3e zoo URDF's chain (tests/data/urdf/SOURCES.md: its numbers with 7 decimals, a
     nominal table 2e-7 from it) and its generated module, written into folder."""
     from derive import urdf
-    from derive.load import solver_sources
-
-    from conftest import import_path
 
     path = Path(__file__).parent / "data" / "urdf" / "ur3e_zoo.urdf"
     chain = urdf.chain_between(urdf.read_urdf(path), "base_link", "tool0", str(path))
     spec = urdf.load_urdf(path, urdf.Options(base="base_link", tip="tool0"))
-    for file, text in solver_sources(build_plan(spec)).items():
-        (folder / file).write_text(text, encoding="utf-8")
-    return chain, import_path(folder / f"{spec.name}.py")
+    return chain, spec_module(spec, folder)
 
 
 def answered_with(chain, module, q: list[float], near: float) -> None:
@@ -705,19 +689,12 @@ def test_a_wrist_singular_within_rounding_keeps_q_ref_s_free_joint(tmp_path):
     got it back at 30 (C) and 23 (Python) of 40 such poses (a new user's attack). The free
     joint is now held at q_ref's value first (refine.py _seed, runtime.c dk_refine_held)."""
     from derive import urdf
-    from derive.load import solver_sources
-
-    from conftest import import_path
 
     path = tmp_path / "ur5_rounded.urdf"
     path.write_text(noisy_urdf("ur5", 3, decimals=10), encoding="utf-8")
     chain = urdf.chain_between(urdf.read_urdf(path), "l0", "tool", str(path))
     spec = urdf.load_urdf(path, urdf.Options(base="l0", tip="tool"))
-    folder = tmp_path / "module"
-    folder.mkdir()
-    for file, text in solver_sources(build_plan(spec)).items():
-        (folder / file).write_text(text, encoding="utf-8")
-    module = import_path(folder / f"{spec.name}.py")
+    module = spec_module(spec, tmp_path / "module")
     assert 0.0 < module._SEED_TOL <= 1e-7  # (the nominal closed form, refined: ~1e-10 off)
     rng = np.random.default_rng(17)
     for q5 in (0.0, math.pi):
@@ -747,16 +724,11 @@ def test_a_task_arm_near_its_singular_configuration_is_answered(tmp_path):
     ik_approximate's seeds) and refines the seeds within _SEED_TOL of the pose, in Python
     (api.py _solve) and C (dk_solve's loose)."""
     from derive import urdf
-    from derive.load import solver_sources
-
-    from conftest import import_path
 
     path = Path(__file__).parent / "data" / "urdf" / "hextilt_flying_arm_5.urdf"
     base, tip = "flying_arm_5__base_link", "flying_arm_5__gripper"
     spec = urdf.load_urdf(path, urdf.Options(base=base, tip=tip))
-    for file, text in solver_sources(build_plan(spec)).items():
-        (tmp_path / file).write_text(text, encoding="utf-8")
-    module = import_path(tmp_path / f"{spec.name}.py")
+    module = spec_module(spec, tmp_path)
     assert module._SEED_TOL > 0.0  # (the nominal closed form, refined)
     near = [1.3287403839903897, 0.23162178599699912, -0.734598188427157, 1.5807926535948966,
             0.03920609479688619]  # fmt: skip
@@ -796,16 +768,11 @@ def test_a_wrist_system_with_no_scale_is_solved_not_divided_by_zero(tmp_path):
     scale of 0 now spreads nothing, in Python and C; every row reproduces the URDF's own
     position and tool axis, the sampled vector among them."""
     from derive import urdf
-    from derive.load import solver_sources
-
-    from conftest import import_path
 
     path = Path(__file__).parent / "data" / "urdf" / "so100_maniskill.urdf"
     spec = urdf.load_urdf(path, urdf.Options(base="Base", tip="Fixed_Jaw_tip"))
     chain = urdf.chain_between(urdf.read_urdf(path), "Base", "Fixed_Jaw_tip", str(path))
-    for file, text in solver_sources(build_plan(spec)).items():
-        (tmp_path / file).write_text(text, encoding="utf-8")
-    module = import_path(tmp_path / f"{spec.name}.py")
+    module = spec_module(spec, tmp_path)
     assert module._SEED_TOL > 0.0  # (the nominal closed form, refined)
     rng = np.random.default_rng(3)
     for q in [np.zeros(5), *rng.uniform(-1.5, 1.5, (4, 5))]:
@@ -831,16 +798,11 @@ def test_an_exact_table_s_straight_wrist_is_answered_by_its_second_pass(tmp_path
     within _LOOSE_TOL (1e-8): its polish stalls 4e-8 to 2e-7 from the pose on the nearly
     continuous solutions elsewhere, and such rows are no solutions."""
     from derive import urdf
-    from derive.load import solver_sources
-
-    from conftest import import_path
 
     path = Path(__file__).parent / "data" / "urdf" / "so100_maniskill.urdf"
     spec = urdf.load_urdf(path, urdf.Options(base="Base", tip="Fixed_Jaw_tip", exact=True))
     chain = urdf.chain_between(urdf.read_urdf(path), "Base", "Fixed_Jaw_tip", str(path))
-    for file, text in solver_sources(build_plan(spec)).items():
-        (tmp_path / file).write_text(text, encoding="utf-8")
-    module = import_path(tmp_path / f"{spec.name}.py")
+    module = spec_module(spec, tmp_path)
     assert module._SEED_TOL == 0.0  # (the exact table's own closed form)
     for q in ([0.0] * 5, [0.2, 0.0, 0.0, 0.0, 0.0], [0.0, 0.1, -0.1, 0.2, 0.0]):
         T = np.array(urdf.urdf_fk(chain, q))
@@ -1074,19 +1036,12 @@ def test_a_refined_task_arm_s_c_answers_as_python(task, call, tmp_path):
     position task's error with the tool axis's entries too, and kept only the rows that
     reproduced the whole pose: one of four). The same rows from either backend."""
     from derive import urdf
-    from derive.load import solver_sources
-
-    from conftest import import_path
 
     path = tmp_path / "ur5_noisy.urdf"
     path.write_text(noisy_urdf("ur5", 1), encoding="utf-8")
     spec = urdf.load_urdf(path, urdf.Options(base="l0", tip="tool", task=task))
     assert spec.exact is not None
-    folder = tmp_path / "module"
-    folder.mkdir()
-    for file, text in solver_sources(build_plan(spec)).items():
-        (folder / file).write_text(text, encoding="utf-8")
-    module = import_path(folder / f"{spec.name}.py")
+    module = spec_module(spec, tmp_path / "module")
     rng = np.random.default_rng(4)
     counts = []
     for q in rng.uniform(-3.1, 3.1, (60, 6)):
@@ -1127,16 +1082,10 @@ def test_a_quartic_left_a_cubic_is_solved_in_c(tmp_path):
     Python's rows, the sampled vector among them."""
     from derive import urdf
     from derive.cbuild import Harness
-    from derive.load import solver_sources
-
-    from conftest import import_path
 
     path = Path(__file__).parent / "data" / "urdf" / "so100_maniskill.urdf"
     spec = urdf.load_urdf(path, urdf.Options(base="Base", tip="Fixed_Jaw_tip"))
-    (tmp_path / "module").mkdir()
-    for file, text in solver_sources(build_plan(spec)).items():
-        (tmp_path / "module" / file).write_text(text, encoding="utf-8")
-    module = import_path(tmp_path / "module" / f"{spec.name}.py")
+    module = spec_module(spec, tmp_path / "module")
     rng = np.random.default_rng(1)
     Q = rng.uniform(-1.5, 1.5, (40, 5))
     Q[:20, 0], Q[20:, 0] = 0.0, math.pi
