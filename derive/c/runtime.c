@@ -2416,6 +2416,10 @@ static void dk_refine_lanes(const double chain[DK_REFINE_N + 1][12],
     /* the seed each lane refines (-1: none), its steps and the steps since its error last
        fell; whether a seed is to be refined alone */
     int who[DK_LANES], its[DK_LANES], worse[DK_LANES], alone[DK_PENDING], measure[DK_PENDING];
+    /* a lane's point judged (dk_refine's course) since its last step; whether that was the
+       seed's last measure (last) or its end (done); the error measured there */
+    int judged[DK_LANES], last[DK_LANES], done[DK_LANES];
+    double now[DK_LANES];
     double seeds[DK_PENDING][DK_REFINE_N];
     int next = 0, busy = 0, i, k, l, m, r;
     for (k = 0; k < DK_REFINE_M; k++) {
@@ -2434,8 +2438,8 @@ static void dk_refine_lanes(const double chain[DK_REFINE_N + 1][12],
     }
     for (l = 0; l < DK_LANES; l++) {
         who[l] = -1;
-        its[l] = worse[l] = 0;
-        reused[l] = floor[l] = HUGE_VAL;
+        its[l] = worse[l] = judged[l] = last[l] = done[l] = 0;
+        reused[l] = floor[l] = now[l] = HUGE_VAL;
     }
     for (k = 0; k < count; k++) {
         alone[k] = measure[k] = 0;
@@ -2447,14 +2451,14 @@ static void dk_refine_lanes(const double chain[DK_REFINE_N + 1][12],
     for (;;) {
         dk_lane pose[12], axes[DK_REFINE_N][3], origins[DK_REFINE_N][3], error[6];
         dk_lane step[DK_REFINE_M], again[DK_REFINE_M], mu, stride;
-        double now[DK_LANES], longest[DK_LANES], least[DK_LANES];
-        int last[DK_LANES], done[DK_LANES];
+        double longest[DK_LANES], least[DK_LANES], measured[DK_LANES];
+        int ended = 0;
         for (l = 0; l < DK_LANES; l++) { /* (a lane whose seed is done takes the next) */
             if (who[l] >= 0 || next == count) {
                 continue;
             }
             who[l] = next++;
-            its[l] = worse[l] = 0;
+            its[l] = worse[l] = judged[l] = 0;
             reused[l] = floor[l] = HUGE_VAL;
             for (i = 0; i < DK_REFINE_N; i++) {
                 DK_AT(cur[i], l) = q[who[l]][i];
@@ -2492,7 +2496,7 @@ static void dk_refine_lanes(const double chain[DK_REFINE_N + 1][12],
                     }
                 }
             }
-            now[l] = most;
+            measured[l] = most;
         }
 #else
         for (l = 0; l < DK_LANES; l++) { /* (the other tasks' error: dk_task_error's, a lane
@@ -2501,18 +2505,21 @@ static void dk_refine_lanes(const double chain[DK_REFINE_N + 1][12],
             for (k = 0; k < 12; k++) {
                 one[k] = DK_AT(pose[k], l);
             }
-            now[l] = dk_task_error(one, t, reach, gaps);
+            measured[l] = dk_task_error(one, t, reach, gaps);
             for (r = 0; r < 6; r++) {
                 DK_AT(error[r], l) = gaps[r];
             }
         }
 #endif
-        for (l = 0; l < DK_LANES; l++) { /* (dk_refine's course, a lane at a time) */
+        for (l = 0; l < DK_LANES; l++) { /* (dk_refine's course, a lane at a time: where the
+                                            lane's point is not judged yet) */
             const int w = who[l];
-            last[l] = done[l] = 0;
-            if (w < 0) {
+            if (w < 0 || judged[l]) {
                 continue;
             }
+            judged[l] = 1;
+            last[l] = done[l] = 0;
+            now[l] = measured[l];
             if (now[l] < size[w]) {
                 size[w] = now[l];
                 worse[l] = 0;
@@ -2524,12 +2531,13 @@ static void dk_refine_lanes(const double chain[DK_REFINE_N + 1][12],
             }
             if (worse[l] == patience && size[w] <= DK_REFINE_SETTLE) { /* (dk_refine goes on
                 by QR's steps: alone) */
-                alone[w] = done[l] = 1;
+                alone[w] = done[l] = ended = 1;
                 continue;
             }
             done[l] = now[l] <= DK_REFINE_DONE || worse[l] == patience;
             measure[w] = worse[l] == patience;
             last[l] = !done[l] && now[l] <= DK_REFINE_LAST && worse[l] == 0;
+            ended |= done[l];
         }
         /* the last step, with the previous factor where the previous step was within
            DK_REFINE_SMALL (dk_refine's): in every lane, taken in the lanes it is theirs */
@@ -2542,7 +2550,7 @@ static void dk_refine_lanes(const double chain[DK_REFINE_N + 1][12],
         dk_ldl_again((const dk_lane(*)[DK_REFINE_M])normal, inverse, again);
         for (l = 0; l < DK_LANES; l++) {
             double most = 0.0;
-            if (!last[l] || !(reused[l] <= DK_REFINE_SMALL)) {
+            if (who[l] < 0 || done[l] || !last[l] || !(reused[l] <= DK_REFINE_SMALL)) {
                 continue;
             }
             for (k = 0; k < DK_REFINE_M; k++) { /* (a nan: nan) */
@@ -2552,9 +2560,23 @@ static void dk_refine_lanes(const double chain[DK_REFINE_N + 1][12],
                 for (k = 0; k < DK_REFINE_M; k++) {
                     q[who[l]][solved[k]] = DK_AT(cur[solved[k]], l) + DK_AT(again[k], l);
                 }
-                done[l] = 1;
+                done[l] = ended = 1;
                 measure[who[l]] = now[l] > DK_LANE_TRUSTED && floor[l] < DK_LANE_FLOOR;
             }
+        }
+        /* a seed that ended leaves its lane to the next seed, measured before the lanes' next
+           step (rather than the step taken in a lane whose seed is done) */
+        for (l = 0; l < DK_LANES; l++) {
+            if (who[l] >= 0 && done[l]) {
+                who[l] = -1;
+                busy--;
+            }
+        }
+        if (ended && next < count) {
+            continue;
+        }
+        if (busy == 0) {
+            break;
         }
         /* the Jacobian (dk_task_jacobian), the normal equations damped by the error's
            square, their factor */
@@ -2676,9 +2698,10 @@ static void dk_refine_lanes(const double chain[DK_REFINE_N + 1][12],
         }
         for (l = 0; l < DK_LANES; l++) {
             const int w = who[l];
-            if (w < 0 || done[l]) {
+            if (w < 0) {
                 continue;
             }
+            judged[l] = 0;
             if (!(least[l] > 0.0)) { /* (J^T J singular to roundings: dk_refine's QR course) */
                 alone[w] = done[l] = 1;
                 continue;
