@@ -266,6 +266,10 @@ class Eigen(Solve):
     first: int = 1
     # the six joints' kinds, R or P, in the arm's order
     kinds: str = "RRRRRR"
+    # the ends of the six (0: their first three joints, 3: their last three) whose wrist flip
+    # leaves the pose unchanged, on the arm's own table (derive/methods/general.py, flip_ends):
+    # the run time's wrist-flip partners are tried there only
+    flips: tuple[int, ...] = (0, 3)
 
     @property
     def indices(self) -> range:

@@ -37,7 +37,7 @@ if "_RUNTIME_VERSION" not in globals():  # (imported on its own, not run by a mo
         "namespace; it is not a module to import"
     )
 # this runtime's version: a module runs the runtime of its own version only
-_RUNTIME_VERSION = "c6b59eb96f1df6b7"
+_RUNTIME_VERSION = "17fa4b8f1e20f939"
 
 if TYPE_CHECKING:  # defined by the module running this file
     from derive.runtime.arm import (
@@ -47,6 +47,7 @@ if TYPE_CHECKING:  # defined by the module running this file
         _PLANE_ROTATION,
         _PLANE_SLIDE,
         _REVOLUTE,
+        _RR_FLIPS,
         _RR_LENGTH,
         _RR_PIVOTS,
         _RR_SPLITS,
@@ -2820,16 +2821,15 @@ class _RRLeads:
 
 
 def _rr_partners(targets, rows):
-    """The wrist-flip partners of the rows: each row with the three joints at either end
-    turned as a spherical wrist's flip, (t1 + pi, -t2, t3 + pi) (an end with a sliding joint
-    left alone), polished by Newton's steps on split 0's frame and the arm's own table; the
-    arm's values of those that reach _RR_GOOD (the caller merges repeats). Where those axes
-    do not meet, Newton ends elsewhere or nowhere: nothing unsound is added either way."""
+    """The wrist-flip partners of the rows: each row with the three joints at an end that is
+    a spherical wrist (_RR_FLIPS) turned as its flip, (t1 + pi, -t2, t3 + pi) (an end with a
+    sliding joint left alone), polished by Newton's steps on split 0's frame and the arm's own
+    table; the arm's values of those that reach _RR_GOOD (the caller merges repeats)."""
     _, _, true_rows, slide = _RR_SPLITS[0]
     slider = (3 if _RR_SPLITS[0][0] else 2) if slide[0] else -1
     starts = []
     for q in rows:
-        for first in (0, 3):
+        for first in _RR_FLIPS:
             if first <= slider < first + 3:
                 continue
             p = np.array(q, dtype=float)

@@ -618,6 +618,9 @@ _RR_SPLITS = (
     ),
 )
 _RR_LENGTH = 1.5
+# the ends of the arm's six joints (0: joints 1-3, 3: joints 4-6) whose wrist flip leaves
+# the pose unchanged: _rr_partners tries the flips there
+_RR_FLIPS = ()
 # per split, the null vectors its lifted 12 x 12 matrix has at x3 = i whatever the pose
 # (real and imaginary parts in turn, _RR_SPURIOUS_COUNT columns, then zeros): the
 # companion matrix's eigenvalues there are deflated (_rr_deflated)
@@ -1233,7 +1236,7 @@ def _rr_fill(k, l_x, l_y, l_z, p_x, p_y, p_z, out):
 
 _RUNTIME = "derive_ik_runtime.py"
 # the version of the runtime this module was generated with (the runtime's _RUNTIME_VERSION)
-_RUNTIME_VERSION = "c6b59eb96f1df6b7"
+_RUNTIME_VERSION = "17fa4b8f1e20f939"
 # the runtime's line stating its version, in whatever form a formatter leaves it
 _RUNTIME_LINE = re.compile(
     rb"^_RUNTIME_VERSION\s*(?::\s*str\s*)?=\s*[\"']([0-9a-fA-F]+)[\"']", re.M

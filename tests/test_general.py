@@ -347,6 +347,41 @@ def test_wrist_flip_partners_lost_in_pairs_are_found_without_an_odd_count(tmp_pa
             assert np.abs(closed.fk(row) - T).max() <= 1e-9
 
 
+def wrist_rows(offset: float, miss: float) -> tuple[tuple[float, ...], ...]:
+    """Split rows (d, a, cos alpha, sin alpha) of a PUMA-like arm in units of its size: joints
+    4-6 a wrist with joint 5 offset along its axis by `offset` and axis 4 missing axis 5 by
+    `miss`."""
+    return (
+        (0.0, 0.0, 0.0, -1.0), (0.0, 0.6, 1.0, 0.0), (0.2, 0.05, 0.0, 1.0),
+        (0.6, miss, 0.0, -1.0), (offset, 0.0, 0.0, 1.0), (0.0, 0.0, 1.0, 0.0),
+    )  # fmt: skip
+
+
+@pytest.mark.parametrize(
+    ("offset", "miss", "reversed_", "flips"),
+    [
+        (0.0, 0.0, False, (3,)),  # a spherical wrist at joints 4-6
+        (0.0, 0.0, True, (0,)),  # ... read from the tool: the arm's joints 1-3
+        (0.0, 2e-4, False, (3,)),  # a calibrated wrist (axes 0.2 mm apart on a 1 m arm)
+        (0.15, 0.0, False, ()),  # an offset wrist (the CRX's)
+        (0.0, 0.05, False, ()),  # axes 5 cm apart
+    ],
+)
+def test_wrist_flips_are_tried_where_the_flip_leaves_the_pose(offset, miss, reversed_, flips):
+    """_rr_partners turns a row's three joints at an end as a spherical wrist's flip (t1 +
+    pi, -t2, t3 + pi) and polishes it: the flip is another solution where those axes meet at
+    right angles, and nearly one where they nearly do; at an offset wrist it is none (on 800
+    poses of the CRX-like arm and the Jaco2 Newton's steps from the flips found no row, and
+    took a fifth of their Python ik's time). flip_ends says where to try it, in the arm's
+    joints (the reversed chain's first three are the arm's last three)."""
+    from derive.methods.general import flip_ends
+    from derive.plan import Split
+
+    rows = wrist_rows(offset, miss)
+    split = Split(reversed_, (), rows, rows, 0, 0, 1.0, False)
+    assert flip_ends(split) == flips
+
+
 # cobots whose own tables give singular pencils (issue 39 item 7): Kinova's Jaco2 with its
 # curved wrist (Kinova's published standard-DH table: D1 0.2755, D2 0.41, D3 0.2073, D4 = D5 =
 # 0.0741, D6 0.16, e2 0.0098 m, wrist twists 60 deg), and an arm shaped like FANUC's CRX
@@ -403,7 +438,7 @@ def test_cobots_with_singular_pencils_are_answered_completely(name, tmp_path):
     took these arms' compiled ik from 690 and 917 us to 262 and 302 us (a perturbed table's
     clusters start the fallback split only)."""
     m = build_module(spec_text(name, "standard", COBOTS[name]), tmp_path)
-    assert m.METHOD == "general"
+    assert m.METHOD == "general" and m._RR_FLIPS == ()  # (offset wrists: no flips tried)
     result = roundtrip(m, sample_joints(m, 300, np.random.default_rng(39)), "c")
     assert result.unsound == [] and result.misses == [], result.summary()
     assert result.singular_posed == result.singular, result.summary()

@@ -103,6 +103,7 @@ def derive(chain: Chain, structure: Structure) -> IkPlan | str:
             unit=length,
             splits=chosen,
             kinds="".join(j.kind for j in chain.joints),
+            flips=flip_ends(first),
         )
     )
     return IkPlan(
@@ -425,6 +426,41 @@ def _split_joint(i: int, value: float, rows, slide) -> np.ndarray:
     if i == 2 and slide[0]:
         return split_link(slide[1], (value, *rows[2][1:]))
     return split_link(value, rows[i])
+
+
+# a wrist flip of three joints, (t1 + pi, -t2, t3 + pi), leaves their motion unchanged where
+# their axes meet at right angles (a spherical wrist's): the run time tries each row's flip at
+# such an end (_rr_partners), for a partner a perturbed table walked onto its twin. An end
+# counts as such a wrist where the flip moves the motion by at most this (the largest entry's
+# change, lengths in the split's unit), at FLIP_SAMPLES: a calibrated wrist's axes miss each
+# other by a fraction of a millimetre; an offset wrist's (the cobots' 0.1-0.2 m) moves it by
+# 0.4-2, and Newton's steps from its flips found no row on 800 poses of two such arms
+FLIP_TOL = 1e-2
+FLIP_SAMPLES = ((0.3, 0.7, -1.1), (2.0, -0.4, 0.9), (-2.5, 1.9, 2.7))
+
+
+def flip_ends(split: Split) -> tuple[int, ...]:
+    """The arm's ends (0: joints 1-3, 3: joints 4-6) where the wrist flip leaves the motion
+    of the three joints unchanged within FLIP_TOL on the split's own rows (the reversed
+    chain's first three joints are the arm's last three); an end with the sliding joint is
+    none."""
+    ends = []
+    for first in (0, 3):
+        if split.slide[0] and first == 0:  # (the split's joint 3 slides)
+            continue
+        worst = 0.0
+        for t1, t2, t3 in FLIP_SAMPLES:
+            turned = (t1 + math.pi, -t2, t3 + math.pi)
+            motions = [
+                split_link(a, split.true_rows[first])
+                @ split_link(b, split.true_rows[first + 1])
+                @ split_link(c, (0.0, 0.0, 1.0, 0.0))
+                for a, b, c in ((t1, t2, t3), turned)
+            ]
+            worst = max(worst, float(np.abs(motions[0] - motions[1]).max()))
+        if worst <= FLIP_TOL:
+            ends.append(3 - first if split.reversed else first)
+    return tuple(sorted(ends))
 
 
 def split_link(theta: float, row) -> np.ndarray:

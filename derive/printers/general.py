@@ -70,6 +70,11 @@ def general_code(plan: Plan) -> str:
         slide = ", ".join(float_literal(v) for v in split.slide)
         lines += [*rows(split.true_rows), f"        ({slide}),", "    ),"]
     lines += [")", f"_RR_LENGTH = {float_literal(step.unit)}"]
+    lines += [
+        "# the ends of the arm's six joints (0: joints 1-3, 3: joints 4-6) whose wrist flip leaves",
+        "# the pose unchanged: _rr_partners tries the flips there",
+        f"_RR_FLIPS = {tuple(step.flips)}",
+    ]
     counts, width = spurious_counts(step)
     lines += [
         "# per split, the null vectors its lifted 12 x 12 matrix has at x3 = i whatever the pose",

@@ -72,6 +72,9 @@ _RR_SPLITS: tuple[
 ]
 _RR_SPLITS = ()
 _RR_LENGTH = 1.0
+# the ends of the six joints (0: joints 1-3, 3: joints 4-6) whose wrist flip leaves the pose
+# unchanged (Eigen.flips)
+_RR_FLIPS: tuple[int, ...] = ()
 # per split, the vectors of Split.spurious (12 x _RR_SPURIOUS_COUNT[k] of the columns; the
 # rest zeros)
 _RR_SPURIOUS = np.zeros((0, 12, 0))

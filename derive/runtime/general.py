@@ -34,6 +34,7 @@ import math
 import numpy as np
 
 from derive.runtime.arm import (
+    _RR_FLIPS,
     _RR_LENGTH,
     _RR_PIVOTS,
     _RR_SPLITS,
@@ -227,16 +228,15 @@ class _RRLeads:
 
 
 def _rr_partners(targets, rows):
-    """The wrist-flip partners of the rows: each row with the three joints at either end
-    turned as a spherical wrist's flip, (t1 + pi, -t2, t3 + pi) (an end with a sliding joint
-    left alone), polished by Newton's steps on split 0's frame and the arm's own table; the
-    arm's values of those that reach _RR_GOOD (the caller merges repeats). Where those axes
-    do not meet, Newton ends elsewhere or nowhere: nothing unsound is added either way."""
+    """The wrist-flip partners of the rows: each row with the three joints at an end that is
+    a spherical wrist (_RR_FLIPS) turned as its flip, (t1 + pi, -t2, t3 + pi) (an end with a
+    sliding joint left alone), polished by Newton's steps on split 0's frame and the arm's own
+    table; the arm's values of those that reach _RR_GOOD (the caller merges repeats)."""
     _, _, true_rows, slide = _RR_SPLITS[0]
     slider = (3 if _RR_SPLITS[0][0] else 2) if slide[0] else -1
     starts = []
     for q in rows:
-        for first in (0, 3):
+        for first in _RR_FLIPS:
             if first <= slider < first + 3:
                 continue
             p = np.array(q, dtype=float)
