@@ -49,6 +49,7 @@ IMPORTS = (
     ("from math import {}", "cos"),
     ("from math import {}", "sin"),
     ("from math import {}", "sqrt"),
+    ("from operator import mul as _mul", "_mul"),
     ("from operator import sub as _sub", "_sub"),
     ("from time import time as _time", "_time"),
     ("from typing import {}", "TYPE_CHECKING"),

@@ -19,6 +19,7 @@ error within _REFINE_LAST) with the step before's Jacobian and factor: the two a
 from __future__ import annotations
 
 import math
+from operator import mul as _mul
 
 from derive.runtime.arm import (
     _CHAIN,
@@ -134,13 +135,13 @@ def _refine(q, t, held=(), patience=_REFINE_PATIENCE):
         if settle:
             step = _qr_solve(columns, error)
         else:
-            mu = sum(e * e for e in error)
-            step = [sum(c * e for c, e in zip(column, error)) for column in columns]
-            normal = [
-                [sum(a * b for a, b in zip(columns[i], columns[j])) + (mu if i == j else 0.0)
-                 for j in range(m)]
-                for i in range(m)
-            ]  # fmt: skip
+            mu = _dot(error, error)
+            step = [_dot(column, error) for column in columns]
+            normal = [[0.0] * m for _ in range(m)]
+            for i in range(m):  # (J^T J is symmetric: its lower triangle, mirrored)
+                for j in range(i + 1):
+                    normal[i][j] = normal[j][i] = _dot(columns[i], columns[j])
+                normal[i][i] += mu
             for k in range(m):
                 if _SOLVED[k] in held:
                     normal[k][k] = 1.0
@@ -204,7 +205,7 @@ def _least_squares(q, t):
     value = 0.5 * sum(e * e for e in error)
     damping = 1e-3
     for _ in range(_LSQ_STEPS):
-        gradient = [sum(c * e for c, e in zip(column, error)) for column in columns]
+        gradient = [_dot(column, error) for column in columns]
         if max(map(abs, gradient)) <= _LSQ_FLAT:
             break
         normal = [[sum(a * b for a, b in zip(columns[i], columns[j])) for j in range(m)]
@@ -315,17 +316,24 @@ def _cholesky_solve(A, x):
     Cholesky factor); False where A is not positive definite."""
     m = len(x)
     for j in range(m):
-        d = A[j][j] - sum(A[j][k] * A[j][k] for k in range(j))
+        d = A[j][j] - _dot(A[j][:j], A[j][:j])
         if not d > 0.0:
             return False
         A[j][j] = math.sqrt(d)
         for i in range(j + 1, m):
-            A[i][j] = (A[i][j] - sum(A[i][k] * A[j][k] for k in range(j))) / A[j][j]
+            A[i][j] = (A[i][j] - _dot(A[i][:j], A[j][:j])) / A[j][j]
     for i in range(m):
-        x[i] = (x[i] - sum(A[i][k] * x[k] for k in range(i))) / A[i][i]
+        x[i] = (x[i] - _dot(A[i][:i], x[:i])) / A[i][i]
     for i in reversed(range(m)):
-        x[i] = (x[i] - sum(A[k][i] * x[k] for k in range(i + 1, m))) / A[i][i]
+        x[i] = (x[i] - _dot([A[k][i] for k in range(i + 1, m)], x[i + 1 :])) / A[i][i]
     return True
+
+
+def _dot(a, b):
+    """a_1 b_1 + a_2 b_2 + ..., summed in order (as sum() of a generator, in a third of its
+    time: the refinement's normal equations and their factor were most of a refined arm's
+    Python time)."""
+    return sum(map(_mul, a, b))
 
 
 def _chain_pose(q):
