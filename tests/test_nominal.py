@@ -1074,6 +1074,27 @@ def test_a_last_step_near_a_singular_configuration_is_measured_again(tmp_path):
 
 
 @needs_cc
+def test_the_wrist_flip_shortcut_is_not_taken_after_a_spread(tmp_path):
+    """C solves a Pieper wrist's second theta5 branch as the first's flip (theta4 + pi,
+    theta6 + pi) where the first's theta4 is single. A rough theta4 (a nominal table's near
+    singular wrist) spreads (dk_spread_more) after its first value gave no row: the flip then
+    took the first value's theta4 with the last spread value's theta6, a seed that is no
+    solution's, and the calibrated iiwa14 with q2 = pi (its shoulder singular, q3 = -pi/2,
+    q5 = pi/2) got no row in C where Python has one (2 of 300 such poses; 0 after). C's rows
+    within 1e-10 of the pose, as many as Python's."""
+    text = (Path(__file__).parent / "data" / "specs" / "iiwa14_cal.toml").read_text()
+    module = build_module(text, tmp_path, c=True)
+    q = np.array([-1.3803, -math.pi, -math.pi / 2, 0.9315, math.pi / 2, 1.7933, 1.8734])
+    T = module.fk(q)
+    rows = {b: module.ik(T, backend=b, q_ref=q) for b in ("c", "python")}
+    assert len(rows["c"]) == len(rows["python"]) > 0
+    for row in rows["c"]:
+        E = module.fk(row)
+        assert np.max(np.abs(E[:3, :3] - T[:3, :3])) <= 1e-10
+        assert np.max(np.abs(E[:3, 3] - T[:3, 3])) <= 1e-10 * module.REACH
+
+
+@needs_cc
 def test_a_quartic_left_a_cubic_is_solved_in_c(tmp_path):
     """ManiSkill's SO-100 URDF at q1 = 0 or pi: its theta1 quartic's two ends vanish, and
     dropping the leading one left a cubic, which C's dk_roots refused where DK_POLY_MAX is 4

@@ -401,11 +401,13 @@ def solve_lines(plan: Plan) -> tuple[tuple[int, str], ...]:
                 ]
             )
         if flip and j == flip[0]:
+            # (theta4 single to the end of the first branch: a rough value's spread
+            # (dk_spread_more) gives it more values, and theta6 then holds the last one's)
             j4, j6 = flip[1:]
             endings[id(closing[-1])] = [
                 Line(depth + 1, f"dk_flip = dk_k{j} == 0 && dk_v{j}.n == 2 && !dk_v{j}.free &&"),
                 Line(depth + 3, f"dk_v{j}.s[0] != 0.0 && dk_v{j}.t[1] == -dk_v{j}.t[0] &&"),
-                Line(depth + 3, f"dk_f{j4}[3] == 1.0 && dk_f{j6}[3] == 1.0;"),
+                Line(depth + 3, f"dk_f{j4}[3] == 1.0 && dk_f{j6}[3] == 1.0 && dk_v{j4}.n == 1;"),
             ]
         depth += 1
     outputs = [printer.doprint(e) for e in plan.ik.outputs]
