@@ -1060,10 +1060,17 @@ def test_a_last_step_near_a_singular_configuration_is_measured_again(tmp_path):
     the cos and sin its steps had turned) and C returned it, 1.01e-10 from the pose by the
     library's: such a row is measured again (DK_LANE_TRUSTED, DK_LANE_FLOOR). Every row within
     1e-10, and C's count Python's."""
-    text = (Path(__file__).parent / "data" / "specs" / "iiwa14_cal.toml").read_text()
-    module = build_module(text, tmp_path, c=True)
     q = np.array([-math.pi / 2, 1.2612320778281472, -1.745245660536844, 0.0, -0.5261791612971365])
-    q = np.append(q, [1.7499815894415338, 2.359215238646848])
+    calibrated_iiwa_answers_as_python(
+        np.append(q, [1.7499815894415338, 2.359215238646848]), tmp_path
+    )
+
+
+def calibrated_iiwa_answers_as_python(q: np.ndarray, folder: Path) -> None:
+    """The calibrated iiwa14 (tests/data/specs/iiwa14_cal.toml) at q's pose (q7 free at q's):
+    C's rows as many as Python's, at least one, each within 1e-10 of the pose."""
+    text = (Path(__file__).parent / "data" / "specs" / "iiwa14_cal.toml").read_text()
+    module = build_module(text, folder, c=True)
     T = module.fk(q)
     rows = {b: module.ik(T, backend=b, q_ref=q) for b in ("c", "python")}
     assert len(rows["c"]) == len(rows["python"]) > 0
@@ -1082,16 +1089,8 @@ def test_the_wrist_flip_shortcut_is_not_taken_after_a_spread(tmp_path):
     solution's, and the calibrated iiwa14 with q2 = pi (its shoulder singular, q3 = -pi/2,
     q5 = pi/2) got no row in C where Python has one (2 of 300 such poses; 0 after). C's rows
     within 1e-10 of the pose, as many as Python's."""
-    text = (Path(__file__).parent / "data" / "specs" / "iiwa14_cal.toml").read_text()
-    module = build_module(text, tmp_path, c=True)
     q = np.array([-1.3803, -math.pi, -math.pi / 2, 0.9315, math.pi / 2, 1.7933, 1.8734])
-    T = module.fk(q)
-    rows = {b: module.ik(T, backend=b, q_ref=q) for b in ("c", "python")}
-    assert len(rows["c"]) == len(rows["python"]) > 0
-    for row in rows["c"]:
-        E = module.fk(row)
-        assert np.max(np.abs(E[:3, :3] - T[:3, :3])) <= 1e-10
-        assert np.max(np.abs(E[:3, 3] - T[:3, 3])) <= 1e-10 * module.REACH
+    calibrated_iiwa_answers_as_python(q, tmp_path)
 
 
 @needs_cc
