@@ -9,7 +9,7 @@
    is solved by it): one copy serves every arm of a folder, and each arm's file gets its own
    static copy of the routines, so arms link together in one program. Compile <name>_ik.c
    with it beside the file; do not include it anywhere else. */
-#define DK_RUNTIME 0x6ceea9473ef1
+#define DK_RUNTIME 0x2229a893dcf2
 
 #include <math.h>
 #include <stddef.h>
@@ -3814,19 +3814,25 @@ static void dk_rr_columns(const double rows[7][4], const double frames[7][4][4],
    Levenberg-Marquardt's (damping |error|^2) where damped is set, `steps` + 1 of them (the
    last measured only where it is Newton's last, _RR_NEWTON_DONE); where track is set,
    `steps` Newton steps and q where they end (a continuation's corrector: not measured). The
-   pose error at q (track: before the last step). */
-static double dk_rr_walk(const double rows[7][4], const double F[4][4], double q[6], int damped,
-                         int steps, double reach, int track)
+   pose error at q (track: before the last step). Where turns is given, the joints' cos and
+   sin at the q returned go there; where carried is set too, they are q's on entry (a
+   candidate's walk goes on from where the last ended: a tenth of a cobot's time went to the
+   sincos of each walk's start). */
+static double dk_rr_turned_walk(const double rows[7][4], const double F[4][4], double q[6],
+                                int damped, int steps, double reach, int track,
+                                double turns[6][2], int carried)
 {
-    double cur[6], cs[6][2], frames[7][4][4], J[6][6], normal[6][6], rhs[6], step[6];
-    double best = HUGE_VAL;
+    double cur[6], cs[6][2], best_cs[6][2], frames[7][4][4], J[6][6], normal[6][6], rhs[6];
+    double step[6], best = HUGE_VAL;
     const int slider = rows[6][0] != 0.0 ? 2 : -1;
     int it, i, r, c, k;
     for (i = 0; i < 6; i++) {
         const double angle = i == slider ? rows[6][1] : q[i];
         cur[i] = q[i];
-        cs[i][0] = cos(angle);
-        cs[i][1] = sin(angle);
+        cs[i][0] = turns != NULL && carried ? turns[i][0] : cos(angle);
+        cs[i][1] = turns != NULL && carried ? turns[i][1] : sin(angle);
+        best_cs[i][0] = cs[i][0];
+        best_cs[i][1] = cs[i][1];
     }
     dk_eye4(frames[0]);
     for (it = 0; it < steps + !track; it++) {
@@ -3844,6 +3850,8 @@ static double dk_rr_walk(const double rows[7][4], const double F[4][4], double q
             best = size;
             for (i = 0; i < 6; i++) {
                 q[i] = cur[i];
+                best_cs[i][0] = cs[i][0];
+                best_cs[i][1] = cs[i][1];
             }
         }
         if (size <= 1e-15 || size > reach) {
@@ -3909,15 +3917,28 @@ static double dk_rr_walk(const double rows[7][4], const double F[4][4], double q
             /* the last step, not measured (the Python solver's _RR_NEWTON_DONE) */
             for (i = 0; i < 6; i++) {
                 q[i] = cur[i];
+                best_cs[i][0] = cs[i][0];
+                best_cs[i][1] = cs[i][1];
             }
             best = size;
             break;
         }
     }
+    for (i = 0; i < 6 && turns != NULL; i++) {
+        turns[i][0] = track ? cs[i][0] : best_cs[i][0];
+        turns[i][1] = track ? cs[i][1] : best_cs[i][1];
+    }
     for (i = 0; i < 6 && track; i++) {
         q[i] = cur[i];
     }
     return best;
+}
+
+/* dk_rr_turned_walk from q's own cos and sin */
+static double dk_rr_walk(const double rows[7][4], const double F[4][4], double q[6], int damped,
+                         int steps, double reach, int track)
+{
+    return dk_rr_turned_walk(rows, F, q, damped, steps, reach, track, NULL, 0);
 }
 
 /* dk_rr_walk's DK_RR_NEWTON_STEPS steps within DK_RR_NEWTON_REACH */
@@ -3931,9 +3952,11 @@ static double dk_rr_steps(const double rows[7][4], const double F[4][4], double 
    best point met (the Python solver's _rr_newton): q in place, the pose error there; *used
    set where the damped steps were taken */
 static double dk_rr_newton(const double rows[7][4], const double F[4][4], double q[6],
-                           int *used, int extra)
+                           int *used, int extra, double turns[6][2])
 {
-    double damped[6], error = dk_rr_steps(rows, F, q, 0), damped_error;
+    double damped[6], damped_error;
+    double error = dk_rr_turned_walk(rows, F, q, 0, DK_RR_NEWTON_STEPS, DK_RR_NEWTON_REACH, 0,
+                                     turns, turns != NULL);
     int i;
     if (DK_RR_NEWTON_DONE < error && error <= DK_RR_GOOD) { /* (slowly: near a double root) */
         error = fmin(error, dk_rr_steps(rows, F, q, 0));
@@ -4633,7 +4656,7 @@ static int dk_rr_split(int k, const double F[4][4], const double moved[4][4],
         n = 0;
     }
     for (c = 0; c < n; c++) {
-        double q[6], arm[6], error;
+        double q[6], arm[6], turns[6][2], error;
         int seen = 0;
         dk_rr_arm(k, cands[c], arm);
         /* (on a perturbed table, a row this split found too: _rr_split says why) */
@@ -4649,12 +4672,12 @@ static int dk_rr_split(int k, const double F[4][4], const double moved[4][4],
         if (perturbed) {
             for (i = 0; i < (int)(sizeof DK_RR_PATH / sizeof DK_RR_PATH[0]); i++) {
                 dk_rr_between(DK_RR_FILL[k], DK_RR_TRUE[k], DK_RR_PATH[i], between);
-                /* (Newton only on the way) */
-                dk_rr_walk((const double(*)[4])between, F, q, 0, DK_RR_PATH_STEPS,
-                           DK_RR_NEWTON_REACH, 1);
+                /* (Newton only on the way, each walk from where the last ended) */
+                dk_rr_turned_walk((const double(*)[4])between, F, q, 0, DK_RR_PATH_STEPS,
+                                  DK_RR_NEWTON_REACH, 1, turns, i > 0);
             }
         }
-        error = dk_rr_newton(DK_RR_TRUE[k], F, q, &damped, extra[c]);
+        error = dk_rr_newton(DK_RR_TRUE[k], F, q, &damped, extra[c], perturbed ? turns : NULL);
         if (damped && !perturbed && !extra[c]) { /* Newton alone did not settle it */
             *doubt = DK_RR_RESCUE;
         }
