@@ -422,7 +422,7 @@ static int dk_solve(const double t[12], double tol, const double ref[DK_DOF],
                     }
                     dk_flip = dk_k5 == 0 && dk_v5.n == 2 && !dk_v5.free &&
                             dk_v5.s[0] != 0.0 && dk_v5.t[1] == -dk_v5.t[0] &&
-                            dk_f4[3] == 1.0 && dk_f6[3] == 1.0 && dk_v4.n == 1;
+                            dk_f4[3] == 1.0 && dk_f6[3] == 1.0;
                     if (dk_v5.free && n > dk_m5) {
                         break;
                     }

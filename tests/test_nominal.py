@@ -1070,9 +1070,14 @@ def calibrated_iiwa_answers_as_python(q: np.ndarray, folder: Path) -> None:
     """The calibrated iiwa14 (tests/data/specs/iiwa14_cal.toml) at q's pose (q7 free at q's):
     C's rows as many as Python's, at least one, each within 1e-10 of the pose."""
     text = (Path(__file__).parent / "data" / "specs" / "iiwa14_cal.toml").read_text()
-    module = build_module(text, folder, c=True)
+    c_answers_as_python(build_module(text, folder, c=True), q, q)
+
+
+def c_answers_as_python(module, q: np.ndarray, q_ref: np.ndarray | None = None) -> None:
+    """At q's pose: the module's C rows as many as its Python rows, at least one, each within
+    1e-10 of the pose."""
     T = module.fk(q)
-    rows = {b: module.ik(T, backend=b, q_ref=q) for b in ("c", "python")}
+    rows = {b: module.ik(T, backend=b, q_ref=q_ref) for b in ("c", "python")}
     assert len(rows["c"]) == len(rows["python"]) > 0
     for row in rows["c"]:
         E = module.fk(row)
@@ -1081,16 +1086,33 @@ def calibrated_iiwa_answers_as_python(q: np.ndarray, folder: Path) -> None:
 
 
 @needs_cc
-def test_the_wrist_flip_shortcut_is_not_taken_after_a_spread(tmp_path):
-    """C solves a Pieper wrist's second theta5 branch as the first's flip (theta4 + pi,
-    theta6 + pi) where the first's theta4 is single. A rough theta4 (a nominal table's near
-    singular wrist) spreads (dk_spread_more) after its first value gave no row: the flip then
-    took the first value's theta4 with the last spread value's theta6, a seed that is no
-    solution's, and the calibrated iiwa14 with q2 = pi (its shoulder singular, q3 = -pi/2,
-    q5 = pi/2) got no row in C where Python has one (2 of 300 such poses; 0 after). C's rows
-    within 1e-10 of the pose, as many as Python's."""
-    q = np.array([-1.3803, -math.pi, -math.pi / 2, 0.9315, math.pi / 2, 1.7933, 1.8734])
-    calibrated_iiwa_answers_as_python(q, tmp_path)
+@pytest.mark.parametrize(
+    ("name", "q"),
+    [
+        ("iiwa14", [-1.3803, -math.pi, -math.pi / 2, 0.9315, math.pi / 2, 1.7933, 1.8734]),
+        ("iiwa14", [-2.216405336929399, 0.0, -0.5827079051416266, 2.6853776878584092,
+                    1.466199995978429, 0.0, -2.4661450606703896]),
+        ("irb2400", [-1.9173180662277631, 1.404993249725206, math.pi / 2, 0.6830094293461246,
+                     -0.0018785377316594834, -0.5672357081330155]),
+        ("puma", [math.pi / 2, -math.pi / 2, math.pi / 2, -2.0156615911600557, 0.0, math.pi]),
+        ("tx2_60", [-math.pi / 2, 2.535826448351271, 0.048062758765410774, 2.793623728320533,
+                    3.1415881929755285, -1.306843733238506]),
+    ],
+)  # fmt: skip
+def test_a_refined_arm_s_second_wrist_branch_is_solved_not_flipped(name, q, tmp_path):
+    """C solves an exact Pieper wrist's second theta5 branch as the first's flip (theta4 + pi,
+    -theta5, theta6 + pi). On a refined (calibrated) arm the seeds of the second branch are
+    not the first's flipped: a rough theta4 spreads in each branch on its own (as Python's
+    does), and the flip took the first value's theta4 with the last spread value's theta6.
+    C lost rows Python has: the calibrated iiwa14 with its shoulder singular (q2 = pi, or q2
+    = q6 = 0), and the calibrated IRB 2400, PUMA and TX2-60 near a straight wrist (1 to 3 of
+    600 such poses each; a reviewer's attack). Refined arms' C takes no flip now: C's rows
+    Python's in number, each within 1e-10 of the pose."""
+    q = np.array(q)
+    if name == "iiwa14":
+        calibrated_iiwa_answers_as_python(q, tmp_path)
+        return
+    c_answers_as_python(build_module(calibrated(name), tmp_path, c=True), q)
 
 
 @needs_cc

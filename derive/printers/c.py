@@ -289,7 +289,10 @@ def solve_lines(plan: Plan) -> tuple[tuple[int, str], ...]:
     closing: list[Line] = []
     # lines ending a loop's body, before its free-joint check (by the loop's closing line)
     endings: dict[int, list[Line]] = {}
-    flip = wrist_flip(plan)
+    # (not on a refined arm: there the second branch's own theta4 can spread, as the Python
+    # solver's does, and the first's flip lost rows at 1 to 3 of 600 near-singular wrist poses
+    # of five calibrated arms, a reviewer's attack)
+    flip = wrist_flip(plan) if not fix else None
     turned: dict[str, tuple[str, str]] = {}  # an angle's variable: its cos and sin
     seamed = seamed_outputs(plan) if not fix else frozenset()
     hoisted = HoistedFK.of(plan) if same_joints(plan) and not fix else None
@@ -401,13 +404,11 @@ def solve_lines(plan: Plan) -> tuple[tuple[int, str], ...]:
                 ]
             )
         if flip and j == flip[0]:
-            # (theta4 single to the end of the first branch: a rough value's spread
-            # (dk_spread_more) gives it more values, and theta6 then holds the last one's)
             j4, j6 = flip[1:]
             endings[id(closing[-1])] = [
                 Line(depth + 1, f"dk_flip = dk_k{j} == 0 && dk_v{j}.n == 2 && !dk_v{j}.free &&"),
                 Line(depth + 3, f"dk_v{j}.s[0] != 0.0 && dk_v{j}.t[1] == -dk_v{j}.t[0] &&"),
-                Line(depth + 3, f"dk_f{j4}[3] == 1.0 && dk_f{j6}[3] == 1.0 && dk_v{j4}.n == 1;"),
+                Line(depth + 3, f"dk_f{j4}[3] == 1.0 && dk_f{j6}[3] == 1.0;"),
             ]
         depth += 1
     outputs = [printer.doprint(e) for e in plan.ik.outputs]
