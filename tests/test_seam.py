@@ -32,14 +32,19 @@ def seam_poses(m, n: int, seed: int) -> np.ndarray:
     return m.fk_batch(Q)
 
 
-def compare(reference: np.ndarray, other: np.ndarray) -> str:
+def compare(reference: np.ndarray, other: np.ndarray, ordered: bool = True) -> str:
     """How two solution arrays of one pose compare: "count" (different numbers of rows),
     "turn" (a value a full turn, or anything above 1e-6, apart), "seam" (a value exactly pi
-    in one and not in the other), "rounding" (within 1e-6 but not 1e-12) or "same"."""
+    in one and not in the other), "rounding" (within 1e-6 but not 1e-12) or "same". Not
+    ordered (an arm whose rows have no branch order: the general method's): each of other's
+    rows compared with the reference's row nearest it (around the circle)."""
     if reference.shape != other.shape:
         return "count"
     if reference.size == 0:
         return "same"
+    if not ordered:
+        gaps = np.abs((reference[:, None] - other[None] + math.pi) % (2 * math.pi) - math.pi)
+        other = other[gaps.max(axis=2).argmin(axis=1)]
     d = np.abs(reference - other).max()
     if d > 1e-6:
         return "turn"
@@ -66,7 +71,7 @@ def tally(m, backends: tuple[str, ...]) -> dict[str, dict[str, int]]:
                 (f"ik {b}", m.ik(T[i], backend=b)),
                 (f"ik_batch {b}", Q[i][valid[i]]),
             ):
-                kind = compare(reference, rows)
+                kind = compare(reference, rows, ordered=m.METHOD != "general")
                 counts.setdefault(what, {}).setdefault(kind, 0)
                 counts[what][kind] += 1
     return counts
@@ -89,12 +94,14 @@ def tally(m, backends: tuple[str, ...]) -> dict[str, dict[str, int]]:
 # (at most 1.6e-11) and 3-5 such seam values; parallel_6r has one pose whose elbow is 2e-7
 # from folded, where the compiled solver merges two solutions 2e-6 apart and the Python one
 # keeps both. No backend returns a value a full turn away from another's, and none -pi.
-# manocha_canny (general method, 2,000 poses): 7 differ by more than 1e-6 ("turn") and 3 by
-# rounding between the compiled and the Python ik (on 10,000: 21, 11 and 1 at the seam):
-# poses where axes 3 and 6 line up (a self-motion, theta3 + theta6 fixed) have a curve of
-# solutions, and each backend returns its own certified points of it (the general method has
-# no reference value to give a free joint); elsewhere the eigenvalue routines (LAPACK's and
-# the kernel's) round apart.
+# manocha_canny (general method, 2,000 poses): its rows have no branch order, and the
+# backends' orders differ where eigenvalues lie close (ordered, 12 poses differed by more than
+# 1e-6 and then 13 after issue 39's changes to the C walks, every one the same set of rows
+# within 1e-13, or 7e-8 at sigma_min 1e-10): they are compared as sets. Then 1 differs by
+# more than 1e-6 ("turn") and 6 by rounding between C and the Python ik: poses where axes 3
+# and 6 line up (a self-motion, theta3 + theta6 fixed) have a curve of solutions, and each
+# backend returns its own certified points of it (the general method has no reference value
+# to give a free joint); elsewhere the eigenvalue routines (LAPACK's and C's) round apart.
 # iiwa14 and panda (q7 free, at its default 0; Pieper on the reversed remainder): iiwa14 has 2
 # poses beyond 1e-12 between the Python ik and ik_batch, and against the compiled ik 15 such,
 # 4 at the seam and 1 whose theta6 is 1.3e-8 above -pi in one backend and 1.2e-8 above pi in
@@ -124,7 +131,7 @@ ALLOWED = {
     "iiwa14": {"rounding": 30, "seam": 10, "turn": 26},
     "panda": {"rounding": 5},
     "lecture_6r": {"rounding": 500, "seam": 50, "turn": 1, "count": 1},
-    "manocha_canny": {"rounding": 10, "seam": 5, "turn": 12, "count": 5},
+    "manocha_canny": {"rounding": 10, "seam": 5, "turn": 3, "count": 5},
     "parallel_6r": {"rounding": 20, "count": 1, "seam": 5},
     "puma560": {"rounding": 30, "seam": 10},
 }
