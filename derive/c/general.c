@@ -652,12 +652,11 @@ static void dk_rr_link(double t, const double rows[7][4], int i, double M[4][4])
     dk_rr_link_cs(ct, st, t, rows, i, (const double(*)[4])M, M);
 }
 
-/* A := the factor of M by Gaussian elimination with partial pivoting (U on and above the
-   diagonal, the multipliers below it), perm[k] the row swapped with row k at step k, |det M|
-   into *size where size is not NULL; 0 where M is singular */
-static int dk_lu6(const double M[6][6], double A[6][6], int perm[6], double *size)
+/* x := A^-1 x for a 6 x 6 A by Gaussian elimination with partial pivoting (dk_solve_into's
+   steps, its size fixed), |det A| into *size where size is not NULL; 0 where A is singular */
+static int dk_solve6(const double M[6][6], double x[6], double *size)
 {
-    double det = 1.0;
+    double A[6][6], det = 1.0;
     int k, i, j, p;
     for (i = 0; i < 6; i++) {
         for (j = 0; j < 6; j++) {
@@ -678,42 +677,23 @@ static int dk_lu6(const double M[6][6], double A[6][6], int perm[6], double *siz
             return 0;
         }
         det *= fabs(A[p][k]);
-        perm[k] = p;
-        if (p != k) { /* (the columns from k: the multipliers before it stay in their rows,
-                         which dk_lu6_again's swaps, taken in turn, expect) */
-            for (j = k; j < 6; j++) {
-                const double t = A[k][j];
+        if (p != k) {
+            double t;
+            for (j = 0; j < 6; j++) {
+                t = A[k][j];
                 A[k][j] = A[p][j];
                 A[p][j] = t;
             }
+            t = x[k];
+            x[k] = x[p];
+            x[p] = t;
         }
         for (i = k + 1; i < 6; i++) {
             const double f = A[i][k] / A[k][k];
             for (j = k + 1; j < 6; j++) {
                 A[i][j] -= f * A[k][j];
             }
-            A[i][k] = f;
-        }
-    }
-    if (size != NULL) {
-        *size = det;
-    }
-    return 1;
-}
-
-/* x := M^-1 x, A and perm dk_lu6's factor of M (the same operations, in the same order, as
-   eliminating x beside M) */
-static void dk_lu6_again(const double A[6][6], const int perm[6], double x[6])
-{
-    int k, i;
-    for (k = 0; k < 6; k++) {
-        if (perm[k] != k) {
-            const double t = x[k];
-            x[k] = x[perm[k]];
-            x[perm[k]] = t;
-        }
-        for (i = k + 1; i < 6; i++) {
-            x[i] -= A[i][k] * x[k];
+            x[i] -= f * x[k];
         }
     }
     for (k = 5; k >= 0; k--) {
@@ -723,18 +703,9 @@ static void dk_lu6_again(const double A[6][6], const int perm[6], double x[6])
         }
         x[k] = total / A[k][k];
     }
-}
-
-/* x := A^-1 x for a 6 x 6 A by Gaussian elimination with partial pivoting (dk_solve_into's
-   steps, its size fixed), |det A| into *size where size is not NULL; 0 where A is singular */
-static int dk_solve6(const double M[6][6], double x[6], double *size)
-{
-    double A[6][6];
-    int perm[6];
-    if (!dk_lu6(M, A, perm, size)) {
-        return 0;
+    if (size != NULL) {
+        *size = det;
     }
-    dk_lu6_again((const double(*)[6])A, perm, x);
     return 1;
 }
 
@@ -916,9 +887,9 @@ static double dk_rr_turned_walk(const double rows[7][4], const double F[4][4], d
                                 double turns[6][2], int carried)
 {
     double cur[6], cs[6][2], best_cs[6][2], frames[7][4][4], J[6][6], normal[6][6], rhs[6];
-    double step[6], factor[6][6], best = HUGE_VAL;
+    double step[6], best = HUGE_VAL;
     const int slider = rows[6][0] != 0.0 ? 2 : -1;
-    int it, i, r, c, k, perm[6];
+    int it, i, r, c, k;
     for (i = 0; i < 6; i++) {
         const double angle = i == slider ? rows[6][1] : q[i];
         cur[i] = q[i];
@@ -963,37 +934,31 @@ static double dk_rr_turned_walk(const double rows[7][4], const double F[4][4], d
             }
             step[3 + r] = 0.5 * total;
         }
-        if (track && it > 0) { /* a continuation's corrector: its first step's factor again
-                                  (a chord step; the walk's end is polished on the arm) */
-            dk_lu6_again((const double(*)[6])factor, perm, step);
-        } else {
-            dk_rr_columns(rows, (const double(*)[4][4])frames, J);
-            if (damped) { /* (J^T J + mu) step = J^T error, mu = |error|^2 */
-                for (r = 0; r < 6; r++) {
-                    mu += step[r] * step[r];
+        dk_rr_columns(rows, (const double(*)[4][4])frames, J);
+        if (damped) { /* (J^T J + mu) step = J^T error, mu = |error|^2 */
+            for (r = 0; r < 6; r++) {
+                mu += step[r] * step[r];
+            }
+            for (r = 0; r < 6; r++) {
+                rhs[r] = 0.0;
+                for (k = 0; k < 6; k++) {
+                    rhs[r] += J[k][r] * step[k];
                 }
-                for (r = 0; r < 6; r++) {
-                    rhs[r] = 0.0;
+                for (c = 0; c < 6; c++) {
+                    normal[r][c] = 0.0;
                     for (k = 0; k < 6; k++) {
-                        rhs[r] += J[k][r] * step[k];
+                        normal[r][c] += J[k][r] * J[k][c];
                     }
-                    for (c = 0; c < 6; c++) {
-                        normal[r][c] = 0.0;
-                        for (k = 0; k < 6; k++) {
-                            normal[r][c] += J[k][r] * J[k][c];
-                        }
-                    }
-                    normal[r][r] += mu;
                 }
-                for (r = 0; r < 6; r++) {
-                    step[r] = rhs[r];
-                }
+                normal[r][r] += mu;
             }
-            if (!dk_lu6(damped ? (const double(*)[6])normal : (const double(*)[6])J, factor,
-                        perm, NULL)) {
-                break;
+            for (r = 0; r < 6; r++) {
+                step[r] = rhs[r];
             }
-            dk_lu6_again((const double(*)[6])factor, perm, step);
+        }
+        if (!dk_solve6(damped ? (const double(*)[6])normal : (const double(*)[6])J, step,
+                       NULL)) {
+            break;
         }
         for (i = 0; i < 6; i++) {
             longest = fmax(longest, fabs(step[i]));
