@@ -9,7 +9,7 @@
    is solved by it): one copy serves every arm of a folder, and each arm's file gets its own
    static copy of the routines, so arms link together in one program. Compile <name>_ik.c
    with it beside the file; do not include it anywhere else. */
-#define DK_RUNTIME 0x43c61e326029
+#define DK_RUNTIME 0x1f3a4d104126
 
 #include <math.h>
 #include <stddef.h>
@@ -4810,10 +4810,10 @@ static int dk_rr_near_singular(const double row[6])
 }
 
 /* The wrist-flip partners of out[0..count) (the Python solver's _rr_partners): each row with
-   the three joints at an end that is a spherical wrist (DK_RR_FLIPS) turned as its flip,
-   (t1 + pi, -t2, t3 + pi) (an end with a sliding joint left alone), polished by Newton's
-   steps on split 0's frame and the arm's own table, added where they reach DK_RR_GOOD and are
-   new. The new count. */
+   the three joints at an end that is a spherical wrist (DK_RR_FLIPS: never the end with a
+   sliding joint) turned as its flip, (t1 + pi, -t2, t3 + pi), polished by Newton's steps on
+   split 0's frame and the arm's own table, added where they reach DK_RR_GOOD and are new.
+   The new count. */
 static int dk_rr_partners(const double F[4][4], double out[DK_RR_ROWS][6], int count)
 {
     const int rows = count;
@@ -4822,7 +4822,7 @@ static int dk_rr_partners(const double F[4][4], double out[DK_RR_ROWS][6], int c
     for (r = 0; r < rows && count < DK_RR_ROWS; r++) {
         for (first = 0; first <= 3 && count < DK_RR_ROWS; first += 3) {
             double p[6], q[6];
-            if (!DK_RR_FLIPS[first / 3] || (first <= slider && slider < first + 3)) {
+            if (!DK_RR_FLIPS[first / 3]) {
                 continue;
             }
             for (j = 0; j < 6; j++) {

@@ -38,7 +38,7 @@ if "_RUNTIME_VERSION" not in globals():  # (imported on its own, not run by a mo
         "namespace; it is not a module to import"
     )
 # this runtime's version: a module runs the runtime of its own version only
-_RUNTIME_VERSION = "5af676192d4141e0"
+_RUNTIME_VERSION = "230ab25f7e70f1ff"
 
 if TYPE_CHECKING:  # defined by the module running this file
     from derive.runtime.arm import (
@@ -2823,16 +2823,13 @@ class _RRLeads:
 
 def _rr_partners(targets, rows):
     """The wrist-flip partners of the rows: each row with the three joints at an end that is
-    a spherical wrist (_RR_FLIPS) turned as its flip, (t1 + pi, -t2, t3 + pi) (an end with a
-    sliding joint left alone), polished by Newton's steps on split 0's frame and the arm's own
+    a spherical wrist (_RR_FLIPS: never the end with a sliding joint) turned as its flip,
+    (t1 + pi, -t2, t3 + pi), polished by Newton's steps on split 0's frame and the arm's own
     table; the arm's values of those that reach _RR_GOOD (the caller merges repeats)."""
     _, _, true_rows, slide = _RR_SPLITS[0]
-    slider = (3 if _RR_SPLITS[0][0] else 2) if slide[0] else -1
     starts = []
     for q in rows:
         for first in _RR_FLIPS:
-            if first <= slider < first + 3:
-                continue
             p = np.array(q, dtype=float)
             p[first : first + 3] = (p[first] + math.pi, -p[first + 1], p[first + 2] + math.pi)
             starts.append(_rr_from_arm(0, p))
