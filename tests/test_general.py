@@ -461,10 +461,10 @@ def newton_solutions(m, T: np.ndarray, starts: int, rng: np.random.Generator) ->
 @pytest.mark.parametrize("name", sorted(COBOTS) + sorted(REAL_COBOTS))
 def test_cobots_with_singular_pencils_are_answered_completely(name, tmp_path):
     """Our two shapes and the vendors' three tables are all solved on perturbed tables. In C:
-    300 samples (a fifth of the joints at
-    0, +-90 or 180 deg), every row sound, the sampled vector among the rows on every regular
-    one, an answer at every singular one; at 3 poses multistart Newton (60 starts) finds no
-    solution the solver misses, and finds all it returns. This guards the doubt rules that
+    300 samples (a fifth of the joints at 0, +-90 or 180 deg), every row sound, the sampled
+    vector among the rows on every regular one, an answer at every singular one; at 3 poses
+    multistart Newton (60 or 200 starts) finds no solution the solver misses, and finds all
+    it returns. This guards the doubt rules that
     took these arms' compiled ik from 690 and 917 us to 262 and 302 us (a perturbed table's
     clusters start the fallback split only)."""
     if name in COBOTS:
