@@ -291,3 +291,38 @@ def test_a_humanoid_arm_s_position_round_trips(tmp_path):
     for backend in ("c", "python"):
         missed, empty, worst = free_round_trips(module, backend, 200, 9)
         assert missed == 0 and empty == 0 and worst <= 1e-10
+
+
+# an Allegro hand's finger (example-robot-data 6.0.0, allegro_right_hand.urdf, palm_link to
+# link_3.0_tip, as derive import-urdf writes it): a sideways joint, then three parallel ones,
+# the tip 26.7 mm beyond the last along its link
+ALLEGRO_FINGER = spec_text(
+    "allegro_finger",
+    "modified",
+    [(0, 0, 0, 0), (90, 0, 0, 90), (0, 0.054, 0, 0), (0, 0.0384, 0, 0)],
+    extra="\n[tool]\nmatrix = [[0, 0, 1, 0.0267], [1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 0, 1]]\n"
+    '\n[ik]\ntask = "position"\n',
+)
+
+
+@pytest.mark.parametrize("backend", ["python", pytest.param("c", marks=needs_cc)])
+def test_a_free_joint_that_puts_the_point_on_frame_3_s_x_axis_is_solved(backend, tmp_path):
+    """The finger's position with q4 free: at q4 = 0 (the finger straight, and the default
+    free value) the tool point lies on the x axis of frame 3, d4 = 0 and alpha3 any; the
+    solver divided by d4 (ZeroDivisionError in Python, no row in C: a new user's attack). Now
+    the sampled vector is among the rows at q4 = 0, 1e-9 and 0.5, and with no free value
+    given at q4 = 0."""
+    module = build_module(ALLEGRO_FINGER, tmp_path, c=backend == "c")
+    assert module.FREE == (4,)
+    for q4 in (0.0, 1e-9, 0.5):
+        q = np.array([0.2, 0.5, 0.3, q4])
+        p = module.fk(q)[:3, 3]
+        calls = [{"free": [q4]}] + ([{}] if q4 == 0.0 else [])
+        for kw in calls:
+            rows = module.ik_position(p, backend=backend, **kw)
+            assert len(rows) == 4
+            assert np.min(np.max(np.abs(rows - q), axis=1)) <= 1e-9, (q4, kw, rows)
+            for row in rows:
+                assert np.max(np.abs(module.fk(row)[:3, 3] - p)) <= 1e-10 * module.REACH
+    missed, empty, worst = free_round_trips(module, backend, 200, 11)
+    assert missed == 0 and empty == 0 and worst <= 1e-10

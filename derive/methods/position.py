@@ -44,24 +44,24 @@ def derive(chain: Chain, structure: Structure) -> IkPlan | str:
     if any(v.free_symbols for v in (px, py, pz)):
         # free joints after joint 3 move the tool point in frame 3 (derive/free.py): the
         # solver computes it from their values first, and from it the wrist centre's a3, d4
-        # and alpha3 as below (d4 = 0, the point on axis 4 at those values, has no rows)
+        # and alpha3 as below. alpha3 enters the equations only as d4 cos(alpha3) = p_z and
+        # d4 sin(alpha3) = -p_y (SymPy cancels d4 / d4), so that d4 = 0 (the point on the x
+        # axis of frame 3 at those values, any alpha3 right) divides nothing: an Allegro
+        # finger's straight pose, its default free value, raised ZeroDivisionError
         names = tuple(sym.named(f"tool3{axis}") for axis in "xyz")
-        d4, ca, sa = (sym.named(f"tool3{n}") for n in ("d4", "ca", "sa"))
+        d4 = sym.named("tool3d4")
         moved += [
             Assign(names, (px, py, pz), "the tool point in frame 3, moved by the free joints"),
             Assign((d4,), (sp.sqrt(names[1] ** 2 + names[2] ** 2),), "... as a3, d4 and alpha3"),
-            Assign((ca, sa), (names[2] / d4, -names[1] / d4), "cos(alpha3), sin(alpha3)"),
         ]
         numbers[sym.link_a(3)], numbers[sym.d(4)] = names[0], d4
-        numbers[sym.cos_alpha(3)], numbers[sym.sin_alpha(3)] = ca, sa
+        numbers[sym.cos_alpha(3)], numbers[sym.sin_alpha(3)] = names[2] / d4, -names[1] / d4
         mapping = {"tool_point_in_frame_3": sp.Matrix([px, py, pz])}
         free_values = {s: sp.S.Zero for v in (px, py, pz) for s in v.free_symbols}
         free_values |= {s: sp.S.One for s in free_values if s.name.startswith("cfree")}
         point0 = [v.xreplace(free_values) for v in (px, py, pz)]
         typical = dict(zip(names, point0))
         typical[d4] = sp.sqrt(point0[1] ** 2 + point0[2] ** 2)
-        typical[ca] = point0[2] / typical[d4] if typical[d4] != 0 else sp.S.One
-        typical[sa] = -point0[1] / typical[d4] if typical[d4] != 0 else sp.S.Zero
         length += _farthest(px, py, pz)
     else:
         d4 = sp.sqrt(py**2 + pz**2)
