@@ -37,10 +37,11 @@ from derive.outputs import (
     writable_file,
     write_atomic,
 )
-from derive.pipeline import build_plan
+from derive.pipeline import build_plan, task_of
 from derive.plan import Plan
 from derive.report import Example, render_report
-from derive.spec import IK_METHODS, IK_TASKS, TOOL_AXES, ArmSpec, SpecError, load_spec
+from derive.spec import IK_METHODS, IK_TASKS, TOOL_AXES, ArmSpec, SpecError, load_spec, parse_spec
+from derive.transforms import chain_from_spec
 
 DEFAULT_OUT = "generated"
 
@@ -1269,6 +1270,10 @@ def write_import(
     """import-urdf's and import-mjcf's work: the spec to the output, the record to stderr."""
     output = text_output(args.output)
     text, conversion = convert(Path(source), urdf_options(args))
+    # a task the chain cannot do is refused here, as generate refuses it, rather than written
+    # into a spec every later command refuses
+    spec = parse_spec(text, f"{source} ({args.base} .. {args.tip})")
+    task_of(spec, chain_from_spec(spec))
     if output is not None:
         write_atomic(output, text)
     else:

@@ -1165,3 +1165,26 @@ def test_ik_path_follows_a_task_arm_s_straight_lines(generated, name):
             assert min(task_sigma(module, q, T) for q, T in zip(fine[done], Tf[done])) < 0.005
             jumped += 1
     assert unbroken >= 18 and jumped <= 1
+
+
+@pytest.mark.parametrize(
+    ("options", "message"),
+    [
+        (["--task", "direction"], '"direction" needs at least 5 joints, the arm has 2'),
+        (["--task", "position"], '"position" needs at least 3 joints, the arm has 2'),
+        (["--task", "lookat", "--base-axis", "x"], 'ik.base_axis: only the "axisangle" task'),
+    ],
+)
+def test_import_refuses_a_task_the_chain_cannot_do(options, message, tmp_path, capsys):
+    """import-urdf --task on LoCoBot's two-joint pan-tilt head: a task it cannot do is
+    refused in one line, as generate refuses it, and nothing is written (it wrote a spec that
+    every later command refused: a new user's attack)."""
+    from derive import cli
+
+    out = tmp_path / "head.toml"
+    urdf = str(DATA / "urdf" / "locobot.urdf")
+    chain = ["--base", "locobot/camera_tower_link", "--tip", "locobot/camera_depth_link"]
+    assert cli.main(["import-urdf", urdf, *chain, *options, "-o", str(out)]) == 2
+    assert message in capsys.readouterr().err and not out.exists()
+    assert cli.main(["import-urdf", urdf, *chain, "--task", "lookat", "-o", str(out)]) == 0
+    assert 'task = "lookat"' in out.read_text()
