@@ -112,9 +112,13 @@ def jacobian_lines(plan: Plan) -> tuple[tuple[str, ...], tuple[str, ...]]:
     (derive/jacobian.py), and the 6 n names holding them, row-major."""
     names = sp.numbered_symbols("x")
     J = plan.jacobian
-    n = J.shape[1]
-    entries = [J[i, j] for i in range(6) for j in range(n)]
+    n = plan.arm.dof
     targets = tuple(sym.named(f"j{i}_{j}") for i in range(6) for j in range(n))
+    if J is None:  # (exact frames: the chain's, at run time)
+        return (f"({', '.join(map(str, targets))},) = _chain_jacobian(q)",), tuple(
+            str(t) for t in targets
+        )
+    entries = [J[i, j] for i in range(6) for j in range(n)]
     printer = CodePrinter()
     head = []
     for k, target, expr, turns in used_joints(plan, J.free_symbols):

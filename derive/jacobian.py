@@ -10,7 +10,11 @@ column and o_i its origin, and p the tool point, column i of the Jacobian is
 
 (the tool point's velocity over the angular velocity, in the world: d p / d q_i and the axis
 of the rotation d R / d q_i R^T). The entries are unexpanded products of the factors in c_i,
-s_i and d_i, printed with CSE beside the forward kinematics (Python and C).
+s_i and d_i, printed with CSE beside the forward kinematics (Python and C). An arm with exact
+frames (a URDF's, every frame a dense matrix) has no printed Jacobian: the common
+subexpressions of its entries took half of its generation (a zoo URDF's UR3e 23.5 s, 6.2 s
+without), and its module computes the same columns from its chain at run time
+(_chain_jacobian in derive/runtime/refine.py, dk_chain_jacobian in derive/c/runtime.c).
 """
 
 from __future__ import annotations

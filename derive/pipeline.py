@@ -149,11 +149,15 @@ def build_plan(spec: ArmSpec, method: str | None = None) -> Plan:
         pose = frames_pose(spec.exact, chain)
         factors = frames_factors(spec.exact, chain)
         joints = [1 + 2 * k for k in range(chain.dof)]
-    velocity = jacobian.geometric(factors, joints, spec.joint_types)
+    # (exact frames, dense: the module computes the Jacobian from the chain at run time)
+    velocity = (
+        None if spec.exact is not None else jacobian.geometric(factors, joints, spec.joint_types)
+    )
     joint_defs = joint_definitions(chain)
     if ik is not None and ik.relabel != 0:
         pose, joint_defs = relabelled(pose, joint_defs, chain, ik.relabel)
-        velocity = in_steps_variable(velocity, chain, ik.relabel)
+        if velocity is not None:
+            velocity = in_steps_variable(velocity, chain, ik.relabel)
     return Plan(
         arm=arm_info(spec, chain),
         structure=facts,

@@ -379,7 +379,8 @@ class Plan:
         structure: structure facts found by classification, e.g. "spherical wrist at joints 4-6".
         fk_pose: world pose B 0_nT E as a 4x4 matrix in c_i, s_i (R) and d_i (P).
         jacobian: the geometric Jacobian at the tool point in the world frame, 6 x n (linear
-            velocity over angular velocity; derive/jacobian.py), in the same symbols.
+            velocity over angular velocity; derive/jacobian.py), in the same symbols; None
+            for an arm with exact frames (a URDF's), which computes it from its chain.
         links: the link transforms (i-1)_iT in the spec's convention, in c_i, s_i and d_i.
         joint_defs: (symbol, expression in q_i) defining theta_i or d_i for each joint.
         ik: the IK plan, or None when no method applies.
@@ -393,7 +394,7 @@ class Plan:
     arm: ArmInfo
     structure: tuple[str, ...]
     fk_pose: sp.Matrix
-    jacobian: sp.Matrix
+    jacobian: sp.Matrix | None
     links: tuple[sp.Matrix, ...]
     joint_defs: tuple[tuple[sp.Symbol, sp.Expr], ...]
     ik: IkPlan | None

@@ -701,10 +701,13 @@ def exact_frames(path: list[UrdfJoint]) -> list[list[float]]:
 def _onto_z(axis: Vector) -> Matrix:
     """A rotation R (4x4) with R e_z = axis (a unit vector)."""
     x, y, z = axis
-    if z < -1.0 + 1e-12:  # (the half turn about x)
+    if z < 0.0 and x * x + y * y < 1e-30:  # (the half turn about x: within 1e-15 of -e_z)
         return [[1.0, 0.0, 0.0, 0.0], [0.0, -1.0, 0.0, 0.0], [0.0, 0.0, -1.0, 0.0], [0, 0, 0, 1.0]]
-    # Rodrigues' rotation about e_z x axis by the angle between them, written without it
-    k = 1.0 / (1.0 + z)
+    # Rodrigues' rotation about e_z x axis by the angle between them, written without it;
+    # 1 / (1 + z) = (1 - z) / (x^2 + y^2) for a unit axis, the second where z < 0: near -e_z
+    # 1 + z loses its digits (an axis "0 -0.0015509 -1", a DClaw finger's, made frames 9e-11
+    # from orthonormal and fk 8e-11 from the URDF's, a new user's attack)
+    k = 1.0 / (1.0 + z) if z >= 0.0 else (1.0 - z) / (x * x + y * y)
     return [
         [1.0 - k * x * x, -k * x * y, x, 0.0],
         [-k * x * y, 1.0 - k * y * y, y, 0.0],

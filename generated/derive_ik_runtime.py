@@ -38,7 +38,7 @@ if "_RUNTIME_VERSION" not in globals():  # (imported on its own, not run by a mo
         "namespace; it is not a module to import"
     )
 # this runtime's version: a module runs the runtime of its own version only
-_RUNTIME_VERSION = "6883cff34cdb24cd"
+_RUNTIME_VERSION = "35dfc46be3afb6f8"
 
 if TYPE_CHECKING:  # defined by the module running this file
     from derive.runtime.arm import (
@@ -4402,6 +4402,27 @@ def _dot(a, b):
     time: the refinement's normal equations and their factor were most of a refined arm's
     Python time)."""
     return sum(map(_mul, a, b))
+
+
+def _chain_jacobian(q):
+    """The geometric Jacobian at the tool point in the world (linear velocity over angular
+    velocity) of the exact chain at q, 6 * DOF entries row-major: column i is
+    (z_i x (p - o_i), z_i) for a revolute joint, (z_i, 0) for a prismatic one. An arm with
+    exact frames (a URDF's) computes its Jacobian so (_jacobian_q), rather than from printed
+    expressions, whose common subexpressions took half of such an arm's generation."""
+    pose, axes, origins = _chain_pose(q)
+    n = len(_REVOLUTE)
+    J = [0.0] * (6 * n)
+    for i, (z, o) in enumerate(zip(axes, origins)):
+        if _REVOLUTE[i]:
+            dx, dy, dz = pose[3] - o[0], pose[7] - o[1], pose[11] - o[2]
+            J[i] = z[1] * dz - z[2] * dy
+            J[n + i] = z[2] * dx - z[0] * dz
+            J[2 * n + i] = z[0] * dy - z[1] * dx
+            J[3 * n + i], J[4 * n + i], J[5 * n + i] = z
+        else:
+            J[i], J[n + i], J[2 * n + i] = z
+    return J
 
 
 def _chain_pose(q):

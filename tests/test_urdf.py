@@ -458,3 +458,16 @@ def test_a_robot_named_as_a_keyword_or_a_module_gets_a_spec_name_it_may_have(rob
     path = tmp_path / "finger.urdf"
     path.write_text(text.replace('<robot name="chain">', f'<robot name="{robot}">'))
     assert urdf.load_urdf(path, options(base, tip)).name == name
+
+
+@pytest.mark.parametrize("tilt", [0.0015509, 1e-4, 1e-7, 1e-16, 0.3, 1.0])
+def test_a_joint_axis_near_minus_z_gets_an_orthonormal_frame(tilt):
+    """The rotation taking e_z onto a joint's axis (urdf._onto_z) for axes near -e_z: 1 + z
+    lost its digits there, and a DClaw finger's axis "0 -0.0015509 -1" (mani-skill's
+    dclaw_gripper_glb.urdf) made [exact] frames 9.2e-11 from orthonormal and the module's fk
+    8e-11 from the URDF's (a new user's attack). Orthonormal and onto the axis to 1e-15."""
+    norm = math.sqrt(1.0 + tilt * tilt)
+    for axis in ((0.0, -tilt / norm, -1.0 / norm), (tilt / norm, 0.0, -1.0 / norm)):
+        R = np.array(urdf._onto_z(axis))[:3, :3]
+        assert np.abs(R.T @ R - np.eye(3)).max() <= 1e-15
+        assert np.abs(R[:, 2] - axis).max() <= 1e-15 and np.linalg.det(R) > 0.0

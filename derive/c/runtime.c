@@ -2822,6 +2822,37 @@ static void dk_defer(dk_pending *p, const double q[DK_REFINE_N], const double cs
     }
 }
 
+/* e := e J(q): Rz(q) for a revolute joint, Tz(q) for a sliding one (e: the top three rows) */
+static void dk_chain_joint(double e[12], int revolute, double q)
+{
+    int r;
+    if (revolute) {
+        const double cq = cos(q), sq = sin(q);
+        for (r = 0; r < 3; r++) {
+            const double x = e[4 * r], y = e[4 * r + 1];
+            e[4 * r] = cq * x + sq * y;
+            e[4 * r + 1] = cq * y - sq * x;
+        }
+    } else {
+        for (r = 0; r < 3; r++) {
+            e[4 * r + 3] += q * e[4 * r + 2];
+        }
+    }
+}
+
+/* e := e F (both the top three rows of a rigid motion) */
+static void dk_chain_fixed(double e[12], const double f[12])
+{
+    int r;
+    for (r = 0; r < 3; r++) {
+        const double p0 = e[4 * r], p1 = e[4 * r + 1], p2 = e[4 * r + 2];
+        e[4 * r] = p0 * f[0] + p1 * f[4] + p2 * f[8];
+        e[4 * r + 1] = p0 * f[1] + p1 * f[5] + p2 * f[9];
+        e[4 * r + 2] = p0 * f[2] + p1 * f[6] + p2 * f[10];
+        e[4 * r + 3] = p0 * f[3] + p1 * f[7] + p2 * f[11] + e[4 * r + 3];
+    }
+}
+
 /* The pose of frame k of a chain of n joints and fixed frames (12 entries each: T(q) = F_0
    J_1(q_1) F_1 ... J_n(q_n) F_n, J_i = Rz(q_i) or Tz(q_i)), top three rows into out: k = 1..n
    the frame of joint k, F_0 J_1 F_1 ... F_{k-1} J_k (its z the joint's axis, its origin on
@@ -2829,38 +2860,64 @@ static void dk_defer(dk_pending *p, const double q[DK_REFINE_N], const double cs
 static void dk_chain_frame(const double (*chain)[12], const int *revolute, int n,
                            const double *q, int k, double out[12])
 {
-    int i, r, c;
+    int i;
     for (i = 0; i < 12; i++) {
         out[i] = chain[0][i];
     }
     for (i = 0; i < k && i < n; i++) {
-        if (revolute[i]) { /* out := out Rz(q_i) */
-            const double cq = cos(q[i]), sq = sin(q[i]);
-            for (r = 0; r < 3; r++) {
-                const double x = out[4 * r], y = out[4 * r + 1];
-                out[4 * r] = cq * x + sq * y;
-                out[4 * r + 1] = cq * y - sq * x;
-            }
-        } else { /* out := out Tz(q_i) */
-            for (r = 0; r < 3; r++) {
-                out[4 * r + 3] += q[i] * out[4 * r + 2];
-            }
-        }
-        if (i + 1 < k) { /* out := out F_{i+1} */
-            const double *f = chain[i + 1];
-            for (r = 0; r < 3; r++) {
-                const double p0 = out[4 * r], p1 = out[4 * r + 1], p2 = out[4 * r + 2];
-                for (c = 0; c < 4; c++) {
-                    out[4 * r + c] = p0 * f[c] + p1 * f[4 + c] + p2 * f[8 + c] +
-                                     (c == 3 ? out[4 * r + 3] : 0.0);
-                }
-            }
+        dk_chain_joint(out, revolute[i], q[i]);
+        if (i + 1 < k) {
+            dk_chain_fixed(out, chain[i + 1]);
         }
     }
 }
 
 /* the most joints an arm has (derive/spec.py, MAX_JOINTS): the size of dk_svd_columns's arrays */
 #define DK_JOINTS_MAX 12
+
+/* The geometric Jacobian at the tool point in the world (linear velocity over angular
+   velocity) of a chain of n joints and fixed frames (dk_chain_frame's), row-major into J (6
+   rows of n), and the tool's pose's top three rows into e: column i is (z_i x (p - o_i), z_i)
+   for a revolute joint, (z_i, 0) for a prismatic one, z_i and o_i the axis and origin of the
+   frame joint i turns in, p the tool point. An arm with exact frames (a URDF's) computes its
+   Jacobian so rather than from printed expressions, whose common subexpressions took half
+   of such an arm's generation (derive/jacobian.py). */
+static void dk_chain_jacobian(const double (*chain)[12], const int *revolute, int n,
+                              const double *q, double *J, double e[12])
+{
+    double axes[DK_JOINTS_MAX][3], origins[DK_JOINTS_MAX][3];
+    int i, r;
+    for (i = 0; i < 12; i++) {
+        e[i] = chain[0][i];
+    }
+    for (i = 0; i < n; i++) {
+        for (r = 0; r < 3; r++) {
+            axes[i][r] = e[4 * r + 2];
+            origins[i][r] = e[4 * r + 3];
+        }
+        dk_chain_joint(e, revolute[i], q[i]);
+        dk_chain_fixed(e, chain[i + 1]);
+    }
+    for (i = 0; i < n; i++) {
+        const double *z = axes[i];
+        if (revolute[i]) {
+            const double dx = e[3] - origins[i][0], dy = e[7] - origins[i][1];
+            const double dz = e[11] - origins[i][2];
+            J[i] = z[1] * dz - z[2] * dy;
+            J[n + i] = z[2] * dx - z[0] * dz;
+            J[2 * n + i] = z[0] * dy - z[1] * dx;
+            J[3 * n + i] = z[0];
+            J[4 * n + i] = z[1];
+            J[5 * n + i] = z[2];
+        } else {
+            for (r = 0; r < 3; r++) {
+                J[r * n + i] = z[r];
+                J[(3 + r) * n + i] = 0.0;
+            }
+        }
+    }
+}
+
 /* Jacobi's sweeps stop when every pair of columns is orthogonal to this fraction of their
    lengths' product (or after DK_SVD_SWEEPS sweeps) */
 #define DK_SVD_DONE (1e-15)
