@@ -38,7 +38,7 @@ if "_RUNTIME_VERSION" not in globals():  # (imported on its own, not run by a mo
         "namespace; it is not a module to import"
     )
 # this runtime's version: a module runs the runtime of its own version only
-_RUNTIME_VERSION = "35dfc46be3afb6f8"
+_RUNTIME_VERSION = "ec1ce9facd96402e"
 
 if TYPE_CHECKING:  # defined by the module running this file
     from derive.runtime.arm import (
@@ -4116,6 +4116,13 @@ _REFINE_STALL = 1e-9
 _REFINE_SETTLE = 1e-6
 
 
+# a step no longer than this from an error above _REFINE_SETTLE: a stationary point of the
+# error, no solution (a look-at seed aimed away from its point, whose error is the point's
+# distance behind the camera, took _REFINE_PATIENCE steps of 1e-16 to give up); the seed ends
+# there, as it would have after them
+_REFINE_STILL = 1e-12
+
+
 # an exact table's row certified within ik's tol but not within this is polished (_keep): a
 # far look-at point's rows came within 1e-10 of the ray by the certification's largest
 # entry and 1.5e-10 by its length (a new user's attack)
@@ -4219,7 +4226,9 @@ def _refine(q, t, held=(), patience=_REFINE_PATIENCE):
                 worse = patience - 1
                 continue
         longest = max(map(abs, step))
-        if not longest < math.inf:
+        if not longest < math.inf or (
+            longest <= _REFINE_STILL and size > _REFINE_SETTLE and not settle
+        ):
             break
         shrink = _REFINE_STRIDE / longest if longest > _REFINE_STRIDE else 1.0
         for k, i in enumerate(_SOLVED):

@@ -1738,6 +1738,11 @@ static void dk_rigid(const double T[16], double t[12])
    Gauss-Newton steps by QR go on from the best point met (derive/runtime/refine.py,
    _REFINE_SETTLE, says why) */
 #define DK_REFINE_SETTLE (1e-6)
+/* a step no longer than this from an error above DK_REFINE_SETTLE: a stationary point of the
+   error, no solution (a look-at seed aimed away from its point, whose error is the point's
+   distance behind the camera; it took DK_REFINE_PATIENCE steps of 1e-16 to give up, 20 of a
+   pan-tilt head's 21 steps a pose); the seed ends there, as it would have after them */
+#define DK_REFINE_STILL (1e-12)
 /* an exact table's row certified within ik's tol but not within this is polished (dk_polish;
    derive/runtime/refine.py, _REFINE_POLISH, says why) */
 #define DK_REFINE_POLISH (1e-10)
@@ -2202,7 +2207,8 @@ static double dk_refine(const double chain[DK_REFINE_N + 1][12], const int revol
         for (k = 0; k < DK_REFINE_M; k++) {
             longest = fabs(step[k]) > longest ? fabs(step[k]) : longest;
         }
-        if (!(longest < HUGE_VAL)) {
+        if (!(longest < HUGE_VAL) || (!settle && longest <= DK_REFINE_STILL &&
+                                      size > DK_REFINE_SETTLE)) {
             break;
         }
         dk_take_step(revolute, solved, step, longest, cur, cs);
@@ -2719,6 +2725,10 @@ static void dk_refine_lanes(const double chain[DK_REFINE_N + 1][12],
             }
             reused[l] = longest[l];
             floor[l] = least[l];
+            if (longest[l] <= DK_REFINE_STILL && now[l] > DK_REFINE_SETTLE) { /* (stationary) */
+                done[l] = measure[w] = 1;
+                continue;
+            }
             if (last[l] && longest[l] <= DK_REFINE_TRUST * now[l]) { /* (Newton's step from
                 there: the error squared, not measured) */
                 for (i = 0; i < DK_REFINE_N; i++) {
