@@ -687,6 +687,7 @@ def test_a_tool_axis_without_a_task_of_one_is_refused():
         (((0, 0, 0.3), (0, 0, 0)), "d must be a direction: not all 0"),
         (((0, 0, 0.3), (0, math.inf, 1)), "d must be 3 finite numbers"),
         (((0, 0, 0.3), "up"), "d must be"),
+        (((0, 0, 0.3), None), "d must be"),  # (it was solved as the world's z: an attack)
     ],
 )
 def test_task_arguments_are_checked(generated, args, message):
