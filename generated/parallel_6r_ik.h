@@ -79,10 +79,10 @@ void parallel_6r_twist(const double q[6], const double dq[6], int frame,
    singular value is at least band, below it lambda^2 = damping^2 (1 - (sigma / band)^2), which
    bounds every rate by |twist| / (2 damping) at a singular configuration, by |twist| / band
    anywhere where damping >= band (the defaults: equal); an arm of fewer than 6 joints gets
-   the least-squares dq. preferred (NULL: none): joint values the arm drifts toward at rate gain in
-           the
-   Jacobian's null space (its self-motion). Returns 0, or PARALLEL_6R_INVALID_ARGUMENT (a
-   number not finite, damping or band negative, frame neither 0 nor 1). */
+   the least-squares dq. preferred (NULL: none): joint values the arm drifts toward at rate
+   gain in the Jacobian's null space (its self-motion). Returns 0, or
+   PARALLEL_6R_INVALID_ARGUMENT (a number not finite, damping or band negative, frame
+   neither 0 nor 1). */
 int parallel_6r_ik_velocity(const double q[6], const double twist[6], int frame,
                            double damping, double band, const double *preferred, double gain,
                            double dq[6]);
