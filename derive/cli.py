@@ -558,6 +558,10 @@ def task_pose(spec: ArmSpec, module: ModuleType, args: argparse.Namespace) -> An
                 f"--point: {spec.name} is solved for a point and a direction: give --direction"
             )
         direction = direction_numbers(args.direction)
+    if direction is None:  # (a task that reads the point only, as a look-at)
+        pose = np.eye(4)
+        pose[:3, 3] = point
+        return pose
     return module._task_pose(point, direction)
 
 
