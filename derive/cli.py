@@ -530,10 +530,6 @@ def task_pose(spec: ArmSpec, module: ModuleType, args: argparse.Namespace) -> An
         raise UsageError(f"--point: give 3 numbers, x y z (got {len(point)})")
     if max(map(abs, point)) > far:
         raise UsageError(f"--point: beyond {far:g} (a million times the reach): out of reach")
-    if task == "position":
-        pose = np.eye(4)
-        pose[:3, 3] = point
-        return pose
     direction = None
     if task == "axisangle":
         if args.direction is not None or args.angle is None:
@@ -558,7 +554,7 @@ def task_pose(spec: ArmSpec, module: ModuleType, args: argparse.Namespace) -> An
                 f"--point: {spec.name} is solved for a point and a direction: give --direction"
             )
         direction = direction_numbers(args.direction)
-    if direction is None:  # (a task that reads the point only, as a look-at)
+    if direction is None:  # (a task that reads the point only: position, look-at)
         pose = np.eye(4)
         pose[:3, 3] = point
         return pose
