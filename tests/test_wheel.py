@@ -4,6 +4,7 @@ source tree. Slow (it builds the wheel and installs its dependencies): about a m
 from __future__ import annotations
 
 import os
+import shutil
 import subprocess
 import sys
 from pathlib import Path
@@ -25,6 +26,17 @@ def venv(tmp_path_factory) -> Path:
     """A fresh virtual environment with the wheel built from this checkout installed, and a
     poisoned top-level `templates/` folder in its site-packages."""
     base = tmp_path_factory.mktemp("wheel")
+    # pip builds a local folder in place (its build/ folder): a copy, so that two test workers
+    # building at once do not share one build/ (CI failed on 'File exists: build/bdist...'),
+    # and the checkout is left as it was
+    source = base / "source"
+    shutil.copytree(
+        ROOT,
+        source,
+        ignore=shutil.ignore_patterns(
+            ".git", ".venv", "build", "*.egg-info", "__pycache__", ".pytest_cache", "generated"
+        ),
+    )
     built = call(
         [
             sys.executable,
@@ -34,7 +46,7 @@ def venv(tmp_path_factory) -> Path:
             "--no-deps",
             "--quiet",
             "--disable-pip-version-check",
-            str(ROOT),
+            str(source),
             "-w",
             str(base / "dist"),
         ],
