@@ -57,10 +57,8 @@ settings.load_profile("ci")
 
 
 # tests of the compiled (C) solvers need a C compiler
-needs_cc = pytest.mark.skipif(
-    not (os.environ.get("CC") or shutil.which("cc") or shutil.which("gcc")),
-    reason="no C compiler (set CC, or install cc)",
-)
+HAVE_CC = bool(os.environ.get("CC") or shutil.which("cc") or shutil.which("gcc"))
+needs_cc = pytest.mark.skipif(not HAVE_CC, reason="no C compiler (set CC, or install cc)")
 
 
 def write_runtime(folder: Path) -> None:
