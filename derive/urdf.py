@@ -326,6 +326,11 @@ def _joint(element, where: str) -> UrdfJoint:
     kind = element.get("type", "")
     if kind not in KNOWN_TYPES:
         raise UrdfError(f"{at}: type {_shown(kind)}; allowed: {', '.join(KNOWN_TYPES)}")
+    for tag in ("parent", "child", "origin", "axis", "limit"):  # (the kinematics' elements:
+        # two would leave it to the reader which one counts)
+        count = len(element.findall(tag))
+        if count > 1:
+            raise UrdfError(f"{at}: {count} <{tag}> elements; allowed: one")
     ends = []
     for tag in ("parent", "child"):
         node = element.find(tag)

@@ -510,3 +510,22 @@ def test_a_misspelled_tip_is_answered_with_the_nearest_names(tmp_path, capsys):
                  str(tmp_path / "out")])  # fmt: skip
     err = capsys.readouterr().err
     assert code == 2 and "--tip 'link_6': no such link; did you mean 'link6'" in err
+
+
+@pytest.mark.parametrize(
+    ("tag", "old", "new"),
+    [
+        ("child", '<child link="c"/>', '<child link="c"/><child link="a"/>'),
+        ("parent", '<parent link="b"/>', '<parent link="b"/><parent link="a"/>'),
+        ("axis", '<axis xyz="0 0 1"/>', '<axis xyz="0 0 1"/><axis xyz="1 0 0"/>'),
+    ],
+)
+def test_a_joint_with_two_of_an_element_is_refused(tag, old, new, tmp_path, fails):
+    """Two <child> (or <parent>, <origin>, <axis>, <limit>) elements in one joint leave it
+    to the reader which counts (it had been the first, silently: a new user's attack)."""
+    text = urdf_text(two_joints(), ["a", "b", "c"])
+    assert text.count(old) >= 1
+    head, tail = text.split('name="j2"', 1)
+    path = write(tmp_path, head + 'name="j2"' + tail.replace(old, new, 1))
+    line = fails("import-urdf", str(path), "--base", "a", "--tip", "c")
+    assert "joint 'j2'" in line and f"2 <{tag}> elements" in line and "allowed: one" in line
