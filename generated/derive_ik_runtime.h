@@ -9,7 +9,7 @@
    is solved by it): one copy serves every arm of a folder, and each arm's file gets its own
    static copy of the routines, so arms link together in one program. Compile <name>_ik.c
    with it beside the file; do not include it anywhere else. */
-#define DK_RUNTIME 0x3148ff7ee0d4
+#define DK_RUNTIME 0x678ca481267e
 
 #include <math.h>
 #include <stddef.h>
@@ -2560,14 +2560,20 @@ static void dk_refine_lanes(const double chain[DK_REFINE_N + 1][12],
             ended |= done[l];
         }
         /* the last step, with the previous factor where the previous step was within
-           DK_REFINE_SMALL (dk_refine's): in every lane, taken in the lanes it is theirs */
-        for (k = 0; k < DK_REFINE_M; k++) {
-            again[k] = zero;
-            for (r = 0; r < DK_REFINE_ROWS; r++) {
-                again[k] += J[r][k] * error[r];
-            }
+           DK_REFINE_SMALL (dk_refine's): in every lane where a lane's is (taken in the lanes
+           it is theirs) */
+        for (l = 0, m = 0; l < DK_LANES; l++) {
+            m |= who[l] >= 0 && !done[l] && last[l] && reused[l] <= DK_REFINE_SMALL;
         }
-        dk_ldl_again((const dk_lane(*)[DK_REFINE_M])normal, inverse, again);
+        if (m) {
+            for (k = 0; k < DK_REFINE_M; k++) {
+                again[k] = zero;
+                for (r = 0; r < DK_REFINE_ROWS; r++) {
+                    again[k] += J[r][k] * error[r];
+                }
+            }
+            dk_ldl_again((const dk_lane(*)[DK_REFINE_M])normal, inverse, again);
+        }
         for (l = 0; l < DK_LANES; l++) {
             double most = 0.0;
             if (who[l] < 0 || done[l] || !last[l] || !(reused[l] <= DK_REFINE_SMALL)) {
