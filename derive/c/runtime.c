@@ -992,8 +992,10 @@ static double dk_newton(const double *p, int d, double x)
 /* the real parts of the near-real zs[0..m), polished (simple roots) and merged (near-equal
    ones, and clusters of a split multiple root that are not all real: their mean), ascending,
    into out: their count, or -1 where check is set and one, or a complex one, fails the
-   residual test */
-static int dk_accept(const double *p, int d, const dk_cx *zs, int m, int check, double *out)
+   residual test; on a nominal table, also the real parts of its complex roots within
+   sqrt(DK_SEED_TOL) of real (any, loose: the solver's second pass) and either side of them */
+static int dk_accept(const double *p, int d, const dk_cx *zs, int m, int check, int loose,
+                     double *out)
 {
     double xs[DK_POLY_MAX];
     int simple[DK_POLY_MAX], n = 0, count = 0, split = 0, used[DK_POLY_MAX] = {0}, k, j;
@@ -1090,8 +1092,10 @@ static int dk_accept(const double *p, int d, const dk_cx *zs, int m, int check, 
         }
         out[count++] = x;
     }
-    if (DK_SEED_TOL > 0.0) { /* a nominal near-double root, split by the arm's difference */
-        const double near = sqrt(DK_SEED_TOL);
+    if (DK_SEED_TOL > 0.0) { /* a nominal near-double root, split by the arm's difference
+                                (in the second pass, loose: any complex root, as the Python
+                                solver's _accept) */
+        const double near = loose ? HUGE_VAL : sqrt(DK_SEED_TOL);
         for (k = 0; k < m; k++) {
             const double size = 1.0 + dk_cx_abs(zs[k]);
             if (zs[k].im > DK_ROOT_IMAG_TOL * size && zs[k].im <= near * size) {
@@ -1158,7 +1162,7 @@ static void dk_aberth(const double *p, int d, dk_cx *z)
    unchecked; forward kinematics certifies every solution either way); another degree (a
    cubic: a quartic whose leading coefficient vanished) the Aberth iteration's roots from a
    circle, accepted unchecked (numpy.roots' in the Python solver); -1 above DK_POLY_MAX */
-static int dk_roots(const double *p, int d, double *out)
+static int dk_roots(const double *p, int d, int loose, double *out)
 {
     dk_cx z[DK_POLY_MAX];
     int n;
@@ -1205,14 +1209,14 @@ static int dk_roots(const double *p, int d, double *out)
             z[k] = dk_cx_make(bound * cos(angle), bound * sin(angle));
         }
         dk_aberth(p, d, z);
-        return dk_accept(p, d, z, d, 0, out);
+        return dk_accept(p, d, z, d, 0, loose, out);
     }
-    n = dk_accept(p, d, z, d, 1, out);
+    n = dk_accept(p, d, z, d, 1, loose, out);
     if (n >= 0) {
         return n;
     }
     dk_aberth(p, d, z);
-    return dk_accept(p, d, z, d, 0, out);
+    return dk_accept(p, d, z, d, 0, loose, out);
 }
 
 /* The values of a joint from a polynomial (highest degree first): in u = tan(t/2) (angles;
@@ -1268,7 +1272,7 @@ static int dk_poly(dk_values *v, const double *coeffs, int d, int angles, double
         }
     }
     if (d > 0) {
-        n = dk_roots(p, d, x);
+        n = dk_roots(p, d, v->loose, x);
         if (n < 0) {
             return -1;
         }

@@ -460,8 +460,11 @@ def _accept(p: list[float], zs: list[complex], check: bool = True) -> list[float
         out.append(x)
         k += 1
     if _SEED_TOL or _LOOSE.on:  # a nominal table's near-double root, split by the arm's
-        # difference (or any complex root, seeding ik_approximate)
-        near = math.inf if _LOOSE.on else math.sqrt(_SEED_TOL)
+        # difference (or any complex root, seeding ik_approximate or ik's second pass: a thin
+        # reach, as a Kinova Gen3 position task's, its tip 0.175 mm from the last solved
+        # axis, leaves poses near its edge an imaginary pair 0.041-0.062 from real in u,
+        # beyond this window's 0.039; _seed drops the seeds beyond _SEED_TOL of the pose)
+        near = math.inf if _LOOSE.on or _LOOSE.near else math.sqrt(_SEED_TOL)
         for z in map(complex, zs):
             if _ROOT_IMAG_TOL * (1.0 + abs(z)) < z.imag <= near * (1.0 + abs(z)):
                 out.append(z.real)
