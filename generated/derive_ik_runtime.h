@@ -9,7 +9,7 @@
    is solved by it): one copy serves every arm of a folder, and each arm's file gets its own
    static copy of the routines, so arms link together in one program. Compile <name>_ik.c
    with it beside the file; do not include it anywhere else. */
-#define DK_RUNTIME 0xe8fff01a68d8
+#define DK_RUNTIME 0x75f6ff639db2
 
 #include <math.h>
 #include <stddef.h>
@@ -3104,6 +3104,7 @@ static void dk_dls(const double *J, int n, const double t[6], double damping, do
 #define DK_RR_PAIR_ANGLE (0.15)
 #define DK_RR_SEARCH_FROM (0.1)
 #define DK_RR_SEARCH_BAIL (0.3)
+#define DK_RR_SINGULAR (1e-12)
 #define DK_RR_SEARCH_STEPS 40
 #define DK_RR_SEARCH_SLIDE (1.5)
 #define DK_RR_MOTION_COUNT 2
@@ -3380,6 +3381,54 @@ static double dk_pivot_ratio(const double M[12][12])
         }
     }
     return big / small;
+}
+
+/* the ratio of the smallest to the largest pivot of M's (12 x 12) LU factorisation with
+   complete pivoting (0 where singular): within a modest factor of its least singular value
+   over its largest, where partial pivoting's least pivot can be 1e2 to 1e3 times above it (a
+   pencil singular to roundings: 1e-12 by partial pivots, 2e-14 by singular values) */
+static double dk_rank_ratio(const double M[12][12])
+{
+    double A[12][12], big = 0.0, small = HUGE_VAL;
+    int n = 12, k, i, j, p, q;
+    for (i = 0; i < n; i++) {
+        for (j = 0; j < n; j++) {
+            A[i][j] = M[i][j];
+        }
+    }
+    for (k = 0; k < n; k++) {
+        p = q = k;
+        for (i = k; i < n; i++) {
+            for (j = k; j < n; j++) {
+                if (fabs(A[i][j]) > fabs(A[p][q])) {
+                    p = i;
+                    q = j;
+                }
+            }
+        }
+        if (A[p][q] == 0.0) {
+            return 0.0;
+        }
+        for (j = 0; j < n; j++) { /* (row p to k, column q to k) */
+            double t = A[k][j];
+            A[k][j] = A[p][j];
+            A[p][j] = t;
+        }
+        for (i = 0; i < n; i++) {
+            double t = A[i][k];
+            A[i][k] = A[i][q];
+            A[i][q] = t;
+        }
+        big = fmax(big, fabs(A[k][k]));
+        small = fmin(small, fabs(A[k][k]));
+        for (i = k + 1; i < n; i++) {
+            double f = A[i][k] / A[k][k];
+            for (j = k + 1; j < n; j++) {
+                A[i][j] -= f * A[k][j];
+            }
+        }
+    }
+    return small / big;
 }
 
 /* rows spanning the left null space of Q (14 x 8) into N, six of them (fixed combinations
@@ -4452,36 +4501,20 @@ static int dk_rr_deflate(double K[24][24], int k, const double *moebius)
     return n;
 }
 
-/* the candidate joint vectors of one split: their count written to out, extra[c] set for
-   those from nearly real pairs, or -1 where the pencil is singular (no usable one: the Python
-   solver's None); *doubt: whether the answer is in doubt (clusters on the arm's own table, or
-   no usable pencil); *reals: the real eigenvalues within reach, *pair: the least
-   |Im y| / (1 + |y|) of the others (HUGE_VAL where none) */
-static int dk_rr_candidates(const double values[490], const double F[4][4],
-                            const double rows[7][4], double out[DK_RR_CANDS][6], int extra[],
-                            int *doubt, double imag_tol, int split, int *reals_found,
-                            double *pair)
+/* the pencil in x3 of a split's matrices (values: P0, Ps, Pc, Q as dk_rr_fill writes them):
+   A6 x3^2 + B6 x3 + C6, Q's left null space times P's (the Python solver's _rr_pencil6); 0
+   where Q's null space is empty */
+static int dk_rr_pencil6(const double values[490], double A6[6][9], double B6[6][9],
+                         double C6[6][9])
 {
-    double N[14][14], A6[6][9], B6[6][9], C6[6][9], pencil[3][12][12], best_pencil[3][12][12];
-    double K[24][24], rhs[12][24], wr[24], wi[24], reals[24], extras[48], V[3][12];
-    double best = HUGE_VAL;
-    /* a sliding joint 3: |d3| <= |p| + the other links' lengths (roots beyond are spurious) */
-    double reach = fabs(F[0][3]) + fabs(F[1][3]) + fabs(F[2][3]);
-    const double *moebius = DK_RR_MOEBIUS[0];
-    int rank_rows, i, m, r, col, c, n_eig, n_real = 0, n_extra = 0, count = 0, start = 0;
+    double N[14][14];
     const double(*P0)[9] = (const double(*)[9])values;
     const double(*Ps)[9] = (const double(*)[9])(values + 126);
     const double(*Pc)[9] = (const double(*)[9])(values + 252);
     const double(*Q)[8] = (const double(*)[8])(values + 378);
-    *doubt = DK_RR_RESCUE;
-    *reals_found = 0;
-    *pair = HUGE_VAL;
-    for (i = 0; i < 6; i++) {
-        reach += fabs(rows[i][0]) + fabs(rows[i][1]);
-    }
-    rank_rows = dk_null_left(Q, N);
+    int rank_rows = dk_null_left(Q, N), i, m, r, col;
     if (rank_rows == 0) {
-        return -1;
+        return 0;
     }
     for (i = 0; i < 6; i++) {
         for (col = 0; col < 9; col++) {
@@ -4505,6 +4538,35 @@ static int dk_rr_candidates(const double values[490], const double F[4][4],
                 }
             }
         }
+    }
+    return rank_rows;
+}
+
+/* the candidate joint vectors of one split: their count written to out, extra[c] set for
+   those from nearly real pairs, or -1 where the pencil is singular (no usable one: the Python
+   solver's None); *doubt: whether the answer is in doubt (clusters on the arm's own table, or
+   no usable pencil); *reals: the real eigenvalues within reach, *pair: the least
+   |Im y| / (1 + |y|) of the others (HUGE_VAL where none) */
+static int dk_rr_candidates(const double values[490], const double F[4][4],
+                            const double rows[7][4], double out[DK_RR_CANDS][6], int extra[],
+                            int *doubt, double imag_tol, int split, int *reals_found,
+                            double *pair)
+{
+    double A6[6][9], B6[6][9], C6[6][9], pencil[3][12][12], best_pencil[3][12][12];
+    double K[24][24], rhs[12][24], wr[24], wi[24], reals[24], extras[48], V[3][12];
+    double best = HUGE_VAL;
+    /* a sliding joint 3: |d3| <= |p| + the other links' lengths (roots beyond are spurious) */
+    double reach = fabs(F[0][3]) + fabs(F[1][3]) + fabs(F[2][3]);
+    const double *moebius = DK_RR_MOEBIUS[0];
+    int i, m, col, c, n_eig, n_real = 0, n_extra = 0, count = 0, start = 0;
+    *doubt = DK_RR_RESCUE;
+    *reals_found = 0;
+    *pair = HUGE_VAL;
+    for (i = 0; i < 6; i++) {
+        reach += fabs(rows[i][0]) + fabs(rows[i][1]);
+    }
+    if (!dk_rr_pencil6(values, A6, B6, C6)) {
+        return -1;
     }
     for (c = 0; c < 3; c++) {
         double ratio;
@@ -4962,6 +5024,31 @@ static int dk_rr_search(const double F[4][4], const double starts[DK_RR_ROWS][6]
     return count;
 }
 
+/* whether split k's pencil at the target F is singular to roundings (the Python solver's
+   _rr_singular): the leading matrix under every Moebius map, the pencil at three values of
+   x3, has an LU factor (complete pivoting) whose least pivot is within DK_RR_SINGULAR of its
+   largest */
+static int dk_rr_singular(int k, const double F[4][4])
+{
+    double values[490], A6[6][9], B6[6][9], C6[6][9], pencil[3][12][12];
+    int i, c;
+    for (i = 0; i < 490; i++) {
+        values[i] = 0.0;
+    }
+    dk_rr_fill(k, F[0][2], F[1][2], F[2][2], F[0][3], F[1][3], F[2][3], values);
+    if (!dk_rr_pencil6(values, A6, B6, C6)) {
+        return 0;
+    }
+    for (c = 0; c < 3; c++) {
+        dk_rr_pencil((const double(*)[9])A6, (const double(*)[9])B6, (const double(*)[9])C6,
+                     DK_RR_MOEBIUS[c], pencil);
+        if (!(dk_rank_ratio((const double(*)[12])pencil[0]) <= DK_RR_SINGULAR)) {
+            return 0;
+        }
+    }
+    return 1;
+}
+
 /* The general method's solutions of one pose into out (the first DK_RR_ROWS found where a
    self-motion gives more; then, on a nominal table, up to DK_RR_ROWS seeds of its near
    misses, for the caller to refine and certify): their count (0: the pose out of reach, as
@@ -5052,6 +5139,12 @@ static int dk_general(const double flanges[DK_RR_SPLIT_COUNT][12], double out[DK
                 return count;
             }
         }
+    }
+    for (k = 0; k < DK_RR_SPLIT_COUNT && count == 0 && leads.n_near == 0 && !leads.singular &&
+                leads.n == 0;
+         k++) { /* (a pencil singular to roundings at the pose, which its eigenvalues do not
+                   show) */
+        leads.singular = !dk_rr_perturbed(k) && dk_rr_singular(k, (const double(*)[4])targets[k]);
     }
     if (count == 0 && leads.n_near == 0 && (leads.singular || leads.n > 0)) {
         /* a curve of solutions that none of the above reached: a search from the leads */

@@ -238,5 +238,12 @@ _RR_FOLD_STEP = 1e-3
 # size) look for it; it ends after a quarter of them where no row came within _RR_SEARCH_BAIL
 _RR_SEARCH_FROM = 0.1
 _RR_SEARCH_BAIL = 0.3
+# ... "singular at the pose": where nothing polishes and nothing came near, a pencil on the
+# arm's own table whose leading matrix under each Moebius map (the pencil at three values of
+# x3) has its least singular value (C: its completely pivoted LU factor's least pivot) within
+# this of its largest: det vanishing identically in x3, theta3 free along a curve of
+# solutions, the eigenvalues the roundings' (a Panda's joints 3-7 with joints 6, 7 at 90 and
+# 0 deg, its direction task: 1.6e-14 to 3.1e-14 at all three, and no row)
+_RR_SINGULAR = 1e-12
 _RR_SEARCH_STEPS = 40
 _RR_SEARCH_SLIDE = 1.5

@@ -72,6 +72,7 @@ from derive.runtime.constants import (
     _RR_SEARCH_STEPS,
     _RR_SETTLED,
     _RR_SHIFT45,
+    _RR_SINGULAR,
     _TWO_PI,
 )
 
@@ -166,6 +167,12 @@ def _general(flanges, tol):
             candidates, close, _ = _rr_split(k, F, F @ motion, leads, found, _RR_IMAG_LOOSE)
             _rr_merge(found, [_rr_to_arm(k, q) for q in candidates])
             _rr_merge(near, [_rr_to_arm(k, q) for q in close])
+    if not found and not near and not leads.singular and not leads.rows:
+        # a pencil singular to roundings at the pose, which its eigenvalues do not show
+        leads.singular = any(
+            _RR_SPLITS[k][1] == _RR_SPLITS[k][2] and _rr_singular(k, F)
+            for k, F in enumerate(targets)
+        )
     if not found and not near and (leads.singular or leads.rows):
         # a curve of solutions that none of the above reached: a search (_rr_search)
         _rr_merge(found, _rr_search(targets, leads.rows))
@@ -646,21 +653,46 @@ def _rr_unit_solutions(U, S, Vt, e):
     ]
 
 
-def _rr_eigenvalues(P0, Ps, Pc, Q, spurious=None):
-    """The eigenvalues y of the pencil (24, complex; without the 2r known ones where
-    spurious is (vectors, pivots) of Split.spurious: _rr_deflated), the pencil (A, B, C) and
-    the Moebius map used; None where no map gives a usable leading matrix (a singular
-    pencil)."""
+def _rr_pencil6(P0, Ps, Pc, Q):
+    """The pencil in x3 (6 x 9 each: x3^2, x3, 1; flattened, a row each): Q's left null
+    space N (a generic mix of it where it has more than 6 rows) times P's."""
     U, S, _ = np.linalg.svd(Q)
     floor = _RR_RANK_TOL * max(S[0], 1.0)
     rank = int((floor < S).sum())
     N = U[:, rank:].T
     if N.shape[0] > 6:
         N = _RR_MIX[:, : N.shape[0]] @ N
-    # the pencil in x3 (6 x 9 each: x3^2, x3, 1), lifted and mapped per Moebius map
-    pencil6 = np.array(
+    return np.array(
         (N @ (P0 - Pc) @ _RR_H45, N @ (2.0 * Ps) @ _RR_H45, N @ (P0 + Pc) @ _RR_H45)
     ).reshape(3, 54)
+
+
+def _rr_singular(k, F):
+    """Whether split k's pencil at the target F is singular to roundings: its leading matrix
+    under every Moebius map (the pencil at three values of x3) singular within _RR_SINGULAR
+    of its largest singular value (C: dk_rr_singular, by completely pivoted LU)."""
+    values = np.zeros(490)
+    _rr_fill(k, *F[:3, 2], *F[:3, 3], values)
+    pencil6 = _rr_pencil6(
+        values[:126].reshape(14, 9),
+        values[126:252].reshape(14, 9),
+        values[252:378].reshape(14, 9),
+        values[378:].reshape(14, 8),
+    )
+    for moebius in _RR_MOEBIUS:
+        s = np.linalg.svd(_rr_pencil(pencil6, moebius)[0], compute_uv=False)
+        if not s[-1] <= _RR_SINGULAR * s[0]:
+            return False
+    return True
+
+
+def _rr_eigenvalues(P0, Ps, Pc, Q, spurious=None):
+    """The eigenvalues y of the pencil (24, complex; without the 2r known ones where
+    spurious is (vectors, pivots) of Split.spurious: _rr_deflated), the pencil (A, B, C) and
+    the Moebius map used; None where no map gives a usable leading matrix (a singular
+    pencil)."""
+    # the pencil in x3, lifted and mapped per Moebius map
+    pencil6 = _rr_pencil6(P0, Ps, Pc, Q)
     # a map whose leading matrix has a 1-norm condition number below _RR_COND_LIMIT / 12 has
     # a (2-norm) one below _RR_COND_LIMIT: the first map is taken at the cost of the inverse
     # the companion matrix needs anyway; otherwise as before, by the condition numbers
