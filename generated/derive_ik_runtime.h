@@ -9,7 +9,7 @@
    is solved by it): one copy serves every arm of a folder, and each arm's file gets its own
    static copy of the routines, so arms link together in one program. Compile <name>_ik.c
    with it beside the file; do not include it anywhere else. */
-#define DK_RUNTIME 0x75f6ff639db2
+#define DK_RUNTIME 0xebb8d6f71a89
 
 #include <math.h>
 #include <stddef.h>
@@ -3343,25 +3343,31 @@ static int dk_solve_into(const double *M, int n, double *X, int m)
     return 1;
 }
 
-/* the ratio of the largest to the smallest pivot of M's (12 x 12) LU factorisation with
-   partial pivoting (HUGE_VAL where singular) */
-static double dk_pivot_ratio(const double M[12][12])
+/* the ratio of the largest to the smallest pivot of M's (12 x 12) LU factorisation (HUGE_VAL
+   where singular), with partial pivoting, or complete (complete set): its least pivot is then
+   within a modest factor of M's least singular value, where partial pivoting's can be 1e2 to
+   1e3 times above it (a pencil singular to roundings: 8e11 to 2e12 by partial pivots, 3e13
+   to 6e13 by singular values) */
+static double dk_pivot_ratio(const double M[12][12], int complete)
 {
     double A[12][12], big = 0.0, small = HUGE_VAL;
-    int n = 12, k, i, j, p;
+    int n = 12, k, i, j, p, q;
     for (i = 0; i < n; i++) {
         for (j = 0; j < n; j++) {
             A[i][j] = M[i][j];
         }
     }
     for (k = 0; k < n; k++) {
-        p = k;
-        for (i = k + 1; i < n; i++) {
-            if (fabs(A[i][k]) > fabs(A[p][k])) {
-                p = i;
+        p = q = k;
+        for (i = k; i < n; i++) {
+            for (j = k; j < (complete ? n : k + 1); j++) {
+                if (fabs(A[i][j]) > fabs(A[p][q])) {
+                    p = i;
+                    q = j;
+                }
             }
         }
-        if (A[p][k] == 0.0) {
+        if (A[p][q] == 0.0) {
             return HUGE_VAL;
         }
         if (p != k) {
@@ -3369,6 +3375,13 @@ static double dk_pivot_ratio(const double M[12][12])
                 double t = A[k][j];
                 A[k][j] = A[p][j];
                 A[p][j] = t;
+            }
+        }
+        if (q != k) {
+            for (i = 0; i < n; i++) {
+                double t = A[i][k];
+                A[i][k] = A[i][q];
+                A[i][q] = t;
             }
         }
         big = fmax(big, fabs(A[k][k]));
@@ -3381,54 +3394,6 @@ static double dk_pivot_ratio(const double M[12][12])
         }
     }
     return big / small;
-}
-
-/* the ratio of the smallest to the largest pivot of M's (12 x 12) LU factorisation with
-   complete pivoting (0 where singular): within a modest factor of its least singular value
-   over its largest, where partial pivoting's least pivot can be 1e2 to 1e3 times above it (a
-   pencil singular to roundings: 1e-12 by partial pivots, 2e-14 by singular values) */
-static double dk_rank_ratio(const double M[12][12])
-{
-    double A[12][12], big = 0.0, small = HUGE_VAL;
-    int n = 12, k, i, j, p, q;
-    for (i = 0; i < n; i++) {
-        for (j = 0; j < n; j++) {
-            A[i][j] = M[i][j];
-        }
-    }
-    for (k = 0; k < n; k++) {
-        p = q = k;
-        for (i = k; i < n; i++) {
-            for (j = k; j < n; j++) {
-                if (fabs(A[i][j]) > fabs(A[p][q])) {
-                    p = i;
-                    q = j;
-                }
-            }
-        }
-        if (A[p][q] == 0.0) {
-            return 0.0;
-        }
-        for (j = 0; j < n; j++) { /* (row p to k, column q to k) */
-            double t = A[k][j];
-            A[k][j] = A[p][j];
-            A[p][j] = t;
-        }
-        for (i = 0; i < n; i++) {
-            double t = A[i][k];
-            A[i][k] = A[i][q];
-            A[i][q] = t;
-        }
-        big = fmax(big, fabs(A[k][k]));
-        small = fmin(small, fabs(A[k][k]));
-        for (i = k + 1; i < n; i++) {
-            double f = A[i][k] / A[k][k];
-            for (j = k + 1; j < n; j++) {
-                A[i][j] -= f * A[k][j];
-            }
-        }
-    }
-    return small / big;
 }
 
 /* rows spanning the left null space of Q (14 x 8) into N, six of them (fixed combinations
@@ -4572,7 +4537,7 @@ static int dk_rr_candidates(const double values[490], const double F[4][4],
         double ratio;
         dk_rr_pencil((const double(*)[9])A6, (const double(*)[9])B6, (const double(*)[9])C6,
                      DK_RR_MOEBIUS[c], pencil);
-        ratio = dk_pivot_ratio((const double(*)[12])pencil[0]);
+        ratio = dk_pivot_ratio((const double(*)[12])pencil[0], 0);
         if (ratio < best) {
             best = ratio;
             moebius = DK_RR_MOEBIUS[c];
@@ -5042,7 +5007,7 @@ static int dk_rr_singular(int k, const double F[4][4])
     for (c = 0; c < 3; c++) {
         dk_rr_pencil((const double(*)[9])A6, (const double(*)[9])B6, (const double(*)[9])C6,
                      DK_RR_MOEBIUS[c], pencil);
-        if (!(dk_rank_ratio((const double(*)[12])pencil[0]) <= DK_RR_SINGULAR)) {
+        if (!(dk_pivot_ratio((const double(*)[12])pencil[0], 1) * DK_RR_SINGULAR >= 1.0)) {
             return 0;
         }
     }
