@@ -99,9 +99,10 @@ class UrdfJoint:
     # a revolute or prismatic joint whose <limit> gives neither lower nor upper (read as
     # unlimited, and said in a note: URDF's defaults, 0 and 0, would hold it at 0)
     unbounded: bool = False
-    # where its <limit>'s lower is above its upper: the message (a chain through it is refused;
-    # one elsewhere in the file is not: a NICO's left arm, read for its head)
-    inverted: str = ""
+    # what refuses a chain through it (one elsewhere in the file is not refused: a NICO's left
+    # arm, read for its head): its <limit>'s lower above its upper, or two of its <origin>,
+    # <axis> or <limit> elements (which one counts would be the reader's choice)
+    refused: str = ""
 
 
 @dataclass(frozen=True)
@@ -326,11 +327,14 @@ def _joint(element, where: str) -> UrdfJoint:
     kind = element.get("type", "")
     if kind not in KNOWN_TYPES:
         raise UrdfError(f"{at}: type {_shown(kind)}; allowed: {', '.join(KNOWN_TYPES)}")
+    refused = ""
     for tag in ("parent", "child", "origin", "axis", "limit"):  # (the kinematics' elements:
-        # two would leave it to the reader which one counts)
+        # two would leave it to the reader which one counts; two ends, which way the tree goes)
         count = len(element.findall(tag))
-        if count > 1:
+        if count > 1 and tag in ("parent", "child"):
             raise UrdfError(f"{at}: {count} <{tag}> elements; allowed: one")
+        if count > 1 and not refused:
+            refused = f"{at}: {count} <{tag}> elements; allowed: one"
     ends = []
     for tag in ("parent", "child"):
         node = element.find(tag)
@@ -348,13 +352,12 @@ def _joint(element, where: str) -> UrdfJoint:
     if kind in MOVING and norm < 1e-9:
         raise UrdfError(f"{at}: axis xyz is zero")
     limits = None
-    inverted = ""
     limit = element.find("limit")
     if kind in ("revolute", "prismatic") and limit is not None:
         lo = _numbers(limit.get("lower"), 1, f"{at}: limit lower", (0.0,))[0]
         hi = _numbers(limit.get("upper"), 1, f"{at}: limit upper", (0.0,))[0]
-        if lo > hi:  # (refused where the chain uses the joint: import_chain)
-            inverted = f"{at}: limit lower {lo} is above upper {hi}"
+        if lo > hi and not refused:  # (refused where the chain uses the joint: import_chain)
+            refused = f"{at}: limit lower {lo} is above upper {hi}"
         limits = (lo, hi) if lo < hi else None  # lower = upper = 0: URDF's "no limits given"
     return UrdfJoint(
         name=name,
@@ -369,7 +372,7 @@ def _joint(element, where: str) -> UrdfJoint:
         and kind in ("revolute", "prismatic")
         and limit.get("lower") is None
         and limit.get("upper") is None,
-        inverted=inverted,
+        refused=refused,
     )
 
 
@@ -1064,8 +1067,8 @@ def import_chain(
     where = str(path)
     assert options.base is not None and options.tip is not None
     for joint in chain:
-        if joint.inverted:
-            raise UrdfError(joint.inverted)
+        if joint.refused:
+            raise UrdfError(joint.refused)
     conversion = convert(
         chain, where, options.angle_tol, options.length_tol, options.exact, options.task
     )
