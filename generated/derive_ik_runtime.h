@@ -9,7 +9,7 @@
    is solved by it): one copy serves every arm of a folder, and each arm's file gets its own
    static copy of the routines, so arms link together in one program. Compile <name>_ik.c
    with it beside the file; do not include it anywhere else. */
-#define DK_RUNTIME 0xebb8d6f71a89
+#define DK_RUNTIME 0x29fb50655b9d
 
 #include <math.h>
 #include <stddef.h>
@@ -1003,6 +1003,10 @@ static double dk_newton(const double *p, int d, double x)
     return x;
 }
 
+/* the most values dk_roots (dk_accept) gives: a polynomial's real roots, and on a nominal
+   table three seeds of each complex root above the real line */
+#define DK_ROOTS_MAX (2 * DK_POLY_MAX)
+
 /* the real parts of the near-real zs[0..m), polished (simple roots) and merged (near-equal
    ones, and clusters of a split multiple root that are not all real: their mean), ascending,
    into out: their count, or -1 where check is set and one, or a complex one, fails the
@@ -1067,6 +1071,12 @@ static int dk_accept(const double *p, int d, const dk_cx *zs, int m, int check, 
                     }
                 }
                 z = dk_cx_scale(sum, 1.0 / size);
+                if (fabs(z.im) <= DK_CLUSTER_TOL * (1.0 + dk_cx_abs(z))) { /* (a real
+                    polynomial's cluster near the real line: its mirror image is its own, and
+                    their mean real; Aberth's iterates of a multiple root need not be
+                    symmetric, and a cubic's near-triple root had all three above the line) */
+                    z.im = 0.0;
+                }
             }
             if (fabs(z.im) <= DK_ROOT_IMAG_TOL * (1.0 + dk_cx_abs(z))) {
                 xs[n] = z.re;
@@ -1110,7 +1120,8 @@ static int dk_accept(const double *p, int d, const dk_cx *zs, int m, int check, 
                                 (in the second pass, loose: any complex root, as the Python
                                 solver's _accept) */
         const double near = loose ? HUGE_VAL : sqrt(DK_SEED_TOL);
-        for (k = 0; k < m; k++) {
+        for (k = 0; k < m && count + 3 <= DK_ROOTS_MAX; k++) { /* (Aberth's iterates of a
+            multiple root can all lie above the line: not one pair's upper one each) */
             const double size = 1.0 + dk_cx_abs(zs[k]);
             if (zs[k].im > DK_ROOT_IMAG_TOL * size && zs[k].im <= near * size) {
                 const double w = atan(zs[k].re); /* (and either side of the fold, _FOLD_SEEDS) */
@@ -1242,8 +1253,9 @@ static int dk_roots(const double *p, int d, int loose, double *out)
 static int dk_poly(dk_values *v, const double *coeffs, int d, int angles, double free_tol,
                    double unit, double ref)
 {
-    double p[DK_POLY_MAX + 1], x[2 * DK_POLY_MAX], t[2 * DK_POLY_MAX], c[2 * DK_POLY_MAX], s[2 *
-            DK_POLY_MAX], size = 0.0;
+    /* (t, c, s: the roots at infinity the vanishing leading coefficients give, then x's) */
+    double p[DK_POLY_MAX + 1], x[DK_ROOTS_MAX], t[DK_ROOTS_MAX + DK_POLY_MAX];
+    double c[DK_ROOTS_MAX + DK_POLY_MAX], s[DK_ROOTS_MAX + DK_POLY_MAX], size = 0.0;
     int flip, n = 0, k, j, extra = 0;
     v->n = 0;
     v->free = 0;
@@ -3346,8 +3358,8 @@ static int dk_solve_into(const double *M, int n, double *X, int m)
 /* the ratio of the largest to the smallest pivot of M's (12 x 12) LU factorisation (HUGE_VAL
    where singular), with partial pivoting, or complete (complete set): its least pivot is then
    within a modest factor of M's least singular value, where partial pivoting's can be 1e2 to
-   1e3 times above it (a pencil singular to roundings: 8e11 to 2e12 by partial pivots, 3e13
-   to 6e13 by singular values) */
+   1e3 times above it (a pencil singular to roundings, pybullet's Panda's: 8e11 to 2e12 by
+   partial pivots, 3e13 to 6e13 by singular values) */
 static double dk_pivot_ratio(const double M[12][12], int complete)
 {
     double A[12][12], big = 0.0, small = HUGE_VAL;

@@ -38,7 +38,7 @@ if "_RUNTIME_VERSION" not in globals():  # (imported on its own, not run by a mo
         "namespace; it is not a module to import"
     )
 # this runtime's version: a module runs the runtime of its own version only
-_RUNTIME_VERSION = "113c6e8d9d6d04b0"
+_RUNTIME_VERSION = "29adfeec51b5ae3c"
 
 if TYPE_CHECKING:  # defined by the module running this file
     from derive.runtime.arm import (
@@ -451,7 +451,8 @@ _RR_SEARCH_BAIL = 0.3
 # x3) has its least singular value (C: its completely pivoted LU factor's least pivot) within
 # this of its largest: det vanishing identically in x3, theta3 free along a curve of
 # solutions, the eigenvalues the roundings' (a Panda's joints 3-7 with joints 6, 7 at 90 and
-# 0 deg, its direction task: 1.6e-14 to 3.1e-14 at all three, and no row)
+# 0 deg, its direction task: 1.6e-14 to 3.1e-14 at all three on pybullet's URDF, 1.8e-16 or
+# less on example-robot-data's, and no row)
 _RR_SINGULAR = 1e-12
 
 

@@ -111,6 +111,7 @@ def test_the_c_runtime_holds_the_python_runtimes_constants():
         "NEAR_SINGULAR",
         "PAIR_DOUBT",
         "FOLD_STEP",
+        "SINGULAR",
     ):
         assert float(found[f"DK_RR_{name}"]) == getattr(constants, f"_RR_{name}"), name
     assert (float(found["DK_RR_NEWTON_DONE"]), float(found["DK_RR_NEWTON_DONE_STEP"])) == (

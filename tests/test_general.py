@@ -630,7 +630,8 @@ def test_a_self_motion_whose_pencil_is_singular_to_roundings_is_searched(backend
     joints, the tool point and its x axis; the general method) with joints 6 and 7 at 90 and
     0 deg: joint 5 then turns about the tool x axis through the tool point, a curve of
     solutions. The pencil on the arm's own table is singular to roundings (least singular
-    value 1.6e-14 to 3.1e-14 of the largest under each Moebius map) but passed the eigenvalue
+    value 1.6e-14 to 3.1e-14 of the largest under each Moebius map on pybullet's copy, 1.8e-16
+    or less on this one) but passed the eigenvalue
     routine's test (a condition number below 1e16), its eigenvalues scattered, nothing
     polished and no lead started the search: 142 of 200 such poses got no row in C (pybullet's
     copy; a new user's attack). Now such a pencil starts the search: every pose answered,

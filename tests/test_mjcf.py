@@ -350,7 +350,7 @@ def test_a_thin_reach_s_poses_near_its_edge_are_answered(backend, tmp_path):
     """robosuite's Kinova Gen3, joints 3-6 (HalfArm1_Link to SphericalWrist2_Link; tip on
     axis 6, so joint 6 is free): the tip lies 0.175 mm from axis 5, so what joints 3-5 reach
     is a shell 14 um thick, and the MJCF's twists (90.00024 deg, snapped) move its edge.
-    Near the edge (joint 5 within 0.1 rad of 180 deg) the nominal table's quadratic in
+    Near the edge (joint 5 within 0.14 rad of 180 deg) the nominal table's quadratic in
     tan(theta3/2) has an imaginary pair 0.041-0.062 from real, beyond the near-double root's
     window (sqrt(_SEED_TOL) = 0.039): 265 of 400 such poses got no row in either backend (a
     new user's attack). The second pass now seeds every complex root's real part: each sample

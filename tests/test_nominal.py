@@ -1142,3 +1142,61 @@ def test_a_quartic_left_a_cubic_is_solved_in_c(tmp_path):
         assert wrapped.max(axis=2).min(axis=1).max() <= 1e-9
         gaps = np.abs(np.remainder(c - q + math.pi, 2 * math.pi) - math.pi)
         assert np.max(gaps, axis=1).min() <= 1e-8
+
+
+ROOTS_PROBE = r"""
+#include <stdio.h>
+#include "NAME_ik.c"
+#ifndef DK_ROOTS_MAX
+#define DK_ROOTS_MAX (2 * DK_POLY_MAX)
+#endif
+int main(void)
+{
+    /* (x + 0.6177...)^3 to roundings: a near-triple real root */
+    const double p[4] = {0x1p+0, 0x1.da6b56af3759bp+0, 0x1.25108e00ceeb6p+0,
+                         0x1.e2c323a0e27eap-3};
+    double x[DK_ROOTS_MAX];
+    int loose, n, k;
+    for (loose = 0; loose < 2; loose++) {
+        n = dk_roots(p, 3, loose, x);
+        printf("%d %d", DK_ROOTS_MAX, n);
+        for (k = 0; k < n; k++) {
+            printf(" %.17g", x[k]);
+        }
+        printf("\n");
+    }
+    return 0;
+}
+"""
+
+
+@needs_cc
+def test_a_cubic_s_near_triple_root_is_real_and_its_seeds_fit(tmp_path):
+    """C's dk_roots on a nominal table (the seeds of complex roots on): Aberth's iterates of a
+    cubic's near-triple real root all lay above the real line, so its cluster's mean was not
+    real (the root lost) and each gave three seeds, 9 values into dk_poly's array of 8 (a
+    stack buffer overflow under AddressSanitizer; a reviewer's find, helper 46). Now the
+    cluster's mean is real and the seeds stop where the array does; compiled with
+    AddressSanitizer and UndefinedBehaviorSanitizer."""
+    import subprocess
+
+    from derive.cbuild import SANITIZE, WARNINGS, c_compiler
+    from derive.load import solver_sources
+
+    plan = build_plan(parse_spec(calibrated("puma"), "<test>"))
+    for file, text in solver_sources(plan).items():
+        (tmp_path / file).write_text(text, encoding="utf-8")
+    (tmp_path / "probe.c").write_text(ROOTS_PROBE.replace("NAME", plan.arm.name))
+    exe = tmp_path / "probe"
+    built = subprocess.run(
+        [c_compiler(), *WARNINGS, *SANITIZE, "-Wno-unused-function", str(tmp_path / "probe.c"),
+         "-o", str(exe), "-lm"],
+        capture_output=True, text=True,
+    )  # fmt: skip
+    assert built.returncode == 0, built.stderr
+    done = subprocess.run([str(exe)], capture_output=True, text=True)
+    assert done.returncode == 0, done.stderr[-2000:]
+    for line in done.stdout.splitlines():
+        room, n, *values = line.split()
+        assert int(n) <= int(room)
+        assert min(abs(float(v) + 0.6177335) for v in values) <= 1e-4, line

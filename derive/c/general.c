@@ -271,8 +271,8 @@ static int dk_solve_into(const double *M, int n, double *X, int m)
 /* the ratio of the largest to the smallest pivot of M's (12 x 12) LU factorisation (HUGE_VAL
    where singular), with partial pivoting, or complete (complete set): its least pivot is then
    within a modest factor of M's least singular value, where partial pivoting's can be 1e2 to
-   1e3 times above it (a pencil singular to roundings: 8e11 to 2e12 by partial pivots, 3e13
-   to 6e13 by singular values) */
+   1e3 times above it (a pencil singular to roundings, pybullet's Panda's: 8e11 to 2e12 by
+   partial pivots, 3e13 to 6e13 by singular values) */
 static double dk_pivot_ratio(const double M[12][12], int complete)
 {
     double A[12][12], big = 0.0, small = HUGE_VAL;

@@ -989,6 +989,10 @@ static double dk_newton(const double *p, int d, double x)
     return x;
 }
 
+/* the most values dk_roots (dk_accept) gives: a polynomial's real roots, and on a nominal
+   table three seeds of each complex root above the real line */
+#define DK_ROOTS_MAX (2 * DK_POLY_MAX)
+
 /* the real parts of the near-real zs[0..m), polished (simple roots) and merged (near-equal
    ones, and clusters of a split multiple root that are not all real: their mean), ascending,
    into out: their count, or -1 where check is set and one, or a complex one, fails the
@@ -1053,6 +1057,12 @@ static int dk_accept(const double *p, int d, const dk_cx *zs, int m, int check, 
                     }
                 }
                 z = dk_cx_scale(sum, 1.0 / size);
+                if (fabs(z.im) <= DK_CLUSTER_TOL * (1.0 + dk_cx_abs(z))) { /* (a real
+                    polynomial's cluster near the real line: its mirror image is its own, and
+                    their mean real; Aberth's iterates of a multiple root need not be
+                    symmetric, and a cubic's near-triple root had all three above the line) */
+                    z.im = 0.0;
+                }
             }
             if (fabs(z.im) <= DK_ROOT_IMAG_TOL * (1.0 + dk_cx_abs(z))) {
                 xs[n] = z.re;
@@ -1096,7 +1106,8 @@ static int dk_accept(const double *p, int d, const dk_cx *zs, int m, int check, 
                                 (in the second pass, loose: any complex root, as the Python
                                 solver's _accept) */
         const double near = loose ? HUGE_VAL : sqrt(DK_SEED_TOL);
-        for (k = 0; k < m; k++) {
+        for (k = 0; k < m && count + 3 <= DK_ROOTS_MAX; k++) { /* (Aberth's iterates of a
+            multiple root can all lie above the line: not one pair's upper one each) */
             const double size = 1.0 + dk_cx_abs(zs[k]);
             if (zs[k].im > DK_ROOT_IMAG_TOL * size && zs[k].im <= near * size) {
                 const double w = atan(zs[k].re); /* (and either side of the fold, _FOLD_SEEDS) */
@@ -1228,8 +1239,9 @@ static int dk_roots(const double *p, int d, int loose, double *out)
 static int dk_poly(dk_values *v, const double *coeffs, int d, int angles, double free_tol,
                    double unit, double ref)
 {
-    double p[DK_POLY_MAX + 1], x[2 * DK_POLY_MAX], t[2 * DK_POLY_MAX], c[2 * DK_POLY_MAX], s[2 *
-            DK_POLY_MAX], size = 0.0;
+    /* (t, c, s: the roots at infinity the vanishing leading coefficients give, then x's) */
+    double p[DK_POLY_MAX + 1], x[DK_ROOTS_MAX], t[DK_ROOTS_MAX + DK_POLY_MAX];
+    double c[DK_ROOTS_MAX + DK_POLY_MAX], s[DK_ROOTS_MAX + DK_POLY_MAX], size = 0.0;
     int flip, n = 0, k, j, extra = 0;
     v->n = 0;
     v->free = 0;

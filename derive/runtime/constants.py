@@ -243,7 +243,8 @@ _RR_SEARCH_BAIL = 0.3
 # x3) has its least singular value (C: its completely pivoted LU factor's least pivot) within
 # this of its largest: det vanishing identically in x3, theta3 free along a curve of
 # solutions, the eigenvalues the roundings' (a Panda's joints 3-7 with joints 6, 7 at 90 and
-# 0 deg, its direction task: 1.6e-14 to 3.1e-14 at all three, and no row)
+# 0 deg, its direction task: 1.6e-14 to 3.1e-14 at all three on pybullet's URDF, 1.8e-16 or
+# less on example-robot-data's, and no row)
 _RR_SINGULAR = 1e-12
 _RR_SEARCH_STEPS = 40
 _RR_SEARCH_SLIDE = 1.5
