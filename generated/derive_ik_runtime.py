@@ -38,7 +38,7 @@ if "_RUNTIME_VERSION" not in globals():  # (imported on its own, not run by a mo
         "namespace; it is not a module to import"
     )
 # this runtime's version: a module runs the runtime of its own version only
-_RUNTIME_VERSION = "29adfeec51b5ae3c"
+_RUNTIME_VERSION = "c212e296d8f93f38"
 
 if TYPE_CHECKING:  # defined by the module running this file
     from derive.runtime.arm import (
@@ -833,14 +833,29 @@ def _solve(target, solve, tol):
     from it: measured 0.026 or more on a hextilt arm, where the seeds that reach the pose
     were within 2e-4), and kept where certified (_seed). The C solver takes the same second
     pass (dk_solve, loose), and keeps rows within _LOOSE_TOL (or tol, if smaller) only."""
-    rows = _ik_scalar(target, *solve, tol)
+    rows = _exact_first(_ik_scalar, target, solve, tol)
     if rows:
         return rows
     _LOOSE.near = True
     try:
-        return _ik_scalar(target, *solve, min(tol, _LOOSE_TOL))
+        return _exact_first(_ik_scalar, target, solve, min(tol, _LOOSE_TOL))
     finally:
         _LOOSE.near = False
+
+
+def _exact_first(solver, target, solve, tol):
+    """solver's rows of target, but those that polishing left beyond _LOOSE_TOL (_keep notes
+    them in _LOOSE.rough) where the pose has others: they are a branch's that misses the
+    pose by up to tol, not its solutions (C: dk_drop_rough)."""
+    _LOOSE.rough = []
+    try:
+        rows = solver(target, *solve, tol)
+        rough = _LOOSE.rough
+    finally:
+        _LOOSE.rough = None
+    if rough and len(rough) < len(rows):
+        rows = [r for r in rows if not any(r is x for x in rough)]
+    return rows
 
 
 def ik_approximate(
@@ -3648,10 +3663,13 @@ class _Loose(threading.local):
     _solve; C's dk_solve with loose): then _cs1 solves at its boundary where it misses, a
     free joint takes q_ref's value only, and on a nominal table neither _cs1 nor
     _wrist_spread adds seeds round a fold, and the seeds are refined only where their pose
-    error is within _SEED_TOL, and kept where certified (refine.py, _seed)."""
+    error is within _SEED_TOL, and kept where certified (refine.py, _seed); rough, where ik
+    solves a pose (_solve), the rows kept within tol that polishing left beyond _LOOSE_TOL
+    (_keep), dropped where the pose has other rows."""
 
     on = False
     near = False
+    rough: list | None = None
 
 
 _LOOSE = _Loose()

@@ -34,7 +34,7 @@
 /* --- the routines every generated C solver shares: derive_ik_runtime.h beside this file ---- */
 
 #include "derive_ik_runtime.h"
-#if DK_RUNTIME != 0x29fb50655b9d
+#if DK_RUNTIME != 0x99b45f7ad42e
 #error "derive_ik_runtime.h is another derive-ik's: generate the arms of a folder with one"
 #endif
 
@@ -143,6 +143,7 @@ static int dk_solve(const double t[12], double tol, const double ref[DK_DOF],
     double wz = t[11];
     const double ptol = tol * DK_REACH;
     const double dk_fine = fmin(tol, DK_REFINE_POLISH);
+    unsigned char dk_rough[DK_MAX];
     int n = 0;
     int dk_close = 1;
     /* tool point in frame 1 without d1: (B X0 Tz(d1))^-1 p; the arm controls a position */
@@ -221,9 +222,11 @@ static int dk_solve(const double t[12], double tol, const double ref[DK_DOF],
                         DK_REACH, 3, 2)) || (n < DK_MAX && dk_aims_at(e, t, tol, DK_REACH, 3, 2))) {
                     found[n][0] = theta1;
                     found[n][1] = theta2 - 1.5707963267948966;
-                    if (dk_fine_ok || dk_polish(DK_CHAIN, DK_REVOLUTE, DK_SOLVED, DK_REACH, t,
-                            found[n], (dk_v1.free ? 1u : 0u) | (dk_v2.free ? 2u : 0u), tol, dk_ok))
-                            {
+                    const int dk_kept = dk_fine_ok ? 1 : dk_polish(DK_CHAIN, DK_REVOLUTE, DK_SOLVED,
+                            DK_REACH, t, found[n], (dk_v1.free ? 1u : 0u) | (dk_v2.free ? 2u : 0u),
+                            tol, dk_ok);
+                    if (dk_kept) {
+                        dk_rough[n] = dk_kept == 2;
                         n++;
                     }
                 }
@@ -239,6 +242,7 @@ static int dk_solve(const double t[12], double tol, const double ref[DK_DOF],
             break;
         }
     }
+    n = dk_drop_rough(found, n, dk_rough);
     *repeats = dk_close;
     return n;
 }

@@ -77,6 +77,7 @@ if TYPE_CHECKING:  # defined at the end of this file, by running derive_ik_runti
     from derive_ik_runtime import (
         _LOOSE,
         _LOOSE_REACH,
+        _LOOSE_TOL,
         _REFINE_POLISH,
         _REFINE_POLISH_PATIENCE,
         _REFINE_TOL,
@@ -446,7 +447,10 @@ def _keep(found, t, q, e, tol, frees=()):
     were returned). A look-at row whose ray passes the point within tol or _AIM_POLISH
     radians but not within tol * REACH (a point far away: _aims_at), and in ik's second pass
     a row within _LOOSE_REACH of the pose, are polished too, and kept if that brings them
-    within tol."""
+    within tol. A certified row that polishing leaves beyond _LOOSE_TOL is noted (_LOOSE.rough):
+    _solve drops it where the pose has rows that are not (a branch that misses the pose by
+    its tol: an exact UR5's elbow 2.65e-6 rad from straight left a row at the fold, 6e-8 off,
+    beside the pose's four exact ones; a reviewer's find, helper 47)."""
     if _matches(e, t, min(tol, _REFINE_POLISH)):  # (most rows: one comparison settles it)
         found.append(q)
     elif (
@@ -461,6 +465,8 @@ def _keep(found, t, q, e, tol, frees=()):
             moved, size = _refine(q, t, (), _REFINE_POLISH_PATIENCE)
         if certified or size <= limit:
             found.append(moved)
+            if certified and size > _LOOSE_TOL and _LOOSE.rough is not None:
+                _LOOSE.rough.append(moved)  # (_solve drops it where the pose has other rows)
 
 
 def _matches(e, t, tol):
@@ -594,7 +600,7 @@ def _branch_signs(target, q):
 
 _RUNTIME = "derive_ik_runtime.py"
 # the version of the runtime this module was generated with (the runtime's _RUNTIME_VERSION)
-_RUNTIME_VERSION = "29adfeec51b5ae3c"
+_RUNTIME_VERSION = "c212e296d8f93f38"
 # the runtime's line stating its version, in whatever form a formatter leaves it
 _RUNTIME_LINE = re.compile(
     rb"^_RUNTIME_VERSION\s*(?::\s*str\s*)?=\s*[\"']([0-9a-fA-F]+)[\"']", re.M

@@ -34,7 +34,7 @@
 /* --- the routines every generated C solver shares: derive_ik_runtime.h beside this file ---- */
 
 #include "derive_ik_runtime.h"
-#if DK_RUNTIME != 0x29fb50655b9d
+#if DK_RUNTIME != 0x99b45f7ad42e
 #error "derive_ik_runtime.h is another derive-ik's: generate the arms of a folder with one"
 #endif
 
@@ -200,6 +200,7 @@ static int dk_solve(const double t[12], double tol, const double ref[DK_DOF],
     double wz = t[11];
     const double ptol = tol * DK_REACH;
     const double dk_fine = fmin(tol, DK_REFINE_POLISH);
+    unsigned char dk_rough[DK_MAX];
     int n = 0;
     int dk_close = 1;
     /* flange target 0_nT = (B X0 Tz(d1))^-1 T (Tz(dn) Xn E)^-1 */
@@ -391,10 +392,13 @@ static int dk_solve(const double t[12], double tol, const double ref[DK_DOF],
                                 found[n][2] = theta3 + 0.28230856322733766;
                                 found[n][3] = theta4 + 1.5322620031578618;
                                 found[n][4] = theta5 - 1.5707963267948966;
-                                if (dk_fine_ok || dk_polish(DK_CHAIN, DK_REVOLUTE, DK_SOLVED,
-                                        DK_REACH, t, found[n], (dk_v1.free ? 1u : 0u) | (dk_v2.free
-                                        ? 2u : 0u) | (dk_v3.free ? 4u : 0u) | (dk_v4.free ? 8u : 0u)
-                                        | (dk_v5.free ? 16u : 0u), tol, dk_ok)) {
+                                const int dk_kept = dk_fine_ok ? 1 : dk_polish(DK_CHAIN,
+                                        DK_REVOLUTE, DK_SOLVED, DK_REACH, t, found[n], (dk_v1.free ?
+                                        1u : 0u) | (dk_v2.free ? 2u : 0u) | (dk_v3.free ? 4u : 0u) |
+                                        (dk_v4.free ? 8u : 0u) | (dk_v5.free ? 16u : 0u), tol,
+                                        dk_ok);
+                                if (dk_kept) {
+                                    dk_rough[n] = dk_kept == 2;
                                     n++;
                                 }
                             }
@@ -422,6 +426,7 @@ static int dk_solve(const double t[12], double tol, const double ref[DK_DOF],
             break;
         }
     }
+    n = dk_drop_rough(found, n, dk_rough);
     *repeats = dk_close;
     return n;
 }

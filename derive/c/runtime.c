@@ -2301,26 +2301,50 @@ static double dk_refine_held(const double chain[DK_REFINE_N + 1][12],
    left free, kept first, and moved too where keeping them does not reach DK_REFINE_TOL):
    the best point met, never worse than q; or a look-at row not certified but aimed within
    tol or DK_AIM_POLISH radians (dk_aims_at), taken where they bring it within tol. Returns
-   whether q is kept: certified, or brought within tol (the Python solver's _keep). */
+   whether q is kept: certified, or brought within tol (the Python solver's _keep); 2 for a
+   certified row left beyond DK_LOOSE_TOL (dk_drop_rough drops it where the pose has others) */
 static int dk_polish(const double chain[DK_REFINE_N + 1][12], const int revolute[DK_REFINE_N],
                      const int solved[DK_REFINE_M], double reach, const double t[12],
                      double q[DK_REFINE_N], unsigned held, double tol, int certified)
 {
     const double limit = certified ? DK_REFINE_TOL : tol;
-    double moved[DK_REFINE_N];
+    double moved[DK_REFINE_N], size;
     int i;
     for (i = 0; i < DK_REFINE_N; i++) {
         moved[i] = q[i];
     }
-    if (dk_refine_held(chain, revolute, solved, reach, t, moved, held, limit,
-                       DK_REFINE_POLISH_PATIENCE) <= limit ||
-        certified) {
+    size = dk_refine_held(chain, revolute, solved, reach, t, moved, held, limit,
+                          DK_REFINE_POLISH_PATIENCE);
+    if (size <= limit || certified) {
         for (i = 0; i < DK_REFINE_N; i++) {
             q[i] = moved[i];
         }
-        return 1;
+        return certified && !(size <= DK_LOOSE_TOL) ? 2 : 1;
     }
     return certified;
+}
+
+/* the n rows of found without those rough[r] marks (dk_polish's 2: certified within ik's tol,
+   polishing left them beyond DK_LOOSE_TOL) where any row is not marked: they are a branch's
+   that misses the pose by up to tol, not its solutions (the Python solver's _exact_first) */
+static int dk_drop_rough(double (*found)[DK_REFINE_N], int n, const unsigned char *rough)
+{
+    int kept = 0, r, j, any = 0;
+    for (r = 0; r < n; r++) {
+        any |= !rough[r];
+    }
+    if (!any) {
+        return n;
+    }
+    for (r = 0; r < n; r++) {
+        if (!rough[r]) {
+            for (j = 0; j < DK_REFINE_N; j++) {
+                found[kept][j] = found[r][j];
+            }
+            kept++;
+        }
+    }
+    return kept;
 }
 
 /* --- seeds refined side by side: dk_refine's plain course, DK_LANES seeds at a time ------- */

@@ -272,6 +272,8 @@ def solve_lines(plan: Plan) -> tuple[tuple[int, str], ...]:
         body.append(Line(0, "const double ptol = tol * DK_REACH;"))
         # (rows within this need no polish: dk_polish; most are, and one dk_match settles it)
         body.append(Line(0, "const double dk_fine = fmin(tol, DK_REFINE_POLISH);"))
+        # (a row polishing left beyond DK_LOOSE_TOL: dk_drop_rough)
+        body.append(Line(0, "unsigned char dk_rough[DK_MAX];"))
     body.append(Line(0, "int n = 0;"))
     if fix:  # (the seeds wait for others, and are refined with them: dk_defer)
         body.append(Line(0, "dk_pending dk_p;"))
@@ -478,7 +480,9 @@ def solve_lines(plan: Plan) -> tuple[tuple[int, str], ...]:
             f"dk_polish(DK_CHAIN, DK_REVOLUTE, DK_SOLVED, DK_REACH, t, found[n], {held or '0u'}, "
             f"tol, {flag})"
         )
-        body.append(Line(depth + 1, f"if (dk_fine_ok || {polish}) {{"))
+        body.append(Line(depth + 1, f"const int dk_kept = dk_fine_ok ? 1 : {polish};"))
+        body.append(Line(depth + 1, "if (dk_kept) {"))
+        body.append(Line(depth + 2, "dk_rough[n] = dk_kept == 2;"))
         body.append(Line(depth + 2, "n++;"))
         body.append(Line(depth + 1, "}"))
         body.append(Line(depth, "}"))
@@ -492,6 +496,8 @@ def solve_lines(plan: Plan) -> tuple[tuple[int, str], ...]:
         scope.levels.pop()
     if fix:
         body.append(Line(0, "dk_settle(&dk_p, found, &n);"))
+    else:  # (the rows polishing left beyond DK_LOOSE_TOL, where the pose has others)
+        body.append(Line(0, "n = dk_drop_rough(found, n, dk_rough);"))
     body.append(Line(0, "*repeats = dk_close;"))
     body.append(Line(0, "return n;"))
     return tuple((ln.depth, ln.text) for ln in body)

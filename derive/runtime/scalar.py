@@ -54,10 +54,13 @@ class _Loose(threading.local):
     _solve; C's dk_solve with loose): then _cs1 solves at its boundary where it misses, a
     free joint takes q_ref's value only, and on a nominal table neither _cs1 nor
     _wrist_spread adds seeds round a fold, and the seeds are refined only where their pose
-    error is within _SEED_TOL, and kept where certified (refine.py, _seed)."""
+    error is within _SEED_TOL, and kept where certified (refine.py, _seed); rough, where ik
+    solves a pose (_solve), the rows kept within tol that polishing left beyond _LOOSE_TOL
+    (_keep), dropped where the pose has other rows."""
 
     on = False
     near = False
+    rough: list | None = None
 
 
 _LOOSE = _Loose()
