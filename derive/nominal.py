@@ -61,21 +61,25 @@ def link_size(spec: ArmSpec) -> float:
     cancel (a calibrated KR6 URDF's axes 2 and 3, 2e-5 rad from parallel: d2 = 15.5958 m, d3 =
     -15.5958 m, which made the arm's size 32 m, not 1.4 m: its real 25 mm shoulder offset
     was then snapped to 0 and its rows certified 20 times too loosely). A run of such joints
-    is one group."""
+    is one group; an axis that points back along the one before (a twist near 180 deg) runs
+    its offset the other way (a calibrated KR6 written as a URDF with arbitrary link frames:
+    d2 = -1.2822 m, d3 = -1.2825 m at 179.98 deg, which made its size 4.66 m, not 1.42 m; a
+    reviewer's find, helper 47)."""
     to_rad = math.radians if spec.angle_unit == "deg" else float
     joints = spec.joints
     # the twist between axes k and k + 1 (0-based): modified row k + 1's, standard row k's
     twists = [to_rad(j.alpha) for j in (joints[1:] if spec.convention == "modified" else joints)]
     size = sum(abs(j.a) for j in joints)
-    group = 0.0
+    group, sign = 0.0, 1.0
     for k, joint in enumerate(joints):
-        group += joint.d if joint.kind == "R" else 0.0
+        group += sign * joint.d if joint.kind == "R" else 0.0
         twist = twists[k] if k < len(twists) else 0.0
         off = abs(math.remainder(twist, math.pi))
         if k + 1 < len(joints) and 0.0 < off <= NEARLY_PARALLEL:
+            sign = -sign if math.cos(twist) < 0.0 else sign  # (axis k + 1 points back)
             continue  # (joint k + 1's offset joins this group)
         size += abs(group)
-        group = 0.0
+        group, sign = 0.0, 1.0
     size += sum(abs(j.d) for j in joints if j.kind == "P")
     return size
 

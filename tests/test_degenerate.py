@@ -7,6 +7,7 @@ import math
 
 import numpy as np
 import pytest
+from test_nominal import TABLES
 
 from conftest import build_module, needs_cc, spec_text
 from degenerate import WORST, contains, run_suite, solve_checked
@@ -192,16 +193,6 @@ def test_a_puma_a_micrometre_long_is_solved(tmp_path):
             assert max(np.abs(E[:3, :3]).max(), np.abs(E[:3, 3]).max() / m.REACH) <= 1e-10
 
 
-UR5_DH = [
-    (90, 0, 0.089159, 0),
-    (0, -0.425, 0, 0),
-    (0, -0.39225, 0, 0),
-    (90, 0, 0.10915, 0),
-    (-90, 0, 0.09465, 0),
-    (0, 0, 0.0823, 0),
-]
-
-
 @pytest.mark.parametrize("backend", ["python", pytest.param("c", marks=needs_cc)])
 def test_a_branch_that_misses_by_less_than_tol_is_no_row_beside_exact_ones(backend, tmp_path):
     """The UR5's public table, its elbow 2.65e-6 rad from straight (robosuite's UR5e limit,
@@ -210,7 +201,8 @@ def test_a_branch_that_misses_by_less_than_tol_is_no_row_beside_exact_ones(backe
     so returned, though polishing could not bring it within 1e-8 (a reviewer's find, helper
     47: at 50 of 50 such poses, and at 24 of 50 with the wrist turned). Such a row is dropped
     where the pose has rows that are not; where none is, the rows within tol stay."""
-    module = build_module(spec_text("ur5_dh", "standard", UR5_DH), tmp_path, c=backend == "c")
+    ur5 = spec_text("ur5_dh", "standard", TABLES["ur5"])  # (the UR5's public table)
+    module = build_module(ur5, tmp_path, c=backend == "c")
     rng = np.random.default_rng(1)
     for k in range(30):
         q = np.array([rng.uniform(-math.pi, math.pi), (0.0, math.pi)[k % 2], math.pi - 2.65e-6,

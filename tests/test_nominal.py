@@ -1200,3 +1200,29 @@ def test_a_cubic_s_near_triple_root_is_real_and_its_seeds_fit(tmp_path):
         room, n, *values = line.split()
         assert int(n) <= int(room)
         assert min(abs(float(v) + 0.6177335) for v in values) <= 1e-4, line
+
+
+@pytest.mark.parametrize("twist", [0.01, 179.99, -179.99])
+def test_offsets_of_nearly_anti_parallel_axes_cancel_in_the_size(twist):
+    """Axes 2 and 3 nearly parallel (twist near 0) or nearly anti-parallel (near 180 deg):
+    their common normal lies far out along them, and their offsets cancel, d2 + d3 along
+    one way or d2 - d3 where axis 3 points back (link_size). Anti-parallel ones had been
+    summed as parallel ones, so a calibrated KR6 written as a URDF with arbitrary link
+    frames (d2 = -1.2822 m, d3 = -1.2825 m at 179.98 deg) measured 4.66 m, not 1.42 m, and
+    its rows were certified twice as loosely (a reviewer's find, helper 47)."""
+    from derive.nominal import link_size
+
+    d3 = 1.282 if abs(twist) < 90 else -1.282
+    rows = [
+        (0.0, 0.0, 0.0, 0.0),
+        (-90.0, 0.025, -1.282, 0.0),
+        (twist, 0.455, d3, 0.0),
+        (90.0, 0.035, 0.42, 0.0),
+        (90.0, 0.0, 0.0, 0.0),
+        (-90.0, 0.0, 0.0, 0.0),
+    ]
+    text = 'name = "offsets"\nconvention = "modified"\nangle_unit = "deg"\nlength_unit = "m"\n'
+    for alpha, a, d, theta in rows:
+        text += f'[[joint]]\ntype = "R"\nalpha = {alpha}\na = {a}\nd = {d}\ntheta = {theta}\n'
+    size = link_size(parse_spec(text, "<test>"))
+    assert size == pytest.approx(0.025 + 0.455 + 0.035 + 0.42, abs=1e-12), size
