@@ -194,23 +194,23 @@ def _solve(target, solve, tol):
     from it: measured 0.026 or more on a hextilt arm, where the seeds that reach the pose
     were within 2e-4), and kept where certified (_seed). The C solver takes the same second
     pass (dk_solve, loose), and keeps rows within _LOOSE_TOL (or tol, if smaller) only."""
-    rows = _exact_first(_ik_scalar, target, solve, tol)
+    rows = _exact_first(target, solve, tol)
     if rows:
         return rows
     _LOOSE.near = True
     try:
-        return _exact_first(_ik_scalar, target, solve, min(tol, _LOOSE_TOL))
+        return _exact_first(target, solve, min(tol, _LOOSE_TOL))
     finally:
         _LOOSE.near = False
 
 
-def _exact_first(solver, target, solve, tol):
-    """solver's rows of target, but those that polishing left beyond _LOOSE_TOL (_keep notes
+def _exact_first(target, solve, tol):
+    """_ik_scalar's rows of target, but those that polishing left beyond _LOOSE_TOL (_keep notes
     them in _LOOSE.rough) where the pose has others: they are a branch's that misses the
     pose by up to tol, not its solutions (C: dk_drop_rough)."""
     _LOOSE.rough = []
     try:
-        rows = solver(target, *solve, tol)
+        rows = _ik_scalar(target, *solve, tol)
         rough = _LOOSE.rough
     finally:
         _LOOSE.rough = None
