@@ -624,6 +624,38 @@ def test_a_calibrated_ur5_s_pair_near_its_shoulder_singularity_is_found(tmp_path
         assert len(module.ik(np.array(urdf.urdf_fk(chain, q)), backend=backend)) == 6
 
 
+@needs_cc
+def test_far_common_normals_of_parallel_axes_do_not_widen_a_nominal_table_s_bands(tmp_path):
+    """The calibrated UR5 URDF's nominal table keeps the exact arm's far common normals of its
+    nearly parallel axes 2-4 (d = 10.56, -3.37, -7.07 m for a 0.11 m offset). The methods took
+    the sum of the |d| as the arm's length: 21.9 m, not 1.1, and theta1's equation spread 16
+    seeds all round wherever the wrist centre came within 0.21 m of axis 1 (the elbow folded
+    back): about 300 seeds at such a pose, 0.3-0.4 s in Python and 1-1.5 ms in C (C's mean over
+    1,500 uniform poses 118 us, its median 2.7). The offsets of parallel axes are now summed
+    first (derive/methods/common.py chain_length): the steps' scales are of the arm's size,
+    and such a pose refines a few seeds a branch, in both backends the same rows."""
+    from derive import urdf
+
+    path = Path(__file__).parent / "data" / "urdf" / "ur5_calibrated.urdf"
+    chain = urdf.chain_between(urdf.read_urdf(path), "l0", "tool", str(path))
+    spec = urdf.load_urdf(path, urdf.Options(base="l0", tip="tool"))
+    module = spec_module(spec, tmp_path)
+    plan = build_plan(spec)
+    assert plan.ik is not None
+    scales = [step.scale for step in plan.ik.steps if getattr(step, "scale", 0.0) > 0.0]
+    assert scales and max(scales) <= (2.0 * module.REACH) ** 2, (scales, module.REACH)
+    seeds = []
+    seed = module._seed
+    module._seed = lambda *args, **kwargs: seeds.append(1) or seed(*args, **kwargs)
+    for q in ([-2.4760698953920413, -2.3867198484651135, -2.922582491590029, -2.259188029115788,
+               -2.9479990425301072, 2.157428607042066],
+              [-1.35840959236056, -0.5692963919392118, -2.756904406873693, 2.9905000525022896,
+               -1.5717092505293135, 0.9855386169669798]):  # fmt: skip
+        seeds.clear()
+        answered_with(chain, module, q, 1e-9)
+        assert 0 < len(seeds) <= 2 * 48, len(seeds)  # (python's: 16 x 2 x 3 x 5 before)
+
+
 def zoo_ur3e(folder: Path):
     """The UR3e zoo URDF's chain (tests/data/urdf/SOURCES.md: its numbers with 7 decimals, a
     nominal table 2e-7 from it) and its generated module, written into folder."""

@@ -29,6 +29,7 @@ from derive.classify import Structure
 from derive.halfangle import half_angle_poly, linear_coeffs, reduce_pairs
 from derive.methods.common import (
     NotApplicable,
+    chain_length,
     flange_target,
     joint_outputs,
     joint_refs,
@@ -144,9 +145,7 @@ def derive_123(chain: Chain, target: sp.Matrix, refs: tuple[sp.Expr, ...], prefi
     lhs = sym.flange_pose()[2, :]
     rhs = (row * rest).applyfunc(sp.expand)
     equations = [sp.expand(lhs[k] - rhs[k]) for k in range(4)]
-    length = sum(abs(float(t.a)) for t in chain.twists) + sum(
-        abs(float(j.d)) for j in chain.joints if j.kind == "R"
-    )
+    length = chain_length(chain)
     g = sp.Matrix(3, 4, lambda i, j: sym.named(f"G{i + 1}{j + 1}"))
     g_value = (sym.flange_pose() * inverse(rest))[:3, :].applyfunc(sp.expand)
     position = planar_part[:2, 3].applyfunc(sp.expand)
@@ -267,7 +266,7 @@ def derive_234(chain: Chain, target: sp.Matrix, refs: tuple[sp.Expr, ...], prefi
     lhs = (inverse(base_part) * sym.flange_pose())[2, :].applyfunc(sp.expand)
     rhs = (row * wrist_part).applyfunc(sp.expand)
     equations = [sp.expand(lhs[k] - rhs[k]) for k in range(4)]
-    length = sum(abs(float(t.a)) for t in chain.twists) + sum(abs(float(j.d)) for j in chain.joints)
+    length = chain_length(chain, prismatic=True)
     g = sp.Matrix(3, 4, lambda i, j: sym.named(f"G{i + 1}{j + 1}"))
     g_value = (inverse(base_part) * sym.flange_pose() * inverse(wrist_part))[:3, :]
     g_value = g_value.applyfunc(sp.expand)

@@ -30,6 +30,7 @@ from derive.classify import Structure, is_zero
 from derive.halfangle import half_angle_poly, linear_coeffs, reduce_pairs
 from derive.methods.common import (
     NotApplicable,
+    chain_length,
     flange_target,
     joint_outputs,
     joint_refs,
@@ -113,8 +114,7 @@ def derive_wrist_last(
     if kinds not in ("RRRRRR", "RRPRRR"):
         return "Pieper: prismatic joints are supported at position 3 of the position chain only"
     numbers = numbers_of(chain)
-    length = sum(abs(float(t.a)) for t in chain.twists)
-    length += sum(abs(float(j.d)) for j in chain.joints if j.kind == "R")
+    length = chain_length(chain)
     try:
         position = position_equations(numbers, max(length, 1e-300), refs, kinds[2] == "P")
     except NotApplicable as exc:

@@ -21,7 +21,13 @@ import sympy as sp
 from derive import symbols as sym
 from derive.classify import Structure
 from derive.halfangle import linear_coeffs, reduce_pairs
-from derive.methods.common import NotApplicable, flange_target, joint_outputs, joint_refs
+from derive.methods.common import (
+    NotApplicable,
+    chain_length,
+    flange_target,
+    joint_outputs,
+    joint_refs,
+)
 from derive.plan import Assign, Atan2, Cs1, Cs2, IkPlan, PolyD, Solve, Step
 from derive.transforms import Chain, inverse, numbers_of, product, x_factor, z_factor
 
@@ -50,10 +56,8 @@ def derive(chain: Chain, structure: Structure) -> IkPlan | str:
 
 
 def arm_length(chain: Chain) -> float:
-    """Sum of |a_i| and the constant |d_i|: the scale of the singularity tests."""
-    return sum(abs(float(t.a)) for t in chain.twists) + sum(
-        abs(float(j.d)) for j in chain.joints if j.kind == "R"
-    )
+    """The scale of the singularity tests (chain_length)."""
+    return chain_length(chain)
 
 
 def flange_factors(chain: Chain) -> list[sp.Matrix]:

@@ -17,7 +17,7 @@ import sympy as sp
 
 from derive import symbols as sym
 from derive.classify import Structure
-from derive.methods.common import NotApplicable, joint_outputs, joint_refs
+from derive.methods.common import NotApplicable, chain_length, joint_outputs, joint_refs
 from derive.methods.pieper import position_equations
 from derive.plan import Assign, IkPlan, Step
 from derive.transforms import Chain, inverse, numbers_of, product, trans, x_factor
@@ -39,8 +39,7 @@ def derive(chain: Chain, structure: Structure) -> IkPlan | str:
     px, py, pz = (sp.expand(v.xreplace(numbers)) for v in point)
     moved: list[Step] = []
     typical: dict[sp.Symbol, sp.Expr] = {}
-    length = sum(abs(float(t.a)) for t in chain.twists[:-1])
-    length += sum(abs(float(j.d)) for j in chain.joints if j.kind == "R")
+    length = chain_length(chain, last=False)
     if any(v.free_symbols for v in (px, py, pz)):
         # free joints after joint 3 move the tool point in frame 3 (derive/free.py): the
         # solver computes it from their values first, and from it the wrist centre's a3, d4
