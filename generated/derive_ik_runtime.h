@@ -9,7 +9,7 @@
    is solved by it): one copy serves every arm of a folder, and each arm's file gets its own
    static copy of the routines, so arms link together in one program. Compile <name>_ik.c
    with it beside the file; do not include it anywhere else. */
-#define DK_RUNTIME 0x99b45f7ad42e
+#define DK_RUNTIME 0x1db9e3d4b28f
 
 #include <math.h>
 #include <stddef.h>
@@ -2823,7 +2823,14 @@ static void dk_refine_lanes(const double chain[DK_REFINE_N + 1][12],
 
 /* the seeds of a pose's rows waiting for dk_refine_lanes, in the solver's order (dk_defer),
    with what refines them: the exact chain, its revolute joints, the joints it moves, its
-   reach, the pose t, the error a row is kept within, the room for rows (DK_MAX) */
+   reach, the pose t, the error a row is kept within, the room for rows (DK_MAX); and met, the
+   seeds refined within that error but not kept (a row already, or no room): the solver's
+   loops count the rows met as the Python solver's do, repeats too (its _seed appends every
+   one, its finish drops repeats), so a free joint's loop ends at the first value whose seed
+   refines onto a row, a row already or not (a straight wrist's side seeds, theta5 +- 0.03,
+   refine onto the row theta5 = 0 gave: C went on to theta4's next free values, 5 deg away,
+   and returned three rows of a branch where Python returns one; a new user's find, helper
+   49) */
 typedef struct {
     const double (*chain)[12];
     const int *revolute;
@@ -2833,6 +2840,7 @@ typedef struct {
     double limit;
     int room;
     int count;
+    int met;
     double q[DK_PENDING][DK_REFINE_N], cs[DK_PENDING][DK_REFINE_N][2];
 } dk_pending;
 
@@ -2850,30 +2858,50 @@ static void dk_pending_start(dk_pending *p, const double (*chain)[12], const int
     p->limit = limit;
     p->room = room;
     p->count = 0;
+    p->met = 0;
 }
 
-/* the waiting seeds refined (dk_refine_lanes), each then a row of found (n of them) where its
-   error is within limit, it is not a row already (dk_seen) and there is room: as the solver
-   kept its seeds one by one. The count of rows, n's new value. */
+/* q, a seed refined within p's limit, a row of found (n of them) where it is not one already
+   (dk_seen) and there is room; else counted in p->met */
+static void dk_keep(dk_pending *p, double (*found)[DK_REFINE_N], int *n,
+                    const double q[DK_REFINE_N])
+{
+    int j;
+    if (*n < p->room && !dk_seen((const double(*)[DK_REFINE_N])found, *n, p->revolute, q)) {
+        for (j = 0; j < DK_REFINE_N; j++) {
+            found[*n][j] = q[j];
+        }
+        (*n)++;
+    } else {
+        p->met++;
+    }
+}
+
+/* the waiting seeds refined (dk_refine_lanes), each kept (dk_keep) where its error is within
+   limit: as the solver kept its seeds one by one. The count of rows met, repeats too (n's new
+   value and p->met: the Python solver's len(found)). */
 static int dk_settle(dk_pending *p, double (*found)[DK_REFINE_N], int *n)
 {
     double size[DK_PENDING];
-    int l, j;
+    int l;
     if (p->count > 0) {
         dk_refine_lanes(p->chain, p->revolute, p->solved, p->reach, p->t, p->q,
                         (const double(*)[DK_REFINE_N][2])p->cs, p->count, size);
         for (l = 0; l < p->count; l++) {
-            if (*n < p->room && size[l] <= p->limit &&
-                !dk_seen((const double(*)[DK_REFINE_N])found, *n, p->revolute, p->q[l])) {
-                for (j = 0; j < DK_REFINE_N; j++) {
-                    found[*n][j] = p->q[l][j];
-                }
-                (*n)++;
+            if (size[l] <= p->limit) {
+                dk_keep(p, found, n, p->q[l]);
             }
         }
         p->count = 0;
     }
-    return *n;
+    return *n + p->met;
+}
+
+/* whether there is room for a row after the waiting seeds are settled (dk_settle) */
+static int dk_room(dk_pending *p, double (*found)[DK_REFINE_N], int *n)
+{
+    dk_settle(p, found, n);
+    return *n < p->room;
 }
 
 /* the seed q (its joints held nowhere) to wait with up to DK_PENDING others (dk_settle): the

@@ -656,6 +656,35 @@ def test_far_common_normals_of_parallel_axes_do_not_widen_a_nominal_table_s_band
         assert 0 < len(seeds) <= 2 * 48, len(seeds)  # (python's: 16 x 2 x 3 x 5 before)
 
 
+@needs_cc
+def test_a_free_wrist_s_loop_ends_where_a_seed_refines_onto_a_row_already_found(tmp_path):
+    """The ViperX 300 URDF (tests/data/urdf/SOURCES.md): its frames are 2e-13 from a spherical
+    wrist's, so it is solved on a nominal table and refined. At a straight wrist theta4 is
+    free, and its loop ends at the first value whose seed refines onto a row. The wrist's side
+    seeds (theta5 +- 0.03) refine onto the row theta5 = 0 gave: C did not count a row already
+    found, went on to theta4's next free values 5 deg away, and returned three rows of a
+    branch where Python returns one (10 rows against 6 at q = 0; C and Python differed at 100
+    of 100 poses with q5 = 0; a new user's find, helper 49)."""
+    from derive import urdf
+
+    path = Path(__file__).parent / "data" / "urdf" / "vx300s.urdf"
+    base, tip = "vx300s/base_link", "vx300s/ee_gripper_link"
+    chain = urdf.chain_between(urdf.read_urdf(path), base, tip, str(path))
+    module = spec_module(urdf.load_urdf(path, urdf.Options(base=base, tip=tip)), tmp_path)
+    assert module._SEED_TOL > 0.0
+    Q = np.random.default_rng(2).uniform(-2.5, 2.5, (30, 6))
+    Q[:, 4] = 0.0  # (the wrist straight)
+    Q[0] = 0.0
+    for q in Q:
+        T = np.array(urdf.urdf_fk(chain, list(q)))
+        rows = {backend: module.ik(T, backend=backend) for backend in ("c", "python")}
+        assert len(rows["c"]) == len(rows["python"]) > 0, (q, rows)
+        for row in rows["c"]:
+            gaps = np.abs(np.remainder(rows["python"] - row + math.pi, 2 * math.pi) - math.pi)
+            assert np.min(np.max(gaps, axis=1)) <= 1e-9, (q, rows)
+        assert len({module.branch(row) for row in rows["c"]}) == len(rows["c"]), (q, rows)
+
+
 def zoo_ur3e(folder: Path):
     """The UR3e zoo URDF's chain (tests/data/urdf/SOURCES.md: its numbers with 7 decimals, a
     nominal table 2e-7 from it) and its generated module, written into folder."""

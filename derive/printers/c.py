@@ -438,14 +438,12 @@ def solve_lines(plan: Plan) -> tuple[tuple[int, str], ...]:
         body.append(
             Line(
                 depth + 2,
-                "} else if (dk_settle(&dk_p, found, &n) < DK_MAX && dk_refine_held(DK_CHAIN, "
-                "DK_REVOLUTE, DK_SOLVED, DK_REACH, t, dk_q, dk_held, dk_p.limit, "
-                "DK_REFINE_PATIENCE) <= dk_p.limit && "
-                "!dk_seen((const double(*)[DK_DOF])found, n, DK_REVOLUTE, dk_q)) {",
+                "} else if (dk_room(&dk_p, found, &n) && dk_refine_held(DK_CHAIN, DK_REVOLUTE, "
+                "DK_SOLVED, DK_REACH, t, dk_q, dk_held, dk_p.limit, DK_REFINE_PATIENCE) <= "
+                "dk_p.limit) {",
             )
         )
-        body += [Line(depth + 3, f"found[n][{k}] = dk_q[{k}];") for k in range(len(outputs))]
-        body.append(Line(depth + 3, "n++;"))
+        body.append(Line(depth + 3, "dk_keep(&dk_p, found, &n, dk_q);"))
         body.append(Line(depth + 2, "}"))
         body.append(Line(depth + 1, "}"))
         body.append(Line(depth, "}"))

