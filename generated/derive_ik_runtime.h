@@ -9,7 +9,7 @@
    is solved by it): one copy serves every arm of a folder, and each arm's file gets its own
    static copy of the routines, so arms link together in one program. Compile <name>_ik.c
    with it beside the file; do not include it anywhere else. */
-#define DK_RUNTIME 0x1db9e3d4b28f
+#define DK_RUNTIME 0x70c0b2a54b5f
 
 #include <math.h>
 #include <stddef.h>
@@ -56,6 +56,10 @@
 /* beyond this acos argument (a nominal fold), the fold's angle +- each of these seeds the
    refinement too (derive/runtime/constants.py, _FOLD_NEAR and _FOLD_SEEDS, say why) */
 #define DK_FOLD_NEAR (0.9999995)
+/* ... or beyond 1 - DK_FOLD_WIDTH DK_SEED_TOL, where that is lower (_FOLD_WIDTH says why) */
+#define DK_FOLD_WIDTH (0.03)
+#define DK_FOLD_AT (1.0 - DK_FOLD_WIDTH * DK_SEED_TOL < DK_FOLD_NEAR ? \
+                        1.0 - DK_FOLD_WIDTH * DK_SEED_TOL : DK_FOLD_NEAR)
 #define DK_FOLD_SEED_COUNT 1
 static const double DK_FOLD_SEEDS[DK_FOLD_SEED_COUNT] = {0.03};
 /* how far beyond 1 a nominal table's acos argument still seeds the refinement (0: exact arms;
@@ -1423,7 +1427,7 @@ static int dk_cs1x(dk_values *v, double a, double b, double e, double rest, doub
     v->s[1] = sb * ratio - cb * sd;
     /* (b = 0: (c, s) and (c, -s) exactly, and dk_uangle is odd in s: no second call) */
     v->t[1] = sb == 0.0 && sd > 0.0 ? -v->t[0] : dk_uangle(v->s[1], v->c[1]);
-    if (DK_SEED_TOL > 0.0 && !loose && fabs(ratio) > DK_FOLD_NEAR) {
+    if (DK_SEED_TOL > 0.0 && !loose && fabs(ratio) > DK_FOLD_AT) {
         /* a nominal fold: seeds either side of it (the Python solver's order) */
         const double fold = atan2(b, a) + (ratio > 0.0 ? 0.0 : DK_PI);
         int k;

@@ -38,7 +38,7 @@ if "_RUNTIME_VERSION" not in globals():  # (imported on its own, not run by a mo
         "namespace; it is not a module to import"
     )
 # this runtime's version: a module runs the runtime of its own version only
-_RUNTIME_VERSION = "ed53d83200f02594"
+_RUNTIME_VERSION = "a6348dec29749429"
 
 if TYPE_CHECKING:  # defined by the module running this file
     from derive.runtime.arm import (
@@ -252,6 +252,15 @@ _FOLD_NEAR = 0.9999995
 
 
 _FOLD_SEEDS = (0.03,)
+
+
+# ... or beyond 1 - _FOLD_WIDTH _SEED_TOL (three times the arm's difference), where that is
+# lower: a calibration moves a nominal fold's pair more than 1e-3 apart. A calibrated UR5
+# URDF (deviation 4.8e-4) near its shoulder's double root had theta1's nominal values 1.2e-3
+# from the fold and the exact pair 0.025 either side of it: both values refined onto one of
+# the pair, and the sampled vector was missed at 14 (C) and 15 (Python) of 1,960 regular
+# poses within 2 mm of the double root, 0 and 0 with this (_cs1)
+_FOLD_WIDTH = 0.03
 
 
 # ... and its acos argument up to _SEED_BAND beyond 1 (or _SEED_TOL, if larger) still seeds
@@ -3700,6 +3709,10 @@ class _Spread(list):
 _SEED_MISS = max(_SEED_TOL, _SEED_BAND) if _SEED_TOL > 0.0 else 0.0
 
 
+# beyond this acos argument a nominal table's values are near their fold (constants.py)
+_FOLD_AT = min(_FOLD_NEAR, 1.0 - _FOLD_WIDTH * _SEED_TOL)
+
+
 def _ray_gap(e, t, axis):
     """The distance of the point t's position from the ray of e's tool axis (0 x, 1 y, 2 z)
     from e's origin (a pose's 12 top entries each): the look-at task's miss."""
@@ -3787,7 +3800,7 @@ def _cs1(
         delta = 0.0 if ratio > 0.0 else math.pi
     else:
         delta = acos(ratio)
-    if _SEED_TOL and not loose and abs(ratio) > _FOLD_NEAR:
+    if _SEED_TOL and not loose and abs(ratio) > _FOLD_AT:
         fold = base if ratio > 0.0 else base + math.pi  # (a nominal fold: seeds either side)
         sides = tuple(fold + s * d for d in _FOLD_SEEDS for s in (1.0, -1.0))
         if delta in (0.0, math.pi):  # (the double root once, not twice)

@@ -58,7 +58,15 @@ def test_the_c_runtime_holds_the_python_runtimes_constants():
     tolerances = ("FREE_TOL", "FREE_TOL_EXACT", "CLAMP_TOL", "CLAMP_ABS", "FOLD_TOL", "LEAD_TOL")
     for name in (*tolerances, "ROOT_IMAG_TOL", "MERGE_TOL", "SPLIT_TOL"):
         assert float(found[f"DK_{name}"]) == getattr(constants, f"_{name}"), name
-    for name in ("CLUSTER_TOL", "RESIDUAL_TOL", "SEAM", "SEAM_SNAP", "BRANCH_FOLD", "FOLD_NEAR"):
+    for name in (
+        "CLUSTER_TOL",
+        "RESIDUAL_TOL",
+        "SEAM",
+        "SEAM_SNAP",
+        "BRANCH_FOLD",
+        "FOLD_NEAR",
+        "FOLD_WIDTH",
+    ):
         assert float(found[f"DK_{name}"]) == getattr(constants, f"_{name}"), name
     for name in (
         "SPREAD_WIDTH",

@@ -657,6 +657,27 @@ def test_far_common_normals_of_parallel_axes_do_not_widen_a_nominal_table_s_band
 
 
 @needs_cc
+def test_a_calibration_s_fold_wider_than_1e_3_gets_seeds_either_side(tmp_path):
+    """The calibrated UR5 URDF (deviation 4.8e-4) 8e-8 m from its shoulder's double root, a
+    regular pose (sigma_min 1.9e-3): theta1's nominal values lie 1.2e-3 from their fold, the
+    exact pair 0.025 either side of it. Only values within 1e-3 of a fold got seeds either
+    side; both values refined onto one of the pair, and the sampled vector, on the other, was
+    missed in C and Python. Now a nominal table's fold window is 3 times its difference wide
+    (_FOLD_WIDTH): 1,960 regular poses within 2 mm of the double root missed 14 (C) and 15
+    (Python) sampled vectors before chain_length, 1 and 1 of 340 within 2e-5 after it, 0 and 0
+    now."""
+    from derive import urdf
+
+    path = Path(__file__).parent / "data" / "urdf" / "ur5_calibrated.urdf"
+    chain = urdf.chain_between(urdf.read_urdf(path), "l0", "tool", str(path))
+    module = spec_module(urdf.load_urdf(path, urdf.Options(base="l0", tip="tool")), tmp_path)
+    q = [-1.7258697049511436, -2.3083909188809173, 2.0113048324541065, 2.29450664121054]
+    q += [-1.2772641470940118, -2.6974669715675037]
+    assert np.linalg.svd(module.jacobian(q), compute_uv=False)[-1] > 1e-3  # (regular)
+    answered_with(chain, module, q, 1e-9)
+
+
+@needs_cc
 def test_a_free_wrist_s_loop_ends_where_a_seed_refines_onto_a_row_already_found(tmp_path):
     """The ViperX 300 URDF (tests/data/urdf/SOURCES.md): its frames are 2e-13 from a spherical
     wrist's, so it is solved on a nominal table and refined. At a straight wrist theta4 is

@@ -116,6 +116,13 @@ _AIM_POLISH = 1e-2
 # offset of 0.03 finds what 0.01 and 0.1 found on the SO-101, at half the cost)
 _FOLD_NEAR = 0.9999995
 _FOLD_SEEDS = (0.03,)
+# ... or beyond 1 - _FOLD_WIDTH _SEED_TOL (three times the arm's difference), where that is
+# lower: a calibration moves a nominal fold's pair more than 1e-3 apart. A calibrated UR5
+# URDF (deviation 4.8e-4) near its shoulder's double root had theta1's nominal values 1.2e-3
+# from the fold and the exact pair 0.025 either side of it: both values refined onto one of
+# the pair, and the sampled vector was missed at 14 (C) and 15 (Python) of 1,960 regular
+# poses within 2 mm of the double root, 0 and 0 with this (_cs1)
+_FOLD_WIDTH = 0.03
 # ... and its acos argument up to _SEED_BAND beyond 1 (or _SEED_TOL, if larger) still seeds
 # the refinement, at the boundary: a step before it near a singular configuration amplifies
 # the arm's difference (measured: the SO-ARM100 from its MJCF, deviation 4.2e-6, its virtual

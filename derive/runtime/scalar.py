@@ -30,6 +30,7 @@ from derive.runtime.constants import (
     _FOLD_SEEDS,
     _FOLD_SPREAD,
     _FOLD_TOL,
+    _FOLD_WIDTH,
     _FREE_STEPS,
     _FREE_TOL,
     _FREE_TOL_EXACT,
@@ -89,6 +90,8 @@ class _Spread(list):
 
 # how far beyond 1 a nominal table's acos argument still seeds the refinement (0: exact arms)
 _SEED_MISS = max(_SEED_TOL, _SEED_BAND) if _SEED_TOL > 0.0 else 0.0
+# beyond this acos argument a nominal table's values are near their fold (constants.py)
+_FOLD_AT = min(_FOLD_NEAR, 1.0 - _FOLD_WIDTH * _SEED_TOL)
 
 
 def _ray_gap(e, t, axis):
@@ -178,7 +181,7 @@ def _cs1(
         delta = 0.0 if ratio > 0.0 else math.pi
     else:
         delta = acos(ratio)
-    if _SEED_TOL and not loose and abs(ratio) > _FOLD_NEAR:
+    if _SEED_TOL and not loose and abs(ratio) > _FOLD_AT:
         fold = base if ratio > 0.0 else base + math.pi  # (a nominal fold: seeds either side)
         sides = tuple(fold + s * d for d in _FOLD_SEEDS for s in (1.0, -1.0))
         if delta in (0.0, math.pi):  # (the double root once, not twice)
