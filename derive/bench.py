@@ -240,8 +240,9 @@ def bench_text(name: str, f: dict) -> str:
         return line
     if f["backend"] == "c":
         line += (
-            f"\n  compiled (C, ik_batch on {f['threads']} threads; first calls "
-            f"{f['compile_s']:.1f} s): ik {f['ik_us']:.1f} us/pose (median); ik_batch "
+            f"\n  compiled (C, ik_batch on {f['threads']} "
+            f"thread{'' if f['threads'] == 1 else 's'}; first calls {f['compile_s']:.1f} s): "
+            f"ik {f['ik_us']:.1f} us/pose (median); ik_batch "
             f"{f['ik_batch_us']:.2f} us/pose at N = {f['batch_n']}, "
             f"{f['ik_batch_1thread_us']:.2f} on one thread"
         )

@@ -32,6 +32,7 @@ from derive.load import LoadError, load_solver, solver_sources
 from derive.outputs import (
     OutputError,
     describe_difference,
+    existing_folder,
     output_file,
     output_folder,
     writable_file,
@@ -206,9 +207,13 @@ def cmd_check(args: argparse.Namespace) -> int:
     out = output_folder(Path(args.out), "--out")
     specs = load_specs(args.specs, urdf_options(args))
     expected: dict[str, bytes] = {}
+    c_only = []  # (arms generated with --lang c alone: C files, no module or report beside)
     with tempfile.TemporaryDirectory() as tmp:
         for spec in specs:
-            plan, files = outputs_for(spec, args.figures)
+            python = any((out / f"{spec.name}{end}").exists() for end in (".py", ".md"))
+            python = python or not (out / f"{spec.name}_ik.c").exists()
+            c_only += [] if python else [spec.name]
+            plan, files = outputs_for(spec, args.figures, "python" if python else "c")
             # the files of other languages the arm was generated in (a marker file is there)
             for language in LANGUAGES.values():
                 if language.marker and (out / f"{spec.name}{language.marker}").exists():
@@ -238,8 +243,9 @@ def cmd_check(args: argparse.Namespace) -> int:
     specs_text = " ".join(args.specs)
     if any(p.split(":")[0].endswith(".cpp") for p in problems):
         print(f"to update the IKFast shims: derive generate ARM --lang cpp-ikfast --out {out}")
+    lang = " --lang c" if c_only and len(c_only) == len(specs) else ""
     print(
-        f"to update: derive generate {specs_text + ' ' if specs_text else ''}--out {out}"
+        f"to update: derive generate {specs_text + ' ' if specs_text else ''}--out {out}{lang}"
         + (" and delete the stale files" if any("stale" in p for p in problems) else "")
     )
     return 1
@@ -807,12 +813,13 @@ def cmd_bench(args: argparse.Namespace) -> int:
 
     from derive.bench import bench_text, machine, measure
 
+    specs = load_specs(args.specs, urdf_options(args))  # (a bad spec: its error line only)
     if not args.json:
         print(f"machine: {machine()}", flush=True)
     if args.lang == "c":
-        return bench_c(args)
+        return bench_c(args, specs)
     results = []
-    for spec in load_specs(args.specs, urdf_options(args)):
+    for spec in specs:
         start = time.perf_counter()
         render_module(build_plan(spec))
         generation = time.perf_counter() - start
@@ -834,16 +841,17 @@ def cmd_bench(args: argparse.Namespace) -> int:
 BENCH_CFLAGS = ("-O3", "-march=native")
 
 
-def bench_c(args: argparse.Namespace) -> int:
-    """`derive bench --lang c`: the C solver compiled (BENCH_CFLAGS) and timed by its harness on
-    --samples random poses (no joint at a special value), beside the compiled Python ik."""
+def bench_c(args: argparse.Namespace, specs: list[ArmSpec]) -> int:
+    """`derive bench --lang c`: the C solver of each spec compiled (BENCH_CFLAGS) and timed by
+    its harness on --samples random poses (no joint at a special value), beside the compiled
+    Python ik."""
     import numpy as np
 
     from derive.bench import eaik_figures, median_us, solve_with
     from derive.cbuild import BuildError, Harness
     from derive.verify import sample_joints
 
-    for spec in load_specs(args.specs, urdf_options(args)):
+    for spec in specs:
         plan = build_plan(spec)
         with tempfile.TemporaryDirectory() as tmp:
             try:
@@ -934,7 +942,9 @@ def text_output(option: str | None) -> Path | None:
     if option is None or option == "-":
         return None
     try:
-        return output_file(Path(option))
+        path = output_file(Path(option))
+        existing_folder(path.parent, option)
+        return path
     except OutputError as exc:
         raise OutputError(f"{exc} (-o - prints to standard output)") from None
 

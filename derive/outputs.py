@@ -89,8 +89,8 @@ def output_file(path: Path) -> Path:
         raise OutputError("-: this output cannot go to standard output; give a file name")
     try:
         mode = path.stat().st_mode
-    except FileNotFoundError:
-        mode = stat.S_IFREG
+    except (FileNotFoundError, NotADirectoryError):  # (a folder above it a file: see
+        mode = stat.S_IFREG  # existing_folder)
     if not stat.S_ISREG(mode):
         raise OutputError(
             f"{path}: is {node_kind(mode)}; derive writes regular files only (or the "
@@ -110,9 +110,7 @@ def writable_file(path: Path) -> Path:
     user's ``derive path ... -o /proc/p.svg`` printed its table, then named a temporary file
     that could not be made)."""
     target = output_file(path)
-    folder = target.parent
-    while not folder.exists() and folder != folder.parent:
-        folder = folder.parent
+    folder = existing_folder(target.parent, str(path))
     try:
         fd, probe = tempfile.mkstemp(prefix=f".{target.name}.", suffix=TMP_SUFFIX, dir=folder)
     except OSError as exc:
@@ -122,8 +120,23 @@ def writable_file(path: Path) -> Path:
     return target
 
 
+def existing_folder(folder: Path, what: str) -> Path:
+    """The nearest of folder and the folders above it that exists (the rest are made when
+    written), refused where that is not a folder (a new user's ``--out afile/g`` got "[Errno
+    20] Not a directory: 'afile/g/puma560.py'" after the work)."""
+    while not folder.exists() and folder != folder.parent:
+        folder = folder.parent
+    if not folder.is_dir():
+        raise OutputError(
+            f"{what}: {folder} is {node_kind(folder.stat().st_mode)}, not a folder; no "
+            "folder can be made in it"
+        )
+    return folder
+
+
 def output_folder(path: Path, option: str) -> Path:
-    """A folder to write files into (``option``'s): a folder, or a path where none is yet."""
+    """A folder to write files into (``option``'s): a folder, or a path where none is yet
+    (under a folder: existing_folder)."""
     if str(path) == "-":
         raise OutputError(f"{option} -: {option} names a folder, not standard output")
     if path.exists() and not path.is_dir():
@@ -131,6 +144,7 @@ def output_folder(path: Path, option: str) -> Path:
             f"{option} {path}: is {node_kind(path.stat().st_mode)}, not a folder; {option} "
             "names the folder to write into (created if missing)"
         )
+    existing_folder(path, f"{option} {path}")
     return path
 
 

@@ -509,7 +509,8 @@ def _free(table: object, where: str, joints: tuple[Joint, ...]) -> tuple[int, ..
         or not all(type(v) is int and 1 <= v <= n for v in value)
         or len(set(value)) != len(value)
     ):
-        raise SpecError(f"{where}: ik.free: {str(value)[:40]} is not allowed; {allowed}")
+        shown = repr(value) if isinstance(value, str) else str(value)  # ("7", not 7)
+        raise SpecError(f"{where}: ik.free: {shown[:40]} is not allowed; {allowed}")
     return tuple(sorted(value))
 
 

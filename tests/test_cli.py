@@ -210,3 +210,43 @@ def test_solve_residual_is_over_what_the_solver_reproduces(capsys):
     assert main(["solve", "planar_2r", "--q", "0", "90"]) == 0
     residuals = [float(r) for r in re.findall(r"residual (\S+)", capsys.readouterr().out)]
     assert len(residuals) == 2 and max(residuals) < 1e-12
+
+
+def test_check_compares_a_c_only_folder_s_c_files(tmp_path, capsys):
+    """`derive generate ARM --lang c` writes the C files alone; `derive check` compared them
+    with the Python module's files too and called the module and report missing (a new
+    user's find, helper 51)."""
+    out = tmp_path / "cgen"
+    assert main(["generate", "planar_2r", "--lang", "c", "--out", str(out)]) == 0
+    assert not (out / "planar_2r.py").exists()
+    assert main(["check", "planar_2r", "--out", str(out)]) == 0
+    assert "up to date (3 files)" in capsys.readouterr().out
+    c_file = out / "planar_2r_ik.c"
+    c_file.write_text(c_file.read_text() + "\n")
+    assert main(["check", "planar_2r", "--out", str(out)]) == 1
+    report = capsys.readouterr().out
+    assert f"{c_file}: differs" in report and "--out " + str(out) + " --lang c" in report
+
+
+def test_an_output_under_a_regular_file_is_refused_before_the_work(tmp_path):
+    """`--out afile/g` printed "[Errno 20] Not a directory: 'afile/g/puma560.py'" after the
+    work, `report -o afile/r.md` "afile/r.md: Not a directory" (helper 51)."""
+    (tmp_path / "afile").write_text("")
+    for args in (
+        ["generate", "planar_2r", "--out", "afile/g"],
+        ["generate", "planar_2r", "--lang", "c", "--out", "afile/g"],
+        ["report", "planar_2r", "-o", "afile/r.md"],
+    ):
+        done = run(*args, cwd=tmp_path)
+        assert done.returncode == 2 and done.stdout == "", (args, done.stdout)
+        assert done.stderr.count("\n") == 1 and "afile is a regular file, not a folder" in (
+            done.stderr
+        ), (args, done.stderr)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["afile"]
+
+
+def test_bench_of_an_unknown_arm_prints_its_error_only():
+    for lang in ("python", "c"):
+        done = run("bench", "no_such_arm", "--lang", lang)
+        assert done.returncode == 2 and done.stdout == "", done.stdout
+        assert done.stderr.startswith("error: no_such_arm: no such spec file or bundled arm")

@@ -263,6 +263,7 @@ def test_a_middle_joint_is_refused_with_the_reason(free, message):
         ("[ik]\nfree = [1, 7]\n", "ik.free: [1, 7] is not allowed"),
         ("[ik]\nfree = 7\n", "ik.free: 7 is not allowed"),
         ('[ik]\nfree = ["7"]\n', "ik.free: ['7'] is not allowed"),
+        ('[ik]\nfree = "7"\n', "ik.free: '7' is not allowed"),  # (a string, shown as one)
         ("[ik]\nlock = [7]\n", "ik.lock: unknown key; allowed keys: free"),
     ],
 )
