@@ -124,7 +124,9 @@ def test_a_figure_that_cannot_be_written_is_refused_before_the_work(tmp_path, ca
         captured = capsys.readouterr()
         assert captured.out == ""
         assert captured.err.startswith(f"error: {out}: ") and captured.err.count("\n") == 1
-        assert "Not a directory" in captured.err or "cannot write there" in captured.err
+        assert "is a regular file, not a folder" in captured.err or (
+            "cannot write there" in captured.err
+        )
 
 
 @pytest.mark.parametrize(("fmt", "ext"), [("md", "svg"), ("tex", "png")])
