@@ -207,13 +207,13 @@ def cmd_check(args: argparse.Namespace) -> int:
     out = output_folder(Path(args.out), "--out")
     specs = load_specs(args.specs, urdf_options(args))
     expected: dict[str, bytes] = {}
-    c_only = []  # (arms generated with --lang c alone: C files, no module or report beside)
+    c_only = 0  # (arms generated with --lang c alone: C files, no module or report beside)
     with tempfile.TemporaryDirectory() as tmp:
         for spec in specs:
-            python = any((out / f"{spec.name}{end}").exists() for end in (".py", ".md"))
-            python = python or not (out / f"{spec.name}_ik.c").exists()
-            c_only += [] if python else [spec.name]
-            plan, files = outputs_for(spec, args.figures, "python" if python else "c")
+            module = any((out / f"{spec.name}{end}").exists() for end in (".py", ".md"))
+            c_alone = not module and (out / f"{spec.name}_ik.c").exists()
+            c_only += c_alone
+            plan, files = outputs_for(spec, args.figures, "c" if c_alone else "python")
             # the files of other languages the arm was generated in (a marker file is there)
             for language in LANGUAGES.values():
                 if language.marker and (out / f"{spec.name}{language.marker}").exists():
@@ -243,7 +243,7 @@ def cmd_check(args: argparse.Namespace) -> int:
     specs_text = " ".join(args.specs)
     if any(p.split(":")[0].endswith(".cpp") for p in problems):
         print(f"to update the IKFast shims: derive generate ARM --lang cpp-ikfast --out {out}")
-    lang = " --lang c" if c_only and len(c_only) == len(specs) else ""
+    lang = " --lang c" if c_only == len(specs) else ""
     print(
         f"to update: derive generate {specs_text + ' ' if specs_text else ''}--out {out}{lang}"
         + (" and delete the stale files" if any("stale" in p for p in problems) else "")

@@ -32,8 +32,8 @@ import sympy as sp
 
 from derive import symbols as sym
 from derive.halfangle import linear_coeffs
-from derive.methods.common import NotApplicable, joint_outputs, joint_refs
-from derive.methods.planar import arm_length, heading_step, planar_steps
+from derive.methods.common import NotApplicable, chain_length, joint_outputs, joint_refs
+from derive.methods.planar import heading_step, planar_steps
 from derive.plan import Assign, Cs1, IkPlan, Step
 from derive.tasks import AXES, arm_size, spins, tool_line
 from derive.transforms import Chain, JointZ, inverse, product, rot_z, trans, x_factor, z_factor
@@ -129,7 +129,7 @@ def derive(chain: Chain, axis: int, cone: int, tol: float = 0.0) -> IkPlan:
     a1, b1, e1 = _linear(in1p[2] - lateral, 1)
     if a1 == 0 and b1 == 0:
         raise NotApplicable("joint 2's axis is parallel to joint 1's")
-    length = arm_length(arm) + math.sqrt(float(sum(v**2 for v in t4)))
+    length = chain_length(arm) + math.sqrt(float(sum(v**2 for v in t4)))
     target = (in1p[:3, 0] - turned * flip * t4).applyfunc(sp.expand)
     x, y = sym.named("x"), sym.named("y")
     cone_name = AXES[cone]

@@ -55,11 +55,6 @@ def derive(chain: Chain, structure: Structure) -> IkPlan | str:
         return str(exc)
 
 
-def arm_length(chain: Chain) -> float:
-    """The scale of the singularity tests (chain_length)."""
-    return chain_length(chain)
-
-
 def flange_factors(chain: Chain) -> list[sp.Matrix]:
     """Z_1 X_1 ... X_{n-1} Z_n of the flange target of :func:`flange_target`.
 
@@ -102,7 +97,7 @@ def position_mode(
         target[0],
         target[1],
         refs,
-        arm_length(chain),
+        chain_length(chain),
     )
     solves_for = "the tool point's x and y" + (" and z" if prismatic else "") + " in frame 0"
     return IkPlan(
@@ -137,7 +132,7 @@ def pose_mode(
         sym.named("px"),
         sym.named("py"),
         refs,
-        arm_length(chain),
+        chain_length(chain),
     )
     at = 2 * (last - 1)
     before = product(mats[:at])[:3, :3].xreplace(numbers)
