@@ -453,6 +453,66 @@ def test_c_files_compile_without_warnings_at_other_optimisation_levels(tmp_path,
         assert done.returncode == 0, f"{path.name} {opt}:\n{done.stderr}"
 
 
+# the PR2's pan-tilt head as example-robot-data 6.0.0's pr2.urdf has it (torso_lift_link to
+# high_def_optical_frame; derive import-urdf's spec: the file's exact frames refined from the
+# snapped table, 7e-12 from them), its look-at task refining two joints
+_PR2_HEAD = """
+name = "pr2_head"
+convention = "modified"
+angle_unit = "deg"
+length_unit = "m"
+[[joint]]
+type = "R"
+alpha = 0.0
+a = 0.0
+d = 0.0
+theta = 0.0
+limits = [-172.288408995839, 172.288408995839]
+[[joint]]
+type = "R"
+alpha = -90.0
+a = 0.068
+d = 0.0
+theta = 0.0
+limits = [-26.9999485461859, 79.9998051029363]
+[base]
+matrix = [[1.0, 0.0, 0.0, -0.01707], [0.0, 1.0, 0.0, 0.0], [0.0, 0.0, 1.0, 0.38145],
+    [0.0, 0.0, 0.0, 1.0]]
+[tool]
+matrix = [[0.0, 0.0, 1.0, 0.0232], [0.0, 1.0, 0.0, -0.0995], [-1.0, 0.0, 0.0, -0.109],
+    [0.0, 0.0, 0.0, 1.0]]
+[ik]
+task = "lookat"
+[exact]
+frames = [
+    [1.0, 0.0, 0.0, -0.01707, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.38145],
+    [1.0, 0.0, 0.0, 0.068, 0.0, 0.0, 1.0, 0.0, 0.0, -1.0, 0.0, 0.0],
+    [4.8965888601467475e-12, 4.8965888601467475e-12, 1.0, 0.0232, 0.0, 1.0,
+     -4.8965888601467475e-12, -0.0995, -1.0, 0.0, 4.8965888601467475e-12, -0.109],
+]
+"""
+
+
+def test_a_two_joint_look_at_head_compiles_at_o3_native_without_warnings(tmp_path):
+    """The refinement's last-step vector was set only where it is read, which GCC 12 at -O3
+    -march=native could not tell for a head refining two joints (maybe-uninitialized, an
+    error under -Werror): `derive bench --lang c` gave no C figures for the PR2's head (a new
+    user's find)."""
+    from derive.cli import BENCH_CFLAGS
+
+    compiler = cbuild.c_compiler()
+    assert compiler is not None
+    files = render_c(build_plan(parse_spec(_PR2_HEAD, "pr2_head.toml")))
+    assert "dk_refine_lanes(p->chain" in files["derive_ik_runtime.h"]  # (the exact chain's)
+    for name, text in files.items():
+        (tmp_path / name).write_text(text)
+    command = [compiler, *cbuild.WARNINGS, *BENCH_CFLAGS, "-c", str(tmp_path / "pr2_head_ik.c")]
+    done = subprocess.run(
+        [*command, "-o", str(tmp_path / "head.o")], capture_output=True, text=True, check=False
+    )
+    assert done.returncode == 0, done.stderr
+
+
 def test_fast_math_is_refused_by_name(tmp_path):
     """-ffast-math's -ffinite-math-only lets the compiler drop the solver's isfinite tests
     and NaN's comparisons (a NaN position crashed youbot's C in dk_uangle, a NaN row was

@@ -2461,7 +2461,9 @@ static void dk_refine_lanes(const double chain[DK_REFINE_N + 1][12],
     const dk_lane zero = {0.0};
     dk_lane cur[DK_REFINE_N], c[DK_REFINE_N], s[DK_REFINE_N];
     dk_lane J[6][DK_REFINE_M], normal[DK_REFINE_M][DK_REFINE_M];
-    dk_lane pivot[DK_REFINE_M], inverse[DK_REFINE_M];
+    /* (again: the last step's, set wherever it is read; zeroed here for GCC 12's -O3
+       -Wmaybe-uninitialized, which cannot tell: a new user's -Werror build of a look-at head) */
+    dk_lane pivot[DK_REFINE_M], inverse[DK_REFINE_M], again[DK_REFINE_M];
     double reused[DK_LANES], floor[DK_LANES];
     /* the seed each lane refines (-1: none), its steps and the steps since its error last
        fell; whether a seed is to be refined alone */
@@ -2479,7 +2481,7 @@ static void dk_refine_lanes(const double chain[DK_REFINE_N + 1][12],
         for (m = 0; m < DK_REFINE_M; m++) {
             normal[k][m] = zero;
         }
-        pivot[k] = inverse[k] = zero;
+        pivot[k] = inverse[k] = again[k] = zero;
     }
     for (i = 0; i < DK_REFINE_N; i++) {
         cur[i] = zero;
@@ -2500,7 +2502,7 @@ static void dk_refine_lanes(const double chain[DK_REFINE_N + 1][12],
     }
     for (;;) {
         dk_lane pose[12], axes[DK_REFINE_N][3], origins[DK_REFINE_N][3], error[6];
-        dk_lane step[DK_REFINE_M], again[DK_REFINE_M], mu, stride;
+        dk_lane step[DK_REFINE_M], mu, stride;
         double longest[DK_LANES], least[DK_LANES], measured[DK_LANES];
         int ended = 0;
         for (l = 0; l < DK_LANES; l++) { /* (a lane whose seed is done takes the next) */
