@@ -291,7 +291,11 @@ def choose(
                 # a special case (a5 = 0: the exact a5 = 6e-7 left a degenerate quartic)
                 exact = tasks.extend(arm, looks)
                 exact_ik, _ = choose_pose(exact, classify(exact), named, names, n + 1)
-                if exact_ik is not None and (ik is None or exact_ik.case == ik.case):
+                if (
+                    exact_ik is not None
+                    and (ik is None or exact_ik.case == ik.case)
+                    and not tasks.far_link(arm, exact)
+                ):
                     ik, extended, snap = exact_ik, exact, 0.0
             if ik is not None:
                 return tasks.lower(ik, arm, extended, aimed, snap), ""

@@ -219,6 +219,25 @@ def extend_snapped(chain: Chain, task: Task, tol: float = 0.0) -> tuple[Chain, f
     return extended, snap
 
 
+# an exact virtual link reaching farther than this many times the arm's size from it (a tool
+# axis nearly parallel to joint n's: their common normal is far out along them) is not solved
+# as it stands (choose: the snapped one is)
+FAR_LINK = 10.0
+
+
+def far_link(chain: Chain, extended: Chain) -> bool:
+    """Whether extended's virtual link (extend_snapped's) lies far from the arm: the tool's
+    distance s along the task's axis from the common normal's foot, or joint n's offset moved
+    by more than FAR_LINK times the arm's size. A tool z axis 4.4e-6 rad from an SO-101's roll
+    axis and 8 mm beside it put the foot 1,040 m away: the solver's target then cancelled
+    1,040 m terms to millimetres, and poses with the axis along joint 1 got no row (a new
+    user's find)."""
+    size = arm_size(chain)
+    s = abs(float(extended.tool[2, 3]))
+    moved = abs(float(extended.joints[chain.dof - 1].d - chain.joints[-1].d))
+    return max(s, moved) > FAR_LINK * size
+
+
 def tool_line(chain: Chain, axis: int) -> tuple[list[sp.Expr], list[sp.Expr]]:
     """The tool point o and the tool axis's direction u in joint n's frame after Z_n."""
     frame = product([x_factor(chain.twists[-1]), chain.tool, _ALIGN[axis]])

