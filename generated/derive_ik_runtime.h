@@ -9,7 +9,7 @@
    is solved by it): one copy serves every arm of a folder, and each arm's file gets its own
    static copy of the routines, so arms link together in one program. Compile <name>_ik.c
    with it beside the file; do not include it anywhere else. */
-#define DK_RUNTIME 0xa08421c5b1af
+#define DK_RUNTIME 0x4f13e157636f
 
 #include <math.h>
 #include <stddef.h>
@@ -1384,7 +1384,8 @@ static int dk_cs1x(dk_values *v, double a, double b, double e, double rest, doub
     v->free = 0;
     v->ref = 0.0; /* (unread unless free; set so that no compiler sees it unset) */
     if (free || (small && fabs(e) > rho * (1.0 + DK_CLAMP_TOL))) {
-        if (e * e <= DK_FREE_TOL * scale || loose) {
+        /* (e within a nominal table's difference of 0 too: the Python _cs1 says why) */
+        if (e * e <= DK_FREE_TOL * scale || fabs(e) <= DK_SEED_TOL * sqrt(scale) || loose) {
             dk_set_free(v, ref, 1);
         }
         return 0;

@@ -734,6 +734,33 @@ def answered_with(chain, module, q: list[float], near: float) -> None:
 
 
 @needs_cc
+def test_a_zoo_iiwa_s_elbow_folded_back_onto_its_shoulder_is_answered(tmp_path):
+    """A KUKA iiwa 7 written as a zoo URDF (tests/data/urdf/SOURCES.md; joint 7 free) with its
+    elbow folded back: the wrist centre 1.3e-7 from the shoulder's, where the nominal table
+    (d3 + d5 = 1.37e-7 off) reaches no nearer. Theta3 was clamped to its fold, which left
+    theta2's a and b 0 and e 1.3e-7: no value, and no row in C, Python or ik_batch at these
+    three poses (a new user's find, helper 53). An e within the table's difference of 0 now
+    frees the joint, as a vanishing one does."""
+    from derive import urdf
+
+    path = Path(__file__).parent / "data" / "urdf" / "iiwa7_zoo.urdf"
+    chain = urdf.chain_between(urdf.read_urdf(path), "base", "flange", str(path))
+    spec = urdf.load_urdf(path, urdf.Options(base="base", tip="flange"))
+    module = spec_module(spec, tmp_path)
+    assert module.FREE == (7,)
+    for degrees in ((0, 90, 0, 180, 180, -90, 0), (90, -90, 0, 180, 180, -90, 0)):
+        q = list(np.radians(degrees))
+        T = np.array(urdf.urdf_fk(chain, q))
+        for backend in ("c", "python"):
+            rows = module.ik(T, free=[q[6]], backend=backend)
+            assert len(rows), (degrees, backend)
+            for row in rows:
+                E = np.array(urdf.urdf_fk(chain, list(row))) - T
+                error = max(np.abs(E[:3, :3]).max(), np.abs(E[:3, 3]).max() / module.REACH)
+                assert error <= 1e-10 and abs(row[6] - q[6]) <= 1e-12, (degrees, backend)
+
+
+@needs_cc
 def test_a_singular_pose_of_a_zoo_urdf_gets_its_rows(tmp_path):
     """A UR3e written as a zoo URDF (tests/data/urdf/SOURCES.md), at q5 = 0 (its wrist
     singular within the file's 7 decimals: sigma_min 3.4e-9): the nominal seeds' damped

@@ -1370,7 +1370,8 @@ static int dk_cs1x(dk_values *v, double a, double b, double e, double rest, doub
     v->free = 0;
     v->ref = 0.0; /* (unread unless free; set so that no compiler sees it unset) */
     if (free || (small && fabs(e) > rho * (1.0 + DK_CLAMP_TOL))) {
-        if (e * e <= DK_FREE_TOL * scale || loose) {
+        /* (e within a nominal table's difference of 0 too: the Python _cs1 says why) */
+        if (e * e <= DK_FREE_TOL * scale || fabs(e) <= DK_SEED_TOL * sqrt(scale) || loose) {
             dk_set_free(v, ref, 1);
         }
         return 0;

@@ -162,7 +162,12 @@ def _cs1(
     free = small if _SEED_TOL else rho * rho <= _FREE_TOL_EXACT * scale
     loose = _LOOSE.on or _LOOSE.near  # (ik_approximate's seeds, or ik's second pass)
     if free or (small and abs(e) > rho * (1.0 + _CLAMP_TOL)):  # (loose: any seed)
-        return _free(ref) if e * e <= _FREE_TOL * scale or loose else ()
+        # (a nominal table's e within its difference of 0 too: an exact elbow folded back
+        # whose wrist centre is 1.3e-7 from the shoulder's, where the nominal table's
+        # nearest is 1.37e-7, had theta3 clamped to the fold, theta2's a and b 0 and e 1.3e-7:
+        # a 7-decimal iiwa 7 URDF got no row there; a new user's find, helper 53)
+        near = e * e <= _FREE_TOL * scale or abs(e) <= _SEED_TOL * sqrt(scale)
+        return _free(ref) if near or loose else ()
     if rho == 0.0:
         return (ref,) if loose else ()
     if rho <= _SPREAD_WIDTH * _SEED_TOL * sqrt(scale) and not loose:
