@@ -9,7 +9,7 @@
    is solved by it): one copy serves every arm of a folder, and each arm's file gets its own
    static copy of the routines, so arms link together in one program. Compile <name>_ik.c
    with it beside the file; do not include it anywhere else. */
-#define DK_RUNTIME 0x4f13e157636f
+#define DK_RUNTIME 0x735c2ae0cbc0
 
 #include <math.h>
 #include <stddef.h>
@@ -3202,6 +3202,9 @@ static void dk_dls(const double *J, int n, const double t[6], double damping, do
    pose seeds the refinement, with the points this far each way along the direction the
    table's Jacobian nearly loses (a pair of the exact arm near a fold: dk_rr_fold_seeds) */
 #define DK_RR_FOLD_STEP (0.001)
+/* a merged pair's partner is looked for where J's least singular value is within this
+   (dk_rr_fold_partners; the Python _RR_FOLD_NEAR says why) */
+#define DK_RR_FOLD_NEAR (0.01)
 #define DK_RR_SEARCH_COUNT 64
 
 static const double DK_RR_MOEBIUS[3][4] = {{1.0, 0.3, -0.4, 1.0}, {1.0, -0.7, 0.5, 1.0}, {0.6, 1.0,
@@ -4780,6 +4783,20 @@ static int dk_rr_unsettled_copy(int k, const double q[6], const double out[DK_RR
 
 /* split k's joint values q (as the arm's) added to out[0..count) unless there already (within
    1e-7): the new count */
+/* the index of the row of out[0..count) split k's q is (within the dedup's 1e-7), or -1 */
+static int dk_rr_index(int k, const double q[6], const double out[DK_RR_ROWS][6], int count)
+{
+    double arm[6];
+    int r;
+    dk_rr_arm(k, q, arm);
+    for (r = 0; r < count; r++) {
+        if (dk_rr_gap(arm, out[r]) <= 1e-7) {
+            return r;
+        }
+    }
+    return -1;
+}
+
 static int dk_rr_add(int k, const double q[6], double out[DK_RR_ROWS][6], int count)
 {
     double arm[6];
@@ -4818,10 +4835,30 @@ static void dk_rr_jacobian(int k, const double q[6], double J[6][6])
    Python solver's _rr_fold_seeds): q, and q +- DK_RR_FOLD_STEP along the direction the
    table's Jacobian nearly loses there (two steps of inverse iteration on J^T J from (1, ...,
    1)), as the arm's values, added to seeds[0..n) where new and room is left: the new count */
+static double dk_rr_lost_direction(int k, const double q[6], double v[6]);
+
 static int dk_rr_fold_seeds(int k, const double q[6], double seeds[DK_RR_ROWS][6], int n)
 {
-    double J[6][6], A[6][6], v[6], w[6], x[6], size;
-    int i, j, r, it, h;
+    double v[6], x[6];
+    int i, h;
+    (void)dk_rr_lost_direction(k, q, v);
+    for (h = 0; h < 3 && n < DK_RR_ROWS; h++) {
+        const double step = h == 0 ? 0.0 : (h == 1 ? DK_RR_FOLD_STEP : -DK_RR_FOLD_STEP);
+        for (i = 0; i < 6; i++) {
+            x[i] = q[i] + step * v[i];
+        }
+        n = dk_rr_add(k, x, seeds, n);
+    }
+    return n;
+}
+
+/* v := the unit direction the Jacobian of split k's own table nearly loses at its values q
+   (two steps of inverse iteration on J^T J from (1, ..., 1)); the least eigenvalue of J^T J
+   that estimates (0 where J^T J is singular): the Python _rr_lost_direction */
+static double dk_rr_lost_direction(int k, const double q[6], double v[6])
+{
+    double J[6][6], A[6][6], w[6], size, least = 0.0;
+    int i, j, r, it;
     dk_rr_jacobian(k, q, J);
     for (i = 0; i < 6; i++) {
         for (j = 0; j < 6; j++) {
@@ -4837,6 +4874,7 @@ static int dk_rr_fold_seeds(int k, const double q[6], double seeds[DK_RR_ROWS][6
             w[i] = v[i];
         }
         if (!dk_solve6((const double(*)[6])A, w, NULL)) {
+            least = 0.0;
             break; /* (singular: v is as good a direction as any) */
         }
         size = 0.0;
@@ -4845,20 +4883,43 @@ static int dk_rr_fold_seeds(int k, const double q[6], double seeds[DK_RR_ROWS][6
         }
         size = sqrt(size);
         if (!(0.0 < size && size < HUGE_VAL)) {
+            least = 0.0;
             break;
         }
         for (i = 0; i < 6; i++) {
             v[i] = w[i] / size;
         }
+        least = 1.0 / size;
     }
-    for (h = 0; h < 3 && n < DK_RR_ROWS; h++) {
-        const double step = h == 0 ? 0.0 : (h == 1 ? DK_RR_FOLD_STEP : -DK_RR_FOLD_STEP);
+    return least;
+}
+
+/* split k's rows that Newton's steps reach from q +- h along the direction its Jacobian
+   nearly loses (dk_rr_lost_direction), h the gap between q and start, the candidate
+   it came from (at least DK_RR_FOLD_STEP), added to out[count..] where new: the partner of a
+   row two candidates of a nearly real pair both polished onto, where J's least singular value
+   at q is within DK_RR_FOLD_NEAR (the Python _rr_fold_partners); the new count */
+static int dk_rr_fold_partners(int k, const double F[4][4], const double q[6],
+                               const double start[6], double out[DK_RR_ROWS][6], int count)
+{
+    static const double steps[2] = {1.0, -1.0};
+    double v[6], x[6], a[6], b[6], h;
+    int i, s;
+    dk_rr_arm(k, start, a);
+    dk_rr_arm(k, q, b);
+    h = fmax(DK_RR_FOLD_STEP, dk_rr_gap(a, b));
+    if (dk_rr_lost_direction(k, q, v) > DK_RR_FOLD_NEAR * DK_RR_FOLD_NEAR) {
+        return count; /* (not near a fold: a complex pair's real row, alone) */
+    }
+    for (s = 0; s < 2 && count < DK_RR_ROWS; s++) {
         for (i = 0; i < 6; i++) {
-            x[i] = q[i] + step * v[i];
+            x[i] = q[i] + steps[s] * h * v[i];
         }
-        n = dk_rr_add(k, x, seeds, n);
+        if (dk_rr_steps(DK_RR_TRUE[k], F, x, 0) <= DK_RR_GOOD) {
+            count = dk_rr_add(k, x, out, count);
+        }
     }
-    return n;
+    return count;
 }
 
 /* what the candidates that did not polish leave for a pose with no row (the Python solver's
@@ -4886,6 +4947,10 @@ static int dk_rr_split(int k, const double F[4][4], const double moved[4][4],
     const int known = count;
     double pair;
     int extra[DK_RR_CANDS], perturbed = dk_rr_perturbed(k), damped = 0, reals, n, c, i, j, r;
+    int paired[DK_RR_ROWS]; /* (per row of out: an extra candidate's, first) */
+    for (r = 0; r < DK_RR_ROWS; r++) {
+        paired[r] = 0;
+    }
     for (i = 0; i < 490; i++) {
         values[i] = 0.0;
     }
@@ -4942,7 +5007,14 @@ static int dk_rr_split(int k, const double F[4][4], const double moved[4][4],
             dk_rr_unsettled_copy(k, q, (const double(*)[6])out, count)) {
             error = fmin(error, dk_rr_walk(DK_RR_TRUE[k], F, q, 0, 2, DK_RR_NEWTON_REACH, 0));
         }
-        count = dk_rr_add(k, q, out, count);
+        r = dk_rr_index(k, q, (const double(*)[6])out, count);
+        if (r < 0) {
+            count = dk_rr_add(k, q, out, count);
+            paired[count - 1] = extra[c];
+        } else if (extra[c] && r >= known && paired[r]) { /* (a nearly real pair's
+            candidates polished onto one row: the row across the fold, _rr_split says why) */
+            count = dk_rr_fold_partners(k, F, q, cands[c], out, count);
+        }
         if (count == DK_RR_ROWS) {
             return count;
         }

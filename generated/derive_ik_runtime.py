@@ -38,7 +38,7 @@ if "_RUNTIME_VERSION" not in globals():  # (imported on its own, not run by a mo
         "namespace; it is not a module to import"
     )
 # this runtime's version: a module runs the runtime of its own version only
-_RUNTIME_VERSION = "cc14ac2c94a916d3"
+_RUNTIME_VERSION = "4c9126de9c86d81a"
 
 if TYPE_CHECKING:  # defined by the module running this file
     from derive.runtime.arm import (
@@ -442,6 +442,13 @@ _RR_RESCUE = ((1e-4, 1e-4), (-2e-4, 1.5e-4))
 # solutions lie (measured on the xArm6 URDF: both found from +-1e-3 at pairs 1e-4 to 1e-2
 # apart)
 _RR_FOLD_STEP = 1e-3
+
+
+# two candidates of a nearly real pair that polish onto one row whose Jacobian's least singular
+# value is within this (lengths in units of _RR_LENGTH) lost its partner across the fold
+# (_rr_fold_partners); elsewhere the pair is complex and its real parts' row is alone (the
+# partners' Newton steps there cost the cobots 5-14% of their C time)
+_RR_FOLD_NEAR = 1e-2
 
 
 # where nothing polishes and a pencil on the arm's own table is singular at the pose (or at a
@@ -2855,18 +2862,47 @@ def _rr_fold_seeds(k, q, rows, slide):
     direction the table's Jacobian nearly loses there (two steps of inverse iteration on
     J^T J from (1, ..., 1)), where the exact arm's two solutions lie when q is near a fold;
     as the arm's values. The caller refines and certifies them."""
+    v, _ = _rr_lost_direction(q, rows, slide)
+    return [_rr_to_arm(k, q + h * v) for h in (0.0, _RR_FOLD_STEP, -_RR_FOLD_STEP)]
+
+
+def _rr_lost_direction(q, rows, slide):
+    """The unit direction the Jacobian of the split's table (rows) nearly loses at q (two
+    steps of inverse iteration on J^T J from (1, ..., 1)), and the least eigenvalue of J^T J
+    that estimates (1 over the last step's growth; 0 where J^T J is singular)."""
     J = _rr_columns(_rr_frames(q[None], rows, slide), slide)[0].T
     v = np.full(6, 1.0 / math.sqrt(6.0))
+    least = 0.0
     for _ in range(2):
         try:
             w = np.linalg.solve(J.T @ J, v)
         except np.linalg.LinAlgError:
+            least = 0.0
             break  # (singular: v is as good a direction as any)
         size = float(np.linalg.norm(w))
         if not 0.0 < size < math.inf:
+            least = 0.0
             break
-        v = w / size
-    return [_rr_to_arm(k, q + h * v) for h in (0.0, _RR_FOLD_STEP, -_RR_FOLD_STEP)]
+        v, least = w / size, 1.0 / size
+    return v, least
+
+
+def _rr_fold_partners(k, F, q, start, rows, slide):
+    """Split k's rows near q that Newton's steps reach from q +- h along the direction the
+    Jacobian nearly loses (_rr_lost_direction), h the gap between q and the
+    candidate it came from (at least _RR_FOLD_STEP): the partner of a row that two candidates
+    of a nearly real pair both polished onto, which lies across the fold between them; none
+    where J's least singular value at q exceeds _RR_FOLD_NEAR."""
+    gap = float(
+        np.abs((_rr_to_arm(k, start) - _rr_to_arm(k, q) + math.pi) % _TWO_PI - math.pi).max()
+    )
+    h = max(_RR_FOLD_STEP, gap)
+    v, least = _rr_lost_direction(q, rows, slide)
+    if least > _RR_FOLD_NEAR**2:  # (not near a fold: a complex pair's real row, alone)
+        return []
+    starts = np.array([q + h * v, q - h * v])
+    Q, errors = _rr_steps_many(rows, F, starts, slide, False)
+    return [p for p, error in zip(Q, errors) if error <= _RR_GOOD]
 
 
 class _RRLeads:
@@ -3016,6 +3052,7 @@ def _rr_split(k, F, moved, leads, known=(), imag_tol=_RR_IMAG_TOL):
     )
     out: list[np.ndarray] = []
     close: list[np.ndarray] = []
+    paired: list[bool] = []  # (per row of out: an extra candidate's, first)
     if candidates is None:  # (a singular pencil)
         leads.singular = leads.singular or fill_rows == true_rows
         return out, close, _RESCUE
@@ -3052,7 +3089,21 @@ def _rr_split(k, F, moved, leads, known=(), imag_tol=_RR_IMAG_TOL):
             if residual > _RR_SETTLED and _rr_unsettled_copy(k, q, known, out):
                 Q1, errors = _rr_steps_many(true_rows, F, q[None], slide, False, steps=2)
                 q, residual = Q1[0], min(residual, float(errors[0]))
+            arm = _rr_to_arm(k, q)
+            seen = _rr_gaps(arm, list(known)).min(initial=math.inf) <= 1e-7
+            same = np.flatnonzero(_rr_gaps(arm, [_rr_to_arm(k, r) for r in out]) <= 1e-7)
             out.append(q)
+            paired.append(extra and not seen and not same.size)
+            if extra and not seen and same.size and paired[same[0]]:
+                # two candidates of a nearly real pair polished onto one row (a Sawyer's pair
+                # 0.023 rad apart near a fold, its candidates' real parts a rounding apart in
+                # C and numpy: C lost the pair's partners, and the sampled vector, at 33 of 71
+                # regular poses there; a new user's find, helper 54): the row across the fold
+                for p in _rr_fold_partners(k, F, q, start, true_rows, slide):
+                    rows_now = list(known) + [_rr_to_arm(k, r) for r in out]
+                    if _rr_gaps(_rr_to_arm(k, p), rows_now).min() > 1e-7:
+                        out.append(p)
+                        paired.append(False)
             continue
         if residual <= _RR_SEARCH_FROM:
             leads.rows.append(_rr_to_arm(k, q))
@@ -3091,6 +3142,13 @@ def _rr_unsettled_copy(k, q, known, out):
         return False
     gaps = np.abs((np.array(rows) - _rr_to_arm(k, q) + math.pi) % _TWO_PI - math.pi).max(axis=1)
     return bool(((gaps <= _RR_SAME) & (gaps > 1e-7)).any())
+
+
+def _rr_gaps(q, rows):
+    """The largest joint gap of q from each of rows (the arm's values; angles modulo 2 pi)."""
+    if not len(rows):
+        return np.zeros(0)
+    return np.abs((np.array(rows) - q + math.pi) % _TWO_PI - math.pi).max(axis=1)
 
 
 def _rr_near(q, rows):

@@ -599,6 +599,30 @@ def test_a_pair_of_solutions_near_a_fold_is_answered_once_by_each_backend(tmp_pa
 
 
 @needs_cc
+def test_a_nearly_real_pair_polished_onto_one_row_gets_its_partner_across_the_fold(tmp_path):
+    """robosuite's Sawyer (tests/data/specs/sawyer_robosuite.toml: the general method, q7
+    free) at a regular pose (sigma_min 1.2e-3) with a pair of solutions 0.023 rad apart near
+    a fold: the perturbed table gives each such pair as two candidates of a nearly real
+    pair, whose real parts C's and numpy's eigenvalues place a rounding apart; in C both of
+    each pair polished onto one row, and C returned 6 rows to Python's 8, without the
+    sampled vector (33 of 71 regular poses around it; a new user's find, helper 54). The row
+    across the fold is looked for now (_rr_fold_partners): 8 rows in both, the same ones."""
+    path = Path(__file__).parent / "data" / "specs" / "sawyer_robosuite.toml"
+    m = build_module(path.read_text(encoding="utf-8"), tmp_path, c=True)
+    assert m.METHOD == "general" and m.FREE == (7,)
+    q = np.array([2.7328209139106416, -2.9789460809547412, 3.009335900012763, math.pi + 1e-13,
+                  -2.536509353594494, -0.01767316025378074, -2.8307512886219546])  # fmt: skip
+    T = m.fk(q)
+    c_rows, rows = (m.ik(T, free=[q[6]], backend=b) for b in ("c", "python"))
+    assert len(c_rows) == len(rows) == 8, (len(c_rows), len(rows))
+    for row in c_rows:
+        gaps = np.abs(np.remainder(rows - row + math.pi, 2 * math.pi) - math.pi).max(axis=1)
+        assert gaps.min() <= 1e-7 and np.abs(m.fk(row) - T).max() <= 1e-10, row
+    gaps = np.abs(np.remainder(c_rows - q + math.pi, 2 * math.pi) - math.pi).max(axis=1)
+    assert gaps.min() <= 1e-9
+
+
+@needs_cc
 def test_a_pose_out_of_reach_is_answered_in_c_not_handed_to_python(generated, monkeypatch):
     """manocha_canny, poses just out of reach (1e-4 to 0.2 of a line's step past its
     boundary; a new user's path): the C solver returned -1 where no candidate polished, and

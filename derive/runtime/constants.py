@@ -238,6 +238,11 @@ _RR_RESCUE = ((1e-4, 1e-4), (-2e-4, 1.5e-4))
 # solutions lie (measured on the xArm6 URDF: both found from +-1e-3 at pairs 1e-4 to 1e-2
 # apart)
 _RR_FOLD_STEP = 1e-3
+# two candidates of a nearly real pair that polish onto one row whose Jacobian's least singular
+# value is within this (lengths in units of _RR_LENGTH) lost its partner across the fold
+# (_rr_fold_partners); elsewhere the pair is complex and its real parts' row is alone (the
+# partners' Newton steps there cost the cobots 5-14% of their C time)
+_RR_FOLD_NEAR = 1e-2
 # where nothing polishes and a pencil on the arm's own table is singular at the pose (or at a
 # moved one), or a candidate's polishing stopped within _RR_SEARCH_FROM of it (a curve of
 # solutions the eigenvalues missed), _RR_SEARCH_STEPS damped steps from those candidates and
