@@ -9,7 +9,7 @@
    is solved by it): one copy serves every arm of a folder, and each arm's file gets its own
    static copy of the routines, so arms link together in one program. Compile <name>_ik.c
    with it beside the file; do not include it anywhere else. */
-#define DK_RUNTIME 0x735c2ae0cbc0
+#define DK_RUNTIME 0x4e072167d8a0
 
 #include <math.h>
 #include <stddef.h>
@@ -4781,8 +4781,6 @@ static int dk_rr_unsettled_copy(int k, const double q[6], const double out[DK_RR
     return 0;
 }
 
-/* split k's joint values q (as the arm's) added to out[0..count) unless there already (within
-   1e-7): the new count */
 /* the index of the row of out[0..count) split k's q is (within the dedup's 1e-7), or -1 */
 static int dk_rr_index(int k, const double q[6], const double out[DK_RR_ROWS][6], int count)
 {
@@ -4797,6 +4795,8 @@ static int dk_rr_index(int k, const double q[6], const double out[DK_RR_ROWS][6]
     return -1;
 }
 
+/* split k's joint values q (as the arm's) added to out[0..count) unless there already (within
+   1e-7): the new count */
 static int dk_rr_add(int k, const double q[6], double out[DK_RR_ROWS][6], int count)
 {
     double arm[6];
@@ -4898,7 +4898,8 @@ static double dk_rr_lost_direction(int k, const double q[6], double v[6])
    nearly loses (dk_rr_lost_direction), h the gap between q and start, the candidate
    it came from (at least DK_RR_FOLD_STEP), added to out[count..] where new: the partner of a
    row two candidates of a nearly real pair both polished onto, where J's least singular value
-   at q is within DK_RR_FOLD_NEAR (the Python _rr_fold_partners); the new count */
+   at q is within DK_RR_FOLD_NEAR, and not within DK_RR_SAME of a row (a copy of it: the Python
+   _rr_split says why); the new count */
 static int dk_rr_fold_partners(int k, const double F[4][4], const double q[6],
                                const double start[6], double out[DK_RR_ROWS][6], int count)
 {
@@ -4916,7 +4917,15 @@ static int dk_rr_fold_partners(int k, const double F[4][4], const double q[6],
             x[i] = q[i] + steps[s] * h * v[i];
         }
         if (dk_rr_steps(DK_RR_TRUE[k], F, x, 0) <= DK_RR_GOOD) {
-            count = dk_rr_add(k, x, out, count);
+            double arm[6], gap = HUGE_VAL;
+            int r;
+            dk_rr_arm(k, x, arm);
+            for (r = 0; r < count; r++) { /* (within DK_RR_SAME of a row: a copy of it) */
+                gap = fmin(gap, dk_rr_gap(arm, out[r]));
+            }
+            if (gap > DK_RR_SAME) {
+                count = dk_rr_add(k, x, out, count);
+            }
         }
     }
     return count;

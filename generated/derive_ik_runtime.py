@@ -38,7 +38,7 @@ if "_RUNTIME_VERSION" not in globals():  # (imported on its own, not run by a mo
         "namespace; it is not a module to import"
     )
 # this runtime's version: a module runs the runtime of its own version only
-_RUNTIME_VERSION = "4c9126de9c86d81a"
+_RUNTIME_VERSION = "717f721644df94cf"
 
 if TYPE_CHECKING:  # defined by the module running this file
     from derive.runtime.arm import (
@@ -2892,7 +2892,8 @@ def _rr_fold_partners(k, F, q, start, rows, slide):
     Jacobian nearly loses (_rr_lost_direction), h the gap between q and the
     candidate it came from (at least _RR_FOLD_STEP): the partner of a row that two candidates
     of a nearly real pair both polished onto, which lies across the fold between them; none
-    where J's least singular value at q exceeds _RR_FOLD_NEAR."""
+    where J's least singular value at q exceeds _RR_FOLD_NEAR. (The caller keeps those not
+    within _RR_SAME of a row.)"""
     gap = float(
         np.abs((_rr_to_arm(k, start) - _rr_to_arm(k, q) + math.pi) % _TWO_PI - math.pi).max()
     )
@@ -3099,9 +3100,12 @@ def _rr_split(k, F, moved, leads, known=(), imag_tol=_RR_IMAG_TOL):
                 # 0.023 rad apart near a fold, its candidates' real parts a rounding apart in
                 # C and numpy: C lost the pair's partners, and the sampled vector, at 33 of 71
                 # regular poses there; a new user's find, helper 54): the row across the fold
+                # (one within _RR_SAME of a row is a copy of it, not its partner: at a singular
+                # pose such copies 1e-5 rad off passed the dedup and took genuine rows' places,
+                # a reviewer's find)
                 for p in _rr_fold_partners(k, F, q, start, true_rows, slide):
                     rows_now = list(known) + [_rr_to_arm(k, r) for r in out]
-                    if _rr_gaps(_rr_to_arm(k, p), rows_now).min() > 1e-7:
+                    if _rr_gaps(_rr_to_arm(k, p), rows_now).min() > _RR_SAME:
                         out.append(p)
                         paired.append(False)
             continue

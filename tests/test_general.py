@@ -623,6 +623,22 @@ def test_a_nearly_real_pair_polished_onto_one_row_gets_its_partner_across_the_fo
 
 
 @needs_cc
+def test_a_partner_within_rr_same_of_a_row_is_a_copy_not_a_new_row(tmp_path):
+    """Yaskawa's HC10 table at a singular pose (q5 = 180 deg, a continuum near): the partner
+    search's points 1e-5 rad from rows already found passed the 1e-7 dedup as new rows, took
+    genuine rows' places, and q itself was lost in C and Python (a reviewer's find, helper
+    55). Partners within _RR_SAME of a row are copies of it and are not kept."""
+    m = build_module(spec_text("hc10", "modified", REAL_COBOTS["hc10"]), tmp_path, c=True)
+    q = np.radians([90.0, -90.0, 90.0, 0.0, 180.0, 0.0])
+    T = m.fk(q)
+    for backend in ("c", "python"):
+        rows = m.ik(T, backend=backend)
+        gaps = np.abs(np.remainder(rows - q + math.pi, 2 * math.pi) - math.pi).max(axis=1)
+        assert gaps.min() <= 1e-6, (backend, len(rows))
+        assert all(np.abs(m.fk(row) - T).max() <= 1e-10 for row in rows)
+
+
+@needs_cc
 def test_a_pose_out_of_reach_is_answered_in_c_not_handed_to_python(generated, monkeypatch):
     """manocha_canny, poses just out of reach (1e-4 to 0.2 of a line's step past its
     boundary; a new user's path): the C solver returned -1 where no candidate polished, and
