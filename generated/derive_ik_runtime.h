@@ -9,7 +9,7 @@
    is solved by it): one copy serves every arm of a folder, and each arm's file gets its own
    static copy of the routines, so arms link together in one program. Compile <name>_ik.c
    with it beside the file; do not include it anywhere else. */
-#define DK_RUNTIME 0x4e072167d8a0
+#define DK_RUNTIME 0x441fc8588ff7
 
 #include <math.h>
 #include <stddef.h>
@@ -4781,14 +4781,16 @@ static int dk_rr_unsettled_copy(int k, const double q[6], const double out[DK_RR
     return 0;
 }
 
-/* the index of the row of out[0..count) split k's q is (within the dedup's 1e-7), or -1 */
-static int dk_rr_index(int k, const double q[6], const double out[DK_RR_ROWS][6], int count)
+/* the index of the first row of out[0..count) within tol of split k's q (as the arm's values),
+   or -1 */
+static int dk_rr_index(int k, const double q[6], const double out[DK_RR_ROWS][6], int count,
+                       double tol)
 {
     double arm[6];
     int r;
     dk_rr_arm(k, q, arm);
     for (r = 0; r < count; r++) {
-        if (dk_rr_gap(arm, out[r]) <= 1e-7) {
+        if (dk_rr_gap(arm, out[r]) <= tol) {
             return r;
         }
     }
@@ -4799,17 +4801,10 @@ static int dk_rr_index(int k, const double q[6], const double out[DK_RR_ROWS][6]
    1e-7): the new count */
 static int dk_rr_add(int k, const double q[6], double out[DK_RR_ROWS][6], int count)
 {
-    double arm[6];
-    int j, r;
-    dk_rr_arm(k, q, arm);
-    for (r = 0; r < count; r++) {
-        if (dk_rr_gap(arm, out[r]) <= 1e-7) {
-            return count;
-        }
+    if (dk_rr_index(k, q, (const double(*)[6])out, count, 1e-7) >= 0) {
+        return count;
     }
-    for (j = 0; j < 6; j++) {
-        out[count][j] = arm[j];
-    }
+    dk_rr_arm(k, q, out[count]);
     return count + 1;
 }
 
@@ -4916,16 +4911,10 @@ static int dk_rr_fold_partners(int k, const double F[4][4], const double q[6],
         for (i = 0; i < 6; i++) {
             x[i] = q[i] + steps[s] * h * v[i];
         }
-        if (dk_rr_steps(DK_RR_TRUE[k], F, x, 0) <= DK_RR_GOOD) {
-            double arm[6], gap = HUGE_VAL;
-            int r;
-            dk_rr_arm(k, x, arm);
-            for (r = 0; r < count; r++) { /* (within DK_RR_SAME of a row: a copy of it) */
-                gap = fmin(gap, dk_rr_gap(arm, out[r]));
-            }
-            if (gap > DK_RR_SAME) {
-                count = dk_rr_add(k, x, out, count);
-            }
+        /* (within DK_RR_SAME of a row: a copy of it) */
+        if (dk_rr_steps(DK_RR_TRUE[k], F, x, 0) <= DK_RR_GOOD &&
+            dk_rr_index(k, x, (const double(*)[6])out, count, DK_RR_SAME) < 0) {
+            count = dk_rr_add(k, x, out, count);
         }
     }
     return count;
@@ -5016,7 +5005,7 @@ static int dk_rr_split(int k, const double F[4][4], const double moved[4][4],
             dk_rr_unsettled_copy(k, q, (const double(*)[6])out, count)) {
             error = fmin(error, dk_rr_walk(DK_RR_TRUE[k], F, q, 0, 2, DK_RR_NEWTON_REACH, 0));
         }
-        r = dk_rr_index(k, q, (const double(*)[6])out, count);
+        r = dk_rr_index(k, q, (const double(*)[6])out, count, 1e-7);
         if (r < 0) {
             count = dk_rr_add(k, q, out, count);
             paired[count - 1] = extra[c];

@@ -241,10 +241,7 @@ def _rr_fold_partners(k, F, q, start, rows, slide):
     of a nearly real pair both polished onto, which lies across the fold between them; none
     where J's least singular value at q exceeds _RR_FOLD_NEAR. (The caller keeps those not
     within _RR_SAME of a row.)"""
-    gap = float(
-        np.abs((_rr_to_arm(k, start) - _rr_to_arm(k, q) + math.pi) % _TWO_PI - math.pi).max()
-    )
-    h = max(_RR_FOLD_STEP, gap)
+    h = max(_RR_FOLD_STEP, float(_rr_gaps(_rr_to_arm(k, start), [_rr_to_arm(k, q)])[0]))
     v, least = _rr_lost_direction(q, rows, slide)
     if least > _RR_FOLD_NEAR**2:  # (not near a fold: a complex pair's real row, alone)
         return []
@@ -486,10 +483,7 @@ def _rr_unsettled_copy(k, q, known, out):
     """Whether split k's q (not settled to rounding) lies within _RR_SAME of a row found
     (known: the arm's values; out: this split's) but not within the dedup's 1e-7: perhaps a
     copy of that row near a fold (_RR_SETTLED says why)."""
-    rows = list(known) + [_rr_to_arm(k, r) for r in out]
-    if not rows:
-        return False
-    gaps = np.abs((np.array(rows) - _rr_to_arm(k, q) + math.pi) % _TWO_PI - math.pi).max(axis=1)
+    gaps = _rr_gaps(_rr_to_arm(k, q), list(known) + [_rr_to_arm(k, r) for r in out])
     return bool(((gaps <= _RR_SAME) & (gaps > 1e-7)).any())
 
 
@@ -502,8 +496,7 @@ def _rr_gaps(q, rows):
 
 def _rr_near(q, rows):
     """Whether q (the arm's values) is within _RR_SAME of one of rows (angles modulo 2 pi)."""
-    gaps = np.abs((np.array(rows) - q + math.pi) % _TWO_PI - math.pi).max(axis=1)
-    return bool((gaps <= _RR_SAME).any())
+    return bool((_rr_gaps(q, rows) <= _RR_SAME).any())
 
 
 def _rr_between(fill_rows, true_rows, t):
