@@ -38,7 +38,7 @@ if "_RUNTIME_VERSION" not in globals():  # (imported on its own, not run by a mo
         "namespace; it is not a module to import"
     )
 # this runtime's version: a module runs the runtime of its own version only
-_RUNTIME_VERSION = "925949d98822bc1d"
+_RUNTIME_VERSION = "758801cc9b16f223"
 
 if TYPE_CHECKING:  # defined by the module running this file
     from derive.runtime.arm import (
@@ -3061,7 +3061,8 @@ def _rr_split(k, F, moved, leads, known=(), imag_tol=_RR_IMAG_TOL):
     # count, which starts it anyway), and only where a row may be missing (_rr_settled)
     doubt = (_FALLBACK if fill_rows != true_rows else _RESCUE) if doubt else 0
     if known and candidates:  # (one within _RR_SAME of a known row is that row again)
-        kept = [c for c, q in enumerate(candidates) if not _rr_near(_rr_to_arm(k, q), known)]
+        near = _rr_gap_table([_rr_to_arm(k, q) for q in candidates], list(known)) <= _RR_SAME
+        kept = np.flatnonzero(~near.any(axis=1))
         candidates = [candidates[c] for c in kept]
         extras = [extras[c] for c in kept]
     if not candidates:
@@ -3073,8 +3074,22 @@ def _rr_split(k, F, moved, leads, known=(), imag_tol=_RR_IMAG_TOL):
         Q, _ = _rr_steps_many(rows, F, Q, slide, False, steps=_RR_PATH_STEPS, track=True)
     Q, residuals, damped = _rr_newton_many(true_rows, F, Q, slide, np.array(extras))
     perturbed = fill_rows != true_rows
-    for start, q, residual, was_damped, extra in zip(candidates, Q, residuals, damped, extras):
-        if perturbed and out and _rr_near(_rr_to_arm(k, start), [_rr_to_arm(k, r) for r in out]):
+    # the arm's values of the starts and rows, and their gaps from each other and from the
+    # known rows, one table each (the Python solver's time went to comparing candidates one
+    # by one: 11% of it on two cobots); a row moved after these (_rr_unsettled_copy), or a
+    # partner, is compared on its own
+    starts = [_rr_to_arm(k, q) for q in candidates]
+    arms = [_rr_to_arm(k, q) for q in Q]
+    start_gaps = _rr_gap_table(starts, arms)
+    row_gaps = _rr_gap_table(arms, arms)
+    known_gaps = _rr_gap_table(arms, list(known)).min(axis=1, initial=math.inf)
+    out_arms: list[np.ndarray] = []  # (the arm's values of out's rows)
+    out_from: list[int] = []  # (per row of out: the candidate whose row it is; -1: moved)
+    for c, (q, residual, was_damped, extra) in enumerate(zip(Q, residuals, damped, extras)):
+        if (
+            perturbed
+            and (_rr_out_gaps(start_gaps[c], starts[c], out_arms, out_from) <= _RR_SAME).any()
+        ):
             # a perturbed table's candidate within _RR_SAME of a row this split found already
             # is that row again (as a later split's is): the C solver does not walk it (on 500
             # Jaco2 poses 5,802 of the 13,152 candidates walked went onto a row found; the
@@ -3084,13 +3099,21 @@ def _rr_split(k, F, moved, leads, known=(), imag_tol=_RR_IMAG_TOL):
         if was_damped and not perturbed and not extra:  # Newton did not settle it
             doubt = _RESCUE
         if residual <= _RR_GOOD:
-            if residual > _RR_SETTLED and _rr_unsettled_copy(k, q, known, out):
+            arm, row = arms[c], c
+            if residual > _RR_SETTLED and _rr_unsettled_copy(arm, list(known) + out_arms):
                 Q1, errors = _rr_steps_many(true_rows, F, q[None], slide, False, steps=2)
                 q, residual = Q1[0], min(residual, float(errors[0]))
-            arm = _rr_to_arm(k, q)
-            seen = _rr_gaps(arm, list(known)).min(initial=math.inf) <= 1e-7
-            same = np.flatnonzero(_rr_gaps(arm, [_rr_to_arm(k, r) for r in out]) <= 1e-7)
+                arm, row = _rr_to_arm(k, q), -1
+            if row >= 0:
+                seen = known_gaps[c] <= 1e-7
+                gaps = _rr_out_gaps(row_gaps[c], arm, out_arms, out_from)
+            else:
+                seen = _rr_gaps(arm, list(known)).min(initial=math.inf) <= 1e-7
+                gaps = _rr_gaps(arm, out_arms)
+            same = np.flatnonzero(gaps <= 1e-7)
             out.append(q)
+            out_arms.append(arm)
+            out_from.append(row)
             paired.append(extra and not seen and not same.size)
             if extra and not seen and same.size and paired[same[0]]:
                 # two candidates of a nearly real pair polished onto one row (a Sawyer's pair
@@ -3100,10 +3123,12 @@ def _rr_split(k, F, moved, leads, known=(), imag_tol=_RR_IMAG_TOL):
                 # (one within _RR_SAME of a row is a copy of it, not its partner: at a singular
                 # pose such copies 1e-5 rad off passed the dedup and took genuine rows' places,
                 # a reviewer's find)
-                for p in _rr_fold_partners(k, F, q, start, true_rows, slide):
-                    rows_now = list(known) + [_rr_to_arm(k, r) for r in out]
-                    if _rr_gaps(_rr_to_arm(k, p), rows_now).min() > _RR_SAME:
+                for p in _rr_fold_partners(k, F, q, candidates[c], true_rows, slide):
+                    p_arm = _rr_to_arm(k, p)
+                    if _rr_gaps(p_arm, list(known) + out_arms).min() > _RR_SAME:
                         out.append(p)
+                        out_arms.append(p_arm)
+                        out_from.append(-1)
                         paired.append(False)
             continue
         if residual <= _RR_SEARCH_FROM:
@@ -3134,11 +3159,11 @@ def _rr_settled(doubt, known, rows, reals, pair):
     return 0 if len(merged) - len(known) >= reals else doubt
 
 
-def _rr_unsettled_copy(k, q, known, out):
-    """Whether split k's q (not settled to rounding) lies within _RR_SAME of a row found
-    (known: the arm's values; out: this split's) but not within the dedup's 1e-7: perhaps a
-    copy of that row near a fold (_RR_SETTLED says why)."""
-    gaps = _rr_gaps(_rr_to_arm(k, q), list(known) + [_rr_to_arm(k, r) for r in out])
+def _rr_unsettled_copy(arm, rows):
+    """Whether a row's values (the arm's; not settled to rounding) lie within _RR_SAME of one
+    of the rows found (the arm's values) but not within the dedup's 1e-7: perhaps a copy of
+    that row near a fold (_RR_SETTLED says why)."""
+    gaps = _rr_gaps(arm, rows)
     return bool(((gaps <= _RR_SAME) & (gaps > 1e-7)).any())
 
 
@@ -3149,9 +3174,28 @@ def _rr_gaps(q, rows):
     return np.abs((np.array(rows) - q + math.pi) % _TWO_PI - math.pi).max(axis=1)
 
 
-def _rr_near(q, rows):
-    """Whether q (the arm's values) is within _RR_SAME of one of rows (angles modulo 2 pi)."""
-    return bool((_rr_gaps(q, rows) <= _RR_SAME).any())
+def _rr_gap_table(qs, rows):
+    """_rr_gaps of each of qs from rows at once: shape (len(qs), len(rows))."""
+    if not len(qs) or not len(rows):
+        return np.zeros((len(qs), len(rows)))
+    # (each value reduced modulo 2 pi first, then each difference: the gap is the shorter
+    # way round)
+    A, B = (np.array(qs) + math.pi) % _TWO_PI, (np.array(rows) + math.pi) % _TWO_PI
+    D = np.abs(B[None, :, :] - A[:, None, :])
+    return np.minimum(D, _TWO_PI - D).max(axis=2)
+
+
+def _rr_out_gaps(table, q, out, out_from):
+    """q's gaps from the rows of out (the arm's values): from its row of a gap table (table,
+    over the candidates) where a row is a candidate's (out_from), on its own where it moved
+    (-1)."""
+    if not out:
+        return np.zeros(0)
+    gaps = table[out_from]
+    moved = [j for j, c in enumerate(out_from) if c < 0]
+    if moved:
+        gaps[moved] = _rr_gaps(q, [out[j] for j in moved])
+    return gaps
 
 
 def _rr_between(fill_rows, true_rows, t):
@@ -3488,11 +3532,12 @@ def _rr_unmix(v1, v2):
     u v1 + w v2 with (u, w) a root of the largest of the quadratic rules v_i v_j = v_k v_l."""
     best = (0.0, 0.0, 0.0)
     size = -1.0
+    a, b = v1.tolist(), v2.tolist()  # (Python's floats: numpy's scalars cost 10 times more)
     for i, j, k, l in _RR_MONOMIAL_RULES:
         # (u v1 + w v2)_i (u v1 + w v2)_j - (...)_k (...)_l = p u^2 + q u w + r w^2
-        p = v1[i] * v1[j] - v1[k] * v1[l]
-        q = v1[i] * v2[j] + v2[i] * v1[j] - v1[k] * v2[l] - v2[k] * v1[l]
-        r = v2[i] * v2[j] - v2[k] * v2[l]
+        p = a[i] * a[j] - a[k] * a[l]
+        q = a[i] * b[j] + b[i] * a[j] - a[k] * b[l] - b[k] * a[l]
+        r = b[i] * b[j] - b[k] * b[l]
         if abs(p) + abs(q) + abs(r) > size:
             best, size = (p, q, r), abs(p) + abs(q) + abs(r)
     p, q, r = best
@@ -3637,26 +3682,32 @@ def _rr_steps_many(
     q = np.array(Q, dtype=float)
     best_q, best = q.copy(), np.full(len(q), math.inf)
     live = np.arange(len(q))
+    Ft = F[:3, :3].T
+    # (each numpy call costs about a microsecond whatever its size: the filters below are
+    # skipped where they would keep every row)
     for _ in range(steps if track else steps + 1):
         x = q[live]
         frames = _rr_frames(x, rows, slide)
-        size = np.abs(F[:3] - frames[:, 6, :3]).max(axis=(1, 2))
-        better = size < best[live]
-        best_q[live[better]], best[live[better]] = x[better], size[better]
-        going = (size > 1e-15) & (size <= reach)
-        live, x, frames = live[going], x[going], frames[going]
-        if not live.size:
-            break
         E = frames[:, 6]
+        size = np.abs(F[:3] - E[:, :3]).max(axis=(1, 2))
+        better = size < best[live]
+        moved = live[better]
+        best_q[moved], best[moved] = x[better], size[better]
+        going = (size > 1e-15) & (size <= reach)
+        if not going.all():
+            live, x, frames, E, size = live[going], x[going], frames[going], E[going], size[going]
+            if not live.size:
+                break
         # position error, and half the sum of E's columns crossed with F's (the rotation):
         # the antisymmetric part of E's rotation times F's transposed
         error = np.empty((len(live), 6))
         error[:, :3] = F[:3, 3] - E[:, :3, 3]
-        P = E[:, :3, :3] @ F[:3, :3].T
+        P = E[:, :3, :3] @ Ft
         error[:, 3:] = 0.5 * (P[:, _RR_NEXT, _RR_LAST] - P[:, _RR_LAST, _RR_NEXT])
         J = _rr_columns(frames, slide).transpose(0, 2, 1)
         moves, solved = _rr_solve_many(J, error, damped)
-        live, x, moves = live[solved], x[solved], moves[solved]  # (a singular J: it stops)
+        if not solved.all():  # (a singular J: it stops)
+            live, x, moves, size = live[solved], x[solved], moves[solved], size[solved]
         longest = np.abs(moves).max(axis=1, initial=0.0)
         q[live] = x + moves * (0.5 / np.maximum(longest, 0.5))[:, None]  # (at most 0.5 a joint)
         if not damped:
@@ -3664,12 +3715,13 @@ def _rr_steps_many(
             # a rounding's width from the solution (the error after it is at most the step
             # squared times the arm's curvature): taken, and not measured again (its error is
             # counted as the one before it; the caller certifies anyway)
-            before = size[going][solved]
-            done = (before <= _RR_NEWTON_DONE[0]) & (longest <= _RR_NEWTON_DONE[1])
-            best_q[live[done]], best[live[done]] = q[live[done]], before[done]
-            live = live[~done]
-            if not live.size:
-                break
+            done = (size <= _RR_NEWTON_DONE[0]) & (longest <= _RR_NEWTON_DONE[1])
+            if done.any():
+                settled = live[done]
+                best_q[settled], best[settled] = q[settled], size[done]
+                live = live[~done]
+                if not live.size:
+                    break
     return (q if track else best_q), best
 
 
@@ -3679,8 +3731,9 @@ def _rr_frames(X, rows, slide):
     links = _rr_chain(X, rows, slide)
     frames = np.empty((len(X), 7, 4, 4))
     frames[:, 0] = _RR_EYE4
-    for i in range(6):
-        frames[:, i + 1] = frames[:, i] @ links[:, i]
+    frames[:, 1] = links[:, 0]
+    for i in range(1, 6):
+        np.matmul(frames[:, i], links[:, i], out=frames[:, i + 1])
     return frames
 
 
@@ -3689,9 +3742,10 @@ def _rr_columns(frames, slide):
     one): z_i x (p - o_i) over z_i (a sliding joint 3: z_3 over 0)."""
     z = frames[:, :6, :3, 2]
     r = frames[:, 6, None, :3, 3] - frames[:, :6, :3, 3]
-    columns = np.concatenate(
-        (z[..., _RR_NEXT] * r[..., _RR_LAST] - z[..., _RR_LAST] * r[..., _RR_NEXT], z), axis=2
-    )
+    columns = np.empty((len(frames), 6, 6))
+    columns[..., :3] = z[..., _RR_NEXT] * r[..., _RR_LAST]
+    columns[..., :3] -= z[..., _RR_LAST] * r[..., _RR_NEXT]
+    columns[..., 3:] = z
     if slide[0]:  # a sliding joint 3 moves the flange along its axis
         columns[:, 2, :3] = z[:, 2]
         columns[:, 2, 3:] = 0.0
