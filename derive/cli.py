@@ -26,7 +26,7 @@ if TYPE_CHECKING:
 
 from derive import extras, mjcf, urdf
 from derive.emit import GenerationError, render_module
-from derive.inputs import bundled_specs, resolve_spec
+from derive.inputs import bundled_specs, converts, resolve_spec
 from derive.languages import LANGUAGES, figure_files, is_planar, worked_example
 from derive.load import LoadError, load_solver, solver_sources
 from derive.outputs import (
@@ -80,11 +80,20 @@ def urdf_options(args: argparse.Namespace) -> urdf.Options:
 def load_specs(texts: list[str], options: urdf.Options | None = None) -> list[ArmSpec]:
     """Specs named on the command line (all bundled arms if none), with unique names."""
     if texts:
-        specs = [resolve_spec(t, options) for t in texts]
+        specs = [resolve_spec(t, o) for t, o in zip(texts, options_for(texts, options))]
     else:
         specs = [load_spec(p) for p in bundled_specs()]
     unique_names(specs)
     return specs
+
+
+def options_for(texts: list[str], options: urdf.Options | None) -> list[urdf.Options | None]:
+    """Per arm named, the conversion's options: where the command line names a URDF or MJCF
+    file, they are its, and a spec or bundled arm beside it keeps its own (`derive bench
+    robot.urdf puma560 --base b --tip t` times both in one run); where it names none, every
+    arm gets them, and a spec refuses them in one line (they would be ignored)."""
+    converting = any(converts(t) for t in texts)
+    return [options if converts(t) or not converting else None for t in texts]
 
 
 def unique_names(specs: Iterable[ArmSpec]) -> None:
@@ -145,9 +154,10 @@ def cmd_generate(args: argparse.Namespace) -> int:
     options = urdf_options(args)  # (a bad option is one line, not one per arm)
     failed, no_ik = [], []
     specs: dict[str, ArmSpec] = {}
-    for text in args.specs or [str(p) for p in bundled_specs()]:
+    texts = args.specs or [str(p) for p in bundled_specs()]
+    for text, text_options in zip(texts, options_for(texts, options)):
         try:
-            specs[text] = resolve_spec(text, options)
+            specs[text] = resolve_spec(text, text_options)
         except (SpecError, UsageError, OutputError, OSError) as exc:
             print(f"error: {exc}", file=sys.stderr)
             failed.append(text)
@@ -1210,7 +1220,11 @@ def add_pose_arguments(command: argparse.ArgumentParser) -> None:
 
 def add_urdf_arguments(command: argparse.ArgumentParser, required: bool) -> None:
     """The options of a URDF's conversion (used where an arm is a .urdf file)."""
-    group = command.add_argument_group("URDF or MJCF input (ARM.urdf, ARM.xml)")
+    group = command.add_argument_group(
+        "URDF or MJCF input (ARM.urdf, ARM.xml)",
+        "applied to the URDF and MJCF files named; spec files and bundled arms named beside "
+        "them keep their own",
+    )
     group.add_argument(
         "--base", required=required, help="the URDF link (MJCF body) the chain starts from"
     )

@@ -94,15 +94,28 @@ def bundled_specs() -> list[Path]:
     )
 
 
+def _reader(path: Path) -> Reader | None:
+    """The reader of a file by its suffix, or by its root element where that is XML (a URDF
+    or MJCF named otherwise, e.g. robot.txt); None for others (a spec or bundled arm name)."""
+    reader = READERS.get(path.suffix.lower())
+    if reader is None and _starts_with_markup(path):
+        reader = _xml_file
+    return reader
+
+
+def converts(text: str) -> bool:
+    """Whether text names a URDF or MJCF file: one the conversion's options apply to."""
+    reader = _reader(Path(text))
+    return reader is not None and reader is not _spec_file
+
+
 def resolve_spec(text: str, options: urdf.Options | None = None) -> ArmSpec:
     """A spec from a file path (a URDF or MJCF with options' base and tip), or a bundled arm
     by name."""
     path = Path(text)
-    reader = READERS.get(path.suffix.lower())
+    reader = _reader(path)
     if reader is None and path.is_dir():
         raise SpecError(f"{text}: a folder, not an arm's file; {FORMATS}")
-    if reader is None and _starts_with_markup(path):  # (a URDF or MJCF named otherwise, e.g.
-        reader = _xml_file  # robot.txt: its root element says which)
     if reader is not None and reader is not _spec_file:
         return reader(path, options or urdf.Options())
     if given := conversion_options(options):

@@ -353,6 +353,22 @@ def test_input_that_is_not_read_as_given_is_one_line(argv, message, tmp_path, ca
     assert not (tmp_path / "out").exists()
 
 
+def test_a_urdf_s_options_apply_to_it_and_not_to_a_bundled_arm_named_beside_it(tmp_path):
+    """`derive bench robot.urdf puma560 --base b --tip t --lang c` was refused ("puma560:
+    --base, --tip: options of a URDF or MJCF file's conversion"), so a task arm could not be
+    timed against the PUMA in one run as issue 40 measures it: a conversion's options now go to
+    the URDF and MJCF files named, and the specs beside them keep their own. The PUMA's module
+    is the bundled one, byte for byte; the URDF's is its conversion with those options."""
+    out = tmp_path / "out"
+    argv = ["generate", str(URDF), "puma560", "--base", "world", "--tip", "tool0"]
+    assert main([*argv, "--task", "position", "--out", str(out)]) == 0
+    puma = (out / "puma560.py").read_bytes()
+    assert puma == (ROOT / "generated" / "puma560.py").read_bytes()
+    ur5 = next(p for p in out.glob("*.py") if p.name not in ("puma560.py", "derive_ik_runtime.py"))
+    assert "ik_position" in ur5.read_text()
+    assert main(["generate", "puma560", "--task", "position", "--out", str(out)]) == 2
+
+
 def test_a_spec_s_method_is_the_only_one_tried():
     """[ik] method = "general" gives an arm the general method (a calibrated arm's complete
     solution set); an unknown method is refused with the allowed ones."""
