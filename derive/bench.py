@@ -17,7 +17,7 @@ from typing import Any
 
 import numpy as np
 
-from derive.verify import roundtrip, sample_joints
+from derive.verify import roundtrip, sample_joints, targets
 
 
 def machine() -> str:
@@ -109,7 +109,7 @@ def batch_figures(module: ModuleType, n: int, seed: int, memory_n: int, threads:
     """ik_batch microseconds per pose at n poses (default backend; with the compiled one also on
     one thread, and the Python backend), and its peak memory at memory_n poses."""
     rng = np.random.default_rng(seed + 1)
-    poses = module.fk_batch(sample_joints(module, n, rng))
+    poses = targets(module, sample_joints(module, n, rng))
     figures = {
         "batch_n": n,
         "ik_batch_us": batch_us(module, poses),
@@ -122,7 +122,7 @@ def batch_figures(module: ModuleType, n: int, seed: int, memory_n: int, threads:
         finally:
             setattr(module, "_THREADS", threads)  # noqa: B010
     if memory_n:
-        big = module.fk_batch(sample_joints(module, memory_n, rng))
+        big = targets(module, sample_joints(module, memory_n, rng))
         tracemalloc.start()
         module.ik_batch(big)
         _, peak = tracemalloc.get_traced_memory()
@@ -176,7 +176,8 @@ def measure(
     """
     rng = np.random.default_rng(seed)
     Q = sample_joints(module, samples, rng)
-    poses = [module.fk(q) for q in Q[: min(samples, 2000)]]
+    # (a look-at's poses carry its point one REACH ahead: targets)
+    poses = list(targets(module, Q[: min(samples, 2000)]))
     figures = {
         "name": module.NAME,
         "fk_us": median_us(module.fk, [(q,) for q in Q[:2000]]),
@@ -198,7 +199,7 @@ def measure(
             )
         result = roundtrip(module, Q)
         figures.update(batch_figures(module, batch_n, seed, memory_n, figures.get("threads", 0)))
-        figures["batch_agrees"] = batch_agreement(module, module.fk_batch(Q))
+        figures["batch_agrees"] = batch_agreement(module, targets(module, Q))
         if module.JOINT_TYPES == "RRRRRR" and module.DOF == 6:
             figures.update(eaik_figures(module, module.fk_batch(Q)))
         figures.update(

@@ -859,7 +859,7 @@ def bench_c(args: argparse.Namespace, specs: list[ArmSpec]) -> int:
 
     from derive.bench import eaik_figures, median_us, solve_with
     from derive.cbuild import BuildError, Harness
-    from derive.verify import sample_joints
+    from derive.verify import sample_joints, targets
 
     for spec in specs:
         plan = build_plan(spec)
@@ -872,7 +872,7 @@ def bench_c(args: argparse.Namespace, specs: list[ArmSpec]) -> int:
             module = load_module(spec)
             rng = np.random.default_rng(args.seed)
             Q = sample_joints(module, args.samples, rng, degenerate_share=0.0)
-            T = module.fk_batch(Q)
+            T = targets(module, Q)  # (a look-at's point one REACH ahead)
             refs = np.zeros_like(Q)
             for j in module.FREE:
                 refs[:, j - 1] = Q[:, j - 1]

@@ -209,8 +209,9 @@ def roundtrip(module: ModuleType, Q: np.ndarray, backend: str | None = None) -> 
     revolute = np.array([k == "R" for k in module.JOINT_TYPES])
     everything = np.ones(module.DOF, dtype=bool)
     free = [j - 1 for j in getattr(module, "FREE", ())]
-    for index, q in enumerate(Q):
-        T = module.fk(q)
+    poses = targets(module, Q)  # (a look-at's point one REACH ahead: its own tool point lies
+    # on every ray, and every row of the head would look at it)
+    for index, (q, T) in enumerate(zip(Q, poses)):
         # an arm with free joints: solved for q's values of them
         sols = module.ik(T, backend=backend, **({"free": q[free]} if free else {}))
         out.samples += 1

@@ -204,6 +204,19 @@ def test_bench_reports_round_trip_figures(capsys):
     assert f"numpy {np.__version__}" in figures["machine"] and "CPU" in figures["machine"]
 
 
+def test_bench_of_a_look_at_head_asks_it_to_look_at_a_point_ahead(capsys):
+    """`derive bench locobot_head` reported "unsound 206; pos inf x reach": its round trip
+    solved ik(fk(q)), asking the head to look at its own tool point, which lies on every ray
+    (a new user's find, helper 56). The round trip and the timings now take the point one
+    REACH ahead on the tool axis (verify.targets), where q looks: every row sound and q found."""
+    import json
+
+    assert main(["bench", "locobot_head", "--n", "200", "--batch", "200", "--json"]) == 0
+    figures = json.loads(capsys.readouterr().out)[0]
+    assert figures["unsound"] == 0 and figures["worst_pos"] < 1e-9, figures["summary"]
+    assert figures["completeness"] == 1.0 and figures["batch_agrees"] == figures["samples"]
+
+
 def test_solve_residual_is_over_what_the_solver_reproduces(capsys):
     """A positioning arm (planar_2r) reproduces the tool point, not its heading: its second
     solution printed 'residual 1.0e+00' (the rotation entries) though it is exact."""
