@@ -63,7 +63,7 @@ def build_plan(spec: ArmSpec, method: str | None = None) -> Plan:
     frames = spec.exact if spec.exact is not None else chain_frames(chain)
     task = task_of(spec, chain)
     tol = STRUCTURE_TOL if spec.structure_tol is None else spec.structure_tol
-    ik, refusal = choose(chain, structure, spec.free, closed, task, tol)
+    ik, refusal = choose(chain, structure, spec.free, closed, task, tol, method)
     correction = None
     facts = structure.describe(chain.dof)
     far = ""  # (a nominal table too far from the arm to refine from)
@@ -72,7 +72,7 @@ def build_plan(spec: ArmSpec, method: str | None = None) -> Plan:
         if near.changes:
             near_chain = chain_from_spec(near.spec)
             near_structure = classify(near_chain)
-            near_ik, _ = choose(near_chain, near_structure, spec.free, closed, task, tol)
+            near_ik, _ = choose(near_chain, near_structure, spec.free, closed, task, tol, method)
             if near_ik is not None:
                 fix = make_correction(near, near_chain, frames, arm_info(spec, chain).reach)
                 if fix.deviation <= NOMINAL_MAX:
@@ -95,7 +95,7 @@ def build_plan(spec: ArmSpec, method: str | None = None) -> Plan:
         elif alone:
             refusal = f"{refusal}; the tool point's position: {alone}"
     if ik is None and general.NAME in names:
-        ik, why = choose(chain, structure, spec.free, (general.NAME,), task, tol)
+        ik, why = choose(chain, structure, spec.free, (general.NAME,), task, tol, method)
         reasons = [r for r in (refusal, why) if r]
         if ik is not None and far:  # (the summary says why the nominal one was not used)
             facts = (*facts, far)
@@ -173,7 +173,7 @@ def build_plan(spec: ArmSpec, method: str | None = None) -> Plan:
 
 
 # a task's `why` where the spec names it
-NAMED = "named in the spec"
+NAMED = "named ([ik] task, or --task)"
 # the task of four revolute joints where the angle task does not apply (choose)
 POSITION_INSTEAD = tasks.Task(
     "position",
@@ -240,6 +240,7 @@ def choose(
     names: tuple[str, ...],
     task: tasks.Task | None = None,
     tol: float = STRUCTURE_TOL,
+    method: str | None = None,
 ) -> tuple[IkPlan | None, str]:
     """The first of the named methods that solves the chain (an arm of more than 6 joints:
     with free joints; a task's arm: extended by its virtual joint, about the task's tool axis,
@@ -251,7 +252,7 @@ def choose(
             return choose_method(chain, structure, solvers) if solvers else (None, "")
         return choose_free(chain, named, solvers, size=3)
     if task is not None and task.kind == "axisangle":
-        return choose_cone(chain, structure, named, names, task, tol)
+        return choose_cone(chain, structure, named, names, task, tol, method)
     if task is not None and task.virtual:
         reasons = []
         if task.why != NAMED:  # (the joints chose it: a method of the arm's own comes first)
@@ -314,6 +315,7 @@ def choose_cone(
     names: tuple[str, ...],
     task: tasks.Task,
     tol: float,
+    method: str | None = None,
 ) -> tuple[IkPlan | None, str]:
     """The "axisangle" task's plan (derive/methods/cone.py) for the task's tool axis, else
     the first of z, x, y that works; where the joints chose the task, a method of the arm's
@@ -322,6 +324,13 @@ def choose_cone(
         ik, why = choose(chain, structure, named, names)
         if ik is not None:
             return ik, why
+    if method is not None:  # ([ik] method or --method: that method only)
+        return None, (
+            f"the {task.kind} task's method is the cone (derive/methods/cone.py), and the "
+            f"method named is {method}"
+        )
+    if general.NAME in names:  # (the general round: the closed forms' round tried the cone)
+        return None, ""
     reasons = []
     for axis in (task.axis,) if task.fixed else tasks.axis_order(chain, tol):
         try:

@@ -4,6 +4,7 @@ for a pan-tilt, each as the pose or position of the arm with one virtual joint m
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from pathlib import Path
 
@@ -910,6 +911,21 @@ def test_a_task_no_method_solves_says_why_for_each_axis_without_empty_reasons():
     assert plan.ik is None
     assert "tool z axis, with virtual joint 3: general: needs 6 joints" in plan.refusal
     assert ": ;" not in plan.refusal and not plan.refusal.endswith(": ")
+
+
+@pytest.mark.parametrize("method", ["pieper", "planar", "general"])
+def test_an_angle_task_s_arm_with_another_method_named_gets_that_method_only(method):
+    """A four-joint arm's angle task was solved by the cone method whatever [ik] method or
+    --method named (a new user's PhantomX Pincher with method = "pieper": exit 0, METHOD =
+    "cone"; helper 56): the method named is the only one tried, as on a pose arm, and the
+    refusal says the task's method is the cone. Without a method the cone solves it, and its
+    reasons are not repeated by the general method's round."""
+    spec = resolve_spec("open_manipulator_x")
+    plan = build_plan(dataclasses.replace(spec, method=method))
+    assert plan.ik is None
+    cone = "the axisangle task's method is the cone (derive/methods/cone.py)"
+    assert f"{cone}, and the method named is {method}" in plan.refusal
+    assert build_plan(spec).ik.method == "cone"
 
 
 def _plane_target(module, q: np.ndarray) -> tuple[float, ...]:
