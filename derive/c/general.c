@@ -1783,7 +1783,10 @@ static int dk_rr_fold_partners(int k, const double F[4][4], const double q[6],
 #define DK_RR_NEAR (1e-07)
 typedef struct {
     double rows[DK_RR_ROWS][6], near[DK_RR_ROWS][6];
-    int n, n_near, singular;
+    /* clear: the first split at the pose gave no real eigenvalue and none within
+       DK_RR_PAIR_DOUBT (a nominal table's seeds' window, if wider) of real (dk_general's
+       early answer) */
+    int n, n_near, singular, clear;
 } dk_rr_leads;
 
 /* split k's polished candidates for the target F (found from the pose `moved`) added to
@@ -1810,6 +1813,9 @@ static int dk_rr_split(int k, const double F[4][4], const double moved[4][4],
                values);
     n = dk_rr_candidates(values, moved, DK_RR_FILL[k], cands, extra, doubt, imag_tol, k, &reals,
                          &pair);
+    if (k == 0 && moved == F) { /* (the first split at the pose itself) */
+        leads->clear = n >= 0 && reals == 0 && pair > fmax(DK_RR_PAIR_DOUBT, sqrt(DK_SEED_TOL));
+    }
     if (n < 0) { /* (a singular pencil) */
         leads->singular |= !perturbed;
         n = 0;
@@ -2018,8 +2024,12 @@ static int dk_general(const double flanges[DK_RR_SPLIT_COUNT][12], double out[DK
 {
     double targets[DK_RR_SPLIT_COUNT][4][4], moved[4][4], seeds[DK_RR_ROWS][6];
     dk_rr_leads leads;
-    int count = 0, doubt = DK_RR_RESCUE, perturbed = 0, grew = 0, n_seeds = 0, k, r, c, m, i;
-    leads.n = leads.n_near = leads.singular = 0;
+    int count = 0, doubt = DK_RR_RESCUE, perturbed = 0, grew = 0, n_seeds = 0, tried = 0, k, r;
+    int c, m, i, regular = 1;
+    /* (an out-of-reach answer from the first split alone where its table is the arm's own,
+       exact: the Python solver's _general) */
+    const int alone = !dk_rr_perturbed(0) && !(DK_SEED_TOL > 0.0);
+    leads.n = leads.n_near = leads.singular = leads.clear = 0;
     for (k = 0; k < DK_RR_SPLIT_COUNT; k++) {
         for (r = 0; r < 4; r++) {
             for (c = 0; c < 4; c++) {
@@ -2034,13 +2044,23 @@ static int dk_general(const double flanges[DK_RR_SPLIT_COUNT][12], double out[DK
         const int before = count;
         count = dk_rr_split(k, (const double(*)[4])targets[k], (const double(*)[4])targets[k],
                             out, count, &doubt, DK_RR_IMAG_TOL, seeds, &n_seeds, &leads);
+        tried++;
         perturbed |= dk_rr_perturbed(k); /* (a perturbed table walked: the partners below) */
         grew |= k > 0 && count > before; /* (the fallback found what the first split missed) */
         if (count == DK_RR_ROWS) {
             return count;
         }
-        if (!doubt && count % 2 == 0) {
-            break;
+        if (!doubt && count % 2 == 0 && (count > 0 || !leads.clear || alone)) {
+            break; /* (nothing found and nothing nearly real: the fallback split too) */
+        }
+    }
+    if (count == 0 && (tried == DK_RR_SPLIT_COUNT || alone) && !doubt && leads.clear &&
+        leads.n == 0 && leads.n_near == 0 && n_seeds == 0) {
+        for (k = 0; k < tried && regular; k++) {
+            regular = dk_rr_perturbed(k) || !dk_rr_singular(k, (const double(*)[4])targets[k]);
+        }
+        if (regular) { /* a pose out of reach: the Python solver's _general says why */
+            return 0;
         }
     }
     for (r = 0; r < count && perturbed && !(doubt & DK_RR_RESCUE); r++) {

@@ -129,15 +129,43 @@ def _general(flanges, tol):
     doubt = _RESCUE
     walked = False  # whether a perturbed table's solutions were walked back to the arm's
     grew = False  # whether the fallback split found what the first missed
+    tried = 0  # (the splits the first round tried)
+    # (an out-of-reach answer from the first split alone: where its table is the arm's own,
+    # exact; a perturbed or nominal one's, the fallback split's too: below)
+    alone = _RR_SPLITS[0][1] == _RR_SPLITS[0][2] and not _SEED_TOL
     for k, F in enumerate(targets):
         candidates, close, doubt = _rr_split(k, F, F, leads, found)
+        tried += 1
         walked |= _RR_SPLITS[k][1] != _RR_SPLITS[k][2]
         before = len(found)
         _rr_merge(found, [_rr_to_arm(k, q) for q in candidates])
         grew |= k > 0 and len(found) > before
         _rr_merge(near, [_rr_to_arm(k, q) for q in close])
-        if not doubt and len(found) % 2 == 0:
-            break
+        if not doubt and len(found) % 2 == 0 and (found or not leads.clear or alone):
+            break  # (nothing found and nothing nearly real: the fallback split too, below)
+    if (
+        not found
+        and (tried == len(targets) or alone)
+        and not doubt
+        and leads.clear
+        and not (near or leads.rows or leads.seeds)
+        and not any(
+            _RR_SPLITS[k][1] == _RR_SPLITS[k][2] and _rr_singular(k, targets[k])
+            for k in range(tried)
+        )
+    ):
+        # a pose out of reach: the first split's pencil regular, with no real eigenvalue and
+        # none nearly real (no pair of the arm's solutions made complex by a perturbed
+        # table's difference, as _rr_settled), and the fallback split's candidates polished
+        # to nothing, not even a near miss: the rescue's moved poses, the last resort and the
+        # search find nothing there, and took 9 to 17 times an answered pose's time (a new
+        # user's seven-joint arms swept over q7, most of whose values leave the pose out of
+        # reach: 1.3 to 2.7 ms a pose in C, helper 56). On the arm's own exact table the
+        # first split's pencil says so alone (a solution would be a real eigenvalue of it);
+        # on a perturbed or nominal table the fallback's candidates must find nothing too
+        # (its near misses seeded the only rows of a snapped SO-101 task's pose whose first,
+        # nominal, split saw nothing).
+        return []
     if walked and doubt != _RESCUE and found and _rr_near_singular(found):
         doubt = _RESCUE  # (a perturbed table's continuation near where solutions meet)
     if doubt == _RESCUE or grew or not found or len(found) % 2:
@@ -260,6 +288,10 @@ class _RRLeads:
         self.singular = False
         self.rows: list[np.ndarray] = []
         self.seeds: list[np.ndarray] = []  # (a nominal table's near misses: _rr_fold_seeds)
+        # whether the first split at the pose gave no real eigenvalue and none within
+        # _RR_PAIR_DOUBT (a nominal table's seeds' window, if wider) of real (_general's early
+        # answer)
+        self.clear = False
 
 
 def _rr_partners(targets, rows):
@@ -388,6 +420,10 @@ def _rr_split(k, F, moved, leads, known=(), imag_tol=_RR_IMAG_TOL):
     candidates, doubt, extras, (reals, pair) = _rr_candidates(
         P0, Ps, Pc, Q, moved, fill_rows, slide, imag_tol, spurious
     )
+    if k == 0 and moved is F:  # (the first split at the pose itself: _general's early
+        # answer; on a nominal table a pair within its seeds' window is nearly real too)
+        window = max(_RR_PAIR_DOUBT, math.sqrt(_SEED_TOL))
+        leads.clear = candidates is not None and reals == 0 and pair > window
     # a perturbed table's solutions are walked back to the arm's in steps (a continuation),
     # so that Newton does not jump to another branch
     path = (
