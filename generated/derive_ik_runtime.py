@@ -38,7 +38,7 @@ if "_RUNTIME_VERSION" not in globals():  # (imported on its own, not run by a mo
         "namespace; it is not a module to import"
     )
 # this runtime's version: a module runs the runtime of its own version only
-_RUNTIME_VERSION = "e7955fff585186a0"
+_RUNTIME_VERSION = "7b6a59074bfe7805"
 
 if TYPE_CHECKING:  # defined by the module running this file
     from derive.runtime.arm import (
@@ -3704,6 +3704,17 @@ _RR_NEXT = np.array([1, 2, 0])
 _RR_LAST = np.array([2, 0, 1])
 
 
+# z @ _RR_CROSS, as 3 x 3, is z's cross-product matrix: (z x r)_i = sum_k [z]_ik r_k, [z]_ik
+# = sum_j eps_ijk z_j (the Levi-Civita symbol)
+_RR_CROSS = np.array(
+    [
+        [0.0, 0.0, 0.0, 0.0, 0.0, -1.0, 0.0, 1.0, 0.0],
+        [0.0, 0.0, 1.0, 0.0, 0.0, 0.0, -1.0, 0.0, 0.0],
+        [0.0, -1.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 0.0],
+    ]
+)
+
+
 def _rr_steps_many(
     rows, F, Q, slide, damped, reach=_RR_NEWTON_REACH, steps=_RR_NEWTON_STEPS, track=False
 ):
@@ -3779,8 +3790,10 @@ def _rr_columns(frames, slide):
     z = frames[:, :6, :3, 2]
     r = frames[:, 6, None, :3, 3] - frames[:, :6, :3, 3]
     columns = np.empty((len(frames), 6, 6))
-    columns[..., :3] = z[..., _RR_NEXT] * r[..., _RR_LAST]
-    columns[..., :3] -= z[..., _RR_LAST] * r[..., _RR_NEXT]
+    # z x r as (z's cross-product matrix) r: the matrix's entries from z by one product
+    # (_RR_CROSS), then one product with r (a call each, where the components' products
+    # took eight)
+    columns[..., :3] = ((z @ _RR_CROSS).reshape(len(frames), 6, 3, 3) @ r[..., None])[..., 0]
     columns[..., 3:] = z
     if slide[0]:  # a sliding joint 3 moves the flange along its axis
         columns[:, 2, :3] = z[:, 2]

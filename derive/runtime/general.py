@@ -1039,6 +1039,15 @@ _RR_EYE12 = np.eye(12)
 # a[LAST] b[NEXT])
 _RR_NEXT = np.array([1, 2, 0])
 _RR_LAST = np.array([2, 0, 1])
+# z @ _RR_CROSS, as 3 x 3, is z's cross-product matrix: (z x r)_i = sum_k [z]_ik r_k, [z]_ik
+# = sum_j eps_ijk z_j (the Levi-Civita symbol)
+_RR_CROSS = np.array(
+    [
+        [0.0, 0.0, 0.0, 0.0, 0.0, -1.0, 0.0, 1.0, 0.0],
+        [0.0, 0.0, 1.0, 0.0, 0.0, 0.0, -1.0, 0.0, 0.0],
+        [0.0, -1.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 0.0],
+    ]
+)
 
 
 def _rr_steps_many(
@@ -1116,8 +1125,10 @@ def _rr_columns(frames, slide):
     z = frames[:, :6, :3, 2]
     r = frames[:, 6, None, :3, 3] - frames[:, :6, :3, 3]
     columns = np.empty((len(frames), 6, 6))
-    columns[..., :3] = z[..., _RR_NEXT] * r[..., _RR_LAST]
-    columns[..., :3] -= z[..., _RR_LAST] * r[..., _RR_NEXT]
+    # z x r as (z's cross-product matrix) r: the matrix's entries from z by one product
+    # (_RR_CROSS), then one product with r (a call each, where the components' products
+    # took eight)
+    columns[..., :3] = ((z @ _RR_CROSS).reshape(len(frames), 6, 3, 3) @ r[..., None])[..., 0]
     columns[..., 3:] = z
     if slide[0]:  # a sliding joint 3 moves the flange along its axis
         columns[:, 2, :3] = z[:, 2]
