@@ -136,10 +136,17 @@ def build_plan(spec: ArmSpec, method: str | None = None) -> Plan:
         shown = task if ik is None else dataclasses.replace(task, axis=ik.tool_axis)
         why = task.why
         if ik is not None and ik.tool_axis != 2 and not task.fixed:
-            why += (
-                f" (the first that works of the tool z, x, y axes, those parallel to joint "
-                f"{chain.dof}'s axis but beside it last: {shown.axis_name})"
+            # (the closed forms try every axis before the general method does: a new user's
+            # Shadow thumb got its tool y axis by a closed form though the general method
+            # solves z, which "the first that works" did not say)
+            order = (
+                f"tool z, x, y axes, those parallel to joint {chain.dof}'s axis but beside it last"
             )
+            if ik.method == general.NAME:
+                why += f" (of the {order}, no closed form solves one; the general method's first:"
+            else:
+                why += f" (the first of the {order}, that a closed form solves:"
+            why += f" {shown.axis_name})"
         facts = (*facts, f"task: {shown.describe()}: {why}")
     pose = world_transform(chain, expand=False)
     # (the pose's factors, and where its joints' are: the Jacobian's, derive/jacobian.py)

@@ -19,8 +19,8 @@ Arm: open_manipulator_x, standard DH, lengths in m, angles of the table in degre
 
 Structure: axes 2, 3, 4 parallel; task: position + angle of the tool x axis to the base z axis
 (TranslationZAxisAngle4D): four revolute joints: position + the angle of a tool axis to the base
-z axis (the first that works of the tool z, x, y axes, those parallel to joint 4's axis but
-beside it last: x).
+z axis (the first of the tool z, x, y axes, those parallel to joint 4's axis but beside it last,
+that a closed form solves: x).
 Inverse kinematics: cone method, case position + angle of the tool x axis to the base z axis
 (TranslationZAxisAngle4D): theta1 from the lateral offset, phi from the tilt, then the planar 2R
 and the heading.

@@ -19,8 +19,9 @@ Arm: youbot, standard DH, lengths in m, angles of the table in degrees.
     5  R     0              0      0.2175  q5 + 0
 
 Structure: axes 2, 3, 4 parallel; task: position + direction of the tool x axis
-(TranslationDirection5D): five joints: position + direction of a tool axis (the first that works
-of the tool z, x, y axes, those parallel to joint 5's axis but beside it last: x).
+(TranslationDirection5D): five joints: position + direction of a tool axis (the first of the
+tool z, x, y axes, those parallel to joint 5's axis but beside it last, that a closed form
+solves: x).
 Inverse kinematics: three-parallel method, case position + direction of the tool x axis
 (TranslationDirection5D) as the pose of the arm with a virtual joint 6: a5 = 0: theta1 from one
 a cos + b sin = c equation.
