@@ -38,7 +38,7 @@ if "_RUNTIME_VERSION" not in globals():  # (imported on its own, not run by a mo
         "namespace; it is not a module to import"
     )
 # this runtime's version: a module runs the runtime of its own version only
-_RUNTIME_VERSION = "7b6a59074bfe7805"
+_RUNTIME_VERSION = "78cde5e996bc7a84"
 
 if TYPE_CHECKING:  # defined by the module running this file
     from derive.runtime.arm import (
@@ -3205,13 +3205,12 @@ def _rr_unsettled_copy(arm, rows):
 
 def _rr_gaps(q, rows):
     """The largest joint gap of q from each of rows (the arm's values; angles modulo 2 pi)."""
-    if not len(rows):
-        return np.zeros(0)
-    return np.abs((np.array(rows) - q + math.pi) % _TWO_PI - math.pi).max(axis=1)
+    return _rr_gap_table([q], rows)[0]
 
 
 def _rr_gap_table(qs, rows):
-    """_rr_gaps of each of qs from rows at once: shape (len(qs), len(rows))."""
+    """The largest joint gap of each of qs from each of rows at once (the arm's values;
+    angles modulo 2 pi): shape (len(qs), len(rows))."""
     if not len(qs) or not len(rows):
         return np.zeros((len(qs), len(rows)))
     # (each value reduced modulo 2 pi first, then each difference: the gap is the shorter

@@ -550,13 +550,12 @@ def _rr_unsettled_copy(arm, rows):
 
 def _rr_gaps(q, rows):
     """The largest joint gap of q from each of rows (the arm's values; angles modulo 2 pi)."""
-    if not len(rows):
-        return np.zeros(0)
-    return np.abs((np.array(rows) - q + math.pi) % _TWO_PI - math.pi).max(axis=1)
+    return _rr_gap_table([q], rows)[0]
 
 
 def _rr_gap_table(qs, rows):
-    """_rr_gaps of each of qs from rows at once: shape (len(qs), len(rows))."""
+    """The largest joint gap of each of qs from each of rows at once (the arm's values;
+    angles modulo 2 pi): shape (len(qs), len(rows))."""
     if not len(qs) or not len(rows):
         return np.zeros((len(qs), len(rows)))
     # (each value reduced modulo 2 pi first, then each difference: the gap is the shorter
