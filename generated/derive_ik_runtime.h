@@ -9,7 +9,7 @@
    is solved by it): one copy serves every arm of a folder, and each arm's file gets its own
    static copy of the routines, so arms link together in one program. Compile <name>_ik.c
    with it beside the file; do not include it anywhere else. */
-#define DK_RUNTIME 0xcbe2446fd347
+#define DK_RUNTIME 0x788403b51690
 
 #include <math.h>
 #include <stddef.h>
@@ -62,9 +62,40 @@
                         1.0 - DK_FOLD_WIDTH * DK_SEED_TOL : DK_FOLD_NEAR)
 #define DK_FOLD_SEED_COUNT 1
 static const double DK_FOLD_SEEDS[DK_FOLD_SEED_COUNT] = {0.03};
-/* how far beyond 1 a nominal table's acos argument still seeds the refinement (0: exact arms;
-   derive/runtime/constants.py, _SEED_BAND, says why) */
-#define DK_SEED_MISS (DK_SEED_TOL > 0.0 ? fmax(DK_SEED_TOL, DK_SEED_BAND) : 0.0)
+/* how far beyond 1 a nominal table's acos argument still seeds the refinement: DK_SEED_TOL,
+   or the uncertainty DK_SEED_TOL / up the steps before it leave (up: the least of their
+   conditions, dk_cs1_sig and dk_cs2_sig), at most DK_SEED_BAND; 0 on an exact table
+   (derive/runtime/constants.py, _SEED_BAND, says why; the Python _seed_miss) */
+static double dk_seed_miss(double up)
+{
+    if (!(DK_SEED_TOL > 0.0)) {
+        return 0.0;
+    }
+    if (up * DK_SEED_BAND <= DK_SEED_TOL) {
+        return DK_SEED_BAND;
+    }
+    return fmax(DK_SEED_TOL, DK_SEED_TOL / up);
+}
+
+/* the condition of a cos t + b sin t = e, for a later step's dk_seed_miss: sqrt(a^2 + b^2 -
+   e^2) over the equation's scale (0 at a fold or beyond; infinite without a scale) */
+static double dk_cs1_sig(double a, double b, double e, double scale)
+{
+    if (scale <= 0.0) {
+        return HUGE_VAL;
+    }
+    return sqrt(fmax(a * a + b * b - e * e, 0.0) / scale);
+}
+
+/* the condition of a two-equation step (dk_cs2), for a later step's dk_seed_miss:
+   sqrt(|det| / det_scale), as dk_wrist_spread's (infinite without a scale) */
+static double dk_cs2_sig(double a1, double b1, double a2, double b2, double det_scale)
+{
+    if (det_scale <= 0.0) {
+        return HUGE_VAL;
+    }
+    return sqrt(fabs(a1 * b2 - a2 * b1) / det_scale);
+}
 
 /* the values a free joint tries, as offsets from its first value: 0, +5, -5, +10, ... deg */
 #define DK_FREE_COUNT 72
@@ -1364,12 +1395,13 @@ static void dk_all_round(dk_values *v, double first, int count)
     }
 }
 
-/* angles t with a cos t + b sin t = e (the half-angle method's two values); free when the
+/* angles t with a cos t + b sin t = e (the half-angle method's two values; on a nominal
+   table seeds at the boundary where e misses by dk_seed_miss(up)); free when the
    equation vanishes identically; where rest >= 0 (a^2 + b^2 - e^2 as a sum of squares, exact
    to roundings: a spherical wrist's W13^2 + W23^2), the half-width's sine is sqrt(rest) / rho,
    not sqrt(1 - ratio^2), which loses half the digits at the fold (the Python _cs1x) */
 static int dk_cs1x(dk_values *v, double a, double b, double e, double rest, double scale,
-                   double ref)
+                   double ref, double up)
 {
     double rho = sqrt(a * a + b * b), inverse, ratio, sd, cb, sb;
     /* free below DK_FREE_TOL_EXACT on an exact table, or where nearly so and unsolvable
@@ -1405,7 +1437,7 @@ static int dk_cs1x(dk_values *v, double a, double b, double e, double rest, doub
     }
     inverse = 1.0 / rho;
     ratio = e * inverse;
-    if (fabs(ratio) > 1.0 + DK_CLAMP_TOL + DK_SEED_MISS &&
+    if (fabs(ratio) > 1.0 + DK_CLAMP_TOL + dk_seed_miss(up) &&
         fabs(e) - rho > fmax(DK_SEED_TOL, DK_CLAMP_ABS) * sqrt(scale) && !loose) {
         /* (the Python _cs1 says why) */
         return 0;
@@ -1445,9 +1477,10 @@ static int dk_cs1x(dk_values *v, double a, double b, double e, double rest, doub
 }
 
 /* dk_cs1x without a sum of squares for a^2 + b^2 - e^2 */
-static int dk_cs1(dk_values *v, double a, double b, double e, double scale, double ref)
+static int dk_cs1(dk_values *v, double a, double b, double e, double scale, double ref,
+                  double up)
 {
-    return dk_cs1x(v, a, b, e, -1.0, scale, ref);
+    return dk_cs1x(v, a, b, e, -1.0, scale, ref, up);
 }
 
 /* the first value of a free t, in 5 degree steps out from ref, at which some t' keeps
@@ -1489,12 +1522,12 @@ static double dk_reach_first2(double A, double B, double C, double lo, double hi
 
 static int dk_cs1r(dk_values *v, double a, double b, double e, double m00, double m01,
                    double m02, double m10, double m11, double m12, double m20, double m21,
-                   double m22, double lo, double hi, double scale, double ref)
+                   double m22, double lo, double hi, double scale, double ref, double up)
 {
     double rho = sqrt(a * a + b * b);
     const double free = DK_SEED_TOL > 0.0 ? DK_FREE_TOL : DK_FREE_TOL_EXACT;
     if (rho * rho > free * scale || e * e > DK_FREE_TOL * scale) {
-        return dk_cs1(v, a, b, e, scale, ref);
+        return dk_cs1(v, a, b, e, scale, ref, up);
     } else {
         const double m[9] = {m00, m01, m02, m10, m11, m12, m20, m21, m22};
         dk_set_free(v, dk_reach_first1(m, lo, hi, ref), 1);

@@ -34,7 +34,7 @@
 /* --- the routines every generated C solver shares: derive_ik_runtime.h beside this file ---- */
 
 #include "derive_ik_runtime.h"
-#if DK_RUNTIME != 0xcbe2446fd347
+#if DK_RUNTIME != 0x788403b51690
 #error "derive_ik_runtime.h is another derive-ik's: generate the arms of a folder with one"
 #endif
 
@@ -165,7 +165,7 @@ static int dk_solve(const double t[12], double tol, const double ref[DK_DOF],
     /* theta2: law of cosines, x^2 + y^2 = 4*c2/5 + 29/25 (elbow up / down) */
     dk_values dk_v2;
     dk_v2.loose = loose;
-    if (dk_cs1(&dk_v2, 0.8, 0.0, (px*px) + (py*py) - 1.16, 0.0, 0.0) < 0) {
+    if (dk_cs1(&dk_v2, 0.8, 0.0, (px*px) + (py*py) - 1.16, 0.0, 0.0, HUGE_VAL) < 0) {
         return DK_UNSETTLED;
     }
     const int dk_m2 = n;

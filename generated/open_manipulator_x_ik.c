@@ -34,7 +34,7 @@
 /* --- the routines every generated C solver shares: derive_ik_runtime.h beside this file ---- */
 
 #include "derive_ik_runtime.h"
-#if DK_RUNTIME != 0xcbe2446fd347
+#if DK_RUNTIME != 0x788403b51690
 #error "derive_ik_runtime.h is another derive-ik's: generate the arms of a folder with one"
 #endif
 
@@ -186,7 +186,7 @@ static int dk_solve(const double t[12], double tol, const double ref[DK_DOF],
             turn about parallel axes) */
     dk_values dk_v1;
     dk_v1.loose = loose;
-    if (dk_cs1(&dk_v1, py, -px, 0.0, 0.32005156436099996, qr1) < 0) {
+    if (dk_cs1(&dk_v1, py, -px, 0.0, 0.32005156436099996, qr1, HUGE_VAL) < 0) {
         return DK_UNSETTLED;
     }
     const int dk_m1 = n;
@@ -202,7 +202,7 @@ static int dk_solve(const double t[12], double tol, const double ref[DK_DOF],
                 about z) */
         dk_values dk_v5;
         dk_v5.loose = loose;
-        if (dk_cs1(&dk_v5, 0.0, -1.0, w31, 1.0, 0.0) < 0) {
+        if (dk_cs1(&dk_v5, 0.0, -1.0, w31, 1.0, 0.0, HUGE_VAL) < 0) {
             return DK_UNSETTLED;
         }
         const int dk_m5 = n;
@@ -217,7 +217,8 @@ static int dk_solve(const double t[12], double tol, const double ref[DK_DOF],
                     (elbow up / down) */
             dk_values dk_v3;
             dk_v3.loose = loose;
-            if (dk_cs1(&dk_v3, 0.032297288, 0.0, (x*x) + (y*y) - 0.032336113361, 0.0, 0.0) < 0) {
+            if (dk_cs1(&dk_v3, 0.032297288, 0.0, (x*x) + (y*y) - 0.032336113361, 0.0, 0.0, HUGE_VAL)
+                    < 0) {
                 return DK_UNSETTLED;
             }
             const int dk_m3 = n;

@@ -34,7 +34,7 @@
 /* --- the routines every generated C solver shares: derive_ik_runtime.h beside this file ---- */
 
 #include "derive_ik_runtime.h"
-#if DK_RUNTIME != 0xcbe2446fd347
+#if DK_RUNTIME != 0x788403b51690
 #error "derive_ik_runtime.h is another derive-ik's: generate the arms of a folder with one"
 #endif
 
@@ -290,7 +290,7 @@ static int dk_solve(const double t[12], double tol, const double ref[DK_DOF],
                 identically */
         dk_values dk_v2;
         dk_v2.loose = loose;
-        if (dk_cs1(&dk_v2, 0.0, 0.0825*c3 - 0.316*s3 - 0.0825, z, 1.653796, -qr5) < 0) {
+        if (dk_cs1(&dk_v2, 0.0, 0.0825*c3 - 0.316*s3 - 0.0825, z, 1.653796, -qr5, HUGE_VAL) < 0) {
             return DK_UNSETTLED;
         }
         const int dk_m2 = n;
@@ -336,7 +336,7 @@ static int dk_solve(const double t[12], double tol, const double ref[DK_DOF],
                         atan2(sqrt(W13^2 + W23^2), W33) (the Z-Y-Z Euler angle's) */
                 dk_values dk_v5;
                 dk_v5.loose = loose;
-                if (dk_cs1x(&dk_v5, 1.0, 0.0, W33, (W13*W13) + (W23*W23), 0.0, 0.0) < 0) {
+                if (dk_cs1x(&dk_v5, 1.0, 0.0, W33, (W13*W13) + (W23*W23), 0.0, 0.0, HUGE_VAL) < 0) {
                     return DK_UNSETTLED;
                 }
                 /* the wrist flip: theta4, theta6 of the second value */

@@ -34,7 +34,7 @@
 /* --- the routines every generated C solver shares: derive_ik_runtime.h beside this file ---- */
 
 #include "derive_ik_runtime.h"
-#if DK_RUNTIME != 0xcbe2446fd347
+#if DK_RUNTIME != 0x788403b51690
 #error "derive_ik_runtime.h is another derive-ik's: generate the arms of a folder with one"
 #endif
 
@@ -239,7 +239,8 @@ static int dk_solve(const double t[12], double tol, const double ref[DK_DOF],
                 identically */
         dk_values dk_v2;
         dk_v2.loose = loose;
-        if (dk_cs1(&dk_v2, 0.433*c3 + 0.02*s3, 0.02*c3 - 0.433*s3 - 0.432, z, 1.069156, qr2) < 0) {
+        if (dk_cs1(&dk_v2, 0.433*c3 + 0.02*s3, 0.02*c3 - 0.433*s3 - 0.432, z, 1.069156, qr2,
+                HUGE_VAL) < 0) {
             return DK_UNSETTLED;
         }
         const int dk_m2 = n;
@@ -308,7 +309,7 @@ static int dk_solve(const double t[12], double tol, const double ref[DK_DOF],
                         atan2(sqrt(W13^2 + W23^2), W33) (the Z-Y-Z Euler angle's) */
                 dk_values dk_v5;
                 dk_v5.loose = loose;
-                if (dk_cs1x(&dk_v5, 1.0, 0.0, W33, (W13*W13) + (W23*W23), 0.0, 0.0) < 0) {
+                if (dk_cs1x(&dk_v5, 1.0, 0.0, W33, (W13*W13) + (W23*W23), 0.0, 0.0, HUGE_VAL) < 0) {
                     return DK_UNSETTLED;
                 }
                 /* the wrist flip: theta4, theta6 of the second value */

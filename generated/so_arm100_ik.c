@@ -34,7 +34,7 @@
 /* --- the routines every generated C solver shares: derive_ik_runtime.h beside this file ---- */
 
 #include "derive_ik_runtime.h"
-#if DK_RUNTIME != 0xcbe2446fd347
+#if DK_RUNTIME != 0x788403b51690
 #error "derive_ik_runtime.h is another derive-ik's: generate the arms of a folder with one"
 #endif
 
@@ -219,7 +219,7 @@ static int dk_solve(const double t[12], double tol, const double ref[DK_DOF],
     /* theta1: translation entry (3,4) of the invariant equation, a c1 + b s1 = c */
     dk_values dk_v1;
     dk_v1.loose = loose;
-    if (dk_cs1(&dk_v1, py, -px, 0.0, 0.11675903098938938, qr1) < 0) {
+    if (dk_cs1(&dk_v1, py, -px, 0.0, 0.11675903098938938, qr1, HUGE_VAL) < 0) {
         return DK_UNSETTLED;
     }
     const int dk_m1 = n;
@@ -233,7 +233,7 @@ static int dk_solve(const double t[12], double tol, const double ref[DK_DOF],
         dk_values dk_v5;
         dk_v5.loose = loose;
         if (dk_cs1x(&dk_v5, 1.0, 0.0, -c1*r23 + r13*s1, ((c1*r21 - r11*s1)*(c1*r21 - r11*s1)) +
-                ((c1*r22 - r12*s1)*(c1*r22 - r12*s1)), 0.0, 0.0) < 0) {
+                ((c1*r22 - r12*s1)*(c1*r22 - r12*s1)), 0.0, 0.0, HUGE_VAL) < 0) {
             return DK_UNSETTLED;
         }
         const int dk_m5 = n;
@@ -299,7 +299,7 @@ static int dk_solve(const double t[12], double tol, const double ref[DK_DOF],
                 dk_values dk_v3;
                 dk_v3.loose = loose;
                 if (dk_cs1(&dk_v3, 0.03132004866552704, 0.0, (G14*G14) + (G24*G24) -
-                        0.03168105490000001, 0.0, 0.0) < 0) {
+                        0.03168105490000001, 0.0, 0.0, HUGE_VAL) < 0) {
                     return DK_UNSETTLED;
                 }
                 const int dk_m3 = n;

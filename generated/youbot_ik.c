@@ -34,7 +34,7 @@
 /* --- the routines every generated C solver shares: derive_ik_runtime.h beside this file ---- */
 
 #include "derive_ik_runtime.h"
-#if DK_RUNTIME != 0xcbe2446fd347
+#if DK_RUNTIME != 0x788403b51690
 #error "derive_ik_runtime.h is another derive-ik's: generate the arms of a folder with one"
 #endif
 
@@ -211,7 +211,7 @@ static int dk_solve(const double t[12], double tol, const double ref[DK_DOF],
     /* theta1: translation entry (3,4) of the invariant equation, a c1 + b s1 = c */
     dk_values dk_v1;
     dk_v1.loose = loose;
-    if (dk_cs1(&dk_v1, -py, px, 0.0, 0.47265625, qr1) < 0) {
+    if (dk_cs1(&dk_v1, -py, px, 0.0, 0.47265625, qr1, HUGE_VAL) < 0) {
         return DK_UNSETTLED;
     }
     const int dk_m1 = n;
@@ -223,7 +223,7 @@ static int dk_solve(const double t[12], double tol, const double ref[DK_DOF],
         dk_values dk_v5;
         dk_v5.loose = loose;
         if (dk_cs1x(&dk_v5, 1.0, 0.0, c1*r23 - r13*s1, ((-c1*r21 + r11*s1)*(-c1*r21 + r11*s1)) +
-                ((-c1*r22 + r12*s1)*(-c1*r22 + r12*s1)), 0.0, 0.0) < 0) {
+                ((-c1*r22 + r12*s1)*(-c1*r22 + r12*s1)), 0.0, 0.0, HUGE_VAL) < 0) {
             return DK_UNSETTLED;
         }
         const int dk_m5 = n;
@@ -283,7 +283,8 @@ static int dk_solve(const double t[12], double tol, const double ref[DK_DOF],
                 /* theta3: law of cosines, x^2 + y^2 = 837*c3/20000 + 169/4000 (elbow up / down) */
                 dk_values dk_v3;
                 dk_v3.loose = loose;
-                if (dk_cs1(&dk_v3, 0.04185, 0.0, (G14*G14) + (G24*G24) - 0.04225, 0.0, 0.0) < 0) {
+                if (dk_cs1(&dk_v3, 0.04185, 0.0, (G14*G14) + (G24*G24) - 0.04225, 0.0, 0.0,
+                        HUGE_VAL) < 0) {
                     return DK_UNSETTLED;
                 }
                 const int dk_m3 = n;

@@ -897,6 +897,54 @@ def test_a_wrist_system_with_no_scale_is_solved_not_divided_by_zero(tmp_path):
 
 
 @needs_cc
+def test_an_acos_step_seeds_beyond_its_boundary_as_far_as_the_steps_before_it_leave_unsure(
+    tmp_path,
+):
+    """A nominal table's acos argument seeds the refinement at its boundary up to
+    _seed_miss(up) beyond 1: _SEED_TOL where the angles solved before it are well conditioned
+    (up, their least condition, large), up to _SEED_BAND where one is nearly singular (a
+    virtual wrist 0.2 deg from straight put the SO-ARM100 MJCF's law of cosines 2.1% beyond 1
+    at a pose it reaches). _SEED_BAND everywhere seeded branches the arm does not reach, whose
+    seeds never converge (ManiSkill's SO100 URDF: 12% of its C time at regular poses). On 300
+    uniform poses the rows are the same either way, in both backends; the seeds that give no
+    row are far fewer."""
+    from derive import urdf
+
+    path = Path(__file__).parent / "data" / "urdf" / "so100_maniskill.urdf"
+    spec = urdf.load_urdf(path, urdf.Options(base="Base", tip="Fixed_Jaw_tip"))
+    module = spec_module(spec, tmp_path)
+    tol, band = module._SEED_TOL, module._SEED_BAND
+    assert 0.0 < tol < band
+    assert module._seed_miss(math.inf) == module._seed_miss(1.0) == tol
+    assert module._seed_miss(0.0) == module._seed_miss(tol / band) == band
+    assert module._seed_miss(0.1) == pytest.approx(tol / 0.1)
+    rng = np.random.default_rng(5)
+    Q = rng.uniform(-math.pi, math.pi, (300, 5))
+    poses = module.fk_batch(Q)
+    seeded = module._seed
+    kept: list[bool] = []
+
+    def counted(found, t, q, tol, frees=()):
+        before = len(found)
+        seeded(found, t, q, tol, frees)
+        kept.append(len(found) > before)
+
+    module._seed = counted
+    rows, wasted = {}, {}
+    for rule, miss in (("band", lambda up: max(tol, band)), ("up", module._seed_miss)):
+        module._seed_miss = miss
+        kept.clear()
+        rows[rule] = [module.ik(T, backend="python") for T in poses]
+        wasted[rule] = kept.count(False)
+    assert wasted["band"] >= 20 and wasted["up"] <= wasted["band"] // 3, wasted
+    for q, T, one, other in zip(Q, poses, rows["band"], rows["up"]):
+        assert one.shape == other.shape and np.abs(one - other).max() <= 1e-12, q
+        assert len(module.ik(T, backend="c")) == len(other), q
+        gaps = np.abs(np.remainder(other - q + math.pi, 2 * math.pi) - math.pi)
+        assert np.min(np.max(gaps, axis=1)) <= 1e-7, q
+
+
+@needs_cc
 def test_an_exact_table_s_straight_wrist_is_answered_by_its_second_pass(tmp_path):
     """The same SO100 URDF converted exactly (--exact: its 1.5708 kept, axes 2-4 parallel
     exactly) with its wrist straight (q5 = 0: the task's Jacobian singular to 7e-7). theta1

@@ -40,11 +40,13 @@ from derive.printers.common import (
     SPREAD_STEPS,
     CodePrinter,
     Line,
+    condition_call,
     cs_arguments,
     held_joints,
     live_steps,
     read_pairs,
     same_joints,
+    seed_conditions,
     used_joints,
     world_names,
 )
@@ -132,8 +134,10 @@ def _poly(step: Solve, values: list[str], ref: str) -> Call:
 
 
 def _cs1(step: Solve, values: list[str], ref: str) -> Call:
+    """(up, the least condition of the steps before it, HUGE_VAL: solve_lines prints the
+    steps' own where a nominal table has them, seed_conditions)"""
     routine = {Cs1Reach: "dk_cs1r", Cs1Unit: "dk_cs1x"}.get(type(step), "dk_cs1")
-    return Call(routine, (*values, repr(step.scale), ref))
+    return Call(routine, (*values, repr(step.scale), ref, "HUGE_VAL"))
 
 
 def _cs2(step: Solve, values: list[str], ref: str) -> Call:
@@ -298,6 +302,9 @@ def solve_lines(plan: Plan) -> tuple[tuple[int, str], ...]:
     turned: dict[str, tuple[str, str]] = {}  # an angle's variable: its cos and sin
     seamed = seamed_outputs(plan) if not fix else frozenset()
     hoisted = HoistedFK.of(plan) if same_joints(plan) and not fix else None
+    # (a nominal acos step's miss: dk_seed_miss of the least condition of the steps before it)
+    ups = seed_conditions(plan)
+    conditioned = {k for joints in ups.values() for k in joints}
     for live in steps:
         step = live.step
         if isinstance(step, Assign):
@@ -320,8 +327,16 @@ def solve_lines(plan: Plan) -> tuple[tuple[int, str], ...]:
         lines, values = _cse_lines((), tuple(step.args), names, printer, depth, scope, None)
         body += lines
         call = CALLS[type(step)](step, values, printer.doprint(step.ref))
+        if j in ups:  # (its miss on a nominal table: dk_seed_miss)
+            up = f"dk_u{ups[j][0]}"
+            for k in ups[j][1:]:
+                up = f"fmin({up}, dk_u{k})"
+            call = Call(call.routine, (*call.args[:-1], up), call.before)
         if call.before:
             body.append(Line(depth, call.before))
+        if j in conditioned:
+            condition = condition_call(step, values, "dk_")
+            body.append(Line(depth, f"const double dk_u{j} = {condition};"))
         body.append(Line(depth, f"dk_values dk_v{j};"))
         body.append(Line(depth, f"dk_v{j}.loose = loose;"))  # (derive/c/runtime.c dk_values)
         if fix and isinstance(step, SPREAD_STEPS):  # (a rough value's spread: dk_wrist_spread)

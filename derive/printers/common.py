@@ -15,7 +15,7 @@ import sympy as sp
 from sympy.printing.str import StrPrinter
 
 from derive import symbols as sym
-from derive.plan import Assign, Cs2, Cs2Reach, Plan, Solve, Step
+from derive.plan import Assign, Cs1, Cs1Reach, Cs2, Cs2Reach, Plan, Solve, Step
 
 
 class UnprintableError(Exception):
@@ -26,6 +26,39 @@ class UnprintableError(Exception):
 # the steps whose value a nominal table fixes only roughly where the wrist is nearly straight:
 # their loops try the values around it where it gives no row (runtime _wrist_spread)
 SPREAD_STEPS = (Cs2, Cs2Reach)
+
+# the steps solving a cos t + b sin t = e (Cs1Unit is a Cs1): on a nominal table their
+# acos argument seeds the refinement up to _seed_miss(up) beyond 1, up the least condition of
+# the one- and two-equation steps before them (runtime _cs1_sig, _cs2_sig)
+CS1_STEPS = (Cs1, Cs1Reach)
+CONDITIONED_STEPS = (Cs1, Cs1Reach, Cs2, Cs2Reach)
+
+
+def seed_conditions(plan: Plan) -> dict[int, tuple[int, ...]]:
+    """On a nominal table (plan.correction): each acos step's joint with the joints of the
+    one- and two-equation steps before it (CONDITIONED_STEPS; the loops nest, so all of them
+    enclose it), where there are any; empty on an exact table."""
+    assert plan.ik is not None
+    if plan.correction is None:
+        return {}
+    before: list[int] = []
+    out = {}
+    for step in plan.ik.steps:
+        if isinstance(step, CS1_STEPS) and before:
+            out[step.joint] = tuple(before)
+        if isinstance(step, CONDITIONED_STEPS):
+            before.append(step.joint)
+    return out
+
+
+def condition_call(step: Solve, values: list[str], prefix: str) -> str:
+    """The call giving a one- or two-equation step's condition from its printed arguments
+    (prefix "_": the Python runtime's, "dk_": the C one's)."""
+    if isinstance(step, CS1_STEPS):  # (a, b, e, ...; the step's scale)
+        return f"{prefix}cs1_sig({values[0]}, {values[1]}, {values[2]}, {step.scale!r})"
+    # (a1, b1, e1, a2, b2, e2, det_scale, ...)
+    return f"{prefix}cs2_sig({values[0]}, {values[1]}, {values[3]}, {values[4]}, {values[6]})"
+
 
 # SymPy function -> the name the generated code calls it by: from `math` in scalar code,
 # `np.` in vectorised code (the module imports exactly these)

@@ -31,10 +31,12 @@ from derive.printers.common import (
     CodePrinter,
     Line,
     assign_lines,
+    condition_call,
     cs_arguments,
     held_joints,
     live_steps,
     same_joints,
+    seed_conditions,
     step_arguments,
 )
 
@@ -71,6 +73,9 @@ def ik_lines(plan: Plan) -> tuple[tuple[int, str], ...]:
     depth = 0
     loops = []
     steps, inputs = live_steps(plan)
+    # (a nominal acos step's miss: _seed_miss of the least condition of the steps before it)
+    ups = seed_conditions(plan)
+    conditioned = {j for joints in ups.values() for j in joints}
     world = ", ".join(name if name in inputs else "_" for name in WORLD)
     lines.append(Line(0, f"({world}) = target"))
     lines.append(Line(0, "found = []"))
@@ -80,7 +85,12 @@ def ik_lines(plan: Plan) -> tuple[tuple[int, str], ...]:
             lines.append(Line(depth, f"# {step.note}"))
             lines += assign_lines(step.targets, step.exprs, names, printer, depth, live.after)
             continue
-        lines += solve_lines(step, live.after, names, printer, depth)
+        up = None
+        if not isinstance(step, Eigen) and step.joint in ups:
+            up = ", ".join(f"_u{j}" for j in ups[step.joint])
+            up = f"min({up})" if len(ups[step.joint]) > 1 else up
+        condition = not isinstance(step, Eigen) and step.joint in conditioned
+        lines += solve_lines(step, live.after, names, printer, depth, up, condition)
         if not isinstance(step, Eigen):  # it gives every joint: no free joint to step
             loops.append((depth, step.joint))
         depth += 1
@@ -120,9 +130,13 @@ def solve_lines(
     names: sp.utilities.iterables.numbered_symbols,
     printer: CodePrinter,
     depth: int,
+    up: str | None = None,
+    condition: bool = False,
 ) -> list[Line]:
     """The loop header of one Solve step, with its arguments CSE'd before it, and the cos
-    and sin of an angle where later steps read them."""
+    and sin of an angle where later steps read them; up: the least condition of the steps
+    before an acos step (printed), and condition: whether a later one reads this step's
+    (_u<joint>)."""
     lines, values = step_arguments(step, names, printer, depth)
     if isinstance(step, Eigen):
         # the splits' flange targets, 12 entries each
@@ -137,7 +151,11 @@ def solve_lines(
     call = SOLVES[type(step)](
         step, ", ".join(values), printer.doprint(step.ref), repr(1e-10 * step.scale)
     )
+    if up is not None:  # (its miss on a nominal table: _seed_miss)
+        call = f"{call[:-1]}, up={up})"
     j = step.joint
+    if condition:
+        lines.append(Line(depth, f"_u{j} = {condition_call(step, values, '_')}"))
     lines.append(Line(depth, f"_n{j} = len(found)"))
     lines.append(Line(depth, f"for {step.variable} in (_v{j} := {call}):"))
     for name, function in ((f"c{j}", "cos"), (f"s{j}", "sin")):

@@ -88,8 +88,36 @@ class _Spread(list):
         self.more = ()
 
 
-# how far beyond 1 a nominal table's acos argument still seeds the refinement (0: exact arms)
-_SEED_MISS = max(_SEED_TOL, _SEED_BAND) if _SEED_TOL > 0.0 else 0.0
+def _seed_miss(up: float) -> float:
+    """How far beyond 1 a nominal table's acos argument still seeds the refinement onto the
+    exact arm: _SEED_TOL, or the uncertainty _SEED_TOL / up that the steps before it leave
+    (up: the least of their conditions, _cs1_sig and _cs2_sig: an angle solved near a
+    singular configuration carries the table's difference amplified), at most _SEED_BAND;
+    0 on an exact table."""
+    if not _SEED_TOL:
+        return 0.0
+    if up * _SEED_BAND <= _SEED_TOL:
+        return _SEED_BAND
+    return max(_SEED_TOL, _SEED_TOL / up)
+
+
+def _cs1_sig(a: float, b: float, e: float, scale: float) -> float:
+    """The condition of a cos t + b sin t = e (printed for a later step's _seed_miss):
+    sqrt(a^2 + b^2 - e^2) over the equation's scale, the table's difference over it being the
+    uncertainty of its angles (0 at a fold or beyond; infinite without a scale)."""
+    if scale <= 0.0:
+        return math.inf
+    return sqrt(max(a * a + b * b - e * e, 0.0) / scale)
+
+
+def _cs2_sig(a1: float, b1: float, a2: float, b2: float, det_scale: float) -> float:
+    """The condition of a two-equation step (_cs2; printed for a later step's _seed_miss):
+    sqrt(|det| / det_scale), as _wrist_spread's (infinite without a scale)."""
+    if det_scale <= 0.0:
+        return math.inf
+    return sqrt(abs(a1 * b2 - a2 * b1) / det_scale)
+
+
 # beyond this acos argument a nominal table's values are near their fold (constants.py)
 _FOLD_AT = min(_FOLD_NEAR, 1.0 - _FOLD_WIDTH * _SEED_TOL)
 
@@ -124,26 +152,35 @@ def _free(t: float) -> _Free:
     return _Free([t + step for step in _FREE_STEPS])
 
 
-def _cs1x(a: float, b: float, e: float, rest: float, scale: float, ref: float) -> tuple[float, ...]:
+def _cs1x(
+    a: float, b: float, e: float, rest: float, scale: float, ref: float, up: float = math.inf
+) -> tuple[float, ...]:
     """_cs1 where rest = a^2 + b^2 - e^2 is given as a sum of squares, exact to roundings
     (derive/plan.py Cs1Unit): the values atan2(b, a) +- atan2(sqrt(rest), e). On a nominal
     table (_SEED_TOL > 0) rest is not read: there a wrist nearly straight is within the arm's
     difference of straight, and the snapped double root's free joint, held and refined onto
     the exact arm, finds its rows where an exact theta5 gave a theta6 the difference had moved
     (a UR5e URDF at q5 = 1e-7: 6 of 40 sampled vectors missed, none with acos's)."""
-    return _cs1(a, b, e, scale, ref, rest)
+    return _cs1(a, b, e, scale, ref, rest, up)
 
 
 def _cs1(
-    a: float, b: float, e: float, scale: float = 0.0, ref: float = 0.0, rest: float = -1.0
+    a: float,
+    b: float,
+    e: float,
+    scale: float = 0.0,
+    ref: float = 0.0,
+    rest: float = -1.0,
+    up: float = math.inf,
 ) -> tuple[float, ...]:
     """Angles t with a cos t + b sin t = e: atan2(b, a) +- acos(e / sqrt(a^2 + b^2)), the
     acos argument clamped when it exceeds 1 by at most _CLAMP_TOL, or |e| exceeds
-    sqrt(a^2 + b^2) by at most _CLAMP_ABS sqrt(scale) (and _SEED_MISS: a nominal table's
+    sqrt(a^2 + b^2) by at most _CLAMP_ABS sqrt(scale) (and _seed_miss(up), up the least
+    condition of the steps before it: a nominal table's
     equation seeds the refinement onto the exact arm at its boundary, as it does where
     |e| exceeds sqrt(a^2 + b^2) by at most _SEED_TOL sqrt(scale): the table's difference moves
     e by about that, which near a singular configuration, a and b small, is far beyond
-    _SEED_MISS of the ratio: a hextilt arm's 0.0008 over 0.0092, 9%; where
+    _SEED_BAND of the ratio: a hextilt arm's 0.0008 over 0.0092, 9%; where
     sqrt(a^2 + b^2) itself is within _SPREAD_WIDTH _SEED_TOL sqrt(scale), as where two links
     of nearly equal length fold back, _FOLD_SPREAD seeds all round; where the argument is
     near +-1, seeds either side of the fold, _FOLD_SEEDS), and taken as +-1 within _FOLD_TOL
@@ -174,7 +211,7 @@ def _cs1(
         return _all_round(atan2(b, a), _FOLD_SPREAD)  # (a nominal fold)
     ratio = e / rho
     if (
-        abs(ratio) > 1.0 + _CLAMP_TOL + _SEED_MISS
+        abs(ratio) > 1.0 + _CLAMP_TOL + _seed_miss(up)
         and abs(e) - rho > max(_SEED_TOL, _CLAMP_ABS) * sqrt(scale)
         and not loose
     ):
@@ -212,13 +249,14 @@ def _cs1_reach(
     hi: float,
     scale: float,
     ref: float,
+    up: float = math.inf,
 ) -> tuple[float, ...]:
     """As _cs1; a free t starts at the first value _reach_first1 finds (the next joint must
     still let the wrist reach)."""
     rho = sqrt(a * a + b * b)
     free = _FREE_TOL if _SEED_TOL else _FREE_TOL_EXACT
     if rho * rho > free * scale or e * e > _FREE_TOL * scale:
-        return _cs1(a, b, e, scale, ref)
+        return _cs1(a, b, e, scale, ref, -1.0, up)
     return _free(_reach_first1(m00, m01, m02, m10, m11, m12, m20, m21, m22, lo, hi, ref))
 
 
