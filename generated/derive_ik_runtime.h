@@ -9,7 +9,7 @@
    is solved by it): one copy serves every arm of a folder, and each arm's file gets its own
    static copy of the routines, so arms link together in one program. Compile <name>_ik.c
    with it beside the file; do not include it anywhere else. */
-#define DK_RUNTIME 0x788403b51690
+#define DK_RUNTIME 0xe47dd5061984
 
 #include <math.h>
 #include <stddef.h>
@@ -53,6 +53,10 @@
 /* a look-at row aimed within this many radians (or tol) is polished (dk_aims_at) */
 #define DK_AIM_POLISH (0.01)
 #define DK_SEED_BAND (0.05)
+/* rows within this of each other whose midpoint reproduces the pose too are one (dk_keep;
+   derive/runtime/constants.py, _CURVE_NEAR, says why) */
+#define DK_CURVE_NEAR (1e-3)
+#define DK_CURVE_FLAT (4.0)
 /* beyond this acos argument (a nominal fold), the fold's angle +- each of these seeds the
    refinement too (derive/runtime/constants.py, _FOLD_NEAR and _FOLD_SEEDS, say why) */
 #define DK_FOLD_NEAR (0.9999995)
@@ -2901,13 +2905,45 @@ static void dk_pending_start(dk_pending *p, const double (*chain)[12], const int
     p->met = 0;
 }
 
+/* whether q lies within DK_CURVE_NEAR of one of the first n rows of found (revolute joints
+   around the circle, lengths over the reach) whose midpoint with q reproduces p's pose within
+   p's limit and DK_CURVE_FLAT times the larger of their errors (or of 2.5e-15): both on one
+   curve of solutions (the Python _curve_row) */
+static int dk_on_curve(const dk_pending *p, const double (*found)[DK_REFINE_N], int n,
+                       const double q[DK_REFINE_N])
+{
+    int r, j;
+    for (r = 0; r < n; r++) {
+        double mid[DK_REFINE_N], worst = 0.0;
+        for (j = 0; j < DK_REFINE_N; j++) {
+            const double d = p->revolute[j] ? remainder(q[j] - found[r][j], DK_TWO_PI)
+                                            : q[j] - found[r][j];
+            const double size = p->revolute[j] ? fabs(d) : fabs(d) / p->reach;
+            worst = size > worst ? size : worst;
+            mid[j] = found[r][j] + 0.5 * d;
+        }
+        if (worst <= DK_CURVE_NEAR) {
+            const double at = dk_chain_error(p->chain, p->revolute, p->reach, p->t, mid);
+            const double ends = fmax(dk_chain_error(p->chain, p->revolute, p->reach, p->t, q),
+                                     dk_chain_error(p->chain, p->revolute, p->reach, p->t,
+                                                    found[r]));
+            if (at <= p->limit && at <= DK_CURVE_FLAT * fmax(ends, 2.5e-15)) {
+                return 1;
+            }
+        }
+    }
+    return 0;
+}
+
 /* q, a seed refined within p's limit, a row of found (n of them) where it is not one already
-   (dk_seen) and there is room; else counted in p->met */
+   (dk_seen), nor on one's curve of solutions (dk_on_curve), and there is room; else counted
+   in p->met */
 static void dk_keep(dk_pending *p, double (*found)[DK_REFINE_N], int *n,
                     const double q[DK_REFINE_N])
 {
     int j;
-    if (*n < p->room && !dk_seen((const double(*)[DK_REFINE_N])found, *n, p->revolute, q)) {
+    if (*n < p->room && !dk_seen((const double(*)[DK_REFINE_N])found, *n, p->revolute, q) &&
+        !dk_on_curve(p, (const double(*)[DK_REFINE_N])found, *n, q)) {
         for (j = 0; j < DK_REFINE_N; j++) {
             found[*n][j] = q[j];
         }

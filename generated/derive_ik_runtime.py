@@ -38,7 +38,7 @@ if "_RUNTIME_VERSION" not in globals():  # (imported on its own, not run by a mo
         "namespace; it is not a module to import"
     )
 # this runtime's version: a module runs the runtime of its own version only
-_RUNTIME_VERSION = "8ab8a863acac266c"
+_RUNTIME_VERSION = "8f4923a52c9755ec"
 
 if TYPE_CHECKING:  # defined by the module running this file
     from derive.runtime.arm import (
@@ -272,6 +272,21 @@ _FOLD_WIDTH = 0.03
 # the arm does not reach as well, whose seeds never converge: ManiSkill's SO100 URDF spent
 # 12% of its C time on them at regular poses, and no row came from them
 _SEED_BAND = 0.05
+
+
+# a refined row within _CURVE_NEAR of an earlier one (radians; lengths over REACH) whose
+# midpoint reproduces the pose as well as they do (within _CURVE_FLAT times the larger of
+# their errors, or of 2.5e-15) is that row: both lie on one curve of solutions, a singular
+# configuration the exact arm keeps, where each seed converges to a point of its own (Alicia-M
+# URDF, its wrist exactly straight: 14 of the 16 rows one configuration, q4 = q6 within 6e-5
+# of 0, their midpoints within 3e-14 of the pose, and the other branches left no room; a new
+# user's find). Two solutions close together that are not one curve's (a pair at a fold)
+# differ at their midpoint by about the square of half their distance: the xArm6 URDF's pairs
+# 7e-6 and 7e-5 apart, rows within 2e-15, 5e-13 and 8e-11 there
+_CURVE_NEAR = 1e-3
+
+
+_CURVE_FLAT = 4.0
 
 
 # The seam: rounding puts a joint at pi on either side of it, and one solution would get two
@@ -4462,11 +4477,31 @@ def _seed(found, t, q, tol, frees=()):
     if held:
         moved, size = _refine(q, t, held)
         if size <= limit:
-            found.append(moved)
+            found.append(_curve_row(found, t, moved, limit))
             return
     q, size = _refine(q, t)
-    if size <= limit or _LOOSE.on:  # (ik_approximate keeps every seed)
+    if _LOOSE.on:  # (ik_approximate keeps every seed)
         found.append(q)
+    elif size <= limit:
+        found.append(_curve_row(found, t, q, limit))
+
+
+def _curve_row(found, t, q, limit):
+    """The first row of found within _CURVE_NEAR of q (revolute joints around the circle,
+    lengths over REACH) whose midpoint with q reproduces t within limit and _CURVE_FLAT times
+    the larger of their errors (or of 2.5e-15) too (both on one curve of solutions: that row
+    again, a repeat _finish drops), else q (the C dk_on_curve)."""
+    for p in found:
+        d = [
+            math.remainder(a - b, _TWO_PI) if turn else a - b for a, b, turn in zip(q, p, _REVOLUTE)
+        ]
+        if max(abs(x) if turn else abs(x) / REACH for x, turn in zip(d, _REVOLUTE)) > _CURVE_NEAR:
+            continue
+        at = _pose_error([b + 0.5 * x for b, x in zip(p, d)], t, False)[2]
+        ends = max(_pose_error(q, t, False)[2], _pose_error(p, t, False)[2])
+        if at <= limit and at <= _CURVE_FLAT * max(ends, 2.5e-15):
+            return p
+    return q
 
 
 def _refine(q, t, held=(), patience=_REFINE_PATIENCE):

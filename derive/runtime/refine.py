@@ -31,6 +31,7 @@ from derive.runtime.arm import (
     REACH,
     TOOL_AXIS,
 )
+from derive.runtime.constants import _CURVE_FLAT, _CURVE_NEAR, _TWO_PI
 from derive.runtime.scalar import _LOOSE, _Free, _ray_gap
 
 # at most this many steps per candidate (a seed on a singular configuration converges
@@ -107,11 +108,31 @@ def _seed(found, t, q, tol, frees=()):
     if held:
         moved, size = _refine(q, t, held)
         if size <= limit:
-            found.append(moved)
+            found.append(_curve_row(found, t, moved, limit))
             return
     q, size = _refine(q, t)
-    if size <= limit or _LOOSE.on:  # (ik_approximate keeps every seed)
+    if _LOOSE.on:  # (ik_approximate keeps every seed)
         found.append(q)
+    elif size <= limit:
+        found.append(_curve_row(found, t, q, limit))
+
+
+def _curve_row(found, t, q, limit):
+    """The first row of found within _CURVE_NEAR of q (revolute joints around the circle,
+    lengths over REACH) whose midpoint with q reproduces t within limit and _CURVE_FLAT times
+    the larger of their errors (or of 2.5e-15) too (both on one curve of solutions: that row
+    again, a repeat _finish drops), else q (the C dk_on_curve)."""
+    for p in found:
+        d = [
+            math.remainder(a - b, _TWO_PI) if turn else a - b for a, b, turn in zip(q, p, _REVOLUTE)
+        ]
+        if max(abs(x) if turn else abs(x) / REACH for x, turn in zip(d, _REVOLUTE)) > _CURVE_NEAR:
+            continue
+        at = _pose_error([b + 0.5 * x for b, x in zip(p, d)], t, False)[2]
+        ends = max(_pose_error(q, t, False)[2], _pose_error(p, t, False)[2])
+        if at <= limit and at <= _CURVE_FLAT * max(ends, 2.5e-15):
+            return p
+    return q
 
 
 def _refine(q, t, held=(), patience=_REFINE_PATIENCE):
