@@ -1314,7 +1314,13 @@ def write_import(
 
 def main(argv: list[str] | None = None) -> int:
     """Entry point of the `derive` command."""
-    args = parser().parse_args(argv)
+    top = parser()
+    args, extra = top.parse_known_args(argv)
+    if extra:  # (spec names after options: `derive bench robot.urdf --base B --tip T puma560`)
+        names = [x for x in extra if not x.startswith("-")]
+        if names != extra or not isinstance(getattr(args, "specs", None), list):
+            top.error(f"unrecognized arguments: {' '.join(extra)}")
+        args.specs += names
     try:
         code: int = args.run(args)
         sys.stdout.flush()  # a closed pipe shows here, inside the handler, not at exit

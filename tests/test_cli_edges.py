@@ -369,6 +369,27 @@ def test_a_urdf_s_options_apply_to_it_and_not_to_a_bundled_arm_named_beside_it(t
     assert main(["generate", "puma560", "--task", "position", "--out", str(out)]) == 2
 
 
+def test_arm_names_after_a_urdf_s_options_are_taken_as_arms(tmp_path, capsys):
+    """`derive bench robot.urdf --base b --tip t puma560 --lang c` exited 2 with
+    "unrecognized arguments: puma560" (a new user's find: argparse takes the names only before
+    the options). Names after options now join the ones before them, in order; an unknown
+    option is still refused in one line, and so is a name where a command takes none."""
+    out = tmp_path / "out"
+    argv = ["generate", str(URDF), "--base", "world", "--tip", "tool0", "puma560"]
+    assert main([*argv, "--out", str(out)]) == 0
+    assert (out / "puma560.py").read_bytes() == (ROOT / "generated" / "puma560.py").read_bytes()
+    assert len(list(out.glob("*.py"))) == 3  # (the UR5's, the PUMA's and the runtime)
+    capsys.readouterr()
+    with pytest.raises(SystemExit) as exit_:
+        main(["generate", "puma560", "--bogus", "--out", str(out)])
+    assert exit_.value.code == 2
+    assert "unrecognized arguments: --bogus" in capsys.readouterr().err
+    with pytest.raises(SystemExit) as exit_:
+        main(["report", "puma560", "--format", "md", "lecture_6r"])
+    assert exit_.value.code == 2
+    assert "unrecognized arguments: lecture_6r" in capsys.readouterr().err
+
+
 def test_a_spec_s_method_is_the_only_one_tried():
     """[ik] method = "general" gives an arm the general method (a calibrated arm's complete
     solution set); an unknown method is refused with the allowed ones."""
