@@ -38,7 +38,7 @@ if "_RUNTIME_VERSION" not in globals():  # (imported on its own, not run by a mo
         "namespace; it is not a module to import"
     )
 # this runtime's version: a module runs the runtime of its own version only
-_RUNTIME_VERSION = "8f4923a52c9755ec"
+_RUNTIME_VERSION = "3bddf00261bf01d2"
 
 if TYPE_CHECKING:  # defined by the module running this file
     from derive.runtime.arm import (
@@ -4492,15 +4492,17 @@ def _curve_row(found, t, q, limit):
     the larger of their errors (or of 2.5e-15) too (both on one curve of solutions: that row
     again, a repeat _finish drops), else q (the C dk_on_curve)."""
     for p in found:
-        d = [
-            math.remainder(a - b, _TWO_PI) if turn else a - b for a, b, turn in zip(q, p, _REVOLUTE)
-        ]
-        if max(abs(x) if turn else abs(x) / REACH for x, turn in zip(d, _REVOLUTE)) > _CURVE_NEAR:
-            continue
-        at = _pose_error([b + 0.5 * x for b, x in zip(p, d)], t, False)[2]
-        ends = max(_pose_error(q, t, False)[2], _pose_error(p, t, False)[2])
-        if at <= limit and at <= _CURVE_FLAT * max(ends, 2.5e-15):
-            return p
+        d = []
+        for a, b, turn in zip(q, p, _REVOLUTE):  # (to the first joint that differs)
+            x = math.remainder(a - b, _TWO_PI) if turn else a - b
+            if not (abs(x) if turn else abs(x) / REACH) <= _CURVE_NEAR:
+                break
+            d.append(x)
+        else:
+            at = _pose_error([b + 0.5 * x for b, x in zip(p, d)], t, False)[2]
+            ends = max(_pose_error(q, t, False)[2], _pose_error(p, t, False)[2])
+            if at <= limit and at <= _CURVE_FLAT * max(ends, 2.5e-15):
+                return p
     return q
 
 

@@ -2900,15 +2900,21 @@ static int dk_on_curve(const dk_pending *p, const double (*found)[DK_REFINE_N], 
 {
     int r, j;
     for (r = 0; r < n; r++) {
-        double mid[DK_REFINE_N], worst = 0.0;
-        for (j = 0; j < DK_REFINE_N; j++) {
-            const double d = p->revolute[j] ? remainder(q[j] - found[r][j], DK_TWO_PI)
-                                            : q[j] - found[r][j];
-            const double size = p->revolute[j] ? fabs(d) : fabs(d) / p->reach;
-            worst = size > worst ? size : worst;
-            mid[j] = found[r][j] + 0.5 * d;
+        for (j = 0; j < DK_REFINE_N; j++) { /* (to the first joint that differs; a row's
+                                              values lie within two turns of 0) */
+            const double a = fabs(q[j] - found[r][j]);
+            if (p->revolute[j] ? a > DK_CURVE_NEAR && fabs(a - DK_TWO_PI) > DK_CURVE_NEAR &&
+                                     fabs(a - 2.0 * DK_TWO_PI) > DK_CURVE_NEAR
+                               : !(a <= DK_CURVE_NEAR * p->reach)) {
+                break;
+            }
         }
-        if (worst <= DK_CURVE_NEAR) {
+        if (j == DK_REFINE_N) {
+            double mid[DK_REFINE_N];
+            for (j = 0; j < DK_REFINE_N; j++) {
+                const double d = q[j] - found[r][j];
+                mid[j] = found[r][j] + 0.5 * (p->revolute[j] ? remainder(d, DK_TWO_PI) : d);
+            }
             const double at = dk_chain_error(p->chain, p->revolute, p->reach, p->t, mid);
             const double ends = fmax(dk_chain_error(p->chain, p->revolute, p->reach, p->t, q),
                                      dk_chain_error(p->chain, p->revolute, p->reach, p->t,

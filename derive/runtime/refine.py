@@ -123,15 +123,17 @@ def _curve_row(found, t, q, limit):
     the larger of their errors (or of 2.5e-15) too (both on one curve of solutions: that row
     again, a repeat _finish drops), else q (the C dk_on_curve)."""
     for p in found:
-        d = [
-            math.remainder(a - b, _TWO_PI) if turn else a - b for a, b, turn in zip(q, p, _REVOLUTE)
-        ]
-        if max(abs(x) if turn else abs(x) / REACH for x, turn in zip(d, _REVOLUTE)) > _CURVE_NEAR:
-            continue
-        at = _pose_error([b + 0.5 * x for b, x in zip(p, d)], t, False)[2]
-        ends = max(_pose_error(q, t, False)[2], _pose_error(p, t, False)[2])
-        if at <= limit and at <= _CURVE_FLAT * max(ends, 2.5e-15):
-            return p
+        d = []
+        for a, b, turn in zip(q, p, _REVOLUTE):  # (to the first joint that differs)
+            x = math.remainder(a - b, _TWO_PI) if turn else a - b
+            if not (abs(x) if turn else abs(x) / REACH) <= _CURVE_NEAR:
+                break
+            d.append(x)
+        else:
+            at = _pose_error([b + 0.5 * x for b, x in zip(p, d)], t, False)[2]
+            ends = max(_pose_error(q, t, False)[2], _pose_error(p, t, False)[2])
+            if at <= limit and at <= _CURVE_FLAT * max(ends, 2.5e-15):
+                return p
     return q
 
 
