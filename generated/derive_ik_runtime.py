@@ -38,7 +38,7 @@ if "_RUNTIME_VERSION" not in globals():  # (imported on its own, not run by a mo
         "namespace; it is not a module to import"
     )
 # this runtime's version: a module runs the runtime of its own version only
-_RUNTIME_VERSION = "3bddf00261bf01d2"
+_RUNTIME_VERSION = "af1f0832ce7ff64a"
 
 if TYPE_CHECKING:  # defined by the module running this file
     from derive.runtime.arm import (
@@ -275,14 +275,16 @@ _SEED_BAND = 0.05
 
 
 # a refined row within _CURVE_NEAR of an earlier one (radians; lengths over REACH) whose
-# midpoint reproduces the pose as well as they do (within _CURVE_FLAT times the larger of
-# their errors, or of 2.5e-15) is that row: both lie on one curve of solutions, a singular
+# midpoint reproduces the pose as well as they do (within _CURVE_FLAT times the smaller of
+# their errors, or 2.5e-15) is that row: both lie on one curve of solutions, a singular
 # configuration the exact arm keeps, where each seed converges to a point of its own (Alicia-M
 # URDF, its wrist exactly straight: 14 of the 16 rows one configuration, q4 = q6 within 6e-5
 # of 0, their midpoints within 3e-14 of the pose, and the other branches left no room; a new
 # user's find). Two solutions close together that are not one curve's (a pair at a fold)
 # differ at their midpoint by about the square of half their distance: the xArm6 URDF's pairs
-# 7e-6 and 7e-5 apart, rows within 2e-15, 5e-13 and 8e-11 there
+# 7e-6 and 7e-5 apart, rows within 2e-15, 5e-13 and 8e-11 there. The smaller error, not the
+# larger: a row that stalled at 5e-11 beside a fold took both of its pair (both within 3e-15,
+# 1e-4 apart) as points of its curve, in C only (a reviewer's attack on a hextilt URDF)
 _CURVE_NEAR = 1e-3
 
 
@@ -4489,8 +4491,8 @@ def _seed(found, t, q, tol, frees=()):
 def _curve_row(found, t, q, limit):
     """The first row of found within _CURVE_NEAR of q (revolute joints around the circle,
     lengths over REACH) whose midpoint with q reproduces t within limit and _CURVE_FLAT times
-    the larger of their errors (or of 2.5e-15) too (both on one curve of solutions: that row
-    again, a repeat _finish drops), else q (the C dk_on_curve)."""
+    the smaller of their errors (or 2.5e-15) too (both on one curve of solutions: that row
+    again, a repeat _finish drops), else q (the C dk_same_row)."""
     for p in found:
         d = []
         for a, b, turn in zip(q, p, _REVOLUTE):  # (to the first joint that differs)
@@ -4500,7 +4502,7 @@ def _curve_row(found, t, q, limit):
             d.append(x)
         else:
             at = _pose_error([b + 0.5 * x for b, x in zip(p, d)], t, False)[2]
-            ends = max(_pose_error(q, t, False)[2], _pose_error(p, t, False)[2])
+            ends = min(_pose_error(q, t, False)[2], _pose_error(p, t, False)[2])
             if at <= limit and at <= _CURVE_FLAT * max(ends, 2.5e-15):
                 return p
     return q

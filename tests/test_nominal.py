@@ -993,6 +993,29 @@ def test_seeds_that_refine_onto_one_solution_s_valley_take_one_row(tmp_path):
 
 
 @needs_cc
+def test_a_fold_s_pair_beside_a_row_that_stalled_stays_two_rows(tmp_path):
+    """The curve test compares a pair's midpoint with 4 times the smaller of the two rows'
+    errors: with the larger, a row that stalled at 5e-11 beside a fold of the hextilt arm (q2
+    2.2e-5 from pi) took both rows of a pair 1e-4 away, each within 3e-15, as points of its
+    curve, in C only, and the sampled vector was lost (a reviewer's attack: C 7 -> 5 rows,
+    the nearest 4.7e-5 from it). Both backends now find it."""
+    from derive import urdf
+
+    path = Path(__file__).parent / "data" / "urdf" / "hextilt_flying_arm_5.urdf"
+    spec = urdf.load_urdf(
+        path, urdf.Options(base="flying_arm_5__base_link", tip="flying_arm_5__gripper")
+    )
+    module = spec_module(spec, tmp_path)
+    q = np.array([-1.510399157885371, 3.1416151181541005, -1.702755382241209, 1.0630473165597305,
+                  -2.358445833047547])  # fmt: skip
+    T = module.fk(q)
+    for backend in ("c", "python"):
+        rows = module.ik(T, backend=backend)
+        gaps = np.abs(np.remainder(rows - q + math.pi, 2 * math.pi) - math.pi)
+        assert np.min(np.max(gaps, axis=1)) <= 1e-7, (backend, rows)
+
+
+@needs_cc
 def test_an_exact_table_s_straight_wrist_is_answered_by_its_second_pass(tmp_path):
     """The same SO100 URDF converted exactly (--exact: its 1.5708 kept, axes 2-4 parallel
     exactly) with its wrist straight (q5 = 0: the task's Jacobian singular to 7e-7). theta1

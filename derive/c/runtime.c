@@ -1910,29 +1910,24 @@ static void dk_qr_solve(double J[6][DK_REFINE_M], double e[6], double x[DK_REFIN
     }
 }
 
-/* whether q is one of the first n rows of found (within DK_DEDUP_TOL, revolute joints a full
-   turn apart the same): seeds that refine onto one solution (a nominal fold's seeds all round)
-   take one of the solver's DK_MAX places, not several */
-static int dk_seen(const double (*found)[DK_REFINE_N], int n, const int revolute[DK_REFINE_N],
+/* whether q is the row f (within DK_DEDUP_TOL, revolute joints a full turn apart the same):
+   seeds that refine onto one solution (a nominal fold's seeds all round) take one of the
+   solver's DK_MAX places, not several (dk_repeat) */
+static int dk_seen(const double f[DK_REFINE_N], const int revolute[DK_REFINE_N],
                    const double q[DK_REFINE_N])
 {
-    int r, j;
-    for (r = 0; r < n; r++) {
-        for (j = 0; j < DK_REFINE_N; j++) { /* (to the first joint that differs) */
-            double d = fabs(q[j] - found[r][j]);
-            if (revolute[j] && d > DK_PI) { /* (within a half turn: fmod's value is d) */
-                d = fmod(d, DK_TWO_PI);
-                d = d > DK_PI ? DK_TWO_PI - d : d;
-            }
-            if (!(d <= DK_DEDUP_TOL)) {
-                break;
-            }
+    int j;
+    for (j = 0; j < DK_REFINE_N; j++) { /* (to the first joint that differs) */
+        double d = fabs(q[j] - f[j]);
+        if (revolute[j] && d > DK_PI) { /* (within a half turn: fmod's value is d) */
+            d = fmod(d, DK_TWO_PI);
+            d = d > DK_PI ? DK_TWO_PI - d : d;
         }
-        if (j == DK_REFINE_N) {
-            return 1;
+        if (!(d <= DK_DEDUP_TOL)) {
+            return 0;
         }
     }
-    return 0;
+    return 1;
 }
 
 /* a task's Jacobian column k (the "direction", "lookat", "pointing" and "axisangle" tasks,
@@ -2891,51 +2886,64 @@ static void dk_pending_start(dk_pending *p, const double (*chain)[12], const int
     p->met = 0;
 }
 
-/* whether q lies within DK_CURVE_NEAR of one of the first n rows of found (revolute joints
-   around the circle, lengths over the reach) whose midpoint with q reproduces p's pose within
-   p's limit and DK_CURVE_FLAT times the larger of their errors (or of 2.5e-15): both on one
-   curve of solutions (the Python _curve_row) */
-static int dk_on_curve(const dk_pending *p, const double (*found)[DK_REFINE_N], int n,
+/* whether q is the row f (dk_seen) or lies on its curve of solutions: within DK_CURVE_NEAR
+   of it (revolute joints around the circle, lengths over the reach), their midpoint
+   reproducing p's pose within p's limit and DK_CURVE_FLAT times the smaller of their errors
+   (or 2.5e-15; the Python _curve_row) */
+#if defined(__GNUC__)
+__attribute__((noinline, cold)) /* (rarely called: kept out of dk_keep's loop) */
+#endif
+static int dk_same_row(const dk_pending *p, const double f[DK_REFINE_N],
                        const double q[DK_REFINE_N])
 {
-    int r, j;
-    for (r = 0; r < n; r++) {
-        for (j = 0; j < DK_REFINE_N; j++) { /* (to the first joint that differs; a row's
-                                              values lie within two turns of 0) */
-            const double a = fabs(q[j] - found[r][j]);
-            if (p->revolute[j] ? a > DK_CURVE_NEAR && fabs(a - DK_TWO_PI) > DK_CURVE_NEAR &&
-                                     fabs(a - 2.0 * DK_TWO_PI) > DK_CURVE_NEAR
-                               : !(a <= DK_CURVE_NEAR * p->reach)) {
-                break;
-            }
+    double mid[DK_REFINE_N], at, ends;
+    int j;
+    if (dk_seen(f, p->revolute, q)) {
+        return 1;
+    }
+    for (j = 0; j < DK_REFINE_N; j++) { /* (to the first joint that differs; a row's values
+                                          lie within two turns of 0) */
+        const double a = fabs(q[j] - f[j]);
+        if (p->revolute[j] ? a > DK_CURVE_NEAR && fabs(a - DK_TWO_PI) > DK_CURVE_NEAR &&
+                                 fabs(a - 2.0 * DK_TWO_PI) > DK_CURVE_NEAR
+                           : !(a <= DK_CURVE_NEAR * p->reach)) {
+            return 0;
         }
-        if (j == DK_REFINE_N) {
-            double mid[DK_REFINE_N];
-            for (j = 0; j < DK_REFINE_N; j++) {
-                const double d = q[j] - found[r][j];
-                mid[j] = found[r][j] + 0.5 * (p->revolute[j] ? remainder(d, DK_TWO_PI) : d);
-            }
-            const double at = dk_chain_error(p->chain, p->revolute, p->reach, p->t, mid);
-            const double ends = fmax(dk_chain_error(p->chain, p->revolute, p->reach, p->t, q),
-                                     dk_chain_error(p->chain, p->revolute, p->reach, p->t,
-                                                    found[r]));
-            if (at <= p->limit && at <= DK_CURVE_FLAT * fmax(ends, 2.5e-15)) {
-                return 1;
-            }
+        mid[j] = f[j] + 0.5 * (p->revolute[j] ? remainder(q[j] - f[j], DK_TWO_PI) : q[j] - f[j]);
+    }
+    at = dk_chain_error(p->chain, p->revolute, p->reach, p->t, mid);
+    ends = fmin(dk_chain_error(p->chain, p->revolute, p->reach, p->t, q),
+                dk_chain_error(p->chain, p->revolute, p->reach, p->t, f));
+    return at <= p->limit && at <= DK_CURVE_FLAT * fmax(ends, 2.5e-15);
+}
+
+/* whether q is one of the first n rows of found, or on one's curve of solutions (dk_same_row):
+   the last joint of each row compared first, without a branch (rows of one arm configuration
+   share their first joints, their wrists differ: most rows are far in the last) */
+static int dk_repeat(const dk_pending *p, const double (*found)[DK_REFINE_N], int n,
+                     const double q[DK_REFINE_N])
+{
+    const int last = DK_REFINE_N - 1;
+    const double near = fmax(DK_CURVE_NEAR * (p->revolute[last] ? 1.0 : p->reach), DK_DEDUP_TOL);
+    int r;
+    for (r = 0; r < n; r++) {
+        const double a = fabs(q[last] - found[r][last]);
+        const int close = a <= near || (p->revolute[last] && (fabs(a - DK_TWO_PI) <= near ||
+                                                              fabs(a - 2.0 * DK_TWO_PI) <= near));
+        if (close && dk_same_row(p, found[r], q)) {
+            return 1;
         }
     }
     return 0;
 }
 
-/* q, a seed refined within p's limit, a row of found (n of them) where it is not one already
-   (dk_seen), nor on one's curve of solutions (dk_on_curve), and there is room; else counted
-   in p->met */
+/* q, a seed refined within p's limit, a row of found (n of them) where it is not one already,
+   nor on one's curve of solutions (dk_repeat), and there is room; else counted in p->met */
 static void dk_keep(dk_pending *p, double (*found)[DK_REFINE_N], int *n,
                     const double q[DK_REFINE_N])
 {
     int j;
-    if (*n < p->room && !dk_seen((const double(*)[DK_REFINE_N])found, *n, p->revolute, q) &&
-        !dk_on_curve(p, (const double(*)[DK_REFINE_N])found, *n, q)) {
+    if (*n < p->room && !dk_repeat(p, (const double(*)[DK_REFINE_N])found, *n, q)) {
         for (j = 0; j < DK_REFINE_N; j++) {
             found[*n][j] = q[j];
         }

@@ -133,14 +133,16 @@ _FOLD_WIDTH = 0.03
 # 12% of its C time on them at regular poses, and no row came from them
 _SEED_BAND = 0.05
 # a refined row within _CURVE_NEAR of an earlier one (radians; lengths over REACH) whose
-# midpoint reproduces the pose as well as they do (within _CURVE_FLAT times the larger of
-# their errors, or of 2.5e-15) is that row: both lie on one curve of solutions, a singular
+# midpoint reproduces the pose as well as they do (within _CURVE_FLAT times the smaller of
+# their errors, or 2.5e-15) is that row: both lie on one curve of solutions, a singular
 # configuration the exact arm keeps, where each seed converges to a point of its own (Alicia-M
 # URDF, its wrist exactly straight: 14 of the 16 rows one configuration, q4 = q6 within 6e-5
 # of 0, their midpoints within 3e-14 of the pose, and the other branches left no room; a new
 # user's find). Two solutions close together that are not one curve's (a pair at a fold)
 # differ at their midpoint by about the square of half their distance: the xArm6 URDF's pairs
-# 7e-6 and 7e-5 apart, rows within 2e-15, 5e-13 and 8e-11 there
+# 7e-6 and 7e-5 apart, rows within 2e-15, 5e-13 and 8e-11 there. The smaller error, not the
+# larger: a row that stalled at 5e-11 beside a fold took both of its pair (both within 3e-15,
+# 1e-4 apart) as points of its curve, in C only (a reviewer's attack on a hextilt URDF)
 _CURVE_NEAR = 1e-3
 _CURVE_FLAT = 4.0
 # The seam: rounding puts a joint at pi on either side of it, and one solution would get two

@@ -120,8 +120,8 @@ def _seed(found, t, q, tol, frees=()):
 def _curve_row(found, t, q, limit):
     """The first row of found within _CURVE_NEAR of q (revolute joints around the circle,
     lengths over REACH) whose midpoint with q reproduces t within limit and _CURVE_FLAT times
-    the larger of their errors (or of 2.5e-15) too (both on one curve of solutions: that row
-    again, a repeat _finish drops), else q (the C dk_on_curve)."""
+    the smaller of their errors (or 2.5e-15) too (both on one curve of solutions: that row
+    again, a repeat _finish drops), else q (the C dk_same_row)."""
     for p in found:
         d = []
         for a, b, turn in zip(q, p, _REVOLUTE):  # (to the first joint that differs)
@@ -131,7 +131,7 @@ def _curve_row(found, t, q, limit):
             d.append(x)
         else:
             at = _pose_error([b + 0.5 * x for b, x in zip(p, d)], t, False)[2]
-            ends = max(_pose_error(q, t, False)[2], _pose_error(p, t, False)[2])
+            ends = min(_pose_error(q, t, False)[2], _pose_error(p, t, False)[2])
             if at <= limit and at <= _CURVE_FLAT * max(ends, 2.5e-15):
                 return p
     return q
