@@ -9,7 +9,7 @@
    is solved by it): one copy serves every arm of a folder, and each arm's file gets its own
    static copy of the routines, so arms link together in one program. Compile <name>_ik.c
    with it beside the file; do not include it anywhere else. */
-#define DK_RUNTIME 0x145610cb0019
+#define DK_RUNTIME 0x88041fef53a9
 
 #include <math.h>
 #include <stddef.h>
@@ -57,6 +57,7 @@
    derive/runtime/constants.py, _CURVE_NEAR, says why) */
 #define DK_CURVE_NEAR (1e-3)
 #define DK_CURVE_FLAT (4.0)
+#define DK_CURVE_FLOOR (2.5e-15)
 /* beyond this acos argument (a nominal fold), the fold's angle +- each of these seeds the
    refinement too (derive/runtime/constants.py, _FOLD_NEAR and _FOLD_SEEDS, say why) */
 #define DK_FOLD_NEAR (0.9999995)
@@ -2903,7 +2904,7 @@ static void dk_pending_start(dk_pending *p, const double (*chain)[12], const int
 /* whether q is the row f (dk_seen) or lies on its curve of solutions: within DK_CURVE_NEAR
    of it (revolute joints around the circle, lengths over the reach), their midpoint
    reproducing p's pose within p's limit and DK_CURVE_FLAT times the smaller of their errors
-   (or 2.5e-15; the Python _curve_row) */
+   (or DK_CURVE_FLOOR; the Python _curve_row) */
 #if defined(__GNUC__)
 __attribute__((noinline, cold)) /* (rarely called: kept out of dk_keep's loop) */
 #endif
@@ -2928,7 +2929,7 @@ static int dk_same_row(const dk_pending *p, const double f[DK_REFINE_N],
     at = dk_chain_error(p->chain, p->revolute, p->reach, p->t, mid);
     ends = fmin(dk_chain_error(p->chain, p->revolute, p->reach, p->t, q),
                 dk_chain_error(p->chain, p->revolute, p->reach, p->t, f));
-    return at <= p->limit && at <= DK_CURVE_FLAT * fmax(ends, 2.5e-15);
+    return at <= p->limit && at <= DK_CURVE_FLAT * fmax(ends, DK_CURVE_FLOOR);
 }
 
 /* whether q is one of the first n rows of found, or on one's curve of solutions (dk_same_row):

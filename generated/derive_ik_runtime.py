@@ -38,7 +38,7 @@ if "_RUNTIME_VERSION" not in globals():  # (imported on its own, not run by a mo
         "namespace; it is not a module to import"
     )
 # this runtime's version: a module runs the runtime of its own version only
-_RUNTIME_VERSION = "af1f0832ce7ff64a"
+_RUNTIME_VERSION = "10321b7f20577e04"
 
 if TYPE_CHECKING:  # defined by the module running this file
     from derive.runtime.arm import (
@@ -276,7 +276,7 @@ _SEED_BAND = 0.05
 
 # a refined row within _CURVE_NEAR of an earlier one (radians; lengths over REACH) whose
 # midpoint reproduces the pose as well as they do (within _CURVE_FLAT times the smaller of
-# their errors, or 2.5e-15) is that row: both lie on one curve of solutions, a singular
+# their errors, or _CURVE_FLOOR) is that row: both lie on one curve of solutions, a singular
 # configuration the exact arm keeps, where each seed converges to a point of its own (Alicia-M
 # URDF, its wrist exactly straight: 14 of the 16 rows one configuration, q4 = q6 within 6e-5
 # of 0, their midpoints within 3e-14 of the pose, and the other branches left no room; a new
@@ -289,6 +289,10 @@ _CURVE_NEAR = 1e-3
 
 
 _CURVE_FLAT = 4.0
+
+
+# ... whose errors count as at least this (a few roundings of the pose's entries)
+_CURVE_FLOOR = 2.5e-15
 
 
 # The seam: rounding puts a joint at pi on either side of it, and one solution would get two
@@ -4491,7 +4495,7 @@ def _seed(found, t, q, tol, frees=()):
 def _curve_row(found, t, q, limit):
     """The first row of found within _CURVE_NEAR of q (revolute joints around the circle,
     lengths over REACH) whose midpoint with q reproduces t within limit and _CURVE_FLAT times
-    the smaller of their errors (or 2.5e-15) too (both on one curve of solutions: that row
+    the smaller of their errors (or _CURVE_FLOOR) too (both on one curve of solutions: that row
     again, a repeat _finish drops), else q (the C dk_same_row)."""
     for p in found:
         d = []
@@ -4503,7 +4507,7 @@ def _curve_row(found, t, q, limit):
         else:
             at = _pose_error([b + 0.5 * x for b, x in zip(p, d)], t, False)[2]
             ends = min(_pose_error(q, t, False)[2], _pose_error(p, t, False)[2])
-            if at <= limit and at <= _CURVE_FLAT * max(ends, 2.5e-15):
+            if at <= limit and at <= _CURVE_FLAT * max(ends, _CURVE_FLOOR):
                 return p
     return q
 

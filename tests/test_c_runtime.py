@@ -77,6 +77,9 @@ def test_the_c_runtime_holds_the_python_runtimes_constants():
         "WRIST_SPREAD",
         "AIM_POLISH",
         "WRIST_NEAR",
+        "CURVE_NEAR",
+        "CURVE_FLAT",
+        "CURVE_FLOOR",
     ):
         assert float(found[f"DK_{name}"]) == getattr(constants, f"_{name}"), name
     for name in ("DEDUP_TOL", "POSE_TOL"):

@@ -134,7 +134,7 @@ _FOLD_WIDTH = 0.03
 _SEED_BAND = 0.05
 # a refined row within _CURVE_NEAR of an earlier one (radians; lengths over REACH) whose
 # midpoint reproduces the pose as well as they do (within _CURVE_FLAT times the smaller of
-# their errors, or 2.5e-15) is that row: both lie on one curve of solutions, a singular
+# their errors, or _CURVE_FLOOR) is that row: both lie on one curve of solutions, a singular
 # configuration the exact arm keeps, where each seed converges to a point of its own (Alicia-M
 # URDF, its wrist exactly straight: 14 of the 16 rows one configuration, q4 = q6 within 6e-5
 # of 0, their midpoints within 3e-14 of the pose, and the other branches left no room; a new
@@ -145,6 +145,8 @@ _SEED_BAND = 0.05
 # 1e-4 apart) as points of its curve, in C only (a reviewer's attack on a hextilt URDF)
 _CURVE_NEAR = 1e-3
 _CURVE_FLAT = 4.0
+# ... whose errors count as at least this (a few roundings of the pose's entries)
+_CURVE_FLOOR = 2.5e-15
 # The seam: rounding puts a joint at pi on either side of it, and one solution would get two
 # values a full turn apart. A revolute value within _SEAM_BAND above -pi is returned as its
 # equivalent just above pi (the value is kept; only the turn changes), and one within

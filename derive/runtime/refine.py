@@ -31,7 +31,7 @@ from derive.runtime.arm import (
     REACH,
     TOOL_AXIS,
 )
-from derive.runtime.constants import _CURVE_FLAT, _CURVE_NEAR, _TWO_PI
+from derive.runtime.constants import _CURVE_FLAT, _CURVE_FLOOR, _CURVE_NEAR, _TWO_PI
 from derive.runtime.scalar import _LOOSE, _Free, _ray_gap
 
 # at most this many steps per candidate (a seed on a singular configuration converges
@@ -120,7 +120,7 @@ def _seed(found, t, q, tol, frees=()):
 def _curve_row(found, t, q, limit):
     """The first row of found within _CURVE_NEAR of q (revolute joints around the circle,
     lengths over REACH) whose midpoint with q reproduces t within limit and _CURVE_FLAT times
-    the smaller of their errors (or 2.5e-15) too (both on one curve of solutions: that row
+    the smaller of their errors (or _CURVE_FLOOR) too (both on one curve of solutions: that row
     again, a repeat _finish drops), else q (the C dk_same_row)."""
     for p in found:
         d = []
@@ -132,7 +132,7 @@ def _curve_row(found, t, q, limit):
         else:
             at = _pose_error([b + 0.5 * x for b, x in zip(p, d)], t, False)[2]
             ends = min(_pose_error(q, t, False)[2], _pose_error(p, t, False)[2])
-            if at <= limit and at <= _CURVE_FLAT * max(ends, 2.5e-15):
+            if at <= limit and at <= _CURVE_FLAT * max(ends, _CURVE_FLOOR):
                 return p
     return q
 
