@@ -7,7 +7,7 @@ them: every later step runs once per value. After the last step the joint values
 complete and the solver certifies them by forward kinematics.
 
 Each kind of Solve step is a subclass of :class:`Solve` (Cs1, Cs1Reach, Cs2, Cs2Reach,
-Atan2, Poly, PolyD: :data:`SOLVE_KINDS`) naming its arguments; each backend's printer in
+Atan2, Poly, PolyPi, PolyD: :data:`SOLVE_KINDS`) naming its arguments; each backend's printer in
 derive/printers/ prints every kind, and the runtime routine it calls solves it.
 """
 
@@ -197,6 +197,17 @@ class Poly(Solve):
 
 
 @dataclass(frozen=True)
+class PolyPi(Poly):
+    """A quartic in u = tan(t/2) that t -> t + pi leaves unchanged (its coefficients a, b, c,
+    -b, a: the equation has only even harmonics, as a quadratic form in (cos t, sin t) equal
+    to a constant). Divided by u^2 it is the quadratic a w^2 + b w + (c + 2a) = 0 in
+    w = u - 1/u = -2 cot t; each real w gives u = (w +- sqrt(w^2 + 4)) / 2, the angles t and
+    t + pi. The quartic's values, from a quadratic."""
+
+    kind: ClassVar[str] = "polypi"
+
+
+@dataclass(frozen=True)
 class PolyD(Solve):
     """A polynomial in a prismatic joint's d_i, coefficients highest degree first."""
 
@@ -286,7 +297,7 @@ class Eigen(Solve):
 
 # every kind of Solve step: each backend's printer has a function for each (a test checks it)
 SOLVE_KINDS: tuple[type[Solve], ...] = (
-    Cs1, Cs1Unit, Cs1Reach, Cs2, Cs2Reach, Atan2, Poly, PolyD, Eigen,
+    Cs1, Cs1Unit, Cs1Reach, Cs2, Cs2Reach, Atan2, Poly, PolyPi, PolyD, Eigen,
 )  # fmt: skip
 
 

@@ -520,9 +520,13 @@ def solve_equations(step: Solve) -> list[tuple[str, str]]:
         return [(tex(a[0] * c + a[1] * s), tex(a[2])), (tex(a[3] * c + a[4] * s), tex(a[5]))]
     if step.kind == "atan2":
         return [(tex(sp.tan(t)), tex(a[0] / a[1]))]
-    var = sym.named("u") if step.kind == "poly" else t
+    var = sym.named("u") if step.kind in ("poly", "polypi") else t
     degree = len(a) - 1
-    return [(tex(sum(cf * var ** (degree - k) for k, cf in enumerate(a))), "0")]
+    out = [(tex(sum(cf * var ** (degree - k) for k, cf in enumerate(a))), "0")]
+    if step.kind == "polypi":  # (divided by u^2: a quadratic in w = u - 1/u)
+        w = sym.named("w")
+        out.append((tex(a[0] * w**2 + a[1] * w + a[2] + 2 * a[0]), "0"))
+    return out
 
 
 def walk(plan: Plan, pose: np.ndarray, q: tuple[float, ...]) -> list[tuple[str, str]]:

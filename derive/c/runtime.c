@@ -1270,6 +1270,32 @@ static int dk_roots(const double *p, int d, int loose, double *out)
     return dk_accept(p, d, z, d, 0, loose, out);
 }
 
+/* v's values: the n angles t (with their cos c and sin s) sorted, in place, those within
+   1e-12 of the one before dropped, at most DK_VALUES_MAX (dk_poly's, dk_poly_pi's) */
+static void dk_sorted_angles(dk_values *v, double *t, double *c, double *s, int n)
+{
+    int k, j;
+    for (k = 1; k < n; k++) { /* sort by angle, carrying cos and sin */
+        double tk = t[k], ck = c[k], sk = s[k];
+        for (j = k - 1; j >= 0 && t[j] > tk; j--) {
+            t[j + 1] = t[j];
+            c[j + 1] = c[j];
+            s[j + 1] = s[j];
+        }
+        t[j + 1] = tk;
+        c[j + 1] = ck;
+        s[j + 1] = sk;
+    }
+    for (k = 0; k < n && v->n < DK_VALUES_MAX; k++) {
+        if (v->n == 0 || t[k] - v->t[v->n - 1] > 1e-12) {
+            v->t[v->n] = t[k];
+            v->c[v->n] = c[k];
+            v->s[v->n] = s[k];
+            v->n++;
+        }
+    }
+}
+
 /* The values of a joint from a polynomial (highest degree first): in u = tan(t/2) (angles;
    in v = 1/u when the last coefficient is the larger end) or in x / unit (a length). Free
    (every coefficient at most `free_tol`): ref. Returns -1 where dk_roots does (a degree above
@@ -1282,7 +1308,7 @@ static int dk_poly(dk_values *v, const double *coeffs, int d, int angles, double
     /* (t, c, s: the roots at infinity the vanishing leading coefficients give, then x's) */
     double p[DK_POLY_MAX + 1], x[DK_ROOTS_MAX], t[DK_ROOTS_MAX + DK_POLY_MAX];
     double c[DK_ROOTS_MAX + DK_POLY_MAX], s[DK_ROOTS_MAX + DK_POLY_MAX], size = 0.0;
-    int flip, n = 0, k, j, extra = 0;
+    int flip, n = 0, k, extra = 0;
     v->n = 0;
     v->free = 0;
     v->ref = 0.0; /* (unread unless free; set so that no compiler sees it unset) */
@@ -1339,25 +1365,7 @@ static int dk_poly(dk_values *v, const double *coeffs, int d, int angles, double
             s[extra + k] = sk;
         }
         n += extra;
-        for (k = 1; k < n; k++) { /* sort by angle, carrying cos and sin */
-            double tk = t[k], ck = c[k], sk = s[k];
-            for (j = k - 1; j >= 0 && t[j] > tk; j--) {
-                t[j + 1] = t[j];
-                c[j + 1] = c[j];
-                s[j + 1] = s[j];
-            }
-            t[j + 1] = tk;
-            c[j + 1] = ck;
-            s[j + 1] = sk;
-        }
-        for (k = 0; k < n && v->n < DK_VALUES_MAX; k++) {
-            if (v->n == 0 || t[k] - v->t[v->n - 1] > 1e-12) {
-                v->t[v->n] = t[k];
-                v->c[v->n] = c[k];
-                v->s[v->n] = s[k];
-                v->n++;
-            }
-        }
+        dk_sorted_angles(v, t, c, s, n);
     } else {
         for (k = 0; k < n && v->n < DK_VALUES_MAX; k++) {
             if (v->n == 0 || fabs(x[k] - v->t[v->n - 1] / unit) > 1e-12 * (1.0 + fabs(x[k]))) {
@@ -1368,6 +1376,48 @@ static int dk_poly(dk_values *v, const double *coeffs, int d, int angles, double
             }
         }
     }
+    return 0;
+}
+
+/* dk_poly of a quartic in u = tan(t/2) that t -> t + pi leaves unchanged, coefficients
+   a, b, c, -b, a (derive/plan.py PolyPi): divided by u^2 it is a w^2 + b w + (c + 2a) = 0
+   in w = u - 1/u = -2 cot t, and each real w gives u = (w +- sqrt(w^2 + 4)) / 2, the angles
+   t and t + pi (cos and sin turned by pi exactly); dk_poly itself where the polynomial is
+   free or a is within DK_LEAD_TOL of vanishing (the Python _poly_angles_pi) */
+static int dk_poly_pi(dk_values *v, const double *coeffs, double free_tol, double ref)
+{
+    double size = 0.0, q[3], w[DK_ROOTS_MAX], t[2 * DK_ROOTS_MAX], c[2 * DK_ROOTS_MAX];
+    double s[2 * DK_ROOTS_MAX];
+    int k, n, m = 0;
+    for (k = 0; k <= 4; k++) {
+        size = fmax(size, fabs(coeffs[k]));
+    }
+    if (size <= free_tol || fabs(coeffs[0]) <= DK_LEAD_TOL * size) {
+        return dk_poly(v, coeffs, 4, 1, free_tol, 1.0, ref);
+    }
+    v->n = 0;
+    v->free = 0;
+    v->ref = 0.0;
+    q[0] = coeffs[0];
+    q[1] = coeffs[1];
+    q[2] = coeffs[2] + 2.0 * coeffs[0];
+    n = dk_roots(q, 2, v->loose, w);
+    if (n < 0) {
+        return -1;
+    }
+    for (k = 0; k < n; k++) {
+        const double u = 0.5 * (w[k] + copysign(sqrt(w[k] * w[k] + 4.0), w[k]));
+        const double h = 1.0 / (1.0 + u * u), ck = (1.0 - u * u) * h, sk = 2.0 * u * h;
+        const double a = dk_uangle(sk, ck), turned = a > 0.0 ? a - DK_PI : a + DK_PI;
+        t[m] = DK_PI - fabs(a) <= 1e-12 ? DK_PI : a;
+        c[m] = ck;
+        s[m] = sk;
+        t[m + 1] = DK_PI - fabs(turned) <= 1e-12 ? DK_PI : turned;
+        c[m + 1] = -ck;
+        s[m + 1] = -sk;
+        m += 2;
+    }
+    dk_sorted_angles(v, t, c, s, m);
     return 0;
 }
 

@@ -5,7 +5,7 @@ from __future__ import annotations
 import sympy as sp
 
 from derive import symbols as sym
-from derive.plan import Assign, Cs1, Cs1Unit, Solve
+from derive.plan import Assign, Cs1, Cs1Unit, Poly, PolyPi, Solve
 from derive.transforms import Chain, inverse, product, trans, x_factor
 
 
@@ -128,3 +128,30 @@ def unit_column_cs1(
         rest = others[0] ** 2 + others[1] ** 2
         return Cs1Unit(joint, (a, b, e, rest), f"{note}, its half-width {half_width}", 2)
     return Cs1(joint, (a, b, e), note, 2)
+
+
+def angle_poly(
+    joint: int,
+    coeffs: tuple[sp.Expr, ...],
+    note: str,
+    ref: sp.Expr,
+    scale: float,
+) -> Poly:
+    """The step solving a polynomial in u = tan(t/2) (coefficients highest degree first): a
+    quartic whose coefficients read a, b, c, -b, a, identically in the pose, is PolyPi (the
+    equation is unchanged by t -> t + pi, so it is a quadratic in w = u - 1/u, and each root
+    gives two angles pi apart); else Poly. Its fanout is its degree."""
+    degree = len(coeffs) - 1
+    if degree == 4 and all(
+        sp.expand(coeffs[k] + sign * coeffs[4 - k]) == 0 for k, sign in ((0, -1), (1, 1))
+    ):
+        return PolyPi(
+            joint,
+            coeffs,
+            f"{note}; unchanged by theta{joint} -> theta{joint} + pi: a quadratic in "
+            f"w = u - 1/u, each root giving theta{joint} and theta{joint} + pi",
+            degree,
+            ref,
+            scale,
+        )
+    return Poly(joint, coeffs, note, degree, ref, scale)

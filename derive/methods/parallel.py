@@ -29,6 +29,7 @@ from derive.classify import Structure
 from derive.halfangle import half_angle_poly, linear_coeffs, reduce_pairs
 from derive.methods.common import (
     NotApplicable,
+    angle_poly,
     chain_length,
     flange_target,
     joint_outputs,
@@ -39,7 +40,7 @@ from derive.methods.common import (
     unreverse_outputs,
 )
 from derive.methods.planar import flange_factors, heading_step, planar_steps
-from derive.plan import Assign, Cs1, Cs2, Cs2Reach, IkPlan, Poly, PolyD, Solve, Step
+from derive.plan import Assign, Cs1, Cs2, Cs2Reach, IkPlan, PolyD, Solve, Step
 from derive.transforms import Chain, inverse, numbers_of, product, reverse_chain
 
 NAME = "three-parallel"
@@ -228,12 +229,11 @@ def joints45_steps(
         raise NotApplicable("three-parallel: entries (3,3) and (3,4) are dependent")
     coeffs = half_angle_poly(equation, c4, s4, u)
     steps = [
-        Poly(
+        angle_poly(
             4,
             coeffs,
             "theta4: (c5, s5) eliminated from entries (3,3), (3,4): "
             f"polynomial of degree {len(coeffs) - 1} in u = tan(theta4/2)",
-            len(coeffs) - 1,
             refs[3],
             typical_magnitude(coeffs, length),
         ),
@@ -351,12 +351,11 @@ def theta1_theta5_steps(
     equation = reduce_pairs(cos5**2 + sin5**2 - det**2, [(s1, c1)])
     coeffs = half_angle_poly(equation, c1, s1, u)
     return [
-        Poly(
+        angle_poly(
             1,
             coeffs,
             f"theta1: (c5, s5) eliminated from entries (3,3), (3,4): "
             f"polynomial of degree {len(coeffs) - 1} in u = tan(theta1/2)",
-            len(coeffs) - 1,
             refs[0],
             typical_magnitude(coeffs, length),
         ),

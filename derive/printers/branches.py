@@ -17,12 +17,12 @@ from dataclasses import dataclass
 import sympy as sp
 
 from derive import symbols as sym
-from derive.plan import Assign, Cs1, Cs1Reach, Cs1Unit, Eigen, Plan, Poly, PolyD, Solve
+from derive.plan import Assign, Cs1, Cs1Reach, Cs1Unit, Eigen, Plan, Poly, PolyD, PolyPi, Solve
 from derive.printers.common import live_steps, read_pairs, world_names
 
 # the Solve kinds whose several values have a branch each (their sign functions: the
 # runtimes' _cs1_branch, _poly_branch, _polyd_branch and dk_..._branch)
-BRANCHING: tuple[type[Solve], ...] = (Cs1, Cs1Unit, Cs1Reach, Poly, PolyD)
+BRANCHING: tuple[type[Solve], ...] = (Cs1, Cs1Unit, Cs1Reach, Poly, PolyPi, PolyD)
 
 
 @dataclass(frozen=True)

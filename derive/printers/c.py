@@ -33,6 +33,7 @@ from derive.plan import (
     Plan,
     Poly,
     PolyD,
+    PolyPi,
     Solve,
 )
 from derive.printers.branches import First, Sign, branch_program, jacobian_branch
@@ -130,6 +131,8 @@ def _poly(step: Solve, values: list[str], ref: str) -> Call:
     coeffs = f"dk_p{step.joint}"
     array = f"const double {coeffs}[] = {{{', '.join(values)}}};"
     length = CPrinter().doprint(unit) if isinstance(unit, sp.Expr) else repr(unit)
+    if isinstance(step, PolyPi):
+        return Call("dk_poly_pi", (coeffs, repr(free), ref), array)
     return Call("dk_poly", (coeffs, str(degree), angles, repr(free), length, ref), array)
 
 
@@ -151,6 +154,7 @@ def _atan2(step: Solve, values: list[str], ref: str) -> Call:
 
 CALLS: dict[type[Solve], Callable[[Solve, list[str], str], Call]] = {
     Poly: _poly,
+    PolyPi: _poly,
     PolyD: _poly,
     Cs1: _cs1,
     Cs1Unit: _cs1,
@@ -553,6 +557,7 @@ SIGNS: dict[type[Solve], str] = {
     Cs1Unit: "dk_cs1_branch",
     Cs1Reach: "dk_cs1_branch",
     Poly: "dk_poly_branch",
+    PolyPi: "dk_poly_branch",
     PolyD: "dk_polyd_branch",
 }
 

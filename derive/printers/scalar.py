@@ -23,6 +23,7 @@ from derive.plan import (
     Plan,
     Poly,
     PolyD,
+    PolyPi,
     Solve,
 )
 from derive.printers.branches import First, Sign, branch_program, jacobian_branch
@@ -53,6 +54,7 @@ def _unit(step: Solve) -> str:
 SolvePrinter = Callable[[Solve, str, str, str], str]
 SOLVES: dict[type[Solve], SolvePrinter] = {
     Poly: lambda step, args, ref, free: f"_poly_angles(({args},), {ref}, {free})",
+    PolyPi: lambda step, args, ref, free: f"_poly_angles_pi(({args},), {ref}, {free})",
     PolyD: lambda step, args, ref, free: f"_poly_real(({args},), {ref}, {free}, {_unit(step)})",
     Cs1: lambda step, args, ref, free: f"_cs1({args}, {step.scale!r}, {ref})",
     Cs1Unit: lambda step, args, ref, free: f"_cs1x({args}, {step.scale!r}, {ref})",
@@ -171,6 +173,7 @@ BRANCHES: dict[type[Solve], Callable[[Solve, list[str]], str]] = {
     Cs1Unit: lambda step, values: f"_cs1_branch({values[0]}, {values[1]}, {step.variable})",
     Cs1Reach: lambda step, values: f"_cs1_branch({values[0]}, {values[1]}, {step.variable})",
     Poly: lambda step, values: f"_poly_branch(({', '.join(values)},), {step.variable})",
+    PolyPi: lambda step, values: f"_poly_branch(({', '.join(values)},), {step.variable})",
     PolyD: lambda step, values: f"_polyd_branch(({', '.join(values)},), {step.variable})",
 }
 

@@ -415,12 +415,39 @@ def _poly_angles(
         angles.append(0.0 if flip else math.pi)
     for x in _real_roots(c) if len(c) > 1 else ():
         angles.append(_wrap_snap(2.0 * atan2(1.0, x) if flip else 2.0 * math.atan(x)))
+    return _sorted_angles(angles)
+
+
+def _sorted_angles(angles: list[float]) -> list[float]:
+    """The angles sorted, each within 1e-12 of the one before dropped."""
     angles.sort()
     out: list[float] = []
     for t in angles:
         if not out or t - out[-1] > 1e-12:
             out.append(t)
     return out
+
+
+def _poly_angles_pi(
+    coeffs: tuple[float, ...] | np.ndarray, ref: float = 0.0, free: float = 0.0
+) -> tuple[float, ...] | list[float]:
+    """_poly_angles of a quartic t -> t + pi leaves unchanged, coefficients a, b, c, -b, a
+    (derive/plan.py PolyPi): divided by u^2 it is a w^2 + b w + (c + 2a) = 0 in
+    w = u - 1/u = -2 cot t, and each real w gives u = (w +- sqrt(w^2 + 4)) / 2, whose angles
+    are t and t + pi: two square roots where the quartic takes Ferrari's formulas (an SO-100's
+    theta1). Where the polynomial is free, or a is within _LEAD_TOL of vanishing (a root near
+    t = 0 or pi, where _poly_angles deflates it exactly), _poly_angles.
+    """
+    c = [float(x) for x in coeffs]
+    size = max(abs(x) for x in c)
+    if size <= free or abs(c[0]) <= _LEAD_TOL * size:
+        return _poly_angles(coeffs, ref, free)
+    angles = []
+    for w in _real_roots([c[0], c[1], c[2] + 2.0 * c[0]]):
+        u = 0.5 * (w + math.copysign(sqrt(w * w + 4.0), w))
+        t = _wrap_snap(2.0 * math.atan(u))
+        angles += [t, _wrap_snap(t - math.pi if t > 0.0 else t + math.pi)]
+    return _sorted_angles(angles)
 
 
 def _wrap_snap(t: float) -> float:
