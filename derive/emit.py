@@ -99,18 +99,16 @@ def fk_pose_lines(plan: Plan) -> tuple[tuple[str, ...], tuple[str, ...]]:
     Returns:
         (the lines, the 12 names holding the top three rows of the pose).
     """
-    names = sp.numbered_symbols("x")
     pose = plan.fk_pose
     entries = [pose[i, j] for i in range(3) for j in range(4)]
     targets = tuple(sym.named(f"t{i}{j}") for i in range(3) for j in range(4))
-    lines = [ln.text for ln in assign_lines(targets, tuple(entries), names, CodePrinter(), 0)]
+    lines = [ln.text for ln in assign_lines(targets, tuple(entries), "x", CodePrinter(), 0)]
     return tuple(lines), tuple(str(t) for t in targets)
 
 
 def jacobian_lines(plan: Plan) -> tuple[tuple[str, ...], tuple[str, ...]]:
     """Body of _jacobian_q: theta_i (c_i, s_i) from q, then the CSE'd Jacobian entries
     (derive/jacobian.py), and the 6 n names holding them, row-major."""
-    names = sp.numbered_symbols("x")
     J = plan.jacobian
     n = plan.arm.dof
     targets = tuple(sym.named(f"j{i}_{j}") for i in range(6) for j in range(n))
@@ -127,7 +125,7 @@ def jacobian_lines(plan: Plan) -> tuple[tuple[str, ...], tuple[str, ...]]:
         )
         if turns:
             head += [f"c{k + 1} = cos({target})", f"s{k + 1} = sin({target})"]
-    lines = [ln.text for ln in assign_lines(targets, tuple(entries), names, printer, 0)]
+    lines = [ln.text for ln in assign_lines(targets, tuple(entries), "x", printer, 0)]
     return (*head, *lines), tuple(str(t) for t in targets)
 
 

@@ -43,6 +43,7 @@ from derive.printers.common import (
     Line,
     condition_call,
     cs_arguments,
+    cse,
     held_joints,
     live_steps,
     read_pairs,
@@ -95,7 +96,7 @@ def _assign(target: str, text: str, depth: int, scope: Scope) -> Line:
 def _cse_lines(
     targets: tuple[sp.Symbol, ...],
     exprs: tuple[sp.Expr, ...],
-    names: sp.utilities.iterables.numbered_symbols,
+    names: sp.utilities.iterables.numbered_symbols | str,
     printer: CPrinter,
     depth: int,
     scope: Scope,
@@ -103,7 +104,7 @@ def _cse_lines(
 ) -> tuple[list[Line], list[str]]:
     """CSE'd declarations for targets = exprs (only those live reads, if given; no targets:
     the temporaries only) and the printed reduced expressions."""
-    temps, reduced = sp.cse(list(exprs), symbols=names, order="canonical")
+    temps, reduced = cse(exprs, names)
     pairs = [*temps, *zip(targets, reduced)]
     if live is not None:
         needed = set(live) | {str(s) for e in reduced[len(targets) :] for s in e.free_symbols}
@@ -240,7 +241,7 @@ class HoistedFK:
     def of(cls, plan: Plan) -> HoistedFK:
         pose = plan.fk_pose
         entries = [pose[i, j] for i in range(3) for j in range(4)]
-        temps, reduced = sp.cse(entries, symbols=sp.numbered_symbols("dk_h"), order="canonical")
+        temps, reduced = cse(tuple(entries), "dk_h")
         pairs = [(str(t), e) for t, e in temps]
         pairs += [(f"dk_e{k}", e) for k, e in enumerate(reduced)]
         return cls(pairs, set(), set())
@@ -783,12 +784,11 @@ def fk_lines(plan: Plan) -> tuple[tuple[str, ...], tuple[str, ...], str]:
     """dk_fk_cs's body (the pose entries from c_i, s_i and d_i), dk_fk_q's body (c_i, s_i from
     q) and dk_fk_cs's parameter list."""
     printer = CPrinter()
-    names = sp.numbered_symbols("x")
     pose = plan.fk_pose
     entries = tuple(pose[i, j] for i in range(3) for j in range(4))
     targets = tuple(sym.named(f"t{i}{j}") for i in range(3) for j in range(4))
     scope = Scope([set()])
-    lines, _ = _cse_lines(targets, entries, names, printer, 0, scope, None)
+    lines, _ = _cse_lines(targets, entries, "x", printer, 0, scope, None)
     pose_body = tuple(ln.text for ln in lines)
     pose_body += tuple(f"e[{k}] = {t};" for k, t in enumerate(targets))
     joints = []
@@ -817,9 +817,7 @@ def jacobian_lines(plan: Plan) -> tuple[tuple[str, ...], tuple[str, ...]]:
     n = J.shape[1]
     entries = tuple(J[i, j] for i in range(6) for j in range(n))
     targets = tuple(sym.named(f"j{i}_{j}") for i in range(6) for j in range(n))
-    lines, _ = _cse_lines(
-        targets, entries, sp.numbered_symbols("x"), printer, 0, Scope([set()]), None
-    )
+    lines, _ = _cse_lines(targets, entries, "x", printer, 0, Scope([set()]), None)
     body: list[str] = []
     tool: list[str] = []
     used = {k for k, *_ in used_joints(plan, J.free_symbols)}

@@ -8,6 +8,7 @@ stream per function.
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass
 
@@ -131,22 +132,44 @@ class Line:
 def assign_lines(
     targets: tuple[sp.Symbol, ...],
     exprs: tuple[sp.Expr, ...],
-    names: sp.utilities.iterables.numbered_symbols,
+    names: sp.utilities.iterables.numbered_symbols | str,
     printer: CodePrinter,
     depth: int,
     live: frozenset[str] | None = None,
 ) -> list[Line]:
-    """CSE'd straight-line code for targets = exprs; with live, only the lines whose value
-    something in live reads, directly or through later lines.
+    """CSE'd straight-line code for targets = exprs (temporaries from names, or from a fresh
+    stream where names is its prefix: cse); with live, only the lines whose value something
+    in live reads, directly or through later lines.
 
     The CSE runs on all the expressions either way, so that the arithmetic of the lines kept
     does not depend on which others are read.
     """
-    temps, reduced = sp.cse(list(exprs), symbols=names, order="canonical")
+    temps, reduced = cse(exprs, names)
     pairs = [*temps, *zip(targets, reduced)]
     if live is not None:
         pairs = read_pairs(pairs, set(live))
     return [Line(depth, f"{t} = {printer.doprint(e)}") for t, e in pairs]
+
+
+def cse(
+    exprs: tuple[sp.Expr, ...], names: sp.utilities.iterables.numbered_symbols | str
+) -> tuple[tuple[tuple[sp.Symbol, sp.Expr], ...], tuple[sp.Expr, ...]]:
+    """sp.cse of exprs in canonical order, its temporaries from names; names a prefix: a fresh
+    stream of it (x0, x1, ... for "x"), and the result is kept for the process (the pose's
+    and the Jacobian's entries, which the Python and the C printer both print, and C's
+    hoisted pose: their CSE was a third of the time a calibrated arm's module took)."""
+    if isinstance(names, str):
+        return _fresh_cse(tuple(exprs), names)
+    temps, reduced = sp.cse(list(exprs), symbols=names, order="canonical")
+    return tuple(temps), tuple(reduced)
+
+
+@functools.lru_cache(maxsize=16)
+def _fresh_cse(
+    exprs: tuple[sp.Expr, ...], prefix: str
+) -> tuple[tuple[tuple[sp.Symbol, sp.Expr], ...], tuple[sp.Expr, ...]]:
+    temps, reduced = sp.cse(list(exprs), symbols=sp.numbered_symbols(prefix), order="canonical")
+    return tuple(temps), tuple(reduced)
 
 
 def read_pairs(
