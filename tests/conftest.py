@@ -17,7 +17,7 @@ from hypothesis import HealthCheck, Phase, settings
 
 from derive.load import solver_sources
 from derive.pipeline import build_plan
-from derive.spec import parse_spec
+from derive.spec import ArmSpec, parse_spec
 
 ROOT = Path(__file__).resolve().parent.parent
 GENERATED = ROOT / "generated"
@@ -91,6 +91,20 @@ def generated():
     return get
 
 
+# the generated files of the specs this test process has generated, by digest and source
+_SOURCES: dict[tuple[str, str], dict[str, str]] = {}
+
+
+def spec_sources(spec: ArmSpec) -> dict[str, str]:
+    """solver_sources(build_plan(spec)), derived once per test process and spec: the files,
+    not a module (each caller writes and imports a copy of its own, so that a test patching
+    its module patches no other's). Tests of the derivation itself call build_plan."""
+    key = (spec.digest(), repr(spec.source))
+    if key not in _SOURCES:
+        _SOURCES[key] = solver_sources(build_plan(spec))
+    return _SOURCES[key]
+
+
 def build_module(text: str, folder: Path, c: bool = False) -> ModuleType:
     """Generate the module of a spec given as TOML text, with its C files, into a folder of
     its own in folder and import it. Its BACKEND is "python" unless c (the C solver is
@@ -98,7 +112,7 @@ def build_module(text: str, folder: Path, c: bool = False) -> ModuleType:
     spec = parse_spec(text, "<test spec>")
     folder = folder / f"{spec.name}_{next(_counter)}"
     folder.mkdir()
-    for name, content in solver_sources(build_plan(spec)).items():
+    for name, content in spec_sources(spec).items():
         (folder / name).write_text(content, encoding="utf-8")
     module = import_path(folder / f"{spec.name}.py")
     if hasattr(module, "BACKEND") and not c:

@@ -109,12 +109,10 @@ def calibrated(name: str, seed: int = 7) -> str:
 def spec_module(spec, folder: Path):
     """The module of a spec (a URDF's conversion, say) generated into folder (made if
     missing), with its C files, and imported."""
-    from derive.load import solver_sources
-
-    from conftest import import_path
+    from conftest import import_path, spec_sources
 
     folder.mkdir(parents=True, exist_ok=True)
-    for file, text in solver_sources(build_plan(spec)).items():
+    for file, text in spec_sources(spec).items():
         (folder / file).write_text(text, encoding="utf-8")
     return import_path(folder / f"{spec.name}.py")
 
