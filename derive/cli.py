@@ -828,11 +828,17 @@ def cmd_bench(args: argparse.Namespace) -> int:
         print(f"machine: {machine()}", flush=True)
     if args.lang == "c":
         return bench_c(args, specs)
-    results = []
+    results: list[dict[str, object]] = []
     for spec in specs:
         start = time.perf_counter()
-        render_module(build_plan(spec))
+        plan = build_plan(spec)
+        render_module(plan)
         generation = time.perf_counter() - start
+        if plan.ik is None:  # (an FK-only arm: nothing to time, said in one line)
+            results.append({"name": spec.name, "generate_s": generation, "no_ik": plan.refusal})
+            if not args.json:
+                print(f"{spec.name}: no IK figures: FK only, no IK: {plan.refusal}", flush=True)
+            continue
         module = load_module(spec)
         figures = {
             "generate_s": generation,
@@ -863,6 +869,9 @@ def bench_c(args: argparse.Namespace, specs: list[ArmSpec]) -> int:
 
     for spec in specs:
         plan = build_plan(spec)
+        if plan.ik is None:
+            print(f"{spec.name}: no C figures: FK only, no IK: {plan.refusal}")
+            continue
         with tempfile.TemporaryDirectory() as tmp:
             try:
                 harness = Harness(plan, Path(tmp), opt=BENCH_CFLAGS)

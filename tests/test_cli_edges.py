@@ -440,3 +440,18 @@ def test_derive_path_says_where_it_stopped_once(capsys):
     assert main([*args, "--to", "180", "-10", "0", "0", "30", "0", "--steps", "10"]) == 1
     out = capsys.readouterr().out
     assert "stopped at pose 3 of 10: out of reach; sigma_min" in out and "pose 3: " not in out
+
+
+@pytest.mark.parametrize("lang", ["python", "c"])
+def test_bench_of_an_fk_only_arm_says_so_in_one_line(tmp_path, capsys, lang):
+    """An arm with no IK (axes 5 and 6 coincide: a redundant joint) gets a line naming why,
+    beside the figures of the arms that have one: `derive bench` ended in a traceback
+    (AssertionError in C's harness, AttributeError in Python's figures)."""
+    spec = tmp_path / "twin_axes.toml"
+    rows = [(90, 0, 0.3, 0), (180, 0.4, 0, 0), (90, 0, 0, 0), (90, 0, 0.2, 0), (0, 0, 0, 0),
+            (0, 0, 0.1, 0)]  # fmt: skip
+    spec.write_text(spec_text("twin_axes", "standard", rows))
+    assert main(["bench", str(spec), "planar_2r", "--lang", lang, "--samples", "20"]) == 0
+    out = capsys.readouterr().out
+    assert "twin_axes: no " in out and "FK only, no IK: axes 5 and 6 coincide" in out, out
+    assert "planar_2r:" in out
