@@ -899,7 +899,7 @@ def test_a_quartic_a_half_turn_leaves_unchanged_is_solved_as_a_quadratic(tmp_pat
     """ManiSkill's SO-100 URDF (position + tool direction): theta1's quartic, (c5, s5)
     eliminated, is a quadratic form in (c1, s1), so its coefficients read a, b, c, -b, a in
     the pose, and the derivation makes the step PolyPi: a quadratic in w = u - 1/u whose
-    roots each give theta1 and theta1 + pi, where Ferrari's formulas took 36% of the C
+    roots each give theta1 and theta1 + pi, where Ferrari's formulas took 12% of the C
     solve's time. A three-parallel 6R arm with a5 != 0 keeps its Poly. On quartics of that form
     (roots anywhere, near 0 and pi, at a double root, or a leading coefficient vanishing)
     _poly_angles_pi gives _poly_angles's angles; C gives Python's rows, the sampled vector
