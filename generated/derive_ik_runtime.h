@@ -9,7 +9,7 @@
    is solved by it): one copy serves every arm of a folder, and each arm's file gets its own
    static copy of the routines, so arms link together in one program. Compile <name>_ik.c
    with it beside the file; do not include it anywhere else. */
-#define DK_RUNTIME 0x11c88173bb99
+#define DK_RUNTIME 0x45574543cc98
 
 #include <math.h>
 #include <stddef.h>
@@ -1868,7 +1868,7 @@ static void dk_rigid(const double T[16], double t[12])
 #define DK_REFINE_STILL (1e-12)
 /* an exact table's row certified within ik's tol but not within this is polished (dk_polish;
    derive/runtime/refine.py, _REFINE_POLISH, says why) */
-#define DK_REFINE_POLISH (1e-10)
+#define DK_REFINE_POLISH (1e-11)
 /* in the second pass (loose) an exact table's row within this of the pose, though not within
    tol, is polished too, and kept if that brings it within tol (derive/runtime/refine.py,
    _LOOSE_REACH, says why) */

@@ -38,7 +38,7 @@ if "_RUNTIME_VERSION" not in globals():  # (imported on its own, not run by a mo
         "namespace; it is not a module to import"
     )
 # this runtime's version: a module runs the runtime of its own version only
-_RUNTIME_VERSION = "612d107772ed4815"
+_RUNTIME_VERSION = "6297d4d7a04e772f"
 
 if TYPE_CHECKING:  # defined by the module running this file
     from derive.runtime.arm import (
@@ -4458,8 +4458,11 @@ _REFINE_STILL = 1e-12
 
 # an exact table's row certified within ik's tol but not within this is polished (_keep): a
 # far look-at point's rows came within 1e-10 of the ray by the certification's largest
-# entry and 1.5e-10 by its length (a new user's attack)
-_REFINE_POLISH = 1e-10
+# entry and 1.5e-10 by its length (a new user's attack); with 1e-10 here, as ik's tol, a
+# Stretch head's rows 5.7 reaches from its point were left 0.9e-10 off by the largest entry
+# and 1.36e-10 by the length (2.3e-11 rad; a new user's, helper 63): 1e-11 keeps the length
+# within 1e-10 (entries within 1e-11, the length within sqrt(3) times that)
+_REFINE_POLISH = 1e-11
 
 
 # ... with this patience (and _REFINE_STEPS / _REFINE_PATIENCE times as many steps at most):

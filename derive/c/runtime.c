@@ -1854,7 +1854,7 @@ static void dk_rigid(const double T[16], double t[12])
 #define DK_REFINE_STILL (1e-12)
 /* an exact table's row certified within ik's tol but not within this is polished (dk_polish;
    derive/runtime/refine.py, _REFINE_POLISH, says why) */
-#define DK_REFINE_POLISH (1e-10)
+#define DK_REFINE_POLISH (1e-11)
 /* in the second pass (loose) an exact table's row within this of the pose, though not within
    tol, is polished too, and kept if that brings it within tol (derive/runtime/refine.py,
    _LOOSE_REACH, says why) */

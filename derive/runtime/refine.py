@@ -66,8 +66,11 @@ _REFINE_SETTLE = 1e-6
 _REFINE_STILL = 1e-12
 # an exact table's row certified within ik's tol but not within this is polished (_keep): a
 # far look-at point's rows came within 1e-10 of the ray by the certification's largest
-# entry and 1.5e-10 by its length (a new user's attack)
-_REFINE_POLISH = 1e-10
+# entry and 1.5e-10 by its length (a new user's attack); with 1e-10 here, as ik's tol, a
+# Stretch head's rows 5.7 reaches from its point were left 0.9e-10 off by the largest entry
+# and 1.36e-10 by the length (2.3e-11 rad; a new user's, helper 63): 1e-11 keeps the length
+# within 1e-10 (entries within 1e-11, the length within sqrt(3) times that)
+_REFINE_POLISH = 1e-11
 # ... with this patience (and _REFINE_STEPS / _REFINE_PATIENCE times as many steps at most):
 # a row taken at a fold lies on a singular configuration, where the damped steps cross a
 # plateau before they converge (an OpenArm's elbow 1e-7 from straight: rows 1e-9 to 1.7e-8
