@@ -194,6 +194,11 @@ def cmd_generate(args: argparse.Namespace) -> int:
         structure = "; ".join(plan.structure)
         if plan.ik:
             method = f"IK {plan.ik.method} ({plan.ik.case}), up to {plan.ik.max_solutions}"
+            if plan.correction is not None:  # (how far the snapped arm is, said where it is)
+                method += (
+                    f", refined onto the exact arm (the nominal table's FK "
+                    f"{plan.correction.deviation:.2g} from it)"
+                )
         else:
             method = f"FK only, no IK: {plan.refusal}"
             no_ik.append(spec.name)

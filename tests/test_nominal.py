@@ -1501,3 +1501,21 @@ def test_offsets_of_nearly_anti_parallel_axes_cancel_in_the_size(twist):
         text += f'[[joint]]\ntype = "R"\nalpha = {alpha}\na = {a}\nd = {d}\ntheta = {theta}\n'
     size = link_size(parse_spec(text, "<test>"))
     assert size == pytest.approx(0.025 + 0.455 + 0.035 + 0.42, abs=1e-12), size
+
+
+def test_generate_says_how_far_the_nominal_table_is_from_the_arm(tmp_path, capsys):
+    """The summary line of an arm solved on its nominal table says that its answers are
+    refined onto the exact arm and how far the two are apart (a new user had to run
+    import-urdf to learn it, helper 63); an exact arm's line does not."""
+    import re
+
+    from derive.cli import main
+
+    spec = tmp_path / "puma_cad.toml"
+    spec.write_text(cad_puma_text(), encoding="utf-8")
+    assert main(["generate", str(spec), "puma560", "--out", str(tmp_path / "out")]) == 0
+    cad, exact = capsys.readouterr().out.strip().splitlines()
+    found = re.search(r"refined onto the exact arm \(the nominal table's FK (\S+) from it\)", cad)
+    assert found and "(nominal table)" in cad, cad
+    assert 1e-7 < float(found.group(1)) < 1e-4
+    assert exact.startswith("puma560:") and "refined" not in exact
