@@ -2937,6 +2937,13 @@ static void dk_pending_start(dk_pending *p, const double (*chain)[12], const int
     p->met = 0;
 }
 
+/* whether a, the difference of two angles, is within near of 0, one turn or two (a row's
+   values lie within two turns of 0) */
+static int dk_turns_within(double a, double near)
+{
+    return a <= near || fabs(a - DK_TWO_PI) <= near || fabs(a - 2.0 * DK_TWO_PI) <= near;
+}
+
 /* whether q is the row f (dk_seen) or lies on its curve of solutions: within DK_CURVE_NEAR
    of it (revolute joints around the circle, lengths over the reach), their midpoint
    reproducing p's pose within p's limit and DK_CURVE_FLAT times the smaller of their errors
@@ -2952,11 +2959,9 @@ static int dk_same_row(const dk_pending *p, const double f[DK_REFINE_N],
     if (dk_seen(f, p->revolute, q)) {
         return 1;
     }
-    for (j = 0; j < DK_REFINE_N; j++) { /* (to the first joint that differs; a row's values
-                                          lie within two turns of 0) */
+    for (j = 0; j < DK_REFINE_N; j++) { /* (to the first joint that differs) */
         const double a = fabs(q[j] - f[j]);
-        if (p->revolute[j] ? a > DK_CURVE_NEAR && fabs(a - DK_TWO_PI) > DK_CURVE_NEAR &&
-                                 fabs(a - 2.0 * DK_TWO_PI) > DK_CURVE_NEAR
+        if (p->revolute[j] ? !dk_turns_within(a, DK_CURVE_NEAR)
                            : !(a <= DK_CURVE_NEAR * p->reach)) {
             return 0;
         }
@@ -2979,8 +2984,7 @@ static int dk_repeat(const dk_pending *p, const double (*found)[DK_REFINE_N], in
     int r;
     for (r = 0; r < n; r++) {
         const double a = fabs(q[last] - found[r][last]);
-        const int close = a <= near || (p->revolute[last] && (fabs(a - DK_TWO_PI) <= near ||
-                                                              fabs(a - 2.0 * DK_TWO_PI) <= near));
+        const int close = p->revolute[last] ? dk_turns_within(a, near) : a <= near;
         if (close && dk_same_row(p, found[r], q)) {
             return 1;
         }
