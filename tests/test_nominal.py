@@ -309,6 +309,37 @@ def test_a_urdf_with_cad_decimals_is_answered_exactly_against_its_own_fk(xarm6):
 
 
 @needs_cc
+def test_one_near_miss_does_not_take_every_seed_of_a_nominal_general_table(tmp_path):
+    """tests/data/urdf/desktop_6r.urdf: the general method solves its nominal table, which
+    misses poses near the elbow's singular set that the file's arm reaches. Every candidate
+    left within _SEED_TOL seeds the refinement onto the exact arm, and twelve candidates of one
+    near miss (3.1 rad from the pose's own rows) each added theirs, a few 1e-4 apart, until
+    the sixteen seeds were theirs: no row in Python, one of the two in C (the sampled vector
+    2e-5 from it). A candidate within _RR_FOLD_STEP of a seed adds none now: both rows, in
+    both backends (a new user's attack, on synriard's Alicia-D URDF)."""
+    from derive import urdf
+
+    path = Path(__file__).parent / "data" / "urdf" / "desktop_6r.urdf"
+    spec = urdf.load_urdf(path, urdf.Options(base="base_link", tip="tool0"))
+    assert spec.exact is not None
+    module = spec_module(spec, tmp_path)
+    assert module.METHOD == "general" and module._SEED_TOL > 0.0
+    chain = urdf.chain_between(urdf.read_urdf(path), "base_link", "tool0", str(path))
+    root = 2.266132010643676  # (q3 where the Jacobian is singular, the other joints as here)
+    for offset in (1e-6, -1e-5, 1e-5, 1e-4, -1e-3, 2e-3, -3e-3):
+        q = np.array([1.722227022403, 0.128383970278, root + offset, 0.349315762343,
+                      -1.403951987015, 0.797066740011])  # fmt: skip
+        T = np.array(urdf.urdf_fk(chain, list(q)))
+        for backend in ("c", "python"):
+            rows = module.ik(T, backend=backend)
+            assert len(rows) == 2, (offset, backend, len(rows))
+            gaps = np.abs(np.remainder(rows - q + math.pi, 2 * math.pi) - math.pi)
+            assert np.min(np.max(gaps, axis=1)) <= 1e-6, (offset, backend)
+            for row in rows:
+                assert np.max(np.abs(np.array(urdf.urdf_fk(chain, list(row))) - T)) <= 1e-9
+
+
+@needs_cc
 def test_a_calibrated_elbow_near_its_stretch_keeps_both_rows_of_each_pair(tmp_path):
     """The calibrated PUMA's elbow near stretched (q3 1.60 here, its fold 1.617): the nominal
     quadratic in tan(theta3 / 2) has a complex pair there (1.0469 +- 0.0324i), which seeded

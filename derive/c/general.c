@@ -1701,6 +1701,32 @@ static int dk_rr_fold_seeds(int k, const double q[6], double seeds[DK_RR_ROWS][6
     return n;
 }
 
+/* The seeds of split k's near misses misses[0..n) on a nominal table (its values) added to
+   seeds[0..n_seeds) (dk_rr_fold_seeds: new ones, while there is room): first those of each
+   miss not within DK_RR_FOLD_STEP of a seed, then the others' (the Python solver's
+   _rr_seed_misses says why); the new count */
+static int dk_rr_seed_misses(int k, const double misses[][6], int n, double seeds[DK_RR_ROWS][6],
+                             int n_seeds)
+{
+    int late[DK_RR_CANDS], m;
+    for (m = 0; m < n; m++) {
+        late[m] = 0;
+    }
+    for (m = 0; m < n && n_seeds < DK_RR_ROWS; m++) {
+        late[m] = dk_rr_index(k, misses[m], (const double(*)[6])seeds, n_seeds,
+                              DK_RR_FOLD_STEP) >= 0;
+        if (!late[m]) {
+            n_seeds = dk_rr_fold_seeds(k, misses[m], seeds, n_seeds);
+        }
+    }
+    for (m = 0; m < n && n_seeds < DK_RR_ROWS; m++) {
+        if (late[m]) {
+            n_seeds = dk_rr_fold_seeds(k, misses[m], seeds, n_seeds);
+        }
+    }
+    return n_seeds;
+}
+
 /* v := the unit direction the Jacobian of split k's own table nearly loses at its values q
    (two steps of inverse iteration on J^T J from (1, ..., 1)); the least eigenvalue of J^T J
    that estimates (0 where J^T J is singular): the Python _rr_lost_direction */
@@ -1798,10 +1824,11 @@ static int dk_rr_split(int k, const double F[4][4], const double moved[4][4],
                        double out[DK_RR_ROWS][6], int count, int *doubt, double imag_tol,
                        double seeds[DK_RR_ROWS][6], int *n_seeds, dk_rr_leads *leads)
 {
-    double values[490], cands[DK_RR_CANDS][6], between[7][4];
+    double values[490], cands[DK_RR_CANDS][6], between[7][4], misses[DK_RR_CANDS][6];
     const int known = count;
     double pair;
     int extra[DK_RR_CANDS], perturbed = dk_rr_perturbed(k), damped = 0, reals, n, c, i, j, r;
+    int n_misses = 0;
     int paired[DK_RR_ROWS]; /* (per row of out: an extra candidate's, first) */
     for (r = 0; r < DK_RR_ROWS; r++) {
         paired[r] = 0;
@@ -1854,7 +1881,10 @@ static int dk_rr_split(int k, const double F[4][4], const double moved[4][4],
                 leads->n_near = dk_rr_add(k, q, leads->near, leads->n_near);
             }
             if (error <= DK_SEED_TOL) { /* (a nominal table's near miss: 0 elsewhere) */
-                *n_seeds = dk_rr_fold_seeds(k, q, seeds, *n_seeds);
+                for (j = 0; j < 6; j++) {
+                    misses[n_misses][j] = q[j];
+                }
+                n_misses++;
             }
             if (!perturbed && !extra[c]) {
                 *doubt = DK_RR_RESCUE;
@@ -1874,9 +1904,11 @@ static int dk_rr_split(int k, const double F[4][4], const double moved[4][4],
             count = dk_rr_fold_partners(k, F, q, cands[c], out, count);
         }
         if (count == DK_RR_ROWS) {
+            *n_seeds = dk_rr_seed_misses(k, (const double(*)[6])misses, n_misses, seeds, *n_seeds);
             return count;
         }
     }
+    *n_seeds = dk_rr_seed_misses(k, (const double(*)[6])misses, n_misses, seeds, *n_seeds);
     if (*doubt == DK_RR_FALLBACK && count - known >= reals && pair > DK_RR_PAIR_DOUBT) {
         *doubt = 0; /* (every real root gave its row, and no pair is nearly real) */
     }
