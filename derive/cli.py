@@ -1159,7 +1159,10 @@ def parser() -> argparse.ArgumentParser:
         "--lang",
         choices=("python", "c"),
         default="python",
-        help="c: time the generated C solver (compiled -O3 -march=native here) instead",
+        help=(
+            "c: time the generated C solver (compiled -O3 -march=native here) instead: timings"
+            " only, no round trip (the default, python, runs that)"
+        ),
     )
     bench.set_defaults(run=cmd_bench)
     build = sub.add_parser(
