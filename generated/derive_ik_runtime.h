@@ -9,7 +9,7 @@
    is solved by it): one copy serves every arm of a folder, and each arm's file gets its own
    static copy of the routines, so arms link together in one program. Compile <name>_ik.c
    with it beside the file; do not include it anywhere else. */
-#define DK_RUNTIME 0x1d173dfdf6c1
+#define DK_RUNTIME 0xcd52f2dcbf9e
 
 #include <math.h>
 #include <stddef.h>
@@ -3306,7 +3306,10 @@ static void dk_dls(const double *J, int n, const double t[6], double damping, do
 #define DK_RR_NEWTON_DONE (1e-11)
 #define DK_RR_NEWTON_DONE_STEP (1e-08)
 #define DK_RR_ROWS 16 /* the most rows one pose gives */
-#define DK_RR_OUT (2 * DK_RR_ROWS) /* the rows, then a nominal table's seeds */
+/* the most seeds a nominal table's near misses give (three each for as many near misses as a
+   pose has rows: the Python solver's _RR_SEEDS_EACH * MAX_SOLUTIONS) */
+#define DK_RR_SEEDS (3 * DK_RR_ROWS)
+#define DK_RR_OUT (DK_RR_ROWS + DK_RR_SEEDS) /* the rows, then a nominal table's seeds */
 #define DK_RR_MAX 16  /* eigenvalues of one split */
 #define DK_RR_CANDS (8 * DK_RR_MAX) /* candidates of one split, the extras' too */
 #define DK_RR_PAIR_TOL (0.05)
@@ -4921,7 +4924,7 @@ static int dk_rr_unsettled_copy(int k, const double q[6], const double out[DK_RR
 
 /* the index of the first row of out[0..count) within tol of split k's q (as the arm's values),
    or -1 */
-static int dk_rr_index(int k, const double q[6], const double out[DK_RR_ROWS][6], int count,
+static int dk_rr_index(int k, const double q[6], const double out[][6], int count,
                        double tol)
 {
     double arm[6];
@@ -4937,7 +4940,7 @@ static int dk_rr_index(int k, const double q[6], const double out[DK_RR_ROWS][6]
 
 /* split k's joint values q (as the arm's) added to out[0..count) unless there already (within
    1e-7): the new count */
-static int dk_rr_add(int k, const double q[6], double out[DK_RR_ROWS][6], int count)
+static int dk_rr_add(int k, const double q[6], double out[][6], int count)
 {
     if (dk_rr_index(k, q, (const double(*)[6])out, count, 1e-7) >= 0) {
         return count;
@@ -4970,12 +4973,12 @@ static void dk_rr_jacobian(int k, const double q[6], double J[6][6])
    1)), as the arm's values, added to seeds[0..n) where new and room is left: the new count */
 static double dk_rr_lost_direction(int k, const double q[6], double v[6]);
 
-static int dk_rr_fold_seeds(int k, const double q[6], double seeds[DK_RR_ROWS][6], int n)
+static int dk_rr_fold_seeds(int k, const double q[6], double seeds[DK_RR_SEEDS][6], int n)
 {
     double v[6], x[6];
     int i, h;
     (void)dk_rr_lost_direction(k, q, v);
-    for (h = 0; h < 3 && n < DK_RR_ROWS; h++) {
+    for (h = 0; h < 3 && n < DK_RR_SEEDS; h++) {
         const double step = h == 0 ? 0.0 : (h == 1 ? DK_RR_FOLD_STEP : -DK_RR_FOLD_STEP);
         for (i = 0; i < 6; i++) {
             x[i] = q[i] + step * v[i];
@@ -4989,21 +4992,21 @@ static int dk_rr_fold_seeds(int k, const double q[6], double seeds[DK_RR_ROWS][6
    seeds[0..n_seeds) (dk_rr_fold_seeds: new ones, while there is room): first those of each
    miss not within DK_RR_FOLD_STEP of a seed, then the others' (the Python solver's
    _rr_seed_misses says why); the new count */
-static int dk_rr_seed_misses(int k, const double misses[][6], int n, double seeds[DK_RR_ROWS][6],
-                             int n_seeds)
+static int dk_rr_seed_misses(int k, const double misses[][6], int n,
+                             double seeds[DK_RR_SEEDS][6], int n_seeds)
 {
     int late[DK_RR_CANDS], m;
     for (m = 0; m < n; m++) {
         late[m] = 0;
     }
-    for (m = 0; m < n && n_seeds < DK_RR_ROWS; m++) {
+    for (m = 0; m < n && n_seeds < DK_RR_SEEDS; m++) {
         late[m] = dk_rr_index(k, misses[m], (const double(*)[6])seeds, n_seeds,
                               DK_RR_FOLD_STEP) >= 0;
         if (!late[m]) {
             n_seeds = dk_rr_fold_seeds(k, misses[m], seeds, n_seeds);
         }
     }
-    for (m = 0; m < n && n_seeds < DK_RR_ROWS; m++) {
+    for (m = 0; m < n && n_seeds < DK_RR_SEEDS; m++) {
         if (late[m]) {
             n_seeds = dk_rr_fold_seeds(k, misses[m], seeds, n_seeds);
         }
@@ -5106,7 +5109,7 @@ typedef struct {
    (dk_rr_fold_seeds) */
 static int dk_rr_split(int k, const double F[4][4], const double moved[4][4],
                        double out[DK_RR_ROWS][6], int count, int *doubt, double imag_tol,
-                       double seeds[DK_RR_ROWS][6], int *n_seeds, dk_rr_leads *leads)
+                       double seeds[DK_RR_SEEDS][6], int *n_seeds, dk_rr_leads *leads)
 {
     double values[490], cands[DK_RR_CANDS][6], between[7][4], misses[DK_RR_CANDS][6];
     const int known = count;
@@ -5332,13 +5335,13 @@ static int dk_rr_singular(int k, const double F[4][4])
 }
 
 /* The general method's solutions of one pose into out (the first DK_RR_ROWS found where a
-   self-motion gives more; then, on a nominal table, up to DK_RR_ROWS seeds of its near
+   self-motion gives more; then, on a nominal table, up to DK_RR_SEEDS seeds of its near
    misses, for the caller to refine and certify): their count (0: the pose out of reach, as
    the Python solver's _general finds it). flanges: per split, the 12 top entries of the
    target in the split's frame. */
 static int dk_general(const double flanges[DK_RR_SPLIT_COUNT][12], double out[DK_RR_OUT][6])
 {
-    double targets[DK_RR_SPLIT_COUNT][4][4], moved[4][4], seeds[DK_RR_ROWS][6];
+    double targets[DK_RR_SPLIT_COUNT][4][4], moved[4][4], seeds[DK_RR_SEEDS][6];
     dk_rr_leads leads;
     int count = 0, doubt = DK_RR_RESCUE, perturbed = 0, grew = 0, n_seeds = 0, tried = 0, k, r;
     int c, m, i, regular = 1;

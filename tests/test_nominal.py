@@ -315,8 +315,11 @@ def test_one_near_miss_does_not_take_every_seed_of_a_nominal_general_table(tmp_p
     left within _SEED_TOL seeds the refinement onto the exact arm, and twelve candidates of one
     near miss (3.1 rad from the pose's own rows) each added theirs, a few 1e-4 apart, until
     the sixteen seeds were theirs: no row in Python, one of the two in C (the sampled vector
-    2e-5 from it). A candidate within _RR_FOLD_STEP of a seed adds none now: both rows, in
-    both backends (a new user's attack, on synriard's Alicia-D URDF)."""
+    2e-5 from it). Each near miss's seeds now come before a second candidate's of the same one
+    (within _RR_FOLD_STEP of a seed), and there is room for three seeds of sixteen near
+    misses: both rows, in both backends (a new user's attack, on synriard's Alicia-D URDF).
+    With the order alone, C lost a pose's own row near the shoulder's singular set (the last
+    pose: 9 rows, the sampled vector 6.7e-4 from the nearest; a reviewer's attack)."""
     from derive import urdf
 
     path = Path(__file__).parent / "data" / "urdf" / "desktop_6r.urdf"
@@ -337,6 +340,13 @@ def test_one_near_miss_does_not_take_every_seed_of_a_nominal_general_table(tmp_p
             assert np.min(np.max(gaps, axis=1)) <= 1e-6, (offset, backend)
             for row in rows:
                 assert np.max(np.abs(np.array(urdf.urdf_fk(chain, list(row))) - T)) <= 1e-9
+    q = np.array([-1.326186714219464, 1.1046813637425572, 0.24965333232800435,
+                  -2.1704742655358586, -0.8193730354162893, -1.729771804425087])  # fmt: skip
+    T = np.array(urdf.urdf_fk(chain, list(q)))
+    for backend in ("c", "python"):
+        rows = module.ik(T, backend=backend)
+        gaps = np.abs(np.remainder(rows - q + math.pi, 2 * math.pi) - math.pi)
+        assert len(rows) == 10 and np.min(np.max(gaps, axis=1)) <= 1e-6, (backend, len(rows))
 
 
 @needs_cc

@@ -108,6 +108,10 @@ _RR_SEARCH_STARTS = math.pi * np.sin(np.outer(np.arange(1, 65), np.arange(1, 7))
 _RR_MIX = np.sin(np.outer(np.arange(1, 7), np.arange(1, 15)) * 0.731 + 0.25)
 # (slides, theta3) of a split whose joint 3 turns; one whose joint 3 slides has (1.0, theta3)
 _RR_TURNS = (0.0, 0.0)
+# the seeds of one near miss (_rr_fold_seeds): a nominal table's near misses give the
+# refinement onto the exact arm at most this many times MAX_SOLUTIONS seeds, three for as many
+# near misses as a pose has rows (_rr_seed_misses; C's DK_RR_SEEDS)
+_RR_SEEDS_EACH = 3
 # the pairs (k, k') of null-vector entries whose ratio is x5 (k' = k + 1) and x4 (k' = k + 3)
 _RR_X5_PAIRS = (np.array([0, 1, 3, 4, 6, 7, 9, 10]), np.array([1, 2, 4, 5, 7, 8, 10, 11]))
 _RR_X4_PAIRS = (np.arange(9), np.arange(3, 12))
@@ -530,15 +534,23 @@ def _rr_split(k, F, moved, leads, known=(), imag_tol=_RR_IMAG_TOL):
 def _rr_seed_misses(k, misses, rows, slide, leads):
     """The seeds of split k's near misses on a nominal table (rows; its values q and the
     arm's, (q, arm) each) added to leads.seeds (_rr_fold_seeds: new ones, at most
-    MAX_SOLUTIONS, the C solver's buffer): first those of each miss not within _RR_FOLD_STEP
-    of a seed, then the others'. Twelve candidates of one near miss, a few 1e-4 apart, each
-    adding theirs in turn filled the sixteen, and the pose's own near miss, later, got none: a
-    pose near a singular set that the exact arm reaches got no row (a new user's attack on
-    synriard's Alicia-D URDF; tests/data/urdf/desktop_6r.urdf). Where the seeds fit they are
-    the same as before, in another order. Leaving the others out instead (the same miss
-    again) lost near-singular samples' vectors: of 200 on that URDF 1e-7 to 1e-2 from a
-    singular set, 15 and 16 missed in C and Python (a radius of _RR_SAME), 8 and 7
-    (_RR_FOLD_STEP), against 10 and 7 before; this order, 9 and 7."""
+    _RR_SEEDS_EACH * MAX_SOLUTIONS, the C solver's buffer): first those of each miss not
+    within _RR_FOLD_STEP of a seed, then the others'. With room for sixteen, filled candidate
+    by candidate, twelve candidates of one near miss, a few 1e-4 apart, took it all, and the
+    pose's own near miss, later, got none: a pose near a singular set that the exact arm
+    reaches got no row (a new user's attack on synriard's Alicia-D URDF;
+    tests/data/urdf/desktop_6r.urdf). Where the seeds fit they are the same as they were, in
+    another order. Leaving the others out instead (the same miss again) lost near-singular
+    samples' vectors: of 200 on that URDF 1e-7 to 1e-2 from a singular set, 15 and 16 missed
+    in C and Python (a radius of _RR_SAME), 8 and 7 (_RR_FOLD_STEP), against 10 and 7
+    before. The order alone, with room for sixteen, lost a row the old order had found at 3
+    poses of a reviewer's attack (300 near-singular and 300 boundary poses on each of eight
+    such arms); hence room for three seeds of as many near misses as a pose has rows.
+    Against the old order and room (that attack's poses, seed 7): on desktop_6r 300
+    near-singular poses missed their vector 21 and 12 times (C, Python) against 26 and 17,
+    300 poses just inside the workspace's boundary 4 and 8 times against 14 and 24, and got
+    no row 0 and 0 times against 5 and 9; on Alicia-D 7 and 2 against 10 and 5, 7 and 5
+    against 17 and 16, none empty against 6 and 11; no pose lost a row it had."""
     late = []
     for q, arm in misses:
         if leads.seeds and _rr_gaps(arm, leads.seeds).min() <= _RR_FOLD_STEP:
@@ -551,11 +563,12 @@ def _rr_seed_misses(k, misses, rows, slide, leads):
 
 def _rr_add_seeds(k, q, rows, slide, leads):
     """_rr_fold_seeds(k, q, rows, slide) added to leads.seeds where new, while there is room
-    (MAX_SOLUTIONS)."""
-    if len(leads.seeds) >= MAX_SOLUTIONS:
+    (_RR_SEEDS_EACH * MAX_SOLUTIONS)."""
+    room = _RR_SEEDS_EACH * MAX_SOLUTIONS
+    if len(leads.seeds) >= room:
         return
     for seed in _rr_fold_seeds(k, q, rows, slide):
-        if len(leads.seeds) < MAX_SOLUTIONS:
+        if len(leads.seeds) < room:
             _rr_merge(leads.seeds, [seed])
 
 
