@@ -13,7 +13,7 @@ import time
 import tracemalloc
 from functools import partial
 from types import ModuleType
-from typing import Any
+from typing import Any, TextIO
 
 import numpy as np
 
@@ -93,32 +93,46 @@ def compiled_backend(module: ModuleType, pose: np.ndarray) -> dict:
     return {"threads": module._THREADS, "compile_s": time.perf_counter() - start}
 
 
-def batch_us(module: ModuleType, poses: np.ndarray, **options) -> float:
+# the longest one timed ik_batch call may take (seconds): a backend's batch is timed on at most
+# as many poses as fit in it by a first call's pace. At the default 100,000 poses the general
+# method's Python ik_batch (about 3 ms a pose on a cobot) took 5 minutes a call, and `derive
+# bench` of such an arm did not end in 24 minutes (six calls, and the C ones)
+BATCH_BUDGET_S = 2.0
+
+
+def batch_us(module: ModuleType, poses: np.ndarray, **options) -> tuple[float, int]:
     """ik_batch microseconds per pose: the best of five calls after a warm-up call (single
-    calls on this kind of machine vary by up to 2x, the best one is repeatable)."""
-    module.ik_batch(poses[:100], **options)
+    calls on this kind of machine vary by up to 2x, the best one is repeatable), on the first
+    poses that fit BATCH_BUDGET_S by the warm-up call's pace (100 poses); and how many."""
+    probe = poses[:100]
+    start = time.perf_counter()
+    module.ik_batch(probe, **options)
+    pace = (time.perf_counter() - start) / len(probe)
+    n = min(len(poses), max(len(probe), int(BATCH_BUDGET_S / max(pace, 1e-9))))
+    poses = poses[:n]
     best = math.inf
     for _ in range(5):
         start = time.perf_counter()
         module.ik_batch(poses, **options)
         best = min(best, time.perf_counter() - start)
-    return 1e6 * best / len(poses)
+    return 1e6 * best / len(poses), n
 
 
 def batch_figures(module: ModuleType, n: int, seed: int, memory_n: int, threads: int) -> dict:
-    """ik_batch microseconds per pose at n poses (default backend; with the compiled one also on
-    one thread, and the Python backend), and its peak memory at memory_n poses."""
+    """ik_batch microseconds per pose at up to n poses (default backend; with the compiled one
+    also on one thread, and the Python backend; each on the poses batch_us times it on, their
+    count beside it), and its peak memory at memory_n poses."""
     rng = np.random.default_rng(seed + 1)
     poses = targets(module, sample_joints(module, n, rng))
-    figures = {
-        "batch_n": n,
-        "ik_batch_us": batch_us(module, poses),
-        "ik_batch_python_us": batch_us(module, poses, backend="python"),
-    }
+    figures: dict = {}
+    figures["ik_batch_us"], figures["batch_n"] = batch_us(module, poses)
+    python = batch_us(module, poses, backend="python")
+    figures["ik_batch_python_us"], figures["batch_python_n"] = python
     if threads:
         setattr(module, "_THREADS", 1)  # noqa: B010 (the generated module's setting)
         try:
-            figures["ik_batch_1thread_us"] = batch_us(module, poses)
+            one = batch_us(module, poses)
+            figures["ik_batch_1thread_us"], figures["batch_1thread_n"] = one
         finally:
             setattr(module, "_THREADS", threads)  # noqa: B010
     if memory_n:
@@ -160,7 +174,12 @@ def eaik_figures(module: ModuleType, poses: np.ndarray) -> dict:
 
 
 def measure(
-    module: ModuleType, samples: int, seed: int = 0, batch_n: int = 100_000, memory_n: int = 0
+    module: ModuleType,
+    samples: int,
+    seed: int = 0,
+    batch_n: int = 100_000,
+    memory_n: int = 0,
+    progress: TextIO | None = None,
 ) -> dict:
     """Timings and round-trip figures of a generated module.
 
@@ -168,12 +187,16 @@ def measure(
         module: the imported generated module.
         samples: joint vectors for the round trip (20% of joints at degenerate values).
         seed: the random seed.
-        batch_n: poses for the ik_batch timing.
+        batch_n: the most poses for the ik_batch timing (batch_us: fewer where a call would
+            take over BATCH_BUDGET_S).
         memory_n: poses for the ik_batch peak-memory figure (0: skip).
+        progress: where to say which step runs (a line rewritten in place; a general arm's
+            steps take up to a minute each), or None.
 
     Returns:
         A dict of figures (JSON-serialisable).
     """
+    stage = partial(_stage, progress, module.NAME)
     rng = np.random.default_rng(seed)
     Q = sample_joints(module, samples, rng)
     # (a look-at's poses carry its point one REACH ahead: targets)
@@ -183,13 +206,16 @@ def measure(
         "fk_us": median_us(module.fk, [(q,) for q in Q[:2000]]),
     }
     if hasattr(module, "ik"):
+        stage("first calls (compiling the C solver or loading it)")
         figures.update(compiled_backend(module, poses[0]))
         figures["backend"] = "c" if "threads" in figures else "python"
         module.ik(poses[0])
+        stage(f"ik on {len(poses)} poses, 3 passes (default and Python backends)")
         figures["ik_us"] = median_us(module.ik, [(T,) for T in poses])
         figures["ik_python_us"] = median_us(
             partial(module.ik, backend="python"), [(T,) for T in poses]
         )
+        stage(f"nearest on {len(poses)} poses")
         # nearest (within the limits, every 2 pi variant considered) against the same poses
         figures["nearest_us"] = median_us(module.nearest, list(zip(poses, Q)))
         if getattr(module, "FREE", ()):
@@ -197,8 +223,11 @@ def measure(
             figures["ik_sweep_us"] = median_us(
                 partial(module.ik_sweep, n=64), [(T,) for T in poses[:200]]
             )
+        stage(f"round trip of {len(Q)} samples")
         result = roundtrip(module, Q)
+        stage(f"ik_batch of up to {batch_n} poses, a call at most {BATCH_BUDGET_S:.0f} s")
         figures.update(batch_figures(module, batch_n, seed, memory_n, figures.get("threads", 0)))
+        stage(f"ik_batch against the Python ik on {len(Q)} poses")
         figures["batch_agrees"] = batch_agreement(module, targets(module, Q))
         if module.JOINT_TYPES == "RRRRRR" and module.DOF == 6:
             figures.update(eaik_figures(module, module.fk_batch(Q)))
@@ -216,7 +245,18 @@ def measure(
             counts={str(k): v for k, v in sorted(result.counts.items())},
             summary=result.summary(),
         )
+    stage("")
     return figures
+
+
+def _stage(out: TextIO | None, name: str, what: str) -> None:
+    """The step of an arm's benchmark now running, on one line rewritten in place (what empty:
+    the line cleared), where out is not None."""
+    if out is None:
+        return
+    text = f"bench {name}: {what}..." if what else ""
+    out.write(f"\r{text:<100.100}\r" if text else f"\r{'':<100}\r")
+    out.flush()
 
 
 def solve_with(module: ModuleType, T: Any, values: dict) -> Any:
@@ -245,14 +285,14 @@ def bench_text(name: str, f: dict) -> str:
             f"thread{'' if f['threads'] == 1 else 's'}; first calls {f['compile_s']:.1f} s): "
             f"ik {f['ik_us']:.1f} us/pose (median); ik_batch "
             f"{f['ik_batch_us']:.2f} us/pose at N = {f['batch_n']}, "
-            f"{f['ik_batch_1thread_us']:.2f} on one thread"
+            f"{f['ik_batch_1thread_us']:.2f} on one thread (N = {f['batch_1thread_n']})"
         )
     line += f"\n  nearest (within limits) {f['nearest_us']:.1f} us/pose (median)"
     if "ik_sweep_us" in f:
         line += f"; ik_sweep (64 free values) {f['ik_sweep_us']:.1f} us/pose (median)"
     line += (
         f"\n  python: ik {f['ik_python_us']:.1f} us/pose (median); ik_batch "
-        f"{f['ik_batch_python_us']:.2f} us/pose at N = {f['batch_n']}"
+        f"{f['ik_batch_python_us']:.2f} us/pose at N = {f['batch_python_n']}"
     )
     if "ik_batch_peak_mb" in f:
         line += (

@@ -848,7 +848,7 @@ def cmd_bench(args: argparse.Namespace) -> int:
         figures = {
             "generate_s": generation,
             "machine": machine(),
-            **measure(module, args.samples, args.seed, args.batch, args.memory),
+            **measure(module, args.samples, args.seed, args.batch, args.memory, sys.stderr),
         }
         results.append(figures)
         if not args.json:
@@ -1147,7 +1147,15 @@ def parser() -> argparse.ArgumentParser:
         "--samples", "--n", type=count(1), default=10000, help="round-trip samples (10000)"
     )
     bench.add_argument("--seed", type=int, default=0, help="random seed (0)")
-    bench.add_argument("--batch", type=count(1), default=100_000, help="poses for ik_batch timing")
+    bench.add_argument(
+        "--batch",
+        type=count(1),
+        default=100_000,
+        help=(
+            "the most poses for ik_batch timing (100000; fewer where one call would take over"
+            " 2 s: the figures say how many)"
+        ),
+    )
     bench.add_argument(
         "--memory",
         type=count(0),

@@ -204,6 +204,32 @@ def test_bench_reports_round_trip_figures(capsys):
     assert f"numpy {np.__version__}" in figures["machine"] and "CPU" in figures["machine"]
 
 
+def test_bench_times_a_slow_batch_on_the_poses_that_fit_its_budget(monkeypatch):
+    """`derive bench` of a cobot (the general method, Python ik_batch about 3 ms a pose) did not
+    end in 24 minutes: each backend's ik_batch was timed six times on 100,000 poses. batch_us
+    now times a backend on the poses its warm-up call's pace fits in BATCH_BUDGET_S, and says
+    how many (here a stand-in solver of 0.2 ms a pose and a budget of 0.1 s: about 500), and
+    at least the warm-up's 100."""
+    import time
+    from types import SimpleNamespace
+
+    from derive import bench
+
+    calls: list[int] = []
+
+    def ik_batch(poses, **options):
+        calls.append(len(poses))
+        time.sleep(2e-4 * len(poses))
+
+    monkeypatch.setattr(bench, "BATCH_BUDGET_S", 0.1)
+    us, n = bench.batch_us(SimpleNamespace(ik_batch=ik_batch), np.zeros((100_000, 4, 4)))
+    assert calls[0] == 100 and 250 <= n <= 500 and calls[1:] == [n] * 5
+    assert 200 <= us <= 400
+    # a fast solver: every pose given
+    us, n = bench.batch_us(SimpleNamespace(ik_batch=lambda poses: None), np.zeros((3000, 4, 4)))
+    assert n == 3000
+
+
 def test_bench_of_a_look_at_head_asks_it_to_look_at_a_point_ahead(capsys):
     """`derive bench locobot_head` reported "unsound 206; pos inf x reach": its round trip
     solved ik(fk(q)), asking the head to look at its own tool point, which lies on every ray
