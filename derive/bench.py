@@ -255,7 +255,7 @@ def _stage(out: TextIO | None, name: str, what: str) -> None:
     if out is None:
         return
     text = f"bench {name}: {what}..." if what else ""
-    out.write(f"\r{text:<100.100}\r" if text else f"\r{'':<100}\r")
+    out.write(f"\r{text:<100.100}\r")
     out.flush()
 
 
