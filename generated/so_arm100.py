@@ -102,6 +102,7 @@ if TYPE_CHECKING:  # defined at the end of this file, by running derive_ik_runti
         FAR_REACH,
         FREE_LIMIT,
         FREE_STEP,
+        HOST_FLAGS,
         MAX_FREE_VALUES,
         MAX_TURN_ROWS,
         NEAREST_BATCH,
@@ -152,15 +153,15 @@ if TYPE_CHECKING:  # defined at the end of this file, by running derive_ik_runti
 
 __all__ = [
     "BACKEND", "BASE", "BRANCHES", "CERTIFY_TOL", "COMPILE_TIMEOUT", "CONE_AXIS", "C_FLAGS",
-    "DEDUP_TOL", "DH", "DOF", "FAR_REACH", "FREE", "FREE_LIMIT", "FREE_STEP", "IK_COMPONENTS",
-    "JOINT_TYPES", "LIMITS", "MAX_FREE_VALUES", "MAX_SOLUTIONS", "MAX_TURN_ROWS", "METHOD", "NAME",
-    "NEAREST_BATCH", "PATH_CONVERGED", "PATH_FOLD_AHEAD", "PATH_FOLD_FLOOR", "PATH_FOLD_PROBE",
-    "PATH_FOLD_SPLITS", "PATH_FREE_SAMPLES", "PATH_GAIN", "PATH_JOINED", "PATH_JUMP", "PATH_NEAR",
-    "PATH_NEWTON", "PATH_SINGULAR", "PATH_SLACK", "PATH_SLACK_MOST", "PATH_SPLITS",
-    "PATH_START_TOL", "POSE_TOL", "REACH", "TOOL", "TOOL_AXIS", "VELOCITY_BAND", "VELOCITY_DAMPING",
-    "branch", "fk", "fk_batch", "ik", "ik_approximate", "ik_batch", "ik_direction", "ik_path",
-    "ik_velocity", "jacobian", "link_transform", "manipulability", "nearest", "straight_line",
-    "warmup",
+    "DEDUP_TOL", "DH", "DOF", "FAR_REACH", "FREE", "FREE_LIMIT", "FREE_STEP", "HOST_FLAGS",
+    "IK_COMPONENTS", "JOINT_TYPES", "LIMITS", "MAX_FREE_VALUES", "MAX_SOLUTIONS", "MAX_TURN_ROWS",
+    "METHOD", "NAME", "NEAREST_BATCH", "PATH_CONVERGED", "PATH_FOLD_AHEAD", "PATH_FOLD_FLOOR",
+    "PATH_FOLD_PROBE", "PATH_FOLD_SPLITS", "PATH_FREE_SAMPLES", "PATH_GAIN", "PATH_JOINED",
+    "PATH_JUMP", "PATH_NEAR", "PATH_NEWTON", "PATH_SINGULAR", "PATH_SLACK", "PATH_SLACK_MOST",
+    "PATH_SPLITS", "PATH_START_TOL", "POSE_TOL", "REACH", "TOOL", "TOOL_AXIS", "VELOCITY_BAND",
+    "VELOCITY_DAMPING", "branch", "fk", "fk_batch", "ik", "ik_approximate", "ik_batch",
+    "ik_direction", "ik_path", "ik_velocity", "jacobian", "link_transform", "manipulability",
+    "nearest", "straight_line", "warmup",
 ]
 
 NAME = "so_arm100"
@@ -626,7 +627,7 @@ def _branch_signs(target, q):
 
 _RUNTIME = "derive_ik_runtime.py"
 # the version of the runtime this module was generated with (the runtime's _RUNTIME_VERSION)
-_RUNTIME_VERSION = "f62081d6b30103ca"
+_RUNTIME_VERSION = "d92dcfa59fc2b18b"
 # the runtime's line stating its version, in whatever form a formatter leaves it
 _RUNTIME_LINE = re.compile(
     rb"^_RUNTIME_VERSION\s*(?::\s*str\s*)?=\s*[\"']([0-9a-fA-F]+)[\"']", re.M

@@ -71,6 +71,56 @@ def test_the_c_solver_is_compiled_once_into_the_cache_and_found_by_the_next_proc
 
 
 @needs_cc
+@pytest.mark.skipif(not Path("/proc/cpuinfo").is_file(), reason="the processor is told on Linux")
+def test_the_c_solver_is_built_for_this_processor_and_keyed_by_it(tmp_path, monkeypatch):
+    """Compiled with HOST_FLAGS for the processor /proc/cpuinfo names; another processor
+    sharing the cache (a cluster's home folder) gets a library of its own, not this one's
+    instructions."""
+    m = import_path(copy_arm("planar_2r", tmp_path))
+    monkeypatch.setenv("DERIVE_IK_CACHE", str(tmp_path / "cache"))
+    log = tmp_path / "calls.log"
+    cc = tmp_path / "cc.sh"  # (the system compiler, its arguments logged)
+    cc.write_text(f'#!/bin/sh\necho "$*" >> {log}\nexec {shutil.which("cc") or "gcc"} "$@"\n')
+    cc.chmod(0o755)
+    monkeypatch.setenv("CC", str(cc))
+    assert m._host() and "-march=native" in m.HOST_FLAGS
+    here, why = m._c_library()
+    assert why == "" and "-march=native" in log.read_text()
+    monkeypatch.setattr(m, "_host", lambda: "model name:another processor")
+    there, why = m._c_library()
+    assert why == "" and there._name != here._name
+    assert len(log.read_text().splitlines()) == 2  # (each built once, for its processor)
+    q = np.array([0.4, -1.1])
+    assert np.abs(m.ik(m.fk(q), backend="c") - m.ik(m.fk(q), backend="python")).max() < 1e-12
+
+
+@needs_cc
+@pytest.mark.skipif(not Path("/proc/cpuinfo").is_file(), reason="the processor is told on Linux")
+def test_a_compiler_that_refuses_the_processor_s_flags_builds_the_portable_one_once(
+    tmp_path, monkeypatch
+):
+    """A compiler without -march=native (tcc, say) fails on HOST_FLAGS: C_FLAGS alone build
+    the solver, and the refusal, noted in the cache, is not asked again by the next process."""
+    path = copy_arm("planar_2r", tmp_path)
+    log = tmp_path / "calls.log"
+    cc = tmp_path / "cc.sh"
+    system = shutil.which("cc") or "gcc"
+    cc.write_text(
+        f'#!/bin/sh\necho "$*" >> {log}\ncase "$*" in *-march=native*)\n'
+        f'  echo "cc.sh: error: unknown option -march=native" >&2; exit 1;;\nesac\n'
+        f'exec {system} "$@"\n'
+    )
+    cc.chmod(0o755)
+    env = dict(os.environ, DERIVE_IK_CACHE=str(tmp_path / "cache"), CC=str(cc))
+    first = probe(path, "first", env)
+    calls = log.read_text().splitlines()
+    assert len(calls) == 2 and "-march=native" in calls[0] and "-march=native" not in calls[1]
+    assert len(list((tmp_path / "cache").glob("planar_2r-*.refused"))) == 1
+    assert probe(path, "second", env) == first
+    assert len(log.read_text().splitlines()) == 2  # (not asked again)
+
+
+@needs_cc
 def test_processes_compiling_at_once_each_get_a_whole_library(tmp_path):
     path = copy_arm("lecture_rrr", tmp_path)
     env = dict(os.environ, DERIVE_IK_CACHE=str(tmp_path / "cache"))
