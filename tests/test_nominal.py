@@ -569,6 +569,29 @@ def noisy_urdf(name: str, seed: int, decimals: int = 7, calibrated: bool = False
     return "\n".join(lines) + "\n"
 
 
+def urdf_round_trips(module, chain, rng: np.random.Generator) -> tuple[int, int]:
+    """200 uniform joint vectors of a URDF's chain through the module's C ik: fk is the
+    URDF's (urdf_fk) to 1e-12, every pose answered, every row within 1e-10 of the URDF's pose;
+    the regular samples (_scaled_jacobian_sigma at least 0.05) and those whose vector no row
+    is within 1e-8 of."""
+    from derive import urdf
+
+    regular = missed = 0
+    for _ in range(200):
+        q = rng.uniform(-3.1, 3.1, 6)
+        T = np.array(urdf.urdf_fk(chain, list(q)))
+        assert np.max(np.abs(module.fk(q) - T)) <= 1e-12
+        rows = module.ik(T, backend="c")
+        assert len(rows) > 0
+        for row in rows:
+            assert np.max(np.abs(np.array(urdf.urdf_fk(chain, list(row))) - T)) <= 1e-10
+        if _scaled_jacobian_sigma(module, q) >= 0.05:
+            regular += 1
+            gaps = np.abs(np.remainder(rows - q + math.pi, 2 * math.pi) - math.pi)
+            missed += bool(np.min(np.max(gaps, axis=1)) > 1e-8)
+    return regular, missed
+
+
 @needs_cc
 @pytest.mark.parametrize("name", ["ur5", "kr6"])
 def test_industrial_arms_written_as_noisy_urdfs_are_answered_exactly(name, tmp_path):
@@ -584,20 +607,7 @@ def test_industrial_arms_written_as_noisy_urdfs_are_answered_exactly(name, tmp_p
     assert spec.exact is not None
     module = spec_module(spec, tmp_path / "module")
     assert METHODS[name] == module.METHOD
-    rng = np.random.default_rng(9)
-    regular = missed = 0
-    for _ in range(200):
-        q = rng.uniform(-3.1, 3.1, 6)
-        T = np.array(urdf.urdf_fk(chain, list(q)))
-        assert np.max(np.abs(module.fk(q) - T)) <= 1e-12
-        rows = module.ik(T, backend="c")
-        assert len(rows) > 0
-        for row in rows:
-            assert np.max(np.abs(np.array(urdf.urdf_fk(chain, list(row))) - T)) <= 1e-10
-        if _scaled_jacobian_sigma(module, q) >= 0.05:
-            regular += 1
-            gaps = np.abs(np.remainder(rows - q + math.pi, 2 * math.pi) - math.pi)
-            missed += bool(np.min(np.max(gaps, axis=1)) > 1e-8)
+    regular, missed = urdf_round_trips(module, chain, np.random.default_rng(9))
     assert regular >= 100 and missed == 0
 
 
@@ -664,21 +674,7 @@ def test_a_calibrated_urdf_whose_common_normal_lies_far_out_is_taken_as_parallel
     spec = urdf.load_urdf(path, urdf.Options(base="l0", tip="tool"))
     assert spec.exact is not None and max(abs(j.d) for j in spec.joints) < 1.0
     module = spec_module(spec, tmp_path / "module")
-    rng = np.random.default_rng(12)
-    regular = missed = 0
-    for _ in range(200):
-        q = rng.uniform(-3.1, 3.1, 6)
-        T = np.array(urdf.urdf_fk(chain, list(q)))
-        assert np.max(np.abs(module.fk(q) - T)) <= 1e-12
-        rows = module.ik(T, backend="c")
-        assert len(rows) > 0
-        for row in rows:
-            E = np.array(urdf.urdf_fk(chain, list(row))) - T
-            assert max(np.abs(E[:3, :3]).max(), np.abs(E[:3, 3]).max() / module.REACH) <= 1e-10
-        if _scaled_jacobian_sigma(module, q) >= 0.05:
-            regular += 1
-            gaps = np.abs(np.remainder(rows - q + math.pi, 2 * math.pi) - math.pi)
-            missed += bool(np.min(np.max(gaps, axis=1)) > 1e-8)
+    regular, missed = urdf_round_trips(module, chain, np.random.default_rng(12))
     assert regular >= 100 and missed == 0, (regular, missed)
 
 
