@@ -99,7 +99,7 @@ def test_the_c_solver_is_built_for_this_processor_and_keyed_by_it(tmp_path, monk
 def test_a_compiler_that_refuses_the_processor_s_flags_builds_the_portable_one_once(
     tmp_path, monkeypatch
 ):
-    """A compiler without -march=native (tcc, say) fails on HOST_FLAGS: C_FLAGS alone build
+    """A compiler that fails on HOST_FLAGS (one without -march=native): C_FLAGS alone build
     the solver, and the refusal, noted in the cache, is not asked again by the next process."""
     path = copy_arm("planar_2r", tmp_path)
     log = tmp_path / "calls.log"
