@@ -38,7 +38,7 @@ if "_RUNTIME_VERSION" not in globals():  # (imported on its own, not run by a mo
         "namespace; it is not a module to import"
     )
 # this runtime's version: a module runs the runtime of its own version only
-_RUNTIME_VERSION = "d92dcfa59fc2b18b"
+_RUNTIME_VERSION = "7b8a35ab4938a589"
 
 if TYPE_CHECKING:  # defined by the module running this file
     from derive.runtime.arm import (
@@ -520,8 +520,9 @@ C_FLAGS = ("-std=c99", "-O2", "-ffp-contract=off", "-fPIC", "-shared")
 # (a complex multiplication's pattern) despite -ffp-contract=off, and the C fk differed from
 # the Python one by a rounding at 80 of 200 lecture_rrr joint vectors (the lanes are vectors
 # of their own: the same refinement, the KR6's output the same bit for bit). A compiler that
-# refuses these flags (a refusal noted beside the library it would have been, so it is asked
-# once) gets C_FLAGS alone.
+# refuses these flags (twice, the portable build between; noted beside the library it would
+# have been, so that it is asked once) gets C_FLAGS alone, and so does a cache that cannot be
+# written where it holds the portable library (_c_library).
 HOST_FLAGS = ("-march=native", "-fno-tree-slp-vectorize", "-fpeel-loops")
 
 
@@ -667,24 +668,32 @@ def _c_library() -> tuple[Any, str]:
     if shutil.which(compiler[0]) is None:
         return None, f"the C compiler {compiler[0]!r} (from $CC) is not found"
     host = _host()
-    if host:  # (for this processor, unless the compiler refused its flags before)
-        target, why, flagged = _cached(compiler, C_FLAGS + HOST_FLAGS, host, source, texts)
+    if not host:
+        target, why, _ = _cached(compiler, C_FLAGS, "", source, texts)
+        return (None, why) if why else _load(target)
+    tuned = C_FLAGS + HOST_FLAGS
+    target, why, flagged = _cached(compiler, tuned, host, source, texts)
+    if not why:
+        return _load(target)
+    # (the portable library: built where the compiler failed with HOST_FLAGS; else, a timeout
+    # or a cache folder it cannot write, one built before serves: a read-only cache prepared
+    # on another processor)
+    portable, failed, _ = _cached(compiler, C_FLAGS, "", source, texts, build=flagged)
+    if failed:
+        return None, failed if flagged else why
+    if flagged and not os.path.exists(target + _REFUSED):
+        # (it built without HOST_FLAGS: asked once more, so that a failure of the moment, cc1
+        # killed, is not taken for a refusal, which is noted so that it is asked once)
+        again, why, flagged = _cached(compiler, tuned, host, source, texts)
         if not why:
-            return _load(target)
-        if not flagged:  # (a timeout, or the cache folder: not the flags)
-            return None, why
-    target, why, _ = _cached(compiler, C_FLAGS, "", source, texts)
-    if why:
-        return None, why
-    refused = _cached(compiler, C_FLAGS + HOST_FLAGS, host, source, texts, False)[0] + _REFUSED
-    if host and not os.path.exists(refused):  # (C_FLAGS alone built it: the compiler refused
-        # HOST_FLAGS, not the C; asked once)
-        try:
-            with open(refused, "w", encoding="utf-8") as file:
-                file.write(shlex.join([*compiler, *HOST_FLAGS]) + "\n")
-        except OSError:
-            pass  # (asked again next time)
-    return _load(target)
+            return _load(again)
+        if flagged:
+            try:
+                with open(target + _REFUSED, "w", encoding="utf-8") as file:
+                    file.write(shlex.join([*compiler, *HOST_FLAGS]) + "\n")
+            except OSError:
+                pass  # (asked again next time)
+    return _load(portable)
 
 
 def _cached(
@@ -696,16 +705,18 @@ def _cached(
     build: bool = True,
 ) -> tuple[str, str, bool]:
     """The cache's library of the C compiled with flags (for the processor cpu, "" for any;
-    both part of its name's digest), built first where it holds no sound one (and build is
-    set); its path, "" or why it cannot be had, and whether the compiler said so (a
-    refusal of HOST_FLAGS is recorded beside the library, and read as one)."""
+    both part of its name's digest), built first where it holds no sound one (where build is
+    set); its path, "" or why it cannot be had, and whether the compiler said so (a refusal
+    of HOST_FLAGS noted beside the library is read as one)."""
     command = shlex.join([*compiler, *flags]).encode()
     key = hashlib.sha256(b"\0".join((*texts.values(), command, cpu.encode()))).hexdigest()
     suffix = ".dll" if os.name == "nt" else ".dylib" if sys.platform == "darwin" else ".so"
     folder = _cache_folder()
     target = os.path.join(folder, f"{NAME}-{key[:24]}{suffix}")
-    if not build or _sound(target):  # (else absent, or damaged since it was built: built)
+    if _sound(target):  # (else absent, or damaged since it was built: built again)
         return target, "", False
+    if not build:
+        return target, f"no compiled solver in {folder}", False
     if os.path.exists(target + _REFUSED):
         return target, "the compiler refused these flags before", True
     try:
