@@ -138,6 +138,7 @@ class Conversion:
         frames: the URDF's own chain as fixed frames (derive/nominal.py): F_0 .. F_n, the
             top three rows of each, row-major; the spec keeps them as [exact] where
             snapping moved its table.
+        far: the snaps of axes taken as parallel for their far common normal (_far_normal).
         reach: the arm's size.
     """
 
@@ -151,6 +152,7 @@ class Conversion:
     rounded: bool = True
     notes: list[str] = field(default_factory=list)
     frames: list[list[float]] = field(default_factory=list)
+    far: list[str] = field(default_factory=list)
 
 
 # --- reading ---------------------------------------------------------------------------------
@@ -578,6 +580,7 @@ def convert(
     origins: list[Vector] = []
     xs: list[Vector] = []
     parallel: set[int] = set()  # (the rows whose axis _far_normal takes as the previous one's)
+    far_snaps: list[str] = []
     for i in range(n):
         p, z = lines[i]
         if i == n - 1:  # the last frame: on its axis where the previous normal meets it
@@ -592,16 +595,18 @@ def convert(
         cross = _cross(z, z_next)
         sine = math.sqrt(_dot(cross, cross))
         start = p if i == 0 else _foot(origins[-1], xs[-1], lines[i])
-        near = exact or sine <= math.sin(angle_tol)
-        out = "" if near else _far_normal(start, lines[i], lines[i + 1], sine, far * reach)
+        taken = sine <= math.sin(angle_tol)
+        feet = None if taken else _normal_feet(lines[i], lines[i + 1], sine)
+        out = "" if exact or feet is None else _far_normal(start, z, feet[0], sine, far * reach)
         if out:
             parallel.add(i + 1)  # (row i + 2's twist: 0 or pi below)
-        if sine <= math.sin(angle_tol) or out:
+        if taken or out:
             if sine > NOISE:
                 snaps.append(
                     f"axes {i + 1} and {i + 2}: {math.asin(min(sine, 1.0)):.3g} rad from "
                     f"parallel: taken as parallel{out}"
                 )
+                far_snaps += [snaps[-1]] if out else []
             # parallel: the normal through `start` (d = 0 for this joint)
             offset = _sub(q_point, start)
             normal = _add(offset, z, -_dot(offset, z))
@@ -610,13 +615,8 @@ def convert(
             xs.append(_across(normal, z) if length > ltol else _perpendicular(z))
             continue
         # skew or intersecting: the feet of the common normal
-        w = _sub(p, q_point)
-        b = _dot(z, z_next)
-        denom = sine * sine  # 1 - b^2, without its cancellation
-        s = (b * _dot(z_next, w) - _dot(z, w)) / denom
-        t = (_dot(z_next, w) - b * _dot(z, w)) / denom
-        foot_i = _add(p, z, s)
-        foot_next = _add(q_point, z_next, t)
+        assert feet is not None
+        foot_i, foot_next = feet
         gap = _sub(foot_next, foot_i)
         distance = math.sqrt(_dot(gap, gap))
         origins.append(foot_i)
@@ -686,33 +686,36 @@ def convert(
         reach=reach,
         rounded=not exact,
         frames=exact_frames(path),
+        far=far_snaps,
     )
 
 
-def _far_normal(
-    start: Vector,
-    line: tuple[Vector, Vector],
-    after: tuple[Vector, Vector],
-    sine: float,
-    beyond: float,
-) -> str:
-    """Where two axes within FAR_PARALLEL of parallel meet their common normal more than
-    `beyond` from start, why they are taken as parallel, else "". A calibrated UR5 written
-    with 7 decimals (tests/test_nominal.py, noisy_urdf) had axes 2 and 3 2.0e-5 rad apart and
-    their normal 312 m out, 242 times its size: refused (OFFSET_LIMIT) at 2 of 100 seeds, at
-    53 of 100 with 5 decimals (a new user's find, helper 67); with only those taken as
-    parallel, its axes 3 and 4, 1.1e-5 apart, kept theirs 98 m out, the nominal table (which
-    snaps them about that far point) was 6.5e-4 from the arm, and a pose near its shoulder
-    singularity got no row. Taken as parallel, the table is the nominal arm the closed form
-    solves (its deviation from the file measured and bounded as any snap's: 3.7e-5 there)
-    and the file's frames, kept exact, are fk's and every answer's."""
+def _normal_feet(
+    line: tuple[Vector, Vector], after: tuple[Vector, Vector], sine: float
+) -> tuple[Vector, Vector]:
+    """The feet of two axes' common normal on each (sine: of the angle between them, not 0)."""
     (p, z), (q, z_next) = line, after
-    if not sine <= FAR_PARALLEL:
-        return ""
     w = _sub(p, q)
     b = _dot(z, z_next)
-    out = abs(_dot(_sub(_add(p, z, (b * _dot(z_next, w) - _dot(z, w)) / (sine * sine)), start), z))
-    if out <= beyond:
+    denom = sine * sine  # 1 - b^2, without its cancellation
+    s = (b * _dot(z_next, w) - _dot(z, w)) / denom
+    t = (_dot(z_next, w) - b * _dot(z, w)) / denom
+    return _add(p, z, s), _add(q, z_next, t)
+
+
+def _far_normal(start: Vector, z: Vector, foot: Vector, sine: float, beyond: float) -> str:
+    """Where two axes within FAR_PARALLEL of parallel meet their common normal (at foot on the
+    first, along z) more than `beyond` from start, why they are taken as parallel, else "". A
+    calibrated UR5 written with 7 decimals (tests/test_nominal.py, noisy_urdf) had axes 2 and
+    3 2.0e-5 rad apart and their normal 312 m out, 242 times its size: refused (OFFSET_LIMIT)
+    at 2 of 100 seeds, at 53 of 100 with 5 decimals (a new user's find, helper 67); with only
+    those taken as parallel, its axes 3 and 4, 1.1e-5 apart, kept theirs 98 m out, the nominal
+    table (which snaps them about that far point) was 6.5e-4 from the arm, and a pose near its
+    shoulder singularity got no row. Taken as parallel, the table is the nominal arm the closed form
+    solves (its deviation from the file measured and bounded as any snap's: 3.7e-5 there)
+    and the file's frames, kept exact, are fk's and every answer's."""
+    out = abs(_dot(_sub(foot, start), z))
+    if not sine <= FAR_PARALLEL or out <= beyond:
         return ""
     return f" (their common normal {out:.3g} away)"
 
@@ -1128,22 +1131,20 @@ def import_chain(
             source, part, ik)  # fmt: skip
     conversion.deviation = measure(parse_spec(spec_text(*args), f"{where} (converted)"), chain,
                                    conversion.reach)  # fmt: skip
-    bound = options.max_deviation if conversion.snaps else 1e-9
-    if not conversion.deviation <= bound and any("common normal" in s for s in conversion.snaps):
+    if conversion.far and not conversion.deviation <= options.max_deviation:
         # (axes taken as parallel for their far normal moved the table too far: only those
         # beyond OFFSET_LIMIT, which would be refused, are taken so)
         conversion = convert(chain, where, *tolerances, far=OFFSET_LIMIT)
         args = (conversion, *args[1:])
         conversion.deviation = measure(parse_spec(spec_text(*args), f"{where} (converted)"),
                                        chain, conversion.reach)  # fmt: skip
-        bound = options.max_deviation if conversion.snaps else 1e-9
+    bound = options.max_deviation if conversion.snaps else 1e-9
     if not conversion.deviation <= bound:
         cause = "after snapping" if conversion.snaps else "without snapping (a converter error)"
-        far = [s for s in conversion.snaps if "common normal" in s]
+        far = f" ({'; '.join(conversion.far)})" if conversion.far else ""
         raise UrdfError(
             f"{where}: the spec's FK differs from the {source}'s by {conversion.deviation:.3g} "
-            f"{cause}{' (' + '; '.join(far) + ')' if far else ''}; allowed {bound:g} "
-            "(--max-deviation; --exact to switch snapping off)"
+            f"{cause}{far}; allowed {bound:g} (--max-deviation; --exact to switch snapping off)"
         )
     if unbounded := [joint.name for joint in chain if joint.unbounded]:
         conversion.notes.append(

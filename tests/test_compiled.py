@@ -78,10 +78,7 @@ def test_the_c_solver_is_built_for_this_processor_and_keyed_by_it(tmp_path, monk
     instructions."""
     m = import_path(copy_arm("planar_2r", tmp_path))
     monkeypatch.setenv("DERIVE_IK_CACHE", str(tmp_path / "cache"))
-    log = tmp_path / "calls.log"
-    cc = tmp_path / "cc.sh"  # (the system compiler, its arguments logged)
-    cc.write_text(f'#!/bin/sh\necho "$*" >> {log}\nexec {shutil.which("cc") or "gcc"} "$@"\n')
-    cc.chmod(0o755)
+    log, cc = logging_compiler(tmp_path, fails="--never--)\n  exit 1;;")
     monkeypatch.setenv("CC", str(cc))
     assert m._host() and "-march=native" in m.HOST_FLAGS
     here, why = m._c_library()
