@@ -1144,7 +1144,7 @@ def import_chain(
         far = f" ({'; '.join(conversion.far)})" if conversion.far else ""
         raise UrdfError(
             f"{where}: the spec's FK differs from the {source}'s by {conversion.deviation:.3g} "
-            f"{cause}{far}; allowed {bound:g} (--max-deviation; --exact to switch snapping off)"
+            f"{cause}{far}; allowed {bound:g} ({_deviation_advice(conversion, bound)})"
         )
     if unbounded := [joint.name for joint in chain if joint.unbounded]:
         conversion.notes.append(
@@ -1159,6 +1159,20 @@ def import_chain(
     for note in conversion.notes:
         print(f"note: {note}", file=sys.stderr)
     return spec_text(*args), conversion
+
+
+def _deviation_advice(conversion: Conversion, bound: float) -> str:
+    """What a refusal for the deviation can do: the --max-deviation that accepts the snapped
+    table (its exact frames keep the module's fk and rows the file's own; up to DEVIATION_RANGE),
+    or --exact."""
+    needed = float(f"{conversion.deviation * 1.05:.2g}")
+    if conversion.snaps and bound < needed <= DEVIATION_RANGE[1]:
+        return (
+            f"--max-deviation {needed:g} accepts it: the module's fk and every row stay the "
+            "file's own, refined from the snapped table's closed form; --exact switches "
+            "snapping off"
+        )
+    return "--max-deviation; --exact to switch snapping off"
 
 
 def load_urdf(path: Path, options: Options) -> ArmSpec:

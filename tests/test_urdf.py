@@ -7,6 +7,7 @@ from __future__ import annotations
 import math
 import os
 import random
+import re
 import subprocess
 import sys
 from pathlib import Path
@@ -274,12 +275,8 @@ def test_a_50_mb_urdf_is_refused_unread(tmp_path):
     assert len(result.stderr.strip().split("\n")) == 1
 
 
-def test_nearly_parallel_axes_are_snapped_or_refused_never_huge_offsets(tmp_path):
-    """A calibrated arm: axes 2 and 3 are 1e-3 rad from parallel. Without snapping the
-    common normal is hundreds of lengths away: taken as parallel for that (urdf._far_normal),
-    which moves this arm by 9.5e-4, beyond --max-deviation, so refused with both reasons;
-    with --angle-tol above 1e-3 they are parallel, and the deviation is reported (and bounded
-    by --max-deviation)."""
+def calibrated_pair_urdf(tmp_path: Path) -> Path:
+    """A two-joint URDF whose axes are 1e-3 rad from parallel (a calibrated arm's)."""
     joints = [
         {"name": "j1", "parent": "a", "child": "b"},
         {"name": "j2", "parent": "b", "child": "c", "xyz": "0.4 0 0"},
@@ -290,6 +287,16 @@ def test_nearly_parallel_axes_are_snapped_or_refused_never_huge_offsets(tmp_path
     )
     path = tmp_path / "cal.urdf"
     path.write_text(text)
+    return path
+
+
+def test_nearly_parallel_axes_are_snapped_or_refused_never_huge_offsets(tmp_path):
+    """A calibrated arm: axes 2 and 3 are 1e-3 rad from parallel. Without snapping the
+    common normal is hundreds of lengths away: taken as parallel for that (urdf._far_normal),
+    which moves this arm by 9.5e-4, beyond --max-deviation, so refused with both reasons;
+    with --angle-tol above 1e-3 they are parallel, and the deviation is reported (and bounded
+    by --max-deviation)."""
+    path = calibrated_pair_urdf(tmp_path)
     with pytest.raises(urdf.UrdfError, match=r"differs .* after snapping \(axes 1 and 2: .*common"):
         urdf.import_urdf(path, options("a", "c"))
     with pytest.raises(urdf.UrdfError, match="differs from the URDF's"):
@@ -297,6 +304,22 @@ def test_nearly_parallel_axes_are_snapped_or_refused_never_huge_offsets(tmp_path
     spec, conversion = urdf.import_urdf(path, options("a", "c", angle_tol=2e-3, max_deviation=1e-2))
     assert conversion.deviation > 1e-4 and "taken as parallel" in spec
     assert all(abs(row[2]) < 1.0 and abs(row[3]) < 1.0 for row in conversion.rows)
+
+
+def test_a_refusal_for_the_deviation_names_the_max_deviation_that_accepts_the_file(tmp_path):
+    """A URDF refused because snapping moved its FK beyond --max-deviation: the message names
+    the --max-deviation that accepts it (just above the measured deviation), and that value
+    does, keeping the file's exact frames for fk; --exact stays named as the other way."""
+    path = calibrated_pair_urdf(tmp_path)
+    with pytest.raises(urdf.UrdfError) as refused:
+        urdf.import_urdf(path, options("a", "c"))
+    message = str(refused.value)
+    found = re.search(r"by ([0-9.e-]+) after .*--max-deviation ([0-9.e-]+) accepts it", message)
+    assert found and "--exact switches snapping off" in message
+    deviation, advised = float(found.group(1)), float(found.group(2))
+    assert deviation < advised <= 1.1 * deviation
+    spec, conversion = urdf.import_urdf(path, options("a", "c", max_deviation=advised))
+    assert conversion.deviation <= advised and "[exact]" in spec
 
 
 def random_chain(rng: random.Random) -> tuple[str, str, str]:
