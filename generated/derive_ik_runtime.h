@@ -9,7 +9,7 @@
    is solved by it): one copy serves every arm of a folder, and each arm's file gets its own
    static copy of the routines, so arms link together in one program. Compile <name>_ik.c
    with it beside the file; do not include it anywhere else. */
-#define DK_RUNTIME 0xcd52f2dcbf9e
+#define DK_RUNTIME 0xdc55254ec6fc
 
 #include <math.h>
 #include <stddef.h>
@@ -1873,6 +1873,11 @@ static void dk_rigid(const double T[16], double t[12])
    tol, is polished too, and kept if that brings it within tol (derive/runtime/refine.py,
    _LOOSE_REACH, says why) */
 #define DK_LOOSE_REACH (1e-4)
+/* in the second pass a seed beyond DK_SEED_TOL but within this is refined for a trial
+   (DK_TRIAL_PATIENCE) and refined in full where that brings it within DK_SEED_TOL
+   (dk_seed_near; derive/runtime/refine.py, _TRIAL_SEED, says why) */
+#define DK_TRIAL_SEED (0.2)
+#define DK_TRIAL_PATIENCE 2
 /* ... and it keeps rows within this (or tol, if smaller) only (_LOOSE_TOL says why) */
 #define DK_LOOSE_TOL (1e-8)
 /* ... with this patience (DK_REFINE_STEPS / DK_REFINE_PATIENCE times as many steps at most):
@@ -2360,13 +2365,27 @@ static double dk_chain_error(const double chain[DK_REFINE_N + 1][12],
 }
 
 /* whether the pose of the chain at q is within DK_SEED_TOL of the target t (the task's
-   error): the solver's second pass refines only such seeds (a pose out of reach gives seeds
-   far from it; the Python solver's _seed, with _LOOSE.near) */
+   error), or within DK_TRIAL_SEED and brought within DK_SEED_TOL by a trial refinement
+   (DK_TRIAL_PATIENCE; q itself unchanged): the solver's second pass refines only such seeds
+   (a pose out of reach gives seeds far from it; the Python solver's _seed_near) */
 static int dk_seed_near(const double chain[DK_REFINE_N + 1][12],
-                        const int revolute[DK_REFINE_N], double reach, const double t[12],
-                        const double q[DK_REFINE_N])
+                        const int revolute[DK_REFINE_N], const int solved[DK_REFINE_M],
+                        double reach, const double t[12], const double q[DK_REFINE_N])
 {
-    return dk_chain_error(chain, revolute, reach, t, q) <= DK_SEED_TOL;
+    double trial[DK_REFINE_N];
+    const double size = dk_chain_error(chain, revolute, reach, t, q);
+    int i;
+    if (size <= DK_SEED_TOL) {
+        return 1;
+    }
+    if (!(size <= DK_TRIAL_SEED)) {
+        return 0;
+    }
+    for (i = 0; i < DK_REFINE_N; i++) {
+        trial[i] = q[i];
+    }
+    return dk_refine(chain, revolute, solved, reach, t, trial, 0u, DK_TRIAL_PATIENCE) <=
+           DK_SEED_TOL;
 }
 
 /* dk_refine of a nominal solution q, the joints in held (a bit per arm joint: those the pose

@@ -101,6 +101,8 @@ def test_the_c_runtime_holds_the_python_runtimes_constants():
     for name in ("SETTLE",):
         assert float(found[f"DK_REFINE_{name}"]) == getattr(refine, f"_REFINE_{name}"), name
     assert float(found["DK_LOOSE_REACH"]) == refine._LOOSE_REACH
+    assert float(found["DK_TRIAL_SEED"]) == refine._TRIAL_SEED
+    assert int(found["DK_TRIAL_PATIENCE"]) == refine._TRIAL_PATIENCE
     assert float(found["DK_PI"]) == np.pi and float(found["DK_TWO_PI"]) == 2 * np.pi
     assert table(runtime, "DK_FREE_STEPS").tolist() == list(constants._FREE_STEPS)
     assert table(runtime, "DK_FOLD_SEEDS").tolist() == list(constants._FOLD_SEEDS)

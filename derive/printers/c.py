@@ -446,7 +446,8 @@ def solve_lines(plan: Plan) -> tuple[tuple[int, str], ...]:
         body.append(
             Line(
                 depth + 1,
-                "if (!loose || dk_seed_near(DK_CHAIN, DK_REVOLUTE, DK_REACH, t, dk_q)) {",
+                "if (!loose || "
+                "dk_seed_near(DK_CHAIN, DK_REVOLUTE, DK_SOLVED, DK_REACH, t, dk_q)) {",
             )
         )
         # (a seed held nowhere waits to be refined with others: dk_defer; one

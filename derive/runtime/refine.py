@@ -89,6 +89,17 @@ _LOOSE_REACH = 1e-4
 # rounding (a myCobot 320's elbow and wrist 1e-10 from straight, sigma_min 1e-17) the rows
 # stall at up to 2.7e-9 (200 poses), and they are the answer
 _LOOSE_TOL = 1e-8
+# in ik's second pass (no row in the first) a nominal table's seed whose pose error is beyond
+# _SEED_TOL but within _TRIAL_SEED is refined for a trial first (_REFINE_STEPS /
+# _REFINE_PATIENCE times _TRIAL_PATIENCE steps at most, given up after _TRIAL_PATIENCE in a row
+# that do not reduce the error), and refined in full where the trial brings it within
+# _SEED_TOL: a pose near two singular configurations at once (an ARX5 MJCF's wrist within 1e-2
+# of straight and its shoulder singular to 5e-9; the table 1.4e-5 from the arm) left every seed
+# 1e-2 to 0.15 from it, and ik answered nothing where ik_approximate's refined seeds reached it
+# to 1e-15 (a new user's attack, helper 70); a pose out of reach by more than _TRIAL_SEED
+# costs nothing more
+_TRIAL_SEED = 0.2
+_TRIAL_PATIENCE = 2
 # ik_approximate's least squares: at most this many steps, done where the gradient of half
 # the squared error is this flat
 _LSQ_STEPS = 200
@@ -106,7 +117,7 @@ def _seed(found, t, q, tol, frees=()):
     away from q_ref)."""
     held = [i for values, i in frees if values.__class__ is _Free]
     limit = min(tol, _REFINE_STALL if _LOOSE.near else _REFINE_TOL)
-    if _LOOSE.near and _pose_error(q, t, False)[2] > _SEED_TOL:
+    if _LOOSE.near and not _seed_near(q, t):
         return  # (ik's second pass: a seed this far is a pose out of reach, not noise)
     if held:
         moved, size = _refine(q, t, held)
@@ -118,6 +129,16 @@ def _seed(found, t, q, tol, frees=()):
         found.append(q)
     elif size <= limit:
         found.append(_curve_row(found, t, q, limit))
+
+
+def _seed_near(q, t):
+    """Whether ik's second pass refines the seed q towards t: its pose error within _SEED_TOL,
+    or within _TRIAL_SEED and brought within _SEED_TOL by a trial (_TRIAL_PATIENCE; the C
+    solver's dk_seed_near)."""
+    size = _pose_error(q, t, False)[2]
+    if size <= _SEED_TOL:
+        return True
+    return size <= _TRIAL_SEED and _refine(q, t, (), _TRIAL_PATIENCE)[1] <= _SEED_TOL
 
 
 def _curve_row(found, t, q, limit):
