@@ -1117,6 +1117,23 @@ def test_seeds_that_refine_onto_one_solution_s_valley_take_one_row(tmp_path):
 
 
 @needs_cc
+def test_a_refined_arm_s_c_rows_are_in_ik_s_range(tmp_path):
+    """ik's rows lie in (-pi, pi]. A refined arm's C solver skipped the wrapping where the
+    closed form's own angles are in range (their steps are brought there, dk_seam), but its rows
+    are the refinement's: the CAD PUMA's C rows came back with q4 = 6.28326 or q6 = -3.72 at 53
+    of 475 (the Python solver's wrapped), and the two backends compared different points."""
+    m = build_module(cad_puma_text(), tmp_path, c=True)
+    rng = np.random.default_rng(0)
+    for q in rng.uniform(-2.5, 2.5, (30, 6)):
+        q[3] = q[4] = 0.0
+        for Q in (q, np.r_[q[:4], 0.01, q[5]], rng.uniform(-math.pi, math.pi, 6)):
+            for backend in ("c", "python"):
+                rows = m.ik(m.fk(Q), backend=backend)
+                assert len(rows), (backend, Q)
+                assert np.all(np.abs(rows) <= math.pi), (backend, rows)
+
+
+@needs_cc
 def test_a_fold_s_pair_beside_a_row_that_stalled_stays_two_rows(tmp_path):
     """The curve test compares a pair's midpoint with 4 times the smaller of the two rows'
     errors: with the larger, a row that stalled at 5e-11 beside a fold of the hextilt arm (q2

@@ -207,8 +207,12 @@ def wrist_flip(plan: Plan) -> tuple[int, int, int] | None:
 def seamed_outputs(plan: Plan) -> frozenset[str]:
     """The angle steps' variables that dk_solve brings to ik's range itself (dk_seam, once
     per value), where every revolute output joint is one of them: then dk_finish need not (a
-    row has 6 joints, a step's value serves several rows). Empty otherwise."""
+    row has 6 joints, a step's value serves several rows). Empty otherwise, and on a refined
+    arm, whose rows are the refinement's (a CAD PUMA's C rows came back with q4 = 6.28326 and
+    q6 = -3.72, 53 of 475 of them beyond pi, where the Python solver's were wrapped)."""
     assert plan.ik is not None
+    if plan.correction is not None:
+        return frozenset()
     angles = {
         step.variable
         for step in plan.ik.steps
@@ -305,7 +309,7 @@ def solve_lines(plan: Plan) -> tuple[tuple[int, str], ...]:
     # of five calibrated arms, a reviewer's attack)
     flip = wrist_flip(plan) if not fix else None
     turned: dict[str, tuple[str, str]] = {}  # an angle's variable: its cos and sin
-    seamed = seamed_outputs(plan) if not fix else frozenset()
+    seamed = seamed_outputs(plan)
     hoisted = HoistedFK.of(plan) if same_joints(plan) and not fix else None
     # (a nominal acos step's miss: dk_seed_miss of the least condition of the steps before it)
     ups = seed_conditions(plan)
