@@ -9,7 +9,7 @@
    is solved by it): one copy serves every arm of a folder, and each arm's file gets its own
    static copy of the routines, so arms link together in one program. Compile <name>_ik.c
    with it beside the file; do not include it anywhere else. */
-#define DK_RUNTIME 0xdc55254ec6fc
+#define DK_RUNTIME 0x09662675d849
 
 #include <math.h>
 #include <stddef.h>
@@ -3023,6 +3023,121 @@ static int dk_repeat(const dk_pending *p, const double (*found)[DK_REFINE_N], in
         }
     }
     return 0;
+}
+
+/* where a nominal table's arm has an odd number of certified rows, the missed one is looked
+   for across a fold from each row where J's least singular value is within DK_PARTNER_NEAR
+   but not below DK_PARTNER_FLOOR, at +- each of DK_PARTNER_STEPS along the direction J nearly
+   loses (dk_fold_partners; derive/runtime/refine.py, _PARTNER_NEAR, says why) */
+#define DK_PARTNER_NEAR (0.01)
+#define DK_PARTNER_FLOOR (1e-09)
+static const double DK_PARTNER_STEPS[4] = { 0.001, 0.004, 0.016, 0.064 };
+
+/* J^T J's least eigenvalue (J at the arm's values q, its columns the joints in solved) and its
+   unit eigenvector into v, by two steps of inverse iteration from (1, ..., 1) (the eigenvalue 1
+   over the last step's growth; 0 where J^T J is singular to roundings): the Python solver's
+   _least_direction */
+static double dk_least_direction(const double chain[DK_REFINE_N + 1][12],
+                                 const int revolute[DK_REFINE_N],
+                                 const int solved[DK_REFINE_M], double reach,
+                                 const double t[12], const double q[DK_REFINE_N],
+                                 double v[DK_REFINE_M])
+{
+    double pose[12], axes[DK_REFINE_N][3], origins[DK_REFINE_N][3], cs[DK_REFINE_N][2];
+    double J[6][DK_REFINE_M], least = 0.0;
+    int i, j, r, it;
+    for (i = 0; i < DK_REFINE_N; i++) {
+        cs[i][0] = cos(q[i]);
+        cs[i][1] = sin(q[i]);
+    }
+    dk_chain_pose(chain, revolute, q, (const double(*)[2])cs, pose, axes, origins);
+    dk_task_jacobian(pose, (const double(*)[3])axes, (const double(*)[3])origins, revolute,
+                     solved, reach, t, 0u, J);
+    for (i = 0; i < DK_REFINE_M; i++) {
+        v[i] = 1.0 / sqrt((double)DK_REFINE_M);
+    }
+    for (it = 0; it < 2; it++) {
+        double normal[DK_REFINE_M][DK_REFINE_M], w[DK_REFINE_M], size = 0.0;
+        for (i = 0; i < DK_REFINE_M; i++) {
+            for (j = 0; j < DK_REFINE_M; j++) {
+                normal[i][j] = 0.0;
+                for (r = 0; r < DK_REFINE_ROWS; r++) {
+                    normal[i][j] += J[r][i] * J[r][j];
+                }
+            }
+            w[i] = v[i];
+        }
+        if (!dk_cholesky_solve(normal, w)) {
+            return 0.0;
+        }
+        for (i = 0; i < DK_REFINE_M; i++) {
+            size += w[i] * w[i];
+        }
+        size = sqrt(size);
+        if (!(size > 0.0 && size < HUGE_VAL)) {
+            return 0.0;
+        }
+        for (i = 0; i < DK_REFINE_M; i++) {
+            v[i] = w[i] / size;
+        }
+        least = 1.0 / size;
+    }
+    return least;
+}
+
+/* rows[0..count) (finished: wrapped, no repeats) and, where count is odd, the rows the
+   refinement reaches from either side of a fold at each row near one (DK_PARTNER_NEAR,
+   DK_PARTNER_STEPS) certified within limit and neither a row nor on one's curve of solutions
+   (dk_repeat), appended wrapped while there is room (at most max in all): the new count
+   (the Python solver's _fold_partners) */
+static int dk_fold_partners(const double chain[DK_REFINE_N + 1][12],
+                            const int revolute[DK_REFINE_N], const int solved[DK_REFINE_M],
+                            double reach, const double t[12], double limit,
+                            double rows[][DK_REFINE_N], int count, int max)
+{
+    const int first = count;
+    int r, h, side, k, i;
+    dk_pending p; /* (what dk_repeat reads: the chain, the pose and limit) */
+    if (!(DK_SEED_TOL > 0.0) || count % 2 == 0) {
+        return count;
+    }
+    dk_pending_start(&p, chain, revolute, solved, reach, t, limit, max);
+    for (r = 0; r < first; r++) {
+        double v[DK_REFINE_M];
+        const double least = dk_least_direction(chain, revolute, solved, reach, t, rows[r], v);
+        if (!(least >= DK_PARTNER_FLOOR * DK_PARTNER_FLOOR &&
+              least <= DK_PARTNER_NEAR * DK_PARTNER_NEAR)) {
+            continue;
+        }
+        for (h = 0; h < 4; h++) {
+            for (side = 0; side < 2; side++) {
+                double q[DK_REFINE_N];
+                for (i = 0; i < DK_REFINE_N; i++) {
+                    q[i] = rows[r][i];
+                }
+                for (k = 0; k < DK_REFINE_M; k++) {
+                    q[solved[k]] += (side ? -1.0 : 1.0) * DK_PARTNER_STEPS[h] * v[k];
+                }
+                if (!(dk_refine(chain, revolute, solved, reach, t, q, 0u, DK_REFINE_PATIENCE) <=
+                      limit)) {
+                    continue;
+                }
+                if (!dk_repeat(&p, (const double(*)[DK_REFINE_N])rows, count, q) && count < max) {
+                    for (i = 0; i < DK_REFINE_N; i++) { /* (wrapped as dk_finish does) */
+                        double x = q[i];
+                        if (revolute[i]) {
+                            x = dk_wrap(x);
+                            x = x < -DK_SEAM ? x + DK_TWO_PI : x;
+                            x = fabs(x - DK_PI) <= DK_SEAM_SNAP ? DK_PI : x;
+                        }
+                        rows[count][i] = x;
+                    }
+                    count++;
+                }
+            }
+        }
+    }
+    return count;
 }
 
 /* q, a seed refined within p's limit, a row of found (n of them) where it is not one already,

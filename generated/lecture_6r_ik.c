@@ -34,7 +34,7 @@
 /* --- the routines every generated C solver shares: derive_ik_runtime.h beside this file ---- */
 
 #include "derive_ik_runtime.h"
-#if DK_RUNTIME != 0xdc55254ec6fc
+#if DK_RUNTIME != 0x09662675d849
 #error "derive_ik_runtime.h is another derive-ik's: generate the arms of a folder with one"
 #endif
 
@@ -776,17 +776,22 @@ int lecture_6r_ik_ref(const double T[16], const double *free, const double *q_re
     }
     {
         double t[12]; /* (T's rotation the nearest rotation where it is not one: dk_rigid) */
+        int loose = 0;
         dk_rigid(T, t);
         /* (the rows straight into q, in range already: only repeats to drop, in place) */
         count = dk_solve(t, tol, ref, q, &repeats, 0);
         if (count == 0) { /* (the second pass: _solve in derive/runtime/api.py says why) */
-            count = dk_solve(t, fmin(tol, DK_LOOSE_TOL), ref, q, &repeats, 1);
+            tol = fmin(tol, DK_LOOSE_TOL);
+            loose = 1;
+            count = dk_solve(t, tol, ref, q, &repeats, 1);
         }
+        if (count < 0) {
+            return LECTURE_6R_UNSETTLED;
+        }
+        count = repeats ? dk_finish(q, count, repeats, q) : count;
+        (void)loose;
     }
-    if (count < 0) {
-        return LECTURE_6R_UNSETTLED;
-    }
-    return repeats ? dk_finish(q, count, repeats, q) : count;
+    return count;
 }
 
 int lecture_6r_ik(const double T[16], const double *free, double tol,

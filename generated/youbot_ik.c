@@ -34,7 +34,7 @@
 /* --- the routines every generated C solver shares: derive_ik_runtime.h beside this file ---- */
 
 #include "derive_ik_runtime.h"
-#if DK_RUNTIME != 0xdc55254ec6fc
+#if DK_RUNTIME != 0x09662675d849
 #error "derive_ik_runtime.h is another derive-ik's: generate the arms of a folder with one"
 #endif
 
@@ -702,16 +702,21 @@ int youbot_ik_ref(const double T[16], const double *free, const double *q_ref, d
     }
     {
         double t[12]; /* (T's rotation the nearest rotation where it is not one: dk_rigid) */
+        int loose = 0;
         dk_rigid(T, t);
         count = dk_solve(t, tol, ref, found, &repeats, 0);
         if (count == 0) { /* (the second pass: _solve in derive/runtime/api.py says why) */
-            count = dk_solve(t, fmin(tol, DK_LOOSE_TOL), ref, found, &repeats, 1);
+            tol = fmin(tol, DK_LOOSE_TOL);
+            loose = 1;
+            count = dk_solve(t, tol, ref, found, &repeats, 1);
         }
+        if (count < 0) {
+            return YOUBOT_UNSETTLED;
+        }
+        count = dk_finish(found, count, repeats, q);
+        (void)loose;
     }
-    if (count < 0) {
-        return YOUBOT_UNSETTLED;
-    }
-    return dk_finish(found, count, repeats, q);
+    return count;
 }
 
 int youbot_ik(const double T[16], const double *free, double tol,

@@ -56,7 +56,7 @@ from derive.runtime.native import (
     _native_solver,
     _scratch,
 )
-from derive.runtime.refine import _LOOSE_TOL, _least_squares, _pose_error
+from derive.runtime.refine import _LOOSE_TOL, _fold_partners, _least_squares, _pose_error
 from derive.runtime.scalar import _LOOSE
 
 
@@ -196,10 +196,11 @@ def _solve(target, solve, tol):
     pass (dk_solve, loose), and keeps rows within _LOOSE_TOL (or tol, if smaller) only."""
     rows = _exact_first(target, solve, tol)
     if rows:
-        return rows
+        return _fold_partners(_finish(rows), target, tol)
     _LOOSE.near = True
     try:
-        return _exact_first(target, solve, min(tol, _LOOSE_TOL))
+        tol = min(tol, _LOOSE_TOL)
+        return _fold_partners(_finish(_exact_first(target, solve, tol)), target, tol)
     finally:
         _LOOSE.near = False
 

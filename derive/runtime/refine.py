@@ -31,7 +31,12 @@ from derive.runtime.arm import (
     REACH,
     TOOL_AXIS,
 )
-from derive.runtime.constants import _CURVE_FLAT, _CURVE_FLOOR, _CURVE_NEAR, _TWO_PI
+from derive.runtime.constants import (
+    _CURVE_FLAT,
+    _CURVE_FLOOR,
+    _CURVE_NEAR,
+    _TWO_PI,
+)
 from derive.runtime.scalar import _LOOSE, _Free, _ray_gap
 
 # at most this many steps per candidate (a seed on a singular configuration converges
@@ -100,6 +105,21 @@ _LOOSE_TOL = 1e-8
 # costs nothing more
 _TRIAL_SEED = 0.2
 _TRIAL_PATIENCE = 2
+# a nominal table's arm whose certified rows are odd in number (real solutions pair up where
+# the pose is regular) looks for the missed one across a fold (_fold_partners): from each row
+# where J's least singular value is within _PARTNER_NEAR (two steps of inverse iteration on
+# J^T J), seeds at +- each of _PARTNER_STEPS along the direction J nearly loses, refined and
+# certified as _seed's: a pybullet xArm6 URDF's pairs 8e-4 to 4.7e-3 rad apart near its
+# shoulder's and wrist's singular sets (sigma_min 2e-5 to 3e-5) lost a row in C or Python, with
+# it the sampled vector (a new user's attack, helper 70; the rows those pairs were missed
+# beside had least singular values 4e-8 to 6e-5); not from a row whose least singular value is
+# below _PARTNER_FLOOR, singular to roundings: at a CAD PUMA's straight wrist (q4 = q5 = 0) the
+# exact arm's rows there (3e-12 to 4e-11) lie on a valley of points within 1e-10 of the pose,
+# and the seeds refined onto other points of it, C keeping one more than Python at 3 of 30
+# poses; with 1e-6 both agreed there but the xArm6's misses came back (Python 2 -> 7 of 1,076)
+_PARTNER_NEAR = 1e-2
+_PARTNER_FLOOR = 1e-9
+_PARTNER_STEPS = (1e-3, 4e-3, 1.6e-2, 6.4e-2)
 # ik_approximate's least squares: at most this many steps, done where the gradient of half
 # the squared error is this flat
 _LSQ_STEPS = 200
@@ -139,6 +159,50 @@ def _seed_near(q, t):
     if size <= _SEED_TOL:
         return True
     return size <= _TRIAL_SEED and _refine(q, t, (), _TRIAL_PATIENCE)[1] <= _SEED_TOL
+
+
+def _fold_partners(rows, t, tol):
+    """rows (finished: wrapped, no repeats) and, where their number is odd on a nominal table's
+    arm solved for the whole pose by all six joints, the rows its refinement reaches from
+    either side of a fold at each row near one (_PARTNER_NEAR, _PARTNER_FLOOR, _PARTNER_STEPS;
+    the C solver's
+    dk_fold_partners), but a row again or one on a row's curve of solutions (_curve_row)."""
+    if not (_SEED_TOL and len(rows) % 2 and len(_SOLVED) == 6 and IK_COMPONENTS == "pose"):
+        return rows
+    limit = min(tol, _REFINE_STALL if _LOOSE.near else _REFINE_TOL)
+    out = list(rows)
+    for q in rows:
+        least, v = _least_direction(_pose_error(q, t, False)[1])
+        if not _PARTNER_FLOOR * _PARTNER_FLOOR <= least <= _PARTNER_NEAR * _PARTNER_NEAR:
+            continue
+        for h in _PARTNER_STEPS:
+            for sign in (1.0, -1.0):
+                seed = list(q)
+                for k, i in enumerate(_SOLVED):
+                    seed[i] += sign * h * v[k]
+                p, size = _refine(seed, t)
+                if size <= limit and _curve_row(out, t, p, limit) is p:
+                    out.append(p)
+    return out
+
+
+def _least_direction(columns):
+    """J^T J's least eigenvalue (J's columns given) and its unit eigenvector, by two steps of
+    inverse iteration from (1, ..., 1) (the eigenvalue 1 over the last step's growth; 0 where
+    J^T J is singular to roundings; the C solver's dk_least_direction)."""
+    m = len(columns)
+    v = [1.0 / math.sqrt(m)] * m
+    least = 0.0
+    for _ in range(2):
+        normal = [[_dot(columns[i], columns[j]) for j in range(m)] for i in range(m)]
+        w = list(v)
+        if not _cholesky_solve(normal, w):
+            return 0.0, v
+        size = math.sqrt(_dot(w, w))
+        if not 0.0 < size < math.inf:
+            return 0.0, v
+        v, least = [x / size for x in w], 1.0 / size
+    return least, v
 
 
 def _curve_row(found, t, q, limit):
