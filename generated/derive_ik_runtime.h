@@ -9,7 +9,7 @@
    is solved by it): one copy serves every arm of a folder, and each arm's file gets its own
    static copy of the routines, so arms link together in one program. Compile <name>_ik.c
    with it beside the file; do not include it anywhere else. */
-#define DK_RUNTIME 0x09662675d849
+#define DK_RUNTIME 0x67b8105d7801
 
 #include <math.h>
 #include <stddef.h>
@@ -3033,10 +3033,11 @@ static int dk_repeat(const dk_pending *p, const double (*found)[DK_REFINE_N], in
 #define DK_PARTNER_FLOOR (1e-09)
 static const double DK_PARTNER_STEPS[4] = { 0.001, 0.004, 0.016, 0.064 };
 
-/* J^T J's least eigenvalue (J at the arm's values q, its columns the joints in solved) and its
-   unit eigenvector into v, by two steps of inverse iteration from (1, ..., 1) (the eigenvalue 1
-   over the last step's growth; 0 where J^T J is singular to roundings): the Python solver's
-   _least_direction */
+/* J^T J's least eigenvalue (J at the arm's values q, its columns the joints in solved: square)
+   and its unit eigenvector into v, by two steps of inverse iteration from (1, ..., 1), each
+   (J^T J)^-1 v = J^-1 J^-T v by Householder's QR with J^T, then J (dk_qr_solve: J's own
+   condition, not the normal equations' square); the eigenvalue 1 over the last step's growth:
+   the Python solver's _least_direction */
 static double dk_least_direction(const double chain[DK_REFINE_N + 1][12],
                                  const int revolute[DK_REFINE_N],
                                  const int solved[DK_REFINE_M], double reach,
@@ -3045,7 +3046,7 @@ static double dk_least_direction(const double chain[DK_REFINE_N + 1][12],
 {
     double pose[12], axes[DK_REFINE_N][3], origins[DK_REFINE_N][3], cs[DK_REFINE_N][2];
     double J[6][DK_REFINE_M], least = 0.0;
-    int i, j, r, it;
+    int i, j, it;
     for (i = 0; i < DK_REFINE_N; i++) {
         cs[i][0] = cos(q[i]);
         cs[i][1] = sin(q[i]);
@@ -3057,19 +3058,21 @@ static double dk_least_direction(const double chain[DK_REFINE_N + 1][12],
         v[i] = 1.0 / sqrt((double)DK_REFINE_M);
     }
     for (it = 0; it < 2; it++) {
-        double normal[DK_REFINE_M][DK_REFINE_M], w[DK_REFINE_M], size = 0.0;
-        for (i = 0; i < DK_REFINE_M; i++) {
+        double A[6][DK_REFINE_M], e[6], w[DK_REFINE_M], size = 0.0;
+        for (i = 0; i < 6; i++) { /* J^T (J square: six rows, six joints) */
             for (j = 0; j < DK_REFINE_M; j++) {
-                normal[i][j] = 0.0;
-                for (r = 0; r < DK_REFINE_ROWS; r++) {
-                    normal[i][j] += J[r][i] * J[r][j];
-                }
+                A[i][j] = i < DK_REFINE_M && j < 6 ? J[j][i] : 0.0;
             }
-            w[i] = v[i];
+            e[i] = i < DK_REFINE_M ? v[i] : 0.0;
         }
-        if (!dk_cholesky_solve(normal, w)) {
-            return 0.0;
+        dk_qr_solve(A, e, w);
+        for (i = 0; i < 6; i++) { /* then J */
+            for (j = 0; j < DK_REFINE_M; j++) {
+                A[i][j] = J[i][j];
+            }
+            e[i] = i < DK_REFINE_M ? w[i] : 0.0;
         }
+        dk_qr_solve(A, e, w);
         for (i = 0; i < DK_REFINE_M; i++) {
             size += w[i] * w[i];
         }

@@ -510,6 +510,47 @@ def test_an_odd_number_of_rows_looks_across_the_fold_for_the_missed_one(xarm6, b
             assert np.max(np.abs(np.array(urdf.urdf_fk(chain, list(row))) - T)) <= 1e-9
 
 
+# the Kinova Jaco j2s6s200 (tests/data/urdf/kinova_j2s6s200.urdf, its nominal table Pieper's)
+# at its wrist singular to roundings (q5 = pi, -4.8e-14, -4.6e-13; sigma_min about 1e-13):
+# seven rows, an odd count that is a double root's (helper 72)
+KINOVA_SINGULAR = [
+    [-2.025924724906742, -1.862996615623441, -1.8910070442478213,
+     2.791790091993029, 3.141592653589793, 2.0148080558725567],
+    [-2.362526077510659, -1.913702915466469, 2.2583565761345987,
+     3.0059773128169613, -4.7761222500772314e-14, 0.2899372377063867],
+    [1.4170634191857685, 0.8768644651652275, -1.0364408218930787,
+     3.11310687476555, -4.57435003351874e-13, 1.4172821542693477],
+]  # fmt: skip
+
+
+@needs_cc
+def test_a_pose_singular_to_roundings_does_not_look_across_a_fold(tmp_path):
+    """An odd count at a pose singular to roundings is a double root's, not a missed partner:
+    the search across the fold skips rows whose Jacobian's least singular value is below
+    _PARTNER_FLOOR. Estimated by inverse iteration on J^T J it could not go below about 1e-8
+    (the normal equations square J's condition), so at these Kinova poses (about 1e-13) the
+    search ran, and its seeds refined onto other points of the wrist's curve of solutions:
+    12 rows 2e-3 rad apart in both backends, or 7 in C and 15 in Python, where the rows are 7
+    (a new user's attack, helper 72). By QR with J^T and J the estimate is J's own: 7 rows in
+    both, at least 1.8 rad apart."""
+    from derive import urdf
+
+    path = Path(__file__).parent / "data" / "urdf" / "kinova_j2s6s200.urdf"
+    options = urdf.Options(base="j2s6s200_link_base", tip="j2s6s200_end_effector")
+    module = spec_module(urdf.load_urdf(path, options), tmp_path)
+    assert module._SEED_TOL > 0.0
+    for q in np.array(KINOVA_SINGULAR):
+        T = module.fk(q)
+        counts = []
+        for backend in ("c", "python"):
+            rows = module.ik(T, backend=backend)
+            counts.append(len(rows))
+            gaps = np.abs(np.remainder(rows[:, None] - rows[None] + math.pi, 2 * math.pi) - math.pi)
+            closest = np.min(gaps.max(axis=2) + np.eye(len(rows)) * 9.0)
+            assert closest > 1.0, (backend, q, len(rows), closest)
+        assert counts == [7, 7], (q, counts)
+
+
 def test_a_path_of_the_general_method_keeps_the_sign_of_det_j(xarm6):
     """The general method names no branch, so ik_path chose by distance alone, and on this
     xArm6 line (20 poses; sigma_min >= 5.3e-3 on it, a 100 times finer nearest-row walk

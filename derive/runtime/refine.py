@@ -107,16 +107,16 @@ _TRIAL_SEED = 0.2
 _TRIAL_PATIENCE = 2
 # a nominal table's arm whose certified rows are odd in number (real solutions pair up where
 # the pose is regular) looks for the missed one across a fold (_fold_partners): from each row
-# where J's least singular value is within _PARTNER_NEAR (two steps of inverse iteration on
-# J^T J), seeds at +- each of _PARTNER_STEPS along the direction J nearly loses, refined and
-# certified as _seed's: a pybullet xArm6 URDF's pairs 8e-4 to 4.7e-3 rad apart near its
-# shoulder's and wrist's singular sets (sigma_min 2e-5 to 3e-5) lost a row in C or Python, with
-# it the sampled vector (a new user's attack, helper 70; the rows those pairs were missed
-# beside had least singular values 4e-8 to 6e-5); not from a row whose least singular value is
-# below _PARTNER_FLOOR, singular to roundings: at a CAD PUMA's straight wrist (q4 = q5 = 0) the
-# exact arm's rows there (3e-12 to 4e-11) lie on a valley of points within 1e-10 of the pose,
-# and the seeds refined onto other points of it, C keeping one more than Python at 3 of 30
-# poses; with 1e-6 both agreed there but the xArm6's misses came back (Python 2 -> 7 of 1,076)
+# where J's least singular value is within _PARTNER_NEAR (_least_direction), seeds at +- each
+# of _PARTNER_STEPS along the direction J nearly loses, refined and certified as _seed's: a
+# pybullet xArm6 URDF's pairs 8e-4 to 4.7e-3 rad apart near its shoulder's and wrist's
+# singular sets (sigma_min 2e-5 to 3e-5) lost a row in C or Python, with it the sampled vector
+# (a new user's attack, helper 70; the rows those pairs were missed beside had least singular
+# values 4e-8 to 6e-5); not from a row whose least singular value is below _PARTNER_FLOOR,
+# singular to roundings: at a CAD PUMA's straight wrist (q4 = q5 = 0) the exact arm's rows
+# there (3e-12 to 4e-11) lie on a valley of points within 1e-10 of the pose, and the seeds
+# refined onto other points of it, C keeping one more than Python at 3 of 30 poses; with 1e-6
+# both agreed there but the xArm6's misses came back (Python 2 -> 7 of 1,076)
 _PARTNER_NEAR = 1e-2
 _PARTNER_FLOOR = 1e-9
 _PARTNER_STEPS = (1e-3, 4e-3, 1.6e-2, 6.4e-2)
@@ -187,17 +187,18 @@ def _fold_partners(rows, t, tol):
 
 
 def _least_direction(columns):
-    """J^T J's least eigenvalue (J's columns given) and its unit eigenvector, by two steps of
-    inverse iteration from (1, ..., 1) (the eigenvalue 1 over the last step's growth; 0 where
-    J^T J is singular to roundings; the C solver's dk_least_direction)."""
+    """J^T J's least eigenvalue (J's columns given: square) and its unit eigenvector, by two
+    steps of inverse iteration from (1, ..., 1), each (J^T J)^-1 v = J^-1 J^-T v by Householder's
+    QR with J^T, then J (_qr_solve: J's own condition; the normal equations' square stopped the
+    estimate of J's least singular value near 1e-8 where it was 6e-13, and a singular wrist's
+    rows took the search, which added points of its curve of solutions: helper 72); the
+    eigenvalue 1 over the last step's growth (the C solver's dk_least_direction)."""
     m = len(columns)
+    rows = [[column[r] for column in columns] for r in range(m)]  # (J^T's columns)
     v = [1.0 / math.sqrt(m)] * m
     least = 0.0
     for _ in range(2):
-        normal = [[_dot(columns[i], columns[j]) for j in range(m)] for i in range(m)]
-        w = list(v)
-        if not _cholesky_solve(normal, w):
-            return 0.0, v
+        w = _qr_solve(columns, _qr_solve(rows, v))
         size = math.sqrt(_dot(w, w))
         if not 0.0 < size < math.inf:
             return 0.0, v
