@@ -38,7 +38,7 @@ if "_RUNTIME_VERSION" not in globals():  # (imported on its own, not run by a mo
         "namespace; it is not a module to import"
     )
 # this runtime's version: a module runs the runtime of its own version only
-_RUNTIME_VERSION = "8a4a42c631c3d44b"
+_RUNTIME_VERSION = "7a21030a6b64b622"
 
 if TYPE_CHECKING:  # defined by the module running this file
     from derive.runtime.arm import (
@@ -4661,7 +4661,11 @@ _TRIAL_PATIENCE = 2
 # singular to roundings: at a CAD PUMA's straight wrist (q4 = q5 = 0) the exact arm's rows
 # there (3e-12 to 4e-11) lie on a valley of points within 1e-10 of the pose, and the seeds
 # refined onto other points of it, C keeping one more than Python at 3 of 30 poses; with 1e-6
-# both agreed there but the xArm6's misses came back (Python 2 -> 7 of 1,076)
+# both agreed there but the xArm6's misses came back (Python 2 -> 7 of 1,076); and from each
+# three revolute joints' flip (q_i + pi, -q_i+1, q_i+2 + pi: a spherical wrist's other
+# solution, exact on the nominal table): a Kinova j2s6s200's wrist 1e-8 to 1e-7 rad from
+# straight (sigma_min 1.7e-9 to 1.7e-8) had 7 rows, the sampled vector's partner the wrist's
+# flip, 2.6 rad away in q4 and q6 (helper 72)
 _PARTNER_NEAR = 1e-2
 
 
@@ -4716,10 +4720,11 @@ def _seed_near(q, t):
 
 def _fold_partners(rows, t, tol):
     """rows (finished: wrapped, no repeats) and, where their number is odd on a nominal table's
-    arm solved for the whole pose by all six joints, the rows its refinement reaches from
-    either side of a fold at each row near one (_PARTNER_NEAR, _PARTNER_FLOOR, _PARTNER_STEPS;
-    the C solver's
-    dk_fold_partners), but a row again or one on a row's curve of solutions (_curve_row)."""
+    arm solved for the whole pose by six joints, the rows its refinement reaches from either
+    side of a fold at each row near one (_PARTNER_NEAR, _PARTNER_FLOOR, _PARTNER_STEPS) and from
+    each three of its solved revolute joints' flips: but a row again, one on a row's curve of
+    solutions (_curve_row) and one singular to roundings itself (below _PARTNER_FLOOR); the C
+    solver's dk_fold_partners."""
     if not (_SEED_TOL and len(rows) % 2 and len(_SOLVED) == 6 and IK_COMPONENTS == "pose"):
         return rows
     limit = min(tol, _REFINE_STALL if _LOOSE.near else _REFINE_TOL)
@@ -4728,14 +4733,28 @@ def _fold_partners(rows, t, tol):
         least, v = _least_direction(_pose_error(q, t, False)[1])
         if not _PARTNER_FLOOR * _PARTNER_FLOOR <= least <= _PARTNER_NEAR * _PARTNER_NEAR:
             continue
+        seeds = []
         for h in _PARTNER_STEPS:
             for sign in (1.0, -1.0):
                 seed = list(q)
                 for k, i in enumerate(_SOLVED):
                     seed[i] += sign * h * v[k]
-                p, size = _refine(seed, t)
-                if size <= limit and _curve_row(out, t, p, limit) is p:
-                    out.append(p)
+                seeds.append(seed)
+        for i in range(len(q) - 2):  # (each three solved revolute joints' flip; a free joint
+            # keeps the caller's value)
+            if all(_REVOLUTE[j] and j in _SOLVED for j in (i, i + 1, i + 2)):
+                seed = list(q)
+                seed[i], seed[i + 1], seed[i + 2] = q[i] + math.pi, -q[i + 1], q[i + 2] + math.pi
+                seeds.append(seed)
+        for seed in seeds:
+            p, size = _refine(seed, t)
+            if size > limit or _curve_row(out, t, p, limit) is not p:
+                continue
+            # (a row singular to roundings lies on a valley or curve of solutions whose rows
+            # the first pass gave: a flip's seed at a Kinova's straight wrist refined onto a
+            # point 3.5e-3 from one)
+            if _least_direction(_pose_error(p, t, False)[1])[0] >= _PARTNER_FLOOR**2:
+                out.append(p)
     return out
 
 

@@ -3074,55 +3074,83 @@ static double dk_least_direction(const double chain[DK_REFINE_N + 1][12],
     return least;
 }
 
+/* whether the arm's joint j is one of solved (a free joint keeps the caller's value) */
+static int dk_moves(const int solved[DK_REFINE_M], int j)
+{
+    int k;
+    for (k = 0; k < DK_REFINE_M; k++) {
+        if (solved[k] == j) {
+            return 1;
+        }
+    }
+    return 0;
+}
+
 /* rows[0..count) (finished: wrapped, no repeats) and, where count is odd, the rows the
    refinement reaches from either side of a fold at each row near one (DK_PARTNER_NEAR,
-   DK_PARTNER_STEPS) certified within limit and neither a row nor on one's curve of solutions
-   (dk_repeat), appended wrapped while there is room (at most max in all): the new count
-   (the Python solver's _fold_partners) */
+   DK_PARTNER_STEPS) and from each three of its solved revolute joints' flips (q_i + pi,
+   -q_i+1, q_i+2 + pi)
+   certified within limit, neither a row nor on one's curve of solutions (dk_repeat) nor
+   singular to roundings itself (DK_PARTNER_FLOOR), appended wrapped while there is room (at
+   most max in all): the new count (the Python solver's _fold_partners) */
 static int dk_fold_partners(const double chain[DK_REFINE_N + 1][12],
                             const int revolute[DK_REFINE_N], const int solved[DK_REFINE_M],
                             double reach, const double t[12], double limit,
                             double rows[][DK_REFINE_N], int count, int max)
 {
     const int first = count;
-    int r, h, side, k, i;
+    int r, h, k, i;
     dk_pending p; /* (what dk_repeat reads: the chain, the pose and limit) */
     if (!(DK_SEED_TOL > 0.0) || count % 2 == 0) {
         return count;
     }
     dk_pending_start(&p, chain, revolute, solved, reach, t, limit, max);
     for (r = 0; r < first; r++) {
-        double v[DK_REFINE_M];
+        double v[DK_REFINE_M], w[DK_REFINE_M];
         const double least = dk_least_direction(chain, revolute, solved, reach, t, rows[r], v);
         if (!(least >= DK_PARTNER_FLOOR * DK_PARTNER_FLOOR &&
               least <= DK_PARTNER_NEAR * DK_PARTNER_NEAR)) {
             continue;
         }
-        for (h = 0; h < 4; h++) {
-            for (side = 0; side < 2; side++) {
-                double q[DK_REFINE_N];
-                for (i = 0; i < DK_REFINE_N; i++) {
-                    q[i] = rows[r][i];
-                }
+        for (h = 0; h < 8 + DK_REFINE_N - 2; h++) {
+            /* (h < 8: a step either side along v; then each three revolute joints' flip) */
+            double q[DK_REFINE_N];
+            const int f = h - 8;
+            for (i = 0; i < DK_REFINE_N; i++) {
+                q[i] = rows[r][i];
+            }
+            if (h < 8) {
                 for (k = 0; k < DK_REFINE_M; k++) {
-                    q[solved[k]] += (side ? -1.0 : 1.0) * DK_PARTNER_STEPS[h] * v[k];
+                    q[solved[k]] += (h % 2 ? -1.0 : 1.0) * DK_PARTNER_STEPS[h / 2] * v[k];
                 }
-                if (!(dk_refine(chain, revolute, solved, reach, t, q, 0u, DK_REFINE_PATIENCE) <=
-                      limit)) {
-                    continue;
-                }
-                if (!dk_repeat(&p, (const double(*)[DK_REFINE_N])rows, count, q) && count < max) {
-                    for (i = 0; i < DK_REFINE_N; i++) { /* (wrapped as dk_finish does) */
-                        double x = q[i];
-                        if (revolute[i]) {
-                            x = dk_wrap(x);
-                            x = x < -DK_SEAM ? x + DK_TWO_PI : x;
-                            x = fabs(x - DK_PI) <= DK_SEAM_SNAP ? DK_PI : x;
-                        }
-                        rows[count][i] = x;
+            } else if (revolute[f] && revolute[f + 1] && revolute[f + 2] &&
+                       dk_moves(solved, f) && dk_moves(solved, f + 1) && dk_moves(solved, f + 2)) {
+                q[f] += DK_PI;
+                q[f + 1] = -q[f + 1];
+                q[f + 2] += DK_PI;
+            } else {
+                continue;
+            }
+            if (!(dk_refine(chain, revolute, solved, reach, t, q, 0u, DK_REFINE_PATIENCE) <=
+                  limit) ||
+                dk_repeat(&p, (const double(*)[DK_REFINE_N])rows, count, q)) {
+                continue;
+            }
+            /* (a row singular to roundings lies on a valley or curve of solutions whose rows the
+               first pass gave) */
+            if (dk_least_direction(chain, revolute, solved, reach, t, q, w) >=
+                    DK_PARTNER_FLOOR * DK_PARTNER_FLOOR &&
+                count < max) {
+                for (i = 0; i < DK_REFINE_N; i++) { /* (wrapped as dk_finish does) */
+                    double x = q[i];
+                    if (revolute[i]) {
+                        x = dk_wrap(x);
+                        x = x < -DK_SEAM ? x + DK_TWO_PI : x;
+                        x = fabs(x - DK_PI) <= DK_SEAM_SNAP ? DK_PI : x;
                     }
-                    count++;
+                    rows[count][i] = x;
                 }
+                count++;
             }
         }
     }
