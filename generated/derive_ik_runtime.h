@@ -9,7 +9,7 @@
    is solved by it): one copy serves every arm of a folder, and each arm's file gets its own
    static copy of the routines, so arms link together in one program. Compile <name>_ik.c
    with it beside the file; do not include it anywhere else. */
-#define DK_RUNTIME 0xaf9e77eca1e7
+#define DK_RUNTIME 0x4eddf794c442
 
 #include <math.h>
 #include <stddef.h>
@@ -3103,7 +3103,7 @@ static int dk_moves(const int solved[DK_REFINE_M], int j)
 /* rows[0..count) (finished: wrapped, no repeats) and, where count is odd, the rows the
    refinement reaches from either side of a fold at each row near one (DK_PARTNER_NEAR,
    DK_PARTNER_STEPS) and from each three of its solved revolute joints' flips (q_i + pi,
-   -q_i+1, q_i+2 + pi)
+   -q_i+1, q_i+2 + pi) within DK_SEED_TOL of the pose
    certified within limit, neither a row nor on one's curve of solutions (dk_repeat) nor
    singular to roundings itself (DK_PARTNER_FLOOR), appended wrapped while there is room (at
    most max in all): the new count (the Python solver's _fold_partners) */
@@ -3142,6 +3142,9 @@ static int dk_fold_partners(const double chain[DK_REFINE_N + 1][12],
                 q[f] += DK_PI;
                 q[f + 1] = -q[f + 1];
                 q[f + 2] += DK_PI;
+                if (!(dk_chain_error(chain, revolute, reach, t, q) <= DK_SEED_TOL)) {
+                    continue; /* (no solution of the nominal table: not refined) */
+                }
             } else {
                 continue;
             }
