@@ -9,7 +9,7 @@
    is solved by it): one copy serves every arm of a folder, and each arm's file gets its own
    static copy of the routines, so arms link together in one program. Compile <name>_ik.c
    with it beside the file; do not include it anywhere else. */
-#define DK_RUNTIME 0x4eddf794c442
+#define DK_RUNTIME 0xf9884ea357e7
 
 #include <math.h>
 #include <stddef.h>
@@ -3159,13 +3159,7 @@ static int dk_fold_partners(const double chain[DK_REFINE_N + 1][12],
                     DK_PARTNER_FLOOR * DK_PARTNER_FLOOR &&
                 count < max) {
                 for (i = 0; i < DK_REFINE_N; i++) { /* (wrapped as dk_finish does) */
-                    double x = q[i];
-                    if (revolute[i]) {
-                        x = dk_wrap(x);
-                        x = x < -DK_SEAM ? x + DK_TWO_PI : x;
-                        x = fabs(x - DK_PI) <= DK_SEAM_SNAP ? DK_PI : x;
-                    }
-                    rows[count][i] = x;
+                    rows[count][i] = revolute[i] ? dk_seam(q[i]) : q[i];
                 }
                 count++;
             }

@@ -34,7 +34,7 @@
 /* --- the routines every generated C solver shares: derive_ik_runtime.h beside this file ---- */
 
 #include "derive_ik_runtime.h"
-#if DK_RUNTIME != 0x4eddf794c442
+#if DK_RUNTIME != 0xf9884ea357e7
 #error "derive_ik_runtime.h is another derive-ik's: generate the arms of a folder with one"
 #endif
 
@@ -779,19 +779,17 @@ int lecture_6r_ik_ref(const double T[16], const double *free, const double *q_re
         int loose = 0;
         dk_rigid(T, t);
         /* (the rows straight into q, in range already: only repeats to drop, in place) */
+        /* (never a refined arm's: seamed_outputs; no odd count to look across a fold for) */
+        (void)loose;
         count = dk_solve(t, tol, ref, q, &repeats, 0);
         if (count == 0) { /* (the second pass: _solve in derive/runtime/api.py says why) */
-            tol = fmin(tol, DK_LOOSE_TOL);
-            loose = 1;
-            count = dk_solve(t, tol, ref, q, &repeats, 1);
+            count = dk_solve(t, fmin(tol, DK_LOOSE_TOL), ref, q, &repeats, 1);
         }
-        if (count < 0) {
-            return LECTURE_6R_UNSETTLED;
-        }
-        count = repeats ? dk_finish(q, count, repeats, q) : count;
-        (void)loose;
     }
-    return count;
+    if (count < 0) {
+        return LECTURE_6R_UNSETTLED;
+    }
+    return repeats ? dk_finish(q, count, repeats, q) : count;
 }
 
 int lecture_6r_ik(const double T[16], const double *free, double tol,

@@ -3145,13 +3145,7 @@ static int dk_fold_partners(const double chain[DK_REFINE_N + 1][12],
                     DK_PARTNER_FLOOR * DK_PARTNER_FLOOR &&
                 count < max) {
                 for (i = 0; i < DK_REFINE_N; i++) { /* (wrapped as dk_finish does) */
-                    double x = q[i];
-                    if (revolute[i]) {
-                        x = dk_wrap(x);
-                        x = x < -DK_SEAM ? x + DK_TWO_PI : x;
-                        x = fabs(x - DK_PI) <= DK_SEAM_SNAP ? DK_PI : x;
-                    }
-                    rows[count][i] = x;
+                    rows[count][i] = revolute[i] ? dk_seam(q[i]) : q[i];
                 }
                 count++;
             }

@@ -31,12 +31,7 @@ from derive.runtime.arm import (
     REACH,
     TOOL_AXIS,
 )
-from derive.runtime.constants import (
-    _CURVE_FLAT,
-    _CURVE_FLOOR,
-    _CURVE_NEAR,
-    _TWO_PI,
-)
+from derive.runtime.constants import _CURVE_FLAT, _CURVE_FLOOR, _CURVE_NEAR, _TWO_PI
 from derive.runtime.scalar import _LOOSE, _Free, _ray_gap
 
 # at most this many steps per candidate (a seed on a singular configuration converges
