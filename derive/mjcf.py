@@ -328,11 +328,13 @@ def import_mjcf(path: Path, options: urdf.Options) -> tuple[str, urdf.Conversion
     """The spec text of the chain options.base .. options.tip (bodies) of an MJCF file, and
     the conversion's record (derive/urdf.py's import_chain)."""
     where = str(path)
-    if not options.base or not options.tip:
-        raise UrdfError(f"{where}: an MJCF needs --base BODY and --tip BODY")
     model = compile_model(path)
     digest = hashlib.sha256(path.read_bytes()).hexdigest()[:16]
     robot, index, places = model_robot(model, where, digest)
+    if not options.base or not options.tip:
+        world = _names(model, 1, _mujoco(where).mjtObj.mjOBJ_BODY, "body")[0]
+        hint = urdf.ends_hint(robot, "bodies and sites", world) if model.nbody > 1 else ""
+        raise UrdfError(f"{where}: an MJCF needs --base BODY and --tip BODY{hint}")
     if model.nbody == 1:  # (only MuJoCo's world: no <worldbody> of the file's own)
         raise UrdfError(
             f"{where}: no bodies but MuJoCo's world (an included fragment without a "

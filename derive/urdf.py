@@ -295,6 +295,21 @@ def _shown(text: str) -> str:
     return repr(_cut(text))
 
 
+def ends_hint(robot: Robot, parts: str = "links", world: str = "") -> str:
+    """Where the caller named no base or tip: the file's root parts (no joint's child; with
+    world, MJCF's world body, the bodies on it) and leaf parts (no joint's parent: URDF links,
+    MJCF bodies and sites), the usual base and tip, as a hint."""
+    children = {j.child for j in robot.joints}
+    parents = {j.parent for j in robot.joints}
+    if world:
+        roots = sorted({j.child for j in robot.joints if j.parent == world})
+    else:
+        roots = [n for n in robot.links if n not in children]
+    leaves = [n for n in robot.links if n not in parents and n in children]
+    first = f"the {parts} on its world" if world else f"its root {parts}"
+    return f" ({first}: {_listing(roots)}; its leaf {parts}: {_listing(leaves)})"
+
+
 def _listing(names: list[str]) -> str:
     """The first LISTED of names, sorted and cut, and how many more there are."""
     ordered = sorted(names)
@@ -1085,9 +1100,9 @@ def import_urdf(path: Path, options: Options) -> tuple[str, Conversion]:
     the converter is wrong), within max_deviation with it (else the user must decide). What
     was ignored is said on stderr, one ``note:`` line each (also in the record's notes)."""
     where = str(path)
-    if not options.base or not options.tip:
-        raise UrdfError(f"{where}: a URDF needs --base LINK and --tip LINK")
     robot = read_urdf(path)
+    if not options.base or not options.tip:
+        raise UrdfError(f"{where}: a URDF needs --base LINK and --tip LINK{ends_hint(robot)}")
     try:
         chain = chain_between(robot, options.base, options.tip, where)
     except UrdfError as exc:

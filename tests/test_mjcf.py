@@ -224,6 +224,17 @@ def test_bad_mjcf_input_is_one_line_naming_the_file(xml, base, tip, message, tmp
     assert err.startswith(f"error: {path}: ") and message in err and err.count("\n") == 1
 
 
+def test_an_mjcf_without_base_or_tip_is_told_the_bodies_on_its_world_and_its_leaves(
+    tmp_path, capsys
+):
+    path = DATA / "jaco_arm.xml"
+    assert cli.main(["generate", str(path), "--tip", "wristsite", "--out", str(tmp_path)]) == 2
+    assert capsys.readouterr().err == (
+        f"error: {path}: an MJCF needs --base BODY and --tip BODY (the bodies and sites on "
+        "its world: 'b_base'; its leaf bodies and sites: 'wristsite')\n"
+    )
+
+
 THREE = (
     '<mujoco model="m"><worldbody><body name="b0"><body name="b1" pos="0 0 0.1">'
     '<joint name="j1" axis="0 0 1" RANGE/><geom size="0.01"/>'

@@ -15,7 +15,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from derive import urdf
+from derive import cli, urdf
 from derive.emit import render_module
 from derive.pipeline import build_plan
 
@@ -264,6 +264,19 @@ def test_bad_and_hostile_urdfs_get_one_line_and_exit_2(case, tmp_path):
         lines = result.stderr.strip().split("\n")
         assert len(lines) == 1 and words in lines[0] and "Traceback" not in result.stderr, lines
     assert not out.exists() and not (tmp_path / "g").exists()
+
+
+def test_a_urdf_without_base_or_tip_is_told_its_root_and_leaf_links(tmp_path, capsys):
+    # (a new user's first try names only the file; the message names the usual base and tip)
+    path = DATA / "irb140.urdf"
+    for args in ([], ["--base", "base_link"], ["--tip", "tool0"]):
+        assert cli.main(["generate", str(path), *args, "--out", str(tmp_path / "g")]) == 2
+        err = capsys.readouterr().err
+        assert err == (
+            f"error: {path}: a URDF needs --base LINK and --tip LINK (its root links: "
+            "'base_link'; its leaf links: 'base', 'tool0')\n"
+        )
+    assert not (tmp_path / "g").exists()
 
 
 def test_a_50_mb_urdf_is_refused_unread(tmp_path):
