@@ -344,8 +344,9 @@ def import_mjcf(path: Path, options: urdf.Options) -> tuple[str, urdf.Conversion
         if name not in places:
             bodies = sorted(n for n, (kind, _) in places.items() if kind == "body")
             sites = sorted(n for n, (kind, _) in places.items() if kind == "site")
+            hint = urdf.did_you_mean(name, places)
             raise UrdfError(
-                f"{where}: {what} {urdf._shown(name)}: no such body or site; bodies: "
+                f"{where}: {what} {urdf._shown(name)}: no such body or site; {hint}bodies: "
                 f"{urdf._listing(bodies)}" + (f"; sites: {urdf._listing(sites)}" if sites else "")
             )
     if places[options.base][0] == "site":

@@ -27,6 +27,7 @@ import random
 import re
 import stat
 import sys
+from collections.abc import Iterable
 from dataclasses import dataclass, field
 from pathlib import Path
 from xml.etree.ElementTree import TreeBuilder
@@ -310,6 +311,18 @@ def ends_hint(robot: Robot, parts: str = "links", world: str = "") -> str:
     return f" ({first}: {_listing(roots)}; its leaf {parts}: {_listing(leaves)})"
 
 
+def did_you_mean(name: str, names: Iterable[str]) -> str:
+    """The hint "did you mean 'a', 'b'? " with the names nearest name (difflib's), or "":
+    the nearest names first (a misspelled --tip "urdf_hed" got the first links alphabetically,
+    which did not include "urdf_head", a new user's attack); not for names or files of hostile
+    sizes (each comparison is quadratic)."""
+    known = sorted(names)
+    if len(name) > 200 or len(known) > 10_000:
+        return ""
+    near = difflib.get_close_matches(name, known, n=3, cutoff=0.6)
+    return f"did you mean {', '.join(map(_shown, near))}? " if near else ""
+
+
 def _listing(names: list[str]) -> str:
     """The first LISTED of names, sorted and cut, and how many more there are."""
     ordered = sorted(names)
@@ -412,14 +425,7 @@ def chain_between(
     for link, what in ((base, "--base"), (tip, "--tip")):
         if link not in robot.links:
             known = _listing(list(robot.links))
-            # (the nearest names first: a misspelled --tip "urdf_hed" got the first links
-            # alphabetically, which did not include "urdf_head", a new user's attack)
-            near = (  # (not for names or files of hostile sizes: each comparison is quadratic)
-                difflib.get_close_matches(link, sorted(robot.links), n=3, cutoff=0.6)
-                if len(link) <= 200 and len(robot.links) <= 10_000
-                else []
-            )
-            hint = f"did you mean {', '.join(map(_shown, near))}? " if near else ""
+            hint = did_you_mean(link, robot.links)
             raise UrdfError(f"{where}: {what} {_shown(link)}: no such link; {hint}links: {known}")
     above = {j.child: j for j in robot.joints}
     path: list[UrdfJoint] = []

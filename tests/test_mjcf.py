@@ -189,6 +189,12 @@ def test_task_tool_axis_and_method_options_reach_the_spec(tmp_path, capsys):
     ("xml", "base", "tip", "message"),
     [
         ("jaco_arm.xml", "b_base", "nope", "--tip 'nope': no such body or site; bodies: 'b_1'"),
+        (  # (a misspelt body: the nearest names first, as for a URDF's links)
+            "jaco_arm.xml",
+            "b_base",
+            "wristsight",
+            "--tip 'wristsight': no such body or site; did you mean 'wristsite'? bodies: 'b_1'",
+        ),
         ("not xml", "a", "b", "MuJoCo cannot compile it: XML parse error"),
         (
             '<mujoco><worldbody><body name="a"><joint type="ball"/><body name="b"/></body>'
