@@ -79,6 +79,8 @@ def test_the_c_runtime_holds_the_python_runtimes_constants():
         "WRIST_NEAR",
         "CURVE_NEAR",
         "CURVE_FLAT",
+        "CURVE_BEND",
+        "STALL_NEAR",
         "CURVE_FLOOR",
     ):
         assert float(found[f"DK_{name}"]) == getattr(constants, f"_{name}"), name

@@ -39,10 +39,13 @@
 /* a look-at row aimed within this many radians (or tol) is polished (dk_aims_at) */
 #define DK_AIM_POLISH (0.01)
 #define DK_SEED_BAND (0.05)
-/* rows within this of each other whose midpoint reproduces the pose too are one (dk_keep;
-   derive/runtime/constants.py, _CURVE_NEAR, says why) */
+/* rows within this of each other whose midpoint reproduces the pose too are one, or within
+   DK_STALL_NEAR where one is a point its refinement stalled at beside the other (dk_keep;
+   derive/runtime/constants.py, _CURVE_NEAR and _STALL_NEAR, say why) */
 #define DK_CURVE_NEAR (1e-3)
 #define DK_CURVE_FLAT (4.0)
+#define DK_STALL_NEAR (0.05)
+#define DK_CURVE_BEND (0.25)
 #define DK_CURVE_FLOOR (2.5e-15)
 /* beyond this acos argument (a nominal fold), the fold's angle +- each of these seeds the
    refinement too (derive/runtime/constants.py, _FOLD_NEAR and _FOLD_SEEDS, say why) */
@@ -2963,48 +2966,136 @@ static int dk_turns_within(double a, double near)
     return a <= near || fabs(a - DK_TWO_PI) <= near || fabs(a - 2.0 * DK_TWO_PI) <= near;
 }
 
-/* whether q is the row f (dk_seen) or lies on its curve of solutions: within DK_CURVE_NEAR
-   of it (revolute joints around the circle, lengths over the reach), their midpoint
-   reproducing p's pose within p's limit and DK_CURVE_FLAT times the smaller of their errors
-   (or DK_CURVE_FLOOR; the Python _curve_row) */
+static double dk_least_direction(const double chain[DK_REFINE_N + 1][12],
+                                 const int revolute[DK_REFINE_N],
+                                 const int solved[DK_REFINE_M], double reach,
+                                 const double t[12], const double q[DK_REFINE_N],
+                                 double v[DK_REFINE_M]);
+
+/* the largest difference of joint values a and b (revolute joints around the circle, lengths
+   over the reach; the Python _joint_distance) */
+static double dk_joint_distance(const int revolute[DK_REFINE_N], double reach,
+                                const double a[DK_REFINE_N], const double b[DK_REFINE_N])
+{
+    double far = 0.0;
+    int j;
+    for (j = 0; j < DK_REFINE_N; j++) {
+        const double d = a[j] - b[j];
+        far = fmax(far, fabs(revolute[j] ? remainder(d, DK_TWO_PI) : d / reach));
+    }
+    return far;
+}
+
+/* where rows f and q (errors ef and eq, far apart, mid their midpoint) are points where the
+   refinement stalled on a valley of points within p's limit that a pose nearly singular makes,
+   beside a solution: mid refined, m, within far of mid, the worse of them not within
+   DK_CURVE_FLAT times m's error (or DK_CURVE_FLOOR), J's least singular value there times far
+   within the limit; then the better row where it is within that of m and m within
+   DK_CURVE_BEND far of it (1 where that is f, else 2 and q into kept), else m (2, into kept);
+   else 0 (the Python _stalled_beside, which says why) */
+static int dk_stalled_beside(const dk_pending *p, const double f[DK_REFINE_N],
+                             const double q[DK_REFINE_N], const double mid[DK_REFINE_N],
+                             double ef, double eq, double far, double kept[DK_REFINE_N])
+{
+    double moved[DK_REFINE_N], v[DK_REFINE_M], exact;
+    const double *better = ef <= eq ? f : q, *worse = ef <= eq ? q : f;
+    int j;
+    if (!(DK_REFINE_M == 6 && DK_REFINE_TASK == 0 &&
+          fmax(ef, eq) > DK_CURVE_FLAT * DK_CURVE_FLOOR)) {
+        return 0; /* (both exact: neither stalled) */
+    }
+    if (!(sqrt(dk_least_direction(p->chain, p->revolute, p->solved, p->reach, p->t, worse, v)) *
+              far <=
+          p->limit)) {
+        return 0;
+    }
+    for (j = 0; j < DK_REFINE_N; j++) {
+        moved[j] = mid[j];
+    }
+    dk_refine(p->chain, p->revolute, p->solved, p->reach, p->t, moved, 0u, DK_REFINE_PATIENCE);
+    exact = DK_CURVE_FLAT *
+            fmax(dk_chain_error(p->chain, p->revolute, p->reach, p->t, moved), DK_CURVE_FLOOR);
+    if (!(fmax(ef, eq) > exact && dk_joint_distance(p->revolute, p->reach, moved, mid) <= far)) {
+        return 0;
+    }
+    if (fmin(ef, eq) <= exact) {
+        if (!(dk_joint_distance(p->revolute, p->reach, moved, better) <= DK_CURVE_BEND * far)) {
+            return 0;
+        }
+        if (better == f) {
+            return 1;
+        }
+        for (j = 0; j < DK_REFINE_N; j++) { /* (q in f's place) */
+            kept[j] = q[j];
+        }
+        return 2;
+    }
+    for (j = 0; j < DK_REFINE_N; j++) { /* (m in f's place) */
+        kept[j] = moved[j];
+    }
+    return 2;
+}
+
+/* whether q is the row f (dk_seen); or, within DK_CURVE_NEAR of it (revolute joints around the
+   circle, lengths over the reach), on its curve of solutions, their midpoint reproducing p's
+   pose within p's limit and DK_CURVE_FLAT times the smaller of their errors (or
+   DK_CURVE_FLOOR): 1; or, within DK_STALL_NEAR, points where the refinement stalled beside one
+   solution (dk_stalled_beside): 1 where that is f, 2 where it is another, into kept; else 0
+   (the Python _curve_row) */
 #if defined(__GNUC__)
 __attribute__((noinline, cold)) /* (rarely called: kept out of dk_keep's loop) */
 #endif
 static int dk_same_row(const dk_pending *p, const double f[DK_REFINE_N],
-                       const double q[DK_REFINE_N])
+                       const double q[DK_REFINE_N], double kept[DK_REFINE_N])
 {
-    double mid[DK_REFINE_N], at, ends;
+    double mid[DK_REFINE_N], at, ef, eq, far = 0.0;
     int j;
     if (dk_seen(f, p->revolute, q)) {
         return 1;
     }
     for (j = 0; j < DK_REFINE_N; j++) { /* (to the first joint that differs) */
         const double a = fabs(q[j] - f[j]);
-        if (p->revolute[j] ? !dk_turns_within(a, DK_CURVE_NEAR)
-                           : !(a <= DK_CURVE_NEAR * p->reach)) {
+        const double d = p->revolute[j] ? remainder(q[j] - f[j], DK_TWO_PI) : q[j] - f[j];
+        if (p->revolute[j] ? !dk_turns_within(a, DK_STALL_NEAR)
+                           : !(a <= DK_STALL_NEAR * p->reach)) {
             return 0;
         }
-        mid[j] = f[j] + 0.5 * (p->revolute[j] ? remainder(q[j] - f[j], DK_TWO_PI) : q[j] - f[j]);
+        mid[j] = f[j] + 0.5 * d;
+        far = fmax(far, fabs(p->revolute[j] ? d : d / p->reach));
     }
-    at = dk_chain_error(p->chain, p->revolute, p->reach, p->t, mid);
-    ends = fmin(dk_chain_error(p->chain, p->revolute, p->reach, p->t, q),
-                dk_chain_error(p->chain, p->revolute, p->reach, p->t, f));
-    return at <= p->limit && at <= DK_CURVE_FLAT * fmax(ends, DK_CURVE_FLOOR);
+    ef = dk_chain_error(p->chain, p->revolute, p->reach, p->t, f);
+    eq = dk_chain_error(p->chain, p->revolute, p->reach, p->t, q);
+    if (far <= DK_CURVE_NEAR) {
+        at = dk_chain_error(p->chain, p->revolute, p->reach, p->t, mid);
+        if (at <= p->limit && at <= DK_CURVE_FLAT * fmax(fmin(ef, eq), DK_CURVE_FLOOR)) {
+            return 1;
+        }
+    }
+    return dk_stalled_beside(p, f, q, mid, ef, eq, far, kept);
 }
 
 /* whether q is one of the first n rows of found, or on one's curve of solutions (dk_same_row):
    the last joint of each row compared first, without a branch (rows of one arm configuration
-   share their first joints, their wrists differ: most rows are far in the last) */
+   share their first joints, their wrists differ: most rows are far in the last); where a
+   better point is to take the row's place (dk_same_row's 2) and better is given, its index
+   there (else -1) and the point in kept */
 static int dk_repeat(const dk_pending *p, const double (*found)[DK_REFINE_N], int n,
-                     const double q[DK_REFINE_N])
+                     const double q[DK_REFINE_N], int *better, double kept[DK_REFINE_N])
 {
     const int last = DK_REFINE_N - 1;
-    const double near = fmax(DK_CURVE_NEAR * (p->revolute[last] ? 1.0 : p->reach), DK_DEDUP_TOL);
-    int r;
+    const double near = fmax(DK_STALL_NEAR * (p->revolute[last] ? 1.0 : p->reach), DK_DEDUP_TOL);
+    double spare[DK_REFINE_N];
+    int r, same;
+    if (better) {
+        *better = -1;
+    }
     for (r = 0; r < n; r++) {
         const double a = fabs(q[last] - found[r][last]);
         const int close = p->revolute[last] ? dk_turns_within(a, near) : a <= near;
-        if (close && dk_same_row(p, found[r], q)) {
+        if (close && (same = dk_same_row(p, found[r], q, kept ? kept : spare)) != 0) {
+            if (better && same == 2) {
+                *better = r;
+            }
             return 1;
         }
     }
@@ -3136,7 +3227,7 @@ static int dk_fold_partners(const double chain[DK_REFINE_N + 1][12],
             }
             if (!(dk_refine(chain, revolute, solved, reach, t, q, 0u, DK_REFINE_PATIENCE) <=
                   limit) ||
-                dk_repeat(&p, (const double(*)[DK_REFINE_N])rows, count, q)) {
+                dk_repeat(&p, (const double(*)[DK_REFINE_N])rows, count, q, NULL, NULL)) {
                 continue;
             }
             /* (a row singular to roundings lies on a valley or curve of solutions whose rows the
@@ -3155,12 +3246,20 @@ static int dk_fold_partners(const double chain[DK_REFINE_N + 1][12],
 }
 
 /* q, a seed refined within p's limit, a row of found (n of them) where it is not one already,
-   nor on one's curve of solutions (dk_repeat), and there is room; else counted in p->met */
+   nor on one's curve of solutions (dk_repeat), and there is room; else counted in p->met, in
+   place of the row it repeats where it is the better of the two (dk_same_row's 2: the
+   Python _curve_row's) */
 static void dk_keep(dk_pending *p, double (*found)[DK_REFINE_N], int *n,
                     const double q[DK_REFINE_N])
 {
-    int j;
-    if (*n < p->room && !dk_repeat(p, (const double(*)[DK_REFINE_N])found, *n, q)) {
+    double kept[DK_REFINE_N] = {0.0}; /* (set where better is) */
+    int better, j;
+    if (dk_repeat(p, (const double(*)[DK_REFINE_N])found, *n, q, &better, kept)) {
+        for (j = 0; better >= 0 && j < DK_REFINE_N; j++) { /* (a better point in its place) */
+            found[better][j] = kept[j];
+        }
+        p->met++;
+    } else if (*n < p->room) {
         for (j = 0; j < DK_REFINE_N; j++) {
             found[*n][j] = q[j];
         }

@@ -145,6 +145,12 @@ _SEED_BAND = 0.05
 # 1e-4 apart) as points of its curve, in C only (a reviewer's attack on a hextilt URDF)
 _CURVE_NEAR = 1e-3
 _CURVE_FLAT = 4.0
+# a refined row within _STALL_NEAR of another that is a point where its refinement stalled
+# beside it, on a valley of points within the row limit that a pose nearly singular makes, is
+# that row (refine.py, _stalled_beside: the midpoint of the two refined lands within
+# _CURVE_BEND times their distance of the other)
+_STALL_NEAR = 0.05
+_CURVE_BEND = 0.25
 # ... whose errors count as at least this (a few roundings of the pose's entries)
 _CURVE_FLOOR = 2.5e-15
 # The seam: rounding puts a joint at pi on either side of it, and one solution would get two

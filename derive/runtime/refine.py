@@ -31,7 +31,14 @@ from derive.runtime.arm import (
     REACH,
     TOOL_AXIS,
 )
-from derive.runtime.constants import _CURVE_FLAT, _CURVE_FLOOR, _CURVE_NEAR, _TWO_PI
+from derive.runtime.constants import (
+    _CURVE_BEND,
+    _CURVE_FLAT,
+    _CURVE_FLOOR,
+    _CURVE_NEAR,
+    _STALL_NEAR,
+    _TWO_PI,
+)
 from derive.runtime.scalar import _LOOSE, _Free, _ray_gap
 
 # at most this many steps per candidate (a seed on a singular configuration converges
@@ -194,7 +201,7 @@ def _fold_partners(rows, t, tol):
                     seeds.append(seed)
         for seed in seeds:
             p, size = _refine(seed, t)
-            if size > limit or _curve_row(out, t, p, limit) is not p:
+            if size > limit or _curve_row(out, t, p, limit, False) is not p:
                 continue
             # (a row singular to roundings lies on a valley or curve of solutions whose rows
             # the first pass gave: a flip's seed at a Kinova's straight wrist refined onto a
@@ -224,24 +231,80 @@ def _least_direction(columns):
     return least, v
 
 
-def _curve_row(found, t, q, limit):
-    """The first row of found within _CURVE_NEAR of q (revolute joints around the circle,
-    lengths over REACH) whose midpoint with q reproduces t within limit and _CURVE_FLAT times
-    the smaller of their errors (or _CURVE_FLOOR) too (both on one curve of solutions: that row
-    again, a repeat _finish drops), else q (the C dk_same_row)."""
+def _curve_row(found, t, q, limit, replace=True):
+    """The first row of found that q repeats (that row again, a repeat _finish drops), else q
+    (the C dk_same_row): within _CURVE_NEAR (revolute joints around the circle, lengths over
+    REACH), both on one curve of solutions, their midpoint reproducing t within limit and
+    _CURVE_FLAT times the smaller of their errors (or _CURVE_FLOOR); or within _STALL_NEAR, points
+    where the refinement stalled beside one solution (_stalled_beside): where that is q or
+    another point (with replace), it takes the row's place in found, and is returned."""
     for p in found:
         d = []
         for a, b, turn in zip(q, p, _REVOLUTE):  # (to the first joint that differs)
             x = math.remainder(a - b, _TWO_PI) if turn else a - b
-            if not (abs(x) if turn else abs(x) / REACH) <= _CURVE_NEAR:
+            if not (abs(x) if turn else abs(x) / REACH) <= _STALL_NEAR:
                 break
             d.append(x)
         else:
-            at = _pose_error([b + 0.5 * x for b, x in zip(p, d)], t, False)[2]
-            ends = min(_pose_error(q, t, False)[2], _pose_error(p, t, False)[2])
-            if at <= limit and at <= _CURVE_FLAT * max(ends, _CURVE_FLOOR):
+            far = max(abs(x) if turn else abs(x) / REACH for x, turn in zip(d, _REVOLUTE))
+            ends = (_pose_error(p, t, False)[2], _pose_error(q, t, False)[2])
+            if far <= _CURVE_NEAR:
+                at = _pose_error([b + 0.5 * x for b, x in zip(p, d)], t, False)[2]
+                if at <= limit and at <= _CURVE_FLAT * max(min(ends), _CURVE_FLOOR):
+                    return p
+            kept = _stalled_beside(p, q, t, ends, far, limit)
+            if kept is not None and kept is not p and replace:  # (the row stalled: in its
+                # place the better point)
+                found[:] = [kept if r is p else r for r in found]
+                return kept
+            if kept is not None:
                 return p
     return q
+
+
+def _stalled_beside(p, q, t, ends, far, limit):
+    """Where rows p and q (errors ends, far apart) are points where the refinement stalled on
+    a valley of points within limit of t that a pose nearly singular makes, beside a solution,
+    that solution: their midpoint refined, m, lands within far of the midpoint, the worse of
+    them is not within _CURVE_FLAT times m's error (or _CURVE_FLOOR) and J's least singular
+    value there times far is within limit (the valley between them within limit); then the
+    better row where it is within that of m and m lands within _CURVE_BEND far of it, else m
+    (a Lite6 MJCF's pose singular to 6e-9 had rows 5.5e-11 and 1.2e-11 off, 3.6e-3 and 9e-4
+    from one within 5.6e-16; at another, singular to 2.9e-9, rows 8.7e-12 to 9.9e-11 off, 1e-3
+    to 1.3e-2 apart, round a solution none had reached; C kept 16 such, the room for rows, and
+    lost the other elbow's: a new user's attack, helper 73). Else None. Two solutions of a
+    fold's pair are both within it, or one stalled where J is not that singular (an xArm6's
+    1e-3 to 1e-2 apart at poses singular to 1.4e-6 and 1.3e-5), and the midpoint's refinement
+    stops at the fold or lands on either. Only an arm solved for the whole pose by six joints
+    (J square)."""
+    if not (len(_SOLVED) == 6 and IK_COMPONENTS == "pose"):
+        return None
+    if not max(ends) > _CURVE_FLAT * _CURVE_FLOOR:  # (both exact: neither stalled)
+        return None
+    (better, worse) = (p, q) if ends[0] <= ends[1] else (q, p)
+    least = _least_direction(_pose_error(worse, t, False)[1])[0]
+    if not math.sqrt(least) * far <= limit:
+        return None
+    mid = [
+        b + 0.5 * (math.remainder(a - b, _TWO_PI) if turn else a - b)
+        for a, b, turn in zip(q, p, _REVOLUTE)
+    ]
+    moved = _refine(mid, t)[0]
+    exact = _CURVE_FLAT * max(_pose_error(moved, t, False)[2], _CURVE_FLOOR)
+    if not (max(ends) > exact and _joint_distance(moved, mid) <= far):
+        return None
+    if min(ends) <= exact:
+        return better if _joint_distance(moved, better) <= _CURVE_BEND * far else None
+    return moved
+
+
+def _joint_distance(a, b):
+    """The largest difference of joint values a and b (revolute joints around the circle,
+    lengths over REACH)."""
+    return max(
+        abs(math.remainder(x - y, _TWO_PI) if turn else (x - y) / REACH)
+        for x, y, turn in zip(a, b, _REVOLUTE)
+    )
 
 
 def _refine(q, t, held=(), patience=_REFINE_PATIENCE):
