@@ -247,12 +247,13 @@ def _curve_row(found, t, q, limit, replace=True):
             d.append(x)
         else:
             far = max(abs(x) if turn else abs(x) / REACH for x, turn in zip(d, _REVOLUTE))
+            mid = [b + 0.5 * x for b, x in zip(p, d)]
             ends = (_pose_error(p, t, False)[2], _pose_error(q, t, False)[2])
             if far <= _CURVE_NEAR:
-                at = _pose_error([b + 0.5 * x for b, x in zip(p, d)], t, False)[2]
+                at = _pose_error(mid, t, False)[2]
                 if at <= limit and at <= _CURVE_FLAT * max(min(ends), _CURVE_FLOOR):
                     return p
-            kept = _stalled_beside(p, q, t, ends, far, limit)
+            kept = _stalled_beside(p, q, mid, t, ends, far, limit)
             if kept is not None and kept is not p and replace:  # (the row stalled: in its
                 # place the better point)
                 found[:] = [kept if r is p else r for r in found]
@@ -262,11 +263,11 @@ def _curve_row(found, t, q, limit, replace=True):
     return q
 
 
-def _stalled_beside(p, q, t, ends, far, limit):
-    """Where rows p and q (errors ends, far apart) are points where the refinement stalled on
-    a valley of points within limit of t that a pose nearly singular makes, beside a solution,
-    that solution: their midpoint refined, m, lands within far of the midpoint, the worse of
-    them is not within _CURVE_FLAT times m's error (or _CURVE_FLOOR) and J's least singular
+def _stalled_beside(p, q, mid, t, ends, far, limit):
+    """Where rows p and q (errors ends, far apart, mid their midpoint) are points where the
+    refinement stalled on a valley of points within limit of t that a pose nearly singular
+    makes, beside a solution, that solution: mid refined, m, lands within far of mid, the worse
+    of them is not within _CURVE_FLAT times m's error (or _CURVE_FLOOR) and J's least singular
     value there times far is within limit (the valley between them within limit); then the
     better row where it is within that of m and m lands within _CURVE_BEND far of it, else m
     (a Lite6 MJCF's pose singular to 6e-9 had rows 5.5e-11 and 1.2e-11 off, 3.6e-3 and 9e-4
@@ -285,10 +286,6 @@ def _stalled_beside(p, q, t, ends, far, limit):
     least = _least_direction(_pose_error(worse, t, False)[1])[0]
     if not math.sqrt(least) * far <= limit:
         return None
-    mid = [
-        b + 0.5 * (math.remainder(a - b, _TWO_PI) if turn else a - b)
-        for a, b, turn in zip(q, p, _REVOLUTE)
-    ]
     moved = _refine(mid, t)[0]
     exact = _CURVE_FLAT * max(_pose_error(moved, t, False)[2], _CURVE_FLOOR)
     if not (max(ends) > exact and _joint_distance(moved, mid) <= far):
