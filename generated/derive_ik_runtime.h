@@ -9,7 +9,7 @@
    is solved by it): one copy serves every arm of a folder, and each arm's file gets its own
    static copy of the routines, so arms link together in one program. Compile <name>_ik.c
    with it beside the file; do not include it anywhere else. */
-#define DK_RUNTIME 0x42d913d40e72
+#define DK_RUNTIME 0x67a4227803e2
 
 #include <math.h>
 #include <stddef.h>
@@ -3123,6 +3123,11 @@ static int dk_repeat(const dk_pending *p, const double (*found)[DK_REFINE_N], in
 #define DK_PARTNER_NEAR (0.01)
 #define DK_PARTNER_FLOOR (1e-09)
 static const double DK_PARTNER_STEPS[4] = { 0.001, 0.004, 0.016, 0.064 };
+/* ... and, where every solved joint turns, a quarter turn either way and a half turn along it
+   (its largest joint turned by these): across the circle of a self-motion of the nominal arm
+   that the exact arm breaks into isolated solutions (_PARTNER_TURNS says why) */
+static const double DK_PARTNER_TURNS[3] = { 1.5707963267948966, -1.5707963267948966,
+                                            3.141592653589793 };
 
 /* J^T J's least eigenvalue (J at the arm's values q, its columns the joints in solved: square)
    and its unit eigenvector into v, by two steps of inverse iteration from (1, ..., 1), each
@@ -3193,8 +3198,9 @@ static int dk_moves(const int solved[DK_REFINE_M], int j)
 
 /* rows[0..count) (finished: wrapped, no repeats) and, where count is odd, the rows the
    refinement reaches from either side of a fold at each row near one (DK_PARTNER_NEAR,
-   DK_PARTNER_STEPS) and from each three of its solved revolute joints' flips (q_i + pi,
-   -q_i+1, q_i+2 + pi) within DK_SEED_TOL of the pose
+   DK_PARTNER_STEPS), across a broken self-motion's circle (DK_PARTNER_TURNS) and from each
+   three of its solved revolute joints' flips (q_i + pi, -q_i+1, q_i+2 + pi) within
+   DK_SEED_TOL of the pose
    certified within limit, neither a row nor on one's curve of solutions (dk_repeat) nor
    singular to roundings itself (DK_PARTNER_FLOOR), appended wrapped while there is room (at
    most max in all): the new count (the Python solver's _fold_partners) */
@@ -3204,29 +3210,43 @@ static int dk_fold_partners(const double chain[DK_REFINE_N + 1][12],
                             double rows[][DK_REFINE_N], int count, int max)
 {
     const int first = count;
-    int r, h, k, i;
+    int r, h, k, i, turning = 1; /* (turning: every solved joint revolute) */
     dk_pending p; /* (what dk_repeat reads: the chain, the pose and limit) */
     if (!(DK_SEED_TOL > 0.0) || count % 2 == 0) {
         return count;
     }
     dk_pending_start(&p, chain, revolute, solved, reach, t, limit, max);
+    for (k = 0; k < DK_REFINE_M; k++) {
+        turning &= revolute[solved[k]];
+    }
     for (r = 0; r < first; r++) {
-        double v[DK_REFINE_M], w[DK_REFINE_M];
+        double v[DK_REFINE_M], w[DK_REFINE_M], top = 0.0;
         const double least = dk_least_direction(chain, revolute, solved, reach, t, rows[r], v);
         if (!(least >= DK_PARTNER_FLOOR * DK_PARTNER_FLOOR &&
               least <= DK_PARTNER_NEAR * DK_PARTNER_NEAR)) {
             continue;
         }
-        for (h = 0; h < 8 + DK_REFINE_N - 2; h++) {
-            /* (h < 8: a step either side along v; then each three revolute joints' flip) */
+        for (k = 0; k < DK_REFINE_M; k++) {
+            top = fmax(top, fabs(v[k]));
+        }
+        for (h = 0; h < 11 + DK_REFINE_N - 2; h++) {
+            /* (h < 8: a step either side along v; h < 11: a turn along it; then each three
+               revolute joints' flip) */
             double q[DK_REFINE_N];
-            const int f = h - 8;
+            const int f = h - 11;
             for (i = 0; i < DK_REFINE_N; i++) {
                 q[i] = rows[r][i];
             }
             if (h < 8) {
                 for (k = 0; k < DK_REFINE_M; k++) {
                     q[solved[k]] += (h % 2 ? -1.0 : 1.0) * DK_PARTNER_STEPS[h / 2] * v[k];
+                }
+            } else if (h < 11) {
+                if (!turning) {
+                    continue;
+                }
+                for (k = 0; k < DK_REFINE_M; k++) {
+                    q[solved[k]] += DK_PARTNER_TURNS[h - 8] * v[k] / top;
                 }
             } else if (revolute[f] && revolute[f + 1] && revolute[f + 2] &&
                        dk_moves(solved, f) && dk_moves(solved, f + 1) && dk_moves(solved, f + 2)) {

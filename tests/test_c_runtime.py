@@ -108,6 +108,7 @@ def test_the_c_runtime_holds_the_python_runtimes_constants():
     assert float(found["DK_PARTNER_NEAR"]) == refine._PARTNER_NEAR
     assert float(found["DK_PARTNER_FLOOR"]) == refine._PARTNER_FLOOR
     assert table(runtime, "DK_PARTNER_STEPS").tolist() == list(refine._PARTNER_STEPS)
+    assert table(runtime, "DK_PARTNER_TURNS").tolist() == list(refine._PARTNER_TURNS)
     assert float(found["DK_PI"]) == np.pi and float(found["DK_TWO_PI"]) == 2 * np.pi
     assert table(runtime, "DK_FREE_STEPS").tolist() == list(constants._FREE_STEPS)
     assert table(runtime, "DK_FOLD_SEEDS").tolist() == list(constants._FOLD_SEEDS)

@@ -574,6 +574,26 @@ def test_an_odd_count_beside_a_nearly_straight_wrist_tries_the_wrist_s_flip(tmp_
         assert len(rows) == 8, (backend, len(rows))
 
 
+@needs_cc
+def test_an_odd_count_looks_a_quarter_turn_along_the_direction_j_loses(tmp_path):
+    """A calibrated UR5 (seed 101) at a pose singular to 1.4e-4: one row in both backends, the
+    sampled vector 0.15 rad from it along the direction the Jacobian nearly loses, beyond the
+    steps across a fold (_PARTNER_STEPS, 0.064 at most). The seeds a quarter and half turn
+    along that direction (_PARTNER_TURNS; for the self-motion of two nearly aligned axes that
+    the exact arm breaks into isolated solutions, 2.8 rad apart on a new user's humanoid arm,
+    helper 74) find it: two rows, the sampled vector among them, in both."""
+    module = build_module(calibrated("ur5", 101), tmp_path, c=True)
+    q = np.array([0.1488577855, -1.501968039936, -0.331383224836,
+                  -0.418056276108, -3.021008657877, -0.753862526077])  # fmt: skip
+    T = module.fk(q)
+    for backend in ("c", "python"):
+        rows = module.ik(T, backend=backend)
+        gaps = np.abs(np.remainder(rows - q + math.pi, 2 * math.pi) - math.pi).max(axis=1)
+        assert len(rows) == 2 and np.min(gaps) <= 1e-9, (backend, len(rows), np.min(gaps))
+        E = module.fk_batch(rows)
+        assert np.abs(E[:, :3] - T[:3]).max() <= 1e-10 * module.REACH
+
+
 def test_a_path_of_the_general_method_keeps_the_sign_of_det_j(xarm6):
     """The general method names no branch, so ik_path chose by distance alone, and on this
     xArm6 line (20 poses; sigma_min >= 5.3e-3 on it, a 100 times finer nearest-row walk
