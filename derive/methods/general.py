@@ -49,6 +49,12 @@ SINGULAR_EVERYWHERE = 1e-10
 # a singular value of the lifted matrix at x3 = i below this share of the largest is zero
 # (the spurious null space's are rounding: 1e-17 in double precision)
 SPURIOUS_RANK_TOL = 1e-12
+# a split of the arm's own table whose generating values were found at this share of the
+# poses at least, and whose eigenvalues came in clusters at this share at least, is nearly
+# special (Split.clustered): a calibrated cobot's (its clusters at 32 to 40 of 40 poses; a
+# generic arm's, manocha_canny's included, at 0 to 11)
+CLUSTERED_FOUND = 0.9
+CLUSTERED_SHARE = 0.5
 Row = tuple[float, float, float, float]
 
 
@@ -263,8 +269,11 @@ def measure(chain: Chain, reversed_: int, length: float, perturb: bool) -> Split
     fill_rows = perturbed(true_rows) if perturb else true_rows
     slide = slide_of(chain)
     fill = fill_expressions(fill_rows, {} if perturb else exact_numbers(chain), slide)
-    recovered, conds = score(fill_rows, true_rows, slide)
+    recovered, conds, clusters = score(fill_rows, true_rows, slide)
     spurious, pivots = spurious_vectors(fill) if not slide[0] else ((), ())
+    clustered = (
+        not perturb and recovered >= CLUSTERED_FOUND * POSES and clusters >= CLUSTERED_SHARE * POSES
+    )
     return Split(
         reversed=bool(reversed_),
         fill=fill,
@@ -277,6 +286,7 @@ def measure(chain: Chain, reversed_: int, length: float, perturb: bool) -> Split
         slide=slide,
         spurious=spurious,
         spurious_pivots=pivots,
+        clustered=clustered,
     )
 
 
@@ -345,12 +355,13 @@ def spurious_vectors(
 
 def score(
     fill_rows: tuple[Row, ...], true_rows: tuple[Row, ...], slide: tuple[float, float]
-) -> tuple[int, list[float]]:
+) -> tuple[int, list[float], int]:
     """Of POSES random poses (a fifth of the joints at 0, +-90 or 180 deg; a sliding joint 3
     within +-1 arm size), how many have their generating joint values among the split's
-    polished candidates; and the condition numbers of the pencil's leading matrix."""
+    polished candidates; the condition numbers of the pencil's leading matrix; and how many
+    have eigenvalues in clusters (an answer in doubt)."""
     rng = np.random.default_rng(20261201)
-    recovered = 0
+    recovered = clusters = 0
     conds = []
     for _ in range(POSES):
         q = rng.uniform(-math.pi, math.pi, 6)
@@ -362,14 +373,15 @@ def score(
         for i, t in enumerate(q):
             F = F @ _split_joint(i, t, true_rows, slide)
         P0, Ps, Pc, Q = matrices_at(fill_rows, F, slide)
-        candidates, _, _, _ = runtime._rr_candidates(P0, Ps, Pc, Q, F, fill_rows, slide)
+        candidates, doubt, _, _ = runtime._rr_candidates(P0, Ps, Pc, Q, F, fill_rows, slide)
+        clusters += bool(doubt)
         conds.append(leading_condition(P0, Ps, Pc, Q))
         if candidates:
             # (Newton's steps only, as the splits were always measured)
             P, errors = runtime._rr_steps_many(true_rows, F, np.array(candidates), slide, False)
             gaps = np.abs((P - q + math.pi) % (2 * math.pi) - math.pi).max(axis=1)
             recovered += bool(((errors <= runtime._RR_GOOD) & (gaps <= 1e-6)).any())
-    return recovered, conds
+    return recovered, conds, clusters
 
 
 def leading_condition(P0, Ps, Pc, Q) -> float:
