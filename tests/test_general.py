@@ -489,6 +489,20 @@ def test_cobots_with_singular_pencils_are_answered_completely(name, tmp_path):
         assert len(newton) == len(rows)
 
 
+def counted_splits(m) -> list[int]:
+    """The splits the module's Python general method solves from now on, appended in turn
+    (its _rr_split wrapped)."""
+    splits: list[int] = []
+    plain = m._rr_split
+
+    def counted(k, *args, **kwargs):
+        splits.append(k)
+        return plain(k, *args, **kwargs)
+
+    m._rr_split = counted
+    return splits
+
+
 def calibrated_cobot(name: str, seed: int) -> str:
     """The vendor's table of a cobot (REAL_COBOTS) moved as a calibration moves it: alpha
     and theta by up to 0.02 deg, a and d by up to 0.2 mm (tests/test_nominal.py's
@@ -528,14 +542,7 @@ def test_a_calibrated_cobot_s_clusters_ask_for_the_fallback_split_only(tmp_path)
             for p in newton:
                 gaps = np.abs((rows - p + math.pi) % (2 * math.pi) - math.pi).max(axis=1)
                 assert gaps.min() < 1e-6, backend
-    splits: list[int] = []
-    plain = m._rr_split
-
-    def counted(k, *args, **kwargs):
-        splits.append(k)
-        return plain(k, *args, **kwargs)
-
-    m._rr_split = counted
+    splits = counted_splits(m)
     for q in rng.uniform(-math.pi, math.pi, (20, 6)):
         m.ik(m.fk(q), backend="python")
     assert len(splits) <= 2 * 20, len(splits)
@@ -569,14 +576,7 @@ def test_a_perturbed_table_s_fallback_split_runs_only_where_rows_may_be_missing(
     if backend == "c":
         return
     jaco = build_module(spec_text("jaco2", "standard", COBOTS["jaco2"]), tmp_path)
-    splits: list[int] = []
-    plain = jaco._rr_split
-
-    def counted(k, *args, **kwargs):
-        splits.append(k)
-        return plain(k, *args, **kwargs)
-
-    jaco._rr_split = counted
+    splits = counted_splits(jaco)
     rng = np.random.default_rng(11)
     fallbacks = 0
     for q in rng.uniform(-math.pi, math.pi, (40, 6)):
