@@ -15,6 +15,7 @@ from hypothesis import HealthCheck, given, settings
 from derive.cli import resolve_spec
 from derive.load import solver_sources
 from derive.pipeline import build_plan
+from derive.printers.general import eigen_step
 from derive.spec import parse_spec
 from derive.verify import roundtrip, sample_joints
 
@@ -546,6 +547,18 @@ def test_a_calibrated_cobot_s_clusters_ask_for_the_fallback_split_only(tmp_path)
     for q in rng.uniform(-math.pi, math.pi, (20, 6)):
         m.ik(m.fk(q), backend="python")
     assert len(splits) <= 2 * 20, len(splits)
+
+
+def test_the_general_method_asked_for_by_name_keeps_the_strict_doubt_rules():
+    """[ik] method = "general" (or --method general) asks for the complete set: no split is
+    marked clustered, so a cluster starts the rescue as on any arm's own table (a calibrated
+    IRB 120 so solved had lost a wrist pair in C under the relaxed rules, helper 75)."""
+    text = calibrated_cobot("hc10", 7)
+    default = eigen_step(build_plan(parse_spec(text, "<t>")))
+    asked = eigen_step(build_plan(parse_spec(text, "<t>"), method="general"))
+    assert default is not None and asked is not None
+    assert all(s.clustered for s in default.splits)
+    assert not any(s.clustered for s in asked.splits)
 
 
 # two regular poses of the CRX-like arm (sigma_min 1e-4 and 1.5e-4: elbow and wrist 3e-4 and
