@@ -107,7 +107,6 @@ def general_constants(plan: Plan) -> dict[str, object]:
         "FILL": nested([(*s.fill_rows, (*s.slide, 0.0, 0.0)) for s in step.splits]),
         "TRUE": nested([(*s.true_rows, (*s.slide, 0.0, 0.0)) for s in step.splits]),
         "FLIPS": nested([int(first in step.flips) for first in (0, 3)]),
-        "CLUSTERED": "{" + ", ".join("1" if s.clustered else "0" for s in step.splits) + "}",
         "fill": c.general_fill(plan),
         **spurious_constants(step),
     }

@@ -96,8 +96,6 @@ def build_plan(spec: ArmSpec, method: str | None = None) -> Plan:
             refusal = f"{refusal}; the tool point's position: {alone}"
     if ik is None and general.NAME in names:
         ik, why = choose(chain, structure, spec.free, (general.NAME,), task, tol, method)
-        if ik is not None and method == general.NAME:  # (the complete set asked for)
-            ik = general.strict(ik)
         reasons = [r for r in (refusal, why) if r]
         if ik is not None and far:  # (the summary says why the nominal one was not used)
             facts = (*facts, far)

@@ -243,10 +243,6 @@ class Split:
             time deflates them. Empty where joint 3 slides.
         spurious_pivots: the r rows where those vectors are the identity (v_j's entry 1 in
             row spurious_pivots[j], the others' 0).
-        clustered: the arm's own table (not perturbed), nearly special: at generation the
-            split found nearly every pose's generating values, but its eigenvalues came in
-            clusters at most of them (pairs sharing the eigen-joint's value, as a calibrated
-            cobot's); the run time treats its doubts as a perturbed table's.
     """
 
     reversed: bool
@@ -260,7 +256,6 @@ class Split:
     slide: tuple[float, float] = (0.0, 0.0)
     spurious: tuple[tuple[float, ...], ...] = ()
     spurious_pivots: tuple[int, ...] = ()
-    clustered: bool = False
 
     @property
     def name(self) -> str:

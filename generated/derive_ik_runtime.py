@@ -38,7 +38,7 @@ if "_RUNTIME_VERSION" not in globals():  # (imported on its own, not run by a mo
         "namespace; it is not a module to import"
     )
 # this runtime's version: a module runs the runtime of its own version only
-_RUNTIME_VERSION = "9771ac516e42a057"
+_RUNTIME_VERSION = "daea9c9e8e9cd6b9"
 
 if TYPE_CHECKING:  # defined by the module running this file
     from derive.runtime.arm import (
@@ -48,7 +48,6 @@ if TYPE_CHECKING:  # defined by the module running this file
         _PLANE_ROTATION,
         _PLANE_SLIDE,
         _REVOLUTE,
-        _RR_CLUSTERED,
         _RR_FLIPS,
         _RR_LENGTH,
         _RR_PIVOTS,
@@ -2922,8 +2921,7 @@ def _general(flanges, tol):
     leads = _RRLeads()
     targets = [_rr_target(f) for f in flanges]
     doubt = _RESCUE
-    walked = False  # whether a perturbed table's solutions were walked back to the arm's (or
-    # a nearly special table answered: _rr_tolerant)
+    walked = False  # whether a perturbed table's solutions were walked back to the arm's
     grew = False  # whether the fallback split found what the first missed
     tried = 0  # (the splits the first round tried)
     # (an out-of-reach answer from the first split alone: where its table is the arm's own,
@@ -2932,7 +2930,7 @@ def _general(flanges, tol):
     for k, F in enumerate(targets):
         candidates, close, doubt = _rr_split(k, F, F, leads, found)
         tried += 1
-        walked |= _rr_tolerant(k)
+        walked |= _RR_SPLITS[k][1] != _RR_SPLITS[k][2]
         before = len(found)
         _rr_merge(found, [_rr_to_arm(k, q) for q in candidates])
         grew |= k > 0 and len(found) > before
@@ -2969,7 +2967,7 @@ def _general(flanges, tol):
         for motion in _RR_MOTIONS:
             for k, F in enumerate(targets):
                 candidates, close, _ = _rr_split(k, F, F @ motion, leads, found)
-                walked |= _rr_tolerant(k)
+                walked |= _RR_SPLITS[k][1] != _RR_SPLITS[k][2]
                 _rr_merge(found, [_rr_to_arm(k, q) for q in candidates])
                 _rr_merge(near, [_rr_to_arm(k, q) for q in close])
     if 0 < len(found) < MAX_SOLUTIONS and walked:
@@ -3199,14 +3197,6 @@ _FALLBACK = 2
 _RESCUE = 1
 
 
-def _rr_tolerant(k):
-    """Whether split k's doubts are a perturbed table's (_FALLBACK; candidates that polish to
-    nothing put nothing in doubt): its table perturbed, or the arm's own but nearly special
-    (_RR_CLUSTERED: a calibrated cobot's pencil clusters at nearly every pose, and the rescue
-    took 6 splits a pose, 10.7 ms in Python and 240 us in C on a calibrated HC10)."""
-    return _RR_SPLITS[k][1] != _RR_SPLITS[k][2] or _RR_CLUSTERED[k]
-
-
 def _rr_split(k, F, moved, leads, known=(), imag_tol=_RR_IMAG_TOL):
     """The polished candidates of split k for the target F, found from the pose `moved` (F
     itself, or F slightly moved in a rescue; eigenvalues real within imag_tol), but those
@@ -3246,7 +3236,7 @@ def _rr_split(k, F, moved, leads, known=(), imag_tol=_RR_IMAG_TOL):
     # search find one lost; they ask for the fallback split only (on 2,000 poses of each of
     # two cobots, the rescue they started added rows at 14 poses, 13 of them with an odd
     # count, which starts it anyway), and only where a row may be missing (_rr_settled)
-    doubt = (_FALLBACK if _rr_tolerant(k) else _RESCUE) if doubt else 0
+    doubt = (_FALLBACK if fill_rows != true_rows else _RESCUE) if doubt else 0
     if known and candidates:  # (one within _RR_SAME of a known row is that row again)
         near = _rr_gap_table([_rr_to_arm(k, q) for q in candidates], list(known)) <= _RR_SAME
         kept = np.flatnonzero(~near.any(axis=1))
@@ -3261,7 +3251,6 @@ def _rr_split(k, F, moved, leads, known=(), imag_tol=_RR_IMAG_TOL):
         Q, _ = _rr_steps_many(rows, F, Q, slide, False, steps=_RR_PATH_STEPS, track=True)
     Q, residuals, damped = _rr_newton_many(true_rows, F, Q, slide, np.array(extras))
     perturbed = fill_rows != true_rows
-    tolerant = _rr_tolerant(k)  # (a perturbed or nearly special table's doubts)
     # the arm's values of the starts and rows, and their gaps from each other and from the
     # known rows, one table each (the Python solver's time went to comparing candidates one
     # by one: 11% of it on two cobots); a row moved after these (_rr_unsettled_copy), or a
@@ -3285,7 +3274,7 @@ def _rr_split(k, F, moved, leads, known=(), imag_tol=_RR_IMAG_TOL):
             # compiled ik of it and of the CRX-like arm took 18% and 17% less time, 3,000
             # uniform poses, the same rows at every one), so it is not kept here either
             continue
-        if was_damped and not tolerant and not extra:  # Newton did not settle it
+        if was_damped and not perturbed and not extra:  # Newton did not settle it
             doubt = _RESCUE
         if residual <= _RR_GOOD:
             arm, row = arms[c], c
@@ -3328,8 +3317,7 @@ def _rr_split(k, F, moved, leads, known=(), imag_tol=_RR_IMAG_TOL):
             continue
         if residual <= _RR_NEAR:
             close.append(q)
-        if not tolerant:  # (a perturbed table has solutions the arm has not; a nearly
-            # special one's ill-conditioned pencil, candidates that polish to nothing)
+        if not perturbed:  # (a perturbed table has solutions the arm has not)
             doubt = _RESCUE
     _rr_seed_misses(k, misses, true_rows, slide, leads)
     return out, close, _rr_settled(doubt, known, [_rr_to_arm(k, q) for q in out], reals, pair)

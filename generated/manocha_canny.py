@@ -626,9 +626,6 @@ _RR_SPLITS = (
     ),
 )
 _RR_LENGTH = 1.5
-# per split, whether it is the arm's own table but nearly special (Split.clustered):
-# its doubts are taken as a perturbed table's
-_RR_CLUSTERED = (False, False)
 # the ends of the arm's six joints (0: joints 1-3, 3: joints 4-6) whose wrist flip leaves
 # the pose unchanged: _rr_partners tries the flips there
 _RR_FLIPS = ()
@@ -1247,7 +1244,7 @@ def _rr_fill(k, l_x, l_y, l_z, p_x, p_y, p_z, out):
 
 _RUNTIME = "derive_ik_runtime.py"
 # the version of the runtime this module was generated with (the runtime's _RUNTIME_VERSION)
-_RUNTIME_VERSION = "9771ac516e42a057"
+_RUNTIME_VERSION = "daea9c9e8e9cd6b9"
 # the runtime's line stating its version, in whatever form a formatter leaves it
 _RUNTIME_LINE = re.compile(
     rb"^_RUNTIME_VERSION\s*(?::\s*str\s*)?=\s*[\"']([0-9a-fA-F]+)[\"']", re.M

@@ -55,9 +55,6 @@ static const double DK_RR_TRUE[DK_RR_SPLIT_COUNT][7][4] = {{{0.0, 0.199999999999
         0.6666666666666666, 0.9998476951563913, 0.01745240643728351}, {0.13333333333333333, 0.0,
         0.0, 1.0}, {0.0, 1.0, 0.9998476951563913, 0.01745240643728351}, {0.0, 0.0, 0.0, 1.0}, {0.0,
         0.0, 1.0, 0.0}, {0.0, 0.0, 0.0, 0.0}}};
-/* per split, whether it is the arm's own table but nearly special (its eigenvalues in clusters
-   at most poses): its doubts are taken as a perturbed table's (dk_rr_tolerant) */
-static const int DK_RR_CLUSTERED[DK_RR_SPLIT_COUNT] = {0, 0};
 /* whether the wrist flip of the arm's joints 1-3, and of 4-6, leaves the pose unchanged:
    dk_rr_partners tries the flips there */
 static const int DK_RR_FLIPS[2] = {0, 0};
@@ -681,7 +678,7 @@ static void dk_rr_fill(int k, double l_x, double l_y, double l_z, double p_x, do
 /* --- the routines every generated C solver shares: derive_ik_runtime.h beside this file ---- */
 
 #include "derive_ik_runtime.h"
-#if DK_RUNTIME != 0xb0d4bbe4b58e
+#if DK_RUNTIME != 0x67a4227803e2
 #error "derive_ik_runtime.h is another derive-ik's: generate the arms of a folder with one"
 #endif
 

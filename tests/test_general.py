@@ -15,7 +15,6 @@ from hypothesis import HealthCheck, given, settings
 from derive.cli import resolve_spec
 from derive.load import solver_sources
 from derive.pipeline import build_plan
-from derive.printers.general import eigen_step
 from derive.spec import parse_spec
 from derive.verify import roundtrip, sample_joints
 
@@ -490,77 +489,6 @@ def test_cobots_with_singular_pencils_are_answered_completely(name, tmp_path):
         assert len(newton) == len(rows)
 
 
-def counted_splits(m) -> list[int]:
-    """The splits the module's Python general method solves from now on, appended in turn
-    (its _rr_split wrapped)."""
-    splits: list[int] = []
-    plain = m._rr_split
-
-    def counted(k, *args, **kwargs):
-        splits.append(k)
-        return plain(k, *args, **kwargs)
-
-    m._rr_split = counted
-    return splits
-
-
-def calibrated_cobot(name: str, seed: int) -> str:
-    """The vendor's table of a cobot (REAL_COBOTS) moved as a calibration moves it: alpha
-    and theta by up to 0.02 deg, a and d by up to 0.2 mm (tests/test_nominal.py's
-    calibrated, for these tables)."""
-    rng = np.random.default_rng(seed)
-    rows = []
-    for alpha, a, d, theta in REAL_COBOTS[name]:
-        da, dt = (float(x) for x in rng.uniform(-0.02, 0.02, 2))
-        la, ld = (float(x) for x in rng.uniform(-2e-4, 2e-4, 2))
-        rows.append((alpha + da, a + la, d + ld, theta + dt))
-    return spec_text(f"{name}_cal", "modified", rows)
-
-
-@needs_cc
-def test_a_calibrated_cobot_s_clusters_ask_for_the_fallback_split_only(tmp_path):
-    """A calibrated HC10: its own pencil is regular, so no table is perturbed, but nearly
-    special: its eigenvalues come in clusters at nearly every pose (the arm's pairs sharing
-    the eigen-joint's value, split by the calibration), and the arm's own table's doubt
-    rules ran the rescue at every pose, 6 splits each (Python 10.7 ms, C 240 us a pose against
-    3.5 ms and 106 us for the vendor's table). Such a split is marked at generation
-    (Split.clustered) and its doubts are a perturbed table's: at most 2 splits a pose here,
-    complete against multistart Newton in both backends, sound and complete on 200 samples
-    in C."""
-    m = build_module(calibrated_cobot("hc10", 7), tmp_path)
-    assert m.METHOD == "general" and all(m._RR_CLUSTERED)
-    assert all(split[1] == split[2] for split in m._RR_SPLITS)  # (the arm's own table)
-    result = roundtrip(m, sample_joints(m, 200, np.random.default_rng(41)), "c")
-    assert result.unsound == [] and result.misses == [], result.summary()
-    assert result.singular_posed == result.singular, result.summary()
-    rng = np.random.default_rng(8)
-    for q in rng.uniform(-math.pi, math.pi, (3, 6)):
-        T = m.fk(q)
-        newton = newton_solutions(m, T, 150, rng)
-        for backend in ("c", "python"):
-            rows = m.ik(T, backend=backend)
-            assert len(rows) == len(newton), (backend, len(rows), len(newton))
-            for p in newton:
-                gaps = np.abs((rows - p + math.pi) % (2 * math.pi) - math.pi).max(axis=1)
-                assert gaps.min() < 1e-6, backend
-    splits = counted_splits(m)
-    for q in rng.uniform(-math.pi, math.pi, (20, 6)):
-        m.ik(m.fk(q), backend="python")
-    assert len(splits) <= 2 * 20, len(splits)
-
-
-def test_the_general_method_asked_for_by_name_keeps_the_strict_doubt_rules():
-    """[ik] method = "general" (or --method general) asks for the complete set: no split is
-    marked clustered, so a cluster starts the rescue as on any arm's own table (a calibrated
-    IRB 120 so solved had lost a wrist pair in C under the relaxed rules, helper 75)."""
-    text = calibrated_cobot("hc10", 7)
-    default = eigen_step(build_plan(parse_spec(text, "<t>")))
-    asked = eigen_step(build_plan(parse_spec(text, "<t>"), method="general"))
-    assert default is not None and asked is not None
-    assert all(s.clustered for s in default.splits)
-    assert not any(s.clustered for s in asked.splits)
-
-
 # two regular poses of the CRX-like arm (sigma_min 1e-4 and 1.5e-4: elbow and wrist 3e-4 and
 # 8e-4 rad from their singular values) where its perturbed table made four of the eight
 # solutions complex pairs (within _RR_PAIR_DOUBT of real): only the fallback split finds them
@@ -589,7 +517,14 @@ def test_a_perturbed_table_s_fallback_split_runs_only_where_rows_may_be_missing(
     if backend == "c":
         return
     jaco = build_module(spec_text("jaco2", "standard", COBOTS["jaco2"]), tmp_path)
-    splits = counted_splits(jaco)
+    splits: list[int] = []
+    plain = jaco._rr_split
+
+    def counted(k, *args, **kwargs):
+        splits.append(k)
+        return plain(k, *args, **kwargs)
+
+    jaco._rr_split = counted
     rng = np.random.default_rng(11)
     fallbacks = 0
     for q in rng.uniform(-math.pi, math.pi, (40, 6)):

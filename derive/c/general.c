@@ -1341,14 +1341,6 @@ static int dk_rr_perturbed(int k)
     return 0;
 }
 
-/* whether split k's doubts are a perturbed table's (DK_RR_FALLBACK; candidates that polish to
-   nothing put nothing in doubt): its table perturbed, or the arm's own but nearly special
-   (DK_RR_CLUSTERED; the Python solver's _rr_tolerant says why) */
-static int dk_rr_tolerant(int k)
-{
-    return dk_rr_perturbed(k) || DK_RR_CLUSTERED[k];
-}
-
 /* split k's companion matrix K without its known eigenvalues (_rr_deflated in
    derive/runtime/general.py): K[o, o] - G K[p', o], p' the rows DK_RR_PIVOTS[k] and 12 more,
    o the others, G = [Re W[o] - (yr / yi) Im W[o], Im W[o] / yi] for W = [v; y+ v] (v the
@@ -1575,7 +1567,7 @@ static int dk_rr_candidates(const double values[490], const double F[4][4],
                value, which its special geometry makes common: both come from the plane, and
                the partners and the search find one lost; they ask for the fallback only) */
             if (!is_extra) {
-                *doubt |= dk_rr_tolerant(split) ? DK_RR_FALLBACK : DK_RR_RESCUE;
+                *doubt |= dk_rr_perturbed(split) ? DK_RR_FALLBACK : DK_RR_RESCUE;
             }
             if (nv == 2) {
                 nv = 1 + dk_rr_unmix(V);
@@ -1839,7 +1831,6 @@ static int dk_rr_split(int k, const double F[4][4], const double moved[4][4],
     const int known = count;
     double pair;
     int extra[DK_RR_CANDS], perturbed = dk_rr_perturbed(k), damped = 0, reals, n, c, i, j, r;
-    const int tolerant = dk_rr_tolerant(k); /* (a perturbed or nearly special table's doubts) */
     int n_misses = 0;
     int paired[DK_RR_ROWS]; /* (per row of out: an extra candidate's, first) */
     for (r = 0; r < DK_RR_ROWS; r++) {
@@ -1882,7 +1873,7 @@ static int dk_rr_split(int k, const double F[4][4], const double moved[4][4],
             }
         }
         error = dk_rr_newton(DK_RR_TRUE[k], F, q, &damped, extra[c], perturbed ? turns : NULL);
-        if (damped && !tolerant && !extra[c]) { /* Newton alone did not settle it */
+        if (damped && !perturbed && !extra[c]) { /* Newton alone did not settle it */
             *doubt = DK_RR_RESCUE;
         }
         if (error > DK_RR_GOOD) {
@@ -1898,7 +1889,7 @@ static int dk_rr_split(int k, const double F[4][4], const double moved[4][4],
                 }
                 n_misses++;
             }
-            if (!tolerant && !extra[c]) {
+            if (!perturbed && !extra[c]) {
                 *doubt = DK_RR_RESCUE;
             }
             continue;
@@ -2089,8 +2080,7 @@ static int dk_general(const double flanges[DK_RR_SPLIT_COUNT][12], double out[DK
         count = dk_rr_split(k, (const double(*)[4])targets[k], (const double(*)[4])targets[k],
                             out, count, &doubt, DK_RR_IMAG_TOL, seeds, &n_seeds, &leads);
         tried++;
-        perturbed |= dk_rr_tolerant(k); /* (a perturbed table walked, or a nearly special
-                                           one answered: the partners below) */
+        perturbed |= dk_rr_perturbed(k); /* (a perturbed table walked: the partners below) */
         grew |= k > 0 && count > before; /* (the fallback found what the first split missed) */
         if (count == DK_RR_ROWS) {
             return count;
@@ -2126,7 +2116,7 @@ static int dk_general(const double flanges[DK_RR_SPLIT_COUNT][12], double out[DK
                 }
                 count = dk_rr_split(k, (const double(*)[4])targets[k], (const double(*)[4])moved,
                                     out, count, &ignored, DK_RR_IMAG_TOL, seeds, &n_seeds, &leads);
-                perturbed |= dk_rr_tolerant(k);
+                perturbed |= dk_rr_perturbed(k);
                 if (count == DK_RR_ROWS) {
                     return count;
                 }

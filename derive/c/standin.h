@@ -20,7 +20,6 @@
 static const int DK_RR_REVERSED[DK_RR_SPLIT_COUNT] = {0};
 static const double DK_RR_FILL[DK_RR_SPLIT_COUNT][7][4] = {{{0.0}}};
 static const double DK_RR_TRUE[DK_RR_SPLIT_COUNT][7][4] = {{{0.0}}};
-static const int DK_RR_CLUSTERED[DK_RR_SPLIT_COUNT] = {0};
 static const int DK_RR_FLIPS[2] = {0, 1};
 #define DK_RR_SPURIOUS_WIDTH 2
 static const int DK_RR_PIVOTS[DK_RR_SPLIT_COUNT][DK_RR_SPURIOUS_WIDTH / 2] = {{0}};

@@ -24,7 +24,6 @@ are in :mod:`derive.runtime.general` (Python) and derive/c/general.c (C).
 
 from __future__ import annotations
 
-import dataclasses
 import math
 from functools import cache
 
@@ -50,12 +49,6 @@ SINGULAR_EVERYWHERE = 1e-10
 # a singular value of the lifted matrix at x3 = i below this share of the largest is zero
 # (the spurious null space's are rounding: 1e-17 in double precision)
 SPURIOUS_RANK_TOL = 1e-12
-# a split of the arm's own table whose generating values were found at this share of the
-# poses at least, and whose eigenvalues came in clusters at this share at least, is nearly
-# special (Split.clustered): a calibrated cobot's (its clusters at 32 to 40 of 40 poses; a
-# generic arm's, manocha_canny's included, at 0 to 11)
-CLUSTERED_FOUND = 0.9
-CLUSTERED_SHARE = 0.5
 Row = tuple[float, float, float, float]
 
 
@@ -120,25 +113,6 @@ def derive(chain: Chain, structure: Structure) -> IkPlan | str:
         steps=tuple(steps),
         outputs=joint_outputs(chain),
     )
-
-
-def strict(plan: IkPlan) -> IkPlan:
-    """The plan with no split marked clustered: the general method asked for by name ([ik]
-    method = "general", the complete set of a calibrated arm whose nominal table has a closed
-    form) keeps the arm's own table's doubt rules, whose rescue solves every pose with
-    clustered eigenvalues again from moved poses. A calibrated IRB 120 (spherical wrist) so
-    solved had both splits marked, and at a pose with its wrist 5.9e-4 rad from straight C's
-    eigenvalues made a complex pair of two real ones numpy found: C returned 6 rows of 8, the
-    sampled vector missed, where the rescue finds all 8 (a reviewer's find, helper 75)."""
-    steps = tuple(
-        dataclasses.replace(
-            step, splits=tuple(dataclasses.replace(s, clustered=False) for s in step.splits)
-        )
-        if isinstance(step, Eigen)
-        else step
-        for step in plan.steps
-    )
-    return dataclasses.replace(plan, steps=steps)
 
 
 def slide_of(chain: Chain) -> tuple[float, float]:
@@ -289,11 +263,8 @@ def measure(chain: Chain, reversed_: int, length: float, perturb: bool) -> Split
     fill_rows = perturbed(true_rows) if perturb else true_rows
     slide = slide_of(chain)
     fill = fill_expressions(fill_rows, {} if perturb else exact_numbers(chain), slide)
-    recovered, conds, clusters = score(fill_rows, true_rows, slide)
+    recovered, conds = score(fill_rows, true_rows, slide)
     spurious, pivots = spurious_vectors(fill) if not slide[0] else ((), ())
-    clustered = (
-        not perturb and recovered >= CLUSTERED_FOUND * POSES and clusters >= CLUSTERED_SHARE * POSES
-    )
     return Split(
         reversed=bool(reversed_),
         fill=fill,
@@ -306,7 +277,6 @@ def measure(chain: Chain, reversed_: int, length: float, perturb: bool) -> Split
         slide=slide,
         spurious=spurious,
         spurious_pivots=pivots,
-        clustered=clustered,
     )
 
 
@@ -375,13 +345,12 @@ def spurious_vectors(
 
 def score(
     fill_rows: tuple[Row, ...], true_rows: tuple[Row, ...], slide: tuple[float, float]
-) -> tuple[int, list[float], int]:
+) -> tuple[int, list[float]]:
     """Of POSES random poses (a fifth of the joints at 0, +-90 or 180 deg; a sliding joint 3
     within +-1 arm size), how many have their generating joint values among the split's
-    polished candidates; the condition numbers of the pencil's leading matrix; and how many
-    have eigenvalues in clusters (an answer in doubt)."""
+    polished candidates; and the condition numbers of the pencil's leading matrix."""
     rng = np.random.default_rng(20261201)
-    recovered = clusters = 0
+    recovered = 0
     conds = []
     for _ in range(POSES):
         q = rng.uniform(-math.pi, math.pi, 6)
@@ -393,15 +362,14 @@ def score(
         for i, t in enumerate(q):
             F = F @ _split_joint(i, t, true_rows, slide)
         P0, Ps, Pc, Q = matrices_at(fill_rows, F, slide)
-        candidates, doubt, _, _ = runtime._rr_candidates(P0, Ps, Pc, Q, F, fill_rows, slide)
-        clusters += bool(doubt)
+        candidates, _, _, _ = runtime._rr_candidates(P0, Ps, Pc, Q, F, fill_rows, slide)
         conds.append(leading_condition(P0, Ps, Pc, Q))
         if candidates:
             # (Newton's steps only, as the splits were always measured)
             P, errors = runtime._rr_steps_many(true_rows, F, np.array(candidates), slide, False)
             gaps = np.abs((P - q + math.pi) % (2 * math.pi) - math.pi).max(axis=1)
             recovered += bool(((errors <= runtime._RR_GOOD) & (gaps <= 1e-6)).any())
-    return recovered, conds, clusters
+    return recovered, conds
 
 
 def leading_condition(P0, Ps, Pc, Q) -> float:

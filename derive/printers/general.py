@@ -71,11 +71,6 @@ def general_code(plan: Plan) -> str:
         lines += [*rows(split.true_rows), f"        ({slide}),", "    ),"]
     lines += [")", f"_RR_LENGTH = {float_literal(step.unit)}"]
     lines += [
-        "# per split, whether it is the arm's own table but nearly special (Split.clustered):",
-        "# its doubts are taken as a perturbed table's",
-        f"_RR_CLUSTERED = {tuple(split.clustered for split in step.splits)}",
-    ]
-    lines += [
         "# the ends of the arm's six joints (0: joints 1-3, 3: joints 4-6) whose wrist flip leaves",
         "# the pose unchanged: _rr_partners tries the flips there",
         f"_RR_FLIPS = {tuple(step.flips)}",

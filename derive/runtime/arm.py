@@ -72,8 +72,6 @@ _RR_SPLITS: tuple[
 ]
 _RR_SPLITS = ()
 _RR_LENGTH = 1.0
-# per split, whether it is the arm's own table but nearly special (Split.clustered)
-_RR_CLUSTERED: tuple[bool, ...] = ()
 # the ends of the six joints (0: joints 1-3, 3: joints 4-6) whose wrist flip leaves the pose
 # unchanged (Eigen.flips)
 _RR_FLIPS: tuple[int, ...] = ()
