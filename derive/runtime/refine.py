@@ -134,7 +134,7 @@ _PARTNER_STEPS = (1e-3, 4e-3, 1.6e-2, 6.4e-2)
 # 1.35e-4): 7 rows, the sampled vector 2.8 rad along q3 - q5 from the row beside it (a new
 # user's attack, helper 74); on 300 near-singular poses of each of six such arms (calibrated
 # UR5, KR6 and PUMA, the pib arm, the xArm6 URDF and Menagerie's M1013) 8 counts went from odd
-# to even, the sampled vector found at 3 poses more, no row lost
+# to even, the sampled vector found at 3 poses more, no count went down
 _PARTNER_TURNS = (math.pi / 2, -math.pi / 2, math.pi)
 # ik_approximate's least squares: at most this many steps, done where the gradient of half
 # the squared error is this flat
@@ -188,6 +188,7 @@ def _fold_partners(rows, t, tol):
     if not (_SEED_TOL and len(rows) % 2 and len(_SOLVED) == 6 and IK_COMPONENTS == "pose"):
         return rows
     limit = min(tol, _REFINE_STALL if _LOOSE.near else _REFINE_TOL)
+    turning = all(_REVOLUTE[i] for i in _SOLVED)  # (every solved joint turns: _PARTNER_TURNS)
     out = list(rows)
     for q in rows:
         least, v = _least_direction(_pose_error(q, t, False)[1])
@@ -200,7 +201,7 @@ def _fold_partners(rows, t, tol):
                 for k, i in enumerate(_SOLVED):
                     seed[i] += sign * h * v[k]
                 seeds.append(seed)
-        if all(_REVOLUTE[i] for i in _SOLVED):  # (across a broken self-motion's circle)
+        if turning:  # (across a broken self-motion's circle)
             top = max(abs(x) for x in v)
             for turn in _PARTNER_TURNS:
                 seed = list(q)
