@@ -9,7 +9,7 @@
    is solved by it): one copy serves every arm of a folder, and each arm's file gets its own
    static copy of the routines, so arms link together in one program. Compile <name>_ik.c
    with it beside the file; do not include it anywhere else. */
-#define DK_RUNTIME 0x67a4227803e2
+#define DK_RUNTIME 0xc4c2946867fa
 
 #include <math.h>
 #include <stddef.h>
@@ -3618,7 +3618,7 @@ static void dk_dls(const double *J, int n, const double t[6], double damping, do
 #define DK_RR_NEAR_SINGULAR (0.001)
 /* a perturbed table's clusters ask for the fallback split unless the split's rows number its
    real eigenvalues and no complex one is within DK_RR_PAIR_DOUBT (1 + |y|) of the real line
-   (the Python solver's _RR_PAIR_DOUBT) */
+   (the Python solver's _RR_PAIR_DOUBT); such a pair asks for it without clusters too */
 #define DK_RR_PAIR_DOUBT (0.03)
 /* on a nominal table (DK_SEED_TOL > 0), a candidate the steps leave within DK_SEED_TOL of the
    pose seeds the refinement, with the points this far each way along the direction the
@@ -5414,6 +5414,11 @@ static int dk_rr_split(int k, const double F[4][4], const double moved[4][4],
     if (n < 0) { /* (a singular pencil) */
         leads->singular |= !perturbed;
         n = 0;
+    } else if (perturbed && pair <= DK_RR_PAIR_DOUBT && k + 1 < DK_RR_SPLIT_COUNT) {
+        /* (a pair nearly real, clusters or not: perhaps two of the arm's solutions the
+           table's difference made complex, which only a plane brings out; _rr_split says
+           why; the last split's has no split to ask for) */
+        *doubt |= DK_RR_FALLBACK;
     }
     for (c = 0; c < n; c++) {
         double q[6], arm[6], turns[6][2], error;

@@ -38,7 +38,7 @@ if "_RUNTIME_VERSION" not in globals():  # (imported on its own, not run by a mo
         "namespace; it is not a module to import"
     )
 # this runtime's version: a module runs the runtime of its own version only
-_RUNTIME_VERSION = "7cad634246a7762d"
+_RUNTIME_VERSION = "bb33ed1b349e9274"
 
 if TYPE_CHECKING:  # defined by the module running this file
     from derive.runtime.arm import (
@@ -462,7 +462,9 @@ _RR_NEAR_SINGULAR = 1e-3
 # made complex by the table's difference. On a Jaco2 and a CRX-like arm (3,000 poses each, a
 # fifth of the joints at 0, +-90 or 180 deg, moved 1e-3 or 1e-2 rad): the fallback split ran
 # at 20% of the poses instead of 90%, and every pose kept its rows; without the second
-# condition, two poses (sigma_min 1e-4) lost 4 of their 8
+# condition, two poses (sigma_min 1e-4) lost 4 of their 8. A pair within it asks for the
+# fallback split without clusters too (_rr_split: the CRB 15000's C ik 9% slower by the mean,
+# the other cobots' the same)
 _RR_PAIR_DOUBT = 0.03
 
 
@@ -3235,8 +3237,20 @@ def _rr_split(k, F, moved, leads, known=(), imag_tol=_RR_IMAG_TOL):
     # its special geometry makes common: both come from the plane, and the partners and the
     # search find one lost; they ask for the fallback split only (on 2,000 poses of each of
     # two cobots, the rescue they started added rows at 14 poses, 13 of them with an odd
-    # count, which starts it anyway), and only where a row may be missing (_rr_settled)
-    doubt = (_FALLBACK if fill_rows != true_rows else _RESCUE) if doubt else 0
+    # count, which starts it anyway), and only where a row may be missing (_rr_settled).
+    # A pair within _RR_PAIR_DOUBT of real does so too, clusters or not: it may be two of the
+    # arm's solutions that the table's difference made complex, whose nearly double roots
+    # only a plane (a second singular value below _RR_NULL2_TOL) brings out, and that test
+    # sits at the edge there (a calibrated CRX-10iA/L's and a nearly nominal INDY7's pose,
+    # the second singular value 4e-6 to 1e-5 of the largest, C's pivots 1.5e-5 to 4e-5: C
+    # saw no plane, lifted no doubt and returned 4 and 2 of the 6 and 8 rows; a reviewer's
+    # find, helper 75). (The last split's pair has no split to ask for: _general's early
+    # answer for a pose out of reach stands.)
+    if fill_rows != true_rows:
+        nearly = pair <= _RR_PAIR_DOUBT and k + 1 < len(_RR_SPLITS)
+        doubt = _FALLBACK if doubt or nearly else 0
+    else:
+        doubt = _RESCUE if doubt else 0
     if known and candidates:  # (one within _RR_SAME of a known row is that row again)
         near = _rr_gap_table([_rr_to_arm(k, q) for q in candidates], list(known)) <= _RR_SAME
         kept = np.flatnonzero(~near.any(axis=1))

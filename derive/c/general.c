@@ -53,7 +53,7 @@
 #define DK_RR_NEAR_SINGULAR (0.001)
 /* a perturbed table's clusters ask for the fallback split unless the split's rows number its
    real eigenvalues and no complex one is within DK_RR_PAIR_DOUBT (1 + |y|) of the real line
-   (the Python solver's _RR_PAIR_DOUBT) */
+   (the Python solver's _RR_PAIR_DOUBT); such a pair asks for it without clusters too */
 #define DK_RR_PAIR_DOUBT (0.03)
 /* on a nominal table (DK_SEED_TOL > 0), a candidate the steps leave within DK_SEED_TOL of the
    pose seeds the refinement, with the points this far each way along the direction the
@@ -1849,6 +1849,11 @@ static int dk_rr_split(int k, const double F[4][4], const double moved[4][4],
     if (n < 0) { /* (a singular pencil) */
         leads->singular |= !perturbed;
         n = 0;
+    } else if (perturbed && pair <= DK_RR_PAIR_DOUBT && k + 1 < DK_RR_SPLIT_COUNT) {
+        /* (a pair nearly real, clusters or not: perhaps two of the arm's solutions the
+           table's difference made complex, which only a plane brings out; _rr_split says
+           why; the last split's has no split to ask for) */
+        *doubt |= DK_RR_FALLBACK;
     }
     for (c = 0; c < n; c++) {
         double q[6], arm[6], turns[6][2], error;
