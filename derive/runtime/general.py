@@ -1105,6 +1105,13 @@ _RR_CROSS = np.array(
 )
 
 
+# P.reshape(9) @ _RR_VEE = 0.5 (P[NEXT, LAST] - P[LAST, NEXT]) per component (a 3 x 3 P
+# flattened by rows; each sum has two terms, halved exactly: the same bits as the indexing)
+_RR_VEE = np.zeros((9, 3))
+_RR_VEE[3 * _RR_NEXT + _RR_LAST, [0, 1, 2]] = 0.5
+_RR_VEE[3 * _RR_LAST + _RR_NEXT, [0, 1, 2]] = -0.5
+
+
 def _rr_steps_many(
     rows, F, Q, slide, damped, reach=_RR_NEWTON_REACH, steps=_RR_NEWTON_STEPS, track=False
 ):
@@ -1115,35 +1122,37 @@ def _rr_steps_many(
     Fukushima: still quadratic onto a curve of solutions, where J is singular and Newton's
     steps jump; slow in a direction J nearly loses, which is why Newton goes first). The best
     point met by each, and its error; where track is set, `steps` Newton steps and the points
-    where they end, not measured (a continuation's corrector), and the errors before."""
+    where they end, not measured (a continuation's corrector), and no errors (None)."""
     q = np.array(Q, dtype=float)
     best_q, best = q.copy(), np.full(len(q), math.inf)
     live = np.arange(len(q))
     Ft = F[:3, :3].T
-    # (each numpy call costs about a microsecond whatever its size: the filters below are
-    # skipped where they would keep every row)
+    # (each numpy call costs about a microsecond whatever its size, and a step is a few dozen
+    # of them, on a few rows: the filters below are skipped where they would keep every row,
+    # and the walk's steps keep no best point)
     for _ in range(steps if track else steps + 1):
         x = q[live]
         frames = _rr_frames(x, rows, slide)
         E = frames[:, 6]
-        size = np.abs(F[:3] - E[:, :3]).max(axis=(1, 2))
-        better = size < best[live]
-        moved = live[better]
-        best_q[moved], best[moved] = x[better], size[better]
+        D = F[:3] - E[:, :3]
+        size = np.abs(D).reshape(len(x), 12).max(axis=1)
+        if not track:
+            better = size < best[live]
+            moved = live[better]
+            best_q[moved], best[moved] = x[better], size[better]
         going = (size > 1e-15) & (size <= reach)
         if not going.all():
-            live, x, frames, E, size = live[going], x[going], frames[going], E[going], size[going]
+            live, x, frames, E, D = live[going], x[going], frames[going], E[going], D[going]
+            size = size[going]
             if not live.size:
                 break
         # position error, and half the sum of E's columns crossed with F's (the rotation):
-        # the antisymmetric part of E's rotation times F's transposed
-        error = np.empty((len(live), 6))
-        error[:, :3] = F[:3, 3] - E[:, :3, 3]
+        # the antisymmetric part of E's rotation times F's transposed (_RR_VEE)
         P = E[:, :3, :3] @ Ft
-        error[:, 3:] = 0.5 * (P[:, _RR_NEXT, _RR_LAST] - P[:, _RR_LAST, _RR_NEXT])
+        error = np.concatenate((D[:, :, 3], P.reshape(len(x), 9) @ _RR_VEE), axis=1)
         J = _rr_columns(frames, slide).transpose(0, 2, 1)
         moves, solved = _rr_solve_many(J, error, damped)
-        if not solved.all():  # (a singular J: it stops)
+        if solved is not None:  # (a singular J: it stops)
             live, x, moves, size = live[solved], x[solved], moves[solved], size[solved]
         longest = np.abs(moves).max(axis=1, initial=0.0)
         q[live] = x + moves * (0.5 / np.maximum(longest, 0.5))[:, None]  # (at most 0.5 a joint)
@@ -1159,7 +1168,7 @@ def _rr_steps_many(
                 live = live[~done]
                 if not live.size:
                     break
-    return (q if track else best_q), best
+    return (q, None) if track else (best_q, best)
 
 
 def _rr_frames(X, rows, slide):
@@ -1192,8 +1201,8 @@ def _rr_columns(frames, slide):
 
 
 def _rr_solve_many(J, error, damped):
-    """The steps J step = error (or the damped ones, as _rr_steps_many) of a stack, and
-    which could be taken (a singular system's cannot)."""
+    """The steps J step = error (or the damped ones, as _rr_steps_many) of a stack, and None
+    where every one could be taken, else which could (a singular system's cannot)."""
     if damped:
         Jt = J.transpose(0, 2, 1)
         mu = np.einsum("ij,ij->i", error, error)
@@ -1202,7 +1211,7 @@ def _rr_solve_many(J, error, damped):
     else:
         A, b = J, error
     try:
-        return np.linalg.solve(A, b[:, :, None])[:, :, 0], np.ones(len(A), dtype=bool)
+        return np.linalg.solve(A, b[:, :, None])[:, :, 0], None
     except np.linalg.LinAlgError:  # one of them is singular: each on its own
         steps, solved = np.zeros_like(b), np.ones(len(A), dtype=bool)
         for k in range(len(A)):
