@@ -24,7 +24,6 @@ from derive.emit import GENERATOR, environment
 from derive.methods import general
 from derive.plan import Assign, Eigen, Plan, Solve
 from derive.runtime import general as runtime_general
-from derive.runtime.constants import _PAIR_NARROW
 
 DIGITS = 4
 CRAIG = "Craig's"
@@ -761,8 +760,8 @@ def correction_blocks(plan: Plan) -> list[Block]:
             "p",
             "Where an equation of the nominal arm just misses (an acos argument above 1 by at "
             f"most {fix.seed_tol:.2g}, a double root split off the real line by at most "
-            f"{math.sqrt(fix.seed_tol) / _PAIR_NARROW:.2g}) its boundary value still seeds a "
-            "refinement: the exact arm may reach what the nominal one does not.",
+            f"{math.sqrt(fix.seed_tol):.2g}) its boundary value still seeds a refinement: the "
+            "exact arm may reach what the nominal one does not.",
         ),
     ]
 

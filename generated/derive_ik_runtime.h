@@ -9,7 +9,7 @@
    is solved by it): one copy serves every arm of a folder, and each arm's file gets its own
    static copy of the routines, so arms link together in one program. Compile <name>_ik.c
    with it beside the file; do not include it anywhere else. */
-#define DK_RUNTIME 0xf387b7e1da6a
+#define DK_RUNTIME 0xc4c2946867fa
 
 #include <math.h>
 #include <stddef.h>
@@ -68,9 +68,6 @@
 #define DK_FOLD_WIDTH (0.03)
 #define DK_FOLD_AT (1.0 - DK_FOLD_WIDTH * DK_SEED_TOL < DK_FOLD_NEAR ? \
                         1.0 - DK_FOLD_WIDTH * DK_SEED_TOL : DK_FOLD_NEAR)
-/* a nominal polynomial's complex pair within sqrt(DK_SEED_TOL) / DK_PAIR_NARROW of real seeds
-   its real part (_PAIR_NARROW says why) */
-#define DK_PAIR_NARROW (3.0)
 #define DK_FOLD_SEED_COUNT 1
 static const double DK_FOLD_SEEDS[DK_FOLD_SEED_COUNT] = {0.03};
 /* how far beyond 1 a nominal table's acos argument still seeds the refinement: DK_SEED_TOL,
@@ -1165,7 +1162,7 @@ static int dk_accept(const double *p, int d, const dk_cx *zs, int m, int check, 
     if (DK_SEED_TOL > 0.0) { /* a nominal near-double root, split by the arm's difference
                                 (in the second pass, loose: any complex root, as the Python
                                 solver's _accept) */
-        const double near = loose ? HUGE_VAL : sqrt(DK_SEED_TOL) / DK_PAIR_NARROW;
+        const double near = loose ? HUGE_VAL : sqrt(DK_SEED_TOL);
         for (k = 0; k < m && count + 3 <= DK_ROOTS_MAX; k++) { /* (Aberth's iterates of a
             multiple root can all lie above the line: not one pair's upper one each) */
             const double size = 1.0 + dk_cx_abs(zs[k]);

@@ -66,7 +66,6 @@ def test_the_c_runtime_holds_the_python_runtimes_constants():
         "BRANCH_FOLD",
         "FOLD_NEAR",
         "FOLD_WIDTH",
-        "PAIR_NARROW",
     ):
         assert float(found[f"DK_{name}"]) == getattr(constants, f"_{name}"), name
     for name in (

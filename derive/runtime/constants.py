@@ -110,21 +110,12 @@ _AIM_POLISH = 1e-2
 # equal seeds refine onto one of the pair and lose the other (a new user's SO-101 MJCF lost
 # the elbow's second row 0.03-0.12 rad from its fold), and Newton's steps from either side of
 # a fold go to that side's solution; values farther apart already seed either side. A
-# polynomial's near-double root (a complex pair within _PAIR_NARROW's window) seeds its real
-# part's angle +- _FOLD_SEEDS[0] too (a calibrated PUMA's elbow near stretched) (with
+# polynomial's near-double root (a complex pair within sqrt(_SEED_TOL)) seeds its real part's
+# angle +- _FOLD_SEEDS[0] too (a calibrated PUMA's elbow near stretched) (with
 # cos 0.01 the seeds came at 13% of a calibrated UR5's poses, and cost 20% of its time; one
 # offset of 0.03 finds what 0.01 and 0.1 found on the SO-101, at half the cost)
 _FOLD_NEAR = 0.9999995
 _FOLD_SEEDS = (0.03,)
-# a nominal polynomial's complex pair seeds its real part where it lies within sqrt(_SEED_TOL) /
-# _PAIR_NARROW of real (relative to 1 + |z|): a double root that the arm's difference d moves
-# splits by about sqrt(d) times a factor of the equation's, and _SEED_TOL is a hundred d, so the
-# window is about 3.3 sqrt(d). With the whole sqrt(_SEED_TOL) (0.32 on a calibrated KR6) the
-# compiled ik of the calibrated KR6, IRB 2400 and M-20iA took 2.26, 2.09 and 1.94 times the
-# nominal's by the mean (1,000 uniform poses, least of 5 interleaved calls), now 2.05, 1.90
-# and 1.78; the same rows at 600 uniform and 200 near-fold poses of each of them and the
-# calibrated PUMA in C (150 each in Python)
-_PAIR_NARROW = 3.0
 # ... or beyond 1 - _FOLD_WIDTH _SEED_TOL (three times the arm's difference), where that is
 # lower: a calibration moves a nominal fold's pair more than 1e-3 apart. A calibrated UR5
 # URDF (deviation 4.8e-4) near its shoulder's double root had theta1's nominal values 1.2e-3

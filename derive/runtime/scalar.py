@@ -37,7 +37,6 @@ from derive.runtime.constants import (
     _FREE_TOL_LOOSE,
     _LEAD_TOL,
     _MERGE_TOL,
-    _PAIR_NARROW,
     _ROOT_IMAG_TOL,
     _SEED_BAND,
     _SPREAD_COUNT,
@@ -541,7 +540,7 @@ def _accept(p: list[float], zs: list[complex], check: bool = True) -> list[float
         # reach, as a Kinova Gen3 position task's, its tip 0.175 mm from the last solved
         # axis, leaves poses near its edge an imaginary pair 0.041-0.062 from real in u,
         # beyond this window's 0.039; _seed drops the seeds beyond _SEED_TOL of the pose)
-        near = math.inf if _LOOSE.on or _LOOSE.near else math.sqrt(_SEED_TOL) / _PAIR_NARROW
+        near = math.inf if _LOOSE.on or _LOOSE.near else math.sqrt(_SEED_TOL)
         for z in map(complex, zs):
             if _ROOT_IMAG_TOL * (1.0 + abs(z)) < z.imag <= near * (1.0 + abs(z)):
                 out.append(z.real)
