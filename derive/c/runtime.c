@@ -1641,12 +1641,20 @@ static void dk_wrist_spread(dk_values *v, double det, double det_scale)
     }
 }
 
-/* v's first value -+ v->more and -+ 2 v->more added, once (dk_wrist_spread) */
+/* v's first value -+ v->more and -+ 2 v->more added, then the rest of DK_SPREAD_COUNT all
+   round from it, once (dk_wrist_spread; the Python solver's _wrist_spread says why) */
 static void dk_spread_more(dk_values *v)
 {
     int k;
     for (k = 1; k <= 4 && v->n < DK_VALUES_MAX; k++) {
         const double t = v->t[0] + (k & 1 ? -1.0 : 1.0) * ((k + 1) / 2) * v->more;
+        v->t[v->n] = t;
+        v->c[v->n] = cos(t);
+        v->s[v->n] = sin(t);
+        v->n++;
+    }
+    for (k = 1; k < DK_SPREAD_COUNT && v->n < DK_VALUES_MAX; k++) {
+        const double t = v->t[0] + DK_TWO_PI * k / DK_SPREAD_COUNT;
         v->t[v->n] = t;
         v->c[v->n] = cos(t);
         v->s[v->n] = sin(t);
