@@ -253,8 +253,8 @@ _RR_NEAR_SINGULAR = 1e-3
 # fifth of the joints at 0, +-90 or 180 deg, moved 1e-3 or 1e-2 rad): the fallback split ran
 # at 20% of the poses instead of 90%, and every pose kept its rows; without the second
 # condition, two poses (sigma_min 1e-4) lost 4 of their 8. A pair within it asks for the
-# fallback split without clusters too (_rr_split: the CRB 15000's C ik 9% slower by the mean,
-# the other cobots' the same)
+# fallback split without clusters too (_rr_split: the CRB 15000's C ik 8% slower by the mean,
+# the other cobots' within 3%)
 _RR_PAIR_DOUBT = 0.03
 _RR_RESCUE = ((1e-4, 1e-4), (-2e-4, 1.5e-4))
 # on a nominal table (an arm whose exact chain is refined from it: _SEED_TOL > 0), a

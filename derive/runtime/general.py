@@ -413,6 +413,7 @@ def _rr_split(k, F, moved, leads, known=(), imag_tol=_RR_IMAG_TOL):
     (_RRLeads): a singular pencil on the arm's own table, and the candidates that stopped
     within _RR_SEARCH_FROM of F."""
     _, fill_rows, true_rows, slide = _RR_SPLITS[k]
+    perturbed = fill_rows != true_rows
     values = np.zeros(490)
     _rr_fill(k, *moved[:3, 2], *moved[:3, 3], values)
     P0 = values[:126].reshape(14, 9)
@@ -430,14 +431,12 @@ def _rr_split(k, F, moved, leads, known=(), imag_tol=_RR_IMAG_TOL):
         leads.clear = candidates is not None and reals == 0 and pair > window
     # a perturbed table's solutions are walked back to the arm's in steps (a continuation),
     # so that Newton does not jump to another branch
-    path = (
-        [_rr_between(fill_rows, true_rows, t) for t in _RR_PATH] if fill_rows != true_rows else []
-    )
+    path = [_rr_between(fill_rows, true_rows, t) for t in _RR_PATH] if perturbed else []
     out: list[np.ndarray] = []
     close: list[np.ndarray] = []
     paired: list[bool] = []  # (per row of out: an extra candidate's, first)
     if candidates is None:  # (a singular pencil)
-        leads.singular = leads.singular or fill_rows == true_rows
+        leads.singular = leads.singular or not perturbed
         return out, close, _RESCUE
     # a perturbed table's clusters are the arm's pairs sharing the eigen-joint's value, which
     # its special geometry makes common: both come from the plane, and the partners and the
@@ -452,7 +451,7 @@ def _rr_split(k, F, moved, leads, known=(), imag_tol=_RR_IMAG_TOL):
     # saw no plane, lifted no doubt and returned 4 and 2 of the 6 and 8 rows; a reviewer's
     # find, helper 75). (The last split's pair has no split to ask for: _general's early
     # answer for a pose out of reach stands.)
-    if fill_rows != true_rows:
+    if perturbed:
         nearly = pair <= _RR_PAIR_DOUBT and k + 1 < len(_RR_SPLITS)
         doubt = _FALLBACK if doubt or nearly else 0
     else:
@@ -470,7 +469,6 @@ def _rr_split(k, F, moved, leads, known=(), imag_tol=_RR_IMAG_TOL):
     for rows in path:  # (Newton's steps only: damped ones may change branch on the way)
         Q, _ = _rr_steps_many(rows, F, Q, slide, False, steps=_RR_PATH_STEPS, track=True)
     Q, residuals, damped = _rr_newton_many(true_rows, F, Q, slide, np.array(extras))
-    perturbed = fill_rows != true_rows
     # the arm's values of the starts and rows, and their gaps from each other and from the
     # known rows, one table each (the Python solver's time went to comparing candidates one
     # by one: 11% of it on two cobots); a row moved after these (_rr_unsettled_copy), or a
