@@ -9,7 +9,7 @@
    is solved by it): one copy serves every arm of a folder, and each arm's file gets its own
    static copy of the routines, so arms link together in one program. Compile <name>_ik.c
    with it beside the file; do not include it anywhere else. */
-#define DK_RUNTIME 0x1d38fb2b2c9d
+#define DK_RUNTIME 0xd13506f6b91c
 
 #include <math.h>
 #include <stddef.h>
@@ -3592,10 +3592,8 @@ static void dk_dls(const double *J, int n, const double t[6], double damping, do
 #define DK_RR_GOOD (1e-10)
 #define DK_RR_NEWTON_STEPS 10
 #define DK_RR_NEWTON_REACH (0.5)
-#define DK_RR_NEWTON_PATIENCE 3
 #define DK_RR_NEWTON_DONE (1e-11)
 #define DK_RR_NEWTON_DONE_STEP (1e-08)
-#define DK_RR_DAMP_NEAR (0.001)
 #define DK_RR_ROWS 16 /* the most rows one pose gives */
 /* the most seeds a nominal table's near misses give (three each for as many near misses as a
    pose has rows: the Python solver's _RR_SEEDS_EACH * MAX_SOLUTIONS) */
@@ -4484,7 +4482,7 @@ static double dk_rr_turned_walk(const double rows[7][4], const double F[4][4], d
     double cur[6], cs[6][2], best_cs[6][2], frames[7][4][4], J[6][6], normal[6][6], rhs[6];
     double step[6], best = HUGE_VAL;
     const int slider = rows[6][0] != 0.0 ? 2 : -1;
-    int it, i, r, c, k, worse = 0; /* (Newton's steps in a row that met no better point) */
+    int it, i, r, c, k;
     for (i = 0; i < 6; i++) {
         const double angle = i == slider ? rows[6][1] : q[i];
         cur[i] = q[i];
@@ -4511,20 +4509,14 @@ static double dk_rr_turned_walk(const double rows[7][4], const double F[4][4], d
         }
         if (size < best) {
             best = size;
-            worse = 0;
             for (i = 0; i < 6; i++) {
                 q[i] = cur[i];
                 best_cs[i][0] = cs[i][0];
                 best_cs[i][1] = cs[i][1];
             }
-        } else {
-            worse++;
         }
         if (size <= 1e-15 || size > reach) {
             break;
-        }
-        if (!damped && !track && worse >= DK_RR_NEWTON_PATIENCE && best > DK_RR_DAMP_NEAR) {
-            break; /* (cycling far from any solution: _RR_NEWTON_PATIENCE) */
         }
         for (r = 0; r < 3; r++) {
             int a = (r + 1) % 3, b = (r + 2) % 3;
@@ -4616,30 +4608,24 @@ static double dk_rr_steps(const double rows[7][4], const double F[4][4], double 
     return dk_rr_walk(rows, F, q, damped, DK_RR_NEWTON_STEPS, DK_RR_NEWTON_REACH, 0);
 }
 
-/* Newton steps (q in place, the pose error there); *used set where they do not reach
-   DK_RR_GOOD and Levenberg-Marquardt steps are to follow (dk_rr_damped; together the Python
-   solver's _rr_newton_many) */
+/* Newton steps, then, where they do not reach DK_RR_GOOD, Levenberg-Marquardt steps from the
+   best point met (the Python solver's _rr_newton): q in place, the pose error there; *used
+   set where the damped steps were taken */
 static double dk_rr_newton(const double rows[7][4], const double F[4][4], double q[6],
                            int *used, int extra, double turns[6][2])
 {
+    double damped[6], damped_error;
     double error = dk_rr_turned_walk(rows, F, q, 0, DK_RR_NEWTON_STEPS, DK_RR_NEWTON_REACH, 0,
                                      turns, turns != NULL);
+    int i;
     if (DK_RR_NEWTON_DONE < error && error <= DK_RR_GOOD) { /* (slowly: near a double root) */
         error = fmin(error, dk_rr_steps(rows, F, q, 0));
     }
     /* (an extra gets Newton's steps only, but on a nominal table: dk_rr_fold_seeds) */
     *used = error > DK_RR_GOOD && (!extra || DK_SEED_TOL > 0.0);
-    return error;
-}
-
-/* Levenberg-Marquardt steps from q, Newton's best point (its error `error`), then Newton's
-   again where they improved on it: a regular solution settled exactly; q in place, the pose
-   error there */
-static double dk_rr_damped(const double rows[7][4], const double F[4][4], double q[6],
-                           double error)
-{
-    double damped[6], damped_error;
-    int i;
+    if (!*used) {
+        return error;
+    }
     for (i = 0; i < 6; i++) {
         damped[i] = q[i];
     }
@@ -5418,10 +5404,7 @@ static int dk_rr_split(int k, const double F[4][4], const double moved[4][4],
     const int known = count;
     double pair;
     int extra[DK_RR_CANDS], perturbed = dk_rr_perturbed(k), damped = 0, reals, n, c, i, j, r;
-    int n_misses = 0, o, order[2 * DK_RR_CANDS], n_order, slow_near = 0, filtered = 0;
-    int damp = 0;
-    double held[DK_RR_CANDS][6], held_error[DK_RR_CANDS]; /* (a perturbed table's candidates
-                                                             Newton left: dk_rr_damped after) */
+    int n_misses = 0;
     int paired[DK_RR_ROWS]; /* (per row of out: an extra candidate's, first) */
     for (r = 0; r < DK_RR_ROWS; r++) {
         paired[r] = 0;
@@ -5445,67 +5428,31 @@ static int dk_rr_split(int k, const double F[4][4], const double moved[4][4],
            why; the last split's has no split to ask for) */
         *doubt |= DK_RR_FALLBACK;
     }
-    /* each candidate in turn; on a perturbed table those that Newton's steps leave beyond
-       DK_RR_GOOD, damped steps to take, come again after the others (order), and take them
-       only where some came within DK_RR_DAMP_NEAR or the new rows with the candidates that
-       were known rows number fewer than the real roots (_rr_split says why) */
     for (c = 0; c < n; c++) {
-        order[c] = c;
-    }
-    n_order = n;
-    for (o = 0; o < n_order; o++) {
         double q[6], arm[6], turns[6][2], error;
         int seen = 0;
-        c = order[o];
-        if (o == n) { /* (the first to come again: whether the damped steps are taken) */
-            damp = slow_near || count - known + filtered < reals;
-        }
         dk_rr_arm(k, cands[c], arm);
         /* (on a perturbed table, a row this split found too: _rr_split says why) */
         for (r = 0; r < (perturbed ? count : known) && !seen; r++) {
             seen = dk_rr_gap(arm, out[r]) <= DK_RR_SAME;
-            filtered += seen && r < known && o < n;
         }
         if (seen) {
             continue;
         }
-        if (o >= n) { /* (again: a perturbed table's candidate Newton left) */
-            for (j = 0; j < 6; j++) {
-                q[j] = held[c][j];
+        for (j = 0; j < 6; j++) {
+            q[j] = cands[c][j];
+        }
+        if (perturbed) {
+            for (i = 0; i < (int)(sizeof DK_RR_PATH / sizeof DK_RR_PATH[0]); i++) {
+                dk_rr_between(DK_RR_FILL[k], DK_RR_TRUE[k], DK_RR_PATH[i], between);
+                /* (Newton only on the way, each walk from where the last ended) */
+                dk_rr_turned_walk((const double(*)[4])between, F, q, 0, DK_RR_PATH_STEPS,
+                                  DK_RR_NEWTON_REACH, 1, turns, i > 0);
             }
-            error = held_error[c];
-            if (damp) {
-                error = dk_rr_damped(DK_RR_TRUE[k], F, q, error);
-            }
-        } else {
-            for (j = 0; j < 6; j++) {
-                q[j] = cands[c][j];
-            }
-            if (perturbed) {
-                for (i = 0; i < (int)(sizeof DK_RR_PATH / sizeof DK_RR_PATH[0]); i++) {
-                    dk_rr_between(DK_RR_FILL[k], DK_RR_TRUE[k], DK_RR_PATH[i], between);
-                    /* (Newton only on the way, each walk from where the last ended) */
-                    dk_rr_turned_walk((const double(*)[4])between, F, q, 0, DK_RR_PATH_STEPS,
-                                      DK_RR_NEWTON_REACH, 1, turns, i > 0);
-                }
-            }
-            error = dk_rr_newton(DK_RR_TRUE[k], F, q, &damped, extra[c],
-                                 perturbed ? turns : NULL);
-            if (damped && perturbed) { /* (damped steps perhaps: after the others) */
-                for (j = 0; j < 6; j++) {
-                    held[c][j] = q[j];
-                }
-                held_error[c] = error;
-                slow_near |= error <= DK_RR_DAMP_NEAR;
-                order[n_order++] = c;
-                continue;
-            }
-            if (damped) {
-                error = dk_rr_damped(DK_RR_TRUE[k], F, q, error);
-                if (!extra[c]) { /* Newton alone did not settle it */
-                    *doubt = DK_RR_RESCUE;
-                }
-            }
+        }
+        error = dk_rr_newton(DK_RR_TRUE[k], F, q, &damped, extra[c], perturbed ? turns : NULL);
+        if (damped && !perturbed && !extra[c]) { /* Newton alone did not settle it */
+            *doubt = DK_RR_RESCUE;
         }
         if (error > DK_RR_GOOD) {
             if (error <= DK_RR_SEARCH_FROM && leads->n < DK_RR_ROWS) {

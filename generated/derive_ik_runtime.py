@@ -38,7 +38,7 @@ if "_RUNTIME_VERSION" not in globals():  # (imported on its own, not run by a mo
         "namespace; it is not a module to import"
     )
 # this runtime's version: a module runs the runtime of its own version only
-_RUNTIME_VERSION = "3d54b6fdc3dd04b1"
+_RUNTIME_VERSION = "1fc0dfd06637a896"
 
 if TYPE_CHECKING:  # defined by the module running this file
     from derive.runtime.arm import (
@@ -416,30 +416,12 @@ _RR_NEWTON_STEPS = 10
 _RR_NEWTON_REACH = 0.5
 
 
-# a candidate whose Newton steps meet no better point this many times in a row, its best
-# error above _RR_DAMP_NEAR, stops there (they cycle: the perturbed table's solutions the arm
-# has not, two steps between 3e-2 and 1e-1 to the end; the damped steps follow as before)
-_RR_NEWTON_PATIENCE = 3
-
-
 # a Newton step from a pose error within _RR_NEWTON_DONE[0], no joint moving more than
 # _RR_NEWTON_DONE[1], is the last (its result is not measured: the error after it is at most
 # the step squared times the arm's curvature; near a singular Jacobian the step is long); a
 # candidate they leave between _RR_NEWTON_DONE[0] and _RR_GOOD (converging slowly, near a
 # double root) gets as many again
 _RR_NEWTON_DONE = (1e-11, 1e-8)
-
-
-# on a perturbed table, the damped steps after Newton's are not taken where Newton left no
-# candidate within this of the pose (but not within _RR_GOOD: a solution near a singular
-# configuration, where Newton converges slowly) and the rows it settled, with the candidates
-# that were rows found before, number the split's real roots (_rr_split): the candidates left
-# are then the perturbed table's own solutions, which the arm has not. On 60 uniform Jaco2 and
-# HC10 poses, 350 such candidates, 3 reached _RR_GOOD with the damped steps, no new row. The
-# count matters: the PUMA's general method (a perturbed table) and an SO-101's direction task
-# (its virtual link) settle their rows only with the damped steps (without the count C lost 4
-# of the PUMA's 8 rows at a pose, and every row of the SO-101's at its home pose)
-_RR_DAMP_NEAR = 1e-3
 
 
 # a perturbed table's candidates are polished on tables these shares of the way back first,
@@ -3268,7 +3250,6 @@ def _rr_split(k, F, moved, leads, known=(), imag_tol=_RR_IMAG_TOL):
         doubt = _FALLBACK if doubt or nearly else 0
     else:
         doubt = _RESCUE if doubt else 0
-    filtered = len(candidates) if candidates else 0  # (less those kept below)
     if known and candidates:  # (one within _RR_SAME of a known row is that row again)
         near = _rr_gap_table([_rr_to_arm(k, q) for q in candidates], list(known)) <= _RR_SAME
         kept = np.flatnonzero(~near.any(axis=1))
@@ -3276,34 +3257,12 @@ def _rr_split(k, F, moved, leads, known=(), imag_tol=_RR_IMAG_TOL):
         extras = [extras[c] for c in kept]
     if not candidates:
         return out, close, _rr_settled(doubt, known, [], reals, pair)
-    filtered -= len(candidates)  # (the candidates that were a known row again)
-
-    def accounted(Q, errors):
-        # a perturbed table's candidates Newton did not settle take no damped steps where
-        # none came within _RR_DAMP_NEAR and the rows it settled (new ones) with the
-        # candidates that were known rows number the split's real roots: every real root
-        # gave its row, and the rest are the perturbed table's own solutions
-        if ((errors > _RR_GOOD) & (errors <= _RR_DAMP_NEAR)).any():
-            return False
-        arms = [_rr_to_arm(k, q) for q in Q[errors <= _RR_GOOD]]
-        if len(arms) + filtered < reals:
-            return False
-        fresh = (_rr_gap_table(arms, list(known)).min(axis=1, initial=math.inf) > 1e-7).tolist()
-        apart = (_rr_gap_table(arms, arms) > 1e-7).tolist()
-        new: list[int] = []  # (the settled rows new to known, repeats once)
-        for i, is_fresh in enumerate(fresh):
-            if is_fresh and all(apart[i][j] for j in new):
-                new.append(i)
-        return len(new) + filtered >= reals
-
     # every candidate at once (numpy's stacked products and solves: the Python solver's time
     # went to calling numpy on 4 x 4 matrices one candidate at a time)
     Q = np.array(candidates)
     for rows in path:  # (Newton's steps only: damped ones may change branch on the way)
         Q, _ = _rr_steps_many(rows, F, Q, slide, False, steps=_RR_PATH_STEPS, track=True)
-    Q, residuals, damped = _rr_newton_many(
-        true_rows, F, Q, slide, np.array(extras), accounted if perturbed else None
-    )
+    Q, residuals, damped = _rr_newton_many(true_rows, F, Q, slide, np.array(extras))
     # the arm's values of the starts and rows, and their gaps from each other and from the
     # known rows, one table each (the Python solver's time went to comparing candidates one
     # by one: 11% of it on two cobots); a row moved after these (_rr_unsettled_copy), or a
@@ -3847,7 +3806,7 @@ def _rr_theta6_many(rows, F, X, slide):
     return np.arctan2(R[:, 1, 0], R[:, 0, 0])
 
 
-def _rr_newton_many(rows, F, Q, slide, extras, accounted=None):
+def _rr_newton_many(rows, F, Q, slide, extras):
     """Newton steps on the split's forward kinematics (geometric Jacobian) from each row of Q
     towards F, then, for those they do not bring within _RR_GOOD, Levenberg-Marquardt steps
     from the best point met: the polished rows, their final errors (largest entry of the top
@@ -3855,9 +3814,7 @@ def _rr_newton_many(rows, F, Q, slide, extras, accounted=None):
     damped steps (a candidate Newton does not settle puts the answer in doubt, as before they
     existed). Newton's steps again after the damped ones: a regular solution the damped steps
     reach slowly is settled exactly, not left a rounding's width from the same solution found
-    otherwise. Rows marked in extras get Newton's steps only (but on a nominal table). Where
-    accounted (a perturbed table's: _rr_split) says so of Newton's rows and errors, the damped
-    steps are not taken (_RR_DAMP_NEAR; the C solver decides after its other candidates)."""
+    otherwise. Rows marked in extras get Newton's steps only (but on a nominal table)."""
     Q, errors = _rr_steps_many(rows, F, Q, slide, False)
     slow = np.flatnonzero((errors > _RR_NEWTON_DONE[0]) & (errors <= _RR_GOOD))
     if slow.size:  # (Newton converges slowly near a double root: as many steps again)
@@ -3866,7 +3823,7 @@ def _rr_newton_many(rows, F, Q, slide, extras, accounted=None):
     # (an extra Newton does not settle is dropped, but on a nominal table, where the damped
     # steps may bring it near enough to seed the refinement: _rr_fold_seeds)
     damped = (errors > _RR_GOOD) & (~extras | (_SEED_TOL > 0.0))
-    if damped.any() and not (accounted is not None and accounted(Q, errors)):
+    if damped.any():
         tried = np.flatnonzero(damped)
         D, damped_errors = _rr_steps_many(rows, F, Q[tried], slide, True)
         better = damped_errors < errors[tried]
@@ -3974,27 +3931,22 @@ def _rr_steps_many(
     where they end, not measured (a continuation's corrector), and no errors (None)."""
     q = np.array(Q, dtype=float)
     best_q, best = q.copy(), np.full(len(q), math.inf)
-    met = np.zeros(len(q), dtype=int)  # (the step at which each met its best point)
     live = np.arange(len(q))
     Ft = F[:3, :3].T
     # (each numpy call costs about a microsecond whatever its size, and a step is a few dozen
     # of them, on a few rows: the filters below are skipped where they would keep every row,
     # and the walk's steps keep no best point)
-    for it in range(steps if track else steps + 1):
+    for _ in range(steps if track else steps + 1):
         x = q[live]
         frames = _rr_frames(x, rows, slide)
         E = frames[:, 6]
         D = F[:3] - E[:, :3]
         size = np.abs(D).reshape(len(x), 12).max(axis=1)
-        going = (size > 1e-15) & (size <= reach)
         if not track:
             better = size < best[live]
             moved = live[better]
             best_q[moved], best[moved] = x[better], size[better]
-            if not damped:  # (a candidate cycling far from any solution: _RR_NEWTON_PATIENCE)
-                met[moved] = it
-                if it >= _RR_NEWTON_PATIENCE:
-                    going &= (it - met[live] < _RR_NEWTON_PATIENCE) | (best[live] <= _RR_DAMP_NEAR)
+        going = (size > 1e-15) & (size <= reach)
         if not going.all():
             live, x, frames, E, D = live[going], x[going], frames[going], E[going], D[going]
             size = size[going]

@@ -218,26 +218,12 @@ _RR_GOOD = 1e-10
 _RR_NEAR = 1e-7
 _RR_NEWTON_STEPS = 10
 _RR_NEWTON_REACH = 0.5
-# a candidate whose Newton steps meet no better point this many times in a row, its best
-# error above _RR_DAMP_NEAR, stops there (they cycle: the perturbed table's solutions the arm
-# has not, two steps between 3e-2 and 1e-1 to the end; the damped steps follow as before)
-_RR_NEWTON_PATIENCE = 3
 # a Newton step from a pose error within _RR_NEWTON_DONE[0], no joint moving more than
 # _RR_NEWTON_DONE[1], is the last (its result is not measured: the error after it is at most
 # the step squared times the arm's curvature; near a singular Jacobian the step is long); a
 # candidate they leave between _RR_NEWTON_DONE[0] and _RR_GOOD (converging slowly, near a
 # double root) gets as many again
 _RR_NEWTON_DONE = (1e-11, 1e-8)
-# on a perturbed table, the damped steps after Newton's are not taken where Newton left no
-# candidate within this of the pose (but not within _RR_GOOD: a solution near a singular
-# configuration, where Newton converges slowly) and the rows it settled, with the candidates
-# that were rows found before, number the split's real roots (_rr_split): the candidates left
-# are then the perturbed table's own solutions, which the arm has not. On 60 uniform Jaco2 and
-# HC10 poses, 350 such candidates, 3 reached _RR_GOOD with the damped steps, no new row. The
-# count matters: the PUMA's general method (a perturbed table) and an SO-101's direction task
-# (its virtual link) settle their rows only with the damped steps (without the count C lost 4
-# of the PUMA's 8 rows at a pose, and every row of the SO-101's at its home pose)
-_RR_DAMP_NEAR = 1e-3
 # a perturbed table's candidates are polished on tables these shares of the way back first,
 # _RR_PATH_STEPS Newton steps on each (a continuation's corrector: it follows the solution,
 # the true table's steps settle it; with one, ABB's GoFa 12 lost the pair of a near fold at

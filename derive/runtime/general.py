@@ -47,7 +47,6 @@ from derive.runtime.arm import (
 from derive.runtime.constants import (
     _RR_CLUSTER_TOL,
     _RR_COND_LIMIT,
-    _RR_DAMP_NEAR,
     _RR_FOLD_NEAR,
     _RR_FOLD_STEP,
     _RR_GOOD,
@@ -57,7 +56,6 @@ from derive.runtime.constants import (
     _RR_NEAR,
     _RR_NEAR_SINGULAR,
     _RR_NEWTON_DONE,
-    _RR_NEWTON_PATIENCE,
     _RR_NEWTON_REACH,
     _RR_NEWTON_STEPS,
     _RR_NULL2_TOL,
@@ -458,7 +456,6 @@ def _rr_split(k, F, moved, leads, known=(), imag_tol=_RR_IMAG_TOL):
         doubt = _FALLBACK if doubt or nearly else 0
     else:
         doubt = _RESCUE if doubt else 0
-    filtered = len(candidates) if candidates else 0  # (less those kept below)
     if known and candidates:  # (one within _RR_SAME of a known row is that row again)
         near = _rr_gap_table([_rr_to_arm(k, q) for q in candidates], list(known)) <= _RR_SAME
         kept = np.flatnonzero(~near.any(axis=1))
@@ -466,34 +463,12 @@ def _rr_split(k, F, moved, leads, known=(), imag_tol=_RR_IMAG_TOL):
         extras = [extras[c] for c in kept]
     if not candidates:
         return out, close, _rr_settled(doubt, known, [], reals, pair)
-    filtered -= len(candidates)  # (the candidates that were a known row again)
-
-    def accounted(Q, errors):
-        # a perturbed table's candidates Newton did not settle take no damped steps where
-        # none came within _RR_DAMP_NEAR and the rows it settled (new ones) with the
-        # candidates that were known rows number the split's real roots: every real root
-        # gave its row, and the rest are the perturbed table's own solutions
-        if ((errors > _RR_GOOD) & (errors <= _RR_DAMP_NEAR)).any():
-            return False
-        arms = [_rr_to_arm(k, q) for q in Q[errors <= _RR_GOOD]]
-        if len(arms) + filtered < reals:
-            return False
-        fresh = (_rr_gap_table(arms, list(known)).min(axis=1, initial=math.inf) > 1e-7).tolist()
-        apart = (_rr_gap_table(arms, arms) > 1e-7).tolist()
-        new: list[int] = []  # (the settled rows new to known, repeats once)
-        for i, is_fresh in enumerate(fresh):
-            if is_fresh and all(apart[i][j] for j in new):
-                new.append(i)
-        return len(new) + filtered >= reals
-
     # every candidate at once (numpy's stacked products and solves: the Python solver's time
     # went to calling numpy on 4 x 4 matrices one candidate at a time)
     Q = np.array(candidates)
     for rows in path:  # (Newton's steps only: damped ones may change branch on the way)
         Q, _ = _rr_steps_many(rows, F, Q, slide, False, steps=_RR_PATH_STEPS, track=True)
-    Q, residuals, damped = _rr_newton_many(
-        true_rows, F, Q, slide, np.array(extras), accounted if perturbed else None
-    )
+    Q, residuals, damped = _rr_newton_many(true_rows, F, Q, slide, np.array(extras))
     # the arm's values of the starts and rows, and their gaps from each other and from the
     # known rows, one table each (the Python solver's time went to comparing candidates one
     # by one: 11% of it on two cobots); a row moved after these (_rr_unsettled_copy), or a
@@ -1037,7 +1012,7 @@ def _rr_theta6_many(rows, F, X, slide):
     return np.arctan2(R[:, 1, 0], R[:, 0, 0])
 
 
-def _rr_newton_many(rows, F, Q, slide, extras, accounted=None):
+def _rr_newton_many(rows, F, Q, slide, extras):
     """Newton steps on the split's forward kinematics (geometric Jacobian) from each row of Q
     towards F, then, for those they do not bring within _RR_GOOD, Levenberg-Marquardt steps
     from the best point met: the polished rows, their final errors (largest entry of the top
@@ -1045,9 +1020,7 @@ def _rr_newton_many(rows, F, Q, slide, extras, accounted=None):
     damped steps (a candidate Newton does not settle puts the answer in doubt, as before they
     existed). Newton's steps again after the damped ones: a regular solution the damped steps
     reach slowly is settled exactly, not left a rounding's width from the same solution found
-    otherwise. Rows marked in extras get Newton's steps only (but on a nominal table). Where
-    accounted (a perturbed table's: _rr_split) says so of Newton's rows and errors, the damped
-    steps are not taken (_RR_DAMP_NEAR; the C solver decides after its other candidates)."""
+    otherwise. Rows marked in extras get Newton's steps only (but on a nominal table)."""
     Q, errors = _rr_steps_many(rows, F, Q, slide, False)
     slow = np.flatnonzero((errors > _RR_NEWTON_DONE[0]) & (errors <= _RR_GOOD))
     if slow.size:  # (Newton converges slowly near a double root: as many steps again)
@@ -1056,7 +1029,7 @@ def _rr_newton_many(rows, F, Q, slide, extras, accounted=None):
     # (an extra Newton does not settle is dropped, but on a nominal table, where the damped
     # steps may bring it near enough to seed the refinement: _rr_fold_seeds)
     damped = (errors > _RR_GOOD) & (~extras | (_SEED_TOL > 0.0))
-    if damped.any() and not (accounted is not None and accounted(Q, errors)):
+    if damped.any():
         tried = np.flatnonzero(damped)
         D, damped_errors = _rr_steps_many(rows, F, Q[tried], slide, True)
         better = damped_errors < errors[tried]
@@ -1150,27 +1123,22 @@ def _rr_steps_many(
     where they end, not measured (a continuation's corrector), and no errors (None)."""
     q = np.array(Q, dtype=float)
     best_q, best = q.copy(), np.full(len(q), math.inf)
-    met = np.zeros(len(q), dtype=int)  # (the step at which each met its best point)
     live = np.arange(len(q))
     Ft = F[:3, :3].T
     # (each numpy call costs about a microsecond whatever its size, and a step is a few dozen
     # of them, on a few rows: the filters below are skipped where they would keep every row,
     # and the walk's steps keep no best point)
-    for it in range(steps if track else steps + 1):
+    for _ in range(steps if track else steps + 1):
         x = q[live]
         frames = _rr_frames(x, rows, slide)
         E = frames[:, 6]
         D = F[:3] - E[:, :3]
         size = np.abs(D).reshape(len(x), 12).max(axis=1)
-        going = (size > 1e-15) & (size <= reach)
         if not track:
             better = size < best[live]
             moved = live[better]
             best_q[moved], best[moved] = x[better], size[better]
-            if not damped:  # (a candidate cycling far from any solution: _RR_NEWTON_PATIENCE)
-                met[moved] = it
-                if it >= _RR_NEWTON_PATIENCE:
-                    going &= (it - met[live] < _RR_NEWTON_PATIENCE) | (best[live] <= _RR_DAMP_NEAR)
+        going = (size > 1e-15) & (size <= reach)
         if not going.all():
             live, x, frames, E, D = live[going], x[going], frames[going], E[going], D[going]
             size = size[going]
