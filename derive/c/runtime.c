@@ -1424,6 +1424,15 @@ static int dk_poly_pi(dk_values *v, const double *coeffs, double free_tol, doubl
     return 0;
 }
 
+/* t appended to v's values, with its cos and sin (the caller leaves room: DK_VALUES_MAX) */
+static void dk_add_value(dk_values *v, double t)
+{
+    v->t[v->n] = t;
+    v->c[v->n] = cos(t);
+    v->s[v->n] = sin(t);
+    v->n++;
+}
+
 /* v's values after its first v->n: first + 2 pi k / DK_SPREAD_COUNT for k = v->n .. (at most
    DK_VALUES_MAX in all): seeds all round a nominal table's angle that its equations fix only
    roughly (the Python solver's _all_round) */
@@ -1431,11 +1440,7 @@ static void dk_all_round(dk_values *v, double first, int count)
 {
     int k;
     for (k = v->n; k < count && v->n < DK_VALUES_MAX; k++) {
-        const double t = first + DK_TWO_PI * k / count;
-        v->t[v->n] = t;
-        v->c[v->n] = cos(t);
-        v->s[v->n] = sin(t);
-        v->n++;
+        dk_add_value(v, first + DK_TWO_PI * k / count);
     }
 }
 
@@ -1510,11 +1515,7 @@ static int dk_cs1x(dk_values *v, double a, double b, double e, double rest, doub
         int k;
         v->n = sd == 0.0 ? 1 : 2; /* (the double root once, not twice) */
         for (k = 0; k < 2 * DK_FOLD_SEED_COUNT && v->n < DK_VALUES_MAX; k++) {
-            const double t = fold + (k % 2 ? -1.0 : 1.0) * DK_FOLD_SEEDS[k / 2];
-            v->t[v->n] = t;
-            v->c[v->n] = cos(t);
-            v->s[v->n] = sin(t);
-            v->n++;
+            dk_add_value(v, fold + (k % 2 ? -1.0 : 1.0) * DK_FOLD_SEEDS[k / 2]);
         }
     }
     return 0;
@@ -1647,18 +1648,10 @@ static void dk_spread_more(dk_values *v)
 {
     int k;
     for (k = 1; k <= 4 && v->n < DK_VALUES_MAX; k++) {
-        const double t = v->t[0] + (k & 1 ? -1.0 : 1.0) * ((k + 1) / 2) * v->more;
-        v->t[v->n] = t;
-        v->c[v->n] = cos(t);
-        v->s[v->n] = sin(t);
-        v->n++;
+        dk_add_value(v, v->t[0] + (k & 1 ? -1.0 : 1.0) * ((k + 1) / 2) * v->more);
     }
     for (k = 1; k < DK_SPREAD_COUNT && v->n < DK_VALUES_MAX; k++) {
-        const double t = v->t[0] + DK_TWO_PI * k / DK_SPREAD_COUNT;
-        v->t[v->n] = t;
-        v->c[v->n] = cos(t);
-        v->s[v->n] = sin(t);
-        v->n++;
+        dk_add_value(v, v->t[0] + DK_TWO_PI * k / DK_SPREAD_COUNT);
     }
     v->more = 0.0;
 }
