@@ -2102,12 +2102,13 @@ static void dk_chain_pose(const double chain[DK_REFINE_N + 1][12],
 static double dk_task_error(const double pose[12], const double t[12], double reach,
                             double error[6])
 {
+    const double per_reach = 1.0 / reach; /* (a product a row: DK_STEP_COS says why) */
     double size = 0.0;
     int r, k;
     for (r = 0; r < 3; r++) {
         int a = (r + 1) % 3, b = (r + 2) % 3;
         double total = 0.0;
-        error[r] = DK_REFINE_TASK == 4 ? 0.0 : (t[4 * r + 3] - pose[4 * r + 3]) / reach;
+        error[r] = DK_REFINE_TASK == 4 ? 0.0 : (t[4 * r + 3] - pose[4 * r + 3]) * per_reach;
         size = fabs(error[r]) > size ? fabs(error[r]) : size;
         for (k = 0; k < 3; k++) {
             total += pose[4 * a + k] * t[4 * b + k] - pose[4 * b + k] * t[4 * a + k];
@@ -2153,6 +2154,7 @@ static void dk_task_jacobian(const double pose[12], const double axes[DK_REFINE_
                              double reach, const double t[12], unsigned held,
                              double J[6][DK_REFINE_M])
 {
+    const double per_reach = 1.0 / reach;
     int k, r;
     for (k = 0; k < DK_REFINE_M; k++) {
         const int j = solved[k];
@@ -2160,15 +2162,15 @@ static void dk_task_jacobian(const double pose[12], const double axes[DK_REFINE_
         if (revolute[j]) {
             const double dx = pose[3] - origins[j][0], dy = pose[7] - origins[j][1];
             const double dz = pose[11] - origins[j][2];
-            J[0][k] = (z[1] * dz - z[2] * dy) / reach;
-            J[1][k] = (z[2] * dx - z[0] * dz) / reach;
-            J[2][k] = (z[0] * dy - z[1] * dx) / reach;
+            J[0][k] = (z[1] * dz - z[2] * dy) * per_reach;
+            J[1][k] = (z[2] * dx - z[0] * dz) * per_reach;
+            J[2][k] = (z[0] * dy - z[1] * dx) * per_reach;
             J[3][k] = z[0];
             J[4][k] = z[1];
             J[5][k] = z[2];
         } else {
             for (r = 0; r < 3; r++) {
-                J[r][k] = z[r] / reach;
+                J[r][k] = z[r] * per_reach;
                 J[3 + r][k] = 0.0;
             }
         }
@@ -2183,13 +2185,31 @@ static void dk_task_jacobian(const double pose[12], const double axes[DK_REFINE_
     }
 }
 
-/* a step within this turns a joint's cos and sin by the angle-sum formulas, with their series
-   to d^7 (error d^8 / 40320: 1e-15 at the bound) for the step's */
+/* A step turns a joint's cos and sin by the angle-sum formulas, the step's own cos and sin
+   from their series in d2 = d * d, no library call: within DK_REFINE_TURN to d^7 (error
+   d^8 / 40320: 1e-15 at the bound), beyond it to d^17 (error d^18 / 18!: 6e-22 at
+   DK_REFINE_STRIDE, the longest step; a travelling seed's library cos and sin, 34 pairs a
+   pose, were 9% of a calibrated KR6's C time). Each term's divisor is a product, its
+   reciprocal a constant, and positions are multiplied by 1 / reach where they were divided:
+   a division costs several multiplications' time (the two 4% of the KR6's). */
 #define DK_REFINE_TURN (0.05)
+#define DK_STEP_COS(d2) \
+    (1.0 - (d2) * (1.0 / 2.0) * (1.0 - (d2) * (1.0 / 12.0) * (1.0 - (d2) * (1.0 / 30.0))))
+#define DK_STEP_SIN(d, d2) \
+    ((d) * (1.0 - (d2) * (1.0 / 6.0) * (1.0 - (d2) * (1.0 / 20.0) \
+        * (1.0 - (d2) * (1.0 / 42.0)))))
+#define DK_STEP_COS_LONG(d2) \
+    (1.0 - (d2) * (1.0 / 2.0) * (1.0 - (d2) * (1.0 / 12.0) * (1.0 - (d2) * (1.0 / 30.0) \
+        * (1.0 - (d2) * (1.0 / 56.0) * (1.0 - (d2) * (1.0 / 90.0) * (1.0 - (d2) * (1.0 / 132.0) \
+        * (1.0 - (d2) * (1.0 / 182.0) * (1.0 - (d2) * (1.0 / 240.0)))))))))
+#define DK_STEP_SIN_LONG(d, d2) \
+    ((d) * (1.0 - (d2) * (1.0 / 6.0) * (1.0 - (d2) * (1.0 / 20.0) * (1.0 - (d2) * (1.0 / 42.0) \
+        * (1.0 - (d2) * (1.0 / 72.0) * (1.0 - (d2) * (1.0 / 110.0) \
+        * (1.0 - (d2) * (1.0 / 156.0) * (1.0 - (d2) * (1.0 / 210.0) \
+        * (1.0 - (d2) * (1.0 / 272.0))))))))))
 
 /* the joints in solved moved by step (its longest entry longest: shortened to
-   DK_REFINE_STRIDE), their cos and sin turned by the step where it is within DK_REFINE_TURN
-   (a nominal seed's first step can be 1e-3 to 1e-2 long: two library calls a joint saved) */
+   DK_REFINE_STRIDE), their cos and sin turned by the step (DK_STEP_COS and the others above) */
 static void dk_take_step(const int revolute[DK_REFINE_N], const int solved[DK_REFINE_M],
                          const double step[DK_REFINE_M], double longest, double cur[DK_REFINE_N],
                          double cs[DK_REFINE_N][2])
@@ -2200,16 +2220,14 @@ static void dk_take_step(const int revolute[DK_REFINE_N], const int solved[DK_RE
         const double d = longest > DK_REFINE_STRIDE ? step[k] * (DK_REFINE_STRIDE / longest)
                                                     : step[k];
         cur[j] += d;
-        if (revolute[j] && fabs(d) <= DK_REFINE_TURN) {
+        if (revolute[j]) {
             const double d2 = d * d;
-            const double cd = 1.0 - d2 / 2.0 * (1.0 - d2 / 12.0 * (1.0 - d2 / 30.0));
-            const double sd = d * (1.0 - d2 / 6.0 * (1.0 - d2 / 20.0 * (1.0 - d2 / 42.0)));
+            const int near = fabs(d) <= DK_REFINE_TURN;
+            const double cd = near ? DK_STEP_COS(d2) : DK_STEP_COS_LONG(d2);
+            const double sd = near ? DK_STEP_SIN(d, d2) : DK_STEP_SIN_LONG(d, d2);
             const double c0 = cs[j][0], s0 = cs[j][1];
             cs[j][0] = c0 * cd - s0 * sd;
             cs[j][1] = s0 * cd + c0 * sd;
-        } else if (revolute[j]) {
-            cs[j][0] = cos(cur[j]);
-            cs[j][1] = sin(cur[j]);
         }
     }
 }
@@ -2479,6 +2497,14 @@ typedef double dk_lane __attribute__((vector_size(DK_LANES * sizeof(double))));
 typedef double dk_lane;
 #define DK_AT(v, l) (v)
 #endif
+/* a loop over the normal equations' rows and columns unrolled, where GCC can be told (8 and
+   newer): their lanes then stay in registers, not memory (a calibrated KR6's C ik 5.58 ->
+   5.28 us, the same operations in the same order) */
+#if defined(__GNUC__) && !defined(__clang__) && __GNUC__ >= 8
+#define DK_UNROLL _Pragma("GCC unroll 8")
+#else
+#define DK_UNROLL
+#endif
 /* 1 where the lanes' error and Jacobian are their own: the pose, position, position and
    direction and direction tasks' (the others' are dk_task_error's and dk_task_jacobian's) */
 #define DK_LANE_TASK (DK_REFINE_TASK <= 2 || DK_REFINE_TASK == 4)
@@ -2566,6 +2592,9 @@ static void dk_refine_lanes(const double chain[DK_REFINE_N + 1][12],
     const int patience = DK_REFINE_PATIENCE;
     const int steps = DK_REFINE_STEPS / DK_REFINE_PATIENCE * patience;
     const dk_lane zero = {0.0};
+#if DK_LANE_TASK
+    const double per_reach = 1.0 / reach;
+#endif
     dk_lane cur[DK_REFINE_N], c[DK_REFINE_N], s[DK_REFINE_N];
     dk_lane J[6][DK_REFINE_M], normal[DK_REFINE_M][DK_REFINE_M];
     /* (again: the last step's, set wherever it is read; zeroed here for GCC 12's -O3
@@ -2634,7 +2663,7 @@ static void dk_refine_lanes(const double chain[DK_REFINE_N + 1][12],
         for (r = 0; r < 3; r++) { /* the error (dk_task_error) */
             const int a = (r + 1) % 3, b = (r + 2) % 3, x = DK_REFINE_AXIS;
             dk_lane total = zero;
-            error[r] = DK_REFINE_TASK == 4 ? zero : (t[4 * r + 3] - pose[4 * r + 3]) / reach;
+            error[r] = DK_REFINE_TASK == 4 ? zero : (t[4 * r + 3] - pose[4 * r + 3]) * per_reach;
             for (k = 0; k < 3; k++) {
                 total += pose[4 * a + k] * t[4 * b + k] - pose[4 * b + k] * t[4 * a + k];
             }
@@ -2752,15 +2781,15 @@ static void dk_refine_lanes(const double chain[DK_REFINE_N + 1][12],
             if (revolute[j]) {
                 const dk_lane dx = pose[3] - origins[j][0], dy = pose[7] - origins[j][1];
                 const dk_lane dz = pose[11] - origins[j][2];
-                J[0][k] = (z[1] * dz - z[2] * dy) / reach;
-                J[1][k] = (z[2] * dx - z[0] * dz) / reach;
-                J[2][k] = (z[0] * dy - z[1] * dx) / reach;
+                J[0][k] = (z[1] * dz - z[2] * dy) * per_reach;
+                J[1][k] = (z[2] * dx - z[0] * dz) * per_reach;
+                J[2][k] = (z[0] * dy - z[1] * dx) * per_reach;
                 J[3][k] = z[0];
                 J[4][k] = z[1];
                 J[5][k] = z[2];
             } else {
                 for (r = 0; r < 3; r++) {
-                    J[r][k] = z[r] / reach;
+                    J[r][k] = z[r] * per_reach;
                     J[3 + r][k] = zero;
                 }
             }
@@ -2801,16 +2830,21 @@ static void dk_refine_lanes(const double chain[DK_REFINE_N + 1][12],
         }
 #endif
         mu = zero;
+        DK_UNROLL
         for (r = 0; r < DK_REFINE_ROWS; r++) {
             mu += error[r] * error[r];
         }
+        DK_UNROLL
         for (k = 0; k < DK_REFINE_M; k++) { /* (J^T J + mu) step = J^T error */
             step[k] = zero;
+            DK_UNROLL
             for (r = 0; r < DK_REFINE_ROWS; r++) {
                 step[k] += J[r][k] * error[r];
             }
+            DK_UNROLL
             for (m = 0; m <= k; m++) {
                 dk_lane v = zero;
+                DK_UNROLL
                 for (r = 0; r < DK_REFINE_ROWS; r++) {
                     v += J[r][k] * J[r][m];
                 }
@@ -2821,8 +2855,10 @@ static void dk_refine_lanes(const double chain[DK_REFINE_N + 1][12],
         for (l = 0; l < DK_LANES; l++) {
             least[l] = HUGE_VAL;
         }
+        DK_UNROLL
         for (k = 0; k < DK_REFINE_M; k++) { /* L D L^T, L's below normal's diagonal */
             dk_lane d = normal[k][k], w[DK_REFINE_M];
+            DK_UNROLL
             for (m = 0; m < k; m++) {
                 w[m] = normal[k][m] * pivot[m];
                 d -= normal[k][m] * w[m];
@@ -2834,6 +2870,7 @@ static void dk_refine_lanes(const double chain[DK_REFINE_N + 1][12],
             }
             for (i = k + 1; i < DK_REFINE_M; i++) {
                 dk_lane v = normal[i][k];
+                DK_UNROLL
                 for (m = 0; m < k; m++) {
                     v -= normal[i][m] * w[m];
                 }
@@ -2853,9 +2890,20 @@ static void dk_refine_lanes(const double chain[DK_REFINE_N + 1][12],
         for (k = 0; k < DK_REFINE_M; k++) { /* the step (dk_take_step), in every lane */
             const int j = solved[k];
             const dk_lane d = step[k] * stride, d2 = d * d;
-            const dk_lane cd = 1.0 - d2 / 2.0 * (1.0 - d2 / 12.0 * (1.0 - d2 / 30.0));
-            const dk_lane sd = d * (1.0 - d2 / 6.0 * (1.0 - d2 / 20.0 * (1.0 - d2 / 42.0)));
+            dk_lane cd = DK_STEP_COS(d2), sd = DK_STEP_SIN(d, d2);
             const dk_lane c0 = c[j], s0 = s[j];
+            for (l = 0, m = 0; l < DK_LANES && revolute[j]; l++) {
+                m |= fabs(DK_AT(d, l)) > DK_REFINE_TURN;
+            }
+            if (m) { /* (a long step in a lane: the longer series, taken in those lanes) */
+                const dk_lane cl = DK_STEP_COS_LONG(d2), sl = DK_STEP_SIN_LONG(d, d2);
+                for (l = 0; l < DK_LANES; l++) {
+                    if (fabs(DK_AT(d, l)) > DK_REFINE_TURN) {
+                        DK_AT(cd, l) = DK_AT(cl, l);
+                        DK_AT(sd, l) = DK_AT(sl, l);
+                    }
+                }
+            }
             cur[j] += d;
             c[j] = c0 * cd - s0 * sd;
             s[j] = s0 * cd + c0 * sd;
@@ -2874,13 +2922,6 @@ static void dk_refine_lanes(const double chain[DK_REFINE_N + 1][12],
             if (!(longest[l] < HUGE_VAL)) {
                 done[l] = 1;
                 continue;
-            }
-            for (k = 0; k < DK_REFINE_M; k++) { /* (a long step: cos and sin anew) */
-                const int j = solved[k];
-                if (revolute[j] && fabs(DK_AT(step[k], l)) > DK_REFINE_TURN) {
-                    DK_AT(c[j], l) = cos(DK_AT(cur[j], l));
-                    DK_AT(s[j], l) = sin(DK_AT(cur[j], l));
-                }
             }
             reused[l] = longest[l];
             floor[l] = least[l];

@@ -11,9 +11,9 @@ the rotation error 1/2 sum_k r_k x t_k (r_k, t_k the columns of the rotations), 
 Jacobian at the solution is the geometric one: J_i = (z_i x (p - o_i) / REACH, z_i) for a
 revolute joint, (z_i / REACH, 0) for a prismatic one; only the joints in _SOLVED move (free
 joints keep the caller's values). The C solver's dk_refine takes the same steps, but turns
-the joints' cos and sin by their series after a small step and takes the last step (from an
-error within _REFINE_LAST) with the step before's Jacobian and factor: the two agree to
-~1e-13.
+the joints' cos and sin by the step's, from their series (no library call), multiplies by
+1 / REACH where this divides, and takes the last step (from an error within _REFINE_LAST) with
+the step before's Jacobian and factor: the two agree to ~1e-13.
 """
 
 from __future__ import annotations
