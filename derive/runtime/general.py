@@ -1045,21 +1045,28 @@ def _rr_newton_many(rows, F, Q, slide, extras):
 def _rr_chain(X, rows, slide, first=0):
     """The split's link transforms A_i of joints first + 1, first + 2, ... at the values in the
     columns of X (one row per candidate): shape (n, columns, 4, 4). Each entry of
-    Rz(theta) Tz(d) Tx(a) Rx(alpha) is cos theta, sin theta or 1 times a constant (the sums
-    below add exact zeros); a sliding joint 3 has theta = slide[1] and d its value."""
+    Rz(theta) Tz(d) Tx(a) Rx(alpha) is cos theta, sin theta or 1 times a constant; a sliding
+    joint 3 has theta = slide[1] and d its value."""
+    return _rr_links(X, _rr_chain_weights(rows, slide[0], first, X.shape[1]), slide, first)
+
+
+def _rr_links(X, weights, slide, first=0):
+    """_rr_chain with its constants (_rr_chain_weights) looked up already: a loop of steps on
+    one table looks them up once (a lookup's key is the table's rows, a few microseconds)."""
     count = X.shape[1]
-    key = (tuple(map(tuple, rows)), slide[0], first, count)
-    weights = _RR_CHAIN_WEIGHTS.get(key)
-    if weights is None:  # (a split's rows are the same pose after pose: computed once)
-        weights = _rr_chain_weights(*key)
-        _RR_CHAIN_WEIGHTS[key] = weights
     sliding = 2 - first if slide[0] and first <= 2 < first + count else -1
     angles = X
     if sliding >= 0:
         angles = X.copy()
         angles[:, sliding] = slide[1]
-    c, s = np.cos(angles)[:, :, None], np.sin(angles)[:, :, None]
-    L = (c * weights[0] + s * weights[1] + weights[2]).reshape(len(X), count, 4, 4)
+    # [cos theta_1 .. cos theta_n, sin theta_1 .. sin theta_n, 1] per row, then each entry's
+    # one factor taken and scaled (two calls, where sums of the three scaled took five)
+    factors = np.empty((len(X), 2 * count + 1))
+    np.cos(angles, out=factors[:, :count])
+    np.sin(angles, out=factors[:, count : 2 * count])
+    factors[:, 2 * count] = 1.0
+    index, scale = weights
+    L = np.multiply(factors.take(index, axis=1), scale).reshape(len(X), count, 4, 4)
     if sliding >= 0:
         L[:, sliding, 2, 3] = X[:, sliding]
     return L
@@ -1071,20 +1078,36 @@ _RR_CHAIN_WEIGHTS: dict = {}
 
 
 def _rr_chain_weights(rows, slides, first, count):
-    """_rr_chain's constants: per joint, the 16 entries' factors of cos theta, of sin theta and
-    of 1."""
-    W = np.zeros((3, count, 16))
+    """_rr_chain's constants: per joint and entry, which factor the entry takes (cos theta of
+    the joint: its index k; sin theta: count + k; 1: 2 count) and the constant it is scaled
+    by (an entry that is 0 takes 1 scaled by 0). Computed once per table (the rows of a split
+    are the same pose after pose)."""
+    key = (tuple(map(tuple, rows)), slides, first, count)
+    found = _RR_CHAIN_WEIGHTS.get(key)
+    if found is not None:
+        return found
+    index = np.full((count, 16), 2 * count)
+    scale = np.zeros((count, 16))
     for k in range(count):
         d, a, ca, sa = rows[first + k]
         if slides and first + k == 2:
             d = 0.0
-        W[0, k, [0, 3, 5, 6]] = 1.0, a, ca, -sa
-        W[1, k, [1, 2, 4, 7]] = -ca, sa, 1.0, a
-        W[2, k, [9, 10, 11, 15]] = sa, ca, d, 1.0
-    W.flags.writeable = False
-    return W
+        index[k, [0, 3, 5, 6]] = k
+        scale[k, [0, 3, 5, 6]] = 1.0, a, ca, -sa
+        index[k, [1, 2, 4, 7]] = count + k
+        scale[k, [1, 2, 4, 7]] = -ca, sa, 1.0, a
+        scale[k, [9, 10, 11, 15]] = sa, ca, d, 1.0
+    index, scale = index.reshape(-1), scale.reshape(-1)
+    index.flags.writeable = False
+    scale.flags.writeable = False
+    _RR_CHAIN_WEIGHTS[key] = (index, scale)
+    return index, scale
 
 
+# numpy's stacked solver of A x = b (x, b vectors) without np.linalg.solve's checks and
+# conversions, which took a third of a step's solve on the cobots' six or so rows (the same
+# LAPACK call, the same bits); where a numpy lacks it, np.linalg.solve
+_SOLVE_STACK = getattr(getattr(np.linalg, "_umath_linalg", None), "solve1", None)
 _RR_EYE4 = np.eye(4)
 _RR_EYE6 = np.eye(6)
 _RR_EYE12 = np.eye(12)
@@ -1125,12 +1148,13 @@ def _rr_steps_many(
     best_q, best = q.copy(), np.full(len(q), math.inf)
     live = np.arange(len(q))
     Ft = F[:3, :3].T
+    weights = _rr_chain_weights(rows, slide[0], 0, 6)
     # (each numpy call costs about a microsecond whatever its size, and a step is a few dozen
     # of them, on a few rows: the filters below are skipped where they would keep every row,
     # and the walk's steps keep no best point)
     for _ in range(steps if track else steps + 1):
         x = q[live]
-        frames = _rr_frames(x, rows, slide)
+        frames = _rr_frames(x, rows, slide, weights)
         E = frames[:, 6]
         D = F[:3] - E[:, :3]
         size = np.abs(D).reshape(len(x), 12).max(axis=1)
@@ -1169,10 +1193,12 @@ def _rr_steps_many(
     return (q, None) if track else (best_q, best)
 
 
-def _rr_frames(X, rows, slide):
+def _rr_frames(X, rows, slide, weights=None):
     """The frames F_0 = I, F_1, ..., F_6 of the split's chain at the joint values in the rows
-    of X: shape (n, 7, 4, 4)."""
-    links = _rr_chain(X, rows, slide)
+    of X: shape (n, 7, 4, 4) (weights: _rr_chain_weights of rows, where looked up already)."""
+    if weights is None:
+        weights = _rr_chain_weights(rows, slide[0], 0, 6)
+    links = _rr_links(X, weights, slide)
     frames = np.empty((len(X), 7, 4, 4))
     frames[:, 0] = _RR_EYE4
     frames[:, 1] = links[:, 0]
@@ -1209,8 +1235,11 @@ def _rr_solve_many(J, error, damped):
     else:
         A, b = J, error
     try:
-        return np.linalg.solve(A, b[:, :, None])[:, :, 0], None
-    except np.linalg.LinAlgError:  # one of them is singular: each on its own
+        if _SOLVE_STACK is None:
+            return np.linalg.solve(A, b[:, :, None])[:, :, 0], None
+        with np.errstate(invalid="raise"):  # (a singular system: LAPACK's info, as NaN)
+            return _SOLVE_STACK(A, b), None
+    except (np.linalg.LinAlgError, FloatingPointError):  # one is singular: each on its own
         steps, solved = np.zeros_like(b), np.ones(len(A), dtype=bool)
         for k in range(len(A)):
             try:
