@@ -1665,9 +1665,9 @@ int main(void)
     const double p[4] = {0x1p+0, 0x1.da6b56af3759bp+0, 0x1.25108e00ceeb6p+0,
                          0x1.e2c323a0e27eap-3};
     double x[DK_ROOTS_MAX];
-    int loose, n, k;
+    int loose, n, k, seeds;
     for (loose = 0; loose < 2; loose++) {
-        n = dk_roots(p, 3, loose, x);
+        n = dk_roots(p, 3, loose, x, &seeds);
         printf("%d %d", DK_ROOTS_MAX, n);
         for (k = 0; k < n; k++) {
             printf(" %.17g", x[k]);
