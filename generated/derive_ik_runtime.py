@@ -38,7 +38,7 @@ if "_RUNTIME_VERSION" not in globals():  # (imported on its own, not run by a mo
         "namespace; it is not a module to import"
     )
 # this runtime's version: a module runs the runtime of its own version only
-_RUNTIME_VERSION = "0f7a9315f08c648c"
+_RUNTIME_VERSION = "d25329d0cd0765bd"
 
 if TYPE_CHECKING:  # defined by the module running this file
     from derive.runtime.arm import (
@@ -4100,19 +4100,6 @@ class _Spread(list):
         self.more = ()
 
 
-class _PairSeed(float):
-    """A polynomial step's value that is a nominal near-double root's seed (_accept: a complex
-    pair's real part, or either side of it), not a root: the branches under it are the exact
-    arm's only where the arm's difference made the pair real. A later step's spread is not
-    tried under it (_Spread.widen: on a calibrated KR6 such seeds' nearly singular theta1
-    spread all round took 9% of the C solver's time at uniform poses; C's dk_pair_seed)."""
-
-
-def _marked(x: float, like: float) -> float:
-    """x, a _PairSeed where like is one."""
-    return _PairSeed(x) if like.__class__ is _PairSeed else x
-
-
 def _seed_miss(up: float) -> float:
     """How far beyond 1 a nominal table's acos argument still seeds the refinement onto the
     exact arm: _SEED_TOL, or the uncertainty _SEED_TOL / up that the steps before it leave
@@ -4407,7 +4394,7 @@ def _poly_real(
     for x in roots:
         if not out or abs(x - out[-1]) > 1e-12 * (1.0 + abs(x)):
             out.append(x)
-    return [_marked(x * unit, x) for x in out]
+    return [x * unit for x in out]
 
 
 def _poly_angles(
@@ -4442,7 +4429,7 @@ def _poly_angles(
         c.pop(0)
         angles.append(0.0 if flip else math.pi)
     for x in _real_roots(c) if len(c) > 1 else ():
-        angles.append(_marked(_wrap_snap(2.0 * atan2(1.0, x) if flip else 2.0 * math.atan(x)), x))
+        angles.append(_wrap_snap(2.0 * atan2(1.0, x) if flip else 2.0 * math.atan(x)))
     return _sorted_angles(angles)
 
 
@@ -4474,7 +4461,7 @@ def _poly_angles_pi(
     for w in _real_roots([c[0], c[1], c[2] + 2.0 * c[0]]):
         u = 0.5 * (w + math.copysign(sqrt(w * w + 4.0), w))
         t = _wrap_snap(2.0 * math.atan(u))
-        angles += [_marked(t, w), _marked(_wrap_snap(t - math.pi if t > 0.0 else t + math.pi), w)]
+        angles += [t, _wrap_snap(t - math.pi if t > 0.0 else t + math.pi)]
     return _sorted_angles(angles)
 
 
@@ -4571,11 +4558,11 @@ def _accept(p: list[float], zs: list[complex], check: bool = True) -> list[float
         near = math.inf if _LOOSE.on or _LOOSE.near else math.sqrt(_SEED_TOL)
         for z in map(complex, zs):
             if _ROOT_IMAG_TOL * (1.0 + abs(z)) < z.imag <= near * (1.0 + abs(z)):
-                out.append(_PairSeed(z.real))
+                out.append(z.real)
                 if not _LOOSE.on:  # (and either side of the fold, as _cs1's _FOLD_SEEDS: a
                     # half-angle's u or 1/u, turned by +-_FOLD_SEEDS[0] / 2)
                     w = math.atan(z.real)
-                    out += [_PairSeed(math.tan(w + s * 0.5 * _FOLD_SEEDS[0])) for s in (1.0, -1.0)]
+                    out += [math.tan(w + s * 0.5 * _FOLD_SEEDS[0]) for s in (1.0, -1.0)]
     return out
 
 

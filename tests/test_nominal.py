@@ -1665,9 +1665,9 @@ int main(void)
     const double p[4] = {0x1p+0, 0x1.da6b56af3759bp+0, 0x1.25108e00ceeb6p+0,
                          0x1.e2c323a0e27eap-3};
     double x[DK_ROOTS_MAX];
-    int loose, n, k, seeds;
+    int loose, n, k;
     for (loose = 0; loose < 2; loose++) {
-        n = dk_roots(p, 3, loose, x, &seeds);
+        n = dk_roots(p, 3, loose, x);
         printf("%d %d", DK_ROOTS_MAX, n);
         for (k = 0; k < n; k++) {
             printf(" %.17g", x[k]);
@@ -1753,88 +1753,3 @@ def test_generate_says_how_far_the_nominal_table_is_from_the_arm(tmp_path, capsy
     assert found and "(nominal table)" in cad, cad
     assert 1e-7 < float(found.group(1)) < 1e-4
     assert exact.startswith("puma560:") and "refined" not in exact
-
-
-PAIR_SEEDS_PROBE = r"""
-#include <stdio.h>
-#include "NAME_ik.c"
-int main(void)
-{
-    /* u = 1, u = -2 and the pair 0.5 +- 0.01 i, within the seeds' window */
-    const double p[5] = {COEFFS};
-    dk_values v;
-    int k;
-    v.loose = 0;
-    v.more = 0.0;
-    if (dk_poly(&v, p, 4, 1, 0.0, 1.0, 0.0) < 0) {
-        return 1;
-    }
-    for (k = 0; k < v.n; k++) {
-        printf("%.17g %d\n", v.t[k], dk_pair_seed(&v, k));
-    }
-    return 0;
-}
-"""
-
-
-@needs_cc
-def test_a_near_double_roots_seeds_spread_nothing_beneath_them(tmp_path):
-    """On a nominal table a complex pair of roots near the real line seeds the refinement at
-    its real part and either side of it (a pair of the exact arm's solutions near a fold may
-    lie there). Those values are marked (Python's _PairSeed, C's dk_pair_seed, the same values
-    in both), and a later two-equation step does not spread its value (t -+ u, -+ 2u and all
-    round, where it gave no row) beneath them: on the calibrated KR6 such a pair's branches
-    have theta1's equations nearly singular, and their spreads made 76 seeds at a pose whose
-    4 rows take 10 (9% of the C solver's time over 1,000 uniform poses). Those poses still
-    get every row, the sampled vector among them, in both backends."""
-    import subprocess
-
-    from derive.cbuild import SANITIZE, WARNINGS, c_compiler
-
-    module = build_module(calibrated("kr6"), tmp_path, c=True)
-    assert module._SEED_TOL > 0.0
-    p = np.poly([1.0, -2.0, 0.5 + 0.01j, 0.5 - 0.01j]).real.tolist()
-    roots = module._real_roots(p)
-    seeds = [x for x in roots if x.__class__ is module._PairSeed]
-    assert sorted(x for x in roots if x.__class__ is not module._PairSeed) == pytest.approx(
-        [-2.0, 1.0], abs=1e-12
-    )
-    assert len(seeds) == 3 and min(abs(x - 0.5) for x in seeds) <= 1e-9
-    angles = module._poly_angles(p)
-    marks = [t.__class__ is module._PairSeed for t in angles]
-    assert sum(marks) == 3 and len(angles) == 5
-    # C marks the same values
-    folder = Path(module.__file__).parent
-    probe = PAIR_SEEDS_PROBE.replace("NAME", module.NAME)
-    (folder / "probe.c").write_text(probe.replace("COEFFS", ", ".join(map(repr, p))))
-    exe = folder / "probe"
-    built = subprocess.run(
-        [c_compiler(), *WARNINGS, *SANITIZE, "-Wno-unused-function", str(folder / "probe.c"),
-         "-o", str(exe), "-lm"],
-        capture_output=True, text=True,
-    )  # fmt: skip
-    assert built.returncode == 0, built.stderr
-    done = subprocess.run([str(exe)], capture_output=True, text=True)
-    assert done.returncode == 0, done.stderr[-2000:]
-    values = [line.split() for line in done.stdout.splitlines()]
-    assert [float(t) for t, _ in values] == pytest.approx(list(angles), abs=1e-12)
-    assert [m == "1" for _, m in values] == marks
-    # the poses (uniform, seed 5) whose theta3 quartic has such a pair, and their seeds
-    seeded = module._seed
-    count = [0]
-
-    def counted(found, t, q, tol, frees=()):
-        count[0] += 1
-        seeded(found, t, q, tol, frees)
-
-    module._seed = counted
-    Q = np.random.default_rng(5).uniform(-math.pi, math.pi, (1000, 6))[[716, 310, 226]]
-    for q in Q:
-        T = module.fk(q)
-        count[0] = 0
-        rows = module.ik(T, backend="python")
-        assert count[0] <= 16, (q, count[0])  # (76 with the spreads beneath the pair)
-        for R in (rows, module.ik(T, backend="c")):
-            assert len(R) == 4
-            gaps = np.abs(np.remainder(R - q + math.pi, 2 * math.pi) - math.pi)
-            assert np.max(gaps, axis=1).min() <= 1e-7, q

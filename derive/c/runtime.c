@@ -124,19 +124,8 @@ typedef struct {
     int loose;
     double ref;
     double more; /* (set by the caller to 0; dk_wrist_spread's u: dk_spread_more) */
-    /* bit k: value k is a seed of a nominal near-double root (dk_accept's, a complex pair's),
-       not a root (set by dk_poly and dk_poly_pi, 0 elsewhere: dk_pair_seed) */
-    unsigned long long pair_seeds;
     double t[DK_VALUES_MAX], c[DK_VALUES_MAX], s[DK_VALUES_MAX];
 } dk_values;
-
-/* whether v's value k is a nominal near-double root's seed (v->pair_seeds): the branches under
-   it are the exact arm's only where the arm's difference made the pair real, and widening
-   them (dk_spread_more) is not worth its time */
-static int dk_pair_seed(const dk_values *v, int k)
-{
-    return !v->free && k < 64 && (v->pair_seeds >> k & 1ULL);
-}
 
 static void dk_value(const dk_values *v, int k, double *t, double *c, double *s)
 {
@@ -155,7 +144,6 @@ static void dk_set_free(dk_values *v, double ref, int angle)
 {
     v->free = angle;
     v->ref = ref;
-    v->pair_seeds = 0;
     v->n = angle && !v->loose ? DK_FREE_COUNT : 1; /* (the second pass: ref only) */
     v->t[0] = ref;
     v->c[0] = 1.0;
@@ -184,7 +172,6 @@ static void dk_flipped(dk_values *v, double t, double c, double s)
     v->n = 1;
     v->free = 0;
     v->ref = 0.0;
-    v->pair_seeds = 0;
     v->t[0] = t + (t <= 0.0 ? DK_PI : -DK_PI);
     v->c[0] = -c;
     v->s[0] = -s;
@@ -1055,7 +1042,7 @@ static double dk_newton(const double *p, int d, double x)
    residual test; on a nominal table, also the real parts of its complex roots within
    sqrt(DK_SEED_TOL) of real (any, loose: the solver's second pass) and either side of them */
 static int dk_accept(const double *p, int d, const dk_cx *zs, int m, int check, int loose,
-                     double *out, int *seeds)
+                     double *out)
 {
     double xs[DK_POLY_MAX];
     int simple[DK_POLY_MAX], n = 0, count = 0, split = 0, used[DK_POLY_MAX] = {0}, k, j;
@@ -1158,7 +1145,6 @@ static int dk_accept(const double *p, int d, const dk_cx *zs, int m, int check, 
         }
         out[count++] = x;
     }
-    *seeds = count; /* (then the seeds: out[*seeds..count), counted below) */
     if (DK_SEED_TOL > 0.0) { /* a nominal near-double root, split by the arm's difference
                                 (in the second pass, loose: any complex root, as the Python
                                 solver's _accept) */
@@ -1174,7 +1160,6 @@ static int dk_accept(const double *p, int d, const dk_cx *zs, int m, int check, 
             }
         }
     }
-    *seeds = count - *seeds;
     return count;
 }
 
@@ -1230,13 +1215,11 @@ static void dk_aberth(const double *p, int d, dk_cx *z)
    residual test, else accepted unchecked (where the Python solver takes numpy.roots'
    unchecked; forward kinematics certifies every solution either way); another degree (a
    cubic: a quartic whose leading coefficient vanished) the Aberth iteration's roots from a
-   circle, accepted unchecked (numpy.roots' in the Python solver); -1 above DK_POLY_MAX. The
-   last *seeds of them are a nominal near-double root's seeds (dk_accept), not roots. */
-static int dk_roots(const double *p, int d, int loose, double *out, int *seeds)
+   circle, accepted unchecked (numpy.roots' in the Python solver); -1 above DK_POLY_MAX */
+static int dk_roots(const double *p, int d, int loose, double *out)
 {
     dk_cx z[DK_POLY_MAX];
     int n;
-    *seeds = 0;
     if (d == 1) {
         out[0] = -p[1] / p[0];
         return 1;
@@ -1280,44 +1263,37 @@ static int dk_roots(const double *p, int d, int loose, double *out, int *seeds)
             z[k] = dk_cx_make(bound * cos(angle), bound * sin(angle));
         }
         dk_aberth(p, d, z);
-        return dk_accept(p, d, z, d, 0, loose, out, seeds);
+        return dk_accept(p, d, z, d, 0, loose, out);
     }
-    n = dk_accept(p, d, z, d, 1, loose, out, seeds);
+    n = dk_accept(p, d, z, d, 1, loose, out);
     if (n >= 0) {
         return n;
     }
     dk_aberth(p, d, z);
-    return dk_accept(p, d, z, d, 0, loose, out, seeds);
+    return dk_accept(p, d, z, d, 0, loose, out);
 }
 
-/* v's values: the n angles t (with their cos c, sin s and whether a seed, dk_pair_seed) sorted,
-   in place, those within 1e-12 of the one before dropped, at most DK_VALUES_MAX (dk_poly's,
-   dk_poly_pi's) */
-static void dk_sorted_angles(dk_values *v, double *t, double *c, double *s, int *seed, int n)
+/* v's values: the n angles t (with their cos c and sin s) sorted, in place, those within
+   1e-12 of the one before dropped, at most DK_VALUES_MAX (dk_poly's, dk_poly_pi's) */
+static void dk_sorted_angles(dk_values *v, double *t, double *c, double *s, int n)
 {
     int k, j;
-    for (k = 1; k < n; k++) { /* sort by angle, carrying cos, sin and seed marks */
+    for (k = 1; k < n; k++) { /* sort by angle, carrying cos and sin */
         double tk = t[k], ck = c[k], sk = s[k];
-        int mk = seed[k];
         for (j = k - 1; j >= 0 && t[j] > tk; j--) {
             t[j + 1] = t[j];
             c[j + 1] = c[j];
             s[j + 1] = s[j];
-            seed[j + 1] = seed[j];
         }
         t[j + 1] = tk;
         c[j + 1] = ck;
         s[j + 1] = sk;
-        seed[j + 1] = mk;
     }
     for (k = 0; k < n && v->n < DK_VALUES_MAX; k++) {
         if (v->n == 0 || t[k] - v->t[v->n - 1] > 1e-12) {
             v->t[v->n] = t[k];
             v->c[v->n] = c[k];
             v->s[v->n] = s[k];
-            if (seed[k] && v->n < 64) {
-                v->pair_seeds |= 1ULL << v->n;
-            }
             v->n++;
         }
     }
@@ -1335,10 +1311,9 @@ static int dk_poly(dk_values *v, const double *coeffs, int d, int angles, double
     /* (t, c, s: the roots at infinity the vanishing leading coefficients give, then x's) */
     double p[DK_POLY_MAX + 1], x[DK_ROOTS_MAX], t[DK_ROOTS_MAX + DK_POLY_MAX];
     double c[DK_ROOTS_MAX + DK_POLY_MAX], s[DK_ROOTS_MAX + DK_POLY_MAX], size = 0.0;
-    int seed[DK_ROOTS_MAX + DK_POLY_MAX], flip, n = 0, k, extra = 0, seeds = 0;
+    int flip, n = 0, k, extra = 0;
     v->n = 0;
     v->free = 0;
-    v->pair_seeds = 0;
     v->ref = 0.0; /* (unread unless free; set so that no compiler sees it unset) */
     if (d > DK_POLY_MAX) {
         return -1;
@@ -1374,12 +1349,11 @@ static int dk_poly(dk_values *v, const double *coeffs, int d, int angles, double
             t[extra] = flip ? 0.0 : DK_PI;
             c[extra] = flip ? 1.0 : -1.0;
             s[extra] = 0.0;
-            seed[extra] = 0;
             extra++;
         }
     }
     if (d > 0) {
-        n = dk_roots(p, d, v->loose, x, &seeds);
+        n = dk_roots(p, d, v->loose, x);
         if (n < 0) {
             return -1;
         }
@@ -1392,19 +1366,15 @@ static int dk_poly(dk_values *v, const double *coeffs, int d, int angles, double
             t[extra + k] = DK_PI - fabs(a) <= 1e-12 ? DK_PI : a;
             c[extra + k] = ck;
             s[extra + k] = sk;
-            seed[extra + k] = k >= n - seeds;
         }
         n += extra;
-        dk_sorted_angles(v, t, c, s, seed, n);
+        dk_sorted_angles(v, t, c, s, n);
     } else {
         for (k = 0; k < n && v->n < DK_VALUES_MAX; k++) {
             if (v->n == 0 || fabs(x[k] - v->t[v->n - 1] / unit) > 1e-12 * (1.0 + fabs(x[k]))) {
                 v->t[v->n] = x[k] * unit;
                 v->c[v->n] = 1.0;
                 v->s[v->n] = 0.0;
-                if (k >= n - seeds && v->n < 64) {
-                    v->pair_seeds |= 1ULL << v->n;
-                }
                 v->n++;
             }
         }
@@ -1421,7 +1391,7 @@ static int dk_poly_pi(dk_values *v, const double *coeffs, double free_tol, doubl
 {
     double size = 0.0, q[3], w[DK_ROOTS_MAX], t[2 * DK_ROOTS_MAX], c[2 * DK_ROOTS_MAX];
     double s[2 * DK_ROOTS_MAX];
-    int seed[2 * DK_ROOTS_MAX], k, n, m = 0, seeds;
+    int k, n, m = 0;
     for (k = 0; k <= 4; k++) {
         size = fmax(size, fabs(coeffs[k]));
     }
@@ -1430,12 +1400,11 @@ static int dk_poly_pi(dk_values *v, const double *coeffs, double free_tol, doubl
     }
     v->n = 0;
     v->free = 0;
-    v->pair_seeds = 0;
     v->ref = 0.0;
     q[0] = coeffs[0];
     q[1] = coeffs[1];
     q[2] = coeffs[2] + 2.0 * coeffs[0];
-    n = dk_roots(q, 2, v->loose, w, &seeds);
+    n = dk_roots(q, 2, v->loose, w);
     if (n < 0) {
         return -1;
     }
@@ -1449,10 +1418,9 @@ static int dk_poly_pi(dk_values *v, const double *coeffs, double free_tol, doubl
         t[m + 1] = DK_PI - fabs(turned) <= 1e-12 ? DK_PI : turned;
         c[m + 1] = -ck;
         s[m + 1] = -sk;
-        seed[m] = seed[m + 1] = k >= n - seeds;
         m += 2;
     }
-    dk_sorted_angles(v, t, c, s, seed, m);
+    dk_sorted_angles(v, t, c, s, m);
     return 0;
 }
 

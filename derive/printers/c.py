@@ -38,7 +38,6 @@ from derive.plan import (
 )
 from derive.printers.branches import First, Sign, branch_program, jacobian_branch
 from derive.printers.common import (
-    PAIR_SEEDED_STEPS,
     SPREAD_STEPS,
     CodePrinter,
     Line,
@@ -315,9 +314,6 @@ def solve_lines(plan: Plan) -> tuple[tuple[int, str], ...]:
     # (a nominal acos step's miss: dk_seed_miss of the least condition of the steps before it)
     ups = seed_conditions(plan)
     conditioned = {k for joints in ups.values() for k in joints}
-    # (the values of the loops around a step that may be a near-double root's seeds: under
-    # one, the step's spread is not tried, dk_pair_seed)
-    seeded: list[str] = []
     for live in steps:
         step = live.step
         if isinstance(step, Assign):
@@ -387,11 +383,8 @@ def solve_lines(plan: Plan) -> tuple[tuple[int, str], ...]:
                 )
             )
             body.append(Line(depth, "int dk_flip = 0;"))
-        # (a value that may spread, dk_wrist_spread, but not under a near-double root's seed)
-        spreads = " && ".join([f"dk_v{j}.more > 0.0", *(f"!{m}" for m in seeded)])
         if fix:  # (a free joint's loop, or one that may spread, counts its rows: dk_settle)
-            grouped = f"({spreads})" if seeded else spreads
-            spread = f" || {grouped}" if isinstance(step, SPREAD_STEPS) else ""
+            spread = f" || dk_v{j}.more > 0.0" if isinstance(step, SPREAD_STEPS) else ""
             body.append(
                 Line(
                     depth,
@@ -431,7 +424,7 @@ def solve_lines(plan: Plan) -> tuple[tuple[int, str], ...]:
             # values around it too, dk_wrist_spread)
             endings.setdefault(id(closing[-1]), []).extend(
                 [
-                    Line(depth + 1, f"if ({spreads} && {count} == dk_m{j}) {{"),
+                    Line(depth + 1, f"if (dk_v{j}.more > 0.0 && {count} == dk_m{j}) {{"),
                     Line(depth + 2, f"dk_spread_more(&dk_v{j});"),
                     Line(depth + 1, "}"),
                 ]
@@ -443,8 +436,6 @@ def solve_lines(plan: Plan) -> tuple[tuple[int, str], ...]:
                 Line(depth + 3, f"dk_v{j}.s[0] != 0.0 && dk_v{j}.t[1] == -dk_v{j}.t[0] &&"),
                 Line(depth + 3, f"dk_f{j4}[3] == 1.0 && dk_f{j6}[3] == 1.0;"),
             ]
-        if fix and isinstance(step, PAIR_SEEDED_STEPS):
-            seeded.append(f"dk_pair_seed(&dk_v{j}, dk_k{j})")
         depth += 1
     outputs = [printer.doprint(e) for e in plan.ik.outputs]
     # (the joints the pose left free, a bit each: a refinement holds them first, a polish

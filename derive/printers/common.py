@@ -16,7 +16,7 @@ import sympy as sp
 from sympy.printing.str import StrPrinter
 
 from derive import symbols as sym
-from derive.plan import Assign, Cs1, Cs1Reach, Cs2, Cs2Reach, Plan, Poly, PolyD, PolyPi, Solve, Step
+from derive.plan import Assign, Cs1, Cs1Reach, Cs2, Cs2Reach, Plan, Solve, Step
 
 
 class UnprintableError(Exception):
@@ -27,10 +27,6 @@ class UnprintableError(Exception):
 # the steps whose value a nominal table fixes only roughly where the wrist is nearly straight:
 # their loops try the values around it where it gives no row (runtime _wrist_spread)
 SPREAD_STEPS = (Cs2, Cs2Reach)
-# the steps whose values on a nominal table include a near-double root's seeds (a complex
-# pair's real part and either side of it: runtime _accept), not roots: the spread of a later
-# step's value under such a seed is not tried (runtime _PairSeed, C dk_pair_seed)
-PAIR_SEEDED_STEPS = (Poly, PolyPi, PolyD)
 
 # the steps solving a cos t + b sin t = e (Cs1Unit is a Cs1): on a nominal table their
 # acos argument seeds the refinement up to _seed_miss(up) beyond 1, up the least condition of

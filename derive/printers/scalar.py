@@ -28,7 +28,6 @@ from derive.plan import (
 )
 from derive.printers.branches import First, Sign, branch_program, jacobian_branch
 from derive.printers.common import (
-    PAIR_SEEDED_STEPS,
     SPREAD_STEPS,
     CodePrinter,
     Line,
@@ -82,10 +81,6 @@ def ik_lines(plan: Plan) -> tuple[tuple[int, str], ...]:
     world = ", ".join(name if name in inputs else "_" for name in WORLD)
     lines.append(Line(0, f"({world}) = target"))
     lines.append(Line(0, "found = []"))
-    # per joint, the loops' values around its step that may be near-double roots' seeds (a
-    # spread is not tried under one: _PairSeed)
-    seeded: list[str] = []
-    under: dict[int, tuple[str, ...]] = {}
     for live in steps:
         step = live.step
         if isinstance(step, Assign):
@@ -100,9 +95,6 @@ def ik_lines(plan: Plan) -> tuple[tuple[int, str], ...]:
         lines += solve_lines(step, live.after, names, printer, depth, up, condition)
         if not isinstance(step, Eigen):  # it gives every joint: no free joint to step
             loops.append((depth, step.joint))
-            under[step.joint] = tuple(seeded)
-            if isinstance(step, PAIR_SEEDED_STEPS):
-                seeded.append(str(step.variable))
         depth += 1
     outputs = ", ".join(printer.doprint(e) for e in plan.ik.outputs)
     # (the joints the pose left free: a refinement holds them first, a polish throughout)
@@ -125,7 +117,6 @@ def ik_lines(plan: Plan) -> tuple[tuple[int, str], ...]:
         if plan.correction is not None and joint in spread:  # (a rough value gave no row:
             # the values around it too, _wrist_spread)
             check = f"_v{joint}.__class__ is _Spread and len(found) == _n{joint}"
-            check += "".join(f" and {v}.__class__ is not _PairSeed" for v in under[joint])
             lines.append(Line(level + 1, f"if {check}:"))
             lines.append(Line(level + 2, f"_v{joint}.widen()"))
     lines.append(Line(0, "return found"))
