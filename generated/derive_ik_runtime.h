@@ -9,7 +9,7 @@
    is solved by it): one copy serves every arm of a folder, and each arm's file gets its own
    static copy of the routines, so arms link together in one program. Compile <name>_ik.c
    with it beside the file; do not include it anywhere else. */
-#define DK_RUNTIME 0x35614bdbd8c5
+#define DK_RUNTIME 0x2eca7c226f3c
 
 #include <math.h>
 #include <stddef.h>
@@ -2906,10 +2906,11 @@ static void dk_refine_lanes(const double chain[DK_REFINE_N + 1][12],
             const dk_lane d = step[k] * stride, d2 = d * d;
             dk_lane cd = DK_STEP_COS(d2), sd = DK_STEP_SIN(d, d2);
             const dk_lane c0 = c[j], s0 = s[j];
-            for (l = 0, m = 0; l < DK_LANES && revolute[j]; l++) {
-                m |= fabs(DK_AT(d, l)) > DK_REFINE_TURN;
+            int long_step = 0; /* (a lane's step beyond DK_REFINE_TURN) */
+            for (l = 0; l < DK_LANES && revolute[j]; l++) {
+                long_step |= fabs(DK_AT(d, l)) > DK_REFINE_TURN;
             }
-            if (m) { /* (a long step in a lane: the longer series, taken in those lanes) */
+            if (long_step) { /* (the longer series, taken in those lanes) */
                 const dk_lane cl = DK_STEP_COS_LONG(d2), sl = DK_STEP_SIN_LONG(d, d2);
                 for (l = 0; l < DK_LANES; l++) {
                     if (fabs(DK_AT(d, l)) > DK_REFINE_TURN) {
