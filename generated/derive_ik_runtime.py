@@ -38,7 +38,7 @@ if "_RUNTIME_VERSION" not in globals():  # (imported on its own, not run by a mo
         "namespace; it is not a module to import"
     )
 # this runtime's version: a module runs the runtime of its own version only
-_RUNTIME_VERSION = "d25329d0cd0765bd"
+_RUNTIME_VERSION = "c7da7605b7ccc06f"
 
 if TYPE_CHECKING:  # defined by the module running this file
     from derive.runtime.arm import (
@@ -908,8 +908,10 @@ def ik(
         backend: "c" runs the arm's C solver (compiled on the first call of a process, or
             at warmup(), into a per-user cache: see _c_library); "python" runs the Python
             solver; "auto" is "c" where the C solver compiles; None (default): BACKEND,
-            which is "auto" unless you set it. The two agree to rounding (far below tol);
-            poses the C solver does not settle (a split multiple root) are solved in Python
+            which is "auto" unless you set it. The two agree to rounding (far below tol)
+            at regular poses; at a pose within about 1e-6 of singular (a curve of solutions,
+            or two that nearly meet) each may return other points of it, every one certified.
+            Poses the C solver does not settle (a split multiple root) are solved in Python
             either way.
         all_turns: with within_limits, every variant of every solution inside the limits
             (all k per joint, as a product; at most MAX_TURN_ROWS rows, else ValueError).

@@ -117,8 +117,10 @@ def ik(
         backend: "c" runs the arm's C solver (compiled on the first call of a process, or
             at warmup(), into a per-user cache: see _c_library); "python" runs the Python
             solver; "auto" is "c" where the C solver compiles; None (default): BACKEND,
-            which is "auto" unless you set it. The two agree to rounding (far below tol);
-            poses the C solver does not settle (a split multiple root) are solved in Python
+            which is "auto" unless you set it. The two agree to rounding (far below tol)
+            at regular poses; at a pose within about 1e-6 of singular (a curve of solutions,
+            or two that nearly meet) each may return other points of it, every one certified.
+            Poses the C solver does not settle (a split multiple root) are solved in Python
             either way.
         all_turns: with within_limits, every variant of every solution inside the limits
             (all k per joint, as a product; at most MAX_TURN_ROWS rows, else ValueError).
