@@ -38,7 +38,7 @@ if "_RUNTIME_VERSION" not in globals():  # (imported on its own, not run by a mo
         "namespace; it is not a module to import"
     )
 # this runtime's version: a module runs the runtime of its own version only
-_RUNTIME_VERSION = "c7da7605b7ccc06f"
+_RUNTIME_VERSION = "72dcac535cb434df"
 
 if TYPE_CHECKING:  # defined by the module running this file
     from derive.runtime.arm import (
@@ -422,6 +422,22 @@ _RR_NEWTON_REACH = 0.5
 # candidate they leave between _RR_NEWTON_DONE[0] and _RR_GOOD (converging slowly, near a
 # double root) gets as many again
 _RR_NEWTON_DONE = (1e-11, 1e-8)
+
+
+# a candidate that Newton's steps leave beyond _RR_DAMPED_FROM of the pose takes no damped
+# steps (it stays unsettled, as if it had), but on a nominal table (the damped steps bring near
+# misses within _SEED_TOL: _rr_fold_seeds) and on an arm with a spherical wrist at an end
+# (_RR_FLIPS): there two solutions share the eigen-joint's value, a perturbed table's
+# candidate of one can stop between them, and the damped steps from far find the other (the
+# PUMA solved by the general method lost solutions at 2 of 440 solves without them, with
+# 1e-2 or 0.1). Elsewhere each solution has a candidate of its own, and Newton's steps bring
+# one near a solution, a singular one too, within 1e-2; from beyond it the damped steps went
+# downhill onto a row another candidate gave. Measured on the five cobots of issue 39: the
+# same rows at 5,000 uniform poses (C and Python); at 3,000 special-value poses (C) 12 rows
+# lost and 10 gained, each lost one within 3e-7 to 3.3e-5 of a row kept (singular rows,
+# sigma_min 1e-8 to 1e-7), where one rounding's move of the poses changed 283 of the
+# Jaco2's and the CRX-10iA/L's rows alone; their Python ik 0.84-0.93x (the CRB 15000's 1.0x)
+_RR_DAMPED_FROM = 1e-2
 
 
 # a perturbed table's candidates are polished on tables these shares of the way back first,
@@ -3810,23 +3826,27 @@ def _rr_theta6_many(rows, F, X, slide):
 
 def _rr_newton_many(rows, F, Q, slide, extras):
     """Newton steps on the split's forward kinematics (geometric Jacobian) from each row of Q
-    towards F, then, for those they do not bring within _RR_GOOD, Levenberg-Marquardt steps
-    from the best point met: the polished rows, their final errors (largest entry of the top
-    three rows of the pose difference, lengths in units of _RR_LENGTH) and which took the
-    damped steps (a candidate Newton does not settle puts the answer in doubt, as before they
-    existed). Newton's steps again after the damped ones: a regular solution the damped steps
-    reach slowly is settled exactly, not left a rounding's width from the same solution found
-    otherwise. Rows marked in extras get Newton's steps only (but on a nominal table)."""
+    towards F, then, for those they do not bring within _RR_GOOD (but leave within
+    _RR_DAMPED_FROM, or on a nominal table or an arm whose wrist flips), Levenberg-Marquardt
+    steps from the best point met: the polished rows, their final errors (largest entry of the
+    top three rows of the pose difference, lengths in units of _RR_LENGTH) and which Newton did
+    not settle, damped steps or not (such a candidate puts the answer in doubt, as before the
+    damped steps existed). Newton's steps again after the damped ones: a regular solution the
+    damped steps reach slowly is settled exactly, not left a rounding's width from the same
+    solution found otherwise. Rows marked in extras get Newton's steps only (but on a nominal
+    table)."""
     Q, errors = _rr_steps_many(rows, F, Q, slide, False)
     slow = np.flatnonzero((errors > _RR_NEWTON_DONE[0]) & (errors <= _RR_GOOD))
     if slow.size:  # (Newton converges slowly near a double root: as many steps again)
         A, again_errors = _rr_steps_many(rows, F, Q[slow], slide, False)
         Q[slow], errors[slow] = A, np.minimum(errors[slow], again_errors)
     # (an extra Newton does not settle is dropped, but on a nominal table, where the damped
-    # steps may bring it near enough to seed the refinement: _rr_fold_seeds)
+    # steps may bring it near enough to seed the refinement: _rr_fold_seeds; one that Newton
+    # leaves beyond _RR_DAMPED_FROM takes none, but there and where a wrist flips)
     damped = (errors > _RR_GOOD) & (~extras | (_SEED_TOL > 0.0))
-    if damped.any():
-        tried = np.flatnonzero(damped)
+    near = damped & ((errors <= _RR_DAMPED_FROM) | (_SEED_TOL > 0.0 or bool(_RR_FLIPS)))
+    if near.any():
+        tried = np.flatnonzero(near)
         D, damped_errors = _rr_steps_many(rows, F, Q[tried], slide, True)
         better = damped_errors < errors[tried]
         kept = tried[better]

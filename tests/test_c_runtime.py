@@ -118,7 +118,14 @@ def test_the_c_runtime_holds_the_python_runtimes_constants():
     found = defines(gen)
     for name in ("RANK_TOL", "COND_LIMIT", "IMAG_TOL", "IMAG_LOOSE", "CLUSTER_TOL", "GOOD"):
         assert float(found[f"DK_RR_{name}"]) == getattr(constants, f"_RR_{name}"), name
-    for name in ("NULL2_TOL", "NEWTON_STEPS", "NEWTON_REACH", "PAIR_TOL", "PAIR_ANGLE"):
+    for name in (
+        "NULL2_TOL",
+        "NEWTON_STEPS",
+        "NEWTON_REACH",
+        "PAIR_TOL",
+        "PAIR_ANGLE",
+        "DAMPED_FROM",
+    ):
         assert float(found[f"DK_RR_{name}"]) == getattr(constants, f"_RR_{name}"), name
     for name in (
         "SEARCH_FROM",

@@ -489,6 +489,46 @@ def test_cobots_with_singular_pencils_are_answered_completely(name, tmp_path):
         assert len(newton) == len(rows)
 
 
+def damped_starts(m, poses) -> list[float]:
+    """The pose errors that the Python general method's damped steps start from, over the
+    poses (each candidate's best after Newton's steps, as _rr_newton_many hands it on)."""
+    starts: list[float] = []
+    steps = m._rr_steps_many
+
+    def watched(rows, F, Q, slide, damped, *args, **kwargs):
+        if damped:
+            walked = steps(rows, F, Q, slide, False, steps=0)  # (one measure: no step taken)
+            starts.extend(float(e) for e in walked[1])
+        return steps(rows, F, Q, slide, damped, *args, **kwargs)
+
+    m._rr_steps_many = watched
+    try:
+        for T in poses:
+            m.ik(T, backend="python")
+    finally:
+        m._rr_steps_many = steps
+    return starts
+
+
+def test_damped_steps_start_only_near_the_pose_but_where_a_wrist_flips(tmp_path):
+    """A candidate that Newton's steps leave beyond _RR_DAMPED_FROM takes no damped steps on
+    an arm without a spherical wrist (the Jaco2: on the five cobots the same rows at 5,000
+    uniform poses, their Python ik 0.84-0.93x), and still does on one whose wrist flips (the
+    PUMA by the general method, where they find a flip's partner nothing else finds: without
+    them 2 of the 440 solves of test_closed_form_arms_solved_again_by_the_general_method lost
+    solutions)."""
+    rng = np.random.default_rng(3)
+    (tmp_path / "jaco2").mkdir()
+    jaco = build_module(spec_text("jaco2", "standard", COBOTS["jaco2"]), tmp_path / "jaco2")
+    assert jaco._RR_FLIPS == () and jaco._SEED_TOL == 0.0
+    starts = damped_starts(jaco, jaco.fk_batch(rng.uniform(-math.pi, math.pi, (30, 6))))
+    assert starts and max(starts) <= jaco._RR_DAMPED_FROM, starts
+    puma, _ = general_and_closed(resolve_spec("puma560"), tmp_path)
+    assert puma._RR_FLIPS
+    starts = damped_starts(puma, puma.fk_batch(rng.uniform(-math.pi, math.pi, (30, 6))))
+    assert max(starts) > puma._RR_DAMPED_FROM, starts
+
+
 # two regular poses of the CRX-like arm (sigma_min 1e-4 and 1.5e-4: elbow and wrist 3e-4 and
 # 8e-4 rad from their singular values) where its perturbed table made four of the eight
 # solutions complex pairs (within _RR_PAIR_DOUBT of real): only the fallback split finds them

@@ -21,6 +21,7 @@
 #define DK_RR_NEWTON_REACH (0.5)
 #define DK_RR_NEWTON_DONE (1e-11)
 #define DK_RR_NEWTON_DONE_STEP (1e-08)
+#define DK_RR_DAMPED_FROM (0.01)
 #define DK_RR_ROWS 16 /* the most rows one pose gives */
 /* the most seeds a nominal table's near misses give (three each for as many near misses as a
    pose has rows: the Python solver's _RR_SEEDS_EACH * MAX_SOLUTIONS) */
@@ -1035,9 +1036,10 @@ static double dk_rr_steps(const double rows[7][4], const double F[4][4], double 
     return dk_rr_walk(rows, F, q, damped, DK_RR_NEWTON_STEPS, DK_RR_NEWTON_REACH, 0);
 }
 
-/* Newton steps, then, where they do not reach DK_RR_GOOD, Levenberg-Marquardt steps from the
-   best point met (the Python solver's _rr_newton): q in place, the pose error there; *used
-   set where the damped steps were taken */
+/* Newton steps, then, where they do not reach DK_RR_GOOD (but end within DK_RR_DAMPED_FROM, or
+   on a nominal table or an arm whose wrist flips), Levenberg-Marquardt steps from the best
+   point met (the Python solver's _rr_newton_many): q in place, the pose error there; *used
+   set where Newton did not settle it, damped steps or not */
 static double dk_rr_newton(const double rows[7][4], const double F[4][4], double q[6],
                            int *used, int extra, double turns[6][2])
 {
@@ -1050,7 +1052,8 @@ static double dk_rr_newton(const double rows[7][4], const double F[4][4], double
     }
     /* (an extra gets Newton's steps only, but on a nominal table: dk_rr_fold_seeds) */
     *used = error > DK_RR_GOOD && (!extra || DK_SEED_TOL > 0.0);
-    if (!*used) {
+    if (!*used || (error > DK_RR_DAMPED_FROM && !(DK_SEED_TOL > 0.0) && !DK_RR_FLIPS[0] &&
+                   !DK_RR_FLIPS[1])) {
         return error;
     }
     for (i = 0; i < 6; i++) {

@@ -47,6 +47,7 @@ from derive.runtime.arm import (
 from derive.runtime.constants import (
     _RR_CLUSTER_TOL,
     _RR_COND_LIMIT,
+    _RR_DAMPED_FROM,
     _RR_FOLD_NEAR,
     _RR_FOLD_STEP,
     _RR_GOOD,
@@ -1014,23 +1015,27 @@ def _rr_theta6_many(rows, F, X, slide):
 
 def _rr_newton_many(rows, F, Q, slide, extras):
     """Newton steps on the split's forward kinematics (geometric Jacobian) from each row of Q
-    towards F, then, for those they do not bring within _RR_GOOD, Levenberg-Marquardt steps
-    from the best point met: the polished rows, their final errors (largest entry of the top
-    three rows of the pose difference, lengths in units of _RR_LENGTH) and which took the
-    damped steps (a candidate Newton does not settle puts the answer in doubt, as before they
-    existed). Newton's steps again after the damped ones: a regular solution the damped steps
-    reach slowly is settled exactly, not left a rounding's width from the same solution found
-    otherwise. Rows marked in extras get Newton's steps only (but on a nominal table)."""
+    towards F, then, for those they do not bring within _RR_GOOD (but leave within
+    _RR_DAMPED_FROM, or on a nominal table or an arm whose wrist flips), Levenberg-Marquardt
+    steps from the best point met: the polished rows, their final errors (largest entry of the
+    top three rows of the pose difference, lengths in units of _RR_LENGTH) and which Newton did
+    not settle, damped steps or not (such a candidate puts the answer in doubt, as before the
+    damped steps existed). Newton's steps again after the damped ones: a regular solution the
+    damped steps reach slowly is settled exactly, not left a rounding's width from the same
+    solution found otherwise. Rows marked in extras get Newton's steps only (but on a nominal
+    table)."""
     Q, errors = _rr_steps_many(rows, F, Q, slide, False)
     slow = np.flatnonzero((errors > _RR_NEWTON_DONE[0]) & (errors <= _RR_GOOD))
     if slow.size:  # (Newton converges slowly near a double root: as many steps again)
         A, again_errors = _rr_steps_many(rows, F, Q[slow], slide, False)
         Q[slow], errors[slow] = A, np.minimum(errors[slow], again_errors)
     # (an extra Newton does not settle is dropped, but on a nominal table, where the damped
-    # steps may bring it near enough to seed the refinement: _rr_fold_seeds)
+    # steps may bring it near enough to seed the refinement: _rr_fold_seeds; one that Newton
+    # leaves beyond _RR_DAMPED_FROM takes none, but there and where a wrist flips)
     damped = (errors > _RR_GOOD) & (~extras | (_SEED_TOL > 0.0))
-    if damped.any():
-        tried = np.flatnonzero(damped)
+    near = damped & ((errors <= _RR_DAMPED_FROM) | (_SEED_TOL > 0.0 or bool(_RR_FLIPS)))
+    if near.any():
+        tried = np.flatnonzero(near)
         D, damped_errors = _rr_steps_many(rows, F, Q[tried], slide, True)
         better = damped_errors < errors[tried]
         kept = tried[better]
