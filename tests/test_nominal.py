@@ -371,6 +371,65 @@ def test_a_calibrated_elbow_near_its_stretch_keeps_both_rows_of_each_pair(tmp_pa
 
 
 @needs_cc
+def test_a_pair_half_the_window_from_real_still_seeds_the_refinement(tmp_path):
+    """A KR6 calibrated by up to 0.1 deg and 1 mm (seed 3), near its elbow's fold (folded
+    back) with its wrist 4e-4 rad from straight (sigma_min 1.9e-5): the nominal quartic's
+    complex pair lies 0.45 sqrt(_SEED_TOL) from real (imaginary part over 1 + |u|), and two
+    of the exact arm's six rows come from its seeds only (with a window of 0.3 sqrt(_SEED_TOL)
+    C and Python returned 4 rows). Within _PAIR_WINDOW (0.5) it seeds the first pass: 6 rows
+    in both backends."""
+    module = build_module(calibrated("kr6", 3, 0.1, 1e-3), tmp_path, c=True)
+    q = np.array([0.9100308063530944, -1.3818505424639351, -1.5177314904480768,
+                  0.25615009066102745, -3.1411401406025945, -2.7340683497213774])  # fmt: skip
+    T = module.fk(q)
+    for backend in ("c", "python"):
+        rows = module.ik(T, backend=backend)
+        assert len(rows) == 6, (backend, len(rows))
+        gaps = np.abs(np.remainder(rows - q + math.pi, 2 * math.pi) - math.pi)
+        assert np.min(np.max(gaps, axis=1)) <= 1e-9, backend
+        assert all(np.abs(module.fk(row) - T).max() <= 1e-10 for row in rows)
+
+
+@needs_cc
+def test_a_pair_near_a_fold_with_the_wrist_nearly_straight_gets_the_wide_pass(tmp_path):
+    """The calibrated KR6 near its elbow's fold (folded back) with its wrist 1.4e-3 rad from
+    straight (sigma_min 1.7e-6): a row of the exact arm comes only from a nominal complex
+    pair 0.90 of its window (sqrt(_SEED_TOL)) from real, beyond _PAIR_WINDOW; the pass left
+    it out and spread the wrist's theta4, so ik takes the wide pass, which seeds it: 4 rows in
+    both backends, at least 0.1 rad apart (without it, 3). (The sampled vector itself is
+    not among them, before the window as now: a singular sample, answered.)"""
+    module = build_module(calibrated("kr6"), tmp_path, c=True)
+    q = np.array([3.1231224358593472, -0.1628683300174072, -1.4854848983574236,
+                  -1.1063734232359632, 3.140231082851027, 0.22987171868881884])  # fmt: skip
+    T = module.fk(q)
+    for backend in ("c", "python"):
+        rows = module.ik(T, backend=backend)
+        assert len(rows) == 4, (backend, len(rows))
+        gaps = np.abs(np.remainder(rows[:, None] - rows[None] + math.pi, 2 * math.pi) - math.pi)
+        assert np.max(gaps, axis=2)[np.triu_indices(4, 1)].min() >= 0.1, backend
+        assert all(np.abs(module.fk(row) - T).max() <= 1e-10 for row in rows)
+
+
+def test_a_pair_beyond_the_window_seeds_nothing(tmp_path):
+    """The calibrated KR6 at a regular pose (sigma_min 0.032) whose nominal quartic has a
+    complex pair 0.82 sqrt(_SEED_TOL) from real: beyond _PAIR_WINDOW, a pair the arm's
+    difference (deviation 1.1e-3) does not make real here, where no step's value is spread
+    (no wide pass). Its real part and either side seeded 6 refinements that found nothing
+    (with the whole window, as before: 10 seeds where the rows need 4; such pairs came at 6%
+    of uniform poses). Now the 4 rows take 4 seeds."""
+    module = build_module(calibrated("kr6"), tmp_path)
+    q = np.random.default_rng(1).uniform(-np.pi, np.pi, (26, 6))[25]
+    seeds = []
+    refine = module._seed
+    module._seed = lambda *args: seeds.append(1) or refine(*args)
+    T = module.fk(q)
+    rows = module.ik(T, backend="python")
+    assert len(rows) == 4 and len(seeds) == 4, (len(rows), len(seeds))
+    gaps = np.abs(np.remainder(rows - q + math.pi, 2 * math.pi) - math.pi)
+    assert np.min(np.max(gaps, axis=1)) <= 1e-9
+
+
+@needs_cc
 def test_a_calibrated_wrist_nearly_straight_is_answered(tmp_path):
     """The calibrated UR5 at q5 = 1.5e-4: the nominal wrist's theta6 comes from s5's terms,
     which the arm's difference swamps there (0.77 rad off), and the elbow after it had no
@@ -1664,10 +1723,12 @@ int main(void)
     /* (x + 0.6177...)^3 to roundings: a near-triple real root */
     const double p[4] = {0x1p+0, 0x1.da6b56af3759bp+0, 0x1.25108e00ceeb6p+0,
                          0x1.e2c323a0e27eap-3};
+    /* (the whole window, as the wide pass's, and any pair, as the second pass's) */
+    const double near[2] = {sqrt(DK_SEED_TOL), HUGE_VAL};
     double x[DK_ROOTS_MAX];
-    int loose, n, k;
-    for (loose = 0; loose < 2; loose++) {
-        n = dk_roots(p, 3, loose, x);
+    int pass, n, k, outer = 0;
+    for (pass = 0; pass < 2; pass++) {
+        n = dk_roots(p, 3, near[pass], &outer, x);
         printf("%d %d", DK_ROOTS_MAX, n);
         for (k = 0; k < n; k++) {
             printf(" %.17g", x[k]);
