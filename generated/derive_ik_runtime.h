@@ -9,7 +9,7 @@
    is solved by it): one copy serves every arm of a folder, and each arm's file gets its own
    static copy of the routines, so arms link together in one program. Compile <name>_ik.c
    with it beside the file; do not include it anywhere else. */
-#define DK_RUNTIME 0x149737884c83
+#define DK_RUNTIME 0x243ba99cb3ff
 
 #include <math.h>
 #include <stddef.h>
@@ -70,9 +70,6 @@
                         1.0 - DK_FOLD_WIDTH * DK_SEED_TOL : DK_FOLD_NEAR)
 #define DK_FOLD_SEED_COUNT 1
 static const double DK_FOLD_SEEDS[DK_FOLD_SEED_COUNT] = {0.03};
-/* a complex pair within DK_PAIR_WINDOW sqrt(DK_SEED_TOL) of real seeds its real part and either
-   side of it (dk_accept; the Python runtime's _PAIR_WINDOW says why) */
-#define DK_PAIR_WINDOW (0.5)
 /* how far beyond 1 a nominal table's acos argument still seeds the refinement: DK_SEED_TOL,
    or the uncertainty DK_SEED_TOL / up the steps before it leave (up: the least of their
    conditions, dk_cs1_sig and dk_cs2_sig), at most DK_SEED_BAND; 0 on an exact table
@@ -141,9 +138,6 @@ typedef struct {
     int loose;
     double ref;
     double more; /* (set by the caller to 0; dk_wrist_spread's u: dk_spread_more) */
-    int wide;  /* (set by the caller: the solver's wide pass, a polynomial's whole pair window) */
-    int outer; /* (a polynomial's complex pair left out beyond DK_PAIR_WINDOW: dk_accept) */
-    int spread; /* (a two-equation step's value spread: dk_wrist_spread) */
     double t[DK_VALUES_MAX], c[DK_VALUES_MAX], s[DK_VALUES_MAX];
 } dk_values;
 
@@ -1059,11 +1053,10 @@ static double dk_newton(const double *p, int d, double x)
 /* the real parts of the near-real zs[0..m), polished (simple roots) and merged (near-equal
    ones, and clusters of a split multiple root that are not all real: their mean), ascending,
    into out: their count, or -1 where check is set and one, or a complex one, fails the
-   residual test; on a nominal table, also the real parts of its complex roots within near
-   of real (dk_pair_window) and either side of them, *outer set where a pair beyond near lay
-   within sqrt(DK_SEED_TOL) */
-static int dk_accept(const double *p, int d, const dk_cx *zs, int m, int check, double near,
-                     int *outer, double *out)
+   residual test; on a nominal table, also the real parts of its complex roots within
+   sqrt(DK_SEED_TOL) of real (any, loose: the solver's second pass) and either side of them */
+static int dk_accept(const double *p, int d, const dk_cx *zs, int m, int check, int loose,
+                     double *out)
 {
     double xs[DK_POLY_MAX];
     int simple[DK_POLY_MAX], n = 0, count = 0, split = 0, used[DK_POLY_MAX] = {0}, k, j;
@@ -1167,7 +1160,9 @@ static int dk_accept(const double *p, int d, const dk_cx *zs, int m, int check, 
         out[count++] = x;
     }
     if (DK_SEED_TOL > 0.0) { /* a nominal near-double root, split by the arm's difference
-                                (as the Python solver's _accept) */
+                                (in the second pass, loose: any complex root, as the Python
+                                solver's _accept) */
+        const double near = loose ? HUGE_VAL : sqrt(DK_SEED_TOL);
         for (k = 0; k < m && count + 3 <= DK_ROOTS_MAX; k++) { /* (Aberth's iterates of a
             multiple root can all lie above the line: not one pair's upper one each) */
             const double size = 1.0 + dk_cx_abs(zs[k]);
@@ -1176,8 +1171,6 @@ static int dk_accept(const double *p, int d, const dk_cx *zs, int m, int check, 
                 out[count++] = zs[k].re;
                 out[count++] = tan(w + 0.5 * DK_FOLD_SEEDS[0]);
                 out[count++] = tan(w - 0.5 * DK_FOLD_SEEDS[0]);
-            } else if (zs[k].im > near * size && zs[k].im <= sqrt(DK_SEED_TOL) * size) {
-                *outer = 1; /* (seeded in the solver's wide pass only) */
             }
         }
     }
@@ -1237,7 +1230,7 @@ static void dk_aberth(const double *p, int d, dk_cx *z)
    unchecked; forward kinematics certifies every solution either way); another degree (a
    cubic: a quartic whose leading coefficient vanished) the Aberth iteration's roots from a
    circle, accepted unchecked (numpy.roots' in the Python solver); -1 above DK_POLY_MAX */
-static int dk_roots(const double *p, int d, double near, int *outer, double *out)
+static int dk_roots(const double *p, int d, int loose, double *out)
 {
     dk_cx z[DK_POLY_MAX];
     int n;
@@ -1284,14 +1277,14 @@ static int dk_roots(const double *p, int d, double near, int *outer, double *out
             z[k] = dk_cx_make(bound * cos(angle), bound * sin(angle));
         }
         dk_aberth(p, d, z);
-        return dk_accept(p, d, z, d, 0, near, outer, out);
+        return dk_accept(p, d, z, d, 0, loose, out);
     }
-    n = dk_accept(p, d, z, d, 1, near, outer, out);
+    n = dk_accept(p, d, z, d, 1, loose, out);
     if (n >= 0) {
         return n;
     }
     dk_aberth(p, d, z);
-    return dk_accept(p, d, z, d, 0, near, outer, out);
+    return dk_accept(p, d, z, d, 0, loose, out);
 }
 
 /* v's values: the n angles t (with their cos c and sin s) sorted, in place, those within
@@ -1320,14 +1313,6 @@ static void dk_sorted_angles(dk_values *v, double *t, double *c, double *s, int 
     }
 }
 
-/* how near real a nominal polynomial's complex pair seeds the refinement (dk_accept): any, in
-   the second pass (loose); within DK_PAIR_WINDOW sqrt(DK_SEED_TOL), or within sqrt(DK_SEED_TOL)
-   in the wide pass (the Python solver's _accept and _solve) */
-static double dk_pair_window(const dk_values *v)
-{
-    return v->loose ? HUGE_VAL : (v->wide ? 1.0 : DK_PAIR_WINDOW) * sqrt(DK_SEED_TOL);
-}
-
 /* The values of a joint from a polynomial (highest degree first): in u = tan(t/2) (angles;
    in v = 1/u when the last coefficient is the larger end) or in x / unit (a length). Free
    (every coefficient at most `free_tol`): ref. Returns -1 where dk_roots does (a degree above
@@ -1343,7 +1328,6 @@ static int dk_poly(dk_values *v, const double *coeffs, int d, int angles, double
     int flip, n = 0, k, extra = 0;
     v->n = 0;
     v->free = 0;
-    v->outer = 0;
     v->ref = 0.0; /* (unread unless free; set so that no compiler sees it unset) */
     if (d > DK_POLY_MAX) {
         return -1;
@@ -1383,7 +1367,7 @@ static int dk_poly(dk_values *v, const double *coeffs, int d, int angles, double
         }
     }
     if (d > 0) {
-        n = dk_roots(p, d, dk_pair_window(v), &v->outer, x);
+        n = dk_roots(p, d, v->loose, x);
         if (n < 0) {
             return -1;
         }
@@ -1430,12 +1414,11 @@ static int dk_poly_pi(dk_values *v, const double *coeffs, double free_tol, doubl
     }
     v->n = 0;
     v->free = 0;
-    v->outer = 0;
     v->ref = 0.0;
     q[0] = coeffs[0];
     q[1] = coeffs[1];
     q[2] = coeffs[2] + 2.0 * coeffs[0];
-    n = dk_roots(q, 2, dk_pair_window(v), &v->outer, w);
+    n = dk_roots(q, 2, v->loose, w);
     if (n < 0) {
         return -1;
     }
@@ -1665,13 +1648,11 @@ static void dk_wrist_spread(dk_values *v, double det, double det_scale)
     }
     if (fabs(det) <= width * width * det_scale) {
         dk_all_round(v, v->t[0], DK_SPREAD_COUNT);
-        v->spread = 1;
         return;
     }
     u = DK_WRIST_SPREAD * DK_SEED_TOL / sqrt(fabs(det) / det_scale);
     if (u >= DK_WRIST_NEAR) {
         v->more = u;
-        v->spread = 1;
     }
 }
 
@@ -1692,7 +1673,6 @@ static void dk_spread_more(dk_values *v)
 static int dk_cs2(dk_values *v, double a1, double b1, double e1, double a2, double b2,
                   double e2, double det_scale, double rhs_scale, double ref)
 {
-    v->spread = 0;
     if (dk_cs2_free(a1, b1, e1, a2, b2, e2, det_scale, rhs_scale, v->loose)) {
         dk_set_free(v, ref, 1);
         return 0;
@@ -1706,7 +1686,6 @@ static int dk_cs2r(dk_values *v, double a1, double b1, double e1, double a2, dou
                    double e2, double det_scale, double rhs_scale, double A, double B, double C,
                    double lo, double hi, double ref)
 {
-    v->spread = 0;
     if (dk_cs2_free(a1, b1, e1, a2, b2, e2, det_scale, rhs_scale, v->loose)) {
         dk_set_free(v, dk_reach_first2(A, B, C, lo, hi, ref), 1);
         return 0;

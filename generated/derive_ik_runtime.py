@@ -38,7 +38,7 @@ if "_RUNTIME_VERSION" not in globals():  # (imported on its own, not run by a mo
         "namespace; it is not a module to import"
     )
 # this runtime's version: a module runs the runtime of its own version only
-_RUNTIME_VERSION = "46fe2ca502c66205"
+_RUNTIME_VERSION = "72dcac535cb434df"
 
 if TYPE_CHECKING:  # defined by the module running this file
     from derive.runtime.arm import (
@@ -244,10 +244,10 @@ _AIM_POLISH = 1e-2
 # equal seeds refine onto one of the pair and lose the other (a new user's SO-101 MJCF lost
 # the elbow's second row 0.03-0.12 rad from its fold), and Newton's steps from either side of
 # a fold go to that side's solution; values farther apart already seed either side. A
-# polynomial's near-double root (a complex pair within _PAIR_WINDOW sqrt(_SEED_TOL) of real)
-# seeds its real part's angle +- _FOLD_SEEDS[0] too (a calibrated PUMA's elbow near
-# stretched) (with cos 0.01 the seeds came at 13% of a calibrated UR5's poses, and cost 20% of
-# its time; one offset of 0.03 finds what 0.01 and 0.1 found on the SO-101, at half the cost)
+# polynomial's near-double root (a complex pair within sqrt(_SEED_TOL)) seeds its real part's
+# angle +- _FOLD_SEEDS[0] too (a calibrated PUMA's elbow near stretched) (with
+# cos 0.01 the seeds came at 13% of a calibrated UR5's poses, and cost 20% of its time; one
+# offset of 0.03 finds what 0.01 and 0.1 found on the SO-101, at half the cost)
 _FOLD_NEAR = 0.9999995
 
 
@@ -261,25 +261,6 @@ _FOLD_SEEDS = (0.03,)
 # the pair, and the sampled vector was missed at 14 (C) and 15 (Python) of 1,960 regular
 # poses within 2 mm of the double root, 0 and 0 with this (_cs1)
 _FOLD_WIDTH = 0.03
-
-
-# ... a pair's window (its imaginary part over 1 + |u|): the pair splits by about the square
-# root of how far the pose is beyond the nominal fold, which the arm's difference moves, so
-# the exact arm's real pairs come from pairs within a few sqrt(deviation) of real
-# (sqrt(_SEED_TOL) is 10 sqrt(deviation)): a pass seeds those within _PAIR_WINDOW of the
-# window. Rows that only such seeds gave (C, old window against new): a calibrated KR6
-# (deviation 1.1e-3) lost 1 row at 2,700 poses with 0.1 and none with 0.3; one calibrated
-# by 0.1 deg and 1 mm lost 2 with 0.3 (its pair 0.45 of the window) and none with 0.5. But
-# near an elbow's fold with the wrist within 0.02 rad of straight, 0.5 lost 32 rows at 21 of
-# 30,400 such poses of seven arms at three calibrations (pairs 0.65-0.92 of the window): the
-# nearly straight wrist amplifies the arm's difference. So where a pass left such a pair out
-# and spread a two-equation step's value (its system nearly singular: a wrist nearly
-# straight, a wrist centre near axis 1), ik takes the pass again with the whole window (the
-# wide pass, api.py _solve): the same rows as the whole window at all 77,700 poses (those,
-# and uniform, near-axis, near-singular ones). The whole window in every pass (before)
-# refined 6 to 42 more seeds (median 6) at 6% of a calibrated KR6's uniform poses, which
-# found nothing
-_PAIR_WINDOW = 0.5
 
 
 # ... and its acos argument up to _SEED_TOL / up beyond 1 (at least _SEED_TOL, at most
@@ -1021,22 +1002,8 @@ def _solve(target, solve, tol):
     seeds whose pose error is within _SEED_TOL are refined (a pose out of reach gives seeds far
     from it: measured 0.026 or more on a hextilt arm, where the seeds that reach the pose
     were within 2e-4), and kept where certified (_seed). The C solver takes the same second
-    pass (dk_solve, loose), and keeps rows within _LOOSE_TOL (or tol, if smaller) only.
-    Where the first pass left out a nominal polynomial's complex pair beyond _PAIR_WINDOW of
-    its window (_LOOSE.outer) and spread a two-equation step's value (_LOOSE.spread: a
-    system nearly singular, as a wrist nearly straight), it is taken again with those pairs
-    seeded too (_LOOSE.wide; the C solver's dk_solve with wide): near a fold whose wrist is
-    nearly straight the arm's difference, amplified, makes real pairs of nominal pairs up to
-    the whole window from real."""
-    _LOOSE.outer = _LOOSE.spread = False
+    pass (dk_solve, loose), and keeps rows within _LOOSE_TOL (or tol, if smaller) only."""
     rows = _exact_first(target, solve, tol)
-    if rows and _LOOSE.outer and _LOOSE.spread:
-        # (a pair beyond _PAIR_WINDOW left out, and a value spread: the wide pass)
-        _LOOSE.wide = True
-        try:
-            rows = _exact_first(target, solve, tol)
-        finally:
-            _LOOSE.wide = False
     if rows:
         return _fold_partners(_finish(rows), target, tol)
     _LOOSE.near = True
@@ -4123,17 +4090,11 @@ class _Loose(threading.local):
     _wrist_spread adds seeds round a fold, and the seeds are refined only where their pose
     error is within _SEED_TOL, and kept where certified (refine.py, _seed); rough, where ik
     solves a pose (_solve), the rows kept within tol that polishing left beyond _LOOSE_TOL
-    (_keep), dropped where the pose has other rows; outer, whether a nominal polynomial's
-    complex pair lay beyond _PAIR_WINDOW's part of its window (not seeded: _accept); spread,
-    whether a two-equation step's value was spread (_wrist_spread); wide, whether ik is
-    taking the pass that seeds those pairs too (_solve)."""
+    (_keep), dropped where the pose has other rows."""
 
     on = False
     near = False
     rough: list | None = None
-    outer = False
-    spread = False
-    wide = False
 
 
 _LOOSE = _Loose()
@@ -4382,11 +4343,9 @@ def _wrist_spread(t: float, det: float, det_scale: float) -> tuple[float, ...] |
     if not _SEED_TOL or loose or det_scale <= 0.0:  # (a scale of 0: a system never free)
         return (t,)
     if abs(det) <= (_WRIST_WIDTH * _SEED_TOL) ** 2 * det_scale:
-        _LOOSE.spread = True
         return _all_round(t)
     u = _WRIST_SPREAD * _SEED_TOL / sqrt(abs(det) / det_scale)
     if u >= _WRIST_NEAR:
-        _LOOSE.spread = True
         return _Spread(t, (t - u, t + u, t - 2.0 * u, t + 2.0 * u, *_all_round(t)[1:]))
     return (t,)
 
@@ -4618,10 +4577,7 @@ def _accept(p: list[float], zs: list[complex], check: bool = True) -> list[float
         # reach, as a Kinova Gen3 position task's, its tip 0.175 mm from the last solved
         # axis, leaves poses near its edge an imaginary pair 0.041-0.062 from real in u,
         # beyond this window's 0.039; _seed drops the seeds beyond _SEED_TOL of the pose)
-        # (a pair beyond _PAIR_WINDOW of the window is seeded in ik's wide pass only: noted)
-        window = math.sqrt(_SEED_TOL)
-        near = window if _LOOSE.wide else _PAIR_WINDOW * window
-        near = math.inf if _LOOSE.on or _LOOSE.near else near
+        near = math.inf if _LOOSE.on or _LOOSE.near else math.sqrt(_SEED_TOL)
         for z in map(complex, zs):
             if _ROOT_IMAG_TOL * (1.0 + abs(z)) < z.imag <= near * (1.0 + abs(z)):
                 out.append(z.real)
@@ -4629,8 +4585,6 @@ def _accept(p: list[float], zs: list[complex], check: bool = True) -> list[float
                     # half-angle's u or 1/u, turned by +-_FOLD_SEEDS[0] / 2)
                     w = math.atan(z.real)
                     out += [math.tan(w + s * 0.5 * _FOLD_SEEDS[0]) for s in (1.0, -1.0)]
-            elif near * (1.0 + abs(z)) < z.imag <= window * (1.0 + abs(z)):
-                _LOOSE.outer = True
     return out
 
 

@@ -34,7 +34,7 @@
 /* --- the routines every generated C solver shares: derive_ik_runtime.h beside this file ---- */
 
 #include "derive_ik_runtime.h"
-#if DK_RUNTIME != 0x149737884c83
+#if DK_RUNTIME != 0x243ba99cb3ff
 #error "derive_ik_runtime.h is another derive-ik's: generate the arms of a folder with one"
 #endif
 
@@ -194,19 +194,12 @@ static void dk_fk_q(const double q[DK_DOF], double e[12])
 /* The certified solutions of the pose t (its 12 top entries) into found, before wrapping and
    dropping repeats: their count, or DK_UNSETTLED. ref: q_ref's values (free joints': theirs).
    loose: the second pass, where the first gave no row (derive/runtime/api.py, _solve, says
-   why, and derive/c/runtime.c, what changes); wide: the pass that seeds a nominal
-   polynomial's complex pairs within its whole window (dk_pair_window); *outer and *spread
-   set where one beyond DK_PAIR_WINDOW of it was left out and where a two-equation step's
-   value was spread (dk_wrist_spread). */
+   why, and derive/c/runtime.c, what changes). */
 static int dk_solve(const double t[12], double tol, const double ref[DK_DOF],
-                    double found[DK_MAX][DK_DOF], int *repeats, int loose, int wide, int *outer,
-                    int *spread)
+                    double found[DK_MAX][DK_DOF], int *repeats, int loose)
 {
     (void)ref;
     (void)loose;
-    (void)wide;
-    (void)outer;
-    (void)spread;
     double qr1 = ref[0];
     double qr3 = ref[2];
     double qr4 = ref[3];
@@ -263,7 +256,6 @@ static int dk_solve(const double t[12], double tol, const double ref[DK_DOF],
     const double dk_p3[] = {0.0004 - r, 0.0, 0.6724 - r};
     dk_values dk_v3;
     dk_v3.loose = loose;
-    dk_v3.wide = wide;
     if (dk_poly(&dk_v3, dk_p3, 2, 1, 5.894361111111113e-11, 1.0, -qr4) < 0) {
         return DK_UNSETTLED;
     }
@@ -808,16 +800,11 @@ int iiwa14_ik_ref(const double T[16], const double *free, const double *q_ref, d
         double t[12]; /* (T's rotation the nearest rotation where it is not one: dk_rigid) */
         int loose = 0;
         dk_rigid(T, t);
-        int outer = 0, spread = 0;
-        count = dk_solve(t, tol, ref, found, &repeats, 0, 0, &outer, &spread);
-        if (count > 0 && outer && spread) { /* (a pair beyond DK_PAIR_WINDOW left out, a value
-            spread: the wide pass, _solve in derive/runtime/api.py) */
-            count = dk_solve(t, tol, ref, found, &repeats, 0, 1, &outer, &spread);
-        }
+        count = dk_solve(t, tol, ref, found, &repeats, 0);
         if (count == 0) { /* (the second pass: _solve in derive/runtime/api.py says why) */
             tol = fmin(tol, DK_LOOSE_TOL);
             loose = 1;
-            count = dk_solve(t, tol, ref, found, &repeats, 1, 0, &outer, &spread);
+            count = dk_solve(t, tol, ref, found, &repeats, 1);
         }
         if (count < 0) {
             return IIWA14_UNSETTLED;

@@ -34,7 +34,7 @@
 /* --- the routines every generated C solver shares: derive_ik_runtime.h beside this file ---- */
 
 #include "derive_ik_runtime.h"
-#if DK_RUNTIME != 0x149737884c83
+#if DK_RUNTIME != 0x243ba99cb3ff
 #error "derive_ik_runtime.h is another derive-ik's: generate the arms of a folder with one"
 #endif
 
@@ -140,19 +140,12 @@ static void dk_fk_q(const double q[DK_DOF], double e[12])
 /* The certified solutions of the pose t (its 12 top entries) into found, before wrapping and
    dropping repeats: their count, or DK_UNSETTLED. ref: q_ref's values (free joints': theirs).
    loose: the second pass, where the first gave no row (derive/runtime/api.py, _solve, says
-   why, and derive/c/runtime.c, what changes); wide: the pass that seeds a nominal
-   polynomial's complex pairs within its whole window (dk_pair_window); *outer and *spread
-   set where one beyond DK_PAIR_WINDOW of it was left out and where a two-equation step's
-   value was spread (dk_wrist_spread). */
+   why, and derive/c/runtime.c, what changes). */
 static int dk_solve(const double t[12], double tol, const double ref[DK_DOF],
-                    double found[DK_MAX][DK_DOF], int *repeats, int loose, int wide, int *outer,
-                    int *spread)
+                    double found[DK_MAX][DK_DOF], int *repeats, int loose)
 {
     (void)ref;
     (void)loose;
-    (void)wide;
-    (void)outer;
-    (void)spread;
     double qr1 = ref[0];
     double qr3 = ref[2];
     double w11 = t[0];
@@ -488,11 +481,10 @@ int lecture_rrr_ik_ref(const double T[16], const double *free, const double *q_r
         dk_rigid(T, t);
         /* (the rows straight into q, in range already: only repeats to drop, in place) */
         /* (never a refined arm's: seamed_outputs; no odd count to look across a fold for) */
-        int outer = 0, spread = 0;
         (void)loose;
-        count = dk_solve(t, tol, ref, q, &repeats, 0, 0, &outer, &spread);
+        count = dk_solve(t, tol, ref, q, &repeats, 0);
         if (count == 0) { /* (the second pass: _solve in derive/runtime/api.py says why) */
-            count = dk_solve(t, fmin(tol, DK_LOOSE_TOL), ref, q, &repeats, 1, 0, &outer, &spread);
+            count = dk_solve(t, fmin(tol, DK_LOOSE_TOL), ref, q, &repeats, 1);
         }
     }
     if (count < 0) {

@@ -112,7 +112,6 @@ def test_the_c_runtime_holds_the_python_runtimes_constants():
     assert float(found["DK_PI"]) == np.pi and float(found["DK_TWO_PI"]) == 2 * np.pi
     assert table(runtime, "DK_FREE_STEPS").tolist() == list(constants._FREE_STEPS)
     assert table(runtime, "DK_FOLD_SEEDS").tolist() == list(constants._FOLD_SEEDS)
-    assert float(found["DK_PAIR_WINDOW"]) == constants._PAIR_WINDOW
     assert table(runtime, "DK_ANGLE_AT").tolist() == list(closed._ANGLE_AT)
     assert table(runtime, "DK_TAN_AT").tolist() == list(closed._TAN_AT)
     assert table(runtime, "DK_UA").tolist() == np.ravel(emit_c.unit_angle_table()).tolist()

@@ -153,9 +153,6 @@ def _atan2(step: Solve, values: list[str], ref: str) -> Call:
     return Call("dk_atan2", (*values, ref))
 
 
-# the routines that solve a polynomial (dk_values' wide: dk_pair_window)
-POLY_ROUTINES = ("dk_poly", "dk_poly_pi")
-
 CALLS: dict[type[Solve], Callable[[Solve, list[str], str], Call]] = {
     Poly: _poly,
     PolyPi: _poly,
@@ -351,8 +348,6 @@ def solve_lines(plan: Plan) -> tuple[tuple[int, str], ...]:
             body.append(Line(depth, f"const double dk_u{j} = {condition};"))
         body.append(Line(depth, f"dk_values dk_v{j};"))
         body.append(Line(depth, f"dk_v{j}.loose = loose;"))  # (derive/c/runtime.c dk_values)
-        if call.routine in POLY_ROUTINES:  # (its complex pairs' window: dk_pair_window)
-            body.append(Line(depth, f"dk_v{j}.wide = wide;"))
         if fix and isinstance(step, SPREAD_STEPS):  # (a rough value's spread: dk_wrist_spread)
             body.append(Line(depth, f"dk_v{j}.more = 0.0;"))
         solve = f"{call.routine}(&dk_v{j}, {', '.join(call.args)}) < 0"
@@ -376,10 +371,6 @@ def solve_lines(plan: Plan) -> tuple[tuple[int, str], ...]:
             body.append(Line(depth, f"if ({solve}) {{"))
             body.append(Line(depth + 1, "return DK_UNSETTLED;"))
             body.append(Line(depth, "}"))
-        if fix and call.routine in POLY_ROUTINES:  # (a pair left out, a value spread:
-            body.append(Line(depth, f"*outer |= dk_v{j}.outer;"))  # the wide pass, dk_solve's)
-        if fix and isinstance(step, SPREAD_STEPS):
-            body.append(Line(depth, f"*spread |= dk_v{j}.spread;"))
         if flip and j == flip[0]:
             j4, j6 = flip[1:]
             body.append(
@@ -623,8 +614,6 @@ def branch_lines(plan: Plan, name: str) -> tuple[str, ...]:
                 lines.append(call.before)
             lines.append(f"dk_values dk_v{j};")
             lines.append(f"dk_v{j}.loose = 0;")
-            if call.routine in POLY_ROUTINES:
-                lines.append(f"dk_v{j}.wide = 0;")
             lines.append(f"double dk_c{j}, dk_s{j};")
             lines.append(
                 f"if ({call.routine}(&dk_v{j}, {', '.join(call.args)}) < 0 || !dk_v{j}.n) {{"

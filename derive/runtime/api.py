@@ -195,22 +195,8 @@ def _solve(target, solve, tol):
     seeds whose pose error is within _SEED_TOL are refined (a pose out of reach gives seeds far
     from it: measured 0.026 or more on a hextilt arm, where the seeds that reach the pose
     were within 2e-4), and kept where certified (_seed). The C solver takes the same second
-    pass (dk_solve, loose), and keeps rows within _LOOSE_TOL (or tol, if smaller) only.
-    Where the first pass left out a nominal polynomial's complex pair beyond _PAIR_WINDOW of
-    its window (_LOOSE.outer) and spread a two-equation step's value (_LOOSE.spread: a
-    system nearly singular, as a wrist nearly straight), it is taken again with those pairs
-    seeded too (_LOOSE.wide; the C solver's dk_solve with wide): near a fold whose wrist is
-    nearly straight the arm's difference, amplified, makes real pairs of nominal pairs up to
-    the whole window from real."""
-    _LOOSE.outer = _LOOSE.spread = False
+    pass (dk_solve, loose), and keeps rows within _LOOSE_TOL (or tol, if smaller) only."""
     rows = _exact_first(target, solve, tol)
-    if rows and _LOOSE.outer and _LOOSE.spread:
-        # (a pair beyond _PAIR_WINDOW left out, and a value spread: the wide pass)
-        _LOOSE.wide = True
-        try:
-            rows = _exact_first(target, solve, tol)
-        finally:
-            _LOOSE.wide = False
     if rows:
         return _fold_partners(_finish(rows), target, tol)
     _LOOSE.near = True

@@ -110,10 +110,10 @@ _AIM_POLISH = 1e-2
 # equal seeds refine onto one of the pair and lose the other (a new user's SO-101 MJCF lost
 # the elbow's second row 0.03-0.12 rad from its fold), and Newton's steps from either side of
 # a fold go to that side's solution; values farther apart already seed either side. A
-# polynomial's near-double root (a complex pair within _PAIR_WINDOW sqrt(_SEED_TOL) of real)
-# seeds its real part's angle +- _FOLD_SEEDS[0] too (a calibrated PUMA's elbow near
-# stretched) (with cos 0.01 the seeds came at 13% of a calibrated UR5's poses, and cost 20% of
-# its time; one offset of 0.03 finds what 0.01 and 0.1 found on the SO-101, at half the cost)
+# polynomial's near-double root (a complex pair within sqrt(_SEED_TOL)) seeds its real part's
+# angle +- _FOLD_SEEDS[0] too (a calibrated PUMA's elbow near stretched) (with
+# cos 0.01 the seeds came at 13% of a calibrated UR5's poses, and cost 20% of its time; one
+# offset of 0.03 finds what 0.01 and 0.1 found on the SO-101, at half the cost)
 _FOLD_NEAR = 0.9999995
 _FOLD_SEEDS = (0.03,)
 # ... or beyond 1 - _FOLD_WIDTH _SEED_TOL (three times the arm's difference), where that is
@@ -123,23 +123,6 @@ _FOLD_SEEDS = (0.03,)
 # the pair, and the sampled vector was missed at 14 (C) and 15 (Python) of 1,960 regular
 # poses within 2 mm of the double root, 0 and 0 with this (_cs1)
 _FOLD_WIDTH = 0.03
-# ... a pair's window (its imaginary part over 1 + |u|): the pair splits by about the square
-# root of how far the pose is beyond the nominal fold, which the arm's difference moves, so
-# the exact arm's real pairs come from pairs within a few sqrt(deviation) of real
-# (sqrt(_SEED_TOL) is 10 sqrt(deviation)): a pass seeds those within _PAIR_WINDOW of the
-# window. Rows that only such seeds gave (C, old window against new): a calibrated KR6
-# (deviation 1.1e-3) lost 1 row at 2,700 poses with 0.1 and none with 0.3; one calibrated
-# by 0.1 deg and 1 mm lost 2 with 0.3 (its pair 0.45 of the window) and none with 0.5. But
-# near an elbow's fold with the wrist within 0.02 rad of straight, 0.5 lost 32 rows at 21 of
-# 30,400 such poses of seven arms at three calibrations (pairs 0.65-0.92 of the window): the
-# nearly straight wrist amplifies the arm's difference. So where a pass left such a pair out
-# and spread a two-equation step's value (its system nearly singular: a wrist nearly
-# straight, a wrist centre near axis 1), ik takes the pass again with the whole window (the
-# wide pass, api.py _solve): the same rows as the whole window at all 77,700 poses (those,
-# and uniform, near-axis, near-singular ones). The whole window in every pass (before)
-# refined 6 to 42 more seeds (median 6) at 6% of a calibrated KR6's uniform poses, which
-# found nothing
-_PAIR_WINDOW = 0.5
 # ... and its acos argument up to _SEED_TOL / up beyond 1 (at least _SEED_TOL, at most
 # _SEED_BAND) still seeds the refinement, at the boundary, up being the least condition of
 # the angles solved before it (scalar.py _seed_miss): a step before it near a singular

@@ -37,7 +37,6 @@ from derive.runtime.constants import (
     _FREE_TOL_LOOSE,
     _LEAD_TOL,
     _MERGE_TOL,
-    _PAIR_WINDOW,
     _ROOT_IMAG_TOL,
     _SEED_BAND,
     _SPREAD_COUNT,
@@ -58,17 +57,11 @@ class _Loose(threading.local):
     _wrist_spread adds seeds round a fold, and the seeds are refined only where their pose
     error is within _SEED_TOL, and kept where certified (refine.py, _seed); rough, where ik
     solves a pose (_solve), the rows kept within tol that polishing left beyond _LOOSE_TOL
-    (_keep), dropped where the pose has other rows; outer, whether a nominal polynomial's
-    complex pair lay beyond _PAIR_WINDOW's part of its window (not seeded: _accept); spread,
-    whether a two-equation step's value was spread (_wrist_spread); wide, whether ik is
-    taking the pass that seeds those pairs too (_solve)."""
+    (_keep), dropped where the pose has other rows."""
 
     on = False
     near = False
     rough: list | None = None
-    outer = False
-    spread = False
-    wide = False
 
 
 _LOOSE = _Loose()
@@ -317,11 +310,9 @@ def _wrist_spread(t: float, det: float, det_scale: float) -> tuple[float, ...] |
     if not _SEED_TOL or loose or det_scale <= 0.0:  # (a scale of 0: a system never free)
         return (t,)
     if abs(det) <= (_WRIST_WIDTH * _SEED_TOL) ** 2 * det_scale:
-        _LOOSE.spread = True
         return _all_round(t)
     u = _WRIST_SPREAD * _SEED_TOL / sqrt(abs(det) / det_scale)
     if u >= _WRIST_NEAR:
-        _LOOSE.spread = True
         return _Spread(t, (t - u, t + u, t - 2.0 * u, t + 2.0 * u, *_all_round(t)[1:]))
     return (t,)
 
@@ -553,10 +544,7 @@ def _accept(p: list[float], zs: list[complex], check: bool = True) -> list[float
         # reach, as a Kinova Gen3 position task's, its tip 0.175 mm from the last solved
         # axis, leaves poses near its edge an imaginary pair 0.041-0.062 from real in u,
         # beyond this window's 0.039; _seed drops the seeds beyond _SEED_TOL of the pose)
-        # (a pair beyond _PAIR_WINDOW of the window is seeded in ik's wide pass only: noted)
-        window = math.sqrt(_SEED_TOL)
-        near = window if _LOOSE.wide else _PAIR_WINDOW * window
-        near = math.inf if _LOOSE.on or _LOOSE.near else near
+        near = math.inf if _LOOSE.on or _LOOSE.near else math.sqrt(_SEED_TOL)
         for z in map(complex, zs):
             if _ROOT_IMAG_TOL * (1.0 + abs(z)) < z.imag <= near * (1.0 + abs(z)):
                 out.append(z.real)
@@ -564,8 +552,6 @@ def _accept(p: list[float], zs: list[complex], check: bool = True) -> list[float
                     # half-angle's u or 1/u, turned by +-_FOLD_SEEDS[0] / 2)
                     w = math.atan(z.real)
                     out += [math.tan(w + s * 0.5 * _FOLD_SEEDS[0]) for s in (1.0, -1.0)]
-            elif near * (1.0 + abs(z)) < z.imag <= window * (1.0 + abs(z)):
-                _LOOSE.outer = True
     return out
 
 
