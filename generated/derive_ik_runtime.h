@@ -9,7 +9,7 @@
    is solved by it): one copy serves every arm of a folder, and each arm's file gets its own
    static copy of the routines, so arms link together in one program. Compile <name>_ik.c
    with it beside the file; do not include it anywhere else. */
-#define DK_RUNTIME 0x1d5edf9a2bbf
+#define DK_RUNTIME 0x243ba99cb3ff
 
 #include <math.h>
 #include <stddef.h>
@@ -2540,9 +2540,6 @@ typedef double dk_lane;
    singular configuration the last step can miss, and a row measured at 9.6e-11 was 1.01e-10
    from the pose (a calibrated iiwa, singular to 6e-8) */
 #define DK_LANE_TRUSTED (1e-12)
-/* a row with no room takes the place of a kept row less exact than it and than this
-   (dk_least_exact; the Python solver's _ROOM_EXACT) */
-#define DK_ROOM_EXACT (1e-12)
 /* ... where the factor of the step's normal equations has a pivot below this (J's least
    singular value below about its square root: a regular row's are 1e-3 to 1) */
 #define DK_LANE_FLOOR (1e-6)
@@ -3336,27 +3333,6 @@ static int dk_fold_partners(const double chain[DK_REFINE_N + 1][12],
     return count;
 }
 
-/* which of the n rows of found a new row q takes the place of where there is no room for it:
-   the least exact, where its error is above DK_ROOM_EXACT and above q's (a point where the
-   refinement stalled within the tolerance beside a solution, as at a thin reach's fold: C
-   kept such points and, out of room, dropped the exact rows Python returned; the Python
-   solver's _finish), else -1 */
-static int dk_least_exact(const dk_pending *p, const double (*found)[DK_REFINE_N], int n,
-                          const double q[DK_REFINE_N])
-{
-    double worst = dk_chain_error(p->chain, p->revolute, p->reach, p->t, q);
-    int r, at = -1;
-    worst = fmax(DK_ROOM_EXACT, worst);
-    for (r = 0; r < n; r++) {
-        const double e = dk_chain_error(p->chain, p->revolute, p->reach, p->t, found[r]);
-        if (e > worst) {
-            worst = e;
-            at = r;
-        }
-    }
-    return at;
-}
-
 /* q, a seed refined within p's limit, a row of found (n of them) where it is not one already,
    nor on one's curve of solutions (dk_repeat), and there is room; else counted in p->met, in
    place of the row it repeats where it is the better of the two (dk_same_row's 2: the
@@ -3376,11 +3352,7 @@ static void dk_keep(dk_pending *p, double (*found)[DK_REFINE_N], int *n,
             found[*n][j] = q[j];
         }
         (*n)++;
-    } else { /* (no room: in the place of the least exact row, where it is not exact) */
-        const int r = dk_least_exact(p, (const double(*)[DK_REFINE_N])found, *n, q);
-        for (j = 0; r >= 0 && j < DK_REFINE_N; j++) {
-            found[r][j] = q[j];
-        }
+    } else {
         p->met++;
     }
 }

@@ -38,7 +38,7 @@ if "_RUNTIME_VERSION" not in globals():  # (imported on its own, not run by a mo
         "namespace; it is not a module to import"
     )
 # this runtime's version: a module runs the runtime of its own version only
-_RUNTIME_VERSION = "2740696b1a51f9c9"
+_RUNTIME_VERSION = "72dcac535cb434df"
 
 if TYPE_CHECKING:  # defined by the module running this file
     from derive.runtime.arm import (
@@ -986,7 +986,7 @@ def ik(
     target = _pose(T)
     if max(abs(target[3]), abs(target[7]), abs(target[11])) > _FAR:
         return result(_finish([]))
-    return result(_finish(_solve(target, solve, tol), target))
+    return result(_finish(_solve(target, solve, tol)))
 
 
 def _solve(target, solve, tol):
@@ -1005,11 +1005,11 @@ def _solve(target, solve, tol):
     pass (dk_solve, loose), and keeps rows within _LOOSE_TOL (or tol, if smaller) only."""
     rows = _exact_first(target, solve, tol)
     if rows:
-        return _fold_partners(_finish(rows, target), target, tol)
+        return _fold_partners(_finish(rows), target, tol)
     _LOOSE.near = True
     try:
         tol = min(tol, _LOOSE_TOL)
-        return _fold_partners(_finish(_exact_first(target, solve, tol), target), target, tol)
+        return _fold_partners(_finish(_exact_first(target, solve, tol)), target, tol)
     finally:
         _LOOSE.near = False
 
@@ -1351,16 +1351,14 @@ def _rigid(v):
     return [*R[0], v[3], *R[1], v[7], *R[2], v[11]]
 
 
-def _finish(found, target=None):
+def _finish(found):
     """Revolute values wrapped to (-pi, pi] (at the seam: _seam) and repeats
     (DEDUP_TOL, revolute differences modulo 2 pi) dropped.
 
     Repeats are found by comparing the last joint first, then all joints; the first of
     equal candidates is kept. At most MAX_SOLUTIONS rows, the first ones, as the C solver's
     buffer keeps: a pose on a curve of solutions (a singular configuration of a nominal table
-    whose exact arm keeps it, SO-ARM100's wrist roll at 90 deg) certifies every seed. On a
-    refined arm, given the target, each later row takes the place of the least exact kept
-    one where that one's error is above _ROOM_EXACT and the later one's (C's dk_keep).
+    whose exact arm keeps it, SO-ARM100's wrist roll at 90 deg) certifies every seed.
     """
     rows: list[tuple[float, ...]] = []
     for q in found:
@@ -1377,16 +1375,7 @@ def _finish(found, target=None):
                 break
         else:
             rows.append(q)
-    if target is None or not _SEED_TOL or len(rows) <= MAX_SOLUTIONS:
-        return rows[:MAX_SOLUTIONS]
-    kept = rows[:MAX_SOLUTIONS]
-    errors = [_pose_error(q, target, False)[2] for q in kept]
-    for q in rows[MAX_SOLUTIONS:]:
-        error = _pose_error(q, target, False)[2]
-        worst = max(range(len(kept)), key=errors.__getitem__)
-        if errors[worst] > max(error, _ROOM_EXACT):
-            kept[worst], errors[worst] = q, error
-    return kept
+    return rows[:MAX_SOLUTIONS]
 
 
 def _as_rows(rows):
@@ -4678,15 +4667,6 @@ _REFINE_LAST = 1e-10
 # ... if it is at most this many times that error long (else measured: near a singular
 # configuration Newton's step can be long, and miss)
 _REFINE_TRUST = 100.0
-
-
-# where a refined arm's rows outnumber MAX_SOLUTIONS, a later row takes the place of the least
-# exact kept one if that row's pose error is above this and above the later one's (_finish;
-# the C solver's dk_least_exact): near a thin reach's fold (robosuite's Kinova Gen3 MJCF,
-# joints 3-6, joint 3 within 3e-3 of pi) the seed at the fold stalled there within the
-# tolerance (2e-11), and C, its room full, dropped the exact rows Python returned (the
-# sampled vector missed at 19 of 2,000 poses)
-_ROOM_EXACT = 1e-12
 
 
 # a refined row is returned if its pose error is within the smaller of this and ik's tol

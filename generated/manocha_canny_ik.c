@@ -678,7 +678,7 @@ static void dk_rr_fill(int k, double l_x, double l_y, double l_z, double p_x, do
 /* --- the routines every generated C solver shares: derive_ik_runtime.h beside this file ---- */
 
 #include "derive_ik_runtime.h"
-#if DK_RUNTIME != 0x1d5edf9a2bbf
+#if DK_RUNTIME != 0x243ba99cb3ff
 #error "derive_ik_runtime.h is another derive-ik's: generate the arms of a folder with one"
 #endif
 

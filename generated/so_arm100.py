@@ -627,7 +627,7 @@ def _branch_signs(target, q):
 
 _RUNTIME = "derive_ik_runtime.py"
 # the version of the runtime this module was generated with (the runtime's _RUNTIME_VERSION)
-_RUNTIME_VERSION = "2740696b1a51f9c9"
+_RUNTIME_VERSION = "72dcac535cb434df"
 # the runtime's line stating its version, in whatever form a formatter leaves it
 _RUNTIME_LINE = re.compile(
     rb"^_RUNTIME_VERSION\s*(?::\s*str\s*)?=\s*[\"']([0-9a-fA-F]+)[\"']", re.M

@@ -103,7 +103,6 @@ def test_the_c_runtime_holds_the_python_runtimes_constants():
     for name in ("SETTLE",):
         assert float(found[f"DK_REFINE_{name}"]) == getattr(refine, f"_REFINE_{name}"), name
     assert float(found["DK_LOOSE_REACH"]) == refine._LOOSE_REACH
-    assert float(found["DK_ROOM_EXACT"]) == refine._ROOM_EXACT
     assert float(found["DK_TRIAL_SEED"]) == refine._TRIAL_SEED
     assert int(found["DK_TRIAL_PATIENCE"]) == refine._TRIAL_PATIENCE
     assert float(found["DK_PARTNER_NEAR"]) == refine._PARTNER_NEAR

@@ -387,30 +387,6 @@ def test_a_thin_reach_s_poses_near_its_edge_are_answered(backend, tmp_path):
         assert np.abs(E[:, :3, 3] - T[:3, 3]).max() <= 1e-9 * module.REACH, q
 
 
-@needs_cc
-def test_a_point_stalled_at_a_thin_reach_s_fold_gives_way_to_an_exact_row(tmp_path):
-    """The Gen3's joints 3-6 above, joint 3 within 0.14 rad of pi: there the exact pair lies
-    a few 1e-3 either side of pi, and the seed at the fold stalled at pi itself, within the
-    certification (2e-11 of the reach). C kept that point and, its room (4 rows) full, dropped
-    the pair's second member, which Python returns: the sampled vector missed at 19 of 2,000
-    poses. A row with no room now takes the place of the least exact one where that is not
-    exact (dk_least_exact, _finish): every sampled vector found in C where joint 3 is more
-    than 1e-3 from pi (3 misses left, within 1.5e-4 of it, where the pair is within rounding of
-    the fold's points)."""
-    path = DATA / "kinova3_robot.xml"
-    text, _ = mjcf.import_mjcf(path, Options(base="HalfArm1_Link", tip="SphericalWrist2_Link"))
-    module = build_module(text, tmp_path, c=True)
-    rng = np.random.default_rng(5)
-    Q = rng.uniform(-2.0, 2.0, (1000, 4))
-    Q[:, 2] = rng.uniform(3.0, math.pi, 1000) * rng.choice([-1.0, 1.0], 1000)
-    Q = Q[np.abs(np.abs(Q[:, 2]) - math.pi) > 1e-3]
-    for q in Q:
-        T = module.fk(q)
-        rows = module.ik(T, free=[q[3]], backend="c")
-        gaps = np.abs(np.remainder(rows - q + math.pi, 2 * math.pi) - math.pi)
-        assert len(rows) and np.max(gaps, axis=1).min() <= 1e-6, q
-
-
 # joint vectors of robosuite's ARX5 (tests/data/mjcf/arx5_robot.xml) near two singular
 # configurations at once: the wrist within 1e-9 to 1.6e-2 of straight (q5 near +-90 deg) and
 # the shoulder singular to 5e-9 or less (a new user's attack, helper 70)

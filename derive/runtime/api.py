@@ -13,7 +13,6 @@ from numpy.typing import ArrayLike
 from derive.runtime.arm import (
     _C_SOURCE,
     _REVOLUTE,
-    _SEED_TOL,
     DOF,
     FREE,
     LIMITS,
@@ -57,13 +56,7 @@ from derive.runtime.native import (
     _native_solver,
     _scratch,
 )
-from derive.runtime.refine import (
-    _LOOSE_TOL,
-    _ROOM_EXACT,
-    _fold_partners,
-    _least_squares,
-    _pose_error,
-)
+from derive.runtime.refine import _LOOSE_TOL, _fold_partners, _least_squares, _pose_error
 from derive.runtime.scalar import _LOOSE
 
 
@@ -186,7 +179,7 @@ def ik(
     target = _pose(T)
     if max(abs(target[3]), abs(target[7]), abs(target[11])) > _FAR:
         return result(_finish([]))
-    return result(_finish(_solve(target, solve, tol), target))
+    return result(_finish(_solve(target, solve, tol)))
 
 
 def _solve(target, solve, tol):
@@ -205,11 +198,11 @@ def _solve(target, solve, tol):
     pass (dk_solve, loose), and keeps rows within _LOOSE_TOL (or tol, if smaller) only."""
     rows = _exact_first(target, solve, tol)
     if rows:
-        return _fold_partners(_finish(rows, target), target, tol)
+        return _fold_partners(_finish(rows), target, tol)
     _LOOSE.near = True
     try:
         tol = min(tol, _LOOSE_TOL)
-        return _fold_partners(_finish(_exact_first(target, solve, tol), target), target, tol)
+        return _fold_partners(_finish(_exact_first(target, solve, tol)), target, tol)
     finally:
         _LOOSE.near = False
 
@@ -551,16 +544,14 @@ def _rigid(v):
     return [*R[0], v[3], *R[1], v[7], *R[2], v[11]]
 
 
-def _finish(found, target=None):
+def _finish(found):
     """Revolute values wrapped to (-pi, pi] (at the seam: _seam) and repeats
     (DEDUP_TOL, revolute differences modulo 2 pi) dropped.
 
     Repeats are found by comparing the last joint first, then all joints; the first of
     equal candidates is kept. At most MAX_SOLUTIONS rows, the first ones, as the C solver's
     buffer keeps: a pose on a curve of solutions (a singular configuration of a nominal table
-    whose exact arm keeps it, SO-ARM100's wrist roll at 90 deg) certifies every seed. On a
-    refined arm, given the target, each later row takes the place of the least exact kept
-    one where that one's error is above _ROOM_EXACT and the later one's (C's dk_keep).
+    whose exact arm keeps it, SO-ARM100's wrist roll at 90 deg) certifies every seed.
     """
     rows: list[tuple[float, ...]] = []
     for q in found:
@@ -577,16 +568,7 @@ def _finish(found, target=None):
                 break
         else:
             rows.append(q)
-    if target is None or not _SEED_TOL or len(rows) <= MAX_SOLUTIONS:
-        return rows[:MAX_SOLUTIONS]
-    kept = rows[:MAX_SOLUTIONS]
-    errors = [_pose_error(q, target, False)[2] for q in kept]
-    for q in rows[MAX_SOLUTIONS:]:
-        error = _pose_error(q, target, False)[2]
-        worst = max(range(len(kept)), key=errors.__getitem__)
-        if errors[worst] > max(error, _ROOM_EXACT):
-            kept[worst], errors[worst] = q, error
-    return kept
+    return rows[:MAX_SOLUTIONS]
 
 
 def _as_rows(rows):

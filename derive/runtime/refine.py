@@ -54,13 +54,6 @@ _REFINE_LAST = 1e-10
 # ... if it is at most this many times that error long (else measured: near a singular
 # configuration Newton's step can be long, and miss)
 _REFINE_TRUST = 100.0
-# where a refined arm's rows outnumber MAX_SOLUTIONS, a later row takes the place of the least
-# exact kept one if that row's pose error is above this and above the later one's (_finish;
-# the C solver's dk_least_exact): near a thin reach's fold (robosuite's Kinova Gen3 MJCF,
-# joints 3-6, joint 3 within 3e-3 of pi) the seed at the fold stalled there within the
-# tolerance (2e-11), and C, its room full, dropped the exact rows Python returned (the
-# sampled vector missed at 19 of 2,000 poses)
-_ROOM_EXACT = 1e-12
 # a refined row is returned if its pose error is within the smaller of this and ik's tol
 _REFINE_TOL = 1e-10
 # ... or of this in ik's second pass (no row within _REFINE_TOL): at a singular configuration
